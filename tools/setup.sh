@@ -1,0 +1,51 @@
+#!/usr/bin/env bash
+# Installs everything Cohort needs to build and test, from the distribution's packages.
+# Idempotent: packages already present are left alone. Works as root or through sudo.
+# Supported: Debian 12 (bookworm) and Ubuntu 24.04 (noble). CUDA is optional and not installed here.
+set -euo pipefail
+
+PACKAGES=(
+  build-essential cmake ninja-build pkg-config git
+  libembree-dev libtbb-dev            # Embree 3 CPU tracer
+  libopenimageio-dev                  # texture loading, EXR/PNG output
+  libglfw3-dev libgl-dev              # gameplay viewer (optional at build time)
+  libglm-dev                          # host-side vector maths
+  ocl-icd-opencl-dev opencl-headers pocl-opencl-icd clinfo   # OpenCL tracer, PoCL on the CPU
+  libgtest-dev libgmock-dev           # tests
+  libcli11-dev nlohmann-json3-dev libzip-dev libspdlog-dev libfmt-dev   # CLI, JSON, .pk4, logging
+  python3 xvfb xauth                  # viewer test under a virtual display
+)
+
+if [ -r /etc/os-release ]; then . /etc/os-release; else ID=unknown; VERSION_ID=; fi
+case "${ID}:${VERSION_ID}" in
+  debian:12|ubuntu:24.04) ;;
+  *) echo "setup.sh: this script supports Debian 12 and Ubuntu 24.04; found '${PRETTY_NAME:-unknown}'." >&2
+     echo "setup.sh: install the equivalents of: ${PACKAGES[*]}" >&2
+     exit 1 ;;
+esac
+
+if ! command -v apt-get >/dev/null; then
+  echo "setup.sh: apt-get not found; cannot install packages." >&2; exit 1
+fi
+
+SUDO=""
+if [ "$(id -u)" -ne 0 ]; then
+  if command -v sudo >/dev/null && sudo -n true 2>/dev/null; then SUDO="sudo"
+  else echo "setup.sh: needs root or passwordless sudo to install packages." >&2; exit 1; fi
+fi
+
+missing=()
+for p in "${PACKAGES[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+
+if [ ${#missing[@]} -eq 0 ]; then
+  echo "setup.sh: all ${#PACKAGES[@]} packages already installed."
+  exit 0
+fi
+
+echo "setup.sh: installing ${#missing[@]} package(s): ${missing[*]}"
+export DEBIAN_FRONTEND=noninteractive
+$SUDO apt-get update -qq
+$SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}"
+echo "setup.sh: done."
