@@ -7,7 +7,7 @@ set -euo pipefail
 PACKAGES=(
   build-essential cmake ninja-build pkg-config git
   libembree-dev libtbb-dev            # Embree 3 CPU tracer
-  libopenimageio-dev                  # texture loading, EXR/PNG output
+  libopenimageio-dev openimageio-tools  # texture loading, EXR/PNG output, oiiotool
   libglfw3-dev libgl-dev              # gameplay viewer (optional at build time)
   libglm-dev                          # host-side vector maths
   ocl-icd-opencl-dev opencl-headers pocl-opencl-icd clinfo   # OpenCL tracer, PoCL on the CPU

@@ -1,0 +1,39 @@
+// A tracer's own copy of everything its kernels read, as flat arrays of the portable layouts. Each
+// tracer keeps one, changes it only by applying commit buffers at frame start, and uploads what the
+// ChangeSet names.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "kernel/layout.h"
+
+namespace cohort::commit {
+
+struct TracerScene {
+  // Geometry pools: BLASes are appended; a rebuilt BLAS gets a new slot (old one freed on resync).
+  std::vector<KVertex> vertices;
+  std::vector<KTriangle> triangles;   // in BLAS leaf order
+  std::vector<KBvhNode> blas_nodes;
+  std::vector<KBlas> blases;
+  // Rebuilt every frame by the core.
+  std::vector<KInstance> instances;   // in TLAS leaf order
+  std::vector<KBvhNode> tlas_nodes;
+  std::vector<KMaterial> materials;
+  std::vector<KTexture> textures;
+  std::vector<uint32_t> texels;       // RGBA8, all textures and their mip levels
+  std::vector<KLight> lights;
+  KCamera camera{};
+  uint64_t version = 0;               // frame number of the last commit applied
+};
+
+// What applying a commit changed, so a GPU tracer uploads only that.
+struct ChangeSet {
+  bool full_resync = false;
+  bool geometry = false;              // vertices/triangles/blas_nodes/blases grew or changed
+  size_t vertices_from = 0, triangles_from = 0, blas_nodes_from = 0, blases_from = 0;  // first changed element
+  bool instances = false, tlas = false, materials = false, textures = false, lights = false, camera = false;
+  bool any() const { return full_resync || geometry || instances || tlas || materials || textures || lights || camera; }
+};
+
+}  // namespace cohort::commit

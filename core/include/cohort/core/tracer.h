@@ -1,0 +1,32 @@
+// The interface every tracer implements. A tracer runs on its own worker thread; once a frame has
+// started the core does not talk to it until it reports its band done (Brigade, §4.2).
+#pragma once
+
+#include <string>
+
+#include "cohort/commit/commit_buffer.h"
+#include "cohort/core/frame_buffer.h"
+#include "kernel/layout.h"
+
+namespace cohort::core {
+
+struct BandJob {
+  KFrameParams params{};   // row_begin/row_end name the band, in full-resolution rows
+  KCamera camera{};
+};
+
+struct BandResult {
+  double device_ms = 0.0;  // time the tracer measured itself (kernel time for GPUs); 0 if it cannot
+};
+
+class Tracer {
+ public:
+  virtual ~Tracer() = default;
+  virtual std::string name() const = 0;
+  // Bring the tracer's scene copy (and device buffers) up to date. Called on the tracer's thread.
+  virtual void apply(const commit::CommitBuffer& commit) = 0;
+  // Render rows [row_begin, row_end) of the frame into target (full frame size; only those rows are written).
+  virtual BandResult render_band(const BandJob& job, FrameBuffer& target) = 0;
+};
+
+}  // namespace cohort::core

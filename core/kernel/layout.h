@@ -1,0 +1,147 @@
+/* GPU data layouts: every struct a tracer reads, identical in C++, CUDA and OpenCL C. Only 4-byte
+ * scalars and arrays of them, sizes multiples of 16 bytes, so no compiler inserts padding.
+ * Indices are kuint; "none" is K_NONE. */
+#ifndef COHORT_KERNEL_LAYOUT_H
+#define COHORT_KERNEL_LAYOUT_H
+#include "portable.h"
+
+#define K_NONE 0xFFFFFFFFu
+
+/* ---- BVH (shared by BLAS and TLAS) ------------------------------------------------------------
+ * count == 0: interior node, children at left_first and left_first + 1.
+ * count  > 0: leaf over primitives [left_first, left_first + count).
+ * In a BLAS, child indices are relative to KBlas.node_offset and primitive indices to
+ * KBlas.tri_offset, so a BLAS built once can be uploaded anywhere. In the TLAS, primitives are
+ * instances (KInstance array order is TLAS leaf order). */
+typedef struct KBvhNode {
+  float bmin[3]; kuint left_first;
+  float bmax[3]; kuint count;
+} KBvhNode;
+
+typedef struct KBlas {
+  kuint node_offset; kuint node_count;
+  kuint tri_offset;  kuint tri_count;
+} KBlas;
+
+/* Instance mask bits: a ray carries a mask and skips instances that share no bit with it. */
+#define K_MASK_PRIMARY 1u   /* visible to camera and bounce rays */
+#define K_MASK_SHADOW  2u   /* casts shadows (cleared for noShadows entities) */
+
+typedef struct KInstance {
+  float object_to_world[12];  /* 3x4 row-major */
+  float world_to_object[12];
+  kuint blas;                 /* index into the KBlas array */
+  kuint mask;
+  kuint entity;               /* the idRenderWorld handle, for picking; K_NONE for the world */
+  kuint material_override;    /* K_NONE: use the triangles' own materials */
+} KInstance;
+
+/* ---- Geometry ---------------------------------------------------------------------------------- */
+typedef struct KVertex {
+  float pos[3];     float u;
+  float normal[3];  float v;
+  float tangent[3]; float bitangent_sign;  /* bitangent = sign * cross(normal, tangent) */
+} KVertex;
+
+/* Vertex indices are absolute into the vertex array; winding as stored in the .proc. */
+typedef struct KTriangle {
+  kuint v0, v1, v2;
+  kuint material;
+} KTriangle;
+
+/* ---- Materials ----------------------------------------------------------------------------- */
+/* How a hit is treated (Doom 3 path tracer write-up, "blend-mode classification"). */
+#define K_BLEND_OPAQUE      0u  /* lit surface: the path bounces here */
+#define K_BLEND_PASSTHROUGH 1u  /* invisible to rays (nodraw, editor, fog/blend lights) */
+#define K_BLEND_ADDITIVE    2u  /* adds its colour and lets the ray continue (glows, decals that add) */
+#define K_BLEND_MODULATE    3u  /* multiplies throughput and continues (filter decals, tinted glass) */
+#define K_BLEND_ALPHA       4u  /* mixes by alpha and continues (blend stages) */
+
+#define K_MAT_ALPHA_TEST   1u
+#define K_MAT_TRANSLUCENT  2u
+#define K_MAT_NO_SHADOWS   4u
+#define K_MAT_TWO_SIDED    8u
+#define K_MAT_NONSOLID     16u
+#define K_MAT_EMISSIVE     32u  /* ambient-only stages: an emitter */
+#define K_MAT_VERTEX_COLOR 64u
+#define K_MAT_NO_SPECULAR  128u
+
+typedef struct KMaterial {
+  float diffuse_color[4];   /* multiplies the diffuse map; rgba */
+  float specular_color[4];
+  float emissive_color[4];  /* multiplies the emissive map for K_MAT_EMISSIVE */
+  float tex_transform[8];   /* st' = (m0 s + m1 t + m2, m3 s + m4 t + m5); m6, m7 unused */
+  kuint diffuse_tex, normal_tex, specular_tex, emissive_tex;  /* K_NONE when absent */
+  kuint flags;
+  kuint blend;              /* K_BLEND_* */
+  float alpha_ref;          /* alphaTest threshold */
+  kuint pad;
+} KMaterial;
+
+/* ---- Textures: RGBA8 texels (R in the low byte) in one buffer, mip levels stored one after another. */
+#define K_TEX_CLAMP   1u
+#define K_TEX_SRGB    2u    /* colour data: decode to linear on read */
+#define K_TEX_NORMAL  4u    /* tangent-space normal map, X in R */
+
+typedef struct KTexture {
+  kuint offset;             /* first texel of level 0 in the texel buffer */
+  kuint width, height;
+  kuint flags_and_levels;   /* low 8 bits: K_TEX_* flags, bits 8..15: mip level count */
+} KTexture;
+
+/* ---- Lights ------------------------------------------------------------------------------------ */
+#define K_LIGHT_POINT     0u
+#define K_LIGHT_PARALLEL  1u
+#define K_LIGHT_PROJECTED 2u
+
+#define K_LIGHT_NO_SHADOWS  1u
+#define K_LIGHT_NO_SPECULAR 2u
+
+typedef struct KLight {
+  float origin[3];  kuint type;
+  float color[3];   kuint flags;        /* colour already includes r_lightScale and the stage colour */
+  float radius[3];  kuint light_tex;    /* light image sampled at (S/Q, T/Q); K_NONE: white */
+  float center[3];  kuint falloff_tex;  /* falloff image at (F, 0.5); K_NONE: windowed (1-(d/r)^2)^2 */
+  float axis[12];                       /* rows of the light axis, each padded to 4 floats */
+  float plane_s[4]; float plane_t[4]; float plane_q[4]; float plane_f[4];  /* world space lightProject */
+  float extent;     float pad[3];       /* soft-shadow jitter radius in world units */
+} KLight;
+
+/* ---- Camera and per-frame parameters ------------------------------------------------------------- */
+typedef struct KCamera {
+  float origin[3];  float tan_half_fov_x;
+  float forward[3]; float tan_half_fov_y;
+  float right[3];   kuint width;
+  float up[3];      kuint height;
+} KCamera;
+
+/* Debug views, like the seed renderer's r_cuMode. */
+#define K_MODE_PATH     0u
+#define K_MODE_DIRECT   1u   /* Whitted-style direct lighting only */
+#define K_MODE_ALBEDO   2u
+#define K_MODE_NORMALS  3u
+#define K_MODE_SPECULAR 4u
+#define K_MODE_BVH      5u   /* BVH traversal cost heat map */
+#define K_MODE_TRIANGLES 6u  /* a colour per triangle */
+
+typedef struct KFrameParams {
+  kuint frame_index;  kuint spp;          kuint max_bounces;   kuint light_samples;
+  float firefly_clamp; float spec_boost;  kuint mode;          kuint light_count;
+  kuint row_begin;    kuint row_end;      kuint instance_count; kuint tlas_node_count;
+  float soft_shadow_scale; float rr_start; float pad0;         float pad1;
+} KFrameParams;
+
+#if defined(__cplusplus) && !defined(__CUDACC_RTC__)
+static_assert(sizeof(KBvhNode) == 32, "KBvhNode layout");
+static_assert(sizeof(KBlas) == 16, "KBlas layout");
+static_assert(sizeof(KInstance) == 112, "KInstance layout");
+static_assert(sizeof(KVertex) == 48, "KVertex layout");
+static_assert(sizeof(KTriangle) == 16, "KTriangle layout");
+static_assert(sizeof(KMaterial) == 112, "KMaterial layout");
+static_assert(sizeof(KTexture) == 16, "KTexture layout");
+static_assert(sizeof(KLight) == 192, "KLight layout");
+static_assert(sizeof(KCamera) == 64, "KCamera layout");
+static_assert(sizeof(KFrameParams) == 64, "KFrameParams layout");
+#endif
+
+#endif

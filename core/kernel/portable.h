@@ -1,0 +1,51 @@
+/* Portability layer: the few qualifiers, types and maths calls that differ between C++, CUDA and
+ * OpenCL C. Everything under core/kernel/ is written against these names only. OpenCL C 1.2 is the
+ * lowest common denominator: no references, no overloading, no templates, explicit __global pointers. */
+#ifndef COHORT_KERNEL_PORTABLE_H
+#define COHORT_KERNEL_PORTABLE_H
+
+#if defined(__OPENCL_VERSION__)
+  #define KFN static inline
+  #define KGLOBAL __global
+  #define KCONSTANT __constant
+  typedef uint kuint;
+  typedef int kint;
+  #define k_sqrt(x) sqrt(x)
+  #define k_fabs(x) fabs(x)
+  #define k_fmin(a, b) fmin(a, b)
+  #define k_fmax(a, b) fmax(a, b)
+  #define k_pow(a, b) pow(a, b)
+  #define k_exp(x) exp(x)
+  #define k_floor(x) floor(x)
+  #define k_cos(x) cos(x)
+  #define k_sin(x) sin(x)
+  #define k_atan2(y, x) atan2(y, x)
+  #define K_INF INFINITY
+#else
+  #if defined(__CUDACC__)
+    #define KFN static __host__ __device__ __forceinline__
+  #else
+    #define KFN static inline
+  #endif
+  #define KGLOBAL
+  #define KCONSTANT static const
+  #include <stdint.h>
+  #include <math.h>
+  typedef uint32_t kuint;
+  typedef int32_t kint;
+  #define k_sqrt(x) sqrtf(x)
+  #define k_fabs(x) fabsf(x)
+  #define k_fmin(a, b) fminf(a, b)
+  #define k_fmax(a, b) fmaxf(a, b)
+  #define k_pow(a, b) powf(a, b)
+  #define k_exp(x) expf(x)
+  #define k_floor(x) floorf(x)
+  #define k_cos(x) cosf(x)
+  #define k_sin(x) sinf(x)
+  #define k_atan2(y, x) atan2f(y, x)
+  #define K_INF INFINITY
+#endif
+
+#define K_PI 3.14159265358979323846f
+
+#endif

@@ -1,0 +1,119 @@
+// The in-memory scene model: what Cohort knows about a Doom 3 level, independent of the files it
+// came from. Loaders fill it from .proc/.map/.mtr and images; scene deltas (render_world.h) change it.
+#pragma once
+
+#include <cstdint>
+#include <map>
+#include <string>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+namespace cohort::scene {
+
+// Decoded texture, RGBA8, rows top to bottom as the image file stores them.
+struct Image {
+  std::string name;        // as a material names it, without extension ("textures/base/floor1")
+  int width = 0, height = 0;
+  std::vector<uint8_t> rgba;
+  bool is_normal_map = false;  // tangent-space normal map, X in R (file order, not the engine's RXGB upload)
+  bool is_placeholder = false; // generated because the file was missing or unreadable
+};
+
+enum class BlendClass : uint8_t { Opaque, PassThrough, Additive, Modulate, Alpha };
+
+struct Material {
+  std::string name;
+  std::string source_file; int source_line = 0;
+  int diffuse_image = -1, normal_image = -1, specular_image = -1, emissive_image = -1;  // into Scene::images
+  glm::vec4 diffuse_color{1.0f}, specular_color{1.0f}, emissive_color{0.0f};
+  float tex_transform[6] = {1, 0, 0, 0, 1, 0};  // st' = (m0 s + m1 t + m2, m3 s + m4 t + m5)
+  bool alpha_test = false; float alpha_ref = 0.5f;
+  bool translucent = false, no_shadows = false, two_sided = false, nonsolid = false;
+  bool emitter = false;        // ambient-only stages: emits its stage image
+  bool vertex_color = false;
+  BlendClass blend = BlendClass::Opaque;
+  // Light materials (lights/...): the projected image and the falloff image.
+  bool is_light_material = false;
+  int light_image = -1, falloff_image = -1;
+  glm::vec3 light_stage_color{1.0f};
+  bool is_default = false;     // made up because the name was not found
+};
+
+struct Vertex {
+  glm::vec3 position{0.0f};
+  glm::vec2 st{0.0f};
+  glm::vec3 normal{0.0f, 0.0f, 1.0f};
+  glm::vec4 tangent{1.0f, 0.0f, 0.0f, 1.0f};  // xyz tangent, w bitangent sign
+};
+
+// A run of triangles sharing one material, indices into Mesh::indices.
+struct Surface {
+  int material = -1;
+  uint32_t first_index = 0, index_count = 0;
+};
+
+struct Mesh {
+  std::string name;            // "_area0", an inline model's name, or a model file path
+  std::vector<Vertex> vertices;
+  std::vector<uint32_t> indices;  // three per triangle, winding as in the .proc
+  std::vector<Surface> surfaces;
+  size_t triangle_count() const { return indices.size() / 3; }
+};
+
+enum class LightType : uint8_t { Point, Parallel, Projected };
+
+struct Light {
+  std::string name;
+  LightType type = LightType::Point;
+  glm::vec3 origin{0.0f};
+  glm::mat3 axis{1.0f};         // columns: the light's x, y, z axes in world space
+  glm::vec3 radius{300.0f};     // light_radius
+  glm::vec3 center{0.0f};       // light_center (parallel: direction toward the light)
+  glm::vec3 color{1.0f};        // _color
+  // Projected lights, relative to origin, in the light's axis frame.
+  glm::vec3 target{0.0f}, right{0.0f}, up{0.0f}, start{0.0f}, end{0.0f};
+  bool has_start_end = false;
+  int material = -1;            // light shader (texture key); -1: the default for its type
+  bool no_shadows = false, no_specular = false;
+  float shader_parms[12] = {1, 1, 1, 1, 0, 0, 0, 0, 0, 0, 0, 0};
+};
+
+struct Entity {
+  std::string name, classname;
+  int mesh = -1;                // into Scene::meshes; -1 for entities without geometry
+  glm::vec3 origin{0.0f};
+  glm::mat3 axis{1.0f};         // columns: the entity's x, y, z axes in world space
+  bool no_shadows = false;
+  std::map<std::string, std::string> keys;
+};
+
+struct Portal {
+  int area_pos = 0, area_neg = 0;
+  std::vector<glm::vec3> points;
+};
+
+struct AreaNode {
+  glm::vec4 plane{0.0f};        // a b c d
+  int pos_child = 0, neg_child = 0;  // 0 solid, <0 area -1-child, >0 node
+};
+
+struct Scene {
+  std::string name;
+  std::vector<Image> images;
+  std::vector<Material> materials;
+  std::vector<Mesh> meshes;
+  std::vector<int> area_meshes;    // the static world: one mesh per area
+  std::vector<Light> lights;
+  std::vector<Entity> entities;
+  std::vector<Portal> portals;
+  std::vector<AreaNode> nodes;
+  std::vector<std::string> warnings;
+  glm::vec3 player_start{0.0f}; float player_yaw = 0.0f;
+
+  int find_material(const std::string& name) const;
+  int find_mesh(const std::string& name) const;
+  size_t world_triangle_count() const;
+};
+
+}  // namespace cohort::scene
