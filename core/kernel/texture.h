@@ -10,8 +10,10 @@ typedef struct KVec4 { float x, y, z, w; } KVec4;
 KFN KVec4 v4(float x, float y, float z, float w) { KVec4 r; r.x = x; r.y = y; r.z = z; r.w = w; return r; }
 KFN KVec3 v4_rgb(KVec4 c) { return v3(c.x, c.y, c.z); }
 
+/* sRGB decode by a cubic fit (error below 0.3% of full scale, exact at 0 and 1): four texels per
+ * bilinear read made the exact pow() the integrator's largest cost on the CPU. */
 KFN float k_srgb_to_linear(float c) {
-  return c <= 0.04045f ? c * (1.0f / 12.92f) : k_pow((c + 0.055f) * (1.0f / 1.055f), 2.4f);
+  return c * (c * (c * 0.305306011f + 0.682171111f) + 0.012522878f);
 }
 
 KFN kuint k_tex_flags(KTexture t) { return t.flags_and_levels & 0xFFu; }

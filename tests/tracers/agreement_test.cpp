@@ -9,6 +9,9 @@
 #include <cstdlib>
 #include <iostream>
 
+#include <filesystem>
+
+#include "cohort/core/scene_pack.h"
 #include "test_scenes.h"
 #include "test_tracers.h"
 
@@ -86,3 +89,36 @@ INSTANTIATE_TEST_SUITE_P(Modes, Agreement,
                                            Case{K_MODE_DIRECT, 0, "direct"}, Case{K_MODE_ALBEDO, 0, "albedo"},
                                            Case{K_MODE_NORMALS, 0, "normals"}),
                          [](const auto& info) { return std::string(info.param.name); });
+
+// A scene pack read back renders exactly like the scene it was written from.
+TEST(ScenePack, RendersLikeTheCompiledScene) {
+  if (!tracer_runs_here("embree")) GTEST_SKIP();
+  core::PackedScene pack;
+  pack.map_name = "test_room";
+  scene::Scene room = test_room();
+  core::CompiledScene compiled = core::compile_scene(room);
+  pack.tracer_scene = compiled.tracer_scene;
+  pack.blas_of_mesh = compiled.blas_of_mesh;
+  pack.world_blas = compiled.world_blas;
+  pack.instance_names.assign(pack.tracer_scene.instances.size(), "x");
+  pack.player_start[0] = room.player_start.x;
+  const char* keep = std::getenv("COHORT_TEST_IMAGES");
+  std::filesystem::path file = keep ? std::filesystem::path(keep) / "test_room.cpack"
+                                    : std::filesystem::temp_directory_path() / "cohort_test_room.cpack";
+  core::write_scene_pack(file, pack);
+  core::PackedScene back = core::read_scene_pack(file);
+  if (!keep) std::filesystem::remove(file);
+  const int w = 32, h = 24;
+  KCamera cam = test_room_camera(w, h);
+  KFrameParams params = frame_params(K_MODE_PATH, 4, 1, h);
+  auto tracer = make_test_tracer("embree");
+  core::FrameBuffer a = render(*tracer, room, cam, params);
+  tracer->apply(commit::CommitBuffer::full(std::make_shared<commit::TracerScene>(back.tracer_scene), 2));
+  core::FrameBuffer b;
+  b.resize(w, h);
+  core::BandJob job;
+  job.params = params;
+  job.camera = cam;
+  tracer->render_band(job, b);
+  EXPECT_EQ(a.rgba, b.rgba);
+}

@@ -4,6 +4,8 @@
 
 #include <embree3/rtcore.h>
 
+#include <cstdint>
+
 #include "kernel/material.h"
 
 namespace cohort::tracers::embree_kernel {
@@ -11,6 +13,7 @@ namespace cohort::tracers::embree_kernel {
 struct TraceCtx {
   KSceneView scene;
   RTCScene top;
+  uint64_t rays;  // rays traced through this context, for the benchmarks
 };
 
 // Embree hands this back to the filter functions (the RTCIntersectContext must come first).
@@ -44,6 +47,7 @@ static inline int k_trace_closest(KTraceCtx* ctx, KVec3 org, KVec3 dir, float tm
   rh.ray.flags = 0;
   rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
   rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+  ++ctx->rays;
   rtcIntersect1(ctx->top, &fc.base, &rh);
   hit->cost = 0u;
   if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return 0;
@@ -70,6 +74,7 @@ static inline int k_trace_occluded(KTraceCtx* ctx, KVec3 org, KVec3 dir, float t
   ray.time = 0.0f;
   ray.id = 0;
   ray.flags = 0;
+  ++ctx->rays;
   rtcOccluded1(ctx->top, &fc.base, &ray);
   return ray.tfar < 0.0f;  // Embree sets tfar to -inf on occlusion
 }

@@ -54,6 +54,7 @@ struct EmbreeTracer::Impl {
   std::vector<RTCScene> blas_scenes;
   commit::TracerScene scene;
   std::unique_ptr<tbb::global_control> thread_limit;
+  uint64_t rays_traced = 0;
 
   ~Impl() {
     release_top();
@@ -130,6 +131,7 @@ struct EmbreeTracer::Impl {
     v.material_count = static_cast<kuint>(scene.materials.size());
     v.texture_count = static_cast<kuint>(scene.textures.size());
     ctx.top = top;
+    ctx.rays = 0;
     return ctx;
   }
 };
@@ -167,6 +169,7 @@ core::BandResult EmbreeTracer::render_band(const core::BandJob& job, core::Frame
   const int row_end = std::min(static_cast<int>(params.row_end), target.height);
   const int width = std::min(static_cast<int>(camera.width), target.width);
   embree_kernel::TraceCtx base = impl_->context();
+  std::atomic<uint64_t> rays{0};
   tbb::parallel_for(tbb::blocked_range<int>(row_begin, row_end, 1), [&](const tbb::blocked_range<int>& rows) {
     embree_kernel::TraceCtx ctx = base;
     for (int y = rows.begin(); y < rows.end(); ++y) {
@@ -179,11 +182,15 @@ core::BandResult EmbreeTracer::render_band(const core::BandJob& job, core::Frame
         out[4 * x + 3] = 1.0f;
       }
     }
+    rays += ctx.rays;
   });
+  impl_->rays_traced += rays.load();
   core::BandResult result;
   result.device_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
   return result;
 }
+
+uint64_t EmbreeTracer::rays_traced() const { return impl_->rays_traced; }
 
 uint64_t EmbreeTracer::trace_camera_rays_only(const core::BandJob& job) {
   if (!impl_->top) throw std::runtime_error("EmbreeTracer: trace before any commit was applied");

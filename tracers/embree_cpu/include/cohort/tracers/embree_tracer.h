@@ -24,6 +24,8 @@ class EmbreeTracer : public core::Tracer {
   // Raw closest-hit throughput: traces exactly the band's camera rays (same jitter as the integrator,
   // params.spp per pixel) with rtcIntersect1 and nothing else. Returns the number of rays that hit.
   uint64_t trace_camera_rays_only(const core::BandJob& job);
+  // Camera, bounce and shadow rays traced by render_band since construction.
+  uint64_t rays_traced() const;
 
  private:
   struct Impl;
