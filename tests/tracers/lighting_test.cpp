@@ -164,6 +164,33 @@ TEST_P(Lighting, ShadowsRespectNoShadowsAndAlphaTest) {
   EXPECT_NEAR(cut_out, lit_expected, 0.03f * lit_expected);
 }
 
+// A light's extent softens shadows: where the hard shadow's edge falls, about half the jittered
+// shadow rays pass; deep inside the umbra none do; well outside all do.
+TEST_P(Lighting, SoftShadowsHaveAPenumbra) {
+  scene::Scene s = floor_scene(300.0f, glm::vec3(0.5f));
+  s.lights.push_back(point_light({0, 0, 100}, 400.0f));  // extent 0.1 * 400 clamped to 32 units
+  int mat = add_diffuse_material(s, "occluder", glm::vec3(0.5f));
+  scene::Mesh m;
+  m.name = "occluder";
+  add_quad(m, mat, {-20, -20, 50}, {20, -20, 50}, {20, 20, 50}, {-20, 20, 50}, {0, 0, 1});
+  add_world_mesh(s, std::move(m));
+  auto visible_fraction = [&](float x, float scale) {
+    // A camera below the occluder looking straight down at (x, 0, 0).
+    KCamera cam = camera_looking_down({x, 0, 40}, 0.001f, 4, 4);
+    KFrameParams p = frame_params(K_MODE_DIRECT, 256, 0, 4);
+    p.soft_shadow_scale = scale;
+    float lit = pixel(render(*tracer_, s, cam, p), 2, 2).x;
+    float d2 = (x * x + 100.0f * 100.0f) / (400.0f * 400.0f);
+    float unshadowed = 0.5f / kPi * 2.0f * (1.0f - d2) * (1.0f - d2) * (100.0f / std::sqrt(x * x + 1e4f));
+    return lit / unshadowed;
+  };
+  EXPECT_NEAR(visible_fraction(40.0f, 1.0f), 0.5f, 0.1f) << "the hard shadow's edge";
+  EXPECT_LT(visible_fraction(0.0f, 1.0f), 0.01f) << "umbra";
+  EXPECT_NEAR(visible_fraction(90.0f, 1.0f), 1.0f, 0.02f) << "outside the penumbra";
+  EXPECT_NEAR(visible_fraction(30.0f, 0.0f), 0.0f, 0.01f) << "hard shadows without jitter";
+  EXPECT_NEAR(visible_fraction(50.0f, 0.0f), 1.0f, 0.02f);
+}
+
 // Closed box, every wall emitting E with albedo a, no lights: with B bounces the radiance everywhere is
 // E * (1 + a + ... + a^B), whatever the sampling, Russian roulette included.
 TEST_P(Lighting, FurnaceConvergesToAnalyticRadiance) {
