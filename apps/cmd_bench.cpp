@@ -1,16 +1,101 @@
+#include <fstream>
 #include <iostream>
+#include <sstream>
 
+#include "balance_bench.h"
 #include "commands.h"
 
 namespace cohort::app {
 
+namespace {
+
+template <typename T>
+std::vector<T> split_list(const std::string& text, const char* what) {
+  std::vector<T> values;
+  std::stringstream ss(text);
+  std::string item;
+  while (std::getline(ss, item, ',')) {
+    if (item.empty()) continue;
+    std::istringstream parse(item);
+    T v{};
+    if (!(parse >> v) || !parse.eof()) throw CLI::ValidationError(what, "cannot read '" + item + "'");
+    values.push_back(v);
+  }
+  return values;
+}
+
+}  // namespace
+
 void add_bench_command(CLI::App& app) {
   auto* cmd = app.add_subcommand("bench", "Benchmarks (balancer efficiency: 'cohort bench balance')");
   cmd->require_subcommand(1);
-  auto* balance = cmd->add_subcommand("balance", "Idle time per balancer and tracer count (Brigade Table 1)");
-  balance->callback([] {
-    std::cerr << "cohort bench balance: not implemented yet (issue 7)\n";
-    std::exit(kExitUnavailable);
+  auto* balance = cmd->add_subcommand(
+      "balance",
+      "Idle time per balancer and tracer count while the camera spins (Brigade Table 1): idle % = time tracers\n"
+      "wait for the slowest one / (tracers x frame time). Simulated tracers run on a virtual clock, so\n"
+      "results are reproducible.");
+  struct Args {
+    std::string balancers, tracers = "2,3,4", speeds = "1", path = "both", real, json, plot;
+    double noise = 0.02;
+    int frames = 360, warmup = 5, rows = 720;
+    uint64_t seed = 1;
+    balance::BalancerOptions options;
+  };
+  auto args = std::make_shared<Args>();
+  balance->add_option("--balancers", args->balancers, "comma-separated balancers (default: all)");
+  balance->add_option("--tracers", args->tracers, "simulated tracer counts, comma-separated")->capture_default_str();
+  balance->add_option("--speeds", args->speeds, "relative speeds of simulated tracers, cycled (e.g. 1,0.7,1.3)")->capture_default_str();
+  balance->add_option("--noise", args->noise, "relative standard deviation of each simulated band time")->capture_default_str();
+  balance->add_option("--frames", args->frames, "frames per run")->capture_default_str()->check(CLI::PositiveNumber);
+  balance->add_option("--warmup", args->warmup, "first frames left out of mean/worst")->capture_default_str()->check(CLI::NonNegativeNumber);
+  balance->add_option("--rows", args->rows, "frame height in rows")->capture_default_str()->check(CLI::PositiveNumber);
+  balance->add_option("--path", args->path, "camera spin: slow (2 deg/frame), fast (10 deg/frame) or both")
+      ->check(CLI::IsMember({"slow", "fast", "both"}))->capture_default_str();
+  balance->add_option("--seed", args->seed, "seed of the scene cost model and the noise")->capture_default_str();
+  balance->add_option("--alpha", args->options.alpha, "Perfect Smooth blend weight of the new division (eq. 2)")->capture_default_str();
+  balance->add_option("--robin-hood-units", args->options.robin_hood_units, "units Robin Hood moves per frame")->capture_default_str();
+  balance->add_option("--real", args->real, "real tracers instead of simulated ones, e.g. embree,opencl,cuda");
+  balance->add_option("--json", args->json, "write every run (per-frame idle %) as JSON");
+  balance->add_option("--plot", args->plot, "write a PNG chart of idle % per frame per balancer");
+  balance->callback([args] {
+    BalanceBenchConfig config;
+    config.balancers = split_list<std::string>(args->balancers, "--balancers");
+    config.tracer_counts = split_list<int>(args->tracers, "--tracers");
+    config.speeds = split_list<double>(args->speeds, "--speeds");
+    config.noise = args->noise;
+    config.frames = args->frames;
+    config.warmup = args->warmup;
+    config.rows = args->rows;
+    config.seed = args->seed;
+    config.balancer_options = args->options;
+    config.real = split_list<std::string>(args->real, "--real");
+    config.paths = args->path == "both" ? std::vector<std::string>{"slow", "fast"} : std::vector<std::string>{args->path};
+    for (int c : config.tracer_counts)
+      if (c < 1) throw CLI::ValidationError("--tracers", "counts must be >= 1");
+    for (double s : config.speeds)
+      if (!(s > 0.0)) throw CLI::ValidationError("--speeds", "speeds must be > 0");
+
+    std::vector<BalanceBenchRun> runs;
+    try {
+      runs = run_balance_bench(config);
+    } catch (const std::runtime_error& e) {
+      std::cerr << "cohort bench balance: " << e.what() << "\n";
+      std::exit(config.real.empty() ? kExitFailure : kExitUnavailable);
+    }
+    std::cout << (config.real.empty() ? "simulated tracers, speeds " + args->speeds + ", noise " + std::to_string(config.noise)
+                                      : "real tracers: " + args->real)
+              << ", " << config.frames << " frames (first " << config.warmup << " not counted), " << config.rows << " rows\n"
+              << balance_bench_table(runs);
+    if (!args->json.empty()) {
+      std::ofstream out(args->json);
+      out << balance_bench_json(config, runs).dump(1) << "\n";
+      if (!out) throw std::runtime_error("cannot write " + args->json);
+      std::cout << "wrote " << args->json << "\n";
+    }
+    if (!args->plot.empty()) {
+      write_balance_plot(args->plot, runs);
+      std::cout << "wrote " << args->plot << "\n";
+    }
   });
 }
 

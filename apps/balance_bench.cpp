@@ -1,0 +1,120 @@
+#include "balance_bench.h"
+
+#include <algorithm>
+#include <cstdio>
+#include <numbers>
+#include <stdexcept>
+
+#include "cohort/core/renderer.h"
+#include "cohort/core/simulated_tracer.h"
+#include "real_tracers.h"
+
+namespace cohort::app {
+
+double path_degrees_per_frame(const std::string& path) {
+  // Slow: a full turn in 180 frames (3 s at 60 Hz); fast: a full turn in 36 frames, where a band's
+  // content changes a lot between frames and last frame's timing is a poor guide.
+  if (path == "slow") return 2.0;
+  if (path == "fast") return 10.0;
+  throw std::invalid_argument("unknown camera path '" + path + "' (known: slow, fast)");
+}
+
+namespace {
+
+BalanceBenchRun run_one(const BalanceBenchConfig& config, const std::string& path, int count, const std::string& balancer) {
+  auto model = std::make_shared<core::SpinSceneCostModel>(config.seed);
+  std::vector<std::unique_ptr<core::Tracer>> tracers;
+  if (!config.real.empty()) {
+    tracers = make_real_tracers(config.real);
+  } else {
+    for (int i = 0; i < count; ++i) {
+      core::SimulatedTracerOptions o;
+      o.name = "sim" + std::to_string(i);
+      o.speed = config.speeds[static_cast<size_t>(i) % config.speeds.size()];
+      o.noise = config.noise;
+      o.seed = config.seed * 1000 + static_cast<uint64_t>(i) + 1;
+      tracers.push_back(std::make_unique<core::SimulatedTracer>(model, o));
+    }
+  }
+  core::RendererOptions options;
+  options.balancer = balancer;
+  options.balancer_options = config.balancer_options;
+  options.use_reported_time = config.real.empty();
+  core::Renderer renderer(std::move(tracers), options);
+
+  BalanceBenchRun run{path, balancer, renderer.tracer_count(), 0.0, 0.0, {}};
+  const double step = path_degrees_per_frame(path) * std::numbers::pi / 180.0;
+  core::FrameBuffer frame;
+  int counted = 0;
+  for (int f = 0; f < config.frames; ++f) {
+    core::BandJob job;
+    job.camera = core::spin_camera(config.width, config.rows, f * step);
+    job.params.frame_index = static_cast<kuint>(f);
+    job.params.spp = 1;
+    const core::FrameStats stats = renderer.render(job, frame);
+    run.idle_percent.push_back(stats.idle_percent);
+    if (f >= config.warmup) {
+      run.mean_idle_percent += stats.idle_percent;
+      run.worst_idle_percent = std::max(run.worst_idle_percent, stats.idle_percent);
+      ++counted;
+    }
+  }
+  if (counted > 0) run.mean_idle_percent /= counted;
+  return run;
+}
+
+}  // namespace
+
+std::vector<BalanceBenchRun> run_balance_bench(const BalanceBenchConfig& config) {
+  if (config.speeds.empty()) throw std::invalid_argument("bench balance: no speeds");
+  const std::vector<std::string> balancers = config.balancers.empty() ? balance::balancer_names() : config.balancers;
+  std::vector<int> counts = config.tracer_counts;
+  if (!config.real.empty()) counts = {static_cast<int>(config.real.size())};
+  std::vector<BalanceBenchRun> runs;
+  for (const std::string& path : config.paths) {
+    for (int count : counts) {
+      for (const std::string& b : balancers) runs.push_back(run_one(config, path, count, b));
+    }
+  }
+  return runs;
+}
+
+nlohmann::json balance_bench_json(const BalanceBenchConfig& config, const std::vector<BalanceBenchRun>& runs) {
+  nlohmann::json j;
+  j["config"] = {{"tracer_counts", config.tracer_counts}, {"speeds", config.speeds},  {"noise", config.noise},
+                 {"frames", config.frames},               {"warmup", config.warmup},  {"paths", config.paths},
+                 {"rows", config.rows},                   {"seed", config.seed},      {"alpha", config.balancer_options.alpha},
+                 {"robin_hood_units", config.balancer_options.robin_hood_units},
+                 {"row_cost_rates", {config.balancer_options.cost_rate, config.balancer_options.speed_rate}},
+                 {"real", config.real},
+                 {"metric", "idle % = sum over tracers of (frame time - tracer time) / (tracers * frame time)"}};
+  j["runs"] = nlohmann::json::array();
+  for (const BalanceBenchRun& r : runs) {
+    j["runs"].push_back({{"path", r.path},
+                         {"tracers", r.tracers},
+                         {"balancer", r.balancer},
+                         {"mean_idle_percent", r.mean_idle_percent},
+                         {"worst_idle_percent", r.worst_idle_percent},
+                         {"idle_percent_per_frame", r.idle_percent}});
+  }
+  return j;
+}
+
+std::string balance_bench_table(const std::vector<BalanceBenchRun>& runs) {
+  std::string out;
+  char line[256];
+  std::snprintf(line, sizeof line, "%-6s %-8s %-16s %12s %12s\n", "path", "tracers", "balancer", "mean idle %", "worst idle %");
+  out += line;
+  std::string last_group;
+  for (const BalanceBenchRun& r : runs) {
+    const std::string group = r.path + std::to_string(r.tracers);
+    if (!last_group.empty() && group != last_group) out += "\n";
+    last_group = group;
+    std::snprintf(line, sizeof line, "%-6s %-8d %-16s %12.2f %12.2f\n", r.path.c_str(), r.tracers, r.balancer.c_str(),
+                  r.mean_idle_percent, r.worst_idle_percent);
+    out += line;
+  }
+  return out;
+}
+
+}  // namespace cohort::app

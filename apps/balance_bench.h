@@ -1,0 +1,48 @@
+// `cohort bench balance`: how much of the summed tracer time each balancer leaves idle while the camera
+// spins (Brigade, Table 1), with simulated tracers of chosen speed and noise, or real ones.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "cohort/balance/balancer.h"
+
+namespace cohort::app {
+
+struct BalanceBenchConfig {
+  std::vector<std::string> balancers;    // empty: all
+  std::vector<int> tracer_counts{2, 3, 4};
+  std::vector<double> speeds{1.0};       // speed of simulated tracer i is speeds[i % size]
+  double noise = 0.02;
+  int frames = 360;
+  int warmup = 5;                        // first frames left out of mean/worst (nothing measured yet)
+  std::vector<std::string> paths{"slow", "fast"};
+  int rows = 720, width = 32;
+  uint64_t seed = 1;
+  balance::BalancerOptions balancer_options;
+  std::vector<std::string> real;         // real tracer names; empty: simulated
+};
+
+struct BalanceBenchRun {
+  std::string path, balancer;
+  int tracers = 0;
+  double mean_idle_percent = 0.0, worst_idle_percent = 0.0;
+  std::vector<double> idle_percent;      // per frame, warm-up included
+};
+
+// Degrees of yaw per frame for a named camera path; throws std::invalid_argument for unknown names.
+double path_degrees_per_frame(const std::string& path);
+
+std::vector<BalanceBenchRun> run_balance_bench(const BalanceBenchConfig& config);
+nlohmann::json balance_bench_json(const BalanceBenchConfig& config, const std::vector<BalanceBenchRun>& runs);
+std::string balance_bench_table(const std::vector<BalanceBenchRun>& runs);
+
+}  // namespace cohort::app
+
+namespace cohort::app {
+// PNG (or PPM without OpenImageIO) chart of idle % per frame, one panel per path and tracer count,
+// one line per balancer.
+void write_balance_plot(const std::string& file, const std::vector<BalanceBenchRun>& runs);
+}  // namespace cohort::app

@@ -1,0 +1,57 @@
+// Balancers size every tracer's row band for the next frame from what the previous frame measured
+// (Brigade, §4.3-4.5). They are pure and single-threaded: the core calls divide() once per frame.
+#pragma once
+
+#include <memory>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "cohort/balance/bands.h"
+
+namespace cohort::balance {
+
+// What one tracer did last frame.
+struct TracerMeasurement {
+  int tracer = 0;   // stable id of the tracer (survives other tracers joining or leaving)
+  Band band;        // the rows it rendered
+  double ms = 0.0;  // how long that took; <= 0 means "not measured" and is ignored
+};
+
+struct DivideInput {
+  int rows = 0;                                // rows in the frame to divide
+  std::vector<int> tracers;                    // ids taking part this frame, in band order (top first)
+  std::vector<TracerMeasurement> previous;     // last frame; may lack ids (new, dropped) or hold extra ones (removed)
+  std::vector<float> row_cost_proxy;           // optional per-row relative cost estimate (size == rows), e.g.
+                                               // last frame's per-row sample count; empty when there is none
+};
+
+class Balancer {
+ public:
+  virtual ~Balancer() = default;
+  virtual std::string name() const = 0;
+  // One band per entry of in.tracers, in that order, covering [0, in.rows) (see check_bands()).
+  virtual std::vector<Band> divide(const DivideInput& in) = 0;
+  // Forget everything learnt (a cut, a resolution change). Balancers also reset themselves when the
+  // row count changes.
+  virtual void reset() = 0;
+};
+
+struct BalancerOptions {
+  // Perfect Smooth (eq. 2): weight of the new Perfect division; 1 - alpha stays with last frame's
+  // division. 0.5 halves the error each frame with a steady cost, damping Perfect's oscillation.
+  double alpha = 0.5;
+  // Robin Hood: work units moved from the slowest to the fastest tracer per frame.
+  int robin_hood_units = 2;
+  // Row Cost: how fast the per-unit cost map follows new measurements (1 = last frame only) and how
+  // fast the per-tracer speeds do. Speeds are hardware properties and change slowly; costs follow the view.
+  double cost_rate = 0.8;
+  double speed_rate = 0.15;
+};
+
+// "none", "robin-hood", "perfect", "perfect-smooth", "row-cost". Throws std::invalid_argument naming
+// the known balancers for any other name.
+std::unique_ptr<Balancer> make_balancer(std::string_view name, const BalancerOptions& options = {});
+std::vector<std::string> balancer_names();
+
+}  // namespace cohort::balance

@@ -1,0 +1,79 @@
+// The balancer implementations; use make_balancer() to get one.
+#pragma once
+
+#include <map>
+#include <vector>
+
+#include "cohort/balance/balancer.h"
+#include "speed_book.h"
+
+namespace cohort::balance {
+
+// Equal rows for everyone, whatever was measured: the baseline.
+class NoneBalancer final : public Balancer {
+ public:
+  std::string name() const override { return "none"; }
+  std::vector<Band> divide(const DivideInput& in) override;
+  void reset() override {}
+};
+
+// Starts equal; every frame moves a fixed number of units from the tracer that took longest to the
+// one that finished first (Brigade, §4.4).
+class RobinHoodBalancer final : public Balancer {
+ public:
+  explicit RobinHoodBalancer(int units_per_frame) : step_(units_per_frame < 1 ? 1 : units_per_frame) {}
+  std::string name() const override { return "robin-hood"; }
+  std::vector<Band> divide(const DivideInput& in) override;
+  void reset() override { units_.clear(); rows_ = -1; }
+
+ private:
+  int step_;
+  int rows_ = -1;
+  std::map<int, int> units_;  // tracer id -> units it holds
+};
+
+// Rows proportional to measured speed (rows/ms) of the previous frame (eq. 1), optionally blended with
+// the previous division: W = (1 - alpha) * W_prev + alpha * W_perfect (eq. 2, "Perfect Smooth").
+class PerfectBalancer final : public Balancer {
+ public:
+  PerfectBalancer(double alpha, bool smooth) : alpha_(alpha), smooth_(smooth) {}
+  std::string name() const override { return smooth_ ? "perfect-smooth" : "perfect"; }
+  std::vector<Band> divide(const DivideInput& in) override;
+  void reset() override { speeds_.clear(); last_rows_.clear(); rows_ = -1; }
+
+ private:
+  double alpha_;
+  bool smooth_;
+  int rows_ = -1;
+  SpeedBook speeds_;
+  std::map<int, double> last_rows_;  // tracer id -> rows it was given last frame (Perfect Smooth's memory)
+};
+
+// Cohort's own scheme. Perfect assumes every row costs the same, so a band over an expensive part of
+// the image makes its tracer look slow and it is starved next frame (and the reverse): Perfect
+// oscillates and Perfect Smooth lags. Row Cost separates the two causes: it keeps a cost per work
+// unit (what the view makes expensive, shared by all tracers) and a speed per tracer (what the
+// hardware does, slowly varying). Each frame a tracer's measured time re-scales the cost of the units
+// it rendered (shaped within the band by the image-space proxy when one is given), speeds follow
+// slowly, and the next cuts make predicted time (band cost / speed) equal for every tracer.
+class RowCostBalancer final : public Balancer {
+ public:
+  RowCostBalancer(double cost_rate, double speed_rate) : cost_rate_(cost_rate), speed_rate_(speed_rate) {}
+  std::string name() const override { return "row-cost"; }
+  std::vector<Band> divide(const DivideInput& in) override;
+  void reset() override { cost_.clear(); speed_.clear(); rows_ = -1; }
+
+  const std::vector<double>& unit_costs() const { return cost_; }
+
+ private:
+  void learn(const DivideInput& in);
+  std::vector<double> unit_proxy(const DivideInput& in) const;
+
+  double cost_rate_;
+  double speed_rate_;
+  int rows_ = -1;
+  std::vector<double> cost_;      // per work unit, mean 1
+  std::map<int, double> speed_;   // tracer id -> cost units per ms
+};
+
+}  // namespace cohort::balance

@@ -1,0 +1,51 @@
+// What one frame cost, per tracer and in total; written to JSON by `cohort render` and the benches.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json_fwd.hpp>
+
+namespace cohort::core {
+
+enum class TracerOutcome {
+  rendered,   // finished its band in time
+  no_rows,    // took part but got an empty band (more tracers than work units)
+  threw,      // render_band or apply threw: dropped for this frame
+  timed_out,  // missed the frame timeout: dropped; it rejoins once it has finished the late work
+  busy,       // still finishing late work from an earlier frame: not asked this frame
+};
+const char* to_string(TracerOutcome outcome);
+
+struct TracerFrameStats {
+  int id = 0;
+  std::string name;
+  TracerOutcome outcome = TracerOutcome::rendered;
+  std::string error;           // what it threw, for TracerOutcome::threw
+  int row_begin = 0, row_end = 0;
+  double ms = 0.0;             // measured band time (virtual time: what the tracer reported)
+  double idle_ms = 0.0;        // frame_ms - ms for tracers that rendered
+  int recovery_rows = 0;       // rows it re-rendered for dropped tracers
+  double recovery_ms = 0.0;
+};
+
+struct FrameStats {
+  uint64_t frame = 0;
+  int rows = 0;
+  std::string balancer;
+  double frame_ms = 0.0;          // slowest rendering tracer's band time (first round)
+  double summed_tracer_ms = 0.0;  // tracers * frame_ms: every tracer is occupied for the whole frame
+  double idle_ms = 0.0;           // sum of idle_ms
+  double idle_percent = 0.0;      // idle_ms / summed_tracer_ms * 100: Brigade's Table 1 metric
+  double recovery_ms = 0.0;       // extra time spent re-rendering dropped tracers' rows
+  double wall_ms = 0.0;           // wall time of the whole frame, recovery included
+  int dropped = 0;                // tracers dropped this frame (threw or timed out)
+  double convergence_f = 1.0;     // blend factor used by adaptive convergence (1 = this frame only)
+  std::vector<TracerFrameStats> tracers;
+};
+
+void to_json(nlohmann::json& j, const TracerFrameStats& s);
+void to_json(nlohmann::json& j, const FrameStats& s);
+
+}  // namespace cohort::core

@@ -1,0 +1,86 @@
+// The frame loop (Brigade, §4.2): one worker thread per tracer. Per frame the core asks the balancer
+// for row bands, hands every tracer its job, and waits; there is no communication with a tracer while
+// it renders. Each tracer renders into its own full-size buffer and the core merges the bands.
+//
+// Commit buffers are double-buffered per tracer: submit_commit() fills the back buffer (for frame N+1)
+// while the tracer renders frame N; at the start of its next job the tracer applies, in order, every
+// commit submitted since its last job (a tracer that missed frames catches up on all of them).
+//
+// Faults: a tracer that throws, or has not finished when the frame timeout expires, is dropped for the
+// frame; its rows are split among the tracers that finished and re-rendered, and the frame is still
+// delivered. A timed-out tracer keeps running on its own thread; it takes part again from the first
+// frame that starts after it has finished.
+#pragma once
+
+#include <chrono>
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "cohort/balance/balancer.h"
+#include "cohort/commit/commit_buffer.h"
+#include "cohort/core/frame_buffer.h"
+#include "cohort/core/frame_stats.h"
+#include "cohort/core/tracer.h"
+
+namespace cohort::core {
+
+struct RendererOptions {
+  std::string balancer = "perfect-smooth";
+  balance::BalancerOptions balancer_options;
+  std::chrono::milliseconds frame_timeout{2000};
+  // Balance on the times tracers report (BandResult::device_ms) instead of wall-clock time. Simulated
+  // tracers on a virtual clock need this; real GPU tracers may prefer their kernel times.
+  bool use_reported_time = false;
+};
+
+class Renderer {
+ public:
+  // Takes ownership of the tracers; tracer i gets id i. Throws std::invalid_argument if there are none
+  // or the balancer name is unknown.
+  Renderer(std::vector<std::unique_ptr<Tracer>> tracers, RendererOptions options);
+  // Waits for every tracer to return from its current job (a hung tracer blocks here).
+  ~Renderer();
+  Renderer(const Renderer&) = delete;
+  Renderer& operator=(const Renderer&) = delete;
+
+  // Queue a commit for every tracer (or one) for their next job. Thread-safe against running frames.
+  void submit_commit(const commit::CommitBuffer& commit);
+  void submit_commit(int tracer, const commit::CommitBuffer& commit);
+
+  // Render one frame of job.camera.width x job.camera.height into `out` (resized if needed).
+  // job.params.row_begin/row_end are set per band. row_cost_proxy (optional, one value per row) is
+  // passed to the balancer. Throws std::runtime_error when no tracer could render some rows.
+  FrameStats render(const BandJob& job, FrameBuffer& out, const std::vector<float>& row_cost_proxy = {});
+
+  int tracer_count() const;
+  std::string tracer_name(int tracer) const;
+  const std::string& balancer_name() const { return options_.balancer; }
+  // Forget balancing history (e.g. on a camera cut).
+  void reset_balancer();
+
+ private:
+  struct Worker;
+  struct Assignment {
+    int worker;
+    balance::Band band;
+  };
+  struct RoundResult {
+    std::vector<int> finished;   // workers that rendered their band
+    std::vector<int> threw;
+    std::vector<int> timed_out;
+  };
+
+  RoundResult run_round(const std::vector<Assignment>& assignments, const BandJob& job, FrameBuffer& out,
+                        std::chrono::steady_clock::time_point deadline);
+  double measured_ms(const Worker& w) const;
+
+  RendererOptions options_;
+  std::unique_ptr<balance::Balancer> balancer_;
+  std::vector<std::unique_ptr<Worker>> workers_;
+  std::vector<balance::TracerMeasurement> last_measurements_;
+  uint64_t next_job_ = 1;
+};
+
+}  // namespace cohort::core

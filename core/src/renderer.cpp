@@ -1,0 +1,324 @@
+#include "cohort/core/renderer.h"
+
+#include <algorithm>
+#include <condition_variable>
+#include <cstring>
+#include <mutex>
+#include <stdexcept>
+#include <thread>
+
+#include <spdlog/spdlog.h>
+
+namespace cohort::core {
+
+using Clock = std::chrono::steady_clock;
+
+namespace {
+
+// Signalled by workers when a job ends; the core waits on it.
+struct Completion {
+  std::mutex mutex;
+  std::condition_variable cv;
+};
+
+}  // namespace
+
+struct Renderer::Worker {
+  int id = 0;
+  std::unique_ptr<Tracer> tracer;
+  std::shared_ptr<Completion> completion;
+
+  // Inbox, guarded by inbox_mutex.
+  std::mutex inbox_mutex;
+  std::condition_variable inbox_cv;
+  bool quit = false;
+  bool has_job = false;
+  uint64_t job_id = 0;
+  BandJob job;
+  std::vector<commit::CommitBuffer> back_commits;  // filled by the core while the tracer renders
+
+  // Outcome of the last job, guarded by completion->mutex.
+  bool busy = false;
+  uint64_t done_job_id = 0;
+  bool ok = false;
+  std::string error;
+  double wall_ms = 0.0;
+  double reported_ms = 0.0;
+
+  // The tracer's private target: only the worker writes it while busy; the core reads its rows after
+  // the job's result is posted and before the next job is handed out.
+  FrameBuffer target;
+  std::thread thread;
+
+  void loop() {
+    for (;;) {
+      BandJob current;
+      uint64_t current_id = 0;
+      std::vector<commit::CommitBuffer> front_commits;
+      {
+        std::unique_lock lock(inbox_mutex);
+        inbox_cv.wait(lock, [&] { return quit || has_job; });
+        if (quit && !has_job) return;
+        current = job;
+        current_id = job_id;
+        has_job = false;
+        front_commits.swap(back_commits);
+      }
+      bool success = false;
+      std::string what;
+      double wall = 0.0, reported = 0.0;
+      try {
+        for (const commit::CommitBuffer& c : front_commits) tracer->apply(c);
+        const auto start = Clock::now();
+        const BandResult result = tracer->render_band(current, target);
+        wall = std::chrono::duration<double, std::milli>(Clock::now() - start).count();
+        reported = result.device_ms;
+        success = true;
+      } catch (const std::exception& e) {
+        what = e.what();
+      } catch (...) {
+        what = "unknown exception";
+      }
+      {
+        std::lock_guard lock(completion->mutex);
+        busy = false;
+        done_job_id = current_id;
+        ok = success;
+        error = std::move(what);
+        wall_ms = wall;
+        reported_ms = reported;
+      }
+      completion->cv.notify_all();
+    }
+  }
+};
+
+Renderer::Renderer(std::vector<std::unique_ptr<Tracer>> tracers, RendererOptions options)
+    : options_(std::move(options)) {
+  if (tracers.empty()) throw std::invalid_argument("Renderer: no tracers");
+  balancer_ = balance::make_balancer(options_.balancer, options_.balancer_options);
+  auto completion = std::make_shared<Completion>();
+  for (size_t i = 0; i < tracers.size(); ++i) {
+    if (!tracers[i]) throw std::invalid_argument("Renderer: tracer " + std::to_string(i) + " is null");
+    auto w = std::make_unique<Worker>();
+    w->id = static_cast<int>(i);
+    w->tracer = std::move(tracers[i]);
+    w->completion = completion;
+    workers_.push_back(std::move(w));
+  }
+  for (auto& w : workers_) w->thread = std::thread([worker = w.get()] { worker->loop(); });
+}
+
+Renderer::~Renderer() {
+  for (auto& w : workers_) {
+    {
+      std::lock_guard lock(w->inbox_mutex);
+      w->quit = true;
+    }
+    w->inbox_cv.notify_all();
+  }
+  for (auto& w : workers_) {
+    if (w->thread.joinable()) w->thread.join();
+  }
+}
+
+void Renderer::submit_commit(const commit::CommitBuffer& commit) {
+  for (int i = 0; i < tracer_count(); ++i) submit_commit(i, commit);
+}
+
+void Renderer::submit_commit(int tracer, const commit::CommitBuffer& commit) {
+  Worker& w = *workers_.at(static_cast<size_t>(tracer));
+  std::lock_guard lock(w.inbox_mutex);
+  w.back_commits.push_back(commit);
+}
+
+int Renderer::tracer_count() const { return static_cast<int>(workers_.size()); }
+std::string Renderer::tracer_name(int tracer) const { return workers_.at(static_cast<size_t>(tracer))->tracer->name(); }
+void Renderer::reset_balancer() {
+  balancer_->reset();
+  last_measurements_.clear();
+}
+
+double Renderer::measured_ms(const Worker& w) const {
+  return options_.use_reported_time && w.reported_ms > 0.0 ? w.reported_ms : w.wall_ms;
+}
+
+Renderer::RoundResult Renderer::run_round(const std::vector<Assignment>& assignments, const BandJob& job,
+                                          FrameBuffer& out, Clock::time_point deadline) {
+  std::vector<uint64_t> ids(assignments.size());
+  for (size_t i = 0; i < assignments.size(); ++i) {
+    Worker& w = *workers_[static_cast<size_t>(assignments[i].worker)];
+    if (w.target.width != out.width || w.target.height != out.height) w.target.resize(out.width, out.height);
+    ids[i] = next_job_++;
+    {
+      std::lock_guard lock(w.completion->mutex);
+      w.busy = true;
+    }
+    std::lock_guard lock(w.inbox_mutex);
+    w.job = job;
+    w.job.params.row_begin = static_cast<kuint>(assignments[i].band.begin);
+    w.job.params.row_end = static_cast<kuint>(assignments[i].band.end);
+    w.job_id = ids[i];
+    w.has_job = true;
+    w.inbox_cv.notify_one();
+  }
+  RoundResult result;
+  if (assignments.empty()) return result;
+  Completion& completion = *workers_.front()->completion;
+  std::unique_lock lock(completion.mutex);
+  auto all_done = [&] {
+    for (size_t i = 0; i < assignments.size(); ++i) {
+      if (workers_[static_cast<size_t>(assignments[i].worker)]->done_job_id != ids[i]) return false;
+    }
+    return true;
+  };
+  completion.cv.wait_until(lock, deadline, all_done);
+  for (size_t i = 0; i < assignments.size(); ++i) {
+    Worker& w = *workers_[static_cast<size_t>(assignments[i].worker)];
+    if (w.done_job_id != ids[i]) {
+      result.timed_out.push_back(w.id);
+    } else if (!w.ok) {
+      result.threw.push_back(w.id);
+    } else {
+      result.finished.push_back(w.id);
+      const balance::Band& band = assignments[i].band;
+      const size_t offset = static_cast<size_t>(band.begin) * out.width * 4;
+      const size_t count = static_cast<size_t>(band.rows()) * out.width * 4;
+      std::memcpy(out.rgba.data() + offset, w.target.rgba.data() + offset, count * sizeof(float));
+    }
+  }
+  return result;
+}
+
+FrameStats Renderer::render(const BandJob& job, FrameBuffer& out, const std::vector<float>& row_cost_proxy) {
+  const auto frame_start = Clock::now();
+  const int width = static_cast<int>(job.camera.width), rows = static_cast<int>(job.camera.height);
+  if (width <= 0 || rows <= 0) throw std::invalid_argument("Renderer::render: camera has no pixels");
+  if (out.width != width || out.height != rows) out.resize(width, rows);
+
+  FrameStats stats;
+  stats.frame = job.params.frame_index;
+  stats.rows = rows;
+  stats.balancer = options_.balancer;
+  stats.tracers.resize(workers_.size());
+
+  // Tracers still finishing late work sit this frame out; the balancer sees them as removed.
+  std::vector<int> ready;
+  {
+    std::lock_guard lock(workers_.front()->completion->mutex);
+    for (auto& w : workers_) {
+      TracerFrameStats& t = stats.tracers[static_cast<size_t>(w->id)];
+      t.id = w->id;
+      t.name = w->tracer->name();
+      if (w->busy) t.outcome = TracerOutcome::busy;
+      else ready.push_back(w->id);
+    }
+  }
+  if (ready.empty()) throw std::runtime_error("frame " + std::to_string(stats.frame) + ": every tracer is still busy with an earlier frame");
+
+  const std::vector<balance::Band> bands = balancer_->divide({rows, ready, last_measurements_, row_cost_proxy});
+  std::vector<Assignment> assignments;
+  for (size_t i = 0; i < ready.size(); ++i) {
+    TracerFrameStats& t = stats.tracers[static_cast<size_t>(ready[i])];
+    t.row_begin = bands[i].begin;
+    t.row_end = bands[i].end;
+    if (bands[i].empty()) t.outcome = TracerOutcome::no_rows;
+    else assignments.push_back({ready[i], bands[i]});
+  }
+
+  RoundResult first = run_round(assignments, job, out, frame_start + options_.frame_timeout);
+  last_measurements_.clear();
+  for (int id : first.finished) {
+    TracerFrameStats& t = stats.tracers[static_cast<size_t>(id)];
+    t.ms = measured_ms(*workers_[static_cast<size_t>(id)]);
+    t.outcome = TracerOutcome::rendered;
+    stats.frame_ms = std::max(stats.frame_ms, t.ms);
+    last_measurements_.push_back({id, balance::Band{t.row_begin, t.row_end}, t.ms});
+  }
+  int taking_part = 0;
+  for (TracerFrameStats& t : stats.tracers) {
+    if (t.outcome == TracerOutcome::rendered || t.outcome == TracerOutcome::no_rows) {
+      t.idle_ms = stats.frame_ms - t.ms;
+      stats.idle_ms += t.idle_ms;
+      ++taking_part;
+    }
+  }
+  stats.summed_tracer_ms = taking_part * stats.frame_ms;
+  stats.idle_percent = stats.summed_tracer_ms > 0.0 ? 100.0 * stats.idle_ms / stats.summed_tracer_ms : 0.0;
+
+  // Re-render what the dropped tracers did not deliver, split among those that finished, in
+  // proportion to the speed they just showed, until every row is covered or nobody is left.
+  std::vector<balance::Band> missing;
+  auto drop = [&](const std::vector<int>& ids, TracerOutcome why, const std::vector<balance::Band>& their_bands) {
+    for (size_t i = 0; i < ids.size(); ++i) {
+      TracerFrameStats& t = stats.tracers[static_cast<size_t>(ids[i])];
+      if (t.outcome != TracerOutcome::threw && t.outcome != TracerOutcome::timed_out) ++stats.dropped;
+      t.outcome = why;
+      if (why == TracerOutcome::threw) {
+        std::lock_guard lock(workers_.front()->completion->mutex);
+        t.error = workers_[static_cast<size_t>(ids[i])]->error;
+      }
+      missing.push_back(their_bands[i]);
+      spdlog::warn("frame {}: tracer {} ({}) {} on rows [{}, {}){}{}; re-rendering them on the others", stats.frame,
+                   t.id, t.name, why == TracerOutcome::threw ? "threw" : "timed out", their_bands[i].begin,
+                   their_bands[i].end, t.error.empty() ? "" : ": ", t.error);
+    }
+  };
+  auto band_of = [&](const std::vector<int>& ids) {
+    std::vector<balance::Band> b;
+    for (int id : ids) b.push_back({stats.tracers[static_cast<size_t>(id)].row_begin, stats.tracers[static_cast<size_t>(id)].row_end});
+    return b;
+  };
+  drop(first.threw, TracerOutcome::threw, band_of(first.threw));
+  drop(first.timed_out, TracerOutcome::timed_out, band_of(first.timed_out));
+
+  std::vector<int> helpers = first.finished;
+  const auto recovery_start = Clock::now();
+  while (!missing.empty()) {
+    if (helpers.empty()) {
+      throw std::runtime_error("frame " + std::to_string(stats.frame) + ": rows [" + std::to_string(missing.front().begin) + ", " +
+                               std::to_string(missing.front().end) + ") could not be rendered: every tracer failed or timed out");
+    }
+    const balance::Band band = missing.back();
+    missing.pop_back();
+    std::vector<double> speeds;
+    for (int id : helpers) {
+      const TracerFrameStats& t = stats.tracers[static_cast<size_t>(id)];
+      speeds.push_back(t.ms > 0.0 && t.row_end > t.row_begin ? (t.row_end - t.row_begin) / t.ms : 1.0);
+    }
+    std::vector<balance::Band> parts = balance::bands_from_shares(band.rows(), speeds);
+    std::vector<Assignment> round;
+    for (size_t i = 0; i < helpers.size(); ++i) {
+      if (!parts[i].empty()) round.push_back({helpers[i], {band.begin + parts[i].begin, band.begin + parts[i].end}});
+    }
+    const auto round_start = Clock::now();
+    RoundResult r = run_round(round, job, out, round_start + options_.frame_timeout);
+    for (const Assignment& a : round) {
+      TracerFrameStats& t = stats.tracers[static_cast<size_t>(a.worker)];
+      if (std::find(r.finished.begin(), r.finished.end(), a.worker) != r.finished.end()) {
+        t.recovery_rows += a.band.rows();
+        t.recovery_ms += measured_ms(*workers_[static_cast<size_t>(a.worker)]);
+      }
+    }
+    std::vector<int> failed = r.threw;
+    failed.insert(failed.end(), r.timed_out.begin(), r.timed_out.end());
+    std::vector<balance::Band> failed_bands;
+    for (int id : failed) {
+      for (const Assignment& a : round) {
+        if (a.worker == id) failed_bands.push_back(a.band);
+      }
+      std::erase(helpers, id);
+      std::erase_if(last_measurements_, [id](const balance::TracerMeasurement& m) { return m.tracer == id; });
+    }
+    std::vector<int> threw_ids = r.threw, late_ids = r.timed_out;
+    drop(threw_ids, TracerOutcome::threw, std::vector<balance::Band>(failed_bands.begin(), failed_bands.begin() + static_cast<long>(threw_ids.size())));
+    drop(late_ids, TracerOutcome::timed_out, std::vector<balance::Band>(failed_bands.begin() + static_cast<long>(threw_ids.size()), failed_bands.end()));
+  }
+  for (const TracerFrameStats& t : stats.tracers) stats.recovery_ms = std::max(stats.recovery_ms, t.recovery_ms);
+  if (!options_.use_reported_time && stats.dropped > 0)
+    stats.recovery_ms = std::chrono::duration<double, std::milli>(Clock::now() - recovery_start).count();
+  stats.wall_ms = std::chrono::duration<double, std::milli>(Clock::now() - frame_start).count();
+  return stats;
+}
+
+}  // namespace cohort::core

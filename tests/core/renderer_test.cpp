@@ -1,0 +1,180 @@
+#include <gtest/gtest.h>
+
+#include <thread>
+
+#include <nlohmann/json.hpp>
+
+#include "cohort/core/renderer.h"
+#include "cohort/core/simulated_tracer.h"
+
+using namespace cohort::core;
+
+namespace {
+
+constexpr int kWidth = 8, kRows = 96;
+
+std::shared_ptr<SpinSceneCostModel> model() { return std::make_shared<SpinSceneCostModel>(3); }
+
+SimulatedTracerOptions sim(uint64_t tag, double speed = 1.0) {
+  SimulatedTracerOptions o;
+  o.name = "sim" + std::to_string(tag);
+  o.seed = tag;
+  o.speed = speed;
+  return o;
+}
+
+BandJob job_for(uint64_t frame) {
+  BandJob job;
+  job.camera = spin_camera(kWidth, kRows, 0.05 * static_cast<double>(frame));
+  job.params.frame_index = static_cast<kuint>(frame);
+  return job;
+}
+
+// Every pixel carries (frame, tag of the tracer that wrote it, 1, 1); checks the frame is complete and
+// each row came from a tracer whose stats say it rendered those rows.
+void expect_complete(const FrameBuffer& fb, uint64_t frame, const FrameStats& stats, const std::vector<uint64_t>& tags) {
+  for (int y = 0; y < fb.height; ++y) {
+    const float* p = fb.row(y);
+    ASSERT_EQ(p[0], static_cast<float>(frame)) << "row " << y << " not rendered for frame " << frame;
+    const uint64_t tag = static_cast<uint64_t>(p[1]);
+    bool owner = false;
+    for (const TracerFrameStats& t : stats.tracers) {
+      if (tags[static_cast<size_t>(t.id)] != tag) continue;
+      owner = owner || (t.outcome == TracerOutcome::rendered && y >= t.row_begin && y < t.row_end) || t.recovery_rows > 0;
+    }
+    EXPECT_TRUE(owner) << "row " << y << " written by tag " << tag << " which had no claim on it";
+  }
+}
+
+}  // namespace
+
+TEST(Renderer, DeliversEveryRowAndBalancesUnequalTracers) {
+  std::vector<std::unique_ptr<Tracer>> tracers;
+  tracers.push_back(std::make_unique<SimulatedTracer>(model(), sim(1, 2.0)));
+  tracers.push_back(std::make_unique<SimulatedTracer>(model(), sim(2, 1.0)));
+  RendererOptions options;
+  options.balancer = "perfect";
+  options.use_reported_time = true;
+  Renderer renderer(std::move(tracers), options);
+  FrameBuffer fb;
+  FrameStats stats;
+  for (uint64_t f = 0; f < 10; ++f) {
+    stats = renderer.render(job_for(f), fb);
+    expect_complete(fb, f, stats, {1, 2});
+  }
+  EXPECT_EQ(stats.dropped, 0);
+  EXPECT_GT(stats.tracers[0].row_end - stats.tracers[0].row_begin, stats.tracers[1].row_end - stats.tracers[1].row_begin);
+  EXPECT_LT(stats.idle_percent, 15.0);
+  const nlohmann::json j = stats;
+  EXPECT_EQ(j["tracers"].size(), 2u);
+  EXPECT_EQ(j["tracers"][0]["outcome"], "rendered");
+  EXPECT_DOUBLE_EQ(j["idle_percent"].get<double>(), stats.idle_percent);
+}
+
+TEST(Renderer, ATracerThatThrowsIsDroppedItsRowsReRenderedAndItRejoins) {
+  std::vector<std::unique_ptr<Tracer>> tracers;
+  auto faulty = sim(2);
+  faulty.throw_on_frames = {3};
+  tracers.push_back(std::make_unique<SimulatedTracer>(model(), sim(1)));
+  tracers.push_back(std::make_unique<SimulatedTracer>(model(), faulty));
+  tracers.push_back(std::make_unique<SimulatedTracer>(model(), sim(3)));
+  RendererOptions options;
+  options.use_reported_time = true;
+  Renderer renderer(std::move(tracers), options);
+  FrameBuffer fb;
+  for (uint64_t f = 0; f < 6; ++f) {
+    const FrameStats stats = renderer.render(job_for(f), fb);
+    expect_complete(fb, f, stats, {1, 2, 3});
+    if (f == 3) {
+      EXPECT_EQ(stats.dropped, 1);
+      EXPECT_EQ(stats.tracers[1].outcome, TracerOutcome::threw);
+      EXPECT_NE(stats.tracers[1].error.find("simulated device fault"), std::string::npos);
+      EXPECT_EQ(stats.tracers[0].recovery_rows + stats.tracers[2].recovery_rows,
+                stats.tracers[1].row_end - stats.tracers[1].row_begin);
+    } else {
+      EXPECT_EQ(stats.dropped, 0) << "frame " << f;
+      EXPECT_EQ(stats.tracers[1].outcome, TracerOutcome::rendered) << "frame " << f;
+    }
+  }
+}
+
+TEST(Renderer, ATracerThatTimesOutIsDroppedAndRejoinsAfterFinishingLateWork) {
+  std::vector<std::unique_ptr<Tracer>> tracers;
+  auto slow = sim(2);
+  slow.hang_on_frames = {1};
+  slow.hang_ms = 300.0;
+  tracers.push_back(std::make_unique<SimulatedTracer>(model(), sim(1)));
+  tracers.push_back(std::make_unique<SimulatedTracer>(model(), slow));
+  RendererOptions options;
+  options.use_reported_time = true;
+  options.frame_timeout = std::chrono::milliseconds(50);
+  Renderer renderer(std::move(tracers), options);
+  FrameBuffer fb;
+  bool rejoined = false, was_busy = false;
+  for (uint64_t f = 0; f < 40 && !rejoined; ++f) {
+    const FrameStats stats = renderer.render(job_for(f), fb);
+    expect_complete(fb, f, stats, {1, 2});
+    if (f == 1) {
+      EXPECT_EQ(stats.tracers[1].outcome, TracerOutcome::timed_out);
+      EXPECT_EQ(stats.dropped, 1);
+      EXPECT_EQ(stats.tracers[0].recovery_rows, stats.tracers[1].row_end - stats.tracers[1].row_begin);
+    } else if (f > 1) {
+      if (stats.tracers[1].outcome == TracerOutcome::busy) {
+        was_busy = true;
+        EXPECT_EQ(stats.tracers[0].row_begin, 0);
+        EXPECT_EQ(stats.tracers[0].row_end, kRows);  // the other tracer renders everything meanwhile
+        std::this_thread::sleep_for(std::chrono::milliseconds(20));
+      } else {
+        EXPECT_EQ(stats.tracers[1].outcome, TracerOutcome::rendered);
+        rejoined = true;
+      }
+    }
+  }
+  EXPECT_TRUE(was_busy);
+  EXPECT_TRUE(rejoined);
+}
+
+TEST(Renderer, WhenEveryTracerFailsTheFrameThrowsWithTheReason) {
+  std::vector<std::unique_ptr<Tracer>> tracers;
+  auto faulty = sim(1);
+  faulty.throw_on_frames = {0};
+  tracers.push_back(std::make_unique<SimulatedTracer>(model(), faulty));
+  Renderer renderer(std::move(tracers), RendererOptions{});
+  FrameBuffer fb;
+  try {
+    renderer.render(job_for(0), fb);
+    FAIL() << "expected an exception";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("could not be rendered"), std::string::npos) << e.what();
+  }
+  EXPECT_NO_THROW(renderer.render(job_for(1), fb));  // it rejoins on the next frame
+}
+
+TEST(Renderer, CommitsReachEveryTracerInOrderIncludingOnesThatMissedFrames) {
+  auto m = model();
+  auto a = std::make_unique<SimulatedTracer>(m, sim(1));
+  SimulatedTracer* a_view = a.get();
+  std::vector<std::unique_ptr<Tracer>> tracers;
+  tracers.push_back(std::move(a));
+  RendererOptions options;
+  options.use_reported_time = true;
+  Renderer renderer(std::move(tracers), options);
+  auto scene = std::make_shared<cohort::commit::TracerScene>();
+  renderer.submit_commit(cohort::commit::CommitBuffer::full(scene, 1));
+  renderer.submit_commit(cohort::commit::CommitBuffer::full(scene, 2));
+  FrameBuffer fb;
+  renderer.render(job_for(0), fb);
+  EXPECT_EQ(a_view->commits_applied(), 2u);
+  EXPECT_EQ(a_view->last_commit_frame(), 2u);
+  renderer.render(job_for(1), fb);
+  EXPECT_EQ(a_view->commits_applied(), 2u);  // nothing new: nothing applied
+}
+
+TEST(Renderer, RejectsNoTracersAndUnknownBalancers) {
+  EXPECT_THROW(Renderer({}, RendererOptions{}), std::invalid_argument);
+  std::vector<std::unique_ptr<Tracer>> tracers;
+  tracers.push_back(std::make_unique<SimulatedTracer>(model(), sim(1)));
+  RendererOptions options;
+  options.balancer = "magic";
+  EXPECT_THROW(Renderer(std::move(tracers), options), std::invalid_argument);
+}

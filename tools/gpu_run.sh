@@ -1,0 +1,47 @@
+#!/usr/bin/env bash
+# Runs Cohort's CUDA tests and benchmarks on the GPU machine lent by the `device` tool.
+#
+#   tools/gpu_run.sh stage     here: build the gpu-travel preset (CUDA on, no OpenImageIO, no viewer),
+#                              pack the test map, and put binaries + Embree/TBB/libzip beside them in .gpu/
+#   tools/gpu_run.sh remote    there (device tool: run command "bash tools/gpu_run.sh remote", carry [".gpu"]):
+#                              registers NVIDIA's OpenCL, runs the GPU tests and benchmarks, writes
+#                              results (logs, JSON, PPM frames) to $OUT
+#
+# The GPU machine (Ubuntu 24.04, newer glibc) lacks Embree, TBB, OpenImageIO, GLFW and GLM; binaries built
+# here run there with the three shared libraries below carried beside them. See README, "GPU machine".
+set -euo pipefail
+cd "$(dirname "$0")/.."
+stage=.gpu
+
+case "${1:-}" in
+  stage)
+    cmake --preset gpu-travel
+    cmake --build --preset gpu-travel -j2 --target cohort cohort_tracers_tests $(ls bench/bench_*.cpp | xargs -n1 basename | sed 's/\.cpp$//')
+    rm -rf "$stage" && mkdir -p "$stage/bin" "$stage/lib"
+    for exe in build/gpu/bin/*; do
+      [ -x "$exe" ] && [ -f "$exe" ] && strip -o "$stage/bin/$(basename "$exe")" "$exe"
+    done
+    for lib in libembree3.so.3 libtbb.so.12 libzip.so.4; do
+      cp -L "/usr/lib/x86_64-linux-gnu/$lib" "$stage/lib/"
+    done
+    # The travelling binary has no OpenImageIO: the pack carries decoded textures.
+    build/default/bin/cohort pack assets/testmap/maps/testmap.map --out "$stage/testmap.cpk"
+    du -sh "$stage"
+    ;;
+  remote)
+    export LD_LIBRARY_PATH="$PWD/$stage/lib${LD_LIBRARY_PATH:+:$LD_LIBRARY_PATH}"
+    mkdir -p /tmp/icd && echo libnvidia-opencl.so.1 > /tmp/icd/nvidia.icd
+    cp /etc/OpenCL/vendors/pocl.icd /tmp/icd/ 2>/dev/null || true
+    export OCL_ICD_VENDORS=/tmp/icd
+    out="${OUT:-/tmp/cohort-out}"; mkdir -p "$out"
+    nvidia-smi --query-gpu=index,name,memory.total,driver_version --format=csv | tee "$out/gpus.csv"
+    status=0
+    "$stage/bin/cohort_tracers_tests" --gtest_output=json:"$out/tracers_tests.json" 2>&1 | tee "$out/tracers_tests.log" || status=1
+    if [ -x "$stage/bin/bench_cuda" ]; then
+      "$stage/bin/bench_cuda" --scene "$stage/testmap.cpk" --json "$out/bench_cuda.json" 2>&1 | tee "$out/bench_cuda.log" || status=1
+    fi
+    exit $status
+    ;;
+  *)
+    sed -n '2,12p' "$0"; exit 2 ;;
+esac

@@ -1,0 +1,30 @@
+// The CUDA tracer: one per GPU. Device buffers mirror the tracer's commit::TracerScene; commits are
+// applied with async copies on the tracer's own stream; the band is rendered by the shared integrator
+// (core/kernel/) compiled as CUDA, and kernel time is measured with CUDA events.
+#pragma once
+
+#include <memory>
+#include <string>
+
+#include "cohort/core/tracer.h"
+
+namespace cohort::tracers {
+
+// Number of usable CUDA devices; 0 when there is no driver or no GPU (never throws).
+int cuda_device_count();
+std::string cuda_device_name(int device);
+
+class CudaTracer final : public core::Tracer {
+ public:
+  explicit CudaTracer(int device);
+  ~CudaTracer() override;
+  std::string name() const override;
+  void apply(const commit::CommitBuffer& commit) override;
+  core::BandResult render_band(const core::BandJob& job, core::FrameBuffer& target) override;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace cohort::tracers
