@@ -32,6 +32,7 @@ struct RenderArgs {
   float fov = 90.0f, exposure = 1.0f, firefly_clamp = 5.0f, spec_boost = 2.0f, soft_shadow_scale = 0.2f;
   float yaw_step = 0.0f;
   std::vector<float> camera;  // x y z yaw pitch
+  std::vector<std::string> bases;
 };
 
 const std::map<std::string, uint32_t>& modes() {
@@ -42,7 +43,7 @@ const std::map<std::string, uint32_t>& modes() {
 }
 
 int run_render(const RenderArgs& a) {
-  RenderScene scene = load_render_scene(a.map);
+  RenderScene scene = load_render_scene(a.map, a.bases);
   std::vector<std::unique_ptr<core::Tracer>> tracers = make_tracers(a.tracers);
   core::RendererOptions options;
   options.balancer = a.balancer;
@@ -102,8 +103,11 @@ void add_render_command(CLI::App& app) {
   auto* cmd = app.add_subcommand("render", "Render frames headless on the chosen tracers and write images and a "
                                            "JSON of per-frame stats");
   auto a = std::make_shared<RenderArgs>();
-  cmd->add_option("map", a->map, "scene pack (or map, once the loader reads maps)")->required();
-  cmd->add_option("--tracers", a->tracers, "comma-separated: embree, opencl[:N|:all], cuda[:N|:all], or all (Embree on the CPU plus every GPU once)")->capture_default_str();
+  cmd->add_option("map", a->map, "scene pack, or map: a .map path, a game path or a bare name")->required();
+  cmd->add_option("--base", a->bases, "extra game folder(s) to search (loose files and .pk4s)");
+  cmd->add_option("--tracers", a->tracers,
+                  "comma-separated: embree, opencl[:N|:all], cuda[:N|:all], or all (Embree on the CPU plus every GPU once)")
+      ->capture_default_str();
   cmd->add_option("--balancer", a->balancer, "row balancer when there are several tracers")->capture_default_str();
   cmd->add_option("--width", a->width, "image width")->capture_default_str()->check(CLI::PositiveNumber);
   cmd->add_option("--height", a->height, "image height")->capture_default_str()->check(CLI::PositiveNumber);

@@ -1,9 +1,10 @@
-// What `cohort render` and the benches render: a compiled scene from a scene pack, or from a map once
-// the scene loader can read one, plus where the player starts.
+// What `cohort render` renders: a compiled scene from a scene pack or a map, plus where the player
+// starts.
 #pragma once
 
 #include <memory>
 #include <string>
+#include <vector>
 
 #include <glm/glm.hpp>
 
@@ -18,7 +19,8 @@ struct RenderScene {
   float player_yaw = 0.0f;
 };
 
-// Throws std::runtime_error with the reason when the file cannot be used.
-RenderScene load_render_scene(const std::string& path);
+// A scene pack, or a map (disk path, game path or bare name; `bases` are extra game folders) loaded
+// and compiled. Throws std::runtime_error (or scene::ParseError) with the reason when it cannot be used.
+RenderScene load_render_scene(const std::string& path, const std::vector<std::string>& bases = {});
 
 }  // namespace cohort::app
