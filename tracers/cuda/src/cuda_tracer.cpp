@@ -40,6 +40,9 @@ struct CudaTracer::Impl {
   DeviceArray<KLight> lights;
   cudaTextureObject_t texel_texture = 0;
   float4* band = nullptr;
+  bool count_rays = false;
+  unsigned long long* ray_counts = nullptr;   // device: closest, occlusion
+  RayCounts last_counts;
   size_t band_capacity = 0;   // pixels
   std::vector<float> host_band;
 
@@ -93,6 +96,7 @@ CudaTracer::~CudaTracer() {
   cudaSetDevice(impl_->device);
   if (impl_->texel_texture) cudaDestroyTextureObject(impl_->texel_texture);
   if (impl_->band) cudaFree(impl_->band);
+  if (impl_->ray_counts) cudaFree(impl_->ray_counts);
   if (impl_->start) cudaEventDestroy(impl_->start);
   if (impl_->stop) cudaEventDestroy(impl_->stop);
   if (impl_->stream) cudaStreamDestroy(impl_->stream);
@@ -147,18 +151,31 @@ core::BandResult CudaTracer::render_band(const core::BandJob& job, core::FrameBu
     COHORT_CUDA(cudaMalloc(&m.band, pixels * sizeof(float4)));
     m.band_capacity = pixels;
   }
+  if (m.count_rays) {
+    if (!m.ray_counts) COHORT_CUDA(cudaMalloc(&m.ray_counts, 2 * sizeof(unsigned long long)));
+    COHORT_CUDA(cudaMemsetAsync(m.ray_counts, 0, 2 * sizeof(unsigned long long), m.stream));
+  }
   COHORT_CUDA(cudaEventRecord(m.start, m.stream));
-  launch_render_band(m.view(), params.tlas_node_count, params, camera, m.band, m.stream);
+  launch_render_band(m.view(), params.tlas_node_count, params, camera, m.band, m.count_rays ? m.ray_counts : nullptr,
+                     m.stream);
   COHORT_CUDA(cudaEventRecord(m.stop, m.stream));
   // The band's rows are contiguous in the frame buffer: one copy straight into place.
   COHORT_CUDA(cudaMemcpyAsync(target.row(int(params.row_begin)), m.band, pixels * sizeof(float4), cudaMemcpyDeviceToHost,
                               m.stream));
+  unsigned long long counts[2] = {0, 0};
+  if (m.count_rays)
+    COHORT_CUDA(cudaMemcpyAsync(counts, m.ray_counts, sizeof counts, cudaMemcpyDeviceToHost, m.stream));
   COHORT_CUDA(cudaStreamSynchronize(m.stream));
+  m.last_counts = RayCounts{counts[0], counts[1]};
   float kernel_ms = 0.0f;
   COHORT_CUDA(cudaEventElapsedTime(&kernel_ms, m.start, m.stop));
   core::BandResult result;
   result.device_ms = kernel_ms;
   return result;
 }
+
+void CudaTracer::set_ray_counting(bool on) { impl_->count_rays = on; }
+CudaTracer::RayCounts CudaTracer::last_ray_counts() const { return impl_->last_counts; }
+int CudaTracer::device() const { return impl_->device; }
 
 }  // namespace cohort::tracers
