@@ -238,6 +238,19 @@ class GeneratorChecks(unittest.TestCase):
         with self.assertRaises(self.checks.CheckError):
             self.checks.check_winding(self.broken(flip))
 
+    def test_inside_out_wall_is_rejected(self):
+        from testmap.bsp import build_nodes
+        nodes = build_nodes(self.grid)
+        self.checks.check_shell_faces_air(self.meshes, nodes)
+
+        def invert(meshes):
+            tris = meshes[0].surfaces["textures/testmap/floor_tiles"]
+            a, b, c = tris[0]
+            flipped = tuple(-x for x in a[2])
+            tris[0] = [(a[0], a[1], flipped), (c[0], c[1], flipped), (b[0], b[1], flipped)]
+        with self.assertRaises(self.checks.CheckError):
+            self.checks.check_shell_faces_air(self.broken(invert), nodes)
+
     def test_node_tree_rejects_wrong_area(self):
         from testmap.bsp import build_nodes
         nodes = build_nodes(self.grid)

@@ -33,6 +33,7 @@ def build():
         o = values["origin"]
         entity_points.append((values["name"], (o[0], o[1], o[2] + 1), expected))
     checks.check_nodes(nodes, grid, entity_points)
+    checks.check_shell_faces_air(area_meshes, nodes)
     checks.check_materials(area_meshes + models, materials.material_names(), materials.referenced_images(),
                            images.keys())
 
