@@ -44,6 +44,7 @@ struct Renderer::Worker {
   std::string error;
   double wall_ms = 0.0;
   double reported_ms = 0.0;
+  std::vector<float> row_work;
 
   // The tracer's private target: only the worker writes it while busy; the core reads its rows after
   // the job's result is posted and before the next job is handed out.
@@ -67,12 +68,14 @@ struct Renderer::Worker {
       bool success = false;
       std::string what;
       double wall = 0.0, reported = 0.0;
+      std::vector<float> work;
       try {
         for (const commit::CommitBuffer& c : front_commits) tracer->apply(c);
         const auto start = Clock::now();
         const BandResult result = tracer->render_band(current, target);
         wall = std::chrono::duration<double, std::milli>(Clock::now() - start).count();
         reported = result.device_ms;
+        if (result.row_work.size() == current.params.row_end - current.params.row_begin) work = result.row_work;
         success = true;
       } catch (const std::exception& e) {
         what = e.what();
@@ -87,6 +90,7 @@ struct Renderer::Worker {
         error = std::move(what);
         wall_ms = wall;
         reported_ms = reported;
+        row_work = std::move(work);
       }
       completion->cv.notify_all();
     }
@@ -185,6 +189,10 @@ Renderer::RoundResult Renderer::run_round(const std::vector<Assignment>& assignm
       const size_t offset = static_cast<size_t>(band.begin) * out.width * 4;
       const size_t count = static_cast<size_t>(band.rows()) * out.width * 4;
       std::memcpy(out.rgba.data() + offset, w.target.rgba.data() + offset, count * sizeof(float));
+      if (w.row_work.size() == static_cast<size_t>(band.rows())) {
+        std::copy(w.row_work.begin(), w.row_work.end(), row_work_.begin() + band.begin);
+        std::fill(row_work_known_.begin() + band.begin, row_work_known_.begin() + band.end, 1);
+      }
     }
   }
   return result;
@@ -216,7 +224,14 @@ FrameStats Renderer::render(const BandJob& job, FrameBuffer& out, const std::vec
   }
   if (ready.empty()) throw std::runtime_error("frame " + std::to_string(stats.frame) + ": every tracer is still busy with an earlier frame");
 
-  const std::vector<balance::Band> bands = balancer_->divide({rows, ready, last_measurements_, row_cost_proxy});
+  // Without a proxy from the caller, last frame's per-row work counts serve, when every row has one.
+  std::vector<float> proxy = row_cost_proxy;
+  if (proxy.empty() && options_.use_row_work && static_cast<int>(row_work_.size()) == rows &&
+      std::all_of(row_work_known_.begin(), row_work_known_.end(), [](uint8_t k) { return k != 0; }))
+    proxy = row_work_;
+  row_work_.assign(static_cast<size_t>(rows), 0.0f);
+  row_work_known_.assign(static_cast<size_t>(rows), 0);
+  const std::vector<balance::Band> bands = balancer_->divide({rows, ready, last_measurements_, std::move(proxy)});
   std::vector<Assignment> assignments;
   for (size_t i = 0; i < ready.size(); ++i) {
     TracerFrameStats& t = stats.tracers[static_cast<size_t>(ready[i])];

@@ -33,6 +33,8 @@ struct RendererOptions {
   // Balance on the times tracers report (BandResult::device_ms) instead of wall-clock time. Simulated
   // tracers on a virtual clock need this; real GPU tracers may prefer their kernel times.
   bool use_reported_time = false;
+  // Pass the tracers' per-row work counts (BandResult::row_work) to the balancer as its cost proxy.
+  bool use_row_work = true;
 };
 
 class Renderer {
@@ -51,7 +53,8 @@ class Renderer {
 
   // Render one frame of job.camera.width x job.camera.height into `out` (resized if needed).
   // job.params.row_begin/row_end are set per band. row_cost_proxy (optional, one value per row) is
-  // passed to the balancer. Throws std::runtime_error when no tracer could render some rows.
+  // passed to the balancer; without one, the per-row work the tracers reported last frame
+  // (BandResult::row_work) is passed when it covers every row. Throws std::runtime_error when no tracer could render some rows.
   FrameStats render(const BandJob& job, FrameBuffer& out, const std::vector<float>& row_cost_proxy = {});
 
   int tracer_count() const;
@@ -80,6 +83,8 @@ class Renderer {
   std::unique_ptr<balance::Balancer> balancer_;
   std::vector<std::unique_ptr<Worker>> workers_;
   std::vector<balance::TracerMeasurement> last_measurements_;
+  std::vector<float> row_work_;            // this frame's per-row work counts, as tracers report them
+  std::vector<uint8_t> row_work_known_;
   uint64_t next_job_ = 1;
 };
 
