@@ -1,3 +1,4 @@
+#include <algorithm>
 #include <fstream>
 #include <iostream>
 #include <sstream>
@@ -87,6 +88,10 @@ void add_bench_command(CLI::App& app) {
     config.balancer_options = args->options;
     config.real = split_list<std::string>(args->real, "--real");
     config.paths = args->path == "both" ? std::vector<std::string>{"slow", "fast"} : std::vector<std::string>{args->path};
+    const std::vector<std::string> known = balance::balancer_names();
+    for (const std::string& b : config.balancers)
+      if (std::find(known.begin(), known.end(), b) == known.end())
+        throw CLI::ValidationError("--balancers", "unknown balancer '" + b + "' (known: none, robin-hood, perfect, perfect-smooth, row-cost)");
     for (int c : config.tracer_counts)
       if (c < 1) throw CLI::ValidationError("--tracers", "counts must be >= 1");
     for (double s : config.speeds)

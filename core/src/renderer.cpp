@@ -36,6 +36,7 @@ struct Renderer::Worker {
   uint64_t job_id = 0;
   BandJob job;
   std::vector<commit::CommitBuffer> back_commits;  // filled by the core while the tracer renders
+  std::vector<commit::CommitBuffer> job_commits;   // handed over with the next job, applied before it
 
   // Outcome of the last job, guarded by completion->mutex.
   bool busy = false;
@@ -63,7 +64,7 @@ struct Renderer::Worker {
         current = job;
         current_id = job_id;
         has_job = false;
-        front_commits.swap(back_commits);
+        front_commits.swap(job_commits);
       }
       bool success = false;
       std::string what;
@@ -147,8 +148,8 @@ double Renderer::measured_ms(const Worker& w) const {
   return options_.use_reported_time && w.reported_ms > 0.0 ? w.reported_ms : w.wall_ms;
 }
 
-Renderer::RoundResult Renderer::run_round(const std::vector<Assignment>& assignments, const BandJob& job,
-                                          FrameBuffer& out, Clock::time_point deadline) {
+std::vector<uint64_t> Renderer::assign(const std::vector<Assignment>& assignments, const BandJob& job, FrameBuffer& out,
+                                       bool with_commits) {
   std::vector<uint64_t> ids(assignments.size());
   for (size_t i = 0; i < assignments.size(); ++i) {
     Worker& w = *workers_[static_cast<size_t>(assignments[i].worker)];
@@ -164,8 +165,20 @@ Renderer::RoundResult Renderer::run_round(const std::vector<Assignment>& assignm
     w.job.params.row_end = static_cast<kuint>(assignments[i].band.end);
     w.job_id = ids[i];
     w.has_job = true;
+    // The commits queued so far belong to this frame; ones submitted from now on wait for the next.
+    // Re-rendering a dropped tracer's rows happens within the same frame, so it takes none.
+    if (with_commits) {
+      w.job_commits.insert(w.job_commits.end(), std::make_move_iterator(w.back_commits.begin()),
+                           std::make_move_iterator(w.back_commits.end()));
+      w.back_commits.clear();
+    }
     w.inbox_cv.notify_one();
   }
+  return ids;
+}
+
+Renderer::RoundResult Renderer::collect(const std::vector<Assignment>& assignments, const std::vector<uint64_t>& ids,
+                                        FrameBuffer& out, Clock::time_point deadline) {
   RoundResult result;
   if (assignments.empty()) return result;
   Completion& completion = *workers_.front()->completion;
@@ -199,6 +212,12 @@ Renderer::RoundResult Renderer::run_round(const std::vector<Assignment>& assignm
 }
 
 FrameStats Renderer::render(const BandJob& job, FrameBuffer& out, const std::vector<float>& row_cost_proxy) {
+  begin_frame(job, out, row_cost_proxy);
+  return finish_frame();
+}
+
+void Renderer::begin_frame(const BandJob& job, FrameBuffer& out, const std::vector<float>& row_cost_proxy) {
+  if (pending_) throw std::logic_error("Renderer::begin_frame: the previous frame was not finished");
   const auto frame_start = Clock::now();
   const int width = static_cast<int>(job.camera.width), rows = static_cast<int>(job.camera.height);
   if (width <= 0 || rows <= 0) throw std::invalid_argument("Renderer::render: camera has no pixels");
@@ -241,7 +260,17 @@ FrameStats Renderer::render(const BandJob& job, FrameBuffer& out, const std::vec
     else assignments.push_back({ready[i], bands[i]});
   }
 
-  RoundResult first = run_round(assignments, job, out, frame_start + options_.frame_timeout);
+  std::vector<uint64_t> ids = assign(assignments, job, out, true);
+  pending_ = std::make_unique<PendingFrame>(PendingFrame{job, &out, std::move(stats), std::move(assignments), std::move(ids), frame_start});
+}
+
+FrameStats Renderer::finish_frame() {
+  if (!pending_) throw std::logic_error("Renderer::finish_frame: no frame was begun");
+  std::unique_ptr<PendingFrame> frame = std::move(pending_);
+  FrameStats& stats = frame->stats;
+  FrameBuffer& out = *frame->out;
+  const BandJob& job = frame->job;
+  RoundResult first = collect(frame->assignments, frame->ids, out, frame->start + options_.frame_timeout);
   last_measurements_.clear();
   for (int id : first.finished) {
     TracerFrameStats& t = stats.tracers[static_cast<size_t>(id)];
@@ -307,7 +336,7 @@ FrameStats Renderer::render(const BandJob& job, FrameBuffer& out, const std::vec
       if (!parts[i].empty()) round.push_back({helpers[i], {band.begin + parts[i].begin, band.begin + parts[i].end}});
     }
     const auto round_start = Clock::now();
-    RoundResult r = run_round(round, job, out, round_start + options_.frame_timeout);
+    RoundResult r = collect(round, assign(round, job, out, false), out, round_start + options_.frame_timeout);
     for (const Assignment& a : round) {
       TracerFrameStats& t = stats.tracers[static_cast<size_t>(a.worker)];
       if (std::find(r.finished.begin(), r.finished.end(), a.worker) != r.finished.end()) {
@@ -332,8 +361,8 @@ FrameStats Renderer::render(const BandJob& job, FrameBuffer& out, const std::vec
   for (const TracerFrameStats& t : stats.tracers) stats.recovery_ms = std::max(stats.recovery_ms, t.recovery_ms);
   if (!options_.use_reported_time && stats.dropped > 0)
     stats.recovery_ms = std::chrono::duration<double, std::milli>(Clock::now() - recovery_start).count();
-  stats.wall_ms = std::chrono::duration<double, std::milli>(Clock::now() - frame_start).count();
-  return stats;
+  stats.wall_ms = std::chrono::duration<double, std::milli>(Clock::now() - frame->start).count();
+  return std::move(stats);
 }
 
 }  // namespace cohort::core
