@@ -1,6 +1,19 @@
 #include "cohort/commit/commit_buffer.h"
 
+#include <algorithm>
+#include <stdexcept>
+#include <string>
+
 namespace cohort::commit {
+
+size_t BlasUpload::bytes() const {
+  return kRecordHeaderBytes + sizeof(blas) + 3 * sizeof(uint32_t) + vertices.size() * sizeof(KVertex) +
+         triangles.size() * sizeof(KTriangle) + nodes.size() * sizeof(KBvhNode);
+}
+
+size_t TextureUpload::bytes() const {
+  return kRecordHeaderBytes + sizeof(texture) + texels.size() * sizeof(uint32_t);
+}
 
 CommitBuffer CommitBuffer::full(std::shared_ptr<const TracerScene> scene, uint64_t frame) {
   CommitBuffer c;
@@ -9,11 +22,177 @@ CommitBuffer CommitBuffer::full(std::shared_ptr<const TracerScene> scene, uint64
   return c;
 }
 
+template <class T>
+void CommitBuffer::set_element(std::map<uint32_t, T>& map, std::optional<uint32_t>& count, uint32_t index,
+                               const T& value) {
+  auto [it, inserted] = map.insert_or_assign(index, value);
+  if (inserted) bytes_ += kRecordHeaderBytes + sizeof(T);
+}
+
+template <class T>
+void CommitBuffer::set_count(std::map<uint32_t, T>& map, std::optional<uint32_t>& count, uint32_t new_count) {
+  if (!count) bytes_ += kRecordHeaderBytes;
+  count = new_count;
+  // Writes past the new end are dead: the array was shrunk after them.
+  for (auto it = map.lower_bound(new_count); it != map.end();) {
+    bytes_ -= kRecordHeaderBytes + sizeof(T);
+    it = map.erase(it);
+  }
+}
+
+void CommitBuffer::set_instance_count(uint32_t count) { set_count(instances_, instance_count_, count); }
+void CommitBuffer::set_instance(uint32_t index, const KInstance& v) { set_element(instances_, instance_count_, index, v); }
+void CommitBuffer::set_light_count(uint32_t count) { set_count(lights_, light_count_, count); }
+void CommitBuffer::set_light(uint32_t index, const KLight& v) { set_element(lights_, light_count_, index, v); }
+void CommitBuffer::set_material_count(uint32_t count) { set_count(materials_, material_count_, count); }
+void CommitBuffer::set_material(uint32_t index, const KMaterial& v) { set_element(materials_, material_count_, index, v); }
+
+void CommitBuffer::set_tlas(std::vector<KBvhNode> nodes) {
+  bytes_ -= tlas_ ? kRecordHeaderBytes + tlas_->size() * sizeof(KBvhNode) : 0;
+  bytes_ += kRecordHeaderBytes + nodes.size() * sizeof(KBvhNode);
+  tlas_ = std::move(nodes);
+}
+
+void CommitBuffer::add_blas(BlasUpload upload) {
+  bytes_ += upload.bytes();
+  blas_uploads_.push_back(std::move(upload));
+}
+
+void CommitBuffer::add_texture(TextureUpload upload) {
+  // A texture re-defined before the tracer saw the first version: only the last one matters, but its
+  // texels may live at a different offset, so both stay unless they are the same slot and range.
+  for (auto& earlier : texture_uploads_) {
+    if (earlier.texture_index == upload.texture_index && earlier.texture.offset == upload.texture.offset &&
+        earlier.texels.size() == upload.texels.size()) {
+      bytes_ -= earlier.bytes();
+      bytes_ += upload.bytes();
+      earlier = std::move(upload);
+      return;
+    }
+  }
+  bytes_ += upload.bytes();
+  texture_uploads_.push_back(std::move(upload));
+}
+
+void CommitBuffer::set_camera(const KCamera& camera) {
+  if (!camera_) bytes_ += kRecordHeaderBytes + sizeof(KCamera);
+  camera_ = camera;
+}
+
+size_t CommitBuffer::record_count() const {
+  return (instance_count_ ? 1 : 0) + instances_.size() + (tlas_ ? 1 : 0) + (light_count_ ? 1 : 0) + lights_.size() +
+         (material_count_ ? 1 : 0) + materials_.size() + blas_uploads_.size() + texture_uploads_.size() +
+         (camera_ ? 1 : 0);
+}
+
+void CommitBuffer::clear() {
+  full_.reset();
+  instance_count_.reset();
+  light_count_.reset();
+  material_count_.reset();
+  instances_.clear();
+  lights_.clear();
+  materials_.clear();
+  tlas_.reset();
+  blas_uploads_.clear();
+  texture_uploads_.clear();
+  camera_.reset();
+  bytes_ = 0;
+}
+
+void CommitBuffer::reset_to_full(std::shared_ptr<const TracerScene> scene, uint64_t frame) {
+  clear();
+  full_ = std::move(scene);
+  frame_ = frame;
+}
+
+void CommitBuffer::merge(const CommitBuffer& later) {
+  if (later.is_full_resync()) {
+    *this = later;
+    return;
+  }
+  // Counts before elements: a shrink drops earlier writes past the end, later writes then land.
+  if (later.instance_count_) set_instance_count(*later.instance_count_);
+  for (const auto& [i, v] : later.instances_) set_instance(i, v);
+  if (later.tlas_) set_tlas(*later.tlas_);
+  if (later.light_count_) set_light_count(*later.light_count_);
+  for (const auto& [i, v] : later.lights_) set_light(i, v);
+  if (later.material_count_) set_material_count(*later.material_count_);
+  for (const auto& [i, v] : later.materials_) set_material(i, v);
+  for (const auto& upload : later.blas_uploads_) add_blas(upload);
+  for (const auto& upload : later.texture_uploads_) add_texture(upload);
+  if (later.camera_) set_camera(*later.camera_);
+  frame_ = later.frame_;
+}
+
+namespace {
+
+template <class T>
+void write_range(std::vector<T>& pool, uint32_t offset, const std::vector<T>& values) {
+  if (values.empty()) return;
+  size_t end = size_t(offset) + values.size();
+  if (pool.size() < end) pool.resize(end);
+  std::copy(values.begin(), values.end(), pool.begin() + offset);
+}
+
+template <class T>
+bool apply_elements(std::vector<T>& array, const std::optional<uint32_t>& count,
+                    const std::map<uint32_t, T>& elements, const char* what) {
+  bool changed = false;
+  if (count && *count != array.size()) {
+    array.resize(*count);
+    changed = true;
+  }
+  for (const auto& [index, value] : elements) {
+    if (index >= array.size())
+      throw std::invalid_argument(std::string("commit writes ") + what + " " + std::to_string(index) +
+                                  " but the tracer scene has only " + std::to_string(array.size()));
+    array[index] = value;
+    changed = true;
+  }
+  return changed;
+}
+
+}  // namespace
+
 ChangeSet apply_commit(const CommitBuffer& commit, TracerScene& scene) {
   ChangeSet changes;
   if (commit.is_full_resync()) {
     scene = *commit.full_scene();
     changes.full_resync = true;
+  }
+  if (!commit.blas_uploads().empty()) {
+    changes.geometry = true;
+    changes.vertices_from = scene.vertices.size();
+    changes.triangles_from = scene.triangles.size();
+    changes.blas_nodes_from = scene.blas_nodes.size();
+    changes.blases_from = scene.blases.size();
+    for (const BlasUpload& up : commit.blas_uploads()) {
+      changes.vertices_from = std::min<size_t>(changes.vertices_from, up.vertex_offset);
+      changes.triangles_from = std::min<size_t>(changes.triangles_from, up.triangle_offset);
+      changes.blas_nodes_from = std::min<size_t>(changes.blas_nodes_from, up.node_offset);
+      changes.blases_from = std::min<size_t>(changes.blases_from, up.blas_index);
+      write_range(scene.vertices, up.vertex_offset, up.vertices);
+      write_range(scene.triangles, up.triangle_offset, up.triangles);
+      write_range(scene.blas_nodes, up.node_offset, up.nodes);
+      write_range(scene.blases, up.blas_index, std::vector<KBlas>{up.blas});
+    }
+  }
+  changes.instances = apply_elements(scene.instances, commit.instance_count(), commit.instances(), "instance");
+  if (commit.tlas()) {
+    scene.tlas_nodes = *commit.tlas();
+    changes.tlas = true;
+  }
+  changes.lights = apply_elements(scene.lights, commit.light_count(), commit.lights(), "light");
+  changes.materials = apply_elements(scene.materials, commit.material_count(), commit.materials(), "material");
+  for (const TextureUpload& up : commit.texture_uploads()) {
+    write_range(scene.textures, up.texture_index, std::vector<KTexture>{up.texture});
+    write_range(scene.texels, up.texture.offset, up.texels);
+    changes.textures = true;
+  }
+  if (commit.camera()) {
+    scene.camera = *commit.camera();
+    changes.camera = true;
   }
   scene.version = commit.frame();
   return changes;

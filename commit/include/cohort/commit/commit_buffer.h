@@ -1,16 +1,55 @@
 // A commit buffer carries what changed in the scene since the frame a tracer last applied. The core
 // fills one per tracer for frame N+1 while the tracer renders frame N from its own copy (Brigade,
-// Fig. 7-8). The simplest commit is a full resync: the whole TracerScene.
+// Fig. 7-8). The simplest commit is a full resync: the whole TracerScene; the usual one is a handful of
+// incremental records (instance transforms, new BLASes, the new TLAS, lights, materials, new textures,
+// the camera).
+//
+// Records coalesce: writing the same element twice keeps only the last value, so a buffer that
+// accumulates several frames (a tracer that skipped frames) stays as small as the set of elements that
+// changed, and applying it gives the same TracerScene as applying every frame's commit in turn.
 #pragma once
 
+#include <cstddef>
+#include <cstdint>
+#include <map>
 #include <memory>
+#include <optional>
+#include <vector>
 
 #include "cohort/commit/tracer_scene.h"
 
 namespace cohort::commit {
 
+// A new BLAS: its nodes, its triangles (leaf order, absolute vertex indices) and the vertices they
+// use, written at the given offsets of the tracer's geometry pools (appended at the end normally).
+struct BlasUpload {
+  uint32_t blas_index = 0;
+  KBlas blas{};
+  uint32_t vertex_offset = 0;
+  std::vector<KVertex> vertices;
+  uint32_t triangle_offset = 0;
+  std::vector<KTriangle> triangles;
+  uint32_t node_offset = 0;
+  std::vector<KBvhNode> nodes;
+  size_t bytes() const;
+};
+
+// A new or replaced texture and its texels (all mip levels) at texel_offset.
+struct TextureUpload {
+  uint32_t texture_index = 0;
+  KTexture texture{};
+  std::vector<uint32_t> texels;   // written at texture.offset
+  size_t bytes() const;
+};
+
+// Per-record framing cost counted in CommitStats::bytes, as if the records were sent over a wire:
+// a 4-byte type and a 4-byte index or count.
+constexpr size_t kRecordHeaderBytes = 8;
+
 class CommitBuffer {
  public:
+  CommitBuffer() = default;
+
   // A commit that replaces the tracer's whole scene.
   static CommitBuffer full(std::shared_ptr<const TracerScene> scene, uint64_t frame);
 
@@ -18,12 +57,66 @@ class CommitBuffer {
   uint64_t frame() const { return frame_; }
   const TracerScene* full_scene() const { return full_.get(); }
 
+  // ---- Filling (the core side). Each call replaces any earlier record for the same element. ----
+  void set_frame(uint64_t frame) { frame_ = frame; }
+  // Resize an array; elements past the old end must then be written with set_*.
+  void set_instance_count(uint32_t count);
+  void set_instance(uint32_t index, const KInstance& instance);
+  void set_tlas(std::vector<KBvhNode> nodes);
+  void set_light_count(uint32_t count);
+  void set_light(uint32_t index, const KLight& light);
+  void set_material_count(uint32_t count);
+  void set_material(uint32_t index, const KMaterial& material);
+  void add_blas(BlasUpload upload);
+  void add_texture(TextureUpload upload);
+  void set_camera(const KCamera& camera);
+
+  // Fold a later commit into this one (the later one wins where both write an element). A full
+  // resync in `later` replaces everything here.
+  void merge(const CommitBuffer& later);
+  // Drop every record and become a full resync to `scene` (the budget overflowed).
+  void reset_to_full(std::shared_ptr<const TracerScene> scene, uint64_t frame);
+  // Drop everything (the buffer is reused for the next frame).
+  void clear();
+
+  // Incremental records only (a full resync's scene is shared, not counted).
+  size_t bytes() const { return bytes_; }
+  size_t record_count() const;
+  bool empty() const { return !is_full_resync() && record_count() == 0; }
+
+  // ---- Reading (apply_commit, tests, tools). ----
+  const std::optional<uint32_t>& instance_count() const { return instance_count_; }
+  const std::map<uint32_t, KInstance>& instances() const { return instances_; }
+  const std::optional<std::vector<KBvhNode>>& tlas() const { return tlas_; }
+  const std::optional<uint32_t>& light_count() const { return light_count_; }
+  const std::map<uint32_t, KLight>& lights() const { return lights_; }
+  const std::optional<uint32_t>& material_count() const { return material_count_; }
+  const std::map<uint32_t, KMaterial>& materials() const { return materials_; }
+  const std::vector<BlasUpload>& blas_uploads() const { return blas_uploads_; }
+  const std::vector<TextureUpload>& texture_uploads() const { return texture_uploads_; }
+  const std::optional<KCamera>& camera() const { return camera_; }
+
  private:
+  template <class T> void set_element(std::map<uint32_t, T>& map, std::optional<uint32_t>& count, uint32_t index,
+                                      const T& value);
+  template <class T> void set_count(std::map<uint32_t, T>& map, std::optional<uint32_t>& count, uint32_t new_count);
+
   std::shared_ptr<const TracerScene> full_;
   uint64_t frame_ = 0;
+  std::optional<uint32_t> instance_count_, light_count_, material_count_;
+  std::map<uint32_t, KInstance> instances_;
+  std::map<uint32_t, KLight> lights_;
+  std::map<uint32_t, KMaterial> materials_;
+  std::optional<std::vector<KBvhNode>> tlas_;
+  std::vector<BlasUpload> blas_uploads_;
+  std::vector<TextureUpload> texture_uploads_;
+  std::optional<KCamera> camera_;
+  size_t bytes_ = 0;
 };
 
-// Apply a commit to a tracer's scene copy; says what changed.
+// Apply a commit to a tracer's scene copy; says what changed. Throws std::invalid_argument when a
+// record does not fit the scene (an element index past the array's end), leaving `scene` partly
+// updated: the caller must then ask for a full resync.
 ChangeSet apply_commit(const CommitBuffer& commit, TracerScene& scene);
 
 }  // namespace cohort::commit

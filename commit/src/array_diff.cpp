@@ -1,0 +1,71 @@
+#include "cohort/commit/array_diff.h"
+
+#include <cstring>
+#include <string>
+
+namespace cohort::commit {
+namespace {
+
+template <class T>
+bool same_bytes(const T& a, const T& b) {
+  return std::memcmp(&a, &b, sizeof(T)) == 0;
+}
+
+template <class T, class SetCount, class Set>
+void diff_array(const std::vector<T>& before, const std::vector<T>& after, SetCount set_count, Set set) {
+  if (before.size() != after.size()) set_count(static_cast<uint32_t>(after.size()));
+  for (size_t i = 0; i < after.size(); ++i)
+    if (i >= before.size() || !same_bytes(before[i], after[i])) set(static_cast<uint32_t>(i), after[i]);
+}
+
+template <class T>
+bool same_array(const std::vector<T>& a, const std::vector<T>& b, const char* name, std::string* where) {
+  if (a.size() != b.size()) {
+    if (where) *where = std::string(name) + ".size() " + std::to_string(a.size()) + " vs " + std::to_string(b.size());
+    return false;
+  }
+  for (size_t i = 0; i < a.size(); ++i) {
+    if (!same_bytes(a[i], b[i])) {
+      if (where) *where = std::string(name) + "[" + std::to_string(i) + "]";
+      return false;
+    }
+  }
+  return true;
+}
+
+}  // namespace
+
+void diff_instances(const std::vector<KInstance>& before, const std::vector<KInstance>& after, CommitBuffer& out) {
+  diff_array(before, after, [&](uint32_t n) { out.set_instance_count(n); },
+             [&](uint32_t i, const KInstance& v) { out.set_instance(i, v); });
+}
+
+void diff_lights(const std::vector<KLight>& before, const std::vector<KLight>& after, CommitBuffer& out) {
+  diff_array(before, after, [&](uint32_t n) { out.set_light_count(n); },
+             [&](uint32_t i, const KLight& v) { out.set_light(i, v); });
+}
+
+void diff_materials(const std::vector<KMaterial>& before, const std::vector<KMaterial>& after, CommitBuffer& out) {
+  diff_array(before, after, [&](uint32_t n) { out.set_material_count(n); },
+             [&](uint32_t i, const KMaterial& v) { out.set_material(i, v); });
+}
+
+void diff_tlas(const std::vector<KBvhNode>& before, const std::vector<KBvhNode>& after, CommitBuffer& out) {
+  if (!same_array(before, after, "tlas", nullptr)) out.set_tlas(after);
+}
+
+bool same_tracer_scene(const TracerScene& a, const TracerScene& b, std::string* where) {
+  return same_array(a.vertices, b.vertices, "vertices", where) &&
+         same_array(a.triangles, b.triangles, "triangles", where) &&
+         same_array(a.blas_nodes, b.blas_nodes, "blas_nodes", where) &&
+         same_array(a.blases, b.blases, "blases", where) &&
+         same_array(a.instances, b.instances, "instances", where) &&
+         same_array(a.tlas_nodes, b.tlas_nodes, "tlas_nodes", where) &&
+         same_array(a.materials, b.materials, "materials", where) &&
+         same_array(a.textures, b.textures, "textures", where) &&
+         same_array(a.texels, b.texels, "texels", where) &&
+         same_array(a.lights, b.lights, "lights", where) &&
+         same_array(std::vector<KCamera>{a.camera}, std::vector<KCamera>{b.camera}, "camera", where);
+}
+
+}  // namespace cohort::commit

@@ -1,0 +1,286 @@
+#include "cohort/scene/render_world.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include <fmt/format.h>
+
+namespace cohort::scene {
+namespace {
+
+template <class T>
+int lowest_free(std::vector<std::optional<T>>& slots, const char* what) {
+  auto it = std::find_if(slots.begin(), slots.end(), [](const auto& s) { return !s.has_value(); });
+  if (it != slots.end()) return static_cast<int>(it - slots.begin());
+  if (slots.size() >= size_t(kMaxHandles))
+    throw RenderWorldError(fmt::format("Add{}Def: all {} handles are in use", what, kMaxHandles));
+  slots.emplace_back();
+  return static_cast<int>(slots.size() - 1);
+}
+
+template <class T>
+T& live(std::vector<std::optional<T>>& slots, int handle, const char* call) {
+  if (handle < 0 || size_t(handle) >= slots.size() || !slots[handle])
+    throw RenderWorldError(fmt::format("{}: handle {} is not a live def", call, handle));
+  return *slots[handle];
+}
+
+bool finite(const glm::vec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
+bool finite(const glm::mat3& m) { return finite(m[0]) && finite(m[1]) && finite(m[2]); }
+
+}  // namespace
+
+RenderEntity render_entity_from(const Entity& entity) {
+  RenderEntity def;
+  def.model = entity.mesh;
+  def.origin = entity.origin;
+  def.axis = entity.axis;
+  def.no_shadows = entity.no_shadows;
+  return def;
+}
+
+RenderLight render_light_from(const Light& light) {
+  RenderLight def;
+  def.origin = light.origin;
+  def.axis = light.axis;
+  def.point_light = light.type != LightType::Projected;
+  def.parallel = light.type == LightType::Parallel;
+  def.radius = light.radius;
+  def.center = light.center;
+  def.target = light.target;
+  def.right = light.right;
+  def.up = light.up;
+  def.start = light.start;
+  def.end = light.end;
+  def.has_start_end = light.has_start_end;
+  def.shader = light.material;
+  std::copy(std::begin(light.shader_parms), std::end(light.shader_parms), def.shader_parms);
+  // _color is what the engine puts in shader parms 0-2.
+  def.shader_parms[kShaderParmRed] = light.color.r;
+  def.shader_parms[kShaderParmGreen] = light.color.g;
+  def.shader_parms[kShaderParmBlue] = light.color.b;
+  def.no_shadows = light.no_shadows;
+  def.no_specular = light.no_specular;
+  return def;
+}
+
+RenderWorld::RenderWorld(Scene scene) : scene_(std::move(scene)) {
+  for (const Entity& e : scene_.entities) {
+    entities_.emplace_back(render_entity_from(e));
+    entity_names_.push_back(e.name);
+  }
+  for (const Light& l : scene_.lights) {
+    lights_.emplace_back(render_light_from(l));
+    light_names_.push_back(l.name);
+  }
+}
+
+RenderEntity RenderWorld::resolved(const RenderEntity& entity) const {
+  RenderEntity def = entity;
+  if (!def.model_name.empty()) {
+    def.model = scene_.find_mesh(def.model_name);
+    if (def.model < 0) throw RenderWorldError(fmt::format("entity def: no model named '{}'", def.model_name));
+  } else if (def.model < -1 || def.model >= int(scene_.meshes.size())) {
+    throw RenderWorldError(fmt::format("entity def: model {} out of range (the scene has {} meshes)", def.model,
+                                       scene_.meshes.size()));
+  }
+  if (def.custom_shader < -1 || def.custom_shader >= int(scene_.materials.size()))
+    throw RenderWorldError(fmt::format("entity def: custom shader {} out of range ({} materials)", def.custom_shader,
+                                       scene_.materials.size()));
+  if (!finite(def.origin) || !finite(def.axis)) throw RenderWorldError("entity def: origin or axis is not finite");
+  def.model_name.clear();  // the state holds the resolved index only
+  return def;
+}
+
+RenderLight RenderWorld::resolved(const RenderLight& light) const {
+  RenderLight def = light;
+  if (!def.shader_name.empty()) {
+    def.shader = scene_.find_material(def.shader_name);
+    if (def.shader < 0) throw RenderWorldError(fmt::format("light def: no light shader named '{}'", def.shader_name));
+  } else if (def.shader < -1 || def.shader >= int(scene_.materials.size())) {
+    throw RenderWorldError(fmt::format("light def: shader {} out of range ({} materials)", def.shader,
+                                       scene_.materials.size()));
+  }
+  if (!finite(def.origin) || !finite(def.axis) || !finite(def.radius) || !finite(def.center) ||
+      !finite(def.target) || !finite(def.right) || !finite(def.up) || !finite(def.start) || !finite(def.end))
+    throw RenderWorldError("light def: a vector is not finite");
+  def.shader_name.clear();
+  return def;
+}
+
+int RenderWorld::AddEntityDef(const RenderEntity& entity) {
+  RenderEntity def = resolved(entity);
+  int handle = lowest_free(entities_, "Entity");
+  entities_[handle] = std::move(def);
+  changes_.entities.insert(handle);
+  return handle;
+}
+
+void RenderWorld::UpdateEntityDef(int handle, const RenderEntity& entity) {
+  RenderEntity def = resolved(entity);
+  live(entities_, handle, "UpdateEntityDef") = std::move(def);
+  changes_.entities.insert(handle);
+}
+
+void RenderWorld::FreeEntityDef(int handle) {
+  live(entities_, handle, "FreeEntityDef");
+  entities_[handle].reset();
+  if (size_t(handle) < entity_names_.size()) entity_names_[handle].clear();
+  changes_.entities.erase(handle);
+  changes_.freed_entities.insert(handle);
+}
+
+int RenderWorld::AddLightDef(const RenderLight& light) {
+  RenderLight def = resolved(light);
+  int handle = lowest_free(lights_, "Light");
+  lights_[handle] = std::move(def);
+  changes_.lights.insert(handle);
+  return handle;
+}
+
+void RenderWorld::UpdateLightDef(int handle, const RenderLight& light) {
+  RenderLight def = resolved(light);
+  live(lights_, handle, "UpdateLightDef") = std::move(def);
+  changes_.lights.insert(handle);
+}
+
+void RenderWorld::FreeLightDef(int handle) {
+  live(lights_, handle, "FreeLightDef");
+  lights_[handle].reset();
+  if (size_t(handle) < light_names_.size()) light_names_[handle].clear();
+  changes_.lights.erase(handle);
+  changes_.freed_lights.insert(handle);
+}
+
+int RenderWorld::DefineMaterial(const Material& material) {
+  auto image_ok = [&](int i) { return i >= -1 && i < int(scene_.images.size()); };
+  for (int i : {material.diffuse_image, material.normal_image, material.specular_image, material.emissive_image,
+                material.light_image, material.falloff_image})
+    if (!image_ok(i))
+      throw RenderWorldError(fmt::format("DefineMaterial '{}': image {} out of range ({} images)", material.name, i,
+                                         scene_.images.size()));
+  int index = scene_.find_material(material.name);
+  if (index < 0) {
+    if (scene_.materials.size() >= size_t(kMaxHandles)) throw RenderWorldError("DefineMaterial: too many materials");
+    index = int(scene_.materials.size());
+    scene_.materials.push_back(material);
+  } else {
+    scene_.materials[index] = material;
+  }
+  changes_.materials.insert(index);
+  return index;
+}
+
+int RenderWorld::DefineTexture(const Image& image) {
+  if (image.width <= 0 || image.height <= 0 ||
+      image.rgba.size() != size_t(image.width) * size_t(image.height) * 4)
+    throw RenderWorldError(fmt::format("DefineTexture '{}': {}x{} needs {} bytes of RGBA, got {}", image.name,
+                                       image.width, image.height, size_t(std::max(image.width, 0)) *
+                                       size_t(std::max(image.height, 0)) * 4, image.rgba.size()));
+  auto it = std::find_if(scene_.images.begin(), scene_.images.end(),
+                         [&](const Image& i) { return i.name == image.name; });
+  int index = int(it - scene_.images.begin());
+  if (it == scene_.images.end()) {
+    if (scene_.images.size() >= size_t(kMaxHandles)) throw RenderWorldError("DefineTexture: too many textures");
+    scene_.images.push_back(image);
+  } else {
+    *it = image;
+  }
+  changes_.textures.insert(index);
+  return index;
+}
+
+int RenderWorld::DefineModel(const Mesh& mesh) {
+  if (mesh.indices.size() % 3 != 0)
+    throw RenderWorldError(fmt::format("DefineModel '{}': {} indices is not whole triangles", mesh.name,
+                                       mesh.indices.size()));
+  for (uint32_t i : mesh.indices)
+    if (i >= mesh.vertices.size())
+      throw RenderWorldError(fmt::format("DefineModel '{}': index {} past its {} vertices", mesh.name, i,
+                                         mesh.vertices.size()));
+  for (const Surface& s : mesh.surfaces) {
+    if (s.material < -1 || s.material >= int(scene_.materials.size()))
+      throw RenderWorldError(fmt::format("DefineModel '{}': surface material {} out of range", mesh.name, s.material));
+    if (size_t(s.first_index) + s.index_count > mesh.indices.size())
+      throw RenderWorldError(fmt::format("DefineModel '{}': a surface runs past the index list", mesh.name));
+  }
+  int index = scene_.find_mesh(mesh.name);
+  if (index < 0) {
+    if (scene_.meshes.size() >= size_t(kMaxHandles)) throw RenderWorldError("DefineModel: too many models");
+    index = int(scene_.meshes.size());
+    scene_.meshes.push_back(mesh);
+  } else {
+    scene_.meshes[index] = mesh;
+  }
+  changes_.models.insert(index);
+  return index;
+}
+
+void RenderWorld::RenderScene(const RenderView& view) {
+  if (!finite(view.origin) || !finite(view.axis) || !(view.fov_x > 0.0f && view.fov_x < 180.0f) ||
+      !(view.fov_y > 0.0f && view.fov_y < 180.0f))
+    throw RenderWorldError(fmt::format("RenderScene: bad view (fov {} x {}, or a non-finite origin/axis)", view.fov_x,
+                                       view.fov_y));
+  view_ = view;
+  changes_.view = true;
+}
+
+void RenderWorld::EndFrame() {
+  ++frames_ended_;
+  ++changes_.frames_ended;
+}
+
+const RenderEntity* RenderWorld::EntityDef(int handle) const {
+  if (handle < 0 || size_t(handle) >= entities_.size() || !entities_[handle]) return nullptr;
+  return &*entities_[handle];
+}
+
+const RenderLight* RenderWorld::LightDef(int handle) const {
+  if (handle < 0 || size_t(handle) >= lights_.size() || !lights_[handle]) return nullptr;
+  return &*lights_[handle];
+}
+
+int RenderWorld::FindEntityDef(const std::string& name) const {
+  for (size_t i = 0; i < entity_names_.size(); ++i)
+    if (entity_names_[i] == name && entities_[i]) return int(i);
+  return -1;
+}
+
+int RenderWorld::FindLightDef(const std::string& name) const {
+  for (size_t i = 0; i < light_names_.size(); ++i)
+    if (light_names_[i] == name && lights_[i]) return int(i);
+  return -1;
+}
+
+ChangeLog RenderWorld::TakeChanges() {
+  ChangeLog taken = std::move(changes_);
+  changes_ = {};
+  return taken;
+}
+
+Light RenderWorld::scene_light(int handle) const {
+  const RenderLight* def = LightDef(handle);
+  if (!def) throw RenderWorldError(fmt::format("scene_light: handle {} is not a live light def", handle));
+  Light light;
+  if (size_t(handle) < light_names_.size()) light.name = light_names_[handle];
+  light.type = def->parallel ? LightType::Parallel : def->point_light ? LightType::Point : LightType::Projected;
+  light.origin = def->origin;
+  light.axis = def->axis;
+  light.radius = def->radius;
+  light.center = def->center;
+  light.color = {def->shader_parms[kShaderParmRed], def->shader_parms[kShaderParmGreen],
+                 def->shader_parms[kShaderParmBlue]};
+  light.target = def->target;
+  light.right = def->right;
+  light.up = def->up;
+  light.start = def->start;
+  light.end = def->end;
+  light.has_start_end = def->has_start_end;
+  light.material = def->shader;
+  std::copy(std::begin(def->shader_parms), std::end(def->shader_parms), light.shader_parms);
+  light.no_shadows = def->no_shadows;
+  light.no_specular = def->no_specular;
+  return light;
+}
+
+}  // namespace cohort::scene
