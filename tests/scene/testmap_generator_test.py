@@ -238,6 +238,19 @@ class GeneratorChecks(unittest.TestCase):
         with self.assertRaises(self.checks.CheckError):
             self.checks.check_winding(self.broken(flip))
 
+    def test_inside_out_wall_is_rejected(self):
+        from testmap.bsp import build_nodes
+        nodes = build_nodes(self.grid)
+        self.checks.check_shell_faces_air(self.meshes, nodes)
+
+        def invert(meshes):
+            tris = meshes[0].surfaces["textures/testmap/floor_tiles"]
+            a, b, c = tris[0]
+            flipped = tuple(-x for x in a[2])
+            tris[0] = [(a[0], a[1], flipped), (c[0], c[1], flipped), (b[0], b[1], flipped)]
+        with self.assertRaises(self.checks.CheckError):
+            self.checks.check_shell_faces_air(self.broken(invert), nodes)
+
     def test_node_tree_rejects_wrong_area(self):
         from testmap.bsp import build_nodes
         nodes = build_nodes(self.grid)
@@ -275,6 +288,15 @@ class Textures(unittest.TestCase):
             for p in pixels[::97]:
                 n = [(c / 255.0) * 2 - 1 for c in p[:3]]
                 self.assertAlmostEqual(sum(c * c for c in n), 1.0, delta=0.03)
+
+    def test_normal_map_y_follows_plus_t(self):
+        """Y = +t (down the rows), as the engine's heightmap(): where height rises going down the image
+        (top bevel of a brick) the normal leans to -Y (green below 128), and the other way at the bottom."""
+        w, h, _, rows = self.load("textures/testmap/bricks_local.tga")
+        top = [rows[y][x][1] for y in (2, 3, 4) for x in range(40, 50)]
+        bottom = [rows[y][x][1] for y in (27, 28, 29) for x in range(40, 50)]
+        self.assertLess(sum(top) / len(top), 110)
+        self.assertGreater(sum(bottom) / len(bottom), 146)
 
     def test_gel_is_colourful_and_falloff_fades(self):
         w, h, _, rows = self.load("lights/testmap_gel.tga")
