@@ -13,6 +13,7 @@ jobs=${JOBS:-2}
 command -v clang++ >/dev/null || { echo "fuzz.sh: clang++ is needed for libFuzzer" >&2; exit 3; }
 cmake -S . -B build/fuzz -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo \
   -DCMAKE_C_COMPILER=clang -DCMAKE_CXX_COMPILER=clang++ -DCOHORT_FUZZERS=ON -DCOHORT_BUILD_TESTS=OFF \
+  -DCMAKE_CXX_FLAGS="-fsanitize=fuzzer-no-link,address,undefined -fno-sanitize-recover=undefined" \
   -DCOHORT_WITH_OIIO=OFF -DCOHORT_WITH_CUDA=OFF -DCOHORT_WITH_OPENCL=OFF -DCOHORT_WITH_EMBREE=OFF \
   -DCOHORT_WITH_VIEWER=OFF >/dev/null
 cmake --build build/fuzz -j"$jobs" --target $(for t in $targets; do printf 'cohort_fuzz_%s ' "$t"; done)
