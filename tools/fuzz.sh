@@ -18,13 +18,23 @@ cmake -S . -B build/fuzz -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo \
   -DCOHORT_WITH_VIEWER=OFF >/dev/null
 cmake --build build/fuzz -j"$jobs" --target $(for t in $targets; do printf 'cohort_fuzz_%s ' "$t"; done)
 
+# The generated test map's files are seeds too, when present.
+seeds_from_testmap() {
+  case "$1" in
+    proc|map) [ -d assets/testmap/maps ] && echo assets/testmap/maps ;;
+    mtr) [ -d assets/testmap/materials ] && echo assets/testmap/materials ;;
+    image) [ -d assets/testmap/lights ] && echo assets/testmap/lights ;;
+  esac
+  return 0
+}
+
 status=0
 for t in $targets; do
   mkdir -p "build/fuzz/corpus/$t" "build/fuzz/artifacts/$t"
   echo "== fuzzing $t for ${seconds}s"
   if ! "build/fuzz/bin/cohort_fuzz_$t" -max_total_time="$seconds" -timeout=10 -rss_limit_mb=2048 \
        -max_len=65536 -print_final_stats=1 -artifact_prefix="build/fuzz/artifacts/$t/" \
-       "build/fuzz/corpus/$t" "scene/fuzz/corpus/$t" 2>"build/fuzz/$t.log"; then
+       "build/fuzz/corpus/$t" "scene/fuzz/corpus/$t" $(seeds_from_testmap "$t") 2>"build/fuzz/$t.log"; then
     echo "!! $t: fuzzer found a failure; see build/fuzz/$t.log and build/fuzz/artifacts/$t/" >&2
     tail -40 "build/fuzz/$t.log" >&2
     status=1
