@@ -284,7 +284,7 @@ class GeneratorChecks(unittest.TestCase):
         from testmap.shell import Grid, build_shell
         cls.checks = checks
         cls.grid = Grid(layout.AREAS, layout.SOLIDS)
-        cls.meshes, faces = build_shell(cls.grid, layout.material_for)
+        cls.meshes, faces = build_shell(cls.grid, layout.material_for, layout.texel_scale_for)
         cls.portals = merge_portals(faces)
 
     def broken(self, mutate):
