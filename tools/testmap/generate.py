@@ -11,7 +11,7 @@ from .tga import encode_tga
 
 def build():
     grid = Grid(layout.AREAS, layout.SOLIDS)
-    area_meshes, portal_faces = build_shell(grid, layout.material_for)
+    area_meshes, portal_faces = build_shell(grid, layout.material_for, layout.texel_scale_for)
     portals = merge_portals(portal_faces)
     layout.add_details(area_meshes)
     models = layout.inline_models()
