@@ -139,14 +139,16 @@ TEST(CudaScenePack, PackedSceneMatchesEmbree) {
     scene = core::compile_scene(test_room()).tracer_scene;
     cam = test_room_camera(w, h);
   }
-  KFrameParams params = frame_params(K_MODE_PATH, 16, 1, h);
+  // 64 spp: on the full map (8 lights, textures, glass) a few samples per thousand take another path
+  // on the GPU (fused multiply-adds shift a light pick or a Russian roulette decision); at 16 spp those
+  // alone came to 0.5% RMSE, at 64 they average down below the bound.
+  KFrameParams params = frame_params(K_MODE_PATH, 64, 1, h);
   params.frame_index = 3;
   auto embree = make_test_tracer("embree");
   auto cuda = make_test_tracer("cuda");
   core::FrameBuffer a = render_scene(*embree, scene, cam, params);
   core::FrameBuffer b = render_scene(*cuda, scene, cam, params);
-  // On the full map at 16 spp a handful of paths diverge (one pixel in 9216 was seen to); compared in
-  // the displayable range the bound is the same 0.5% as everywhere else.
+  // Compared in the displayable range, with the same 0.5% bound as everywhere else.
   double error = relative_rmse(a, b, 1.0);
   std::cout << (pack_file ? pack_file : "test room") << ": relative RMSE embree/cuda (clamped at 1) " << error
             << ", unclamped " << relative_rmse(a, b) << "\n";
