@@ -276,6 +276,15 @@ class Textures(unittest.TestCase):
                 n = [(c / 255.0) * 2 - 1 for c in p[:3]]
                 self.assertAlmostEqual(sum(c * c for c in n), 1.0, delta=0.03)
 
+    def test_normal_map_y_follows_plus_t(self):
+        """Y = +t (down the rows), as the engine's heightmap(): where height rises going down the image
+        (top bevel of a brick) the normal leans to -Y (green below 128), and the other way at the bottom."""
+        w, h, _, rows = self.load("textures/testmap/bricks_local.tga")
+        top = [rows[y][x][1] for y in (2, 3, 4) for x in range(40, 50)]
+        bottom = [rows[y][x][1] for y in (27, 28, 29) for x in range(40, 50)]
+        self.assertLess(sum(top) / len(top), 110)
+        self.assertGreater(sum(bottom) / len(bottom), 146)
+
     def test_gel_is_colourful_and_falloff_fades(self):
         w, h, _, rows = self.load("lights/testmap_gel.tga")
         colours = {tuple(c // 64 for c in p[:3]) for row in rows for p in row}

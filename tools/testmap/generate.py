@@ -59,6 +59,8 @@ def build():
         "lights_parallel": sum(1 for l in lights if "parallel" in l),
         "entities": [(classname, dict(keys)["name"]) for classname, keys in ents],
         "area_names": [a.name for a in layout.AREAS],
+        "area_boxes": [(a.name, a.lo, a.hi, layout.AREA_NOTES[a.name]) for a in layout.AREAS],
+        "views": layout.VIEWS,
     })
     files["README.md"] = readme_text(stats, lights, files).encode("utf-8")
     stats["bytes"] = sum(len(b) for b in files.values())
