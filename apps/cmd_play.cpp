@@ -31,6 +31,7 @@ struct PlayArgs {
   std::string tone = "aces";
   int frames = 0;            // 0: until the window closes
   std::string screenshot;    // written from the last frame
+  std::string window_shot;   // the last frame as the window showed it, HUD included
 };
 
 std::vector<std::string> default_bases() {
@@ -127,7 +128,7 @@ int run_play(PlayArgs a) {
   };
   const std::vector<std::string> balancers = balance::balancer_names();
 
-  viewer::Image8 frame_image, hud_layer;
+  viewer::Image8 frame_image, hud_layer, window_image;
   SessionFrame last;
   bool have_frame = false;
   int frames_done = 0;
@@ -238,10 +239,20 @@ int run_play(PlayArgs a) {
       if (hud_layer.width != fb_w || hud_layer.height != fb_h) hud_layer.resize(fb_w, fb_h);
       viewer::draw_hud(hud_layer, hud, fb_h >= 700 ? 2 : 1);
     }
-    window->present(frame_image, show_hud ? &hud_layer : nullptr);
-
     ++frames_done;
-    if (a.frames > 0 && frames_done >= a.frames) window->request_close();
+    const bool last_frame = a.frames > 0 && frames_done >= a.frames;
+    const bool read_back = last_frame && !a.window_shot.empty();
+    window->present(frame_image, show_hud ? &hud_layer : nullptr, read_back ? &window_image : nullptr);
+    if (last_frame) window->request_close();
+  }
+
+  if (!a.window_shot.empty() && window_image.width > 0) {
+    try {
+      core::write_ldr_image(a.window_shot, window_image.width, window_image.height, window_image.rgba);
+    } catch (const std::exception& e) {
+      std::cerr << "cohort play: " << e.what() << "\n";
+      return kExitFailure;
+    }
   }
 
   if (!a.screenshot.empty()) {
@@ -294,6 +305,8 @@ void add_play_command(CLI::App& app) {
       ->capture_default_str()
       ->check(CLI::NonNegativeNumber);
   cmd->add_option("--screenshot", a->screenshot, "write the last frame to this image file on exit");
+  cmd->add_option("--window-screenshot", a->window_shot, "with --frames: write what the window showed last (the "
+                                                         "frame scaled to the window, HUD included)");
   cmd->callback([a] {
 #ifdef COHORT_HAVE_VIEWER
     const int code = run_play(*a);

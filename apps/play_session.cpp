@@ -10,7 +10,10 @@
 #include "cohort/core/gpu_scene.h"
 #include "cohort/core/renderer.h"
 #include "cohort/core/tonemap.h"
+#if __has_include("cohort/core/world_sync.h")
 #include "cohort/core/world_sync.h"
+#define COHORT_PLAY_HAS_WORLD_SYNC 1
+#endif
 #include "cohort/scene/map_loader.h"
 #include "cohort/scene/render_world.h"
 #include "cohort/scene/scenario.h"
@@ -62,7 +65,9 @@ struct PlaySession::State {
   explicit State(scene::Scene loaded) : world(std::move(loaded)) {}
 
   scene::RenderWorld world;
+#ifdef COHORT_PLAY_HAS_WORLD_SYNC
   std::unique_ptr<core::WorldSync> sync;
+#endif
   std::unique_ptr<scene::Scenario> scenario;
   std::unique_ptr<core::Renderer> renderer;
   core::AdaptiveConvergence convergence;
@@ -78,16 +83,32 @@ PlaySession::PlaySession(const SessionOptions& options) {
   state_ = std::make_unique<State>(load_scene(options));
   State& s = *state_;
   s.map_name = s.world.scene().name.empty() ? options.map : s.world.scene().name;
+#ifdef COHORT_PLAY_HAS_WORLD_SYNC
   s.sync = std::make_unique<core::WorldSync>(s.world, core::compile_scene(s.world.scene()));
+  auto initial_scene = s.sync->snapshot();
+#else
+  auto initial_scene = std::make_shared<const commit::TracerScene>(core::compile_scene(s.world.scene()).tracer_scene);
+#endif
 
   const std::string list = options.tracers.empty() ? default_tracer_list() : options.tracers;
   std::vector<std::unique_ptr<core::Tracer>> tracers;
-  for (const TracerSpec& spec : parse_tracer_list(list)) {
+  auto did_not_start = [&](const std::string& what, const std::string& why) {
+    warnings_.push_back("tracer " + what + " did not start: " + why);
+    spdlog::warn("{}; carrying on with the others", warnings_.back());
+  };
+  for (const TracerSpec& asked : parse_tracer_list(list)) {
+    std::vector<TracerSpec> specs;
     try {
-      tracers.push_back(make_tracer(spec));
+      specs = expand_all_devices({asked});
     } catch (const std::exception& e) {
-      warnings_.push_back("tracer " + spec.text + " did not start: " + e.what());
-      spdlog::warn("{}; carrying on with the others", warnings_.back());
+      did_not_start(asked.text, e.what());
+    }
+    for (const TracerSpec& spec : specs) {
+      try {
+        tracers.push_back(make_tracer(spec));
+      } catch (const std::exception& e) {
+        did_not_start(spec.text, e.what());
+      }
     }
   }
   if (tracers.empty())
@@ -96,9 +117,17 @@ PlaySession::PlaySession(const SessionOptions& options) {
   core::RendererOptions renderer_options;
   renderer_options.balancer = options.balancer;
   s.renderer = std::make_unique<core::Renderer>(std::move(tracers), renderer_options);
-  s.renderer->submit_commit(commit::CommitBuffer::full(s.sync->snapshot(), 0));
+  s.renderer->submit_commit(commit::CommitBuffer::full(initial_scene, 0));
 
+#ifndef COHORT_PLAY_HAS_WORLD_SYNC
   if (options.scenario) {
+    warnings_.push_back("scenario off: this build has no core world sync (core/world_sync.h), the scene stays still");
+    spdlog::warn("{}", warnings_.back());
+  }
+  if (false) {
+#else
+  if (options.scenario) {
+#endif
     try {
       s.scenario = std::make_unique<scene::Scenario>(s.world);
     } catch (const scene::ScenarioError& e) {
@@ -140,8 +169,13 @@ SessionFrame PlaySession::frame(const viewer::FlyCamera& camera, double seconds,
   s.world.EndFrame();
 
   ++s.frame_index;
+#ifdef COHORT_PLAY_HAS_WORLD_SYNC
   const commit::CommitBuffer commit = s.sync->sync(s.world.TakeChanges(), s.frame_index);
   s.renderer->submit_commit(commit);
+#else
+  s.world.TakeChanges();
+  const commit::CommitBuffer commit;
+#endif
 
   core::BandJob job;
   job.camera = camera.to_kcamera(settings.width, settings.height);

@@ -3,6 +3,7 @@
 #define GLFW_INCLUDE_GLEXT
 #include <GLFW/glfw3.h>
 
+#include <algorithm>
 #include <cmath>
 #include <mutex>
 #include <type_traits>
@@ -323,7 +324,7 @@ int GlWindow::framebuffer_height() const {
   return h;
 }
 
-void GlWindow::present(const Image8& frame, const Image8* hud) {
+void GlWindow::present(const Image8& frame, const Image8* hud, Image8* read_back) {
   glfwMakeContextCurrent(impl_->window);
   glViewport(0, 0, framebuffer_width(), framebuffer_height());
   glClearColor(0.05f, 0.05f, 0.06f, 1.0f);
@@ -340,6 +341,17 @@ void GlWindow::present(const Image8& frame, const Image8* hud) {
     impl_->hud.upload(*hud, GL_NEAREST);
     impl_->draw_quad(impl_->hud);
     glDisable(GL_BLEND);
+  }
+  if (read_back) {
+    const int w = framebuffer_width(), h = framebuffer_height();
+    read_back->resize(w, h);
+    std::vector<uint8_t> bottom_up(static_cast<size_t>(w) * h * 4);
+    glPixelStorei(GL_PACK_ALIGNMENT, 1);
+    glReadPixels(0, 0, w, h, GL_RGBA, GL_UNSIGNED_BYTE, bottom_up.data());
+    const size_t row = static_cast<size_t>(w) * 4;
+    for (int y = 0; y < h; ++y)
+      std::copy_n(bottom_up.data() + (h - 1 - y) * row, row, read_back->rgba.data() + y * row);
+    for (size_t i = 3; i < read_back->rgba.size(); i += 4) read_back->rgba[i] = 255;
   }
   glfwSwapBuffers(impl_->window);
 }

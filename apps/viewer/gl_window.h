@@ -42,7 +42,8 @@ class GlWindow {
   int framebuffer_width() const;
   int framebuffer_height() const;
   // Upload the frame (stretched over the window) and the HUD layer (window-sized; null: none), swap.
-  void present(const Image8& frame, const Image8* hud);
+  // With read_back, what was drawn is read back into it first (rows top to bottom).
+  void present(const Image8& frame, const Image8* hud, Image8* read_back = nullptr);
   void set_title(const std::string& title);
   // e.g. "OpenGL 3.3 core (Mesa llvmpipe)".
   const std::string& gl_description() const { return gl_description_; }

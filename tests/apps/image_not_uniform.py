@@ -1,5 +1,6 @@
 #!/usr/bin/env python3
-"""Checks that an 8-bit PNG (RGB/RGBA, non-interlaced) or binary PPM shows a picture: the right size
+"""Usage: image_not_uniform.py IMAGE [WIDTH HEIGHT]
+Checks that an 8-bit PNG (RGB/RGBA, non-interlaced) or binary PPM shows a picture: the right size
 when asked, not one flat colour, not (nearly) black. Standard library only."""
 import struct
 import sys
@@ -76,6 +77,8 @@ def main():
     print(f"{path}: {width}x{height}, mean {mean:.1f}, std {spread:.1f}, {distinct} distinct colours")
     if width * height == 0:
         sys.exit("FAIL: empty image")
+    if len(sys.argv) >= 4 and (width, height) != (int(sys.argv[2]), int(sys.argv[3])):
+        sys.exit(f"FAIL: expected {sys.argv[2]}x{sys.argv[3]}")
     if distinct < 16 or spread < 2.0:
         sys.exit("FAIL: the image is (nearly) uniform")
     if mean < 2.0:

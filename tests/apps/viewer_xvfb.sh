@@ -15,16 +15,18 @@ if ! command -v python3 >/dev/null; then
   exit 77
 fi
 mkdir -p "$(dirname "$shot")"
-rm -f "$shot"
+window_shot="${shot%.*}_window.${shot##*.}"
+rm -f "$shot" "$window_shot"
 # The embree tracer is always on the CPU, so the test does not depend on a GPU; opencl (PoCL) joins
 # when built, to exercise the balancer with two tracers.
 set -x
 xvfb-run -a -s "-screen 0 1024x768x24" "$cohort" play "$map" --frames 5 --width 160 --height 120 --scale 1 \
-  --screenshot "$shot"
+  --screenshot "$shot" --window-screenshot "$window_shot"
 rc=$?
 set +x
 if [ $rc -ne 0 ]; then
   echo "FAIL: cohort play exited with $rc"
   exit 1
 fi
-python3 "$checker" "$shot"
+# The rendered frame, and the window as drawn through the GL texture upload with the HUD over it.
+python3 "$checker" "$shot" 160 120 && python3 "$checker" "$window_shot" 160 120
