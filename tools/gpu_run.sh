@@ -16,16 +16,16 @@ stage=.gpu
 case "${1:-}" in
   stage)
     cmake --preset gpu-travel
-    cmake --build --preset gpu-travel -j2 --target cohort cohort_tracers_tests $(ls bench/bench_*.cpp | xargs -n1 basename | sed 's/\.cpp$//')
+    cmake --build --preset gpu-travel -j2 --target cohort cohort_tracers_tests bench_cuda bench_tracers
     rm -rf "$stage" && mkdir -p "$stage/bin" "$stage/lib"
-    for exe in build/gpu/bin/*; do
+    for exe in build/gpu/bin/cohort build/gpu/bin/cohort_tracers_tests build/gpu/bin/bench_cuda build/gpu/bin/bench_tracers; do
       [ -x "$exe" ] && [ -f "$exe" ] && strip -o "$stage/bin/$(basename "$exe")" "$exe"
     done
     for lib in libembree3.so.3 libtbb.so.12 libzip.so.4; do
       cp -L "/usr/lib/x86_64-linux-gnu/$lib" "$stage/lib/"
     done
     # The travelling binary has no OpenImageIO: the pack carries decoded textures.
-    build/default/bin/cohort pack assets/testmap/maps/testmap.map --out "$stage/testmap.cpk"
+    build/gpu/bin/cohort pack assets/testmap/maps/testmap.map --out "$stage/testmap.cpk"
     du -sh "$stage"
     ;;
   remote)

@@ -11,7 +11,7 @@ from .tga import encode_tga
 
 def build():
     grid = Grid(layout.AREAS, layout.SOLIDS)
-    area_meshes, portal_faces = build_shell(grid, layout.material_for)
+    area_meshes, portal_faces = build_shell(grid, layout.material_for, layout.texel_scale_for)
     portals = merge_portals(portal_faces)
     layout.add_details(area_meshes)
     models = layout.inline_models()
@@ -33,6 +33,7 @@ def build():
         o = values["origin"]
         entity_points.append((values["name"], (o[0], o[1], o[2] + 1), expected))
     checks.check_nodes(nodes, grid, entity_points)
+    checks.check_shell_faces_air(area_meshes, nodes)
     checks.check_materials(area_meshes + models, materials.material_names(), materials.referenced_images(),
                            images.keys())
 

@@ -69,6 +69,14 @@ SOLID_MATERIALS = {
 }
 
 
+# World units per texture repeat on the shell (128 unless listed): bricks come out about 32 x 16 units.
+TEXEL_SCALE = {M + "wall_bricks": 64.0, M + "metalfloor": 64.0}
+
+
+def texel_scale_for(material):
+    return TEXEL_SCALE.get(material, 128.0)
+
+
 def material_for(area_index, inward_normal, neighbour):
     """Material of a shell face of `area_index` whose other side is `neighbour` (solid name or 'void')."""
     area = AREAS[area_index]
