@@ -36,12 +36,6 @@ scene::Scene load_scene(const SessionOptions& options) {
   return loaded;
 }
 
-std::string default_tracer_list() {
-  std::string list;
-  for (const std::string& kind : built_tracer_kinds()) list += (list.empty() ? "" : ",") + kind;
-  return list;
-}
-
 }  // namespace
 
 const std::vector<std::string>& debug_mode_names() {
@@ -90,25 +84,16 @@ PlaySession::PlaySession(const SessionOptions& options) {
   auto initial_scene = std::make_shared<const commit::TracerScene>(core::compile_scene(s.world.scene()).tracer_scene);
 #endif
 
-  const std::string list = options.tracers.empty() ? default_tracer_list() : options.tracers;
+  const std::string list = options.tracers.empty() ? std::string("all") : options.tracers;
   std::vector<std::unique_ptr<core::Tracer>> tracers;
-  auto did_not_start = [&](const std::string& what, const std::string& why) {
-    warnings_.push_back("tracer " + what + " did not start: " + why);
-    spdlog::warn("{}; carrying on with the others", warnings_.back());
-  };
-  for (const TracerSpec& asked : parse_tracer_list(list)) {
-    std::vector<TracerSpec> specs;
+  // parse_tracer_list expands "all" and ":all" by probing devices; a device that then fails to open
+  // is dropped with a warning and the others carry on.
+  for (const TracerSpec& spec : parse_tracer_list(list)) {
     try {
-      specs = expand_all_devices({asked});
+      tracers.push_back(make_tracer(spec));
     } catch (const std::exception& e) {
-      did_not_start(asked.text, e.what());
-    }
-    for (const TracerSpec& spec : specs) {
-      try {
-        tracers.push_back(make_tracer(spec));
-      } catch (const std::exception& e) {
-        did_not_start(spec.text, e.what());
-      }
+      warnings_.push_back("tracer " + spec.text + " did not start: " + e.what());
+      spdlog::warn("{}; carrying on with the others", warnings_.back());
     }
   }
   if (tracers.empty())

@@ -19,7 +19,7 @@ namespace cohort::app {
 struct SessionOptions {
   std::string map;
   std::vector<std::string> bases;
-  std::string tracers;              // empty: every tracer kind this binary has
+  std::string tracers;              // empty: "all" (parse_tracer_list: Embree plus every GPU once)
   std::string balancer = "perfect-smooth";
   bool scenario = true;
 };

@@ -95,17 +95,12 @@ std::vector<TracerSpec> parse_tracer_list(const std::string& list) {
     spec.kind = item.substr(0, colon);
     if (colon != std::string::npos) {
       std::string index = item.substr(colon + 1);
-      if (index == "all" && spec.kind != "embree") {
-        spec.device = kAllDevices;
-        specs.push_back(spec);
-        continue;
-      }
       if (index.empty() || index.find_first_not_of("0123456789") != std::string::npos)
-        throw std::invalid_argument("tracer '" + item + "': the device after ':' must be a number or 'all'");
+        throw std::invalid_argument("tracer '" + item + "': the device after ':' must be a number");
       spec.device = std::stoi(index);
     }
     if (spec.kind != "embree" && spec.kind != "opencl" && spec.kind != "cuda")
-      throw std::invalid_argument("unknown tracer '" + item + "' (known: embree, opencl[:N|:all], cuda[:N|:all])");
+      throw std::invalid_argument("unknown tracer '" + item + "' (known: embree, opencl[:N], cuda[:N])");
     if (spec.kind == "embree" && colon != std::string::npos)
       throw std::invalid_argument("tracer '" + item + "': the Embree tracer takes no device index");
     specs.push_back(spec);
@@ -131,35 +126,9 @@ std::unique_ptr<core::Tracer> make_tracer(const TracerSpec& spec) {
   throw std::runtime_error("tracer '" + spec.text + "' is not built into this binary");
 }
 
-std::vector<TracerSpec> expand_all_devices(const std::vector<TracerSpec>& specs) {
-  std::vector<TracerSpec> out;
-  for (const TracerSpec& spec : specs) {
-    if (spec.device != kAllDevices) {
-      out.push_back(spec);
-      continue;
-    }
-    int count = -1;
-#ifdef COHORT_HAVE_OPENCL
-    if (spec.kind == "opencl") count = static_cast<int>(tracers::OpenCLTracer::list_devices().size());
-#endif
-#ifdef COHORT_HAVE_CUDA
-    if (spec.kind == "cuda") count = tracers::cuda_device_count();
-#endif
-    if (count < 0) throw std::runtime_error("tracer '" + spec.text + "' is not built into this binary");
-    if (count == 0) throw std::runtime_error("tracer '" + spec.text + "': no " + spec.kind + " devices on this machine");
-    for (int d = 0; d < count; ++d) {
-      TracerSpec one = spec;
-      one.device = d;
-      one.text = spec.kind + ":" + std::to_string(d);
-      out.push_back(one);
-    }
-  }
-  return out;
-}
-
 std::vector<std::unique_ptr<core::Tracer>> make_tracers(const std::string& list) {
   std::vector<std::unique_ptr<core::Tracer>> out;
-  for (const TracerSpec& spec : expand_all_devices(parse_tracer_list(list))) out.push_back(make_tracer(spec));
+  for (const TracerSpec& spec : parse_tracer_list(list)) out.push_back(make_tracer(spec));
   return out;
 }
 

@@ -11,20 +11,14 @@
 
 namespace cohort::app {
 
-constexpr int kAllDevices = -1;  // "opencl:all", "cuda:all"
-
 struct TracerSpec {
   std::string kind;  // embree, opencl, cuda
-  int device = 0;    // or kAllDevices
+  int device = 0;
   std::string text;  // as written
 };
 
 // Splits "embree,opencl:1"; throws std::invalid_argument naming a malformed entry.
 std::vector<TracerSpec> parse_tracer_list(const std::string& list);
-
-// Replaces every ":all" spec by one spec per device found ("opencl:0", "opencl:1", ...). Throws
-// std::runtime_error when the kind is not built in or has no device on this machine.
-std::vector<TracerSpec> expand_all_devices(const std::vector<TracerSpec>& specs);
 
 // Throws std::runtime_error when this build lacks the tracer or the device cannot be opened.
 std::unique_ptr<core::Tracer> make_tracer(const TracerSpec& spec);
