@@ -32,6 +32,8 @@ BalanceBenchRun run_one(const BalanceBenchConfig& config, const std::string& pat
       o.name = "sim" + std::to_string(i);
       o.speed = config.speeds[static_cast<size_t>(i) % config.speeds.size()];
       o.noise = config.noise;
+      o.report_row_work = config.row_work;
+      o.row_work_error = config.row_work_error;
       o.seed = config.seed * 1000 + static_cast<uint64_t>(i) + 1;
       tracers.push_back(std::make_unique<core::SimulatedTracer>(model, o));
     }
@@ -81,7 +83,7 @@ std::vector<BalanceBenchRun> run_balance_bench(const BalanceBenchConfig& config)
 
 nlohmann::json balance_bench_json(const BalanceBenchConfig& config, const std::vector<BalanceBenchRun>& runs) {
   nlohmann::json j;
-  j["config"] = {{"tracer_counts", config.tracer_counts}, {"speeds", config.speeds},  {"noise", config.noise},
+  j["config"] = {{"tracer_counts", config.tracer_counts}, {"speeds", config.speeds},  {"noise", config.noise}, {"row_work", config.row_work}, {"row_work_error", config.row_work_error},
                  {"frames", config.frames},               {"warmup", config.warmup},  {"paths", config.paths},
                  {"rows", config.rows},                   {"seed", config.seed},      {"alpha", config.balancer_options.alpha},
                  {"robin_hood_units", config.balancer_options.robin_hood_units},

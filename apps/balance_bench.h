@@ -16,6 +16,8 @@ struct BalanceBenchConfig {
   std::vector<int> tracer_counts{2, 3, 4};
   std::vector<double> speeds{1.0};       // speed of simulated tracer i is speeds[i % size]
   double noise = 0.02;
+  bool row_work = true;                  // simulated tracers report per-row work (the Row Cost proxy)
+  double row_work_error = 0.2;
   int frames = 360;
   int warmup = 5;                        // first frames left out of mean/worst (nothing measured yet)
   std::vector<std::string> paths{"slow", "fast"};

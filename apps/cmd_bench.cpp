@@ -1,3 +1,4 @@
+#include <algorithm>
 #include <fstream>
 #include <iostream>
 #include <sstream>
@@ -24,6 +25,12 @@ std::vector<T> split_list(const std::string& text, const char* what) {
   return values;
 }
 
+std::string format_fraction(double v) {
+  std::ostringstream s;
+  s << v;
+  return s.str();
+}
+
 }  // namespace
 
 void add_bench_command(CLI::App& app) {
@@ -36,7 +43,8 @@ void add_bench_command(CLI::App& app) {
       "results are reproducible.");
   struct Args {
     std::string balancers, tracers = "2,3,4", speeds = "1", path = "both", real, json, plot;
-    double noise = 0.02;
+    double noise = 0.02, row_work_error = 0.2;
+    bool row_work = true;
     int frames = 360, warmup = 5, rows = 720;
     uint64_t seed = 1;
     balance::BalancerOptions options;
@@ -54,6 +62,14 @@ void add_bench_command(CLI::App& app) {
   balance->add_option("--seed", args->seed, "seed of the scene cost model and the noise")->capture_default_str();
   balance->add_option("--alpha", args->options.alpha, "Perfect Smooth blend weight of the new division (eq. 2)")->capture_default_str();
   balance->add_option("--robin-hood-units", args->options.robin_hood_units, "units Robin Hood moves per frame")->capture_default_str();
+  balance->add_flag("!--no-row-work", args->row_work,
+                    "simulated tracers do not report per-row work counts (Row Cost then learns row costs from band times only)");
+  balance->add_option("--row-work-error", args->row_work_error, "relative error of the simulated per-row work counts")
+      ->capture_default_str();
+  balance->add_option("--cost-rate", args->options.cost_rate, "Row Cost: how fast the per-unit cost map follows new times")
+      ->capture_default_str();
+  balance->add_option("--speed-rate", args->options.speed_rate, "Row Cost: how fast per-tracer speeds follow new times")
+      ->capture_default_str();
   balance->add_option("--real", args->real, "real tracers instead of simulated ones, e.g. embree,opencl,cuda");
   balance->add_option("--json", args->json, "write every run (per-frame idle %) as JSON");
   balance->add_option("--plot", args->plot, "write a PNG chart of idle % per frame per balancer");
@@ -63,6 +79,8 @@ void add_bench_command(CLI::App& app) {
     config.tracer_counts = split_list<int>(args->tracers, "--tracers");
     config.speeds = split_list<double>(args->speeds, "--speeds");
     config.noise = args->noise;
+    config.row_work = args->row_work;
+    config.row_work_error = args->row_work_error;
     config.frames = args->frames;
     config.warmup = args->warmup;
     config.rows = args->rows;
@@ -70,6 +88,10 @@ void add_bench_command(CLI::App& app) {
     config.balancer_options = args->options;
     config.real = split_list<std::string>(args->real, "--real");
     config.paths = args->path == "both" ? std::vector<std::string>{"slow", "fast"} : std::vector<std::string>{args->path};
+    const std::vector<std::string> known = balance::balancer_names();
+    for (const std::string& b : config.balancers)
+      if (std::find(known.begin(), known.end(), b) == known.end())
+        throw CLI::ValidationError("--balancers", "unknown balancer '" + b + "' (known: none, robin-hood, perfect, perfect-smooth, row-cost)");
     for (int c : config.tracer_counts)
       if (c < 1) throw CLI::ValidationError("--tracers", "counts must be >= 1");
     for (double s : config.speeds)
@@ -82,7 +104,9 @@ void add_bench_command(CLI::App& app) {
       std::cerr << "cohort bench balance: " << e.what() << "\n";
       std::exit(config.real.empty() ? kExitFailure : kExitUnavailable);
     }
-    std::cout << (config.real.empty() ? "simulated tracers, speeds " + args->speeds + ", noise " + std::to_string(config.noise)
+    std::cout << (config.real.empty() ? "simulated tracers, speeds " + args->speeds + ", noise " + format_fraction(config.noise) +
+                                            (config.row_work ? ", per-row work counts with error " + format_fraction(config.row_work_error)
+                                                             : ", no per-row work counts")
                                       : "real tracers: " + args->real)
               << ", " << config.frames << " frames (first " << config.warmup << " not counted), " << config.rows << " rows\n"
               << balance_bench_table(runs);

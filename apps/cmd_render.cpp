@@ -24,7 +24,7 @@ namespace {
 
 struct RenderArgs {
   std::string map;
-  std::string tracers = "embree";
+  std::string tracers = "all";
   std::string balancer = "perfect-smooth";
   std::string mode = "path";
   std::string out = "render_out";
@@ -105,7 +105,9 @@ void add_render_command(CLI::App& app) {
   auto a = std::make_shared<RenderArgs>();
   cmd->add_option("map", a->map, "scene pack, or map: a .map path, a game path or a bare name")->required();
   cmd->add_option("--base", a->bases, "extra game folder(s) to search (loose files and .pk4s)");
-  cmd->add_option("--tracers", a->tracers, "comma-separated: embree, opencl[:N], cuda[:N]")->capture_default_str();
+  cmd->add_option("--tracers", a->tracers,
+                  "comma-separated: embree, opencl[:N|:all], cuda[:N|:all], or all (Embree on the CPU plus every GPU once)")
+      ->capture_default_str();
   cmd->add_option("--balancer", a->balancer, "row balancer when there are several tracers")->capture_default_str();
   cmd->add_option("--width", a->width, "image width")->capture_default_str()->check(CLI::PositiveNumber);
   cmd->add_option("--height", a->height, "image height")->capture_default_str()->check(CLI::PositiveNumber);

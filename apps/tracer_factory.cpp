@@ -8,8 +8,74 @@
 #ifdef COHORT_HAVE_OPENCL
 #include "cohort/tracers/opencl_tracer.h"
 #endif
+#ifdef COHORT_HAVE_CUDA
+#include "cohort/tracers/cuda_tracer.h"
+#endif
 
 namespace cohort::app {
+
+namespace {
+
+TracerSpec spec_of(const std::string& kind, int device) {
+  TracerSpec spec;
+  spec.kind = kind;
+  spec.device = device;
+  spec.text = kind == "embree" ? kind : kind + ":" + std::to_string(device);
+  return spec;
+}
+
+int cuda_devices() {
+#ifdef COHORT_HAVE_CUDA
+  return tracers::cuda_device_count();
+#else
+  return 0;
+#endif
+}
+
+// OpenCL devices that are not PoCL's CPU device: the CPU already has the Embree tracer.
+std::vector<int> opencl_accelerators() {
+  std::vector<int> found;
+#ifdef COHORT_HAVE_OPENCL
+  auto names = tracers::OpenCLTracer::list_devices();
+  for (size_t i = 0; i < names.size(); ++i)
+    if (names[i].find("Portable Computing Language") == std::string::npos) found.push_back(int(i));
+#endif
+  return found;
+}
+
+// "all": Embree on the CPU plus every GPU once: CUDA devices when there are any, else OpenCL
+// accelerators. "cuda:all" / "opencl:all": every device of that kind (PoCL's CPU device included).
+std::vector<TracerSpec> expand_all(const std::string& item) {
+  std::vector<TracerSpec> specs;
+  if (item == "cuda:all") {
+    for (int d = 0; d < cuda_devices(); ++d) specs.push_back(spec_of("cuda", d));
+    if (specs.empty()) throw std::invalid_argument("cuda:all: no CUDA device on this machine");
+    return specs;
+  }
+  if (item == "opencl:all") {
+#ifdef COHORT_HAVE_OPENCL
+    auto names = tracers::OpenCLTracer::list_devices();
+    for (size_t d = 0; d < names.size(); ++d) specs.push_back(spec_of("opencl", int(d)));
+#endif
+    if (specs.empty()) throw std::invalid_argument("opencl:all: no OpenCL device on this machine");
+    return specs;
+  }
+#ifdef COHORT_HAVE_EMBREE
+  specs.push_back(spec_of("embree", 0));
+#endif
+  if (int n = cuda_devices(); n > 0) {
+    for (int d = 0; d < n; ++d) specs.push_back(spec_of("cuda", d));
+  } else {
+    for (int d : opencl_accelerators()) specs.push_back(spec_of("opencl", d));
+  }
+  if (specs.empty()) {
+    // A build without Embree on a machine without GPUs: PoCL's CPU device is all there is.
+    for (TracerSpec& s : expand_all("opencl:all")) specs.push_back(s);
+  }
+  return specs;
+}
+
+}  // namespace
 
 std::vector<TracerSpec> parse_tracer_list(const std::string& list) {
   std::vector<TracerSpec> specs;
@@ -19,6 +85,10 @@ std::vector<TracerSpec> parse_tracer_list(const std::string& list) {
     std::string item = list.substr(start, comma == std::string::npos ? std::string::npos : comma - start);
     start = comma == std::string::npos ? list.size() + 1 : comma + 1;
     if (item.empty()) continue;
+    if (item == "all" || item == "cuda:all" || item == "opencl:all") {
+      for (TracerSpec& expanded : expand_all(item)) specs.push_back(expanded);
+      continue;
+    }
     TracerSpec spec;
     spec.text = item;
     size_t colon = item.find(':');
@@ -49,6 +119,9 @@ std::unique_ptr<core::Tracer> make_tracer(const TracerSpec& spec) {
     options.device = spec.device;
     return std::make_unique<tracers::OpenCLTracer>(options);
   }
+#endif
+#ifdef COHORT_HAVE_CUDA
+  if (spec.kind == "cuda") return std::make_unique<tracers::CudaTracer>(spec.device);
 #endif
   throw std::runtime_error("tracer '" + spec.text + "' is not built into this binary");
 }

@@ -3,8 +3,8 @@
 // integrator's overhead is a ratio. Both tracers draw the same random numbers, so they trace the
 // same rays: the Embree tracer's exact ray count stands for the others'.
 //
-//   bench_tracers [scene.pack] [--width W] [--height H] [--spp S] [--bounces B] [--repeats R] [--json FILE]
-// Without a pack it renders the procedural test room of the tracer tests.
+//   bench_tracers [scene.pack | map] [--width W] [--height H] [--spp S] [--bounces B] [--repeats R] [--json FILE]
+// Default: the generated test map (assets/testmap), from the player start.
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
@@ -16,8 +16,9 @@
 
 #include <nlohmann/json.hpp>
 
-#include "../tests/tracers/test_scenes.h"
+#include "cohort/core/gpu_scene.h"
 #include "cohort/core/scene_pack.h"
+#include "cohort/scene/map_loader.h"
 #ifdef COHORT_HAVE_EMBREE
 #include "cohort/tracers/embree_tracer.h"
 #endif
@@ -30,7 +31,7 @@ using namespace cohort;
 namespace {
 
 struct Config {
-  std::string pack;
+  std::string scene = std::string(COHORT_SOURCE_DIR) + "/assets/testmap/maps/testmap.map";
   int width = 320, height = 180, spp = 2, bounces = 1, repeats = 3;
   std::string json = "bench_tracers.json";
 };
@@ -52,7 +53,7 @@ Config parse(int argc, char** argv) {
     else if (a == "--bounces") c.bounces = std::stoi(next());
     else if (a == "--repeats") c.repeats = std::stoi(next());
     else if (a == "--json") c.json = next();
-    else if (!a.empty() && a[0] != '-') c.pack = a;
+    else if (!a.empty() && a[0] != '-') c.scene = a;
     else {
       std::cerr << "unknown option " << a << "\n";
       std::exit(2);
@@ -86,20 +87,32 @@ int main(int argc, char** argv) {
   std::shared_ptr<commit::TracerScene> scene;
   KCamera camera{};
   std::string scene_name;
-  if (!cfg.pack.empty()) {
-    core::PackedScene pack = core::read_scene_pack(cfg.pack);
+  glm::vec3 start(0.0f);
+  float yaw = 0.0f;
+  if (core::is_scene_pack(cfg.scene)) {
+    core::PackedScene pack = core::read_scene_pack(cfg.scene);
     scene_name = pack.map_name;
-    camera = core::make_camera(glm::vec3(pack.player_start[0], pack.player_start[1], pack.player_start[2] + 68.0f),
-                               pack.player_yaw, 0.0f, 90.0f, cfg.width, cfg.height);
+    start = glm::vec3(pack.player_start[0], pack.player_start[1], pack.player_start[2]);
+    yaw = pack.player_yaw;
     scene = std::make_shared<commit::TracerScene>(std::move(pack.tracer_scene));
   } else {
-    scene_name = "test_room (procedural)";
-    scene = std::make_shared<commit::TracerScene>(core::compile_scene(test::test_room()).tracer_scene);
-    camera = test::test_room_camera(cfg.width, cfg.height);
+    scene::Vfs vfs;
+    scene::Scene map = scene::load_map(vfs, cfg.scene);
+    scene_name = map.name;
+    start = map.player_start;
+    yaw = map.player_yaw;
+    scene = std::make_shared<commit::TracerScene>(core::compile_scene(map).tracer_scene);
   }
+  camera = core::make_camera(start + glm::vec3(0.0f, 0.0f, 68.0f), yaw, 0.0f, 90.0f, cfg.width, cfg.height);
   core::BandJob job;
   job.camera = camera;
-  job.params = test::frame_params(K_MODE_PATH, uint32_t(cfg.spp), uint32_t(cfg.bounces), cfg.height);
+  job.params.spp = uint32_t(cfg.spp);
+  job.params.max_bounces = uint32_t(cfg.bounces);
+  job.params.light_samples = 1;
+  job.params.spec_boost = 2.0f;
+  job.params.mode = K_MODE_PATH;
+  job.params.row_begin = 0;
+  job.params.row_end = uint32_t(cfg.height);
   job.params.firefly_clamp = 5.0f;
   job.params.soft_shadow_scale = 0.2f;
   job.params.rr_start = 2.0f;

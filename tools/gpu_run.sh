@@ -16,16 +16,16 @@ stage=.gpu
 case "${1:-}" in
   stage)
     cmake --preset gpu-travel
-    cmake --build --preset gpu-travel -j2 --target cohort cohort_tracers_tests $(ls bench/bench_*.cpp | xargs -n1 basename | sed 's/\.cpp$//')
+    cmake --build --preset gpu-travel -j2 --target cohort cohort_tracers_tests bench_cuda bench_tracers
     rm -rf "$stage" && mkdir -p "$stage/bin" "$stage/lib"
-    for exe in build/gpu/bin/*; do
+    for exe in build/gpu/bin/cohort build/gpu/bin/cohort_tracers_tests build/gpu/bin/bench_cuda build/gpu/bin/bench_tracers; do
       [ -x "$exe" ] && [ -f "$exe" ] && strip -o "$stage/bin/$(basename "$exe")" "$exe"
     done
     for lib in libembree3.so.3 libtbb.so.12 libzip.so.4; do
       cp -L "/usr/lib/x86_64-linux-gnu/$lib" "$stage/lib/"
     done
     # The travelling binary has no OpenImageIO: the pack carries decoded textures.
-    build/default/bin/cohort pack assets/testmap/maps/testmap.map --out "$stage/testmap.cpk"
+    build/gpu/bin/cohort pack assets/testmap/maps/testmap.map --out "$stage/testmap.cpk"
     du -sh "$stage"
     ;;
   remote)
@@ -36,10 +36,17 @@ case "${1:-}" in
     out="${OUT:-/tmp/cohort-out}"; mkdir -p "$out"
     nvidia-smi --query-gpu=index,name,memory.total,driver_version --format=csv | tee "$out/gpus.csv"
     status=0
-    "$stage/bin/cohort_tracers_tests" --gtest_output=json:"$out/tracers_tests.json" 2>&1 | tee "$out/tracers_tests.log" || status=1
+    mkdir -p "$out/images"
+    COHORT_PACK="$stage/testmap.cpk" COHORT_TEST_IMAGES="$out/images" \
+      "$stage/bin/cohort_tracers_tests" --gtest_output=json:"$out/tracers_tests.json" 2>&1 | tee "$out/tracers_tests.log" || status=1
     if [ -x "$stage/bin/bench_cuda" ]; then
       "$stage/bin/bench_cuda" --scene "$stage/testmap.cpk" --json "$out/bench_cuda.json" 2>&1 | tee "$out/bench_cuda.log" || status=1
     fi
+    # A frame of the test map through the whole app, every GPU tracer: PFM/PPM since no OpenImageIO travels.
+    "$stage/bin/cohort" render "$stage/testmap.cpk" --tracers "${COHORT_GPU_TRACERS:-cuda:all}" --width 640 --height 360 \
+      --spp 16 --frames 2 --out "$out/render" 2>&1 | tail -n 8 | tee "$out/render.log" || status=1
+    # The device tool brings back at most 8 files: one archive holds them all (logs also print above).
+    tar cf /tmp/cohort-results.tar -C "$out" . && rm -rf "${out:?}"/* && mv /tmp/cohort-results.tar "$out/results.tar"
     exit $status
     ;;
   *)

@@ -53,20 +53,22 @@ class PerfectBalancer final : public Balancer {
 // the image makes its tracer look slow and it is starved next frame (and the reverse): Perfect
 // oscillates and Perfect Smooth lags. Row Cost separates the two causes: it keeps a cost per work
 // unit (what the view makes expensive, shared by all tracers) and a speed per tracer (what the
-// hardware does, slowly varying). Each frame a tracer's measured time re-scales the cost of the units
-// it rendered (shaped within the band by the image-space proxy when one is given), speeds follow
-// slowly, and the next cuts make predicted time (band cost / speed) equal for every tracer.
+// hardware does, slowly varying), and cuts so that predicted time (band cost / speed) is equal for
+// every tracer. With a per-row work proxy (e.g. rays counted per row last frame) the map is the proxy
+// and speeds are measured directly as work per ms; without one, each tracer's measured time re-scales
+// the cost of the units it rendered and the map's shape is learnt as the cuts move.
 class RowCostBalancer final : public Balancer {
  public:
   RowCostBalancer(double cost_rate, double speed_rate) : cost_rate_(cost_rate), speed_rate_(speed_rate) {}
   std::string name() const override { return "row-cost"; }
   std::vector<Band> divide(const DivideInput& in) override;
-  void reset() override { cost_.clear(); speed_.clear(); rows_ = -1; }
+  void reset() override { cost_.clear(); speed_.clear(); rows_ = -1; proxy_mode_ = false; }
 
   const std::vector<double>& unit_costs() const { return cost_; }
 
  private:
-  void learn(const DivideInput& in);
+  void learn_from_proxy(const DivideInput& in, const std::vector<double>& proxy);
+  void learn_from_times(const DivideInput& in);
   std::vector<double> unit_proxy(const DivideInput& in) const;
 
   double cost_rate_;
@@ -74,6 +76,7 @@ class RowCostBalancer final : public Balancer {
   int rows_ = -1;
   std::vector<double> cost_;      // per work unit, mean 1
   std::map<int, double> speed_;   // tracer id -> cost units per ms
+  bool proxy_mode_ = false;       // costs and speeds are in the proxy's work units
 };
 
 }  // namespace cohort::balance

@@ -41,9 +41,25 @@ std::vector<double> RowCostBalancer::unit_proxy(const DivideInput& in) const {
   return proxy;
 }
 
-void RowCostBalancer::learn(const DivideInput& in) {
+void RowCostBalancer::learn_from_proxy(const DivideInput& in, const std::vector<double>& proxy) {
+  // The proxy counts the work of the very frame whose times we hold, so each tracer's speed (work per
+  // ms) is measured directly; the map is simply the proxy. Speeds are hardware properties: smoothing
+  // them over frames cancels the timing noise without lagging behind the view.
+  const int units = static_cast<int>(proxy.size());
+  for (const TracerMeasurement& m : in.previous) {
+    if (!(m.ms > 0.0) || !std::isfinite(m.ms) || m.band.rows() <= 0) continue;
+    const UnitRange r = units_of(m.band, units);
+    const double work = sum_over(proxy, r);
+    if (!(work > 0.0)) continue;
+    const double observed = work / m.ms;
+    auto it = speed_.find(m.tracer);
+    speed_[m.tracer] = it == speed_.end() ? observed : (1.0 - speed_rate_) * it->second + speed_rate_ * observed;
+  }
+  cost_ = proxy;
+}
+
+void RowCostBalancer::learn_from_times(const DivideInput& in) {
   const int units = static_cast<int>(cost_.size());
-  const std::vector<double> proxy = unit_proxy(in);
   std::vector<double> updated = cost_;
   for (const TracerMeasurement& m : in.previous) {
     if (!(m.ms > 0.0) || !std::isfinite(m.ms) || m.band.rows() <= 0) continue;
@@ -56,12 +72,15 @@ void RowCostBalancer::learn(const DivideInput& in) {
     // moves slowly, so that a band turning expensive shows up as cost, not as a slower tracer.
     const double speed = it == speed_.end() ? observed_speed : (1.0 - speed_rate_) * it->second + speed_rate_ * observed_speed;
     speed_[m.tracer] = speed;
+    // The band's measured cost is spread evenly over its units (one time says nothing about where
+    // in the band it went) and blended into the map, which keeps older detail: rows that change
+    // hands carry the cost they showed in their previous band, not the receiving band's average,
+    // as Perfect assumes. (Keeping the old shape inside the band instead was measured worse: it is
+    // stale as soon as the view turns.)
     const double band_cost = m.ms * speed;
-    const std::vector<double>& shape = proxy.empty() ? cost_ : proxy;
-    const double shape_sum = sum_over(shape, r);
-    if (!(shape_sum > 0.0)) continue;
+    if (!(predicted_cost > 0.0)) continue;
+    const double measured = band_cost / (r.end - r.begin);
     for (int u = r.begin; u < r.end; ++u) {
-      const double measured = shape[static_cast<size_t>(u)] * band_cost / shape_sum;
       updated[static_cast<size_t>(u)] = (1.0 - cost_rate_) * cost_[static_cast<size_t>(u)] + cost_rate_ * measured;
     }
   }
@@ -81,14 +100,17 @@ std::vector<Band> RowCostBalancer::divide(const DivideInput& in) {
     reset();
     rows_ = in.rows;
     cost_.assign(static_cast<size_t>(units_for_rows(in.rows)), 1.0);
-    const std::vector<double> proxy = unit_proxy(in);
-    if (!proxy.empty()) {
-      const double mean = std::accumulate(proxy.begin(), proxy.end(), 0.0) / proxy.size();
-      for (size_t u = 0; u < cost_.size(); ++u) cost_[u] = proxy[u] / mean;
-    }
   }
-  if (cost_.empty()) return equal_bands(in.rows, static_cast<int>(count));
-  learn(in);
+  // With a proxy, speeds are in its work units; without, in units of the normalised map. Switching
+  // between the two starts the speeds over.
+  const std::vector<double> proxy = unit_proxy(in);
+  if (proxy.empty() == proxy_mode_) {
+    speed_.clear();
+    proxy_mode_ = !proxy.empty();
+    if (!proxy_mode_) cost_.assign(static_cast<size_t>(units_for_rows(in.rows)), 1.0);
+  }
+  if (proxy_mode_) learn_from_proxy(in, proxy);
+  else learn_from_times(in);
 
   // Speeds of this frame's tracers; a newcomer is assumed average.
   std::vector<double> speeds(count, 0.0);

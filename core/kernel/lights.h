@@ -81,10 +81,12 @@ KFN KVec3 k_light_jittered_direction(KGLOBAL const KLight* light, KVec3 p, float
   return *dist > 0.0f ? v3_scale(d, 1.0f / *dist) : dir;
 }
 
-/* Unshadowed reflected radiance from one light toward wo. */
+/* Unshadowed reflected radiance from one light toward wo. Doom 3 lights a white surface facing a
+ * light of colour c to exactly c (its interaction has no 1/pi), so a light's colour is read as
+ * pi x the radiance it contributes through the Lambert term: Doom's brightness, physical BRDF. */
 KFN KVec3 k_light_unshadowed(const KSceneView* scene, KGLOBAL const KLight* light, const KSurface* sf, KVec3 wo,
                              float spec_boost) {
-  KVec3 radiance = k_light_radiance_at(scene, light, sf->position);
+  KVec3 radiance = v3_scale(k_light_radiance_at(scene, light, sf->position), K_PI);
   if (v3_max_component(radiance) <= 0.0f) return v3s(0.0f);
   float dist;
   KVec3 wi = k_light_direction(light, sf->position, &dist);

@@ -22,7 +22,10 @@
   #define k_atan2(y, x) atan2(y, x)
   #define K_INF INFINITY
 #else
-  #if defined(__CUDACC__)
+  #if defined(__CUDACC__) && defined(K_CUDA_DEVICE_ONLY)
+    /* A kernel translation unit: device-only lets tracer hooks use device intrinsics (tex1Dfetch). */
+    #define KFN static __device__ __forceinline__
+  #elif defined(__CUDACC__)
     #define KFN static __host__ __device__ __forceinline__
   #else
     #define KFN static inline

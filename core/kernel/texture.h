@@ -22,8 +22,13 @@ KFN kuint k_tex_levels(KTexture t) {
   return n == 0u ? 1u : n;
 }
 
+/* A tracer may route texel reads through its own cache path (CUDA: a texture object). */
+#ifndef K_TEXEL_LOAD
+#define K_TEXEL_LOAD(texels, index) ((texels)[index])
+#endif
+
 KFN KVec4 k_texel_fetch(KGLOBAL const kuint* texels, kuint offset, kuint width, kuint x, kuint y, kuint flags) {
-  kuint p = texels[offset + y * width + x];
+  kuint p = K_TEXEL_LOAD(texels, offset + y * width + x);
   KVec4 c = v4((float)(p & 0xFFu), (float)((p >> 8) & 0xFFu), (float)((p >> 16) & 0xFFu), (float)(p >> 24));
   c = v4(c.x * (1.0f / 255.0f), c.y * (1.0f / 255.0f), c.z * (1.0f / 255.0f), c.w * (1.0f / 255.0f));
   if (flags & K_TEX_SRGB) {

@@ -17,6 +17,7 @@
 typedef struct KTraceCtx {
   KSceneView scene;
   kuint tlas_node_count;
+  kuint closest_rays, occlusion_rays;   /* counted per thread, for the rays/s benchmarks */
 } KTraceCtx;
 
 /* Two-sided Moller-Trumbore; (u, v) weight v1 and v2. */
@@ -142,11 +143,13 @@ KFN int k_trace_tlas(KTraceCtx* ctx, KVec3 org, KVec3 dir, float tmax, kuint ray
 }
 
 KFN int k_trace_closest(KTraceCtx* ctx, KVec3 org, KVec3 dir, float tmax, kuint ray_mask, KHit* hit) {
+  ctx->closest_rays++;
   return k_trace_tlas(ctx, org, dir, tmax, ray_mask, 0, hit);
 }
 
 KFN int k_trace_occluded(KTraceCtx* ctx, KVec3 org, KVec3 dir, float tmax, kuint ray_mask) {
   KHit hit;
+  ctx->occlusion_rays++;
   return k_trace_tlas(ctx, org, dir, tmax, ray_mask, 1, &hit);
 }
 

@@ -36,6 +36,7 @@ struct Renderer::Worker {
   uint64_t job_id = 0;
   BandJob job;
   std::vector<commit::CommitBuffer> back_commits;  // filled by the core while the tracer renders
+  std::vector<commit::CommitBuffer> job_commits;   // handed over with the next job, applied before it
 
   // Outcome of the last job, guarded by completion->mutex.
   bool busy = false;
@@ -44,6 +45,7 @@ struct Renderer::Worker {
   std::string error;
   double wall_ms = 0.0;
   double reported_ms = 0.0;
+  std::vector<float> row_work;
 
   // The tracer's private target: only the worker writes it while busy; the core reads its rows after
   // the job's result is posted and before the next job is handed out.
@@ -62,17 +64,19 @@ struct Renderer::Worker {
         current = job;
         current_id = job_id;
         has_job = false;
-        front_commits.swap(back_commits);
+        front_commits.swap(job_commits);
       }
       bool success = false;
       std::string what;
       double wall = 0.0, reported = 0.0;
+      std::vector<float> work;
       try {
         for (const commit::CommitBuffer& c : front_commits) tracer->apply(c);
         const auto start = Clock::now();
         const BandResult result = tracer->render_band(current, target);
         wall = std::chrono::duration<double, std::milli>(Clock::now() - start).count();
         reported = result.device_ms;
+        if (result.row_work.size() == current.params.row_end - current.params.row_begin) work = result.row_work;
         success = true;
       } catch (const std::exception& e) {
         what = e.what();
@@ -87,6 +91,7 @@ struct Renderer::Worker {
         error = std::move(what);
         wall_ms = wall;
         reported_ms = reported;
+        row_work = std::move(work);
       }
       completion->cv.notify_all();
     }
@@ -143,8 +148,8 @@ double Renderer::measured_ms(const Worker& w) const {
   return options_.use_reported_time && w.reported_ms > 0.0 ? w.reported_ms : w.wall_ms;
 }
 
-Renderer::RoundResult Renderer::run_round(const std::vector<Assignment>& assignments, const BandJob& job,
-                                          FrameBuffer& out, Clock::time_point deadline) {
+std::vector<uint64_t> Renderer::assign(const std::vector<Assignment>& assignments, const BandJob& job, FrameBuffer& out,
+                                       bool with_commits) {
   std::vector<uint64_t> ids(assignments.size());
   for (size_t i = 0; i < assignments.size(); ++i) {
     Worker& w = *workers_[static_cast<size_t>(assignments[i].worker)];
@@ -160,8 +165,20 @@ Renderer::RoundResult Renderer::run_round(const std::vector<Assignment>& assignm
     w.job.params.row_end = static_cast<kuint>(assignments[i].band.end);
     w.job_id = ids[i];
     w.has_job = true;
+    // The commits queued so far belong to this frame; ones submitted from now on wait for the next.
+    // Re-rendering a dropped tracer's rows happens within the same frame, so it takes none.
+    if (with_commits) {
+      w.job_commits.insert(w.job_commits.end(), std::make_move_iterator(w.back_commits.begin()),
+                           std::make_move_iterator(w.back_commits.end()));
+      w.back_commits.clear();
+    }
     w.inbox_cv.notify_one();
   }
+  return ids;
+}
+
+Renderer::RoundResult Renderer::collect(const std::vector<Assignment>& assignments, const std::vector<uint64_t>& ids,
+                                        FrameBuffer& out, Clock::time_point deadline) {
   RoundResult result;
   if (assignments.empty()) return result;
   Completion& completion = *workers_.front()->completion;
@@ -185,12 +202,22 @@ Renderer::RoundResult Renderer::run_round(const std::vector<Assignment>& assignm
       const size_t offset = static_cast<size_t>(band.begin) * out.width * 4;
       const size_t count = static_cast<size_t>(band.rows()) * out.width * 4;
       std::memcpy(out.rgba.data() + offset, w.target.rgba.data() + offset, count * sizeof(float));
+      if (w.row_work.size() == static_cast<size_t>(band.rows())) {
+        std::copy(w.row_work.begin(), w.row_work.end(), row_work_.begin() + band.begin);
+        std::fill(row_work_known_.begin() + band.begin, row_work_known_.begin() + band.end, 1);
+      }
     }
   }
   return result;
 }
 
 FrameStats Renderer::render(const BandJob& job, FrameBuffer& out, const std::vector<float>& row_cost_proxy) {
+  begin_frame(job, out, row_cost_proxy);
+  return finish_frame();
+}
+
+void Renderer::begin_frame(const BandJob& job, FrameBuffer& out, const std::vector<float>& row_cost_proxy) {
+  if (pending_) throw std::logic_error("Renderer::begin_frame: the previous frame was not finished");
   const auto frame_start = Clock::now();
   const int width = static_cast<int>(job.camera.width), rows = static_cast<int>(job.camera.height);
   if (width <= 0 || rows <= 0) throw std::invalid_argument("Renderer::render: camera has no pixels");
@@ -216,7 +243,14 @@ FrameStats Renderer::render(const BandJob& job, FrameBuffer& out, const std::vec
   }
   if (ready.empty()) throw std::runtime_error("frame " + std::to_string(stats.frame) + ": every tracer is still busy with an earlier frame");
 
-  const std::vector<balance::Band> bands = balancer_->divide({rows, ready, last_measurements_, row_cost_proxy});
+  // Without a proxy from the caller, last frame's per-row work counts serve, when every row has one.
+  std::vector<float> proxy = row_cost_proxy;
+  if (proxy.empty() && options_.use_row_work && static_cast<int>(row_work_.size()) == rows &&
+      std::all_of(row_work_known_.begin(), row_work_known_.end(), [](uint8_t k) { return k != 0; }))
+    proxy = row_work_;
+  row_work_.assign(static_cast<size_t>(rows), 0.0f);
+  row_work_known_.assign(static_cast<size_t>(rows), 0);
+  const std::vector<balance::Band> bands = balancer_->divide({rows, ready, last_measurements_, std::move(proxy)});
   std::vector<Assignment> assignments;
   for (size_t i = 0; i < ready.size(); ++i) {
     TracerFrameStats& t = stats.tracers[static_cast<size_t>(ready[i])];
@@ -226,7 +260,17 @@ FrameStats Renderer::render(const BandJob& job, FrameBuffer& out, const std::vec
     else assignments.push_back({ready[i], bands[i]});
   }
 
-  RoundResult first = run_round(assignments, job, out, frame_start + options_.frame_timeout);
+  std::vector<uint64_t> ids = assign(assignments, job, out, true);
+  pending_ = std::make_unique<PendingFrame>(PendingFrame{job, &out, std::move(stats), std::move(assignments), std::move(ids), frame_start});
+}
+
+FrameStats Renderer::finish_frame() {
+  if (!pending_) throw std::logic_error("Renderer::finish_frame: no frame was begun");
+  std::unique_ptr<PendingFrame> frame = std::move(pending_);
+  FrameStats& stats = frame->stats;
+  FrameBuffer& out = *frame->out;
+  const BandJob& job = frame->job;
+  RoundResult first = collect(frame->assignments, frame->ids, out, frame->start + options_.frame_timeout);
   last_measurements_.clear();
   for (int id : first.finished) {
     TracerFrameStats& t = stats.tracers[static_cast<size_t>(id)];
@@ -292,7 +336,7 @@ FrameStats Renderer::render(const BandJob& job, FrameBuffer& out, const std::vec
       if (!parts[i].empty()) round.push_back({helpers[i], {band.begin + parts[i].begin, band.begin + parts[i].end}});
     }
     const auto round_start = Clock::now();
-    RoundResult r = run_round(round, job, out, round_start + options_.frame_timeout);
+    RoundResult r = collect(round, assign(round, job, out, false), out, round_start + options_.frame_timeout);
     for (const Assignment& a : round) {
       TracerFrameStats& t = stats.tracers[static_cast<size_t>(a.worker)];
       if (std::find(r.finished.begin(), r.finished.end(), a.worker) != r.finished.end()) {
@@ -317,8 +361,8 @@ FrameStats Renderer::render(const BandJob& job, FrameBuffer& out, const std::vec
   for (const TracerFrameStats& t : stats.tracers) stats.recovery_ms = std::max(stats.recovery_ms, t.recovery_ms);
   if (!options_.use_reported_time && stats.dropped > 0)
     stats.recovery_ms = std::chrono::duration<double, std::milli>(Clock::now() - recovery_start).count();
-  stats.wall_ms = std::chrono::duration<double, std::milli>(Clock::now() - frame_start).count();
-  return stats;
+  stats.wall_ms = std::chrono::duration<double, std::milli>(Clock::now() - frame->start).count();
+  return std::move(stats);
 }
 
 }  // namespace cohort::core

@@ -108,7 +108,10 @@ BandResult SimulatedTracer::render_band(const BandJob& job, FrameBuffer& target)
 
   const int rows = static_cast<int>(job.camera.height);
   const int begin = static_cast<int>(job.params.row_begin), end = static_cast<int>(job.params.row_end);
-  double ms = model_->band_cost(camera_yaw(job.camera), rows, begin, end) * options_.ms_per_cost / options_.speed;
+  const std::vector<double> costs = model_->row_costs(camera_yaw(job.camera), rows);
+  double band_cost = 0.0;
+  for (int r = std::max(begin, 0); r < std::min(end, rows); ++r) band_cost += costs[static_cast<size_t>(r)];
+  double ms = band_cost * options_.ms_per_cost / options_.speed;
   if (options_.noise > 0.0) {
     std::mt19937_64 rng(mix(options_.seed * 0x100000001b3ull ^ frame));
     std::normal_distribution<double> gauss(0.0, options_.noise);
@@ -131,7 +134,21 @@ BandResult SimulatedTracer::render_band(const BandJob& job, FrameBuffer& target)
     while (std::chrono::steady_clock::now() < until) {
     }
   }
-  return BandResult{ms};
+  BandResult result;
+  result.device_ms = ms;
+  if (options_.report_row_work && end > begin) {
+    // The fixed part depends only on the row, so every tracer miscounts a row the same way.
+    std::normal_distribution<double> gauss(0.0, 1.0);
+    std::mt19937_64 fresh(mix(options_.seed ^ (frame * 0x9e3779b97f4a7c15ull) ^ 0x5a5a));
+    result.row_work.resize(static_cast<size_t>(end - begin));
+    for (int r = begin; r < end; ++r) {
+      std::mt19937_64 fixed(mix(0xc0ffee ^ static_cast<uint64_t>(r)));
+      const double error = options_.row_work_error * (0.7 * gauss(fixed) + 0.7 * gauss(fresh));
+      const double cost = r >= 0 && r < rows ? costs[static_cast<size_t>(r)] : 0.0;
+      result.row_work[static_cast<size_t>(r - begin)] = static_cast<float>(cost * std::max(0.1, 1.0 + error));
+    }
+  }
+  return result;
 }
 
 }  // namespace cohort::core

@@ -53,8 +53,8 @@ Image heightmap_to_normals(const Image& height, float scale) {
     for (int x = 0; x < w; ++x) {
       float dx = (level(x + 1, y) - level(x - 1, y)) * 0.5f * scale;
       float dy = (level(x, y + 1) - level(x, y - 1)) * 0.5f * scale;
-      // Rows run top to bottom while +t (green) points up the texture, hence +dy.
-      encode_normal(glm::vec3(-dx, dy, 1.0f), &out.rgba[(static_cast<size_t>(y) * w + x) * 4]);
+      // +t runs down the rows (the engine uploads the top row first), so both slopes enter negated.
+      encode_normal(glm::vec3(-dx, -dy, 1.0f), &out.rgba[(static_cast<size_t>(y) * w + x) * 4]);
     }
   }
   return out;

@@ -161,12 +161,14 @@ class SceneBuilder {
 
   void add_entities(const MapFile& map, const std::string& map_where) {
     for (const std::string& w : map.warnings) scene_.warnings.push_back(w);
-    for (const MapEntity& e : map.entities) {
+    for (size_t index = 0; index < map.entities.size(); ++index) {
+      const MapEntity& e = map.entities[index];
       const std::string where = map_where + ":" + std::to_string(e.line);
       const std::string classname = e.classname();
       if (classname == "worldspawn") continue;
       if (is_light_entity(e)) {
         MapLight light = light_from_entity(e, where, scene_.warnings);
+        if (light.light.name.empty()) light.light.name = "light_" + std::to_string(index);  // as the engine names them
         if (!light.texture.empty()) light.light.material = material(light.texture, true);
         switch (light.light.type) {
           case LightType::Point: ++report_.lights_point; break;
@@ -177,6 +179,7 @@ class SceneBuilder {
         continue;
       }
       Entity entity = entity_from_map(e, where, scene_.warnings);
+      if (entity.name.empty()) entity.name = (classname.empty() ? "entity" : classname) + "_" + std::to_string(index);
       if (classname == "info_player_start") {
         scene_.player_start = entity.origin;
         auto angle = e.get("angle");

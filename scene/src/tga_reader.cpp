@@ -64,7 +64,10 @@ std::optional<Image> decode_tga(std::string_view bytes, std::string& error) {
     return std::nullopt;
   }
   const size_t pixels = static_cast<size_t>(width) * static_cast<size_t>(height);
-  if (!rle && bytes.size() - in.pos < pixels * bpp) {
+  // A run packet covers at most 128 texels and takes at least 1 + bpp bytes: a size the data cannot
+  // fill is refused before the texels are allocated.
+  const size_t data_bytes = bytes.size() - in.pos;
+  if (rle ? pixels > data_bytes / (1u + bpp) * 128u + 128u : data_bytes < pixels * bpp) {
     error = "TGA pixel data truncated";
     return std::nullopt;
   }

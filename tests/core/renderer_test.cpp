@@ -178,3 +178,53 @@ TEST(Renderer, RejectsNoTracersAndUnknownBalancers) {
   options.balancer = "magic";
   EXPECT_THROW(Renderer(std::move(tracers), options), std::invalid_argument);
 }
+
+TEST(Renderer, CommitsSubmittedDuringAFrameWaitForTheNextOne) {
+  auto a = std::make_unique<SimulatedTracer>(model(), sim(1));
+  SimulatedTracer* view = a.get();
+  std::vector<std::unique_ptr<Tracer>> tracers;
+  tracers.push_back(std::move(a));
+  RendererOptions options;
+  options.use_reported_time = true;
+  Renderer renderer(std::move(tracers), options);
+  auto scene = std::make_shared<cohort::commit::TracerScene>();
+  FrameBuffer fb;
+  renderer.submit_commit(cohort::commit::CommitBuffer::full(scene, 1));
+  renderer.begin_frame(job_for(0), fb);
+  renderer.submit_commit(cohort::commit::CommitBuffer::full(scene, 2));  // the core prepares frame 1
+  EXPECT_THROW(renderer.begin_frame(job_for(1), fb), std::logic_error);
+  renderer.finish_frame();
+  EXPECT_EQ(view->last_commit_frame(), 1u);
+  EXPECT_EQ(view->commits_applied(), 1u);
+  renderer.render(job_for(1), fb);
+  EXPECT_EQ(view->last_commit_frame(), 2u);
+  EXPECT_THROW(renderer.finish_frame(), std::logic_error);
+}
+
+TEST(Renderer, PerRowWorkCountsReachTheBalancer) {
+  // Row Cost with the tracers' per-row work counts balances a static view in one step; without
+  // them it has to learn the row costs from band times over several frames.
+  auto idle_after_one_measured_frame = [](bool use_row_work) {
+    std::vector<std::unique_ptr<Tracer>> tracers;
+    for (uint64_t tag : {1u, 2u, 3u}) {
+      auto o = sim(tag);
+      o.report_row_work = true;
+      o.row_work_error = 0.0;
+      tracers.push_back(std::make_unique<SimulatedTracer>(model(), o));
+    }
+    RendererOptions options;
+    options.balancer = "row-cost";
+    options.use_reported_time = true;
+    options.use_row_work = use_row_work;
+    Renderer renderer(std::move(tracers), options);
+    FrameBuffer fb;
+    BandJob job = job_for(0);
+    job.camera = spin_camera(kWidth, 480, 0.7);
+    FrameStats stats;
+    for (int f = 0; f < 2; ++f) stats = renderer.render(job, fb);
+    return stats.idle_percent;
+  };
+  const double with_counts = idle_after_one_measured_frame(true), without = idle_after_one_measured_frame(false);
+  EXPECT_LT(with_counts, 4.0);  // what is left is rounding to 4-row units
+  EXPECT_LT(2.0 * with_counts, without);
+}

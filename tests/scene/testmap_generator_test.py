@@ -178,6 +178,101 @@ class ProcFile(unittest.TestCase):
             self.assertEqual((count, edges.get((b, a), 0)), (1, 1), "edge %s -> %s" % (a, b))
 
 
+def parse_map_entities(text):
+    """Entities of a Version 2 .map as lists of (key, value); brush and patch primitives skipped."""
+    text = re.sub(r"//[^\n]*", "", text)
+    t = re.findall(r'"[^"]*"|[{}()]|[^\s{}()"]+', text)
+    assert t[0] == "Version" and t[1] == "2"
+    i = 2
+    entities = []
+    while i < len(t):
+        assert t[i] == "{", t[i]
+        i += 1
+        keys = []
+        while t[i] != "}":
+            if t[i] == "{":
+                depth = 0
+                while True:
+                    depth += {"{": 1, "}": -1}.get(t[i], 0)
+                    i += 1
+                    if depth == 0:
+                        break
+                continue
+            keys.append((t[i].strip('"'), t[i + 1].strip('"')))
+            i += 2
+        i += 1
+        entities.append(keys)
+    return entities
+
+
+class MapAndMaterials(unittest.TestCase):
+    @classmethod
+    def setUpClass(cls):
+        root = os.path.join(ARGS.repo, "assets", "testmap")
+        with open(os.path.join(root, "maps", "testmap.map")) as handle:
+            cls.entities = [dict(e) for e in parse_map_entities(handle.read())]
+        with open(os.path.join(root, "materials", "testmap.mtr")) as handle:
+            cls.mtr = handle.read()
+        cls.root = root
+        cls.materials = set(re.findall(r"^((?:textures|lights)/\S+)\s*$", cls.mtr, re.M))
+        ProcFile.setUpClass()
+        cls.models = ProcFile.models
+
+    def by_name(self, name):
+        return next(e for e in self.entities if e.get("name") == name)
+
+    def test_worldspawn_first_and_player_start(self):
+        self.assertEqual(self.entities[0]["classname"], "worldspawn")
+        start = next(e for e in self.entities if e["classname"] == "info_player_start")
+        self.assertEqual(len(start["origin"].split()), 3)
+        self.assertIn("angle", start)
+
+    def test_light_kinds_and_keys(self):
+        lights = [e for e in self.entities if e["classname"] == "light"]
+        self.assertEqual(sum(1 for l in lights if l.get("parallel") == "1"), 1)
+        projected = [l for l in lights if "light_target" in l]
+        self.assertGreaterEqual(len(projected), 2)
+        self.assertTrue(all("light_right" in l and "light_up" in l for l in projected))
+        self.assertTrue(any("light_start" in l and "light_end" in l for l in projected))
+        self.assertTrue(any(l.get("texture") == "lights/testmap_gel" for l in projected))
+        self.assertTrue(any(l.get("noshadows") == "1" for l in lights))
+        self.assertTrue(any(l.get("nospecular") == "1" for l in lights))
+        self.assertTrue(any("light_center" in l and "parallel" not in l for l in lights))
+        self.assertIn("light_flicker", {l["name"] for l in lights})
+        for light in lights:
+            if "texture" in light:
+                self.assertIn(light["texture"], self.materials)
+
+    def test_projected_vectors_are_perpendicular(self):
+        for light in self.entities:
+            if "light_target" not in light:
+                continue
+            target, right, up = ([float(x) for x in light[k].split()] for k in ("light_target", "light_right", "light_up"))
+            self.assertEqual(sum(a * b for a, b in zip(target, right)), 0, light["name"])
+            self.assertEqual(sum(a * b for a, b in zip(target, up)), 0, light["name"])
+
+    def test_movers_and_props_name_proc_models(self):
+        self.assertEqual(self.by_name("door_main")["classname"], "func_door")
+        self.assertEqual(self.by_name("fan_spin")["classname"], "func_rotating")
+        for entity in self.entities:
+            if entity["classname"] in ("func_static", "func_door", "func_rotating"):
+                self.assertIn(entity["model"], self.models, entity["name"])
+                self.assertIn("origin", entity)
+
+    def test_every_used_material_defined_and_every_image_present(self):
+        for name, surfaces in self.models.items():
+            for material, _, _ in surfaces:
+                self.assertIn(material, self.materials, name)
+        for image in set(re.findall(r"((?:textures|lights)/[\w/]+\.tga)", self.mtr)):
+            self.assertTrue(os.path.isfile(os.path.join(self.root, image)), image)
+
+    def test_emitters_have_no_interaction_stages(self):
+        for name in ("textures/testmap/lightpanel", "textures/testmap/lightpanel_blue"):
+            body = re.search(re.escape(name) + r"\s*\n\{(.*?)^\}", self.mtr, re.S | re.M).group(1)
+            self.assertIn("blend\tadd", body)
+            self.assertNotRegex(body.lower(), r"diffusemap|bumpmap|specularmap")
+
+
 class GeneratorChecks(unittest.TestCase):
     """The generator's own checks must fail on broken geometry."""
 
@@ -189,7 +284,7 @@ class GeneratorChecks(unittest.TestCase):
         from testmap.shell import Grid, build_shell
         cls.checks = checks
         cls.grid = Grid(layout.AREAS, layout.SOLIDS)
-        cls.meshes, faces = build_shell(cls.grid, layout.material_for)
+        cls.meshes, faces = build_shell(cls.grid, layout.material_for, layout.texel_scale_for)
         cls.portals = merge_portals(faces)
 
     def broken(self, mutate):
@@ -238,6 +333,19 @@ class GeneratorChecks(unittest.TestCase):
         with self.assertRaises(self.checks.CheckError):
             self.checks.check_winding(self.broken(flip))
 
+    def test_inside_out_wall_is_rejected(self):
+        from testmap.bsp import build_nodes
+        nodes = build_nodes(self.grid)
+        self.checks.check_shell_faces_air(self.meshes, nodes)
+
+        def invert(meshes):
+            tris = meshes[0].surfaces["textures/testmap/floor_tiles"]
+            a, b, c = tris[0]
+            flipped = tuple(-x for x in a[2])
+            tris[0] = [(a[0], a[1], flipped), (c[0], c[1], flipped), (b[0], b[1], flipped)]
+        with self.assertRaises(self.checks.CheckError):
+            self.checks.check_shell_faces_air(self.broken(invert), nodes)
+
     def test_node_tree_rejects_wrong_area(self):
         from testmap.bsp import build_nodes
         nodes = build_nodes(self.grid)
@@ -275,6 +383,15 @@ class Textures(unittest.TestCase):
             for p in pixels[::97]:
                 n = [(c / 255.0) * 2 - 1 for c in p[:3]]
                 self.assertAlmostEqual(sum(c * c for c in n), 1.0, delta=0.03)
+
+    def test_normal_map_y_follows_plus_t(self):
+        """Y = +t (down the rows), as the engine's heightmap(): where height rises going down the image
+        (top bevel of a brick) the normal leans to -Y (green below 128), and the other way at the bottom."""
+        w, h, _, rows = self.load("textures/testmap/bricks_local.tga")
+        top = [rows[y][x][1] for y in (2, 3, 4) for x in range(40, 50)]
+        bottom = [rows[y][x][1] for y in (27, 28, 29) for x in range(40, 50)]
+        self.assertLess(sum(top) / len(top), 110)
+        self.assertGreater(sum(bottom) / len(bottom), 146)
 
     def test_gel_is_colourful_and_falloff_fades(self):
         w, h, _, rows = self.load("lights/testmap_gel.tga")

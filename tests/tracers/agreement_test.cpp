@@ -12,6 +12,7 @@
 #include <filesystem>
 
 #include "cohort/core/scene_pack.h"
+#include "cohort/scene/map_loader.h"
 #include "test_scenes.h"
 #include "test_tracers.h"
 
@@ -123,4 +124,28 @@ TEST(ScenePack, RendersLikeTheCompiledScene) {
   job.camera = cam;
   tracer->render_band(job, b);
   EXPECT_EQ(a.rgba, b.rgba);
+}
+
+// The same comparison on the generated test map (assets/testmap), seen from the player start: every
+// material class, entity, and light type it has.
+TEST(AgreementOnTestMap, EmbreeAndOpenCLImagesMatch) {
+  std::vector<std::string> names = built_tracers();
+  if (names.size() < 2 || !tracer_runs_here("opencl")) GTEST_SKIP() << "needs both the Embree and the OpenCL tracer";
+  scene::Vfs vfs;
+  scene::Scene map = scene::load_map(vfs, std::string(COHORT_SOURCE_DIR) + "/assets/testmap/maps/testmap.map");
+  const int w = 64, h = 36;
+  KCamera cam = core::make_camera(map.player_start + glm::vec3(0, 0, 68), map.player_yaw, 0.0f, 90.0f, w, h);
+  KFrameParams params = frame_params(K_MODE_PATH, 8, 1, h);
+  params.firefly_clamp = 5.0f;
+  params.soft_shadow_scale = 0.2f;
+  params.rr_start = 2.0f;
+  auto embree = make_test_tracer("embree");
+  auto opencl = make_test_tracer("opencl");
+  core::FrameBuffer a = render(*embree, map, cam, params);
+  core::FrameBuffer b = render(*opencl, map, cam, params);
+  double mean = 0.0;
+  double error = rmse(a, b, &mean);
+  std::cout << "testmap: RMSE embree/opencl " << error << ", mean " << mean << "\n";
+  EXPECT_GT(mean, 0.01);
+  EXPECT_LT(error, 0.005 * mean);
 }

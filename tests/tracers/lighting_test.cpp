@@ -12,8 +12,6 @@ using namespace cohort::test;
 
 namespace {
 
-constexpr float kPi = 3.14159265358979f;
-
 class Lighting : public ::testing::TestWithParam<std::string> {
  protected:
   void SetUp() override {
@@ -35,7 +33,8 @@ scene::Light point_light(glm::vec3 origin, float radius) {
 }  // namespace
 
 // A white-ish floor under a point light without falloff image: direct radiance must follow
-// albedo/pi * 2 (r_lightScale) * (1 - (d/r)^2)^2 * cos(theta), averaged over each pixel's area.
+// albedo * 2 (r_lightScale) * (1 - (d/r)^2)^2 * cos(theta), averaged over each pixel's area (Doom 3's
+// interaction brightness: no 1/pi).
 TEST_P(Lighting, PointLightFollowsWindowedFalloff) {
   const float albedo = 0.8f, radius = 150.0f, height = 50.0f;
   scene::Scene s = floor_scene(200.0f, glm::vec3(albedo));
@@ -55,7 +54,7 @@ TEST_P(Lighting, PointLightFollowsWindowedFalloff) {
           float d = glm::length(to_light);
           float q = d / radius;
           float window = q < 1.0f ? (1.0f - q * q) * (1.0f - q * q) : 0.0f;
-          expected += albedo / kPi * 2.0f * window * (height / d);
+          expected += albedo * 2.0f * window * (height / d);
         }
       expected /= sub * sub;
       glm::vec3 got = pixel(fb, x, y);
@@ -102,7 +101,7 @@ TEST_P(Lighting, ProjectedGelLandsInItsQuadrant) {
   };
   // Centre of the lit quadrant (a pixel centre): s = t = 0.25 samples the white texel; F = 0.5.
   float d = std::sqrt(22.5f * 22.5f * 2.0f + 100.0f * 100.0f);
-  float expected = 1.0f / kPi * 2.0f * 0.5625f * (100.0f / d);
+  float expected = 2.0f * 0.5625f * (100.0f / d);
   EXPECT_NEAR(at(-22.5f, 22.5f), expected, 0.05f * expected);
   EXPECT_LT(at(22.5f, 22.5f), 0.02f * expected);
   EXPECT_LT(at(-22.5f, -22.5f), 0.02f * expected);
@@ -157,7 +156,7 @@ TEST_P(Lighting, ShadowsRespectNoShadowsAndAlphaTest) {
   float shadowed = centre(make(false, false));
   float exempt = centre(make(true, false));
   float cut_out = centre(make(false, true));
-  float lit_expected = 0.5f / kPi * 2.0f * (1.0f - (100.0f / 400.0f) * (100.0f / 400.0f)) *
+  float lit_expected = 0.5f * 2.0f * (1.0f - (100.0f / 400.0f) * (100.0f / 400.0f)) *
                        (1.0f - (100.0f / 400.0f) * (100.0f / 400.0f));
   EXPECT_LT(shadowed, 0.01f * lit_expected);
   EXPECT_NEAR(exempt, lit_expected, 0.03f * lit_expected);
@@ -181,7 +180,7 @@ TEST_P(Lighting, SoftShadowsHaveAPenumbra) {
     p.soft_shadow_scale = scale;
     float lit = pixel(render(*tracer_, s, cam, p), 2, 2).x;
     float d2 = (x * x + 100.0f * 100.0f) / (400.0f * 400.0f);
-    float unshadowed = 0.5f / kPi * 2.0f * (1.0f - d2) * (1.0f - d2) * (100.0f / std::sqrt(x * x + 1e4f));
+    float unshadowed = 0.5f * 2.0f * (1.0f - d2) * (1.0f - d2) * (100.0f / std::sqrt(x * x + 1e4f));
     return lit / unshadowed;
   };
   EXPECT_NEAR(visible_fraction(40.0f, 1.0f), 0.5f, 0.1f) << "the hard shadow's edge";

@@ -12,6 +12,9 @@
 #ifdef COHORT_HAVE_OPENCL
 #include "cohort/tracers/opencl_tracer.h"
 #endif
+#ifdef COHORT_HAVE_CUDA
+#include "cohort/tracers/cuda_tracer.h"
+#endif
 
 namespace cohort::test {
 
@@ -23,6 +26,9 @@ inline std::vector<std::string> built_tracers() {
 #ifdef COHORT_HAVE_OPENCL
   names.push_back("opencl");
 #endif
+#ifdef COHORT_HAVE_CUDA
+  names.push_back("cuda");
+#endif
   return names;
 }
 
@@ -31,6 +37,9 @@ inline std::vector<std::string> built_tracers() {
 inline bool tracer_runs_here(const std::string& name) {
 #ifdef COHORT_HAVE_OPENCL
   if (name == "opencl") return !tracers::OpenCLTracer::list_devices().empty();
+#endif
+#ifdef COHORT_HAVE_CUDA
+  if (name == "cuda") return tracers::cuda_device_count() > 0;
 #endif
   return true;
 }
@@ -41,6 +50,10 @@ inline std::unique_ptr<core::Tracer> make_test_tracer(const std::string& name) {
 #endif
 #ifdef COHORT_HAVE_OPENCL
   if (name == "opencl") return std::make_unique<tracers::OpenCLTracer>(tracers::OpenCLTracer::Options{});
+#endif
+#ifdef COHORT_HAVE_CUDA
+  if (name == "cuda") return std::make_unique<tracers::CudaTracer>(0);
+  if (name.rfind("cuda:", 0) == 0) return std::make_unique<tracers::CudaTracer>(std::stoi(name.substr(5)));
 #endif
   throw std::runtime_error("no tracer named " + name);
 }

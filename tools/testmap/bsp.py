@@ -1,50 +1,65 @@
-"""Area node tree for the .proc `nodes` block, built over the shell grid.
+"""Area node tree for the .proc `nodes` block.
 
-Splits on grid lines until a block of cells is uniformly one area or solid. Node plane (a b c d)
-classifies point p by a*x + b*y + c*z + d > 0 -> child 0 (positive), else child 1. Child 0 means solid,
-a negative child n means area -1-n, a positive child is a node index.
+Built over the labelled boxes (area air boxes, solids carved out of them) rather than single cells:
+each node splits on a face of some box, preferring planes that cut the fewest boxes, until a region is
+one area box with nothing carved from it (area leaf) or holds no air (solid leaf).
+Node plane (a b c d) classifies point p by a*x + b*y + c*z + d > 0 -> child 0 (positive), else child 1.
+Child 0 means solid, a negative child n means area -1-n, a positive child is a node index.
 """
 
 
-def _uniform(grid, lo, hi):
-    first = None
-    for i in range(lo[0], hi[0]):
-        for j in range(lo[1], hi[1]):
-            for k in range(lo[2], hi[2]):
-                kind, value = grid.labels[(i, j, k)]
-                label = -1 - value if kind == "air" else 0
-                if first is None:
-                    first = label
-                elif label != first:
-                    return None
-    return first
+def _clip(box_lo, box_hi, lo, hi):
+    clo = tuple(max(box_lo[a], lo[a]) for a in range(3))
+    chi = tuple(min(box_hi[a], hi[a]) for a in range(3))
+    if all(clo[a] < chi[a] for a in range(3)):
+        return clo, chi
+    return None
 
 
 def build_nodes(grid):
-    nodes = []  # each: [plane tuple, positive child, negative child]
+    areas = [(index, box.lo, box.hi) for index, box in enumerate(grid.areas)]
+    solids = [(box.lo, box.hi) for box in grid.solids]
+    world_lo = tuple(grid.lines[a][0] - 64.0 for a in range(3))
+    world_hi = tuple(grid.lines[a][-1] + 64.0 for a in range(3))
+    nodes = []
 
     def build(lo, hi):
-        label = _uniform(grid, lo, hi)
-        if label is not None:
-            return label
-        axis = max(range(3), key=lambda a: hi[a] - lo[a])
-        mid = (lo[axis] + hi[axis]) // 2
+        in_areas = [(i, c) for i, blo, bhi in areas for c in [_clip(blo, bhi, lo, hi)] if c]
+        if not in_areas:
+            return 0
+        in_solids = [c for slo, shi in solids for c in [_clip(slo, shi, lo, hi)] if c]
+        if len(in_areas) == 1 and not in_solids and in_areas[0][1] == (lo, hi):
+            return -1 - in_areas[0][0]
+        boxes = [c for _, c in in_areas] + in_solids
+        best = None
+        for axis in range(3):
+            planes = sorted({b[0][axis] for b in boxes} | {b[1][axis] for b in boxes})
+            for plane in planes:
+                if not lo[axis] < plane < hi[axis]:
+                    continue
+                cut = sum(1 for b in boxes if b[0][axis] < plane < b[1][axis])
+                below = sum(1 for b in boxes if b[1][axis] <= plane)
+                above = sum(1 for b in boxes if b[0][axis] >= plane)
+                score = (cut, abs(above - below), axis, plane)
+                if best is None or score < best:
+                    best = score
+        if best is None:
+            # Every box spans the whole region: a solid carved over it wins (solids beat air).
+            return 0 if in_solids else -1 - in_areas[0][0]
+        _, _, axis, plane = best
         index = len(nodes)
-        plane = [0.0, 0.0, 0.0, 0.0]
-        plane[axis] = 1.0
-        plane[3] = -grid.lines[axis][mid]
-        nodes.append([tuple(plane), None, None])
+        normal = [0.0, 0.0, 0.0, -plane]
+        normal[axis] = 1.0
+        nodes.append([tuple(normal), None, None])
         upper_lo = list(lo)
-        upper_lo[axis] = mid
+        upper_lo[axis] = plane
         lower_hi = list(hi)
-        lower_hi[axis] = mid
+        lower_hi[axis] = plane
         nodes[index][1] = build(tuple(upper_lo), hi)
         nodes[index][2] = build(lo, tuple(lower_hi))
         return index
 
-    root = build((0, 0, 0), grid.shape)
-    if root <= 0 and not nodes:
-        raise ValueError("world is a single leaf; need at least one split")
+    build(world_lo, world_hi)
     return [(plane, pos, neg) for plane, pos, neg in nodes]
 
 

@@ -119,3 +119,16 @@ def check_materials(meshes, material_names, image_paths, written_images):
     missing = sorted(set(image_paths) - set(written_images))
     if missing:
         raise CheckError("materials reference images that are not generated: %s" % ", ".join(missing))
+
+
+def check_shell_faces_air(area_meshes, nodes):
+    """Each shell triangle's front (its normal side) looks into its own area's air, as the node tree
+    sees it; its back is solid or another area. Catches inside-out walls."""
+    for index, mesh in enumerate(area_meshes):
+        for tri in shell_triangles(mesh):
+            centre = [sum(v[0][m] for v in tri) / 3.0 for m in range(3)]
+            normal = tri[0][2]
+            front = tuple(centre[m] + 0.5 * normal[m] for m in range(3))
+            back = tuple(centre[m] - 0.5 * normal[m] for m in range(3))
+            if point_area(nodes, front) != index or point_area(nodes, back) == index:
+                raise CheckError("%s: triangle at %s does not face into its area" % (mesh.name, front))

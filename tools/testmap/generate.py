@@ -11,7 +11,7 @@ from .tga import encode_tga
 
 def build():
     grid = Grid(layout.AREAS, layout.SOLIDS)
-    area_meshes, portal_faces = build_shell(grid, layout.material_for)
+    area_meshes, portal_faces = build_shell(grid, layout.material_for, layout.texel_scale_for)
     portals = merge_portals(portal_faces)
     layout.add_details(area_meshes)
     models = layout.inline_models()
@@ -33,6 +33,7 @@ def build():
         o = values["origin"]
         entity_points.append((values["name"], (o[0], o[1], o[2] + 1), expected))
     checks.check_nodes(nodes, grid, entity_points)
+    checks.check_shell_faces_air(area_meshes, nodes)
     checks.check_materials(area_meshes + models, materials.material_names(), materials.referenced_images(),
                            images.keys())
 
@@ -59,6 +60,8 @@ def build():
         "lights_parallel": sum(1 for l in lights if "parallel" in l),
         "entities": [(classname, dict(keys)["name"]) for classname, keys in ents],
         "area_names": [a.name for a in layout.AREAS],
+        "area_boxes": [(a.name, a.lo, a.hi, layout.AREA_NOTES[a.name]) for a in layout.AREAS],
+        "views": layout.VIEWS,
     })
     files["README.md"] = readme_text(stats, lights, files).encode("utf-8")
     stats["bytes"] = sum(len(b) for b in files.values())

@@ -24,6 +24,24 @@ AREAS = [
         ceiling=M + "ceiling"),
 ]
 
+AREA_NOTES = {
+    "hall": "four pillars, ceiling fan `fan_spin`, table, stacked crates, ceiling light panels, blood decal",
+    "corridor_west": "door `door_main`, flickering light, sign decal, light strip",
+    "atrium": "skylight with grate (sun through it), glass screen, plinth with a crate, blue wall panel, "
+              "projected `light_beam`, floor decal",
+    "skylight_shaft": "sky cap (emitter, noshadows), holds `light_sun`",
+    "stairwell": "eight steps (rise 12, run 28) up to the gallery floor at z 96",
+    "gallery": "raised room: pedestal with a glass case, gel projector `light_gel`, blue panels, crate",
+}
+
+# Suggested cameras (origin, yaw degrees, pitch degrees down) for renders and benchmarks.
+VIEWS = [
+    ("hall", (40, 192, 68), 0, 5),
+    ("atrium_skylight", (790, 30, 110), 40, 20),
+    ("stairs_up", (1168, 192, 68), 0, -10),
+    ("gallery", (1440, 300, 164), -30, 15),
+]
+
 STAIR_STEPS = 8
 STAIR_RISE = 12
 STAIR_RUN = 28
@@ -49,6 +67,14 @@ SOLID_MATERIALS = {
     "plinth": M + "concrete",
     "pedestal": M + "metal",
 }
+
+
+# World units per texture repeat on the shell (128 unless listed): bricks come out about 32 x 16 units.
+TEXEL_SCALE = {M + "wall_bricks": 64.0, M + "metalfloor": 64.0}
+
+
+def texel_scale_for(material):
+    return TEXEL_SCALE.get(material, 128.0)
 
 
 def material_for(area_index, inward_normal, neighbour):

@@ -1,4 +1,5 @@
 """assets/testmap/README.md: what the generated map contains, for people and for the loaders' tests."""
+from .numbers import fmt, fmt_vec
 
 
 def readme_text(stats, lights, files):
@@ -16,8 +17,8 @@ def readme_text(stats, lights, files):
     add("")
     add("## Areas (`_areaN` models)")
     add("")
-    for index, name in enumerate(stats["area_names"]):
-        add("- `_area%d`: %s" % (index, name))
+    for index, (name, lo, hi, note) in enumerate(stats["area_boxes"]):
+        add("- `_area%d` %s, box (%s)-(%s): %s" % (index, name, fmt_vec(lo), fmt_vec(hi), note))
     add("")
     add("The world shell is built on one grid shared by every wall, so it is watertight: taken together,")
     add("all areas' shell triangles form a closed surface (every edge used once in each direction), and")
@@ -45,11 +46,19 @@ def readme_text(stats, lights, files):
         extras = [k for k in ("light_center", "light_start", "light_end", "noshadows", "nospecular", "texture")
                   if k in light]
         detail = ", ".join("%s %s" % (k, light[k]) if k == "texture" else k for k in extras)
-        add("- `%s`: %s%s" % (light["name"], kind, (" (" + detail + ")") if detail else ""))
+        add("- `%s` at (%s): %s%s" % (light["name"], fmt_vec(light["origin"]), kind,
+                                      (" (" + detail + ")") if detail else ""))
     add("")
     add("`light_flicker` is meant to flicker: the application animates it by name. `light_sun` shines")
     add("through the skylight grate; the shaft's sky cap is `noshadows` so the sun passes it.")
     add("Lights without `texture` use the renderer's default (no default light images ship with the map).")
+    add("")
+    add("## Suggested views")
+    add("")
+    add("Origin, yaw (degrees about Z from +X), pitch (degrees down):")
+    add("")
+    for name, origin, yaw, pitch in stats["views"]:
+        add("- %s: (%s) yaw %s pitch %s" % (name, fmt_vec(origin), fmt(yaw), fmt(pitch)))
     add("")
     add("## Materials (`materials/testmap.mtr`)")
     add("")
@@ -62,8 +71,9 @@ def readme_text(stats, lights, files):
     add("constants; image programs `addnormals`, `heightmap`, `makealpha`, `makeintensity`; light shaders")
     add("`lights/testmap_round` and `lights/testmap_gel` with `lightFalloffImage`.")
     add("")
-    add("Normal maps (`*_local.tga`) are plain RGB, tangent space: X = +s (image right) in R, Y = image up")
-    add("in G, Z out of the surface in B; `*_h.tga` are height maps for `heightmap()`.")
+    add("Normal maps (`*_local.tga`) are plain RGB, tangent space: X along +s (image right) in R, Y along +t")
+    add("(image down, the row order) in G, Z out of the surface in B: the convention of the engine's")
+    add("`heightmap()` program, which computes (-dh/ds, -dh/dt, 1). `*_h.tga` are height maps for `heightmap()`.")
     add("")
     add("## Files")
     add("")

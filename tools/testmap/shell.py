@@ -73,10 +73,11 @@ def face_corners(grid, cell, axis, positive):
     return corners
 
 
-def build_shell(grid, material_for):
+def build_shell(grid, material_for, texel_scale_for=lambda material: 128.0):
     """Returns (area meshes, portal faces).
 
-    material_for(area_index, inward_normal, solid_name) -> material name.
+    material_for(area_index, inward_normal, solid_name) -> material name; texel_scale_for(material) ->
+    world units per texture repeat.
     Portal faces: {(area_a, area_b, axis, plane): {"faces": [corner lists], "a_below": bool}} with
     area_a < area_b; a_below says area_a lies on the lower-coordinate side of the plane.
     """
@@ -102,5 +103,6 @@ def build_shell(grid, material_for):
                 normal[axis] = -1.0 if positive else 1.0
                 normal = tuple(normal)
                 material = material_for(area, normal, other)
-                meshes[area].add_polygon(material, corners, normal, tag="shell")
+                meshes[area].add_polygon(material, corners, normal, texel_scale=texel_scale_for(material),
+                                         tag="shell")
     return meshes, portals

@@ -22,10 +22,9 @@ def make_image(size_x, size_y, pixel):
 
 
 def height_to_normal_rows(height, strength):
-    """Tangent-space normal map (X = image right, Y = image up, Z out), encoded n*0.5+0.5 in RGB.
-
-    Same orientation as the engine's heightmap() program: a bump's lit side faces up-left for a light
-    up-left of the surface.
+    """Tangent-space normal map, encoded n*0.5+0.5 in RGB: X along +s (image right), Y along +t
+    (image down: row order, t grows with the row), Z out of the surface. Same convention as the
+    engine's heightmap() program, which computes (-dh/ds, -dh/dt, 1).
     """
     h = len(height)
     w = len(height[0])
@@ -36,7 +35,7 @@ def height_to_normal_rows(height, strength):
             dx = (height[y][(x + 1) % w] - height[y][(x - 1) % w]) * 0.5
             dy_down = (height[(y + 1) % h][x] - height[(y - 1) % h][x]) * 0.5
             nx = -dx * strength
-            ny = dy_down * strength
+            ny = -dy_down * strength
             length = math.sqrt(nx * nx + ny * ny + 1.0)
             row.append(rgb((nx / length) * 0.5 + 0.5, (ny / length) * 0.5 + 0.5, (1.0 / length) * 0.5 + 0.5))
         rows.append(row)

@@ -32,6 +32,8 @@ __kernel void cohort_render_band(__global const KVertex* vertices, __global cons
   ctx.scene.material_count = 0u;
   ctx.scene.texture_count = 0u;
   ctx.tlas_node_count = params.tlas_node_count;
+  ctx.closest_rays = 0u;
+  ctx.occlusion_rays = 0u;
   KVec3 c = k_render_pixel(&ctx, &params, &camera, x, y);
   __global float* out = band_rgba + ((size_t)row * camera.width + x) * 4u;
   out[0] = c.x;

@@ -43,10 +43,12 @@ struct BalancerOptions {
   double alpha = 0.5;
   // Robin Hood: work units moved from the slowest to the fastest tracer per frame.
   int robin_hood_units = 2;
-  // Row Cost: how fast the per-unit cost map follows new measurements (1 = last frame only) and how
-  // fast the per-tracer speeds do. Speeds are hardware properties and change slowly; costs follow the view.
-  double cost_rate = 0.8;
-  double speed_rate = 0.15;
+  // Row Cost: how fast the per-unit cost map follows band times when there is no per-row work proxy
+  // (1 = last frame only), and how fast per-tracer speeds follow new measurements. Speeds are
+  // hardware properties, so they are smoothed hard, which cancels timing noise. Chosen by
+  // `cohort bench balance` sweeps (see docs/balancing.md).
+  double cost_rate = 0.5;
+  double speed_rate = 0.1;
 };
 
 // "none", "robin-hood", "perfect", "perfect-smooth", "row-cost". Throws std::invalid_argument naming

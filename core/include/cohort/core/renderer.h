@@ -33,6 +33,8 @@ struct RendererOptions {
   // Balance on the times tracers report (BandResult::device_ms) instead of wall-clock time. Simulated
   // tracers on a virtual clock need this; real GPU tracers may prefer their kernel times.
   bool use_reported_time = false;
+  // Pass the tracers' per-row work counts (BandResult::row_work) to the balancer as its cost proxy.
+  bool use_row_work = true;
 };
 
 class Renderer {
@@ -51,8 +53,15 @@ class Renderer {
 
   // Render one frame of job.camera.width x job.camera.height into `out` (resized if needed).
   // job.params.row_begin/row_end are set per band. row_cost_proxy (optional, one value per row) is
-  // passed to the balancer. Throws std::runtime_error when no tracer could render some rows.
+  // passed to the balancer; without one, the per-row work the tracers reported last frame
+  // (BandResult::row_work) is passed when it covers every row. Throws std::runtime_error when no tracer could render some rows.
   FrameStats render(const BandJob& job, FrameBuffer& out, const std::vector<float>& row_cost_proxy = {});
+  // render() in two halves, so the caller can update the BVH and fill the next commit buffers while
+  // the tracers work: begin_frame() hands out the bands and returns at once; finish_frame() waits,
+  // re-renders dropped tracers' rows and returns the stats. `out` must stay alive and untouched in
+  // between. Commits submitted after begin_frame() go to the next frame.
+  void begin_frame(const BandJob& job, FrameBuffer& out, const std::vector<float>& row_cost_proxy = {});
+  FrameStats finish_frame();
 
   int tracer_count() const;
   std::string tracer_name(int tracer) const;
@@ -72,15 +81,31 @@ class Renderer {
     std::vector<int> timed_out;
   };
 
-  RoundResult run_round(const std::vector<Assignment>& assignments, const BandJob& job, FrameBuffer& out,
-                        std::chrono::steady_clock::time_point deadline);
+  struct PendingFrame {
+    BandJob job;
+    FrameBuffer* out;
+    FrameStats stats;
+    std::vector<Assignment> assignments;
+    std::vector<uint64_t> ids;
+    std::chrono::steady_clock::time_point start;
+  };
+
+  // Hands each assignment to its worker (with the queued commits when with_commits) and returns the
+  // job ids; collect() waits for them until the deadline and merges the finished bands into out.
+  std::vector<uint64_t> assign(const std::vector<Assignment>& assignments, const BandJob& job, FrameBuffer& out,
+                               bool with_commits);
+  RoundResult collect(const std::vector<Assignment>& assignments, const std::vector<uint64_t>& ids, FrameBuffer& out,
+                      std::chrono::steady_clock::time_point deadline);
   double measured_ms(const Worker& w) const;
 
   RendererOptions options_;
   std::unique_ptr<balance::Balancer> balancer_;
   std::vector<std::unique_ptr<Worker>> workers_;
   std::vector<balance::TracerMeasurement> last_measurements_;
+  std::vector<float> row_work_;            // this frame's per-row work counts, as tracers report them
+  std::vector<uint8_t> row_work_known_;
   uint64_t next_job_ = 1;
+  std::unique_ptr<PendingFrame> pending_;
 };
 
 }  // namespace cohort::core

@@ -49,6 +49,10 @@ struct SimulatedTracerOptions {
   double ms_per_cost = 0.05;       // milliseconds per cost unit at speed 1
   SimulatedClock clock = SimulatedClock::virtual_time;
   double time_scale = 1.0;         // sleep/spin clocks wait time_scale * band time
+  // Report a per-row work count (BandResult::row_work) like a kernel counting rays per row: the true
+  // row cost distorted by a fixed per-row error and a per-frame one, each of relative size row_work_error.
+  bool report_row_work = false;
+  double row_work_error = 0.2;
   std::set<uint64_t> throw_on_frames;  // render_band throws on these frame indices
   std::set<uint64_t> hang_on_frames;   // render_band blocks for hang_ms (real time) on these frames
   double hang_ms = 0.0;

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <string>
+#include <vector>
 
 #include "cohort/commit/commit_buffer.h"
 #include "cohort/core/frame_buffer.h"
@@ -17,6 +18,9 @@ struct BandJob {
 
 struct BandResult {
   double device_ms = 0.0;  // time the tracer measured itself (kernel time for GPUs); 0 if it cannot
+  // Optional: a work count per row of the band, row_begin first (e.g. rays traced in that row). The
+  // core hands it to the balancer as an image-space cost map for the next frame. Empty if not counted.
+  std::vector<float> row_work;
 };
 
 class Tracer {

@@ -5,10 +5,10 @@
 
 namespace cohort::scene {
 
-// A grey height map (mean of RGB) to a tangent-space normal map (X in R, Y in G, Z in B), with the
-// engine's convention that `scale` is the bump height of a full-white texel.
+// A grey height map (mean of RGB) to a tangent-space normal map (X along +s in R, Y along +t, i.e.
+// down the rows, in G, Z in B): (-dh/ds, -dh/dt, 1) with heights 0..1 times `scale`, renormalized.
 Image heightmap_to_normals(const Image& height, float scale);
-// Sum of two normal maps, renormalized; `b` is resampled (nearest) to `a`'s size if they differ.
+// Two normal maps combined (xy summed, z multiplied: a detail map over a base), renormalized; `b` is resampled (nearest) to `a`'s size if they differ.
 Image add_normals(const Image& a, const Image& b);
 // A 3x3 average of a normal map, renormalized.
 Image smooth_normals(const Image& normals);

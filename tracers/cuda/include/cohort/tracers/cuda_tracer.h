@@ -22,6 +22,14 @@ class CudaTracer final : public core::Tracer {
   void apply(const commit::CommitBuffer& commit) override;
   core::BandResult render_band(const core::BandJob& job, core::FrameBuffer& target) override;
 
+  // Ray counting for benchmarks (off by default: it costs a reduction per warp).
+  struct RayCounts {
+    unsigned long long closest = 0, occlusion = 0;
+  };
+  void set_ray_counting(bool on);
+  RayCounts last_ray_counts() const;
+  int device() const;
+
  private:
   struct Impl;
   std::unique_ptr<Impl> impl_;

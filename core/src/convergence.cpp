@@ -1,0 +1,80 @@
+#include "cohort/core/convergence.h"
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+#include <stdexcept>
+#include <string>
+
+namespace cohort::core {
+
+namespace {
+
+double angle_between_degrees(const float a[3], const float b[3]) {
+  const double la = std::sqrt(double(a[0]) * a[0] + double(a[1]) * a[1] + double(a[2]) * a[2]);
+  const double lb = std::sqrt(double(b[0]) * b[0] + double(b[1]) * b[1] + double(b[2]) * b[2]);
+  if (la <= 0.0 || lb <= 0.0) return 0.0;
+  const double c = (double(a[0]) * b[0] + double(a[1]) * b[1] + double(a[2]) * b[2]) / (la * lb);
+  return std::acos(std::clamp(c, -1.0, 1.0)) * 180.0 / std::numbers::pi;
+}
+
+}  // namespace
+
+void AdaptiveConvergence::reset() {
+  have_previous_ = false;
+  effective_frames_ = 0.0;
+}
+
+double AdaptiveConvergence::next_factor(const KCamera& camera) {
+  double f = 1.0;
+  if (have_previous_ && camera.width == previous_.width && camera.height == previous_.height) {
+    const double dx = camera.origin[0] - previous_.origin[0], dy = camera.origin[1] - previous_.origin[1],
+                 dz = camera.origin[2] - previous_.origin[2];
+    const double translation = std::sqrt(dx * dx + dy * dy + dz * dz);
+    // Rotation: the larger of the view direction's turn and the roll of the up vector.
+    const double rotation = std::max(angle_between_degrees(camera.forward, previous_.forward),
+                                     angle_between_degrees(camera.up, previous_.up));
+    const bool cut = translation >= options_.cut_translation || rotation >= options_.cut_rotation_degrees;
+    const double motion = translation / options_.full_translation + rotation / options_.full_rotation_degrees;
+    if (cut) {
+      f = 1.0;
+    } else if (motion <= 1e-6) {
+      const double cap = std::max(1, options_.max_frames);
+      f = 1.0 / std::min(effective_frames_ + 1.0, cap);
+    } else {
+      // Continue from what the image is worth now, but never keep more than motion allows.
+      const double still = 1.0 / (effective_frames_ + 1.0);
+      f = std::clamp(std::max(still, options_.moving_floor + (1.0 - options_.moving_floor) * motion), options_.moving_floor, 1.0);
+    }
+  }
+  previous_ = camera;
+  have_previous_ = true;
+  effective_frames_ = 1.0 / f;
+  return f;
+}
+
+double AdaptiveConvergence::accumulate(const KCamera& camera, const FrameBuffer& fresh, const std::vector<float>* motion_mask) {
+  const size_t pixels = static_cast<size_t>(fresh.width) * fresh.height;
+  if (fresh.rgba.size() != pixels * 4) throw std::invalid_argument("AdaptiveConvergence: frame buffer size mismatch");
+  if (motion_mask && motion_mask->size() != pixels)
+    throw std::invalid_argument("AdaptiveConvergence: motion mask has " + std::to_string(motion_mask->size()) +
+                                " values for " + std::to_string(pixels) + " pixels");
+  if (fresh.width != accumulated_.width || fresh.height != accumulated_.height) reset();
+  const double f = next_factor(camera);
+  if (f >= 1.0) {
+    accumulated_ = fresh;
+    return f;
+  }
+  const float global = static_cast<float>(f);
+  const float object_f = static_cast<float>(options_.moving_object_f);
+  for (size_t p = 0; p < pixels; ++p) {
+    float fp = global;
+    if (motion_mask) fp = std::max(fp, std::clamp((*motion_mask)[p], 0.0f, 1.0f) * object_f);
+    float* c = accumulated_.rgba.data() + p * 4;
+    const float* n = fresh.rgba.data() + p * 4;
+    for (int k = 0; k < 4; ++k) c[k] = converge(c[k], n[k], fp);
+  }
+  return f;
+}
+
+}  // namespace cohort::core

@@ -1,0 +1,177 @@
+// The generated test map (assets/testmap) loads completely, and what the loader reports agrees with
+// counts taken from the files by plain text scanning, independent of the parsers.
+#include <gtest/gtest.h>
+
+#include <sstream>
+
+#include "cohort/scene/map_loader.h"
+#include "test_files.h"
+
+using namespace cohort::scene;
+using cohort::scene::test::read_text;
+namespace fs = std::filesystem;
+
+namespace {
+
+fs::path testmap_dir() { return fs::path(COHORT_SOURCE_DIR) / "assets/testmap"; }
+
+struct TextCounts {
+  int area_models = 0, inline_models = 0;
+  size_t world_triangles = 0;
+  int lights = 0, projected = 0, parallel = 0;
+  std::map<std::string, int> classes;
+};
+
+// The number after a "/* label = */" comment on a line, or -1.
+long long labelled_number(const std::string& line, const std::string& label) {
+  auto at = line.find("/* " + label + " = */");
+  if (at == std::string::npos) return -1;
+  return std::stoll(line.substr(at + label.size() + 8));
+}
+
+std::string quoted_after(const std::string& line, size_t from) {
+  auto open = line.find('"', from);
+  auto close = line.find('"', open + 1);
+  return line.substr(open + 1, close - open - 1);
+}
+
+TextCounts count_from_text() {
+  TextCounts counts;
+  std::istringstream proc(read_text(testmap_dir() / "maps/testmap.proc"));
+  bool in_area = false;
+  for (std::string line; std::getline(proc, line);) {
+    if (line.rfind("model {", 0) == 0) {
+      in_area = quoted_after(line, 0).rfind("_area", 0) == 0;
+      (in_area ? counts.area_models : counts.inline_models)++;
+    }
+    long long indexes = labelled_number(line, "numIndexes");
+    if (in_area && indexes > 0) counts.world_triangles += static_cast<size_t>(indexes / 3);
+    if (line.rfind("shadowModel", 0) == 0 || line.rfind("interAreaPortals", 0) == 0) in_area = false;
+  }
+  std::istringstream map(read_text(testmap_dir() / "maps/testmap.map"));
+  bool in_light = false;
+  for (std::string line; std::getline(map, line);) {
+    if (line.rfind("\"classname\"", 0) == 0) {
+      std::string classname = quoted_after(line, 11);
+      in_light = classname == "light";
+      if (in_light) ++counts.lights;
+      else if (classname != "worldspawn") ++counts.classes[classname];
+    }
+    if (in_light && line.rfind("\"light_target\"", 0) == 0) ++counts.projected;
+    if (in_light && line == "\"parallel\" \"1\"") ++counts.parallel;
+  }
+  return counts;
+}
+
+// The value of key in the map entity named name, by text scanning.
+std::string entity_value(const std::string& name, const std::string& key) {
+  std::istringstream map(read_text(testmap_dir() / "maps/testmap.map"));
+  std::vector<std::string> block;
+  for (std::string line; std::getline(map, line);) {
+    if (line == "{") block.clear();
+    block.push_back(line);
+    if (line == "}" && std::find(block.begin(), block.end(), "\"name\" \"" + name + "\"") != block.end())
+      for (const auto& l : block)
+        if (l.rfind("\"" + key + "\"", 0) == 0) return quoted_after(l, key.size() + 2);
+  }
+  return "";
+}
+
+glm::vec3 vec3_of(const std::string& text) {
+  std::istringstream in(text);
+  glm::vec3 v(0.0f);
+  in >> v.x >> v.y >> v.z;
+  return v;
+}
+
+class TestMap : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    if (!fs::exists(testmap_dir() / "maps/testmap.map")) GTEST_SKIP() << "assets/testmap is not generated";
+    Vfs vfs;
+    vfs.add_search_path(testmap_dir());
+    scene = load_map(vfs, "testmap", &report);
+  }
+  Scene scene;
+  LoadReport report;
+};
+
+const Light& light_named(const Scene& s, const std::string& name) {
+  for (const Light& l : s.lights)
+    if (l.name == name) return l;
+  throw std::runtime_error("no light " + name);
+}
+
+}  // namespace
+
+TEST_F(TestMap, CountsAgreeWithTheFiles) {
+  TextCounts expected = count_from_text();
+  EXPECT_EQ(report.areas, expected.area_models);
+  EXPECT_EQ(static_cast<int>(scene.area_meshes.size()), expected.area_models);
+  EXPECT_EQ(report.inline_models, expected.inline_models);
+  EXPECT_EQ(scene.world_triangle_count(), expected.world_triangles);
+  EXPECT_EQ(static_cast<int>(scene.lights.size()), expected.lights);
+  EXPECT_EQ(report.lights_projected, expected.projected);
+  EXPECT_EQ(report.lights_parallel, expected.parallel);
+  EXPECT_EQ(report.lights_point, expected.lights - expected.projected - expected.parallel);
+  EXPECT_EQ(report.entities_by_class, expected.classes);
+  EXPECT_GT(scene.portals.size(), 0u);
+  EXPECT_GT(scene.nodes.size(), 0u);
+}
+
+TEST_F(TestMap, LoadsWithoutWarningsOrPlaceholders) {
+  EXPECT_TRUE(report.warnings.empty()) << ::testing::PrintToString(report.warnings);
+  EXPECT_EQ(report.materials_missing, 0);
+  EXPECT_EQ(report.images_placeholder, 0);
+  for (const Entity& e : scene.entities)
+    if (e.classname != "info_player_start") EXPECT_GE(e.mesh, 0) << e.name;
+}
+
+TEST_F(TestMap, ProjectedBeamMatchesItsKeys) {
+  const Light& beam = light_named(scene, "light_beam");
+  EXPECT_EQ(beam.type, LightType::Projected);
+  EXPECT_EQ(beam.origin, vec3_of(entity_value("light_beam", "origin")));
+  EXPECT_EQ(beam.target, vec3_of(entity_value("light_beam", "light_target")));
+  EXPECT_EQ(beam.right, vec3_of(entity_value("light_beam", "light_right")));
+  EXPECT_EQ(beam.up, vec3_of(entity_value("light_beam", "light_up")));
+  EXPECT_EQ(beam.start, vec3_of(entity_value("light_beam", "light_start")));
+  EXPECT_EQ(beam.end, vec3_of(entity_value("light_beam", "light_end")));
+  EXPECT_EQ(beam.color, vec3_of(entity_value("light_beam", "_color")));
+  EXPECT_TRUE(beam.has_start_end);
+  ASSERT_GE(beam.material, 0);
+  const Material& shader = scene.materials[static_cast<size_t>(beam.material)];
+  EXPECT_EQ(shader.name, entity_value("light_beam", "texture"));
+  EXPECT_TRUE(shader.is_light_material);
+  EXPECT_GE(shader.light_image, 0);
+  EXPECT_GE(shader.falloff_image, 0);
+}
+
+TEST_F(TestMap, SunIsParallelWithItsCenter) {
+  const Light& sun = light_named(scene, "light_sun");
+  EXPECT_EQ(sun.type, LightType::Parallel);
+  EXPECT_EQ(sun.center, vec3_of(entity_value("light_sun", "light_center")));
+  EXPECT_EQ(sun.radius, vec3_of(entity_value("light_sun", "light_radius")));
+}
+
+TEST_F(TestMap, MaterialClasses) {
+  auto m = [&](const char* name) -> const Material& {
+    int i = scene.find_material(name);
+    EXPECT_GE(i, 0) << name;
+    return scene.materials.at(static_cast<size_t>(i));
+  };
+  EXPECT_TRUE(m("textures/testmap/grate").alpha_test);
+  EXPECT_TRUE(m("textures/testmap/grate").two_sided);
+  EXPECT_EQ(m("textures/testmap/glass").blend, BlendClass::Alpha);
+  EXPECT_TRUE(m("textures/testmap/glass").translucent);
+  EXPECT_TRUE(m("textures/testmap/glass").no_shadows);
+  EXPECT_EQ(m("textures/testmap/decal_blood").blend, BlendClass::Modulate);
+  EXPECT_EQ(m("textures/testmap/lightpanel").blend, BlendClass::Additive);
+  EXPECT_TRUE(m("textures/testmap/lightpanel").emitter);
+  EXPECT_EQ(m("textures/testmap/lightpanel_blue").emissive_color, glm::vec4(0.5f, 0.75f, 1.0f, 1.0f));
+  EXPECT_TRUE(m("textures/testmap/sky").emitter);
+  EXPECT_EQ(m("textures/testmap/sky").blend, BlendClass::Opaque);
+  EXPECT_EQ(m("textures/testmap/floor_tiles").blend, BlendClass::Opaque);
+  EXPECT_GE(m("textures/testmap/floor_tiles").normal_image, 0);
+  EXPECT_TRUE(scene.images[static_cast<size_t>(m("textures/testmap/floor_tiles").normal_image)].is_normal_map);
+  EXPECT_FLOAT_EQ(m("textures/testmap/concrete").tex_transform[0], 2.0f);
+}

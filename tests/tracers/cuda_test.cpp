@@ -1,0 +1,160 @@
+// The CUDA tracer against the CPU tracers. Skipped, with the reason, where no GPU exists (CI); run on
+// the GPU machine through tools/gpu_run.sh.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdlib>
+#include <iostream>
+
+#include "cohort/core/gpu_scene.h"
+#include "cohort/core/scene_pack.h"
+#include "test_scenes.h"
+#include "test_tracers.h"
+
+#ifdef COHORT_HAVE_CUDA
+
+using namespace cohort;
+using namespace cohort::test;
+
+namespace {
+
+double relative_rmse(const core::FrameBuffer& a, const core::FrameBuffer& b) {
+  double sum = 0.0, sum_sq = 0.0;
+  size_t n = 0;
+  for (size_t i = 0; i < a.rgba.size(); ++i) {
+    if (i % 4 == 3) continue;
+    double d = double(a.rgba[i]) - double(b.rgba[i]);
+    sum_sq += d * d;
+    sum += 0.5 * (double(a.rgba[i]) + double(b.rgba[i]));
+    ++n;
+  }
+  double mean = sum / double(n);
+  return mean > 0.0 ? std::sqrt(sum_sq / double(n)) / mean : 0.0;
+}
+
+core::FrameBuffer render_scene(core::Tracer& tracer, const commit::TracerScene& scene, const KCamera& cam,
+                               const KFrameParams& params) {
+  tracer.apply(commit::CommitBuffer::full(std::make_shared<commit::TracerScene>(scene), 1));
+  core::FrameBuffer fb;
+  fb.resize(int(cam.width), int(cam.height));
+  core::BandJob job;
+  job.params = params;
+  job.camera = cam;
+  tracer.render_band(job, fb);
+  return fb;
+}
+
+#define REQUIRE_GPU()                                                                                   \
+  if (tracers::cuda_device_count() == 0) GTEST_SKIP() << "no CUDA device on this machine (run tools/gpu_run.sh)"
+
+struct ModeCase {
+  uint32_t mode, bounces;
+  const char* name;
+};
+
+class CudaAgreement : public ::testing::TestWithParam<ModeCase> {};
+
+// Same bound as the Embree/OpenCL agreement test: RMSE below 0.5% of the mean at 16 spp.
+TEST_P(CudaAgreement, MatchesEmbree) {
+  REQUIRE_GPU();
+  const ModeCase c = GetParam();
+  scene::Scene room = test_room();
+  const int w = 64, h = 48;
+  KCamera cam = test_room_camera(w, h);
+  KFrameParams params = frame_params(c.mode, 16, c.bounces, h);
+  params.firefly_clamp = 10.0f;
+  params.soft_shadow_scale = 1.0f;
+  params.rr_start = 2.0f;
+  params.frame_index = 7;
+  auto embree = make_test_tracer("embree");
+  auto cuda = make_test_tracer("cuda");
+  core::FrameBuffer a = render(*embree, room, cam, params);
+  core::FrameBuffer b = render(*cuda, room, cam, params);
+  for (float v : b.rgba) ASSERT_TRUE(std::isfinite(v));
+  double error = relative_rmse(a, b);
+  std::cout << c.name << ": relative RMSE embree/cuda " << error << "\n";
+  EXPECT_LT(error, 0.005) << c.name;
+  if (const char* dir = std::getenv("COHORT_TEST_IMAGES")) {
+    write_preview(std::string(dir) + "/cuda_" + c.name + "_embree.ppm", a);
+    write_preview(std::string(dir) + "/cuda_" + c.name + "_cuda.ppm", b);
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(Modes, CudaAgreement,
+                         ::testing::Values(ModeCase{K_MODE_PATH, 1, "path"}, ModeCase{K_MODE_PATH, 3, "path3"},
+                                           ModeCase{K_MODE_DIRECT, 0, "direct"}, ModeCase{K_MODE_ALBEDO, 0, "albedo"}),
+                         [](const auto& info) { return std::string(info.param.name); });
+
+// Several GPUs render different bands of one frame; the merged frame equals one GPU's whole frame.
+TEST(CudaMultiGpu, BandsMergeIntoTheSingleGpuFrame) {
+  const int gpus = tracers::cuda_device_count();
+  if (gpus < 2) GTEST_SKIP() << "needs at least 2 CUDA devices, found " << gpus;
+  scene::Scene room = test_room();
+  core::CompiledScene compiled = core::compile_scene(room);
+  const int w = 96, h = 64;
+  KCamera cam = test_room_camera(w, h);
+  KFrameParams params = frame_params(K_MODE_PATH, 4, 1, h);
+  tracers::CudaTracer single(0);
+  core::FrameBuffer whole = render_scene(single, compiled.tracer_scene, cam, params);
+
+  core::FrameBuffer merged;
+  merged.resize(w, h);
+  std::vector<std::unique_ptr<tracers::CudaTracer>> per_gpu;
+  for (int g = 0; g < gpus; ++g) {
+    per_gpu.push_back(std::make_unique<tracers::CudaTracer>(g));
+    per_gpu.back()->apply(commit::CommitBuffer::full(std::make_shared<commit::TracerScene>(compiled.tracer_scene), 1));
+  }
+  const int rows_per_gpu = (h / gpus + 3) / 4 * 4;   // bands in whole work units of 4 rows
+  for (int g = 0; g < gpus; ++g) {
+    core::BandJob job;
+    job.params = params;
+    job.camera = cam;
+    job.params.row_begin = uint32_t(std::min(h, g * rows_per_gpu));
+    job.params.row_end = uint32_t(g == gpus - 1 ? h : std::min(h, (g + 1) * rows_per_gpu));
+    per_gpu[size_t(g)]->render_band(job, merged);
+  }
+  // Same integrator, same random numbers, same GPU model: the results agree to rounding.
+  double error = relative_rmse(whole, merged);
+  EXPECT_LT(error, 1e-4) << "relative RMSE " << error;
+}
+
+// A scene pack renders on the GPU like the scene compiled in memory, and (when COHORT_PACK names the
+// packed test map, as tools/gpu_run.sh does) the packed map renders on CUDA like on Embree.
+TEST(CudaScenePack, PackedSceneMatchesEmbree) {
+  REQUIRE_GPU();
+  const char* pack_file = std::getenv("COHORT_PACK");
+  commit::TracerScene scene;
+  KCamera cam;
+  const int w = 128, h = 72;
+  if (pack_file) {
+    core::PackedScene pack = core::read_scene_pack(pack_file);
+    scene = pack.tracer_scene;
+    // Eye height above the player start, looking along its yaw, as `cohort render` does.
+    glm::vec3 eye(pack.player_start[0], pack.player_start[1], pack.player_start[2] + 68.0f);
+    cam = core::make_camera(eye, pack.player_yaw, 0.0f, 90.0f, w, h);
+  } else {
+    scene = core::compile_scene(test_room()).tracer_scene;
+    cam = test_room_camera(w, h);
+  }
+  KFrameParams params = frame_params(K_MODE_PATH, 16, 1, h);
+  params.frame_index = 3;
+  auto embree = make_test_tracer("embree");
+  auto cuda = make_test_tracer("cuda");
+  core::FrameBuffer a = render_scene(*embree, scene, cam, params);
+  core::FrameBuffer b = render_scene(*cuda, scene, cam, params);
+  double error = relative_rmse(a, b);
+  std::cout << (pack_file ? pack_file : "test room") << ": relative RMSE embree/cuda " << error << "\n";
+  EXPECT_LT(error, 0.005);
+  if (const char* dir = std::getenv("COHORT_TEST_IMAGES")) {
+    write_preview(std::string(dir) + "/pack_embree.ppm", a);
+    write_preview(std::string(dir) + "/pack_cuda.ppm", b);
+  }
+}
+
+}  // namespace
+
+#else
+
+TEST(Cuda, NotBuilt) { GTEST_SKIP() << "this build has no CUDA tracer (nvcc not found or COHORT_WITH_CUDA=OFF)"; }
+
+#endif

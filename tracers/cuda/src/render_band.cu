@@ -1,0 +1,56 @@
+// CUDA entry point: one thread per pixel of the band, running the shared integrator over the portable
+// two-level BVH, exactly as the OpenCL kernel does. Texels are read through a texture object (the
+// read-only texture cache); everything else through plain global loads.
+#include <cuda_runtime.h>
+
+#define K_CUDA_DEVICE_ONLY 1
+__constant__ cudaTextureObject_t cohort_texel_texture;
+#define K_TEXEL_LOAD(texels, index) tex1Dfetch<unsigned int>(cohort_texel_texture, (int)(index))
+
+#include "kernel/trace_bvh.h"
+#include "kernel/integrator.h"
+#include "render_band_launch.h"
+
+namespace cohort::tracers {
+
+__global__ void __launch_bounds__(128) render_band_kernel(KSceneView scene, kuint tlas_node_count, KFrameParams params,
+                                                          KCamera camera, float4* band,
+                                                          unsigned long long* ray_counts) {
+  const kuint x = blockIdx.x * blockDim.x + threadIdx.x;
+  const kuint row = blockIdx.y * blockDim.y + threadIdx.y;
+  const kuint y = params.row_begin + row;
+  const bool inside = x < camera.width && y < params.row_end;
+  KTraceCtx ctx;
+  ctx.scene = scene;
+  ctx.tlas_node_count = tlas_node_count;
+  ctx.closest_rays = 0u;
+  ctx.occlusion_rays = 0u;
+  if (inside) {
+    KVec3 c = k_render_pixel(&ctx, &params, &camera, x, y);
+    band[size_t(row) * camera.width + x] = make_float4(c.x, c.y, c.z, 1.0f);
+  }
+  if (ray_counts) {
+    // One atomic per warp: the whole warp reaches here, inside the image or not.
+    unsigned closest = __reduce_add_sync(0xffffffffu, ctx.closest_rays);
+    unsigned occlusion = __reduce_add_sync(0xffffffffu, ctx.occlusion_rays);
+    if ((threadIdx.x + threadIdx.y * blockDim.x) % 32u == 0u) {
+      atomicAdd(&ray_counts[0], (unsigned long long)closest);
+      atomicAdd(&ray_counts[1], (unsigned long long)occlusion);
+    }
+  }
+}
+
+void set_texel_texture(cudaTextureObject_t texture) {
+  COHORT_CUDA(cudaMemcpyToSymbol(cohort_texel_texture, &texture, sizeof texture));
+}
+
+void launch_render_band(const KSceneView& scene, kuint tlas_node_count, const KFrameParams& params,
+                        const KCamera& camera, float4* band, unsigned long long* ray_counts, cudaStream_t stream) {
+  const kuint rows = params.row_end - params.row_begin;
+  const dim3 block(16, 8);
+  const dim3 grid((camera.width + block.x - 1) / block.x, (rows + block.y - 1) / block.y);
+  render_band_kernel<<<grid, block, 0, stream>>>(scene, tlas_node_count, params, camera, band, ray_counts);
+  COHORT_CUDA(cudaGetLastError());
+}
+
+}  // namespace cohort::tracers

@@ -1,0 +1,14 @@
+#pragma once
+
+#include <cuda_runtime.h>
+
+#include "cuda_check.h"
+#include "kernel/scene_view.h"
+
+namespace cohort::tracers {
+
+void set_texel_texture(cudaTextureObject_t texture);
+void launch_render_band(const KSceneView& scene, kuint tlas_node_count, const KFrameParams& params,
+                        const KCamera& camera, float4* band, unsigned long long* ray_counts, cudaStream_t stream);
+
+}  // namespace cohort::tracers
