@@ -207,9 +207,9 @@ KFN int k_bvh_traverse(KSceneRef scene, K_BVH_CONTEXT ctx, int query, KVec3 o, K
       for (kuint i = n->left_first; i < end; ++i) {
         KGLOBAL const KInstance* inst = scene.instances + i;
         if ((inst->mask & mask) == 0u) continue;
-        KBvhRay local = k_bvh_make_ray(xform_point_g(inst->world_to_object, o),
+        KBvhRay object_ray = k_bvh_make_ray(xform_point_g(inst->world_to_object, o),
                                        xform_vector_g(inst->world_to_object, d));
-        if (k_bvh_traverse_blas(scene, ctx, query, i, local, tmin, &tmax, hit, transmittance)) return 1;
+        if (k_bvh_traverse_blas(scene, ctx, query, i, object_ray, tmin, &tmax, hit, transmittance)) return 1;
       }
     } else {
       kuint near_child = n->left_first, far_child = n->left_first + 1u;
