@@ -33,6 +33,10 @@ BalanceBenchRun run_one(const BalanceBenchConfig& config, const std::string& pat
       o.speed = config.speeds[static_cast<size_t>(i) % config.speeds.size()];
       o.noise = config.noise;
       o.report_row_work = config.row_work;
+      o.clock = config.clock == "sleep"   ? core::SimulatedClock::sleep
+                : config.clock == "spin" ? core::SimulatedClock::spin
+                                         : core::SimulatedClock::virtual_time;
+      o.time_scale = config.time_scale;
       o.row_work_error = config.row_work_error;
       o.seed = config.seed * 1000 + static_cast<uint64_t>(i) + 1;
       tracers.push_back(std::make_unique<core::SimulatedTracer>(model, o));
@@ -41,7 +45,7 @@ BalanceBenchRun run_one(const BalanceBenchConfig& config, const std::string& pat
   core::RendererOptions options;
   options.balancer = balancer;
   options.balancer_options = config.balancer_options;
-  options.use_reported_time = config.real.empty();
+  options.use_reported_time = config.real.empty() && config.clock == "virtual";
   core::Renderer renderer(std::move(tracers), options);
 
   BalanceBenchRun run{path, balancer, renderer.tracer_count(), 0.0, 0.0, {}};
@@ -88,7 +92,7 @@ nlohmann::json balance_bench_json(const BalanceBenchConfig& config, const std::v
                  {"rows", config.rows},                   {"seed", config.seed},      {"alpha", config.balancer_options.alpha},
                  {"robin_hood_units", config.balancer_options.robin_hood_units},
                  {"row_cost_rates", {config.balancer_options.cost_rate, config.balancer_options.speed_rate}},
-                 {"real", config.real},
+                 {"real", config.real}, {"clock", config.clock}, {"time_scale", config.time_scale},
                  {"metric", "idle % = sum over tracers of (frame time - tracer time) / (tracers * frame time)"}};
   j["runs"] = nlohmann::json::array();
   for (const BalanceBenchRun& r : runs) {

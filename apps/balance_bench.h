@@ -18,6 +18,10 @@ struct BalanceBenchConfig {
   double noise = 0.02;
   bool row_work = true;                  // simulated tracers report per-row work (the Row Cost proxy)
   double row_work_error = 0.2;
+  // Simulated tracers on the virtual clock report their times; on "sleep" or "spin" they take that
+  // long (times time_scale) and the renderer measures wall-clock time, threads and all.
+  std::string clock = "virtual";
+  double time_scale = 1.0;
   int frames = 360;
   int warmup = 5;                        // first frames left out of mean/worst (nothing measured yet)
   std::vector<std::string> paths{"slow", "fast"};

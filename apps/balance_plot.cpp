@@ -65,7 +65,7 @@ void write_balance_plot(const std::string& file, const std::vector<BalanceBenchR
       for (const BalanceBenchRun& r : runs)
         if (r.path == paths[pi] && r.tracers == counts[ci]) panel.push_back(&r);
       if (panel.empty()) continue;
-      // The y range follows the typical balancer: twice the median over runs of each run's 95th
+      // The y range follows the better balancers: twice the lower-third (over runs) of each run's 95th
       // percentile, so a "none" or oscillating "perfect" line far above is clipped at the top.
       std::vector<double> typical;
       size_t frames = 0;
@@ -77,7 +77,7 @@ void write_balance_plot(const std::string& file, const std::vector<BalanceBenchR
         frames = std::max(frames, r->idle_percent.size());
       }
       std::sort(typical.begin(), typical.end());
-      const double y_max = nice_ceiling(typical.empty() ? 1.0 : 2.0 * typical[typical.size() / 2]);
+      const double y_max = nice_ceiling(typical.empty() ? 1.0 : 2.0 * typical[(typical.size() - 1) / 3]);
       const std::string title = paths[pi] + " spin, " + std::to_string(counts[ci]) + " tracers: idle % per frame";
       canvas.text(x0, y0 - 24, title, kInk);
       for (int t = 0; t <= 4; ++t) {

@@ -45,6 +45,8 @@ void add_bench_command(CLI::App& app) {
     std::string balancers, tracers = "2,3,4", speeds = "1", path = "both", real, json, plot;
     double noise = 0.02, row_work_error = 0.2;
     bool row_work = true;
+    std::string clock = "virtual";
+    double time_scale = 1.0;
     int frames = 360, warmup = 5, rows = 720;
     uint64_t seed = 1;
     balance::BalancerOptions options;
@@ -66,6 +68,12 @@ void add_bench_command(CLI::App& app) {
                     "simulated tracers do not report per-row work counts (Row Cost then learns row costs from band times only)");
   balance->add_option("--row-work-error", args->row_work_error, "relative error of the simulated per-row work counts")
       ->capture_default_str();
+  balance->add_option("--clock", args->clock,
+                      "simulated tracers: virtual (report times, fast and reproducible), sleep or spin (really take "
+                      "the time x --time-scale; the renderer measures wall-clock time)")
+      ->check(CLI::IsMember({"virtual", "sleep", "spin"}))->capture_default_str();
+  balance->add_option("--time-scale", args->time_scale, "sleep/spin clocks: wall time per simulated ms")
+      ->capture_default_str()->check(CLI::PositiveNumber);
   balance->add_option("--cost-rate", args->options.cost_rate, "Row Cost: how fast the per-unit cost map follows new times")
       ->capture_default_str();
   balance->add_option("--speed-rate", args->options.speed_rate, "Row Cost: how fast per-tracer speeds follow new times")
@@ -80,6 +88,8 @@ void add_bench_command(CLI::App& app) {
     config.speeds = split_list<double>(args->speeds, "--speeds");
     config.noise = args->noise;
     config.row_work = args->row_work;
+    config.clock = args->clock;
+    config.time_scale = args->time_scale;
     config.row_work_error = args->row_work_error;
     config.frames = args->frames;
     config.warmup = args->warmup;
@@ -108,7 +118,7 @@ void add_bench_command(CLI::App& app) {
                                             (config.row_work ? ", per-row work counts with error " + format_fraction(config.row_work_error)
                                                              : ", no per-row work counts")
                                       : "real tracers: " + args->real)
-              << ", " << config.frames << " frames (first " << config.warmup << " not counted), " << config.rows << " rows\n"
+              << (config.real.empty() ? ", " + config.clock + " clock" : "") << ", " << config.frames << " frames (first " << config.warmup << " not counted), " << config.rows << " rows\n"
               << balance_bench_table(runs);
     if (!args->json.empty()) {
       std::ofstream out(args->json);

@@ -28,7 +28,7 @@ struct RenderArgs {
   std::string balancer = "perfect-smooth";
   std::string mode = "path";
   std::string out = "render_out";
-  int width = 640, height = 360, spp = 4, frames = 1, bounces = 1, light_samples = 1;
+  int width = 640, height = 360, spp = 4, frames = 1, bounces = 1, light_samples = 0;
   float fov = 90.0f, exposure = 1.0f, firefly_clamp = 5.0f, spec_boost = 2.0f, soft_shadow_scale = 0.2f;
   float yaw_step = 0.0f;
   std::vector<float> camera;  // x y z yaw pitch
@@ -114,7 +114,10 @@ void add_render_command(CLI::App& app) {
   cmd->add_option("--spp", a->spp, "samples per pixel per frame")->capture_default_str()->check(CLI::PositiveNumber);
   cmd->add_option("--frames", a->frames, "frames to render")->capture_default_str()->check(CLI::PositiveNumber);
   cmd->add_option("--bounces", a->bounces, "indirect bounces")->capture_default_str()->check(CLI::NonNegativeNumber);
-  cmd->add_option("--light-samples", a->light_samples, "shadow rays per hit")->capture_default_str();
+  cmd->add_option("--light-samples", a->light_samples,
+                  "lights sampled per hit, picked by contribution (0: every light reaching the point)")
+      ->capture_default_str()
+      ->check(CLI::NonNegativeNumber);
   cmd->add_option("--mode", a->mode, "path, direct, albedo, normals, specular, bvh, triangles")
       ->capture_default_str()
       ->check(CLI::IsMember({"path", "direct", "albedo", "normals", "specular", "bvh", "triangles"}));

@@ -108,7 +108,7 @@ int main(int argc, char** argv) {
   job.camera = camera;
   job.params.spp = uint32_t(cfg.spp);
   job.params.max_bounces = uint32_t(cfg.bounces);
-  job.params.light_samples = 1;
+  job.params.light_samples = 0;  // every light reaching a point, as cohort render does by default
   job.params.spec_boost = 2.0f;
   job.params.mode = K_MODE_PATH;
   job.params.row_begin = 0;

@@ -21,6 +21,8 @@
 #endif
 
 #define K_MAX_LAYERS 16   /* transparent layers a ray may cross without consuming a bounce */
+#define K_REGULARIZED_ROUGHNESS 0.5f  /* least roughness of surfaces reached by a bounce */
+#define K_BOUNCE_SPREAD 0.1f          /* ray-cone widening per bounce (radians), for mip selection */
 
 KFN float k_ray_epsilon(KVec3 p) {
   return 1e-3f + 2e-5f * k_fmax(k_fabs(p.x), k_fmax(k_fabs(p.y), k_fabs(p.z)));
@@ -34,13 +36,37 @@ KFN KVec3 k_camera_direction(const KCamera* cam, float px, float py) {
   return v3_normalize(d);
 }
 
-/* Next-event estimation: picks one light per light sample in proportion to its unshadowed
- * contribution (so the many lights that cannot reach this point cost no rays) and traces one
- * shadow ray toward a point jittered over its extent. */
+/* One shadow ray toward a point jittered over the light's extent: 1 when the light is visible. */
+KFN int k_light_visible(KTraceCtx* ctx, const KFrameParams* params, const KSurface* sf, KGLOBAL const KLight* light,
+                        float u1, float u2) {
+  if (light->flags & K_LIGHT_NO_SHADOWS) return 1;
+  float dist;
+  KVec3 dir = k_light_jittered_direction(light, sf->position, params->soft_shadow_scale, u1, u2, &dist);
+  if (v3_dot(dir, sf->geo_normal) <= 0.0f) return 0;
+  float eps = k_ray_epsilon(sf->position);
+  KVec3 org = v3_madd(sf->position, sf->geo_normal, eps);
+  float tmax = dist < K_INF ? dist - 2.0f * eps : K_INF;
+  return tmax <= 0.0f || !k_trace_occluded(ctx, org, dir, tmax, K_RAY_SHADOW);
+}
+
+/* Next-event estimation. light_samples == 0: every light that reaches the point, one shadow ray each
+ * (as Doom 3 draws every interaction; lowest noise where few lights overlap). Otherwise, per light
+ * sample, one light picked in proportion to its unshadowed contribution (so the many lights that
+ * cannot reach this point cost no rays) and one shadow ray toward it. */
 KFN KVec3 k_direct_lighting(KTraceCtx* ctx, const KFrameParams* params, const KSurface* sf, KVec3 wo, KRng* rng) {
   const KSceneView* scene = K_CTX_SCENE(ctx);
-  kuint samples = params->light_samples > 0u ? params->light_samples : 1u;
   KVec3 sum = v3s(0.0f);
+  if (params->light_samples == 0u) {
+    for (kuint i = 0u; i < params->light_count; ++i) {
+      KGLOBAL const KLight* light = &scene->lights[i];
+      KVec3 c = k_light_unshadowed(scene, light, sf, wo, params->spec_boost);
+      if (v3_max_component(c) <= 0.0f) continue;
+      float u1 = k_rng_next(rng), u2 = k_rng_next(rng);
+      if (k_light_visible(ctx, params, sf, light, u1, u2)) sum = v3_add(sum, c);
+    }
+    return sum;
+  }
+  kuint samples = params->light_samples;
   for (kuint k = 0u; k < samples; ++k) {
     float total = 0.0f, chosen_weight = 0.0f;
     kuint chosen = K_NONE;
@@ -63,16 +89,7 @@ KFN KVec3 k_direct_lighting(KTraceCtx* ctx, const KFrameParams* params, const KS
     }
     float u1 = k_rng_next(rng), u2 = k_rng_next(rng);
     if (chosen == K_NONE) continue;
-    KGLOBAL const KLight* light = &scene->lights[chosen];
-    if (!(light->flags & K_LIGHT_NO_SHADOWS)) {
-      float dist;
-      KVec3 dir = k_light_jittered_direction(light, sf->position, params->soft_shadow_scale, u1, u2, &dist);
-      if (v3_dot(dir, sf->geo_normal) <= 0.0f) continue;
-      float eps = k_ray_epsilon(sf->position);
-      KVec3 org = v3_madd(sf->position, sf->geo_normal, eps);
-      float tmax = dist < K_INF ? dist - 2.0f * eps : K_INF;
-      if (tmax > 0.0f && k_trace_occluded(ctx, org, dir, tmax, K_RAY_SHADOW)) continue;
-    }
+    if (!k_light_visible(ctx, params, sf, &scene->lights[chosen], u1, u2)) continue;
     sum = v3_add(sum, v3_scale(chosen_contrib, total / chosen_weight));
   }
   return v3_scale(sum, 1.0f / (float)samples);
@@ -94,10 +111,12 @@ KFN KVec3 k_id_color(kuint id) {
   return v3((float)(h & 0xFFu) / 255.0f, (float)((h >> 8) & 0xFFu) / 255.0f, (float)((h >> 16) & 0xFFu) / 255.0f);
 }
 
-/* Radiance along one camera ray. */
-KFN KVec3 k_trace_path(KTraceCtx* ctx, const KFrameParams* params, KVec3 org, KVec3 dir, KRng* rng) {
+/* Radiance along one camera ray; pixel_spread is the angle one pixel subtends (for mip selection). */
+KFN KVec3 k_trace_path(KTraceCtx* ctx, const KFrameParams* params, KVec3 org, KVec3 dir, float pixel_spread,
+                       KRng* rng) {
   const KSceneView* scene = K_CTX_SCENE(ctx);
   KVec3 radiance = v3s(0.0f), throughput = v3s(1.0f);
+  float cone_width = 0.0f, spread = pixel_spread;
   kuint bounce = 0u, layers = 0u;
   float tmax = K_INF;
   for (;;) {
@@ -109,7 +128,8 @@ KFN KVec3 k_trace_path(KTraceCtx* ctx, const KFrameParams* params, KVec3 org, KV
     }
     if (params->mode == K_MODE_BVH) { radiance = k_heat_color((float)hit.cost / 200.0f); break; }
     if (params->mode == K_MODE_TRIANGLES) { radiance = k_id_color(hit.triangle); break; }
-    KSurface sf = k_surface_eval(scene, hit, org, dir);
+    cone_width += spread * hit.t;
+    KSurface sf = k_surface_eval(scene, hit, org, dir, cone_width);
     KVec3 wo = v3_neg(dir);
 
     if (sf.blend != K_BLEND_OPAQUE) {
@@ -131,8 +151,15 @@ KFN KVec3 k_trace_path(KTraceCtx* ctx, const KFrameParams* params, KVec3 org, KV
     if (params->mode == K_MODE_NORMALS) { radiance = v3_add(v3_scale(sf.normal, 0.5f), v3s(0.5f)); break; }
     if (params->mode == K_MODE_SPECULAR) { radiance = sf.specular; break; }
 
+    KFrameParams vertex_params = *params;
+    if (bounce > 0u) {
+      /* Path regularisation: after a bounce, a sharp highlight lit by next-event estimation is a
+       * caustic path the bounce found by chance (a firefly). Widen it and drop the boost there. */
+      sf.roughness = k_fmax(sf.roughness, K_REGULARIZED_ROUGHNESS);
+      vertex_params.spec_boost = 1.0f;
+    }
     KVec3 contribution = sf.emission;
-    contribution = v3_add(contribution, k_direct_lighting(ctx, params, &sf, wo, rng));
+    contribution = v3_add(contribution, k_direct_lighting(ctx, &vertex_params, &sf, wo, rng));
     contribution = v3_mul(throughput, contribution);
     if (bounce > 0u) contribution = k_clamp_radiance(contribution, params->firefly_clamp);
     radiance = v3_add(radiance, contribution);
@@ -144,6 +171,7 @@ KFN KVec3 k_trace_path(KTraceCtx* ctx, const KFrameParams* params, KVec3 org, KV
     KVec3 weight = k_brdf_sample(&sf, wo, u_lobe, u1, u2, &wi);
     if (v3_max_component(weight) <= 0.0f || v3_dot(wi, sf.geo_normal) <= 0.0f) break;
     throughput = v3_mul(throughput, weight);
+    spread += K_BOUNCE_SPREAD;
     ++bounce;
     if ((float)bounce >= params->rr_start) {
       float keep = k_clamp(v3_max_component(throughput), 0.05f, 0.95f);
@@ -161,11 +189,12 @@ KFN KVec3 k_render_pixel(KTraceCtx* ctx, const KFrameParams* params, const KCame
   kuint spp = params->spp > 0u ? params->spp : 1u;
   KVec3 sum = v3s(0.0f);
   KVec3 org = v3_load(cam->origin);
+  float pixel_spread = 2.0f * cam->tan_half_fov_x / (float)cam->width;
   for (kuint s = 0u; s < spp; ++s) {
     KRng rng = k_rng_seed(x, y, params->frame_index, s);
     float jx = k_rng_next(&rng), jy = k_rng_next(&rng);
     KVec3 dir = k_camera_direction(cam, (float)x + jx, (float)y + jy);
-    sum = v3_add(sum, k_trace_path(ctx, params, org, dir, &rng));
+    sum = v3_add(sum, k_trace_path(ctx, params, org, dir, pixel_spread, &rng));
   }
   return v3_scale(sum, 1.0f / (float)spp);
 }

@@ -80,7 +80,9 @@ KFN KVec3 k_vertex_normal(KGLOBAL const KVertex* a, KGLOBAL const KVertex* b, KG
             w * a->normal[2] + u * b->normal[2] + v * c->normal[2]);
 }
 
-KFN KSurface k_surface_eval(const KSceneView* scene, KHit hit, KVec3 ray_org, KVec3 ray_dir) {
+/* cone_width: the width of the ray's footprint at the hit (world units, across the ray), which picks
+ * the mip level: texture-space footprint = cone_width / |cos| * sqrt(uv area / world area). */
+KFN KSurface k_surface_eval(const KSceneView* scene, KHit hit, KVec3 ray_org, KVec3 ray_dir, float cone_width) {
   KSurface sf;
   KGLOBAL const KInstance* inst = &scene->instances[hit.instance];
   KTriangle tri = scene->triangles[hit.triangle];
@@ -107,6 +109,18 @@ KFN KSurface k_surface_eval(const KSceneView* scene, KHit hit, KVec3 ray_org, KV
   float s, t;
   k_hit_st(scene, hit.triangle, u, v, m, &s, &t);
 
+  /* Texture-space footprint from the triangle's uv density (after the material's transform). */
+  float footprint = 0.0f;
+  {
+    float du1 = b->u - a->u, dv1 = b->v - a->v, du2 = c->u - a->u, dv2 = c->v - a->v;
+    float det = m->tex_transform[0] * m->tex_transform[4] - m->tex_transform[1] * m->tex_transform[3];
+    float uv_area = k_fabs((du1 * dv2 - dv1 * du2) * det);
+    KVec3 ew = xform_vector_g(inst->object_to_world, v3_cross(v3_sub(p1, p0), v3_sub(p2, p0)));
+    float world_area = v3_length(ew);
+    float cos_in = k_fmax(k_fabs(v3_dot(ng, ray_dir)), 0.1f);
+    if (world_area > 0.0f) footprint = cone_width / cos_in * k_sqrt(uv_area / world_area);
+  }
+
   if (m->normal_tex != K_NONE) {
     KVec3 tan_obj = v3(w * a->tangent[0] + u * b->tangent[0] + v * c->tangent[0],
                        w * a->tangent[1] + u * b->tangent[1] + v * c->tangent[1],
@@ -124,7 +138,7 @@ KFN KSurface k_surface_eval(const KSceneView* scene, KHit hit, KVec3 ray_org, KV
       float sign = a->bitangent_sign < 0.0f ? -1.0f : 1.0f;
       bt = v3_scale(v3_cross(n, tn), sign);
     }
-    KVec3 ln = k_texture_normal(scene, m->normal_tex, s, t);
+    KVec3 ln = k_texture_normal(scene, m->normal_tex, s, t, footprint);
     KVec3 pn = v3_normalize(v3_add(v3_add(v3_scale(tn, ln.x), v3_scale(bt, ln.y)), v3_scale(n, k_fmax(ln.z, 0.0f))));
     if (v3_dot(pn, ng) > 0.0f) n = pn;
   }
@@ -132,14 +146,14 @@ KFN KSurface k_surface_eval(const KSceneView* scene, KHit hit, KVec3 ray_org, KV
 
   KVec4 diffuse = v4(m->diffuse_color[0], m->diffuse_color[1], m->diffuse_color[2], m->diffuse_color[3]);
   if (m->diffuse_tex != K_NONE) {
-    KVec4 d = k_texture_sample(scene, m->diffuse_tex, s, t);
+    KVec4 d = k_texture_sample_footprint(scene, m->diffuse_tex, s, t, footprint);
     diffuse = v4(diffuse.x * d.x, diffuse.y * d.y, diffuse.z * d.z, diffuse.w * d.w);
   }
   sf.albedo = v4_rgb(diffuse);
   sf.alpha = diffuse.w;
 
   KVec3 spec = v3(m->specular_color[0], m->specular_color[1], m->specular_color[2]);
-  if (m->specular_tex != K_NONE) spec = v3_mul(spec, v4_rgb(k_texture_sample(scene, m->specular_tex, s, t)));
+  if (m->specular_tex != K_NONE) spec = v3_mul(spec, v4_rgb(k_texture_sample_footprint(scene, m->specular_tex, s, t, footprint)));
   if (m->flags & K_MAT_NO_SPECULAR) spec = v3s(0.0f);
   k_gloss_to_roughness_metallic(v3_luminance(spec), &sf.roughness, &sf.metallic);
   sf.specular = spec;
@@ -148,7 +162,7 @@ KFN KSurface k_surface_eval(const KSceneView* scene, KHit hit, KVec3 ray_org, KV
   sf.emission = v3s(0.0f);
   if (m->flags & K_MAT_EMISSIVE) {
     KVec3 e = v3(m->emissive_color[0], m->emissive_color[1], m->emissive_color[2]);
-    if (m->emissive_tex != K_NONE) e = v3_mul(e, v4_rgb(k_texture_sample(scene, m->emissive_tex, s, t)));
+    if (m->emissive_tex != K_NONE) e = v3_mul(e, v4_rgb(k_texture_sample_footprint(scene, m->emissive_tex, s, t, footprint)));
     sf.emission = e;
   }
   sf.blend = m->blend;

@@ -81,9 +81,24 @@ KFN KVec4 k_texture_sample(const KSceneView* scene, kuint tex, float s, float t)
   return k_texture_sample_level(scene, tex, s, t, 0u);
 }
 
+/* Mip level for a footprint of `texels` level-0 texels across (nearest level, so one bilinear read). */
+KFN kuint k_mip_level(float texels) {
+  if (!(texels > 1.0f)) return 0u;
+  float lod = k_floor(k_log2(texels) + 0.5f);
+  return lod > 0.0f ? (kuint)lod : 0u;
+}
+
+/* Bilinear read at the level matching a footprint given in texture-space units (1 = the whole
+ * texture): footprint * sqrt(width * height) level-0 texels. */
+KFN KVec4 k_texture_sample_footprint(const KSceneView* scene, kuint tex, float s, float t, float footprint) {
+  KTexture tx = scene->textures[tex];
+  float texels = footprint * k_sqrt((float)tx.width * (float)tx.height);
+  return k_texture_sample_level(scene, tex, s, t, k_mip_level(texels));
+}
+
 /* Tangent-space normal from a normal map (X in R, Y in G, Z in B), not normalised. */
-KFN KVec3 k_texture_normal(const KSceneView* scene, kuint tex, float s, float t) {
-  KVec4 c = k_texture_sample(scene, tex, s, t);
+KFN KVec3 k_texture_normal(const KSceneView* scene, kuint tex, float s, float t, float footprint) {
+  KVec4 c = k_texture_sample_footprint(scene, tex, s, t, footprint);
   return v3(c.x * 2.0f - 1.0f, c.y * 2.0f - 1.0f, c.z * 2.0f - 1.0f);
 }
 

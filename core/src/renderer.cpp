@@ -26,6 +26,7 @@ struct Completion {
 struct Renderer::Worker {
   int id = 0;
   std::unique_ptr<Tracer> tracer;
+  std::string name;  // asked once: the tracer may be busy on its own thread whenever the core looks
   std::shared_ptr<Completion> completion;
 
   // Inbox, guarded by inbox_mutex.
@@ -108,6 +109,7 @@ Renderer::Renderer(std::vector<std::unique_ptr<Tracer>> tracers, RendererOptions
     auto w = std::make_unique<Worker>();
     w->id = static_cast<int>(i);
     w->tracer = std::move(tracers[i]);
+    w->name = w->tracer->name();
     w->completion = completion;
     workers_.push_back(std::move(w));
   }
@@ -138,7 +140,7 @@ void Renderer::submit_commit(int tracer, const commit::CommitBuffer& commit) {
 }
 
 int Renderer::tracer_count() const { return static_cast<int>(workers_.size()); }
-std::string Renderer::tracer_name(int tracer) const { return workers_.at(static_cast<size_t>(tracer))->tracer->name(); }
+std::string Renderer::tracer_name(int tracer) const { return workers_.at(static_cast<size_t>(tracer))->name; }
 void Renderer::reset_balancer() {
   balancer_->reset();
   last_measurements_.clear();
@@ -236,7 +238,7 @@ void Renderer::begin_frame(const BandJob& job, FrameBuffer& out, const std::vect
     for (auto& w : workers_) {
       TracerFrameStats& t = stats.tracers[static_cast<size_t>(w->id)];
       t.id = w->id;
-      t.name = w->tracer->name();
+      t.name = w->name;
       if (w->busy) t.outcome = TracerOutcome::busy;
       else ready.push_back(w->id);
     }

@@ -39,6 +39,7 @@ struct Case {
   uint32_t mode;
   uint32_t bounces;
   const char* name;
+  uint32_t light_samples = 1;
 };
 
 }  // namespace
@@ -58,6 +59,7 @@ TEST_P(Agreement, EmbreeAndOpenCLImagesMatch) {
   params.soft_shadow_scale = 1.0f;
   params.rr_start = 2.0f;
   params.frame_index = 7;
+  params.light_samples = c.light_samples;
   auto embree = make_test_tracer("embree");
   auto opencl = make_test_tracer("opencl");
   core::FrameBuffer a = render(*embree, room, cam, params);
@@ -89,6 +91,7 @@ TEST_P(Agreement, EmbreeAndOpenCLImagesMatch) {
 
 INSTANTIATE_TEST_SUITE_P(Modes, Agreement,
                          ::testing::Values(Case{K_MODE_PATH, 1, "path"}, Case{K_MODE_PATH, 3, "path3"},
+                                           Case{K_MODE_PATH, 1, "path_all_lights", 0},
                                            Case{K_MODE_DIRECT, 0, "direct"}, Case{K_MODE_ALBEDO, 0, "albedo"},
                                            Case{K_MODE_NORMALS, 0, "normals"}),
                          [](const auto& info) { return std::string(info.param.name); });
@@ -136,6 +139,7 @@ TEST(AgreementOnTestMap, EmbreeAndOpenCLImagesMatch) {
   const int w = 64, h = 36;
   KCamera cam = core::make_camera(map.player_start + glm::vec3(0, 0, 68), map.player_yaw, 0.0f, 90.0f, w, h);
   KFrameParams params = frame_params(K_MODE_PATH, 8, 1, h);
+  params.light_samples = 0;
   params.firefly_clamp = 5.0f;
   params.soft_shadow_scale = 0.2f;
   params.rr_start = 2.0f;
@@ -145,7 +149,7 @@ TEST(AgreementOnTestMap, EmbreeAndOpenCLImagesMatch) {
   core::FrameBuffer b = render(*opencl, map, cam, params);
   double mean = 0.0;
   double error = rmse(a, b, &mean);
-  std::cout << "testmap: RMSE embree/opencl " << error << ", mean " << mean << "\n";
+  std::cout << "testmap on " << opencl->name() << ": RMSE embree/opencl " << error << ", mean " << mean << "\n";
   EXPECT_GT(mean, 0.01);
   EXPECT_LT(error, 0.005 * mean);
 }

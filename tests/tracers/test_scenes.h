@@ -321,7 +321,11 @@ inline KCamera test_room_camera(int width, int height) {
 
 
 // Writes an 8-bit preview (clamped, gamma 2.2) for looking at test images (COHORT_TEST_IMAGES=dir).
-inline void write_preview(const std::string& file, const core::FrameBuffer& fb) {
+// Writes a PNG, or a PPM beside it in builds without an image library (the GPU machine's).
+inline void write_preview(const std::string& requested, const core::FrameBuffer& fb) {
+  std::string file = requested;
+  if (!core::have_image_library() && file.size() > 4 && file.substr(file.size() - 4) == ".png")
+    file = file.substr(0, file.size() - 4) + ".ppm";
   std::vector<uint8_t> rgba(size_t(fb.width) * fb.height * 4);
   for (size_t i = 0; i < rgba.size(); ++i) {
     float v = i % 4 == 3 ? 1.0f : std::pow(std::clamp(fb.rgba[i], 0.0f, 1.0f), 1.0f / 2.2f);

@@ -1,6 +1,8 @@
-// The tracers this build has, for tests that run the same checks on each.
+// The tracers this build has, for tests that run the same checks on each. COHORT_TEST_OPENCL_DEVICE
+// picks the OpenCL device (index into OpenCLTracer::list_devices(); default 0).
 #pragma once
 
+#include <cstdlib>
 #include <memory>
 #include <string>
 #include <vector>
@@ -49,7 +51,11 @@ inline std::unique_ptr<core::Tracer> make_test_tracer(const std::string& name) {
   if (name == "embree") return std::make_unique<tracers::EmbreeTracer>();
 #endif
 #ifdef COHORT_HAVE_OPENCL
-  if (name == "opencl") return std::make_unique<tracers::OpenCLTracer>(tracers::OpenCLTracer::Options{});
+  if (name == "opencl") {
+    tracers::OpenCLTracer::Options options;
+    if (const char* device = std::getenv("COHORT_TEST_OPENCL_DEVICE")) options.device = std::atoi(device);
+    return std::make_unique<tracers::OpenCLTracer>(options);
+  }
 #endif
 #ifdef COHORT_HAVE_CUDA
   if (name == "cuda") return std::make_unique<tracers::CudaTracer>(0);

@@ -44,7 +44,25 @@ struct CudaTracer::Impl {
   unsigned long long* ray_counts = nullptr;   // device: closest, occlusion
   RayCounts last_counts;
   size_t band_capacity = 0;   // pixels
-  std::vector<float> host_band;
+  // The frame buffer the band is copied into, page-locked so the copy runs at full DMA speed instead
+  // of through the driver's pageable staging (about 3 ms of a 1080p frame otherwise).
+  void* registered = nullptr;
+  size_t registered_bytes = 0;
+
+  void register_target(core::FrameBuffer& target) {
+    void* ptr = target.rgba.data();
+    size_t bytes = target.rgba.size() * sizeof(float);
+    if (ptr == registered && bytes == registered_bytes) return;
+    if (registered) cudaHostUnregister(registered);
+    registered = nullptr;
+    registered_bytes = 0;
+    if (cudaHostRegister(ptr, bytes, cudaHostRegisterPortable) == cudaSuccess) {
+      registered = ptr;
+      registered_bytes = bytes;
+    } else {
+      cudaGetLastError();   // not fatal: the copy still works from pageable memory, only slower
+    }
+  }
 
   void rebind_texel_texture() {
     if (texel_texture) COHORT_CUDA(cudaDestroyTextureObject(texel_texture));
@@ -95,6 +113,7 @@ CudaTracer::CudaTracer(int device) : impl_(std::make_unique<Impl>()) {
 CudaTracer::~CudaTracer() {
   cudaSetDevice(impl_->device);
   if (impl_->texel_texture) cudaDestroyTextureObject(impl_->texel_texture);
+  if (impl_->registered) cudaHostUnregister(impl_->registered);
   if (impl_->band) cudaFree(impl_->band);
   if (impl_->ray_counts) cudaFree(impl_->ray_counts);
   if (impl_->start) cudaEventDestroy(impl_->start);
@@ -155,6 +174,7 @@ core::BandResult CudaTracer::render_band(const core::BandJob& job, core::FrameBu
     if (!m.ray_counts) COHORT_CUDA(cudaMalloc(&m.ray_counts, 2 * sizeof(unsigned long long)));
     COHORT_CUDA(cudaMemsetAsync(m.ray_counts, 0, 2 * sizeof(unsigned long long), m.stream));
   }
+  m.register_target(target);
   COHORT_CUDA(cudaEventRecord(m.start, m.stream));
   launch_render_band(m.view(), params.tlas_node_count, params, camera, m.band, m.count_rays ? m.ray_counts : nullptr,
                      m.stream);
