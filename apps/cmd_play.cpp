@@ -1,16 +1,323 @@
+// `cohort play <map>`: a window showing the live path-traced frame, a fly camera, the scenario moving
+// and keys to change what is rendered and how (apps/viewer/viewer_actions.h lists them).
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <filesystem>
 #include <iostream>
 
+#include <spdlog/spdlog.h>
+
+#include "cohort/balance/balancer.h"
+#include "cohort/core/image_output.h"
 #include "commands.h"
+#include "play_session.h"
+#include "viewer/hud.h"
+#include "viewer/viewer_actions.h"
+#ifdef COHORT_HAVE_VIEWER
+#include "viewer/gl_window.h"
+#endif
 
 namespace cohort::app {
+namespace {
+
+struct PlayArgs {
+  SessionOptions session;
+  int width = 1280, height = 720;
+  float scale = 0.5f;
+  int spp = 1;
+  int bounces = 1;
+  std::string mode = "path";
+  std::string tone = "aces";
+  int frames = 0;            // 0: until the window closes
+  std::string screenshot;    // written from the last frame
+  std::string window_shot;   // the last frame as the window showed it, HUD included
+};
+
+std::vector<std::string> default_bases() {
+  std::error_code ec;
+  std::filesystem::path fallback = "assets/testmap";
+  if (!std::filesystem::is_directory(fallback, ec)) fallback = std::filesystem::path(COHORT_SOURCE_DIR) / "assets/testmap";
+  if (std::filesystem::is_directory(fallback, ec)) return {fallback.string()};
+  return {};
+}
+
+std::string key_help() {
+  std::string out = "\nKeys:\n";
+  for (const viewer::KeyHelp& k : viewer::kKeyHelp) {
+    std::string keys(k.keys);
+    keys.resize(std::max<size_t>(keys.size(), 24), ' ');
+    out += "  " + keys + std::string(k.what) + "\n";
+  }
+  return out;
+}
+
+#ifdef COHORT_HAVE_VIEWER
+
+constexpr float kScaleSteps[] = {0.125f, 0.25f, 0.375f, 0.5f, 0.625f, 0.75f, 0.875f, 1.0f};
+
+float step_scale(float current, int direction) {
+  const auto* begin = std::begin(kScaleSteps);
+  const auto* end = std::end(kScaleSteps);
+  if (direction > 0) {
+    const auto* next = std::upper_bound(begin, end, current + 1e-4f);
+    return next == end ? end[-1] : *next;
+  }
+  const auto* at = std::lower_bound(begin, end, current - 1e-4f);
+  return at == begin ? *begin : at[-1];
+}
+
+template <typename T>
+const T& cycle(const std::vector<T>& list, const T& current, int direction) {
+  const auto it = std::find(list.begin(), list.end(), current);
+  const long n = static_cast<long>(list.size());
+  long i = it == list.end() ? 0 : (it - list.begin()) + direction;
+  return list[static_cast<size_t>(((i % n) + n) % n)];
+}
+
+std::filesystem::path next_screenshot_name(const std::string& map) {
+  const char* ext = core::have_image_library() ? ".png" : ".ppm";
+  for (int i = 0;; ++i) {
+    char name[64];
+    std::snprintf(name, sizeof name, "cohort_%s_%03d%s", map.c_str(), i, ext);
+    std::error_code ec;
+    if (!std::filesystem::exists(name, ec)) return name;
+  }
+}
+
+// A message shown on the HUD for a few seconds.
+struct Notice {
+  std::string text;
+  std::chrono::steady_clock::time_point until;
+};
+
+int run_play(PlayArgs a) {
+  using clock = std::chrono::steady_clock;
+  if (a.session.bases.empty()) a.session.bases = default_bases();
+  std::unique_ptr<PlaySession> session;
+  try {
+    session = std::make_unique<PlaySession>(a.session);
+  } catch (const std::exception& e) {
+    std::cerr << "cohort play: cannot start on '" << a.session.map << "': " << e.what() << "\n";
+    if (a.session.bases.empty())
+      std::cerr << "  (no --base folder given and assets/testmap not found: point --base at a game's base/ folder)\n";
+    return kExitFailure;
+  }
+
+  std::unique_ptr<viewer::GlWindow> window;
+  try {
+    window = std::make_unique<viewer::GlWindow>(a.width, a.height, "Cohort - " + session->map_name());
+  } catch (const viewer::WindowUnavailable& e) {
+    std::cerr << "cohort play: " << e.what() << "\n";
+    return kExitUnavailable;
+  }
+  spdlog::info("viewer: OpenGL {}; tracers: {}", window->gl_description(), fmt::join(session->tracer_names(), ", "));
+
+  viewer::FlyCamera camera = session->start_camera();
+  FrameSettings settings;
+  settings.spp = a.spp;
+  settings.max_bounces = a.bounces;
+  settings.mode = debug_mode_from_name(a.mode).value_or(K_MODE_PATH);
+  settings.tone_curve = a.tone;
+  float scale = a.scale;
+  bool show_hud = true;
+  std::vector<Notice> notices;
+  auto notify = [&](std::string text) {
+    spdlog::info("{}", text);
+    notices.push_back({std::move(text), clock::now() + std::chrono::seconds(4)});
+  };
+  const std::vector<std::string> balancers = balance::balancer_names();
+
+  viewer::Image8 frame_image, hud_layer, window_image;
+  SessionFrame last;
+  bool have_frame = false;
+  int frames_done = 0;
+  double fps = 0.0;
+  int fps_frames = 0;
+  clock::time_point fps_start = clock::now(), previous = clock::now();
+  int exit_code = kExitOk;
+
+  while (!window->should_close()) {
+    window->poll_events();
+    for (viewer::Action action : window->take_actions()) {
+      using viewer::Action;
+      switch (action) {
+        case Action::quit:
+          if (window->mouse_captured()) window->set_mouse_captured(false);
+          else window->request_close();
+          break;
+        case Action::toggle_mouse_capture: window->set_mouse_captured(!window->mouse_captured()); break;
+        case Action::next_mode: settings.mode = (settings.mode + 1) % 7; break;
+        case Action::previous_mode: settings.mode = (settings.mode + 6) % 7; break;
+        case Action::set_mode_0: case Action::set_mode_1: case Action::set_mode_2: case Action::set_mode_3:
+        case Action::set_mode_4: case Action::set_mode_5: case Action::set_mode_6:
+          settings.mode = static_cast<kuint>(static_cast<int>(action) - static_cast<int>(Action::set_mode_0));
+          break;
+        case Action::next_balancer:
+          session->set_balancer(cycle(balancers, session->balancer(), 1));
+          notify("balancer " + session->balancer());
+          break;
+        case Action::spp_up: settings.spp = std::min(settings.spp * 2, 256); break;
+        case Action::spp_down: settings.spp = std::max(settings.spp / 2, 1); break;
+        case Action::scale_up: scale = step_scale(scale, 1); break;
+        case Action::scale_down: scale = step_scale(scale, -1); break;
+        case Action::next_tone_mapper: settings.tone_curve = cycle(tone_curve_names(), settings.tone_curve, 1); break;
+        case Action::toggle_scenario_pause:
+          if (session->scenario_running()) session->set_scenario_paused(!session->scenario_paused());
+          else notify("no scenario on this map");
+          break;
+        case Action::screenshot:
+          if (have_frame) {
+            const std::filesystem::path file = next_screenshot_name(session->map_name());
+            try {
+              core::write_ldr_image(file, last.width, last.height, last.display);
+              notify("saved " + file.string());
+            } catch (const std::exception& e) {
+              notify(std::string("screenshot failed: ") + e.what());
+            }
+          }
+          break;
+        case Action::toggle_hud: show_hud = !show_hud; break;
+        case Action::speed_up: camera.change_speed(1); break;
+        case Action::speed_down: camera.change_speed(-1); break;
+        case Action::reset_camera: camera = session->start_camera(); break;
+      }
+    }
+
+    const clock::time_point now = clock::now();
+    const double dt = std::min(std::chrono::duration<double>(now - previous).count(), 0.25);
+    previous = now;
+    camera.update(window->take_move_input(), static_cast<float>(dt));
+
+    const int fb_w = std::max(window->framebuffer_width(), 1), fb_h = std::max(window->framebuffer_height(), 1);
+    settings.width = std::max(16, static_cast<int>(std::lround(fb_w * scale)));
+    settings.height = std::max(16, static_cast<int>(std::lround(fb_h * scale)));
+    try {
+      last = session->frame(camera, dt, settings);
+      have_frame = true;
+    } catch (const std::exception& e) {
+      std::cerr << "cohort play: the frame could not be rendered: " << e.what() << "\n";
+      exit_code = kExitFailure;
+      break;
+    }
+    frame_image.width = last.width;
+    frame_image.height = last.height;
+    frame_image.rgba = last.display;
+
+    ++fps_frames;
+    const double window_s = std::chrono::duration<double>(clock::now() - fps_start).count();
+    if (window_s >= 0.5) {
+      fps = fps_frames / window_s;
+      fps_frames = 0;
+      fps_start = clock::now();
+    }
+
+    if (show_hud) {
+      viewer::HudState hud;
+      hud.fps = fps;
+      hud.stats = last.stats;
+      hud.mode = debug_mode_names()[settings.mode];
+      hud.spp = settings.spp;
+      hud.render_scale = scale;
+      hud.render_width = settings.width;
+      hud.render_height = settings.height;
+      hud.tone_mapper = settings.tone_curve;
+      hud.balancer = session->balancer();
+      hud.commit_bytes = last.commit_bytes;
+      hud.scenario_running = session->scenario_running();
+      hud.scenario_paused = session->scenario_paused();
+      hud.camera[0] = camera.position.x;
+      hud.camera[1] = camera.position.y;
+      hud.camera[2] = camera.position.z;
+      hud.yaw = camera.yaw;
+      hud.pitch = camera.pitch;
+      hud.speed = camera.speed;
+      hud.notices = session->warnings();
+      std::erase_if(notices, [&](const Notice& n) { return n.until < clock::now(); });
+      for (const Notice& n : notices) hud.notices.push_back(n.text);
+      if (!window->mouse_captured()) hud.notices.push_back("RIGHT MOUSE OR TAB: LOOK AROUND");
+      if (hud_layer.width != fb_w || hud_layer.height != fb_h) hud_layer.resize(fb_w, fb_h);
+      viewer::draw_hud(hud_layer, hud, fb_h >= 700 ? 2 : 1);
+    }
+    ++frames_done;
+    const bool last_frame = a.frames > 0 && frames_done >= a.frames;
+    const bool read_back = last_frame && !a.window_shot.empty();
+    window->present(frame_image, show_hud ? &hud_layer : nullptr, read_back ? &window_image : nullptr);
+    if (last_frame) window->request_close();
+  }
+
+  if (!a.window_shot.empty() && window_image.width > 0) {
+    try {
+      core::write_ldr_image(a.window_shot, window_image.width, window_image.height, window_image.rgba);
+    } catch (const std::exception& e) {
+      std::cerr << "cohort play: " << e.what() << "\n";
+      return kExitFailure;
+    }
+  }
+
+  if (!a.screenshot.empty()) {
+    if (!have_frame) {
+      std::cerr << "cohort play: no frame was rendered, so no screenshot was written\n";
+      return kExitFailure;
+    }
+    try {
+      core::write_ldr_image(a.screenshot, last.width, last.height, last.display);
+      std::cout << "wrote " << a.screenshot << " (" << last.width << "x" << last.height << ", after " << frames_done
+                << " frames)\n";
+    } catch (const std::exception& e) {
+      std::cerr << "cohort play: " << e.what() << "\n";
+      return kExitFailure;
+    }
+  }
+  return exit_code;
+}
+
+#endif  // COHORT_HAVE_VIEWER
+
+}  // namespace
 
 void add_play_command(CLI::App& app) {
   auto* cmd = app.add_subcommand("play", "Open a window and fly through a map rendered live on every tracer");
-  auto map = std::make_shared<std::string>();
-  cmd->add_option("map", *map, "map name or path")->required();
-  cmd->callback([] {
-    std::cerr << "cohort play: not implemented yet (issue 8)\n";
+  cmd->footer(key_help());
+  auto a = std::make_shared<PlayArgs>();
+  cmd->add_option("map", a->session.map, "a .map path, or a map name looked up under maps/ in the --base folders "
+                                         "(e.g. testmap)")->required();
+  cmd->add_option("--base", a->session.bases, "game folder with loose files and .pk4 archives (e.g. Doom 3's base/); "
+                                              "repeat it (default: assets/testmap)");
+  cmd->add_option("--tracers", a->session.tracers, "comma-separated: embree, opencl[:N|:all], cuda[:N|:all], or "
+                                                   "all (the default: Embree plus every GPU once)");
+  cmd->add_option("--balancer", a->session.balancer, "row balancer (B cycles)")
+      ->capture_default_str()
+      ->check(CLI::IsMember(balance::balancer_names()));
+  cmd->add_option("--width", a->width, "window width")->capture_default_str()->check(CLI::Range(16, 16384));
+  cmd->add_option("--height", a->height, "window height")->capture_default_str()->check(CLI::Range(16, 16384));
+  cmd->add_option("--scale", a->scale, "render resolution / window resolution")
+      ->capture_default_str()
+      ->check(CLI::Range(0.05f, 1.0f));
+  cmd->add_option("--spp", a->spp, "samples per pixel per frame")->capture_default_str()->check(CLI::Range(1, 256));
+  cmd->add_option("--bounces", a->bounces, "indirect bounces")->capture_default_str()->check(CLI::Range(0, 16));
+  cmd->add_option("--mode", a->mode, "debug mode at start")
+      ->capture_default_str()
+      ->check(CLI::IsMember(debug_mode_names()));
+  cmd->add_option("--tone", a->tone, "tone mapper at start")->capture_default_str()->check(CLI::IsMember(tone_curve_names()));
+  cmd->add_flag("!--no-scenario", a->session.scenario, "leave the door, fan, flicker and flashlight still");
+  cmd->add_option("--frames", a->frames, "quit after this many frames (0: when the window closes)")
+      ->capture_default_str()
+      ->check(CLI::NonNegativeNumber);
+  cmd->add_option("--screenshot", a->screenshot, "write the last frame to this image file on exit");
+  cmd->add_option("--window-screenshot", a->window_shot, "with --frames: write what the window showed last (the "
+                                                         "frame scaled to the window, HUD included)");
+  cmd->callback([a] {
+#ifdef COHORT_HAVE_VIEWER
+    const int code = run_play(*a);
+    if (code != kExitOk) std::exit(code);
+#else
+    std::cerr << "cohort play: this binary was built without the viewer (GLFW and OpenGL were not found, or "
+                 "COHORT_WITH_VIEWER=OFF).\n  Install them (tools/setup.sh installs libglfw3-dev and the OpenGL "
+                 "headers), then reconfigure with -DCOHORT_WITH_VIEWER=ON and rebuild;\n  `cohort render "
+              << a->session.map << "` writes images without a window.\n";
     std::exit(kExitUnavailable);
+#endif
   });
 }
 

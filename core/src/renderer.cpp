@@ -141,6 +141,14 @@ void Renderer::submit_commit(int tracer, const commit::CommitBuffer& commit) {
 
 int Renderer::tracer_count() const { return static_cast<int>(workers_.size()); }
 std::string Renderer::tracer_name(int tracer) const { return workers_.at(static_cast<size_t>(tracer))->name; }
+
+void Renderer::set_balancer(const std::string& name) {
+  std::unique_ptr<balance::Balancer> next = balance::make_balancer(name, options_.balancer_options);
+  balancer_ = std::move(next);
+  options_.balancer = name;
+  last_measurements_.clear();
+}
+
 void Renderer::reset_balancer() {
   balancer_->reset();
   last_measurements_.clear();

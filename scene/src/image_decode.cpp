@@ -104,11 +104,16 @@ std::optional<Image> decode_image(std::string_view bytes, const std::string& fil
     }
     return image;
   }
-  std::string oiio_error;
-  if (auto image = decode_with_oiio(bytes, ext.empty() ? "tga" : ext, oiio_error)) return image;
-  if (ext == "tga") return decode_tga(bytes, error);
-  error = oiio_error;
-  return std::nullopt;
+  if (ext == "tga") {
+    // Doom 3's own format goes through the built-in reader: exact, and OpenImageIO's TGA plugin
+    // cannot read from memory (it would need a temporary file per image). OIIO gets what it refuses.
+    if (auto image = decode_tga(bytes, error)) return image;
+    std::string tga_error = error;
+    if (auto image = decode_with_oiio(bytes, ext, error)) return image;
+    error = tga_error;
+    return std::nullopt;
+  }
+  return decode_with_oiio(bytes, ext.empty() ? "tga" : ext, error);
 #else
   if (ext == "tga") return decode_tga(bytes, error);
   error = "." + ext + " images need OpenImageIO (this build has only the TGA reader)";

@@ -116,3 +116,34 @@ TEST(ImageLibrary, MissingImagesGetRolePlaceholdersAndOneWarningEach) {
   EXPECT_FALSE(images[static_cast<size_t>(floor)].is_placeholder);
   EXPECT_EQ(images[static_cast<size_t>(floor)].width, 2);
 }
+
+#ifdef COHORT_HAVE_OIIO
+#include <OpenImageIO/imageio.h>
+
+TEST(ImageLibrary, PngThroughOpenImageIOFoundByBareName) {
+  namespace fs = std::filesystem;
+  fs::path base = fs::path(COHORT_BINARY_DIR) / "test_tmp" / "png_base";
+  fs::remove_all(base);
+  fs::create_directories(base / "textures");
+  const uint8_t pixels[] = {10, 20, 30, 255, 200, 100, 50, 255};
+  auto out = OIIO::ImageOutput::create("png");
+  ASSERT_TRUE(out);
+  OIIO::ImageSpec spec(2, 1, 4, OIIO::TypeDesc::UINT8);
+  ASSERT_TRUE(out->open((base / "textures/pic.png").string(), spec));
+  ASSERT_TRUE(out->write_image(OIIO::TypeDesc::UINT8, pixels));
+  out->close();
+
+  Vfs vfs;
+  vfs.add_search_path(base);
+  std::vector<Image> images;
+  std::vector<std::string> warnings;
+  ImageLibrary library(vfs, images, warnings);
+  ImageProgram program;
+  program.path = "textures/pic.tga";   // materials name .tga; the engine falls back to other formats
+  const Image& image = images[static_cast<size_t>(library.get(program, ImageRole::Color, "m"))];
+  EXPECT_TRUE(warnings.empty()) << ::testing::PrintToString(warnings);
+  ASSERT_EQ(image.width, 2);
+  EXPECT_EQ(texel(image, 1, 0)[0], 200);
+  EXPECT_EQ(texel(image, 0, 0)[2], 30);
+}
+#endif

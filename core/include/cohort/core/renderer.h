@@ -66,6 +66,9 @@ class Renderer {
   int tracer_count() const;
   std::string tracer_name(int tracer) const;
   const std::string& balancer_name() const { return options_.balancer; }
+  // Switch balancers between frames (the viewer's B key); the new one starts without history.
+  // Throws std::invalid_argument for an unknown name and keeps the current one.
+  void set_balancer(const std::string& name);
   // Forget balancing history (e.g. on a camera cut).
   void reset_balancer();
 

@@ -1,5 +1,6 @@
-// Decoding image files to RGBA8: through OpenImageIO when built with it (TGA, PNG, JPEG, DDS, ...),
-// with a built-in TGA reader always available so the build without OpenImageIO still loads TGA maps.
+// Decoding image files to RGBA8: TGA through a built-in reader (always available, so the build
+// without OpenImageIO still loads TGA maps), everything else (PNG, JPEG, DDS, ...) and the TGA
+// variants that reader refuses through OpenImageIO when the build has it.
 #pragma once
 
 #include <optional>

@@ -1,0 +1,212 @@
+#include "play_session.h"
+
+#include <cmath>
+#include <stdexcept>
+
+#include <spdlog/spdlog.h>
+
+#include "cohort/commit/commit_buffer.h"
+#include "cohort/core/convergence.h"
+#include "cohort/core/gpu_scene.h"
+#include "cohort/core/renderer.h"
+#include "cohort/core/tonemap.h"
+#if __has_include("cohort/core/world_sync.h")
+#include "cohort/core/world_sync.h"
+#define COHORT_PLAY_HAS_WORLD_SYNC 1
+#endif
+#include "cohort/scene/map_loader.h"
+#include "cohort/scene/render_world.h"
+#include "cohort/scene/scenario.h"
+#include "tracer_factory.h"
+
+namespace cohort::app {
+namespace {
+
+constexpr double kScenarioFramesPerSecond = 60.0;
+constexpr float kEyeHeight = 68.0f;
+
+scene::Scene load_scene(const SessionOptions& options) {
+  scene::Vfs vfs;
+  for (const std::string& base : options.bases) vfs.add_search_path(base);
+  scene::LoadReport report;
+  scene::Scene loaded = scene::load_map(vfs, options.map, &report);
+  for (size_t i = 0; i < loaded.warnings.size() && i < 10; ++i) spdlog::warn("{}", loaded.warnings[i]);
+  if (loaded.warnings.size() > 10)
+    spdlog::warn("... {} more warnings (`cohort info {}` lists them)", loaded.warnings.size() - 10, options.map);
+  return loaded;
+}
+
+}  // namespace
+
+const std::vector<std::string>& debug_mode_names() {
+  static const std::vector<std::string> names = {"path", "direct", "albedo", "normals", "specular", "bvh", "triangles"};
+  return names;
+}
+
+std::optional<kuint> debug_mode_from_name(const std::string& name) {
+  const auto& names = debug_mode_names();
+  for (size_t i = 0; i < names.size(); ++i)
+    if (names[i] == name) return static_cast<kuint>(i);
+  return std::nullopt;
+}
+
+const std::vector<std::string>& tone_curve_names() {
+  static const std::vector<std::string> names = {"aces", "reinhard", "uncharted2", "gamma"};
+  return names;
+}
+
+struct PlaySession::State {
+  explicit State(scene::Scene loaded) : world(std::move(loaded)) {}
+
+  scene::RenderWorld world;
+#ifdef COHORT_PLAY_HAS_WORLD_SYNC
+  std::unique_ptr<core::WorldSync> sync;
+#endif
+  std::unique_ptr<scene::Scenario> scenario;
+  std::unique_ptr<core::Renderer> renderer;
+  core::AdaptiveConvergence convergence;
+  core::FrameBuffer hdr;
+  std::vector<float> moving_mask;
+  double scenario_seconds = 0.0;
+  uint64_t frame_index = 0;
+  kuint last_mode = K_MODE_PATH;
+  std::string map_name;
+};
+
+PlaySession::PlaySession(const SessionOptions& options) {
+  state_ = std::make_unique<State>(load_scene(options));
+  State& s = *state_;
+  s.map_name = s.world.scene().name.empty() ? options.map : s.world.scene().name;
+#ifdef COHORT_PLAY_HAS_WORLD_SYNC
+  s.sync = std::make_unique<core::WorldSync>(s.world, core::compile_scene(s.world.scene()));
+  auto initial_scene = s.sync->snapshot();
+#else
+  auto initial_scene = std::make_shared<const commit::TracerScene>(core::compile_scene(s.world.scene()).tracer_scene);
+#endif
+
+  const std::string list = options.tracers.empty() ? std::string("all") : options.tracers;
+  std::vector<std::unique_ptr<core::Tracer>> tracers;
+  // parse_tracer_list expands "all" and ":all" by probing devices; a device that then fails to open
+  // is dropped with a warning and the others carry on.
+  for (const TracerSpec& spec : parse_tracer_list(list)) {
+    try {
+      tracers.push_back(make_tracer(spec));
+    } catch (const std::exception& e) {
+      warnings_.push_back("tracer " + spec.text + " did not start: " + e.what());
+      spdlog::warn("{}; carrying on with the others", warnings_.back());
+    }
+  }
+  if (tracers.empty())
+    throw std::runtime_error("no tracer could start (asked for: " + list + "); see the warnings above");
+
+  core::RendererOptions renderer_options;
+  renderer_options.balancer = options.balancer;
+  s.renderer = std::make_unique<core::Renderer>(std::move(tracers), renderer_options);
+  s.renderer->submit_commit(commit::CommitBuffer::full(initial_scene, 0));
+
+#ifndef COHORT_PLAY_HAS_WORLD_SYNC
+  if (options.scenario) {
+    warnings_.push_back("scenario off: this build has no core world sync (core/world_sync.h), the scene stays still");
+    spdlog::warn("{}", warnings_.back());
+  }
+  if (false) {
+#else
+  if (options.scenario) {
+#endif
+    try {
+      s.scenario = std::make_unique<scene::Scenario>(s.world);
+    } catch (const scene::ScenarioError& e) {
+      warnings_.push_back(std::string("scenario off: ") + e.what());
+      spdlog::warn("{}", warnings_.back());
+    }
+  }
+}
+
+PlaySession::~PlaySession() = default;
+
+viewer::FlyCamera PlaySession::start_camera() const {
+  const scene::Scene& scene = state_->world.scene();
+  viewer::FlyCamera cam;
+  cam.position = scene.player_start + glm::vec3(0.0f, 0.0f, kEyeHeight);
+  cam.yaw = scene.player_yaw;
+  return cam;
+}
+
+SessionFrame PlaySession::frame(const viewer::FlyCamera& camera, double seconds, const FrameSettings& settings) {
+  State& s = *state_;
+  const bool animating = s.scenario && !paused_;
+  if (animating) s.scenario_seconds += seconds;
+  const scene::RenderView view =
+      camera.to_render_view(settings.width, settings.height, static_cast<int>(std::lround(s.scenario_seconds * 1000)));
+  if (s.scenario) {
+    s.scenario->frame(static_cast<int>(std::lround(s.scenario_seconds * kScenarioFramesPerSecond)));
+    // The scenario carries its flashlight along its own scripted path; in the viewer it is held by
+    // whoever flies the camera. Same offsets as the scenario: at the right hip, pointing ahead.
+    const int flashlight = s.scenario->flashlight_handle();
+    if (const scene::RenderLight* def = s.world.LightDef(flashlight)) {
+      scene::RenderLight held = *def;
+      held.origin = view.origin - view.axis[1] * 8.0f - view.axis[2] * 12.0f;
+      held.axis = view.axis;
+      s.world.UpdateLightDef(flashlight, held);
+    }
+  }
+  s.world.RenderScene(view);
+  s.world.EndFrame();
+
+  ++s.frame_index;
+#ifdef COHORT_PLAY_HAS_WORLD_SYNC
+  const commit::CommitBuffer commit = s.sync->sync(s.world.TakeChanges(), s.frame_index);
+  s.renderer->submit_commit(commit);
+#else
+  s.world.TakeChanges();
+  const commit::CommitBuffer commit;
+#endif
+
+  core::BandJob job;
+  job.camera = camera.to_kcamera(settings.width, settings.height);
+  KFrameParams& p = job.params;
+  p.frame_index = static_cast<kuint>(s.frame_index);
+  p.spp = static_cast<kuint>(settings.spp);
+  p.max_bounces = static_cast<kuint>(settings.max_bounces);
+  p.light_samples = 1;
+  p.firefly_clamp = 5.0f;
+  p.spec_boost = 2.0f;
+  p.mode = settings.mode;
+  p.soft_shadow_scale = 0.2f;
+  p.rr_start = 2.0f;
+
+  SessionFrame out;
+  out.stats = s.renderer->render(job, s.hdr);
+  out.commit_bytes = commit.bytes();
+
+  if (settings.mode != s.last_mode) s.convergence.reset();  // another view of the scene entirely
+  s.last_mode = settings.mode;
+  // Without per-pixel object ids every pixel counts as possibly moving while the door, fan and
+  // flicker animate; pause the scenario (P) to let the image converge.
+  const std::vector<float>* mask = nullptr;
+  if (animating) {
+    s.moving_mask.assign(static_cast<size_t>(settings.width) * settings.height, 1.0f);
+    mask = &s.moving_mask;
+  }
+  out.stats.convergence_f = s.convergence.accumulate(job.camera, s.hdr, mask);
+
+  core::ToneMapOptions tm;
+  tm.curve = core::parse_tone_curve(settings.tone_curve);
+  out.display = core::tone_map(s.convergence.image(), tm);
+  out.width = s.convergence.image().width;
+  out.height = s.convergence.image().height;
+  return out;
+}
+
+void PlaySession::set_balancer(const std::string& name) { state_->renderer->set_balancer(name); }
+const std::string& PlaySession::balancer() const { return state_->renderer->balancer_name(); }
+bool PlaySession::scenario_running() const { return state_->scenario != nullptr; }
+const std::string& PlaySession::map_name() const { return state_->map_name; }
+
+std::vector<std::string> PlaySession::tracer_names() const {
+  std::vector<std::string> names;
+  for (int i = 0; i < state_->renderer->tracer_count(); ++i) names.push_back(state_->renderer->tracer_name(i));
+  return names;
+}
+
+}  // namespace cohort::app

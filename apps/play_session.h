@@ -1,0 +1,77 @@
+// A live session on a map: the loaded scene in a RenderWorld, the test-map scenario driving it, the
+// core's world sync turning each frame's changes into commit buffers, the Renderer splitting rows
+// over the tracers, adaptive convergence and the tone mapper. `cohort play` draws its frames in a
+// window; the session itself needs no display.
+#pragma once
+
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "cohort/core/frame_buffer.h"
+#include "cohort/core/frame_stats.h"
+#include "kernel/layout.h"
+#include "viewer/fly_camera.h"
+
+namespace cohort::app {
+
+struct SessionOptions {
+  std::string map;
+  std::vector<std::string> bases;
+  std::string tracers;              // empty: "all" (parse_tracer_list: Embree plus every GPU once)
+  std::string balancer = "perfect-smooth";
+  bool scenario = true;
+};
+
+struct FrameSettings {
+  int width = 640, height = 360;
+  int spp = 1;
+  kuint mode = K_MODE_PATH;
+  int max_bounces = 1;
+  std::string tone_curve = "aces";
+};
+
+struct SessionFrame {
+  core::FrameStats stats;
+  size_t commit_bytes = 0;
+  std::vector<uint8_t> display;     // tone-mapped RGBA8 of the converged image
+  int width = 0, height = 0;
+};
+
+class PlaySession {
+ public:
+  // Loads the map and starts the tracers; throws std::runtime_error (or scene::ParseError) with the
+  // reason when the map cannot be used or no tracer starts. Tracers that fail are listed in warnings().
+  explicit PlaySession(const SessionOptions& options);
+  ~PlaySession();
+
+  // Advance the scenario by `seconds` (unless paused), put the flashlight on the camera, sync the
+  // world to the tracers and render one frame.
+  SessionFrame frame(const viewer::FlyCamera& camera, double seconds, const FrameSettings& settings);
+
+  // Where the map's player starts, at eye height, looking along its yaw.
+  viewer::FlyCamera start_camera() const;
+  void set_balancer(const std::string& name);
+  const std::string& balancer() const;
+  bool scenario_running() const;
+  bool scenario_paused() const { return paused_; }
+  void set_scenario_paused(bool paused) { paused_ = paused; }
+  std::vector<std::string> tracer_names() const;
+  // Tracers that did not start, a scenario that cannot run: things the HUD and log should say.
+  const std::vector<std::string>& warnings() const { return warnings_; }
+  const std::string& map_name() const;
+
+ private:
+  struct State;
+  std::unique_ptr<State> state_;
+  bool paused_ = false;
+  std::vector<std::string> warnings_;
+};
+
+// "path", "direct", ... in K_MODE_* order.
+const std::vector<std::string>& debug_mode_names();
+std::optional<kuint> debug_mode_from_name(const std::string& name);
+const std::vector<std::string>& tone_curve_names();
+
+}  // namespace cohort::app

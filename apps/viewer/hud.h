@@ -1,0 +1,39 @@
+// The viewer's heads-up display: what the frame cost and what the keys have set, as text lines drawn
+// with the bitmap font onto a transparent RGBA8 layer that is composited over the frame.
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "bitmap_font.h"
+#include "cohort/core/frame_stats.h"
+
+namespace cohort::viewer {
+
+struct HudState {
+  double fps = 0.0;
+  std::optional<core::FrameStats> stats;  // none before the first frame or when nothing renders
+  std::string mode;                       // debug mode name
+  int spp = 1;
+  float render_scale = 1.0f;
+  int render_width = 0, render_height = 0;
+  std::string tone_mapper;
+  std::string balancer;
+  uint64_t commit_bytes = 0;              // bytes of the commit sent this frame
+  bool scenario_paused = false;
+  bool scenario_running = false;
+  float camera[3] = {0, 0, 0};
+  float yaw = 0, pitch = 0, speed = 0;
+  std::vector<std::string> notices;       // warnings and transient messages, drawn in yellow
+};
+
+// The text, one line per entry; per-tracer rows come from stats.
+std::vector<std::string> hud_lines(const HudState& state);
+std::string format_bytes(uint64_t bytes);
+
+// Draw onto `layer` (cleared first): a translucent box and the lines, top-left.
+void draw_hud(Image8& layer, const HudState& state, int scale = 1);
+
+}  // namespace cohort::viewer

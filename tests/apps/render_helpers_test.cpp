@@ -1,0 +1,57 @@
+#include <sstream>
+
+#include <gtest/gtest.h>
+
+#include "camera_path.h"
+#include "progress_bar.h"
+
+namespace cohort::app {
+namespace {
+
+TEST(CameraPath, ParsesNamesAndRejectsUnknownOnes) {
+  EXPECT_EQ(parse_camera_path("spin").kind, CameraPath::Kind::spin);
+  EXPECT_EQ(parse_camera_path("orbit-fast").kind, CameraPath::Kind::orbit);
+  EXPECT_GT(parse_camera_path("orbit-fast").degrees_per_frame, parse_camera_path("orbit-slow").degrees_per_frame);
+  EXPECT_THROW(parse_camera_path("wobble"), std::invalid_argument);
+  EXPECT_THROW(parse_camera_path("spin-medium"), std::invalid_argument);
+  try {
+    parse_camera_path("zoom");
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("orbit-fast"), std::string::npos) << "the message lists the names";
+  }
+}
+
+TEST(CameraPath, SpinStaysAndTurnsOrbitCirclesFacingTheStart) {
+  const glm::vec3 eye(100, 200, 68);
+  const CameraPath spin = parse_camera_path("spin-slow");
+  const CameraPose p0 = camera_path_pose(spin, eye, 30.0f, 0), p10 = camera_path_pose(spin, eye, 30.0f, 10);
+  EXPECT_EQ(p0.origin, eye);
+  EXPECT_EQ(p10.origin, eye);
+  EXPECT_FLOAT_EQ(p10.yaw - p0.yaw, 10 * spin.degrees_per_frame);
+
+  const CameraPath orbit = parse_camera_path("orbit");
+  for (int f : {0, 7, 45}) {
+    const CameraPose p = camera_path_pose(orbit, eye, 30.0f, f);
+    EXPECT_NEAR(glm::length(p.origin - eye), orbit.orbit_radius, 1e-3f);
+    const glm::vec3 look(std::cos(glm::radians(p.yaw)), std::sin(glm::radians(p.yaw)), 0.0f);
+    EXPECT_NEAR(glm::dot(glm::normalize(eye - p.origin), look), 1.0f, 1e-4f) << "frame " << f;
+  }
+}
+
+TEST(ProgressBar, ReportsFramesRateAndEta) {
+  std::ostringstream out;
+  ProgressBar bar(4, out, false);
+  EXPECT_NE(bar.line().find("0/4 frames"), std::string::npos);
+  bar.frame_done(10.0);
+  bar.frame_done(30.0);
+  EXPECT_NE(bar.line().find("2/4 frames"), std::string::npos) << bar.line();
+  EXPECT_NE(bar.line().find("20.0 ms/frame"), std::string::npos) << bar.line();
+  EXPECT_NE(bar.line().find("ETA 0.0 s"), std::string::npos) << bar.line();  // 2 x 20 ms = 0.04 s
+  bar.frame_done(20.0);
+  bar.frame_done(20.0);
+  bar.finish();
+  EXPECT_NE(out.str().find("[########################] 4/4 frames"), std::string::npos) << out.str();
+}
+
+}  // namespace
+}  // namespace cohort::app

@@ -1,0 +1,32 @@
+#!/usr/bin/env bash
+# Usage: viewer_xvfb.sh COHORT VIEWER_BUILT MAP SCREENSHOT CHECKER  (see viewer_xvfb.cmake)
+set -u
+cohort=$1 viewer_built=$2 map=$3 shot=$4 checker=$5
+if [ "$viewer_built" != 1 ]; then
+  echo "SKIP: cohort was built without the viewer (COHORT_WITH_VIEWER=OFF); nothing to test"
+  exit 77
+fi
+if ! command -v xvfb-run >/dev/null; then
+  echo "SKIP: xvfb-run is not installed (Debian/Ubuntu: apt-get install xvfb)"
+  exit 77
+fi
+if ! command -v python3 >/dev/null; then
+  echo "SKIP: python3 is needed to check the screenshot"
+  exit 77
+fi
+mkdir -p "$(dirname "$shot")"
+window_shot="${shot%.*}_window.${shot##*.}"
+rm -f "$shot" "$window_shot"
+# The embree tracer is always on the CPU, so the test does not depend on a GPU; opencl (PoCL) joins
+# when built, to exercise the balancer with two tracers.
+set -x
+xvfb-run -a -s "-screen 0 1024x768x24" "$cohort" play "$map" --frames 5 --width 160 --height 120 --scale 1 \
+  --screenshot "$shot" --window-screenshot "$window_shot"
+rc=$?
+set +x
+if [ $rc -ne 0 ]; then
+  echo "FAIL: cohort play exited with $rc"
+  exit 1
+fi
+# The rendered frame, and the window as drawn through the GL texture upload with the HUD over it.
+python3 "$checker" "$shot" 160 120 && python3 "$checker" "$window_shot" 160 120
