@@ -18,6 +18,10 @@ typedef struct KBvhNode {
   float bmax[3]; kuint count;
 } KBvhNode;
 
+/* Builders never produce a tree deeper than this many levels, so a traversal stack of this many
+ * entries (near-child-first, one push per level) cannot overflow. */
+#define K_BVH_MAX_DEPTH 48
+
 typedef struct KBlas {
   kuint node_offset; kuint node_count;
   kuint tri_offset;  kuint tri_count;

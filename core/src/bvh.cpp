@@ -1,6 +1,8 @@
 #include "cohort/core/bvh.h"
 
 #include <algorithm>
+#include <stdexcept>
+#include <string>
 
 #include "bvh_binned_sah.h"
 
@@ -10,6 +12,11 @@ namespace {
 using detail::Box;
 
 Box triangle_box(const std::vector<KVertex>& vertices, const KTriangle& t) {
+  if (t.v0 >= vertices.size() || t.v1 >= vertices.size() || t.v2 >= vertices.size()) {
+    throw std::out_of_range("BVH: triangle (" + std::to_string(t.v0) + ", " + std::to_string(t.v1) + ", " +
+                            std::to_string(t.v2) + ") indexes past the " + std::to_string(vertices.size()) +
+                            " vertices");
+  }
   Box b;
   b.grow(vertices[t.v0].pos);
   b.grow(vertices[t.v1].pos);

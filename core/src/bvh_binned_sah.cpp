@@ -9,6 +9,9 @@ namespace {
 
 constexpr int kMaxBins = 64;
 constexpr uint32_t kParallelMinPrims = 4096;   // smaller subtrees are not worth a thread
+// Depth bound for the traversal stacks (K_BVH_MAX_DEPTH): past this depth, object-median splits add at
+// most log2(count) levels, and the last level becomes a leaf whatever its size.
+constexpr int kMedianSplitDepth = 24;
 
 struct Input {
   const std::vector<Box>& boxes;
@@ -63,23 +66,39 @@ Split find_split(const Input& in, const uint32_t* prims, uint32_t count, const B
 }
 
 // Builds the subtree whose root is nodes[root] over prims [first, first + count).
+// Halves prims at the median centroid along the widest centroid axis: bounded depth whatever the input.
+uint32_t median_split(const Input& in, uint32_t* prims, uint32_t count, const Box& centroid_bounds) {
+  int axis = 0;
+  for (int a = 1; a < 3; ++a)
+    if (centroid_bounds.hi[a] - centroid_bounds.lo[a] > centroid_bounds.hi[axis] - centroid_bounds.lo[axis]) axis = a;
+  const uint32_t half = count / 2;
+  std::nth_element(prims, prims + half, prims + count, [&](uint32_t a, uint32_t b) {
+    float ca = in.centroids[a * 3 + axis], cb = in.centroids[b * 3 + axis];
+    return ca < cb || (ca == cb && a < b);
+  });
+  return half;
+}
+
 void build_subtree(const Input& in, std::vector<uint32_t>& order, std::vector<KBvhNode>& nodes, uint32_t root,
-                   uint32_t first, uint32_t count, int parallel_depth) {
+                   uint32_t first, uint32_t count, int parallel_depth, int depth) {
   Box bounds, centroid_bounds;
   for (uint32_t i = first; i < first + count; ++i) {
     bounds.grow(in.boxes[order[i]]);
     centroid_bounds.grow(&in.centroids[order[i] * 3]);
   }
   set_node_box(nodes[root], bounds);
-  if (count <= in.max_leaf) {
+  if (count <= in.max_leaf || depth >= K_BVH_MAX_DEPTH - 1) {
     nodes[root].left_first = first;
     nodes[root].count = count;
     return;
   }
   uint32_t* prims = order.data() + first;
-  Split split = find_split(in, prims, count, centroid_bounds);
+  Split split;
+  if (depth < kMedianSplitDepth) split = find_split(in, prims, count, centroid_bounds);
   uint32_t left_count;
-  if (split.axis < 0) {
+  if (depth >= kMedianSplitDepth) {
+    left_count = median_split(in, prims, count, centroid_bounds);
+  } else if (split.axis < 0) {
     // All centroids coincide: any division is as good; halve so leaves stay small.
     left_count = count / 2;
   } else {
@@ -101,9 +120,9 @@ void build_subtree(const Input& in, std::vector<uint32_t>& order, std::vector<KB
     // the result.
     std::vector<KBvhNode> right_nodes(1);
     auto right_job = std::async(std::launch::async, [&] {
-      build_subtree(in, order, right_nodes, 0, first + left_count, right_count, parallel_depth - 1);
+      build_subtree(in, order, right_nodes, 0, first + left_count, right_count, parallel_depth - 1, depth + 1);
     });
-    build_subtree(in, order, nodes, left, first, left_count, parallel_depth - 1);
+    build_subtree(in, order, nodes, left, first, left_count, parallel_depth - 1, depth + 1);
     right_job.get();
     const uint32_t base = uint32_t(nodes.size()) - 1;   // right_nodes[i >= 1] lands at base + i
     for (KBvhNode& n : right_nodes)
@@ -112,8 +131,8 @@ void build_subtree(const Input& in, std::vector<uint32_t>& order, std::vector<KB
     nodes.insert(nodes.end(), right_nodes.begin() + 1, right_nodes.end());
     return;
   }
-  build_subtree(in, order, nodes, left, first, left_count, parallel_depth);
-  build_subtree(in, order, nodes, left + 1, first + left_count, right_count, parallel_depth);
+  build_subtree(in, order, nodes, left, first, left_count, parallel_depth, depth + 1);
+  build_subtree(in, order, nodes, left + 1, first + left_count, right_count, parallel_depth, depth + 1);
 }
 
 }  // namespace
@@ -149,7 +168,7 @@ BinnedBuild build_binned_sah(const std::vector<Box>& boxes, int bins, int max_le
   int parallel_depth = 0;
   while ((1 << parallel_depth) < threads) ++parallel_depth;
   if (threads > 1) parallel_depth += 2;   // a few more subtrees than threads to even out imbalance
-  build_subtree(in, out.order, out.nodes, 0, 0, uint32_t(boxes.size()), parallel_depth);
+  build_subtree(in, out.order, out.nodes, 0, 0, uint32_t(boxes.size()), parallel_depth, 0);
   return out;
 }
 

@@ -1,0 +1,260 @@
+/* Two-level BVH traversal over the layouts of layout.h, written once for C++, CUDA and OpenCL C 1.2
+ * (portable.h facilities only: KGLOBAL buffers, fixed-size stacks, no recursion, no function pointers).
+ *
+ * Scene (KSceneRef, geometry only): a TLAS over instances (the KInstance array is in TLAS leaf order)
+ * whose leaves name BLASes; a BLAS is a node range and a triangle range in shared buffers (KBlas).
+ * Triangle vertex indices are absolute into the vertex buffer. Rays go into object space through
+ * world_to_object without renormalising, so t is the same ray parameter in every instance.
+ *
+ * Queries (mask: instances sharing no bit with it are skipped, e.g. K_MASK_SHADOW for shadow rays):
+ *   k_bvh_closest(scene, ctx, o, d, tmin, tmax, mask, &hit)  nearest accepted hit in (tmin, tmax);
+ *                                                            hit.triangle is absolute (tri_offset added)
+ *   k_bvh_any(scene, ctx, o, d, tmin, tmax, mask)            1 when an accepted hit lies in (tmin, tmax)
+ *   k_bvh_shadow(scene, ctx, o, d, tmin, tmax, mask, &T)     T = product of the transmittances of every
+ *                                                            surface in (tmin, tmax); returns 1 when T = 0
+ * Triangles are hit from both sides (Möller-Trumbore); the integrator decides what facing means.
+ * (u, v) weight v1 and v2: p = (1-u-v) p0 + u p1 + v p2.
+ *
+ * Material hooks, so traversal needs no knowledge of materials. Define before including:
+ *   K_BVH_CONTEXT                    type handed to the hooks (pointer or scalar); default int
+ *   K_BVH_HIT_PASSES(ctx, instance, triangle, u, v, shadow_ray)
+ *        float: 1 when the ray goes through this surface (pass-through, alpha-test miss), 0 when the
+ *        hit counts. Used by k_bvh_closest (shadow_ray 0) and k_bvh_any (shadow_ray 1).
+ *        Default 0: every surface counts. Same meaning as material.h's k_hit_transmittance.
+ *   K_BVH_SHADOW_TRANSMITTANCE(ctx, instance, triangle, u, v)
+ *        KVec3: the fraction of light the surface lets through (0 opaque; tinted glass in between).
+ *        Products do not depend on order, so k_bvh_shadow visits surfaces in traversal order and
+ *        stops as soon as T reaches 0. Default: v3s(K_BVH_HIT_PASSES(..., 1)).
+ *
+ * Trees from core/bvh.h are at most K_BVH_MAX_DEPTH levels deep (layout.h); near-child-first
+ * traversal pushes at most one node per level, so the stacks below never overflow. */
+#ifndef COHORT_KERNEL_BVH_TRAVERSE_H
+#define COHORT_KERNEL_BVH_TRAVERSE_H
+#include "portable.h"
+#include "vec.h"
+#include "layout.h"
+#include "scene_view.h"
+
+#ifndef K_BVH_CONTEXT
+#define K_BVH_CONTEXT int
+#endif
+#ifndef K_BVH_HIT_PASSES
+#define K_BVH_HIT_PASSES(ctx, instance, triangle, u, v, shadow_ray) 0.0f
+#endif
+#ifndef K_BVH_SHADOW_TRANSMITTANCE
+#define K_BVH_SHADOW_TRANSMITTANCE(ctx, instance, triangle, u, v) \
+  v3s(K_BVH_HIT_PASSES(ctx, instance, triangle, u, v, 1))
+#endif
+
+typedef struct KSceneRef {
+  KGLOBAL const KVertex* vertices;
+  KGLOBAL const KTriangle* triangles;
+  KGLOBAL const KBvhNode* blas_nodes;
+  KGLOBAL const KBlas* blases;
+  KGLOBAL const KInstance* instances;
+  KGLOBAL const KBvhNode* tlas_nodes;
+  kuint instance_count;
+  kuint tlas_node_count;
+} KSceneRef;
+
+#define K_BVH_QUERY_CLOSEST 0
+#define K_BVH_QUERY_ANY 1
+#define K_BVH_QUERY_SHADOW 2
+
+/* A ray in one space with the reciprocal direction for slab tests. */
+typedef struct KBvhRay {
+  KVec3 o, d, inv_d;
+} KBvhRay;
+
+KFN float k_bvh_safe_inverse(float x) {
+  /* 1/0 = inf meets 0 * inf = NaN when the origin lies on a slab plane; a huge finite value does not. */
+  if (k_fabs(x) < 1e-30f) return x >= 0.0f ? 1e30f : -1e30f;
+  return 1.0f / x;
+}
+
+KFN KBvhRay k_bvh_make_ray(KVec3 o, KVec3 d) {
+  KBvhRay r;
+  r.o = o;
+  r.d = d;
+  r.inv_d = v3(k_bvh_safe_inverse(d.x), k_bvh_safe_inverse(d.y), k_bvh_safe_inverse(d.z));
+  return r;
+}
+
+/* Entry distance into the node's box clipped to [tmin, tmax], or K_INF when the ray misses it. */
+KFN float k_bvh_ray_box(KBvhRay r, KGLOBAL const KBvhNode* n, float tmin, float tmax) {
+  float tx1 = (n->bmin[0] - r.o.x) * r.inv_d.x, tx2 = (n->bmax[0] - r.o.x) * r.inv_d.x;
+  float ty1 = (n->bmin[1] - r.o.y) * r.inv_d.y, ty2 = (n->bmax[1] - r.o.y) * r.inv_d.y;
+  float tz1 = (n->bmin[2] - r.o.z) * r.inv_d.z, tz2 = (n->bmax[2] - r.o.z) * r.inv_d.z;
+  float tnear = k_fmax(k_fmax(k_fmin(tx1, tx2), k_fmin(ty1, ty2)), k_fmax(k_fmin(tz1, tz2), tmin));
+  float tfar = k_fmin(k_fmin(k_fmax(tx1, tx2), k_fmax(ty1, ty2)), k_fmin(k_fmax(tz1, tz2), tmax));
+  return tnear <= tfar ? tnear : K_INF;
+}
+
+/* Möller-Trumbore, both-sided: 1 and (t, u, v) when tmin < t < tmax. */
+KFN int k_bvh_ray_triangle(KVec3 o, KVec3 d, KVec3 p0, KVec3 p1, KVec3 p2, float tmin, float tmax,
+                           float* t_out, float* u_out, float* v_out) {
+  KVec3 e1 = v3_sub(p1, p0);
+  KVec3 e2 = v3_sub(p2, p0);
+  KVec3 p = v3_cross(d, e2);
+  float det = v3_dot(e1, p);
+  if (k_fabs(det) < 1e-20f) return 0;
+  float inv_det = 1.0f / det;
+  KVec3 s = v3_sub(o, p0);
+  float u = v3_dot(s, p) * inv_det;
+  if (u < 0.0f || u > 1.0f) return 0;
+  KVec3 q = v3_cross(s, e1);
+  float v = v3_dot(d, q) * inv_det;
+  if (v < 0.0f || u + v > 1.0f) return 0;
+  float t = v3_dot(e2, q) * inv_det;
+  if (!(t > tmin && t < tmax)) return 0;
+  *t_out = t;
+  *u_out = u;
+  *v_out = v;
+  return 1;
+}
+
+KFN int k_bvh_hit_triangle(KSceneRef scene, kuint triangle, KVec3 o, KVec3 d, float tmin, float tmax,
+                           float* t, float* u, float* v) {
+  KGLOBAL const KTriangle* tri = scene.triangles + triangle;
+  return k_bvh_ray_triangle(o, d, v3_load_g(scene.vertices[tri->v0].pos), v3_load_g(scene.vertices[tri->v1].pos),
+                            v3_load_g(scene.vertices[tri->v2].pos), tmin, tmax, t, u, v);
+}
+
+/* One candidate hit. CLOSEST records it and shrinks *tmax; ANY reports it; SHADOW multiplies it
+ * into *transmittance. Returns 1 when the whole query is decided. */
+KFN int k_bvh_accept(K_BVH_CONTEXT ctx, int query, kuint instance, kuint triangle, float t, float u, float v,
+                     float* tmax, KHit* hit, KVec3* transmittance) {
+  if (query == K_BVH_QUERY_SHADOW) {
+    KVec3 through = K_BVH_SHADOW_TRANSMITTANCE(ctx, instance, triangle, u, v);
+    *transmittance = v3_mul(*transmittance, through);
+    return v3_max_component(*transmittance) <= 0.0f;
+  }
+  if (K_BVH_HIT_PASSES(ctx, instance, triangle, u, v, query == K_BVH_QUERY_ANY) > 0.0f) return 0;
+  if (query == K_BVH_QUERY_ANY) return 1;
+  *tmax = t;
+  hit->t = t;
+  hit->u = u;
+  hit->v = v;
+  hit->instance = instance;
+  hit->triangle = triangle;
+  return 0;
+}
+
+/* Walks one instance's BLAS with the object-space ray. */
+KFN int k_bvh_traverse_blas(KSceneRef scene, K_BVH_CONTEXT ctx, int query, kuint instance, KBvhRay r,
+                            float tmin, float* tmax, KHit* hit, KVec3* transmittance) {
+  KGLOBAL const KBlas* blas = scene.blases + scene.instances[instance].blas;
+  if (blas->node_count == 0u) return 0;
+  KGLOBAL const KBvhNode* nodes = scene.blas_nodes + blas->node_offset;
+  kuint stack[K_BVH_MAX_DEPTH];
+  int sp = 0;
+  kuint node = 0u;
+  if (k_bvh_ray_box(r, nodes, tmin, *tmax) == K_INF) return 0;
+  for (;;) {
+    KGLOBAL const KBvhNode* n = nodes + node;
+    hit->cost += 1u;
+    if (n->count > 0u) {
+      kuint end = n->left_first + n->count;
+      for (kuint i = n->left_first; i < end; ++i) {
+        kuint triangle = blas->tri_offset + i;
+        float t, u, v;
+        if (!k_bvh_hit_triangle(scene, triangle, r.o, r.d, tmin, *tmax, &t, &u, &v)) continue;
+        if (k_bvh_accept(ctx, query, instance, triangle, t, u, v, tmax, hit, transmittance)) return 1;
+      }
+    } else {
+      kuint near_child = n->left_first, far_child = n->left_first + 1u;
+      float t_near = k_bvh_ray_box(r, nodes + near_child, tmin, *tmax);
+      float t_far = k_bvh_ray_box(r, nodes + far_child, tmin, *tmax);
+      if (t_far < t_near) {
+        float tt = t_near; t_near = t_far; t_far = tt;
+        kuint tn = near_child; near_child = far_child; far_child = tn;
+      }
+      if (t_near != K_INF) {
+        if (t_far != K_INF && sp < K_BVH_MAX_DEPTH) stack[sp++] = far_child;
+        node = near_child;
+        continue;
+      }
+    }
+    /* Pop, skipping nodes that a closer hit found since they were pushed has made irrelevant. */
+    for (;;) {
+      if (sp == 0) return 0;
+      node = stack[--sp];
+      if (k_bvh_ray_box(r, nodes + node, tmin, *tmax) != K_INF) break;
+    }
+  }
+}
+
+/* Walks the TLAS; per instance leaf whose mask matches, the instance's BLAS in object space. */
+KFN int k_bvh_traverse(KSceneRef scene, K_BVH_CONTEXT ctx, int query, KVec3 o, KVec3 d, float tmin, float tmax,
+                       kuint mask, KHit* hit, KVec3* transmittance) {
+  hit->t = tmax;
+  hit->u = 0.0f;
+  hit->v = 0.0f;
+  hit->instance = K_NONE;
+  hit->triangle = K_NONE;
+  hit->cost = 0u;
+  if (scene.tlas_node_count == 0u || scene.instance_count == 0u) return 0;
+  KBvhRay world = k_bvh_make_ray(o, d);
+  kuint stack[K_BVH_MAX_DEPTH];
+  int sp = 0;
+  kuint node = 0u;
+  if (k_bvh_ray_box(world, scene.tlas_nodes, tmin, tmax) == K_INF) return 0;
+  for (;;) {
+    KGLOBAL const KBvhNode* n = scene.tlas_nodes + node;
+    hit->cost += 1u;
+    if (n->count > 0u) {
+      kuint end = n->left_first + n->count;
+      for (kuint i = n->left_first; i < end; ++i) {
+        KGLOBAL const KInstance* inst = scene.instances + i;
+        if ((inst->mask & mask) == 0u) continue;
+        KBvhRay object_ray = k_bvh_make_ray(xform_point_g(inst->world_to_object, o),
+                                       xform_vector_g(inst->world_to_object, d));
+        if (k_bvh_traverse_blas(scene, ctx, query, i, object_ray, tmin, &tmax, hit, transmittance)) return 1;
+      }
+    } else {
+      kuint near_child = n->left_first, far_child = n->left_first + 1u;
+      float t_near = k_bvh_ray_box(world, scene.tlas_nodes + near_child, tmin, tmax);
+      float t_far = k_bvh_ray_box(world, scene.tlas_nodes + far_child, tmin, tmax);
+      if (t_far < t_near) {
+        float tt = t_near; t_near = t_far; t_far = tt;
+        kuint tn = near_child; near_child = far_child; far_child = tn;
+      }
+      if (t_near != K_INF) {
+        if (t_far != K_INF && sp < K_BVH_MAX_DEPTH) stack[sp++] = far_child;
+        node = near_child;
+        continue;
+      }
+    }
+    for (;;) {
+      if (sp == 0) return 0;
+      node = stack[--sp];
+      if (k_bvh_ray_box(world, scene.tlas_nodes + node, tmin, tmax) != K_INF) break;
+    }
+  }
+}
+
+KFN int k_bvh_closest(KSceneRef scene, K_BVH_CONTEXT ctx, KVec3 o, KVec3 d, float tmin, float tmax, kuint mask,
+                      KHit* hit) {
+  KVec3 unused = v3s(1.0f);
+  k_bvh_traverse(scene, ctx, K_BVH_QUERY_CLOSEST, o, d, tmin, tmax, mask, hit, &unused);
+  return hit->instance != K_NONE;
+}
+
+KFN int k_bvh_any(KSceneRef scene, K_BVH_CONTEXT ctx, KVec3 o, KVec3 d, float tmin, float tmax, kuint mask) {
+  KHit scratch;
+  KVec3 unused = v3s(1.0f);
+  return k_bvh_traverse(scene, ctx, K_BVH_QUERY_ANY, o, d, tmin, tmax, mask, &scratch, &unused);
+}
+
+KFN int k_bvh_shadow(KSceneRef scene, K_BVH_CONTEXT ctx, KVec3 o, KVec3 d, float tmin, float tmax, kuint mask,
+                     KVec3* transmittance) {
+  KHit scratch;
+  *transmittance = v3s(1.0f);
+  if (k_bvh_traverse(scene, ctx, K_BVH_QUERY_SHADOW, o, d, tmin, tmax, mask, &scratch, transmittance)) {
+    *transmittance = v3s(0.0f);
+    return 1;
+  }
+  return 0;
+}
+
+#endif

@@ -1,0 +1,20 @@
+# kernel/bvh_traverse.h on devices: an OpenCL run on whatever platform exists (PoCL on the CPU) and a
+# compile-only nvcc check where a CUDA compiler exists.
+if(TARGET cohort_kernel_tests)
+  target_link_libraries(cohort_kernel_tests PRIVATE cohort_core)
+  if(COHORT_WITH_OPENCL)
+    target_link_libraries(cohort_kernel_tests PRIVATE OpenCL::OpenCL)
+    target_compile_definitions(cohort_kernel_tests PRIVATE COHORT_HAVE_OPENCL=1 CL_TARGET_OPENCL_VERSION=120)
+  endif()
+endif()
+
+set(_nvcc "${CMAKE_CUDA_COMPILER}")
+if(NOT _nvcc)
+  find_program(_nvcc nvcc PATHS /usr/local/cuda/bin)
+endif()
+if(_nvcc)
+  add_test(NAME kernel.bvh_traverse_nvcc_compiles
+           COMMAND ${_nvcc} -x cu -c ${CMAKE_CURRENT_LIST_DIR}/bvh_traverse_cuda_check.cu
+                   -I ${CMAKE_SOURCE_DIR}/core -o ${CMAKE_BINARY_DIR}/bvh_traverse_cuda_check.o)
+  set_tests_properties(kernel.bvh_traverse_nvcc_compiles PROPERTIES LABELS kernel TIMEOUT 300)
+endif()
