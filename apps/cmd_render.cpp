@@ -4,6 +4,7 @@
 #include <fstream>
 #include <iostream>
 #include <map>
+#include <optional>
 
 #include <nlohmann/json.hpp>
 #include <spdlog/spdlog.h>
@@ -14,6 +15,8 @@
 #include "cohort/core/image_output.h"
 #include "cohort/core/renderer.h"
 #include "commands.h"
+#include "camera_path.h"
+#include "progress_bar.h"
 #include "render_scene_source.h"
 #include "tone_map.h"
 #include "tracer_factory.h"
@@ -31,6 +34,8 @@ struct RenderArgs {
   int width = 640, height = 360, spp = 4, frames = 1, bounces = 1, light_samples = 0;
   float fov = 90.0f, exposure = 1.0f, firefly_clamp = 5.0f, spec_boost = 2.0f, soft_shadow_scale = 0.2f;
   float yaw_step = 0.0f;
+  std::string camera_path;    // spin/orbit[-slow|-fast]; empty: fixed camera (plus --yaw-step)
+  std::string write = "all";  // images of every frame, or only the last
   std::vector<float> camera;  // x y z yaw pitch
   std::vector<std::string> bases;
 };
@@ -42,8 +47,18 @@ const std::map<std::string, uint32_t>& modes() {
   return m;
 }
 
+// Like `cohort info` and `cohort play`: with no --base, the bundled test map's folder.
+std::vector<std::string> bases_or_test_map(const std::vector<std::string>& bases) {
+  if (!bases.empty()) return bases;
+  std::error_code ec;
+  std::filesystem::path fallback = "assets/testmap";
+  if (!std::filesystem::is_directory(fallback, ec)) fallback = std::filesystem::path(COHORT_SOURCE_DIR) / "assets/testmap";
+  if (std::filesystem::is_directory(fallback, ec)) return {fallback.string()};
+  return {};
+}
+
 int run_render(const RenderArgs& a) {
-  RenderScene scene = load_render_scene(a.map, a.bases);
+  RenderScene scene = load_render_scene(a.map, bases_or_test_map(a.bases));
   std::vector<std::unique_ptr<core::Tracer>> tracers = make_tracers(a.tracers);
   core::RendererOptions options;
   options.balancer = a.balancer;
@@ -62,9 +77,17 @@ int run_render(const RenderArgs& a) {
   const bool oiio = core::have_image_library();
   nlohmann::json stats_json = nlohmann::json::array();
   core::FrameBuffer frame;
+  const std::optional<CameraPath> path =
+      a.camera_path.empty() ? std::nullopt : std::optional<CameraPath>(parse_camera_path(a.camera_path));
+  ProgressBar progress(a.frames, std::cerr, stderr_is_terminal());
   for (int f = 0; f < a.frames; ++f) {
     core::BandJob job;
-    job.camera = core::make_camera(eye, yaw + a.yaw_step * float(f), pitch, a.fov, a.width, a.height);
+    if (path) {
+      const CameraPose pose = camera_path_pose(*path, eye, yaw, f);
+      job.camera = core::make_camera(pose.origin, pose.yaw, pitch + pose.pitch, a.fov, a.width, a.height);
+    } else {
+      job.camera = core::make_camera(eye, yaw + a.yaw_step * float(f), pitch, a.fov, a.width, a.height);
+    }
     KFrameParams& p = job.params;
     p.frame_index = static_cast<kuint>(f);
     p.spp = static_cast<kuint>(a.spp);
@@ -76,6 +99,11 @@ int run_render(const RenderArgs& a) {
     p.soft_shadow_scale = a.soft_shadow_scale;
     p.rr_start = 2.0f;
     core::FrameStats stats = renderer.render(job, frame);
+    progress.frame_done(stats.wall_ms);
+    if (a.write == "last" && f + 1 < a.frames) {
+      stats_json.push_back(nlohmann::json(stats));
+      continue;
+    }
     char stem[32];
     std::snprintf(stem, sizeof stem, "frame_%04d", f);
     std::filesystem::path base = std::filesystem::path(a.out) / stem;
@@ -85,13 +113,14 @@ int run_render(const RenderArgs& a) {
     core::write_hdr_image(base.string() + (oiio ? ".exr" : ".pfm"), frame);
     nlohmann::json j = stats;
     stats_json.push_back(j);
-    spdlog::info("frame {}: {:.1f} ms ({} tracers, idle {:.1f}%)", f, stats.frame_ms, stats.tracers.size(),
-                 stats.idle_percent);
+    spdlog::debug("frame {}: {:.1f} ms ({} tracers, idle {:.1f}%)", f, stats.frame_ms, stats.tracers.size(),
+                  stats.idle_percent);
   }
+  progress.finish();
   nlohmann::json report = {{"map", a.map},       {"scene", scene.name},     {"tracers", a.tracers},
                            {"balancer", a.balancer}, {"width", a.width},     {"height", a.height},
                            {"spp", a.spp},       {"bounces", a.bounces},    {"mode", a.mode},
-                           {"frames", stats_json}};
+                           {"camera_path", a.camera_path}, {"frames", stats_json}};
   std::ofstream(std::filesystem::path(a.out) / "stats.json") << report.dump(2) << "\n";
   std::cout << "wrote " << a.frames << " frame(s) and stats.json to " << a.out << "\n";
   return kExitOk;
@@ -123,6 +152,19 @@ void add_render_command(CLI::App& app) {
       ->check(CLI::IsMember({"path", "direct", "albedo", "normals", "specular", "bvh", "triangles"}));
   cmd->add_option("--fov", a->fov, "horizontal field of view in degrees")->capture_default_str();
   cmd->add_option("--camera", a->camera, "x y z yaw pitch (default: the player start at eye height)")->expected(5);
+  cmd->add_option("--camera-path", a->camera_path, "scripted camera from the start: spin or orbit, -slow (default) or "
+                                                   "-fast, e.g. orbit-fast")
+      ->check([](const std::string& v) {
+        try {
+          parse_camera_path(v);
+          return std::string();
+        } catch (const std::exception& e) {
+          return std::string(e.what());
+        }
+      });
+  cmd->add_option("--write", a->write, "images of every frame, or only the last (stats.json always has every frame)")
+      ->capture_default_str()
+      ->check(CLI::IsMember({"all", "last"}));
   cmd->add_option("--yaw-step", a->yaw_step, "degrees the camera turns per frame")->capture_default_str();
   cmd->add_option("--exposure", a->exposure, "exposure before the tone curve")->capture_default_str();
   cmd->add_option("--firefly-clamp", a->firefly_clamp, "max indirect contribution (0: off)")->capture_default_str();
