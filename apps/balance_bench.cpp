@@ -24,8 +24,11 @@ namespace {
 BalanceBenchRun run_one(const BalanceBenchConfig& config, const std::string& path, int count, const std::string& balancer) {
   auto model = std::make_shared<core::SpinSceneCostModel>(config.seed);
   std::vector<std::unique_ptr<core::Tracer>> tracers;
+  glm::vec3 eye(0.0f);
   if (!config.real.empty()) {
-    tracers = make_real_tracers(config.real);
+    RealTracers real = make_real_tracers(config.real, config.real_scene);
+    tracers = std::move(real.tracers);
+    eye = real.eye;
   } else {
     for (int i = 0; i < count; ++i) {
       core::SimulatedTracerOptions o;
@@ -54,9 +57,23 @@ BalanceBenchRun run_one(const BalanceBenchConfig& config, const std::string& pat
   int counted = 0;
   for (int f = 0; f < config.frames; ++f) {
     core::BandJob job;
-    job.camera = core::spin_camera(config.width, config.rows, f * step);
+    // Simulated tracers only need rows; real ones get a 16:9 image so the view is not a sliver.
+    const int width = config.real.empty() ? config.width : std::max(config.width, config.rows * 16 / 9);
+    job.camera = core::spin_camera(width, config.rows, f * step);
     job.params.frame_index = static_cast<kuint>(f);
     job.params.spp = 1;
+    if (!config.real.empty()) {
+      // Real tracers path-trace the scene from the player start: NEE, one bounce, as `cohort render`.
+      job.camera.origin[0] = eye.x;
+      job.camera.origin[1] = eye.y;
+      job.camera.origin[2] = eye.z;
+      job.params.max_bounces = 1;
+      job.params.light_samples = 1;
+      job.params.firefly_clamp = 5.0f;
+      job.params.spec_boost = 2.0f;
+      job.params.soft_shadow_scale = 0.2f;
+      job.params.rr_start = 2.0f;
+    }
     const core::FrameStats stats = renderer.render(job, frame);
     run.idle_percent.push_back(stats.idle_percent);
     if (f >= config.warmup) {

@@ -29,6 +29,7 @@ struct BalanceBenchConfig {
   uint64_t seed = 1;
   balance::BalancerOptions balancer_options;
   std::vector<std::string> real;         // real tracer names; empty: simulated
+  std::string real_scene = "assets/testmap/maps/testmap.map";   // what real tracers render
 };
 
 struct BalanceBenchRun {

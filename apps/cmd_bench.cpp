@@ -43,6 +43,7 @@ void add_bench_command(CLI::App& app) {
       "results are reproducible.");
   struct Args {
     std::string balancers, tracers = "2,3,4", speeds = "1", path = "both", real, json, plot;
+    std::string scene = "assets/testmap/maps/testmap.map";
     double noise = 0.02, row_work_error = 0.2;
     bool row_work = true;
     std::string clock = "virtual";
@@ -78,7 +79,9 @@ void add_bench_command(CLI::App& app) {
       ->capture_default_str();
   balance->add_option("--speed-rate", args->options.speed_rate, "Row Cost: how fast per-tracer speeds follow new times")
       ->capture_default_str();
-  balance->add_option("--real", args->real, "real tracers instead of simulated ones, e.g. embree,opencl,cuda");
+  balance->add_option("--real", args->real,
+                      "real tracers instead of simulated ones, e.g. embree,opencl:0 or cuda:all (they render --scene)");
+  balance->add_option("--scene", args->scene, "map or scene pack the real tracers render")->capture_default_str();
   balance->add_option("--json", args->json, "write every run (per-frame idle %) as JSON");
   balance->add_option("--plot", args->plot, "write a PNG chart of idle % per frame per balancer");
   balance->callback([args] {
@@ -97,6 +100,7 @@ void add_bench_command(CLI::App& app) {
     config.seed = args->seed;
     config.balancer_options = args->options;
     config.real = split_list<std::string>(args->real, "--real");
+    config.real_scene = args->scene;
     config.paths = args->path == "both" ? std::vector<std::string>{"slow", "fast"} : std::vector<std::string>{args->path};
     const std::vector<std::string> known = balance::balancer_names();
     for (const std::string& b : config.balancers)

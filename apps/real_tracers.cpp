@@ -1,16 +1,25 @@
 #include "real_tracers.h"
 
-#include <stdexcept>
+#include <spdlog/spdlog.h>
+
+#include "render_scene_source.h"
+#include "tracer_factory.h"
 
 namespace cohort::app {
 
-// The tracer modules register their factories here once they exist (issues 8-10); until then every
-// name is refused with the reason, and `cohort bench balance` falls back to simulated tracers only.
-std::vector<std::unique_ptr<core::Tracer>> make_real_tracers(const std::vector<std::string>& names) {
+RealTracers make_real_tracers(const std::vector<std::string>& names, const std::string& scene_path) {
   std::string list;
   for (const std::string& n : names) list += (list.empty() ? "" : ",") + n;
-  throw std::runtime_error("no real tracers are built into this binary yet (asked for: " + list +
-                           "); the Embree/OpenCL/CUDA tracers register in apps/real_tracers.cpp");
+  RealTracers out;
+  out.tracers = make_tracers(list);
+  RenderScene scene = load_render_scene(scene_path, {});
+  auto commit = commit::CommitBuffer::full(scene.tracer_scene, 1);
+  for (auto& t : out.tracers) {
+    spdlog::info("bench balance: {} loads {}", t->name(), scene.name);
+    t->apply(commit);
+  }
+  out.eye = scene.player_start + glm::vec3(0.0f, 0.0f, 68.0f);
+  return out;
 }
 
 }  // namespace cohort::app

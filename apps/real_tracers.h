@@ -1,17 +1,24 @@
-// The hook through which `cohort bench balance --real` gets real tracers (Embree, OpenCL, CUDA).
+// The real tracers `cohort bench balance --real` measures (Embree, OpenCL, CUDA), each with the
+// bundled test map (or the given scene) already applied.
 #pragma once
 
 #include <memory>
 #include <string>
 #include <vector>
 
+#include <glm/glm.hpp>
+
 #include "cohort/core/tracer.h"
 
 namespace cohort::app {
 
-// Tracers for the given names ("embree", "opencl", "cuda", "cuda:1", ...), each with its scene already
-// applied, ready to render. Throws std::runtime_error saying what is missing when a name cannot be
-// served by this build.
-std::vector<std::unique_ptr<core::Tracer>> make_real_tracers(const std::vector<std::string>& names);
+struct RealTracers {
+  std::vector<std::unique_ptr<core::Tracer>> tracers;
+  glm::vec3 eye{0.0f};   // where the spinning camera stands: the scene's player start at eye height
+};
+
+// names: tracer specs as `--tracers` takes them ("embree", "opencl:0", "cuda:1", "all", ...).
+// Throws std::runtime_error / std::invalid_argument saying what is missing.
+RealTracers make_real_tracers(const std::vector<std::string>& names, const std::string& scene);
 
 }  // namespace cohort::app

@@ -45,6 +45,9 @@ case "${1:-}" in
     # A frame of the test map through the whole app, every GPU tracer: PFM/PPM since no OpenImageIO travels.
     "$stage/bin/cohort" render "$stage/testmap.cpk" --tracers "${COHORT_GPU_TRACERS:-cuda:all}" --width 640 --height 360 \
       --spp 16 --frames 2 --out "$out/render" 2>&1 | tail -n 8 | tee "$out/render.log" || status=1
+    # Balancer efficiency with real GPU tracers (the paper's Table 1 metric), both camera paths.
+    "$stage/bin/cohort" bench balance --real "${COHORT_GPU_TRACERS:-cuda:all}" --scene "$stage/testmap.cpk" --rows 720 \
+      --frames 200 --json "$out/bench_balance_gpu.json" 2>&1 | grep -v "loads" | tee "$out/bench_balance_gpu.log" || status=1
     # The device tool brings back at most 8 files: one archive holds them all (logs also print above).
     tar cf /tmp/cohort-results.tar -C "$out" . && rm -rf "${out:?}"/* && mv /tmp/cohort-results.tar "$out/results.tar"
     exit $status
