@@ -114,7 +114,7 @@ void add_bench_command(CLI::App& app) {
     std::vector<BalanceBenchRun> runs;
     try {
       runs = run_balance_bench(config);
-    } catch (const std::runtime_error& e) {
+    } catch (const std::exception& e) {  // unknown names (invalid_argument) as well as missing devices
       std::cerr << "cohort bench balance: " << e.what() << "\n";
       std::exit(config.real.empty() ? kExitFailure : kExitUnavailable);
     }

@@ -12,6 +12,7 @@
 #include "cohort/commit/commit_buffer.h"
 #include "cohort/core/frame_stats.h"
 #include "cohort/core/gpu_scene.h"
+#include "cohort/core/convergence.h"
 #include "cohort/core/image_output.h"
 #include "cohort/core/renderer.h"
 #include "commands.h"
@@ -38,6 +39,7 @@ struct RenderArgs {
   std::string write = "all";  // images of every frame, or only the last
   std::vector<float> camera;  // x y z yaw pitch
   std::vector<std::string> bases;
+  bool no_convergence = false;
 };
 
 const std::map<std::string, uint32_t>& modes() {
@@ -77,6 +79,7 @@ int run_render(const RenderArgs& a) {
   const bool oiio = core::have_image_library();
   nlohmann::json stats_json = nlohmann::json::array();
   core::FrameBuffer frame;
+  core::AdaptiveConvergence convergence;
   const std::optional<CameraPath> path =
       a.camera_path.empty() ? std::nullopt : std::optional<CameraPath>(parse_camera_path(a.camera_path));
   ProgressBar progress(a.frames, std::cerr, stderr_is_terminal());
@@ -99,6 +102,9 @@ int run_render(const RenderArgs& a) {
     p.soft_shadow_scale = a.soft_shadow_scale;
     p.rr_start = 2.0f;
     core::FrameStats stats = renderer.render(job, frame);
+    // Adaptive convergence: a still camera accumulates every frame; motion raises f (see convergence.h).
+    if (!a.no_convergence) stats.convergence_f = convergence.accumulate(job.camera, frame);
+    const core::FrameBuffer& shown = a.no_convergence ? frame : convergence.image();
     progress.frame_done(stats.wall_ms);
     if (a.write == "last" && f + 1 < a.frames) {
       stats_json.push_back(nlohmann::json(stats));
@@ -109,8 +115,8 @@ int run_render(const RenderArgs& a) {
     std::filesystem::path base = std::filesystem::path(a.out) / stem;
     ToneMapOptions tm;
     tm.exposure = a.exposure;
-    core::write_ldr_image(base.string() + (oiio ? ".png" : ".ppm"), frame.width, frame.height, tone_map(frame, tm));
-    core::write_hdr_image(base.string() + (oiio ? ".exr" : ".pfm"), frame);
+    core::write_ldr_image(base.string() + (oiio ? ".png" : ".ppm"), shown.width, shown.height, tone_map(shown, tm));
+    core::write_hdr_image(base.string() + (oiio ? ".exr" : ".pfm"), shown);
     nlohmann::json j = stats;
     stats_json.push_back(j);
     spdlog::debug("frame {}: {:.1f} ms ({} tracers, idle {:.1f}%)", f, stats.frame_ms, stats.tracers.size(),
@@ -162,6 +168,8 @@ void add_render_command(CLI::App& app) {
           return std::string(e.what());
         }
       });
+  cmd->add_flag("--no-convergence", a->no_convergence,
+                 "write each frame as rendered instead of blending frames with adaptive convergence");
   cmd->add_option("--write", a->write, "images of every frame, or only the last (stats.json always has every frame)")
       ->capture_default_str()
       ->check(CLI::IsMember({"all", "last"}));

@@ -7,4 +7,4 @@ cd "$(dirname "$0")/.."
 cmake --preset default
 cmake --build --preset default
 ./build/default/bin/cohort render assets/testmap/maps/testmap.map --tracers all --frames 8 \
-  --out out/quickstart "$@"
+  --write last --out out/quickstart "$@"
