@@ -19,4 +19,9 @@ if(TARGET cohort)
                    ${CMAKE_BINARY_DIR}/test_output/viewer_xvfb/screenshot.${_shot_ext}
                    ${CMAKE_CURRENT_LIST_DIR}/image_not_uniform.py)
   set_tests_properties(apps.viewer_xvfb PROPERTIES LABELS apps TIMEOUT 600 SKIP_RETURN_CODE 77)
+  if(COHORT_SANITIZE)
+    # Mesa's llvmpipe driver (dlopen'ed, no symbols) leaks a few hundred bytes at exit; the leak checker
+    # cannot attribute them, so it is off for this test only. ASan's other checks stay on.
+    set_tests_properties(apps.viewer_xvfb PROPERTIES ENVIRONMENT "ASAN_OPTIONS=detect_leaks=0")
+  endif()
 endif()
