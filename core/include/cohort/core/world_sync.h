@@ -7,6 +7,15 @@
 // build for the same state), lights are the live light defs in handle order, textures use
 // texture_slot(). compile_scene puts a default material right after the map's materials; materials
 // defined later go after it, so no triangle's material index ever moves (kmaterial_index()).
+//
+// Replaying a recorded stream (`cohort render --replay FILE`), per frame:
+//   scene::Player player(file);                       // player.header().map_name names the map to load
+//   scene::RenderWorld world(load the map);
+//   WorldSync sync(world, compile_scene(world.scene()), options);
+//   while (player.play_frame(world)) {
+//     renderer.submit_commit(sync.sync(world.TakeChanges(), frame));   // or sync_and_publish + channels
+//     render with sync.master().camera ...
+//   }
 #pragma once
 
 #include <array>
