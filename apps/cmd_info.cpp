@@ -1,17 +1,75 @@
 #include <iostream>
 
+#include "cohort/scene/map_loader.h"
 #include "commands.h"
 
 namespace cohort::app {
+
+namespace {
+
+int run_info(const std::string& map, std::vector<std::string> bases, size_t max_warnings) {
+  scene::Vfs vfs;
+  scene::LoadReport report;
+  scene::Scene loaded;
+  try {
+    for (const std::string& base : bases) vfs.add_search_path(base);
+    loaded = scene::load_map(vfs, map, &report);
+  } catch (const scene::ParseError& e) {
+    std::cerr << "cohort info: " << e.what() << "\n";
+    return kExitFailure;
+  } catch (const std::exception& e) {
+    std::cerr << "cohort info: " << e.what() << "\n";
+    return kExitFailure;
+  }
+  std::cout << "map        " << loaded.name << "\n"
+            << "  .map     " << report.map_file << "\n"
+            << "  .proc    " << report.proc_file << "\n"
+            << "areas      " << report.areas << " (" << report.portals << " portals, " << report.nodes
+            << " nodes, " << report.shadow_models_skipped << " shadow models skipped)\n"
+            << "triangles  " << report.world_triangles << " world, " << report.entity_triangles << " in entities ("
+            << report.inline_models << " inline models)\n"
+            << "materials  " << report.materials_used << " used (" << report.materials_missing << " missing, "
+            << report.emitters << " emitters), " << report.materials_declared << " declared in "
+            << report.material_files << " .mtr files\n"
+            << "textures   " << report.images_loaded + report.images_placeholder << " (" << report.images_placeholder
+            << " placeholders)\n"
+            << "lights     " << loaded.lights.size() << ": " << report.lights_point << " point, "
+            << report.lights_projected << " projected, " << report.lights_parallel << " parallel\n"
+            << "entities   " << loaded.entities.size() << "\n";
+  for (const auto& [classname, count] : report.entities_by_class)
+    std::cout << "  " << classname << " " << count << "\n";
+  std::cout << "player     (" << loaded.player_start.x << " " << loaded.player_start.y << " " << loaded.player_start.z
+            << ") yaw " << loaded.player_yaw << "\n"
+            << "warnings   " << report.warnings.size() << "\n";
+  for (size_t i = 0; i < report.warnings.size() && i < max_warnings; ++i)
+    std::cout << "  " << report.warnings[i] << "\n";
+  if (report.warnings.size() > max_warnings)
+    std::cout << "  ... " << report.warnings.size() - max_warnings << " more (--max-warnings)\n";
+  return kExitOk;
+}
+
+}  // namespace
 
 void add_info_command(CLI::App& app) {
   auto* cmd = app.add_subcommand("info", "Load a map and print what it contains (areas, triangles, materials, "
                                          "textures, lights by type, entities, warnings)");
   auto map = std::make_shared<std::string>();
-  cmd->add_option("map", *map, "map name or path (e.g. assets/testmap/maps/testmap.map)")->required();
-  cmd->callback([map] {
-    std::cerr << "cohort info: map loading is not implemented yet (issue 3)\n";
-    std::exit(kExitUnavailable);
+  auto bases = std::make_shared<std::vector<std::string>>();
+  auto max_warnings = std::make_shared<size_t>(50);
+  cmd->add_option("map", *map, "a .map file path, or a map name looked up under maps/ in the --base folders "
+                               "(e.g. testmap)")->required();
+  cmd->add_option("--base", *bases, "game folder with loose files and .pk4 archives; repeat it, later folders "
+                                    "override earlier ones (default: assets/testmap)");
+  cmd->add_option("--max-warnings", *max_warnings, "how many warnings to print");
+  cmd->callback([map, bases, max_warnings] {
+    std::vector<std::string> folders = *bases;
+    if (folders.empty()) {
+      std::error_code ec;
+      std::filesystem::path fallback = "assets/testmap";
+      if (!std::filesystem::is_directory(fallback, ec)) fallback = std::filesystem::path(COHORT_SOURCE_DIR) / "assets/testmap";
+      if (std::filesystem::is_directory(fallback, ec)) folders.push_back(fallback.string());
+    }
+    std::exit(run_info(*map, folders, *max_warnings));
   });
 }
 

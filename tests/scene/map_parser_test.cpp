@@ -12,7 +12,7 @@ using cohort::scene::test::data_dir;
 using cohort::scene::test::read_text;
 
 TEST(MapParser, EntitiesKeysAndSkippedPrimitives) {
-  MapFile map = parse_map(read_text(data_dir() / "two_rooms.map"), "two_rooms.map");
+  MapFile map = parse_map(read_text(data_dir() / "base/maps/two_rooms.map"), "two_rooms.map");
   EXPECT_EQ(map.version, 2);
   ASSERT_EQ(map.entities.size(), 6u);
   EXPECT_EQ(map.entities[0].classname(), "worldspawn");
@@ -24,7 +24,7 @@ TEST(MapParser, EntitiesKeysAndSkippedPrimitives) {
 }
 
 TEST(MapEntities, PointLightKeys) {
-  MapFile map = parse_map(read_text(data_dir() / "two_rooms.map"), "two_rooms.map");
+  MapFile map = parse_map(read_text(data_dir() / "base/maps/two_rooms.map"), "two_rooms.map");
   std::vector<std::string> warnings;
   MapLight point = light_from_entity(map.entities[2], "two_rooms.map", warnings);
   EXPECT_EQ(point.light.type, LightType::Point);
@@ -41,7 +41,7 @@ TEST(MapEntities, PointLightKeys) {
 }
 
 TEST(MapEntities, ProjectedLightDefaultsEndToTargetAndStartToZero) {
-  MapFile map = parse_map(read_text(data_dir() / "two_rooms.map"), "two_rooms.map");
+  MapFile map = parse_map(read_text(data_dir() / "base/maps/two_rooms.map"), "two_rooms.map");
   std::vector<std::string> warnings;
   MapLight spot = light_from_entity(map.entities[3], "two_rooms.map", warnings);
   EXPECT_EQ(spot.light.type, LightType::Projected);
@@ -62,7 +62,7 @@ TEST(MapEntities, ProjectedLightDefaultsEndToTargetAndStartToZero) {
 }
 
 TEST(MapEntities, ParallelLightWithAngle) {
-  MapFile map = parse_map(read_text(data_dir() / "two_rooms.map"), "two_rooms.map");
+  MapFile map = parse_map(read_text(data_dir() / "base/maps/two_rooms.map"), "two_rooms.map");
   std::vector<std::string> warnings;
   MapLight sun = light_from_entity(map.entities[4], "two_rooms.map", warnings);
   EXPECT_EQ(sun.light.type, LightType::Parallel);
@@ -85,7 +85,7 @@ TEST(MapEntities, DefaultRadiusAndMalformedValuesWarn) {
 }
 
 TEST(MapEntities, EntityRotationRowsAreAxes) {
-  MapFile map = parse_map(read_text(data_dir() / "two_rooms.map"), "two_rooms.map");
+  MapFile map = parse_map(read_text(data_dir() / "base/maps/two_rooms.map"), "two_rooms.map");
   std::vector<std::string> warnings;
   Entity crate = entity_from_map(map.entities[5], "two_rooms.map", warnings);
   EXPECT_EQ(crate.classname, "func_static");

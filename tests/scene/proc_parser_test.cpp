@@ -10,7 +10,7 @@ using cohort::scene::test::data_dir;
 using cohort::scene::test::read_text;
 
 TEST(ProcParser, ReadsAreasInlineModelsPortalsAndNodes) {
-  ProcFile proc = parse_proc(read_text(data_dir() / "two_rooms.proc"), "two_rooms.proc");
+  ProcFile proc = parse_proc(read_text(data_dir() / "base/maps/two_rooms.proc"), "two_rooms.proc");
   ASSERT_EQ(proc.models.size(), 3u);
   EXPECT_EQ(proc.area_count, 2);
   EXPECT_EQ(proc.shadow_models_skipped, 1);
@@ -45,7 +45,7 @@ TEST(ProcParser, ReadsAreasInlineModelsPortalsAndNodes) {
 }
 
 TEST(ProcParser, TangentsFollowTextureS) {
-  ProcFile proc = parse_proc(read_text(data_dir() / "two_rooms.proc"), "two_rooms.proc");
+  ProcFile proc = parse_proc(read_text(data_dir() / "base/maps/two_rooms.proc"), "two_rooms.proc");
   for (const Vertex& v : proc.models[0].mesh.vertices) {
     // s grows along +x on the floor quad; t decreases along +y, so the bitangent (+t) points to -y.
     EXPECT_NEAR(v.tangent.x, 1.0f, 1e-5f);

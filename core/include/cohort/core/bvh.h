@@ -20,15 +20,20 @@ struct BvhBuildOptions {
   int threads = 0;                    // 0: hardware concurrency
 };
 
-// Binned-SAH BLAS over triangles whose vertex indices point into `vertices`.
+// Binned-SAH BLAS over triangles whose vertex indices point into `vertices`. The same tree for any
+// thread count. No triangles give no nodes.
 BlasBuild build_blas(const std::vector<KVertex>& vertices, const std::vector<KTriangle>& triangles,
                      const BvhBuildOptions& options = {});
 
 // Refit in place after vertices moved (same topology); returns the new SAH cost.
 float refit_blas(const std::vector<KVertex>& vertices, BlasBuild& blas);
 
-// TLAS over instances: `instances` is reordered to leaf order; blas_bounds[i] is the object-space
-// root box of BLAS i (bmin, bmax).
+// Refitting keeps the topology, whose quality decays as a mesh deforms: rebuild once the refit SAH
+// cost exceeds the freshly built one by `threshold`.
+bool blas_needs_rebuild(float built_sah, float refit_sah, float threshold = 1.5f);
+
+// TLAS over instances: `instances` is reordered to leaf order; blas_roots[i] is the root node of BLAS i
+// (its object-space box). No instances give no nodes; traversal treats that as an empty scene.
 std::vector<KBvhNode> build_tlas(std::vector<KInstance>& instances, const std::vector<KBvhNode>& blas_roots);
 
 // SAH cost of a built tree (traversal cost 1, intersection cost 1 per primitive), for quality checks.

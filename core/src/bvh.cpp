@@ -1,0 +1,96 @@
+#include "cohort/core/bvh.h"
+
+#include <algorithm>
+
+#include "bvh_binned_sah.h"
+
+namespace cohort::core {
+namespace {
+
+using detail::Box;
+
+Box triangle_box(const std::vector<KVertex>& vertices, const KTriangle& t) {
+  Box b;
+  b.grow(vertices[t.v0].pos);
+  b.grow(vertices[t.v1].pos);
+  b.grow(vertices[t.v2].pos);
+  return b;
+}
+
+Box instance_world_box(const KInstance& inst, const KBvhNode& blas_root) {
+  Box world;
+  const float* m = inst.object_to_world;
+  for (int corner = 0; corner < 8; ++corner) {
+    float p[3] = {corner & 1 ? blas_root.bmax[0] : blas_root.bmin[0], corner & 2 ? blas_root.bmax[1] : blas_root.bmin[1],
+                  corner & 4 ? blas_root.bmax[2] : blas_root.bmin[2]};
+    float w[3];
+    for (int r = 0; r < 3; ++r) w[r] = m[r * 4 + 0] * p[0] + m[r * 4 + 1] * p[1] + m[r * 4 + 2] * p[2] + m[r * 4 + 3];
+    world.grow(w);
+  }
+  return world;
+}
+
+}  // namespace
+
+BlasBuild build_blas(const std::vector<KVertex>& vertices, const std::vector<KTriangle>& triangles,
+                     const BvhBuildOptions& options) {
+  std::vector<Box> boxes(triangles.size());
+  for (size_t i = 0; i < triangles.size(); ++i) boxes[i] = triangle_box(vertices, triangles[i]);
+  detail::BinnedBuild built = detail::build_binned_sah(boxes, options.bins, options.max_leaf_size, options.threads);
+  BlasBuild out;
+  out.nodes = std::move(built.nodes);
+  out.triangles.resize(triangles.size());
+  for (size_t i = 0; i < built.order.size(); ++i) out.triangles[i] = triangles[built.order[i]];
+  out.sah_cost = sah_cost(out.nodes);
+  return out;
+}
+
+float refit_blas(const std::vector<KVertex>& vertices, BlasBuild& blas) {
+  // Children are always stored after their parent, so a reverse sweep sees children first.
+  for (size_t i = blas.nodes.size(); i-- > 0;) {
+    KBvhNode& n = blas.nodes[i];
+    Box b;
+    if (n.count > 0) {
+      for (uint32_t t = n.left_first; t < n.left_first + n.count; ++t) b.grow(triangle_box(vertices, blas.triangles[t]));
+    } else {
+      b = detail::node_box(blas.nodes[n.left_first]);
+      b.grow(detail::node_box(blas.nodes[n.left_first + 1]));
+    }
+    detail::set_node_box(n, b);
+  }
+  blas.sah_cost = sah_cost(blas.nodes);
+  return blas.sah_cost;
+}
+
+bool blas_needs_rebuild(float built_sah, float refit_sah, float threshold) {
+  return built_sah > 0.0f && refit_sah > built_sah * threshold;
+}
+
+std::vector<KBvhNode> build_tlas(std::vector<KInstance>& instances, const std::vector<KBvhNode>& blas_roots) {
+  std::vector<Box> boxes(instances.size());
+  for (size_t i = 0; i < instances.size(); ++i) {
+    const KInstance& inst = instances[i];
+    if (inst.blas < blas_roots.size()) boxes[i] = instance_world_box(inst, blas_roots[inst.blas]);
+    // An instance of an empty BLAS keeps an empty box: it can never be hit.
+  }
+  // One instance per leaf keeps instance tests (a ray transform each) to the minimum; a TLAS is small.
+  detail::BinnedBuild built = detail::build_binned_sah(boxes, 16, 1, 1);
+  std::vector<KInstance> ordered(instances.size());
+  for (size_t i = 0; i < built.order.size(); ++i) ordered[i] = instances[built.order[i]];
+  instances = std::move(ordered);
+  return std::move(built.nodes);
+}
+
+float sah_cost(const std::vector<KBvhNode>& nodes) {
+  if (nodes.empty()) return 0.0f;
+  const float root_area = detail::node_box(nodes[0]).half_area();
+  if (root_area <= 0.0f) return float(nodes[0].count);
+  float cost = 0.0f;
+  for (const KBvhNode& n : nodes) {
+    float a = detail::node_box(n).half_area() / root_area;
+    cost += n.count > 0 ? a * float(n.count) : a;
+  }
+  return cost;
+}
+
+}  // namespace cohort::core

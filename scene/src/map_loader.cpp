@@ -1,0 +1,237 @@
+#include "cohort/scene/map_loader.h"
+
+#include <algorithm>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include "cohort/scene/image_library.h"
+#include "cohort/scene/map_entities.h"
+#include "cohort/scene/map_file.h"
+#include "cohort/scene/material_build.h"
+#include "cohort/scene/material_file.h"
+#include "cohort/scene/proc_file.h"
+
+namespace cohort::scene {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+std::string lowercase(std::string s) {
+  for (char& c : s)
+    if (c >= 'A' && c <= 'Z') c = static_cast<char>(c - 'A' + 'a');
+  return s;
+}
+
+bool ends_with(const std::string& s, const std::string& suffix) {
+  return s.size() >= suffix.size() && s.compare(s.size() - suffix.size(), suffix.size(), suffix) == 0;
+}
+
+std::string read_disk_file(const fs::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw std::runtime_error(path.string() + ": cannot read");
+  std::ostringstream out;
+  out << in.rdbuf();
+  return out.str();
+}
+
+struct MapSource {
+  std::string map_text, proc_text, map_where, proc_where, name;
+};
+
+MapSource find_map(Vfs& vfs, const std::string& map) {
+  MapSource src;
+  std::error_code ec;
+  fs::path disk(map);
+  if (ends_with(lowercase(map), ".map") && fs::is_regular_file(disk, ec)) {
+    fs::path folder = fs::absolute(disk, ec).parent_path();
+    if (lowercase(folder.filename().string()) == "maps") {
+      fs::path base = folder.parent_path();
+      bool known = std::any_of(vfs.search_paths().begin(), vfs.search_paths().end(),
+                               [&](const fs::path& p) { return fs::equivalent(p, base, ec); });
+      if (!known) vfs.add_search_path(base);
+    }
+    src.name = disk.stem().string();
+    src.map_where = disk.string();
+    src.map_text = read_disk_file(disk);
+    fs::path proc = disk;
+    proc.replace_extension(".proc");
+    if (!fs::is_regular_file(proc, ec))
+      throw std::runtime_error(proc.string() + ": no .proc beside the map (compile it with dmap)");
+    src.proc_where = proc.string();
+    src.proc_text = read_disk_file(proc);
+    return src;
+  }
+  std::string game_path = Vfs::normalize(map);
+  if (game_path.rfind("maps/", 0) != 0) game_path = "maps/" + game_path;
+  if (!ends_with(game_path, ".map")) game_path += ".map";
+  auto text = vfs.read(game_path);
+  if (!text) {
+    std::string searched;
+    for (const auto& p : vfs.search_paths()) searched += (searched.empty() ? "" : ", ") + p.string();
+    throw std::runtime_error("map '" + map + "' not found as a file nor as " + game_path + " in [" + searched + "]");
+  }
+  src.name = fs::path(game_path).stem().string();
+  src.map_where = vfs.describe(game_path);
+  src.map_text = std::move(*text);
+  std::string proc_path = game_path.substr(0, game_path.size() - 4) + ".proc";
+  auto proc = vfs.read(proc_path);
+  if (!proc) throw std::runtime_error(proc_path + ": no .proc beside the map (compile it with dmap)");
+  src.proc_where = vfs.describe(proc_path);
+  src.proc_text = std::move(*proc);
+  return src;
+}
+
+class SceneBuilder {
+ public:
+  SceneBuilder(Vfs& vfs, Scene& scene, LoadReport& report)
+      : scene_(scene), report_(report), images_(vfs, scene.images, scene.warnings) {}
+
+  void read_materials(Vfs& vfs) {
+    for (const std::string& file : vfs.list("materials", ".mtr")) {
+      auto text = vfs.read(file);
+      if (!text) continue;
+      MaterialFile parsed = parse_materials(*text, vfs.describe(file), tables_);
+      ++report_.material_files;
+      for (auto& w : parsed.warnings) scene_.warnings.push_back(std::move(w));
+      for (auto& decl : parsed.materials) {
+        ++report_.materials_declared;
+        std::string key = lowercase(decl.name);
+        auto existing = decls_.find(key);
+        if (existing != decls_.end()) {
+          scene_.warnings.push_back(decl.file + ":" + std::to_string(decl.line) + ": material " + decl.name +
+                                    " already defined at " + existing->second.file + ":" +
+                                    std::to_string(existing->second.line) + "; the first is kept");
+          continue;
+        }
+        decls_.emplace(std::move(key), std::move(decl));
+      }
+    }
+  }
+
+  int material(const std::string& name, bool as_light) {
+    std::string key = lowercase(name) + (as_light ? "#light" : "");
+    auto found = used_.find(key);
+    if (found != used_.end()) return found->second;
+    auto decl = decls_.find(lowercase(name));
+    Material m;
+    if (decl != decls_.end()) {
+      m = build_material(decl->second, images_, as_light);
+    } else {
+      ++report_.materials_missing;
+      scene_.warnings.push_back("material '" + name + "' is not defined in any materials/*.mtr; " +
+                                (images_.can_find(name) ? "using the image of that name" : "using a checker"));
+      m = default_material(name, images_);
+    }
+    int index = static_cast<int>(scene_.materials.size());
+    scene_.materials.push_back(std::move(m));
+    used_[key] = index;
+    return index;
+  }
+
+  void add_proc(ProcFile& proc) {
+    std::vector<std::pair<int, int>> areas;  // area number, mesh index
+    for (ProcModel& model : proc.models) {
+      for (size_t s = 0; s < model.mesh.surfaces.size(); ++s)
+        model.mesh.surfaces[s].material = material(model.surface_materials[s], false);
+      int index = static_cast<int>(scene_.meshes.size());
+      if (model.area >= 0) {
+        areas.emplace_back(model.area, index);
+        report_.world_triangles += model.mesh.triangle_count();
+      } else {
+        ++report_.inline_models;
+      }
+      scene_.meshes.push_back(std::move(model.mesh));
+    }
+    std::sort(areas.begin(), areas.end());
+    for (size_t i = 0; i < areas.size(); ++i) {
+      if (areas[i].first != static_cast<int>(i))
+        scene_.warnings.push_back("the .proc has no model for area " + std::to_string(i) +
+                                  "; Scene::area_meshes is in area order without it");
+      scene_.area_meshes.push_back(areas[i].second);
+    }
+    report_.areas = proc.area_count;
+    report_.portals = static_cast<int>(proc.portals.size());
+    report_.nodes = static_cast<int>(proc.nodes.size());
+    report_.shadow_models_skipped = proc.shadow_models_skipped;
+    scene_.portals = std::move(proc.portals);
+    scene_.nodes = std::move(proc.nodes);
+  }
+
+  void add_entities(const MapFile& map, const std::string& map_where) {
+    for (const std::string& w : map.warnings) scene_.warnings.push_back(w);
+    for (const MapEntity& e : map.entities) {
+      const std::string where = map_where + ":" + std::to_string(e.line);
+      const std::string classname = e.classname();
+      if (classname == "worldspawn") continue;
+      if (is_light_entity(e)) {
+        MapLight light = light_from_entity(e, where, scene_.warnings);
+        if (!light.texture.empty()) light.light.material = material(light.texture, true);
+        switch (light.light.type) {
+          case LightType::Point: ++report_.lights_point; break;
+          case LightType::Projected: ++report_.lights_projected; break;
+          case LightType::Parallel: ++report_.lights_parallel; break;
+        }
+        scene_.lights.push_back(std::move(light.light));
+        continue;
+      }
+      Entity entity = entity_from_map(e, where, scene_.warnings);
+      if (classname == "info_player_start") {
+        scene_.player_start = entity.origin;
+        auto angle = e.get("angle");
+        auto yaw = angle ? parse_floats(*angle, 1) : std::nullopt;
+        scene_.player_yaw = yaw ? (*yaw)[0] : 0.0f;
+      }
+      auto model = e.get("model");
+      if (model) entity.mesh = scene_.find_mesh(*model);
+      if (entity.mesh < 0 && !entity.name.empty() && (!model || *model == entity.name))
+        entity.mesh = scene_.find_mesh(entity.name);
+      if (entity.mesh < 0 && model)
+        scene_.warnings.push_back(where + ": entity " + entity.name + ": model '" + *model +
+                                  "' is not an inline model of the .proc (model files are not loaded)");
+      if (entity.mesh >= 0) report_.entity_triangles += scene_.meshes[static_cast<size_t>(entity.mesh)].triangle_count();
+      ++report_.entities_by_class[classname.empty() ? "(no classname)" : classname];
+      scene_.entities.push_back(std::move(entity));
+    }
+  }
+
+  void finish() {
+    report_.materials_used = static_cast<int>(scene_.materials.size());
+    report_.images_loaded = images_.loaded_count();
+    report_.images_placeholder = images_.placeholder_count();
+    for (const Material& m : scene_.materials) report_.emitters += m.emitter ? 1 : 0;
+  }
+
+ private:
+  Scene& scene_;
+  LoadReport& report_;
+  ImageLibrary images_;
+  MaterialTables tables_;
+  std::map<std::string, MaterialDecl> decls_;
+  std::map<std::string, int> used_;
+};
+
+}  // namespace
+
+Scene load_map(Vfs& vfs, const std::string& map, LoadReport* report_out) {
+  MapSource src = find_map(vfs, map);
+  LoadReport report;
+  report.map_file = src.map_where;
+  report.proc_file = src.proc_where;
+  MapFile parsed_map = parse_map(src.map_text, src.map_where);
+  ProcFile proc = parse_proc(src.proc_text, src.proc_where);
+
+  Scene scene;
+  scene.name = src.name;
+  SceneBuilder builder(vfs, scene, report);
+  builder.read_materials(vfs);
+  builder.add_proc(proc);
+  builder.add_entities(parsed_map, src.map_where);
+  builder.finish();
+  report.warnings = scene.warnings;
+  if (report_out) *report_out = std::move(report);
+  return scene;
+}
+
+}  // namespace cohort::scene

@@ -1,0 +1,161 @@
+#include "cohort/scene/material_build.h"
+
+namespace cohort::scene {
+
+namespace {
+
+bool starts_with_ignoring_case(const std::string& s, const char* prefix) {
+  size_t i = 0;
+  for (; prefix[i]; ++i) {
+    if (i >= s.size()) return false;
+    char c = s[i];
+    if (c >= 'A' && c <= 'Z') c = static_cast<char>(c - 'A' + 'a');
+    if (c != prefix[i]) return false;
+  }
+  return true;
+}
+
+bool draws_image(const MaterialStage& s) { return !s.image.empty() && s.special_map.empty(); }
+
+void build_light_material(const MaterialDecl& decl, ImageLibrary& images, Material& m) {
+  m.is_light_material = true;
+  const std::string context = "light material " + decl.name;
+  for (const MaterialStage& s : decl.stages) {
+    if (!draws_image(s)) continue;
+    m.light_image = images.get(s.image, ImageRole::LightProjection, context);
+    m.light_stage_color = glm::vec3(s.color);
+    break;
+  }
+  if (!decl.falloff_image.empty()) m.falloff_image = images.get(decl.falloff_image, ImageRole::LightFalloff, context);
+  if (decl.fog_light || decl.blend_light) m.blend = BlendClass::PassThrough;
+}
+
+void copy_stage_look(const MaterialStage& s, Material& m) {
+  std::copy(std::begin(s.tex_transform), std::end(s.tex_transform), m.tex_transform);
+  if (s.alpha_test) {
+    m.alpha_test = true;
+    m.alpha_ref = s.alpha_ref;
+  }
+  m.vertex_color = m.vertex_color || s.vertex_color;
+}
+
+}  // namespace
+
+Material build_material(const MaterialDecl& decl, ImageLibrary& images, bool as_light) {
+  Material m;
+  m.name = decl.name;
+  m.source_file = decl.file;
+  m.source_line = decl.line;
+  m.translucent = decl.translucent;
+  m.no_shadows = decl.no_shadows;
+  m.two_sided = decl.two_sided;
+  m.nonsolid = decl.nonsolid;
+  const bool light_like = as_light || !decl.falloff_image.empty() || decl.fog_light || decl.blend_light ||
+                          decl.ambient_light || starts_with_ignoring_case(decl.name, "lights/");
+  if (light_like) {
+    build_light_material(decl, images, m);
+    if (as_light || m.blend == BlendClass::PassThrough) return m;
+  }
+
+  const std::string context = "material " + decl.name;
+  bool lit = false, has_specular = false;
+  const MaterialStage* first_ambient = nullptr;
+  for (const MaterialStage& s : decl.stages) {
+    switch (s.role) {
+      case StageRole::Diffuse:
+        lit = true;
+        if (m.diffuse_image >= 0 || !draws_image(s)) break;
+        m.diffuse_image = images.get(s.image, ImageRole::Color, context);
+        m.diffuse_color = s.color;
+        copy_stage_look(s, m);
+        break;
+      case StageRole::Bump:
+        lit = true;
+        if (m.normal_image < 0 && draws_image(s)) m.normal_image = images.get(s.image, ImageRole::Normal, context);
+        break;
+      case StageRole::Specular:
+        lit = true;
+        if (has_specular || !draws_image(s)) break;
+        has_specular = true;
+        m.specular_image = images.get(s.image, ImageRole::Specular, context);
+        m.specular_color = s.color;
+        break;
+      case StageRole::Ambient:
+        if (!first_ambient && draws_image(s) && s.blend != StageBlend::None) first_ambient = &s;
+        break;
+    }
+  }
+  if (!has_specular) m.specular_color = glm::vec4(0.0f, 0.0f, 0.0f, 1.0f);  // the engine's default: no specular
+
+  if (lit) {
+    m.blend = BlendClass::Opaque;
+    // A lit surface with an added or replacing unlit stage glows: Doom 3's light panels and screens.
+    for (const MaterialStage& s : decl.stages) {
+      if (s.role != StageRole::Ambient || !draws_image(s)) continue;
+      if (s.blend == StageBlend::Add || s.blend == StageBlend::Replace) {
+        m.emitter = true;
+        m.emissive_image = images.get(s.image, ImageRole::Color, context);
+        m.emissive_color = s.color;
+        break;
+      }
+    }
+    return m;
+  }
+  if (!first_ambient) {
+    m.blend = BlendClass::PassThrough;   // nodraw, caulk, clip, areaportal: nothing drawn
+    return m;
+  }
+  const MaterialStage& s = *first_ambient;
+  copy_stage_look(s, m);
+  const int image = images.get(s.image, ImageRole::Color, context);
+  switch (s.blend) {
+    case StageBlend::Add:
+      m.blend = BlendClass::Additive;
+      m.emitter = true;
+      m.emissive_image = image;
+      m.emissive_color = s.color;
+      m.diffuse_color = glm::vec4(0.0f, 0.0f, 0.0f, 1.0f);
+      m.translucent = true;
+      break;
+    case StageBlend::Replace:
+      m.blend = BlendClass::Opaque;   // unlit, drawn as is: it shows its image whatever the lighting
+      m.emitter = true;
+      m.emissive_image = image;
+      m.emissive_color = s.color;
+      m.diffuse_color = glm::vec4(0.0f, 0.0f, 0.0f, 1.0f);
+      break;
+    case StageBlend::Modulate:
+      m.blend = BlendClass::Modulate;
+      m.diffuse_image = image;
+      m.diffuse_color = s.color;
+      m.translucent = true;
+      break;
+    case StageBlend::AlphaBlend:
+      m.blend = BlendClass::Alpha;
+      m.diffuse_image = image;
+      m.diffuse_color = s.color;
+      m.translucent = true;
+      break;
+    case StageBlend::None:
+      m.blend = BlendClass::PassThrough;
+      break;
+  }
+  return m;
+}
+
+Material default_material(const std::string& name, ImageLibrary& images) {
+  Material m;
+  m.name = name;
+  m.is_default = true;
+  m.specular_color = glm::vec4(0.0f, 0.0f, 0.0f, 1.0f);
+  ImageProgram program;
+  if (images.can_find(name)) {
+    program.path = name;
+  } else {
+    program.path = "_default";
+  }
+  m.diffuse_image = images.get(program, ImageRole::Color, "material " + name);
+  return m;
+}
+
+}  // namespace cohort::scene

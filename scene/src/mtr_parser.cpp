@@ -1,0 +1,290 @@
+#include <set>
+
+#include "cohort/scene/material_file.h"
+
+namespace cohort::scene {
+
+namespace {
+
+std::string lowercase(std::string s) {
+  for (char& c : s)
+    if (c >= 'A' && c <= 'Z') c = static_cast<char>(c - 'A' + 'a');
+  return s;
+}
+
+std::string at(const std::string& file, int line) { return file + ":" + std::to_string(line) + ": "; }
+
+// st' = old(reg(st)): the engine multiplies each new transform on the right of the stage's matrix.
+void multiply_transform(float (&old)[6], const float (&reg)[6]) {
+  float r[6];
+  r[0] = old[0] * reg[0] + old[1] * reg[3];
+  r[1] = old[0] * reg[1] + old[1] * reg[4];
+  r[2] = old[0] * reg[2] + old[1] * reg[5] + old[2];
+  r[3] = old[3] * reg[0] + old[4] * reg[3];
+  r[4] = old[3] * reg[1] + old[4] * reg[4];
+  r[5] = old[3] * reg[2] + old[4] * reg[5] + old[5];
+  for (int i = 0; i < 6; ++i) old[i] = r[i];
+}
+
+StageBlend gl_blend_pair(Lexer& lex, const Token& src_token) {
+  lex.expect(",");
+  Token dst_token = lex.expect_any("a destination blend factor");
+  std::string src = lowercase(src_token.text), dst = lowercase(dst_token.text);
+  if (dst.rfind("gl_", 0) != 0) lex.fail(dst_token, "unknown blend factor '" + dst_token.text + "'");
+  if (src == "gl_one" && dst == "gl_zero") return StageBlend::Replace;
+  if (src == "gl_zero" && dst == "gl_one") return StageBlend::None;
+  if ((src == "gl_dst_color" && dst == "gl_zero") || (src == "gl_zero" && dst == "gl_src_color"))
+    return StageBlend::Modulate;
+  if (dst == "gl_one") return StageBlend::Add;   // (one, one), (src_alpha, one), (dst_color, one): adds light
+  return StageBlend::AlphaBlend;
+}
+
+const std::set<std::string>& ignored_stage_words() {
+  static const std::set<std::string> words = {
+      "maskred", "maskgreen", "maskblue", "maskalpha", "maskcolor", "maskdepth", "ignorealphatest",
+      "nearest", "linear", "clamp", "zeroclamp", "alphazeroclamp", "noclamp", "uncompressed", "highquality",
+      "forcehighquality", "nopicmip", "ignoredepth", "colored"};
+  return words;
+}
+
+const std::set<std::string>& ignored_material_words() {
+  static const std::set<std::string> words = {
+      "mirror", "forceoverlays", "forceopaque", "forceshadows", "noselfshadow", "noportalfog",
+      "unsmoothedtangents", "discrete", "nofragment", "noimpact", "nooverlays", "playerclip", "monsterclip",
+      "moveableclip", "ikclip", "blood", "trigger", "aassolid", "aasobstacle", "flashlight_trigger",
+      "nullnormal", "areaportal", "qer_nocarve", "collision", "nodamage", "solid", "water", "clamp", "zeroclamp",
+      "alphazeroclamp", "ladder", "nosteps", "nofog", "metal", "stone", "flesh", "wood", "cardboard", "liquid",
+      "glass", "plastic", "ricochet", "surftype10", "surftype11", "surftype12", "surftype13", "surftype14",
+      "surftype15", "lightfalloffimage_none", "isolatedsurface", "nodecal"};
+  return words;
+}
+
+const std::set<std::string>& rest_of_line_material_words() {
+  static const std::set<std::string> words = {"qer_editorimage", "sort", "polygonoffset", "spectrum", "renderbump",
+                                              "deform", "guisurf", "decalinfo", "materialtype", "qer_trans",
+                                              "lightcolor", "portalsky"};
+  return words;
+}
+
+const std::set<std::string>& skipped_decl_types() {
+  static const std::set<std::string> types = {"skin", "particle", "fx", "entitydef", "sound", "mapdef",
+                                              "articulatedfigure", "pda", "email", "video", "audio", "model",
+                                              "af", "export", "camera"};
+  return types;
+}
+
+class MaterialReader {
+ public:
+  MaterialReader(const std::string& file, MaterialTables& tables, std::vector<std::string>& warnings)
+      : file_(file), tables_(tables), warnings_(warnings) {}
+
+  void read_body(Lexer& lex, MaterialDecl& m) {
+    ExpressionContext context;
+    context.tables = &tables_;
+    while (!lex.at_end()) {
+      Token t = lex.next();
+      std::string word = lowercase(t.text);
+      if (t.is("{")) {
+        read_stage(lex, t, m, context);
+      } else if (word == "diffusemap" || word == "bumpmap" || word == "specularmap") {
+        MaterialStage stage;
+        stage.line = t.line;
+        stage.role = word == "diffusemap" ? StageRole::Diffuse : word == "bumpmap" ? StageRole::Bump : StageRole::Specular;
+        stage.image = parse_image_program(lex);
+        m.stages.push_back(std::move(stage));
+      } else if (word == "translucent") {
+        m.translucent = true;
+      } else if (word == "noshadows") {
+        m.no_shadows = true;
+      } else if (word == "twosided") {
+        m.two_sided = true;
+      } else if (word == "nonsolid") {
+        m.nonsolid = true;
+      } else if (word == "decal_macro") {
+        m.no_shadows = true;   // the macro: polygonOffset, discrete, sort decal, noShadows
+      } else if (word == "lightfalloffimage") {
+        m.falloff_image = parse_image_program(lex);
+      } else if (word == "foglight") {
+        m.fog_light = true;
+      } else if (word == "blendlight") {
+        m.blend_light = true;
+      } else if (word == "ambientlight") {
+        m.ambient_light = true;
+      } else if (word == "description") {
+        m.description = lex.expect_string("a description");
+      } else if (rest_of_line_material_words().count(word)) {
+        lex.skip_rest_of_line();
+      } else if (ignored_material_words().count(word)) {
+      } else {
+        warnings_.push_back(at(file_, t.line) + "material " + m.name + ": unknown keyword '" + t.text + "' skipped");
+        lex.skip_rest_of_line();
+      }
+    }
+    if (context.approximated)
+      warnings_.push_back(at(file_, m.line) + "material " + m.name + ": '" + context.approximation +
+                          "' evaluated once at time 0 (animated expressions are not supported)");
+  }
+
+ private:
+  void read_stage(Lexer& outer, const Token& open, MaterialDecl& m, ExpressionContext& context) {
+    std::string_view body = outer.braced_block_text(open);
+    Lexer lex(body, file_, open.line, open.column + 1);
+    MaterialStage stage;
+    stage.line = open.line;
+    try {
+      while (!lex.at_end()) read_stage_keyword(lex, stage, m, context);
+    } catch (const ParseError& e) {
+      warnings_.push_back(std::string(e.what()) + " (stage of material " + m.name + " dropped)");
+      return;
+    }
+    m.stages.push_back(std::move(stage));
+  }
+
+  void read_stage_keyword(Lexer& lex, MaterialStage& stage, const MaterialDecl& m, ExpressionContext& context) {
+    Token t = lex.next();
+    std::string word = lowercase(t.text);
+    if (word == "blend") {
+      Token mode = lex.expect_any("a blend mode");
+      std::string b = lowercase(mode.text);
+      if (b == "diffusemap") stage.role = StageRole::Diffuse;
+      else if (b == "bumpmap") stage.role = StageRole::Bump;
+      else if (b == "specularmap") stage.role = StageRole::Specular;
+      else if (b == "blend") stage.blend = StageBlend::AlphaBlend;
+      else if (b == "add") stage.blend = StageBlend::Add;
+      else if (b == "filter" || b == "modulate") stage.blend = StageBlend::Modulate;
+      else if (b == "none") stage.blend = StageBlend::None;
+      else if (b.rfind("gl_", 0) == 0) stage.blend = gl_blend_pair(lex, mode);
+      else lex.fail(mode, "unknown blend mode '" + mode.text + "'");
+    } else if (word == "map") {
+      stage.image = parse_image_program(lex);
+    } else if (word == "cubemap" || word == "cameracubemap" || word == "videomap" || word == "soundmap" ||
+               word == "mirrorrendermap" || word == "remoterendermap" || word == "xrayrendermap" ||
+               word == "fragmentprogram" || word == "vertexprogram" || word == "program" || word == "megatexture") {
+      stage.special_map = t.text;
+      lex.skip_rest_of_line();
+    } else if (word == "vertexparm" || word == "fragmentmap" || word == "texgen" || word == "privatepolygonoffset") {
+      lex.skip_rest_of_line();
+    } else if (word == "alphatest") {
+      stage.alpha_test = true;
+      stage.alpha_ref = parse_expression(lex, context);
+    } else if (word == "vertexcolor" || word == "inversevertexcolor") {
+      stage.vertex_color = true;
+    } else if (word == "red" || word == "green" || word == "blue" || word == "alpha") {
+      int c = word == "red" ? 0 : word == "green" ? 1 : word == "blue" ? 2 : 3;
+      stage.color[c] = parse_expression(lex, context);
+    } else if (word == "rgb") {
+      float v = parse_expression(lex, context);
+      stage.color = glm::vec4(v, v, v, stage.color.a);
+    } else if (word == "rgba") {
+      stage.color = glm::vec4(parse_expression(lex, context));
+    } else if (word == "color") {
+      for (int c = 0; c < 4; ++c) {
+        if (c > 0) lex.expect(",");
+        stage.color[c] = parse_expression(lex, context);
+      }
+    } else if (word == "scale" || word == "centerscale" || word == "scroll" || word == "translate" ||
+               word == "shear") {
+      float a = parse_expression(lex, context);
+      lex.expect(",");
+      float b = parse_expression(lex, context);
+      float reg[6];
+      if (word == "scale") {
+        float r[6] = {a, 0, 0, 0, b, 0};
+        std::copy(r, r + 6, reg);
+      } else if (word == "centerscale") {
+        float r[6] = {a, 0, 0.5f - 0.5f * a, 0, b, 0.5f - 0.5f * b};
+        std::copy(r, r + 6, reg);
+      } else if (word == "shear") {
+        float r[6] = {1, a, -0.5f * a, b, 1, -0.5f * b};
+        std::copy(r, r + 6, reg);
+      } else {
+        float r[6] = {1, 0, a, 0, 1, b};
+        std::copy(r, r + 6, reg);
+      }
+      multiply_transform(stage.tex_transform, reg);
+    } else if (word == "rotate") {
+      float turns = parse_expression(lex, context);   // the engine's rotate is in full turns
+      float angle = turns * 6.28318530718f;
+      float c = std::cos(angle), s = std::sin(angle);
+      float reg[6] = {c, -s, 0.5f - 0.5f * c + 0.5f * s, s, c, 0.5f - 0.5f * s - 0.5f * c};
+      multiply_transform(stage.tex_transform, reg);
+    } else if (word == "if") {
+      parse_expression(lex, context);   // conditions are evaluated per frame by the engine; the stage is kept
+    } else if (ignored_stage_words().count(word)) {
+    } else {
+      warnings_.push_back(at(file_, t.line) + "material " + m.name + ": unknown stage keyword '" + t.text + "' skipped");
+      lex.skip_rest_of_line();
+    }
+  }
+
+  const std::string& file_;
+  MaterialTables& tables_;
+  std::vector<std::string>& warnings_;
+};
+
+}  // namespace
+
+MaterialFile parse_materials(std::string_view text, const std::string& file_name, MaterialTables& tables) {
+  Lexer lex(text, file_name);
+  MaterialFile out;
+  MaterialReader reader(file_name, tables, out.warnings);
+  while (!lex.at_end()) {
+    Token t = lex.next();
+    std::string word = lowercase(t.text);
+    if (t.kind == Token::Kind::Punct) {
+      if (t.text == "{") {
+        out.warnings.push_back(at(file_name, t.line) + "a block without a name skipped");
+        lex.skip_braced_block();
+      } else {
+        out.warnings.push_back(at(file_name, t.line) + "unexpected '" + t.text + "' skipped");
+      }
+      continue;
+    }
+    if (t.kind == Token::Kind::Name && word == "guide") {
+      lex.skip_rest_of_line();
+      out.warnings.push_back(at(file_name, t.line) + "material guide skipped (guides are not expanded)");
+      continue;
+    }
+    if (t.kind == Token::Kind::Name && (word == "table" || skipped_decl_types().count(word))) {
+      Token name = lex.expect_any("a declaration name");
+      Token open = lex.next();
+      if (!open.is("{")) lex.fail(open, "expected '{' after " + word + " " + name.text);
+      if (word != "table") {
+        lex.skip_braced_block();
+        continue;
+      }
+      std::string_view body = lex.braced_block_text(open);
+      Lexer table_lex(body, file_name, open.line, open.column + 1);
+      try {
+        tables[lowercase(name.text)] = parse_table_body(table_lex);
+      } catch (const ParseError& e) {
+        out.warnings.push_back(std::string(e.what()) + " (table " + name.text + " skipped)");
+      }
+      continue;
+    }
+    Token name_token = t;
+    if (t.kind == Token::Kind::Name && word == "material") name_token = lex.expect_any("a material name");
+    if (name_token.kind != Token::Kind::Name && name_token.kind != Token::Kind::String)
+      lex.fail(name_token, "expected a material name, found '" + name_token.text + "'");
+    if (!lex.peek().is("{")) {
+      out.warnings.push_back(at(file_name, name_token.line) + "'" + name_token.text + "' is not followed by '{'; skipped");
+      continue;
+    }
+    Token open = lex.next();
+    std::string_view body = lex.braced_block_text(open);
+    MaterialDecl m;
+    m.name = name_token.text;
+    m.file = file_name;
+    m.line = name_token.line;
+    Lexer body_lex(body, file_name, open.line, open.column + 1);
+    try {
+      reader.read_body(body_lex, m);
+    } catch (const ParseError& e) {
+      out.warnings.push_back(std::string(e.what()) + " (rest of material " + m.name + " skipped)");
+    }
+    out.materials.push_back(std::move(m));
+  }
+  return out;
+}
+
+}  // namespace cohort::scene
