@@ -1,0 +1,160 @@
+/* Surface evaluation at a hit: interpolated geometry, textures, the Doom 3 material mapped to the
+ * BRDF inputs, and the blend-mode classification that decides what a ray does there. */
+#ifndef COHORT_KERNEL_MATERIAL_H
+#define COHORT_KERNEL_MATERIAL_H
+#include "texture.h"
+
+typedef struct KSurface {
+  KVec3 position;
+  KVec3 geo_normal;  /* faces the incoming ray */
+  KVec3 normal;      /* shading normal, in geo_normal's hemisphere */
+  KVec3 albedo;      /* linear diffuse reflectance (or layer colour for non-opaque blends) */
+  KVec3 specular;    /* Fresnel reflectance at normal incidence */
+  KVec3 emission;
+  float alpha;
+  float roughness;
+  float metallic;
+  kuint blend;
+  kuint flags;
+  kuint material;
+} KSurface;
+
+KFN kuint k_hit_material(const KSceneView* scene, kuint instance, kuint triangle) {
+  kuint over = scene->instances[instance].material_override;
+  return over != K_NONE ? over : scene->triangles[triangle].material;
+}
+
+KFN void k_hit_st(const KSceneView* scene, kuint triangle, float u, float v, KGLOBAL const KMaterial* m,
+                  float* s, float* t) {
+  KTriangle tri = scene->triangles[triangle];
+  KGLOBAL const KVertex* a = &scene->vertices[tri.v0];
+  KGLOBAL const KVertex* b = &scene->vertices[tri.v1];
+  KGLOBAL const KVertex* c = &scene->vertices[tri.v2];
+  float w = 1.0f - u - v;
+  float s0 = w * a->u + u * b->u + v * c->u;
+  float t0 = w * a->v + u * b->v + v * c->v;
+  *s = m->tex_transform[0] * s0 + m->tex_transform[1] * t0 + m->tex_transform[2];
+  *t = m->tex_transform[3] * s0 + m->tex_transform[4] * t0 + m->tex_transform[5];
+}
+
+/* Coverage of an alpha-tested surface at the hit: the diffuse map's alpha times the colour's. */
+KFN float k_hit_alpha(const KSceneView* scene, kuint triangle, float u, float v, KGLOBAL const KMaterial* m) {
+  float alpha = m->diffuse_color[3];
+  if (m->diffuse_tex != K_NONE) {
+    float s, t;
+    k_hit_st(scene, triangle, u, v, m, &s, &t);
+    alpha *= k_texture_sample(scene, m->diffuse_tex, s, t).w;
+  }
+  return alpha;
+}
+
+/* The hook both ways of tracing call for every candidate hit (Embree's filter functions and
+ * bvh_traverse.h's K_SURFACE_TRANSMITTANCE): 1 when the ray passes through this surface, 0 when the
+ * hit counts. Camera and bounce rays skip pass-through surfaces and alpha-test misses; shadow rays
+ * also skip everything that is not an opaque shadow caster (translucent layers, noShadows decals). */
+KFN float k_hit_transmittance(const KSceneView* scene, kuint instance, kuint triangle, float u, float v,
+                              int shadow_ray) {
+  KGLOBAL const KMaterial* m = &scene->materials[k_hit_material(scene, instance, triangle)];
+  if (m->blend == K_BLEND_PASSTHROUGH) return 1.0f;
+  if (shadow_ray) {
+    if (m->blend != K_BLEND_OPAQUE) return 1.0f;
+    if (m->flags & (K_MAT_NO_SHADOWS | K_MAT_TRANSLUCENT)) return 1.0f;
+  }
+  if ((m->flags & K_MAT_ALPHA_TEST) && k_hit_alpha(scene, triangle, u, v, m) < m->alpha_ref) return 1.0f;
+  return 0.0f;
+}
+
+/* Doom 3 has one specular map; we read its luminance as glossiness: bright, sharp highlights for
+ * metal and polished surfaces, dull broad ones for stone and cloth. */
+KFN void k_gloss_to_roughness_metallic(float gloss, float* roughness, float* metallic) {
+  gloss = k_saturate(gloss);
+  *roughness = 1.0f - 0.75f * k_sqrt(gloss);
+  *metallic = k_saturate((gloss - 0.5f) * 2.0f);
+}
+
+KFN KVec3 k_vertex_normal(KGLOBAL const KVertex* a, KGLOBAL const KVertex* b, KGLOBAL const KVertex* c,
+                          float u, float v) {
+  float w = 1.0f - u - v;
+  return v3(w * a->normal[0] + u * b->normal[0] + v * c->normal[0],
+            w * a->normal[1] + u * b->normal[1] + v * c->normal[1],
+            w * a->normal[2] + u * b->normal[2] + v * c->normal[2]);
+}
+
+KFN KSurface k_surface_eval(const KSceneView* scene, KHit hit, KVec3 ray_org, KVec3 ray_dir) {
+  KSurface sf;
+  KGLOBAL const KInstance* inst = &scene->instances[hit.instance];
+  KTriangle tri = scene->triangles[hit.triangle];
+  kuint mat = k_hit_material(scene, hit.instance, hit.triangle);
+  KGLOBAL const KMaterial* m = &scene->materials[mat];
+  KGLOBAL const KVertex* a = &scene->vertices[tri.v0];
+  KGLOBAL const KVertex* b = &scene->vertices[tri.v1];
+  KGLOBAL const KVertex* c = &scene->vertices[tri.v2];
+  float u = hit.u, v = hit.v, w = 1.0f - hit.u - hit.v;
+
+  sf.position = v3_madd(ray_org, ray_dir, hit.t);
+  KVec3 p0 = v3_load_g(a->pos), p1 = v3_load_g(b->pos), p2 = v3_load_g(c->pos);
+  KVec3 ng = xform_normal_by_inverse_g(inst->world_to_object, v3_cross(v3_sub(p1, p0), v3_sub(p2, p0)));
+  ng = v3_normalize(ng);
+  int flipped = v3_dot(ng, ray_dir) > 0.0f;
+  if (flipped) ng = v3_neg(ng);
+  sf.geo_normal = ng;
+
+  KVec3 n_obj = k_vertex_normal(a, b, c, u, v);
+  KVec3 n = v3_normalize(xform_normal_by_inverse_g(inst->world_to_object, n_obj));
+  if (v3_dot(n_obj, n_obj) < 1e-12f) n = ng;
+  if (v3_dot(n, ng) < 0.0f) n = v3_neg(n);
+
+  float s, t;
+  k_hit_st(scene, hit.triangle, u, v, m, &s, &t);
+
+  if (m->normal_tex != K_NONE) {
+    KVec3 tan_obj = v3(w * a->tangent[0] + u * b->tangent[0] + v * c->tangent[0],
+                       w * a->tangent[1] + u * b->tangent[1] + v * c->tangent[1],
+                       w * a->tangent[2] + u * b->tangent[2] + v * c->tangent[2]);
+    KVec3 tn = xform_vector_g(inst->object_to_world, tan_obj);
+    /* Gram-Schmidt against the shading normal; degenerate tangents fall back to an arbitrary basis. */
+    tn = v3_sub(tn, v3_scale(n, v3_dot(tn, n)));
+    KVec3 bt;
+    if (v3_dot(tn, tn) < 1e-10f) {
+      KFrame f = k_frame_from_normal(n);
+      tn = f.t;
+      bt = f.b;
+    } else {
+      tn = v3_normalize(tn);
+      float sign = a->bitangent_sign < 0.0f ? -1.0f : 1.0f;
+      bt = v3_scale(v3_cross(n, tn), sign);
+    }
+    KVec3 ln = k_texture_normal(scene, m->normal_tex, s, t);
+    KVec3 pn = v3_normalize(v3_add(v3_add(v3_scale(tn, ln.x), v3_scale(bt, ln.y)), v3_scale(n, k_fmax(ln.z, 0.0f))));
+    if (v3_dot(pn, ng) > 0.0f) n = pn;
+  }
+  sf.normal = n;
+
+  KVec4 diffuse = v4(m->diffuse_color[0], m->diffuse_color[1], m->diffuse_color[2], m->diffuse_color[3]);
+  if (m->diffuse_tex != K_NONE) {
+    KVec4 d = k_texture_sample(scene, m->diffuse_tex, s, t);
+    diffuse = v4(diffuse.x * d.x, diffuse.y * d.y, diffuse.z * d.z, diffuse.w * d.w);
+  }
+  sf.albedo = v4_rgb(diffuse);
+  sf.alpha = diffuse.w;
+
+  KVec3 spec = v3(m->specular_color[0], m->specular_color[1], m->specular_color[2]);
+  if (m->specular_tex != K_NONE) spec = v3_mul(spec, v4_rgb(k_texture_sample(scene, m->specular_tex, s, t)));
+  if (m->flags & K_MAT_NO_SPECULAR) spec = v3s(0.0f);
+  k_gloss_to_roughness_metallic(v3_luminance(spec), &sf.roughness, &sf.metallic);
+  sf.specular = spec;
+  sf.albedo = v3_scale(sf.albedo, 1.0f - sf.metallic);
+
+  sf.emission = v3s(0.0f);
+  if (m->flags & K_MAT_EMISSIVE) {
+    KVec3 e = v3(m->emissive_color[0], m->emissive_color[1], m->emissive_color[2]);
+    if (m->emissive_tex != K_NONE) e = v3_mul(e, v4_rgb(k_texture_sample(scene, m->emissive_tex, s, t)));
+    sf.emission = e;
+  }
+  sf.blend = m->blend;
+  sf.flags = m->flags;
+  sf.material = mat;
+  return sf;
+}
+
+#endif

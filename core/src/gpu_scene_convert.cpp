@@ -1,0 +1,188 @@
+// Per-object conversions from the scene model to the kernel layouts: materials, lights, transforms,
+// cameras.
+#include <algorithm>
+#include <cmath>
+
+#include "cohort/core/gpu_scene.h"
+
+namespace cohort::core {
+namespace {
+
+uint32_t to_kblend(scene::BlendClass blend) {
+  switch (blend) {
+    case scene::BlendClass::Opaque: return K_BLEND_OPAQUE;
+    case scene::BlendClass::PassThrough: return K_BLEND_PASSTHROUGH;
+    case scene::BlendClass::Additive: return K_BLEND_ADDITIVE;
+    case scene::BlendClass::Modulate: return K_BLEND_MODULATE;
+    case scene::BlendClass::Alpha: return K_BLEND_ALPHA;
+  }
+  return K_BLEND_OPAQUE;
+}
+
+void store(float* dst, const glm::vec4& v) { dst[0] = v.x; dst[1] = v.y; dst[2] = v.z; dst[3] = v.w; }
+void store(float* dst, const glm::vec3& v) { dst[0] = v.x; dst[1] = v.y; dst[2] = v.z; }
+
+// A plane given in the light's local frame (l = axis^T (p - origin)) moved to world space.
+void store_world_plane(float* dst, const glm::vec4& local, const glm::mat3& axis, const glm::vec3& origin) {
+  glm::vec3 n = axis * glm::vec3(local);
+  store(dst, glm::vec4(n, local.w - glm::dot(n, origin)));
+}
+
+// R_SetLightProject (dhewm3 tr_lightrun.cpp) with the origin at zero, in light-local space.
+void projected_light_planes(const scene::Light& light, glm::vec4 planes[4]) {
+  glm::vec3 right = light.right, up = light.up;
+  float r_len = glm::length(right), u_len = glm::length(up);
+  right = r_len > 0.0f ? right / r_len : glm::vec3(0, -1, 0);
+  up = u_len > 0.0f ? up / u_len : glm::vec3(0, 0, 1);
+  if (r_len <= 0.0f) r_len = 1.0f;
+  if (u_len <= 0.0f) u_len = 1.0f;
+  glm::vec3 normal = glm::normalize(glm::cross(up, right));
+  float dist = glm::dot(light.target, normal);
+  if (dist < 0.0f) { dist = -dist; normal = -normal; }
+  glm::vec4 s(right * (0.5f * dist / r_len), 0.0f);
+  glm::vec4 t(up * (-(0.5f * dist) / u_len), 0.0f);
+  glm::vec4 q(normal, 0.0f);
+  glm::vec4 target(light.target, 1.0f);
+  float tq = glm::dot(target, q);
+  if (std::fabs(tq) < 1e-6f) tq = 1e-6f;
+  s += (0.5f - glm::dot(target, s) / tq) * q;
+  t += (0.5f - glm::dot(target, t) / tq) * q;
+  glm::vec3 start = light.has_start_end ? light.start : glm::vec3(0.0f);
+  glm::vec3 end = light.has_start_end ? light.end : light.target;
+  glm::vec3 fall = end - start;
+  float len = glm::length(fall);
+  if (len <= 0.0f) { fall = normal; len = 1.0f; } else { fall /= len; }
+  // F = 0 at start, 1 at end.
+  glm::vec4 f(fall / len, -glm::dot(start, fall) / len);
+  planes[0] = s; planes[1] = t; planes[2] = q; planes[3] = f;
+}
+
+void box_light_planes(const scene::Light& light, glm::vec4 planes[4]) {
+  glm::vec3 r = glm::max(light.radius, glm::vec3(1e-3f));
+  planes[0] = glm::vec4(0.5f / r.x, 0.0f, 0.0f, 0.5f);
+  planes[1] = glm::vec4(0.0f, 0.5f / r.y, 0.0f, 0.5f);
+  planes[2] = glm::vec4(0.0f, 0.0f, 0.0f, 1.0f);
+  planes[3] = glm::vec4(0.0f, 0.0f, 0.5f / r.z, 0.5f);
+}
+
+}  // namespace
+
+KMaterial to_kmaterial(const scene::Material& material, const scene::Scene& scene) {
+  KMaterial k{};
+  store(k.diffuse_color, material.diffuse_color);
+  // Doom 3 surfaces without a specular map have no specular at all.
+  store(k.specular_color, material.specular_image >= 0 ? material.specular_color : glm::vec4(0.0f));
+  store(k.emissive_color, material.emissive_color);
+  for (int i = 0; i < 6; ++i) k.tex_transform[i] = material.tex_transform[i];
+  k.diffuse_tex = texture_slot(material.diffuse_image, TextureUse::Surface, scene);
+  k.normal_tex = texture_slot(material.normal_image, TextureUse::Surface, scene);
+  k.specular_tex = texture_slot(material.specular_image, TextureUse::Surface, scene);
+  k.emissive_tex = texture_slot(material.emissive_image, TextureUse::Surface, scene);
+  k.blend = to_kblend(material.blend);
+  k.alpha_ref = material.alpha_ref;
+  uint32_t flags = 0;
+  if (material.alpha_test) flags |= K_MAT_ALPHA_TEST;
+  if (material.translucent) flags |= K_MAT_TRANSLUCENT;
+  if (material.no_shadows) flags |= K_MAT_NO_SHADOWS;
+  if (material.two_sided) flags |= K_MAT_TWO_SIDED;
+  if (material.nonsolid) flags |= K_MAT_NONSOLID;
+  if (material.emitter) flags |= K_MAT_EMISSIVE;
+  if (material.vertex_color) flags |= K_MAT_VERTEX_COLOR;
+  if (k.blend != K_BLEND_OPAQUE) {
+    // A blended layer is its stage image: the kernel reads it as the layer colour, unlit.
+    if (k.diffuse_tex == K_NONE && k.emissive_tex != K_NONE) {
+      k.diffuse_tex = k.emissive_tex;
+      store(k.diffuse_color, glm::vec4(glm::vec3(material.emissive_color), 1.0f));
+    }
+    k.emissive_tex = K_NONE;
+    flags &= ~K_MAT_EMISSIVE;
+  }
+  k.flags = flags;
+  return k;
+}
+
+KLight to_klight(const scene::Light& light, const scene::Scene& scene, const GpuSceneOptions& options) {
+  KLight k{};
+  int material = light.material;
+  if (material < 0)
+    material = scene.find_material(light.type == scene::LightType::Projected ? "lights/defaultProjectedLight"
+                                                                              : "lights/defaultPointLight");
+  glm::vec3 stage_color(1.0f);
+  k.light_tex = K_NONE;
+  k.falloff_tex = K_NONE;
+  if (material >= 0) {
+    const scene::Material& m = scene.materials[static_cast<size_t>(material)];
+    stage_color = m.light_stage_color;
+    k.light_tex = texture_slot(m.light_image, TextureUse::LightImage, scene);
+    k.falloff_tex = texture_slot(m.falloff_image, TextureUse::Falloff, scene);
+  }
+  store(k.origin, light.origin);
+  store(k.color, options.light_scale * stage_color * light.color);
+  store(k.radius, light.radius);
+  k.flags = (light.no_shadows ? K_LIGHT_NO_SHADOWS : 0u) | (light.no_specular ? K_LIGHT_NO_SPECULAR : 0u);
+  for (int row = 0; row < 3; ++row) store(k.axis + 4 * row, glm::vec4(light.axis[row], 0.0f));
+
+  glm::vec4 planes[4] = {glm::vec4(0.0f), glm::vec4(0.0f), glm::vec4(0.0f), glm::vec4(0.0f)};
+  switch (light.type) {
+    case scene::LightType::Point:
+      k.type = K_LIGHT_POINT;
+      box_light_planes(light, planes);
+      store(k.center, light.origin + light.axis * light.center);
+      k.extent = std::clamp(0.1f * std::min({light.radius.x, light.radius.y, light.radius.z}), 1.0f, 32.0f);
+      break;
+    case scene::LightType::Parallel: {
+      k.type = K_LIGHT_PARALLEL;
+      box_light_planes(light, planes);
+      glm::vec3 dir = light.axis * light.center;
+      float len = glm::length(dir);
+      store(k.center, len > 0.0f ? dir / len : glm::vec3(0.0f, 0.0f, 1.0f));
+      k.extent = 0.02f;
+      break;
+    }
+    case scene::LightType::Projected:
+      k.type = K_LIGHT_PROJECTED;
+      projected_light_planes(light, planes);
+      store(k.center, light.origin);
+      k.extent = 4.0f;
+      break;
+  }
+  store_world_plane(k.plane_s, planes[0], light.axis, light.origin);
+  store_world_plane(k.plane_t, planes[1], light.axis, light.origin);
+  store_world_plane(k.plane_q, planes[2], light.axis, light.origin);
+  store_world_plane(k.plane_f, planes[3], light.axis, light.origin);
+  return k;
+}
+
+void set_instance_transform(KInstance& instance, const glm::vec3& origin, const glm::mat3& axis) {
+  glm::mat3 inv = glm::inverse(axis);
+  glm::vec3 inv_t = -(inv * origin);
+  for (int r = 0; r < 3; ++r) {
+    for (int c = 0; c < 3; ++c) {
+      instance.object_to_world[4 * r + c] = axis[c][r];
+      instance.world_to_object[4 * r + c] = inv[c][r];
+    }
+    instance.object_to_world[4 * r + 3] = origin[r];
+    instance.world_to_object[4 * r + 3] = inv_t[r];
+  }
+}
+
+KCamera make_camera(const glm::vec3& origin, float yaw_degrees, float pitch_degrees, float fov_x_degrees, int width,
+                    int height) {
+  float yaw = glm::radians(yaw_degrees), pitch = glm::radians(pitch_degrees);
+  glm::vec3 forward(std::cos(yaw) * std::cos(pitch), std::sin(yaw) * std::cos(pitch), std::sin(pitch));
+  glm::vec3 right = glm::normalize(glm::cross(forward, glm::vec3(0.0f, 0.0f, 1.0f)));
+  if (!std::isfinite(right.x)) right = glm::vec3(0.0f, -1.0f, 0.0f);
+  glm::vec3 up = glm::cross(right, forward);
+  KCamera cam{};
+  store(cam.origin, origin);
+  store(cam.forward, forward);
+  store(cam.right, right);
+  store(cam.up, up);
+  cam.width = static_cast<uint32_t>(width);
+  cam.height = static_cast<uint32_t>(height);
+  cam.tan_half_fov_x = std::tan(0.5f * glm::radians(fov_x_degrees));
+  cam.tan_half_fov_y = cam.tan_half_fov_x * static_cast<float>(height) / static_cast<float>(std::max(width, 1));
+  return cam;
+}
+
+}  // namespace cohort::core

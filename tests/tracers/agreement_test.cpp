@@ -1,0 +1,126 @@
+// Tracers produce the same image for the same input (Brigade §4.1.4): the Embree and OpenCL tracers
+// run the same integrator with the same per-pixel random numbers, so their images differ only where
+// floating-point differences send a path another way. Bound: RMSE below 0.5% of the mean pixel value
+// per channel, at 16 spp (noise between two 16-spp renders with different frame indices is far above
+// it, so the bound would catch a tracer drawing different samples or shading differently).
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdlib>
+#include <iostream>
+
+#include <filesystem>
+
+#include "cohort/core/scene_pack.h"
+#include "test_scenes.h"
+#include "test_tracers.h"
+
+using namespace cohort;
+using namespace cohort::test;
+
+namespace {
+
+double rmse(const core::FrameBuffer& a, const core::FrameBuffer& b, double* mean) {
+  double sum = 0.0, sum_sq = 0.0;
+  size_t n = 0;
+  for (size_t i = 0; i < a.rgba.size(); ++i) {
+    if (i % 4 == 3) continue;
+    double d = double(a.rgba[i]) - double(b.rgba[i]);
+    sum_sq += d * d;
+    sum += 0.5 * (double(a.rgba[i]) + double(b.rgba[i]));
+    ++n;
+  }
+  *mean = sum / double(n);
+  return std::sqrt(sum_sq / double(n));
+}
+
+struct Case {
+  uint32_t mode;
+  uint32_t bounces;
+  const char* name;
+};
+
+}  // namespace
+
+class Agreement : public ::testing::TestWithParam<Case> {};
+
+TEST_P(Agreement, EmbreeAndOpenCLImagesMatch) {
+  std::vector<std::string> names = built_tracers();
+  if (names.size() < 2) GTEST_SKIP() << "needs both the Embree and the OpenCL tracer";
+  if (!tracer_runs_here("opencl")) GTEST_SKIP() << "no OpenCL device here";
+  const Case c = GetParam();
+  scene::Scene room = test_room();
+  const int w = 64, h = 48;
+  KCamera cam = test_room_camera(w, h);
+  KFrameParams params = frame_params(c.mode, 16, c.bounces, h);
+  params.firefly_clamp = 10.0f;
+  params.soft_shadow_scale = 1.0f;
+  params.rr_start = 2.0f;
+  params.frame_index = 7;
+  auto embree = make_test_tracer("embree");
+  auto opencl = make_test_tracer("opencl");
+  core::FrameBuffer a = render(*embree, room, cam, params);
+  core::FrameBuffer b = render(*opencl, room, cam, params);
+  for (float v : a.rgba) ASSERT_TRUE(std::isfinite(v)) << "embree wrote a non-finite value";
+  for (float v : b.rgba) ASSERT_TRUE(std::isfinite(v)) << "opencl wrote a non-finite value";
+  double mean = 0.0;
+  double error = rmse(a, b, &mean);
+  EXPECT_GT(mean, 0.01) << "the room should be lit";
+  EXPECT_LT(error, 0.005 * mean) << c.name << ": RMSE " << error << " vs mean " << mean;
+
+  // The same tracer with a different frame index draws different samples: the bound must be tighter
+  // than that noise, or this test could not tell two tracers apart.
+  KFrameParams other = params;
+  other.frame_index = 8;
+  core::FrameBuffer noise = render(*embree, room, cam, other);
+  double noise_mean = 0.0;
+  double noise_error = rmse(a, noise, &noise_mean);
+  if (c.mode == K_MODE_PATH) {
+    EXPECT_GT(noise_error, 2.0 * error) << "sample noise " << noise_error;
+  }
+  std::cout << c.name << ": RMSE embree/opencl " << error << ", frame-to-frame noise " << noise_error << ", mean "
+            << mean << "\n";
+  if (const char* dir = std::getenv("COHORT_TEST_IMAGES")) {
+    write_preview(std::string(dir) + "/agreement_" + c.name + "_embree.png", a);
+    write_preview(std::string(dir) + "/agreement_" + c.name + "_opencl.png", b);
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(Modes, Agreement,
+                         ::testing::Values(Case{K_MODE_PATH, 1, "path"}, Case{K_MODE_PATH, 3, "path3"},
+                                           Case{K_MODE_DIRECT, 0, "direct"}, Case{K_MODE_ALBEDO, 0, "albedo"},
+                                           Case{K_MODE_NORMALS, 0, "normals"}),
+                         [](const auto& info) { return std::string(info.param.name); });
+
+// A scene pack read back renders exactly like the scene it was written from.
+TEST(ScenePack, RendersLikeTheCompiledScene) {
+  if (!tracer_runs_here("embree")) GTEST_SKIP();
+  core::PackedScene pack;
+  pack.map_name = "test_room";
+  scene::Scene room = test_room();
+  core::CompiledScene compiled = core::compile_scene(room);
+  pack.tracer_scene = compiled.tracer_scene;
+  pack.blas_of_mesh = compiled.blas_of_mesh;
+  pack.world_blas = compiled.world_blas;
+  pack.instance_names.assign(pack.tracer_scene.instances.size(), "x");
+  pack.player_start[0] = room.player_start.x;
+  const char* keep = std::getenv("COHORT_TEST_IMAGES");
+  std::filesystem::path file = keep ? std::filesystem::path(keep) / "test_room.cpack"
+                                    : std::filesystem::temp_directory_path() / "cohort_test_room.cpack";
+  core::write_scene_pack(file, pack);
+  core::PackedScene back = core::read_scene_pack(file);
+  if (!keep) std::filesystem::remove(file);
+  const int w = 32, h = 24;
+  KCamera cam = test_room_camera(w, h);
+  KFrameParams params = frame_params(K_MODE_PATH, 4, 1, h);
+  auto tracer = make_test_tracer("embree");
+  core::FrameBuffer a = render(*tracer, room, cam, params);
+  tracer->apply(commit::CommitBuffer::full(std::make_shared<commit::TracerScene>(back.tracer_scene), 2));
+  core::FrameBuffer b;
+  b.resize(w, h);
+  core::BandJob job;
+  job.params = params;
+  job.camera = cam;
+  tracer->render_band(job, b);
+  EXPECT_EQ(a.rgba, b.rgba);
+}

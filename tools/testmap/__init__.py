@@ -1,0 +1,1 @@
+"""Cohort's Doom 3-format test map generator (standard library only, deterministic output)."""

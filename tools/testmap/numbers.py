@@ -1,0 +1,16 @@
+"""Fixed number formatting so output bytes never depend on float repr details."""
+
+
+def fmt(value):
+    if isinstance(value, str):
+        return value
+    v = round(float(value), 4)
+    if v == 0:
+        return "0"
+    if v == int(v):
+        return str(int(v))
+    return ("%.4f" % v).rstrip("0").rstrip(".")
+
+
+def fmt_vec(values):
+    return " ".join(fmt(v) for v in values)

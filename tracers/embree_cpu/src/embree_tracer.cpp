@@ -1,0 +1,221 @@
+#include "cohort/tracers/embree_tracer.h"
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include <tbb/blocked_range.h>
+#include <tbb/global_control.h>
+#include <tbb/parallel_for.h>
+
+#include "cohort/commit/tracer_scene.h"
+#include "embree_kernel.h"
+
+namespace cohort::tracers {
+
+namespace embree_kernel {
+
+void filter_hit(const RTCFilterFunctionNArguments* args) {
+  const auto* fc = reinterpret_cast<const FilterContext*>(args->context);
+  const KSceneView* scene = fc->scene;
+  for (unsigned i = 0; i < args->N; ++i) {
+    if (args->valid[i] == 0) continue;
+    kuint instance = args->context->instID[0];
+    const KInstance& inst = scene->instances[instance];
+    if ((inst.mask & fc->ray_mask) == 0u) {
+      args->valid[i] = 0;
+      continue;
+    }
+    kuint triangle = scene->blases[inst.blas].tri_offset + RTCHitN_primID(args->hit, args->N, i);
+    float u = RTCHitN_u(args->hit, args->N, i), v = RTCHitN_v(args->hit, args->N, i);
+    if (k_hit_transmittance(scene, instance, triangle, u, v, fc->shadow_ray) > 0.0f) args->valid[i] = 0;
+  }
+}
+
+}  // namespace embree_kernel
+
+namespace {
+
+void check_device(RTCDevice device, const char* what) {
+  RTCError code = rtcGetDeviceError(device);
+  if (code != RTC_ERROR_NONE)
+    throw std::runtime_error(std::string("EmbreeTracer: Embree error ") + std::to_string(static_cast<int>(code)) +
+                             " while " + what);
+}
+
+}  // namespace
+
+struct EmbreeTracer::Impl {
+  RTCDevice device = nullptr;
+  RTCScene top = nullptr;
+  std::vector<RTCScene> blas_scenes;
+  commit::TracerScene scene;
+  std::unique_ptr<tbb::global_control> thread_limit;
+  uint64_t rays_traced = 0;
+
+  ~Impl() {
+    release_top();
+    release_blases();
+    if (device) rtcReleaseDevice(device);
+  }
+
+  void release_top() {
+    if (top) rtcReleaseScene(top);
+    top = nullptr;
+  }
+  void release_blases() {
+    for (RTCScene s : blas_scenes)
+      if (s) rtcReleaseScene(s);
+    blas_scenes.clear();
+  }
+
+  // One Embree scene per KBlas, sharing the TracerScene's vertex and triangle arrays (no copies).
+  void build_blases() {
+    release_blases();
+    for (const KBlas& b : scene.blases) {
+      RTCScene s = rtcNewScene(device);
+      if (b.tri_count > 0) {
+        RTCGeometry g = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_TRIANGLE);
+        rtcSetSharedGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, scene.vertices.data(), 0,
+                                   sizeof(KVertex), scene.vertices.size());
+        rtcSetSharedGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, scene.triangles.data(),
+                                   size_t(b.tri_offset) * sizeof(KTriangle), sizeof(KTriangle), b.tri_count);
+        rtcSetGeometryIntersectFilterFunction(g, embree_kernel::filter_hit);
+        rtcSetGeometryOccludedFilterFunction(g, embree_kernel::filter_hit);
+        rtcCommitGeometry(g);
+        rtcAttachGeometryByID(s, g, 0);
+        rtcReleaseGeometry(g);
+      }
+      rtcCommitScene(s);
+      blas_scenes.push_back(s);
+    }
+  }
+
+  // Instance geometry IDs equal KInstance indices, so instID[0] indexes the instance array directly.
+  void build_top() {
+    release_top();
+    top = rtcNewScene(device);
+    for (size_t i = 0; i < scene.instances.size(); ++i) {
+      const KInstance& inst = scene.instances[i];
+      if (inst.blas >= blas_scenes.size())
+        throw std::runtime_error("EmbreeTracer: instance " + std::to_string(i) + " names BLAS " +
+                                 std::to_string(inst.blas) + " of " + std::to_string(blas_scenes.size()));
+      RTCGeometry g = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_INSTANCE);
+      rtcSetGeometryInstancedScene(g, blas_scenes[inst.blas]);
+      rtcSetGeometryTransform(g, 0, RTC_FORMAT_FLOAT3X4_ROW_MAJOR, inst.object_to_world);
+      rtcCommitGeometry(g);
+      rtcAttachGeometryByID(top, g, static_cast<unsigned>(i));
+      rtcReleaseGeometry(g);
+    }
+    rtcCommitScene(top);
+  }
+
+  embree_kernel::TraceCtx context() const {
+    embree_kernel::TraceCtx ctx{};
+    KSceneView& v = ctx.scene;
+    v.vertices = scene.vertices.data();
+    v.triangles = scene.triangles.data();
+    v.blas_nodes = scene.blas_nodes.data();
+    v.blases = scene.blases.data();
+    v.instances = scene.instances.data();
+    v.tlas_nodes = scene.tlas_nodes.data();
+    v.materials = scene.materials.data();
+    v.textures = scene.textures.data();
+    v.texels = scene.texels.data();
+    v.lights = scene.lights.data();
+    v.instance_count = static_cast<kuint>(scene.instances.size());
+    v.light_count = static_cast<kuint>(scene.lights.size());
+    v.material_count = static_cast<kuint>(scene.materials.size());
+    v.texture_count = static_cast<kuint>(scene.textures.size());
+    ctx.top = top;
+    ctx.rays = 0;
+    return ctx;
+  }
+};
+
+EmbreeTracer::EmbreeTracer(int threads) : impl_(std::make_unique<Impl>()) {
+  impl_->device = rtcNewDevice(nullptr);
+  if (!impl_->device) throw std::runtime_error("EmbreeTracer: rtcNewDevice failed");
+  if (threads > 0)
+    impl_->thread_limit =
+        std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism, size_t(threads));
+}
+
+EmbreeTracer::~EmbreeTracer() = default;
+
+void EmbreeTracer::apply(const commit::CommitBuffer& commit) {
+  commit::ChangeSet changes = commit::apply_commit(commit, impl_->scene);
+  if (changes.full_resync || changes.geometry) {
+    impl_->build_blases();
+    check_device(impl_->device, "building the BLAS scenes");
+    impl_->build_top();
+  } else if (changes.instances || changes.tlas || !impl_->top) {
+    impl_->build_top();
+  }
+  check_device(impl_->device, "building the instance scene");
+}
+
+core::BandResult EmbreeTracer::render_band(const core::BandJob& job, core::FrameBuffer& target) {
+  if (!impl_->top) throw std::runtime_error("EmbreeTracer: render_band before any commit was applied");
+  auto start = std::chrono::steady_clock::now();
+  KFrameParams params = job.params;
+  params.light_count = static_cast<kuint>(impl_->scene.lights.size());
+  params.instance_count = static_cast<kuint>(impl_->scene.instances.size());
+  const KCamera camera = job.camera;
+  const int row_begin = static_cast<int>(params.row_begin);
+  const int row_end = std::min(static_cast<int>(params.row_end), target.height);
+  const int width = std::min(static_cast<int>(camera.width), target.width);
+  embree_kernel::TraceCtx base = impl_->context();
+  std::atomic<uint64_t> rays{0};
+  tbb::parallel_for(tbb::blocked_range<int>(row_begin, row_end, 1), [&](const tbb::blocked_range<int>& rows) {
+    embree_kernel::TraceCtx ctx = base;
+    for (int y = rows.begin(); y < rows.end(); ++y) {
+      float* out = target.row(y);
+      for (int x = 0; x < width; ++x) {
+        KVec3 c = k_render_pixel(&ctx, &params, &camera, static_cast<kuint>(x), static_cast<kuint>(y));
+        out[4 * x + 0] = c.x;
+        out[4 * x + 1] = c.y;
+        out[4 * x + 2] = c.z;
+        out[4 * x + 3] = 1.0f;
+      }
+    }
+    rays += ctx.rays;
+  });
+  impl_->rays_traced += rays.load();
+  core::BandResult result;
+  result.device_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  return result;
+}
+
+uint64_t EmbreeTracer::rays_traced() const { return impl_->rays_traced; }
+
+uint64_t EmbreeTracer::trace_camera_rays_only(const core::BandJob& job) {
+  if (!impl_->top) throw std::runtime_error("EmbreeTracer: trace before any commit was applied");
+  const KFrameParams params = job.params;
+  const KCamera camera = job.camera;
+  const kuint spp = params.spp > 0u ? params.spp : 1u;
+  embree_kernel::TraceCtx base = impl_->context();
+  std::atomic<uint64_t> hits{0};
+  tbb::parallel_for(tbb::blocked_range<int>(static_cast<int>(params.row_begin), static_cast<int>(params.row_end), 1),
+                    [&](const tbb::blocked_range<int>& rows) {
+                      embree_kernel::TraceCtx ctx = base;
+                      uint64_t local = 0;
+                      KVec3 org = v3_load(camera.origin);
+                      for (int y = rows.begin(); y < rows.end(); ++y)
+                        for (kuint x = 0; x < camera.width; ++x)
+                          for (kuint s = 0; s < spp; ++s) {
+                            KRng rng = k_rng_seed(x, static_cast<kuint>(y), params.frame_index, s);
+                            float jx = k_rng_next(&rng), jy = k_rng_next(&rng);
+                            KVec3 dir = k_camera_direction(&camera, float(x) + jx, float(y) + jy);
+                            KHit hit;
+                            local += static_cast<uint64_t>(k_trace_closest(&ctx, org, dir, K_INF, K_RAY_PRIMARY, &hit));
+                          }
+                      hits += local;
+                    });
+  return hits.load();
+}
+
+}  // namespace cohort::tracers

@@ -1,0 +1,38 @@
+// The OpenCL tracer: the shared integrator (core/kernel/integrator.h) over the portable two-level BVH
+// (core/kernel/trace_bvh.h), compiled at run time from kernel text embedded at build time.
+#pragma once
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "cohort/core/tracer.h"
+
+namespace cohort::tracers {
+
+class OpenCLTracer : public core::Tracer {
+ public:
+  struct Options {
+    int device = 0;         // index into list_devices(): every device of every platform, in order
+    std::string build_options;  // extra OpenCL compiler options
+  };
+  // Throws std::runtime_error when there is no such device or the kernel does not compile (the
+  // message carries the build log).
+  explicit OpenCLTracer(const Options& options);
+  ~OpenCLTracer() override;
+  OpenCLTracer(const OpenCLTracer&) = delete;
+  OpenCLTracer& operator=(const OpenCLTracer&) = delete;
+
+  std::string name() const override;
+  void apply(const commit::CommitBuffer& commit) override;
+  core::BandResult render_band(const core::BandJob& job, core::FrameBuffer& target) override;
+
+  // "platform / device" for every OpenCL device on this machine, in the order Options::device counts.
+  static std::vector<std::string> list_devices();
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace cohort::tracers

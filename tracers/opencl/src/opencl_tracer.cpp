@@ -1,0 +1,251 @@
+#include "cohort/tracers/opencl_tracer.h"
+
+#include <CL/cl.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cstring>
+#include <iostream>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "cohort/commit/tracer_scene.h"
+
+namespace cohort::tracers {
+
+namespace opencl_source {
+extern const char* const kRenderBand;
+}
+
+namespace {
+
+void check(cl_int err, const char* what) {
+  if (err != CL_SUCCESS) throw std::runtime_error(std::string("OpenCLTracer: ") + what + " failed (error " + std::to_string(err) + ")");
+}
+
+std::string platform_info(cl_platform_id p, cl_platform_info what) {
+  size_t n = 0;
+  clGetPlatformInfo(p, what, 0, nullptr, &n);
+  std::string s(n, '\0');
+  clGetPlatformInfo(p, what, n, s.data(), nullptr);
+  while (!s.empty() && s.back() == '\0') s.pop_back();
+  return s;
+}
+
+std::string device_info(cl_device_id d, cl_device_info what) {
+  size_t n = 0;
+  clGetDeviceInfo(d, what, 0, nullptr, &n);
+  std::string s(n, '\0');
+  clGetDeviceInfo(d, what, n, s.data(), nullptr);
+  while (!s.empty() && s.back() == '\0') s.pop_back();
+  return s;
+}
+
+struct DeviceEntry {
+  cl_platform_id platform;
+  cl_device_id device;
+  std::string label;
+};
+
+std::vector<DeviceEntry> all_devices() {
+  std::vector<DeviceEntry> out;
+  cl_uint np = 0;
+  if (clGetPlatformIDs(0, nullptr, &np) != CL_SUCCESS || np == 0) return out;
+  std::vector<cl_platform_id> platforms(np);
+  clGetPlatformIDs(np, platforms.data(), nullptr);
+  for (cl_platform_id p : platforms) {
+    cl_uint nd = 0;
+    if (clGetDeviceIDs(p, CL_DEVICE_TYPE_ALL, 0, nullptr, &nd) != CL_SUCCESS || nd == 0) continue;
+    std::vector<cl_device_id> devices(nd);
+    clGetDeviceIDs(p, CL_DEVICE_TYPE_ALL, nd, devices.data(), nullptr);
+    for (cl_device_id d : devices)
+      out.push_back({p, d, platform_info(p, CL_PLATFORM_NAME) + " / " + device_info(d, CL_DEVICE_NAME)});
+  }
+  return out;
+}
+
+// A device buffer holding a copy of a host array (at least 16 bytes: OpenCL refuses empty buffers).
+class DeviceBuffer {
+ public:
+  DeviceBuffer() = default;
+  DeviceBuffer(const DeviceBuffer&) = delete;
+  DeviceBuffer& operator=(const DeviceBuffer&) = delete;
+  ~DeviceBuffer() { reset(); }
+  void reset() {
+    if (mem_) clReleaseMemObject(mem_);
+    mem_ = nullptr;
+    bytes_ = 0;
+  }
+  template <class T>
+  void upload(cl_context context, cl_command_queue queue, const std::vector<T>& data, const char* what) {
+    size_t bytes = std::max<size_t>(data.size() * sizeof(T), 16);
+    if (bytes > bytes_) {
+      reset();
+      cl_int err = CL_SUCCESS;
+      mem_ = clCreateBuffer(context, CL_MEM_READ_ONLY, bytes, nullptr, &err);
+      check(err, what);
+      bytes_ = bytes;
+    }
+    if (!data.empty())
+      check(clEnqueueWriteBuffer(queue, mem_, CL_TRUE, 0, data.size() * sizeof(T), data.data(), 0, nullptr, nullptr),
+            what);
+  }
+  cl_mem mem() const { return mem_; }
+
+ private:
+  cl_mem mem_ = nullptr;
+  size_t bytes_ = 0;
+};
+
+}  // namespace
+
+struct OpenCLTracer::Impl {
+  std::string label;
+  cl_context context = nullptr;
+  cl_command_queue queue = nullptr;
+  cl_program program = nullptr;
+  cl_kernel kernel = nullptr;
+  commit::TracerScene scene;
+  DeviceBuffer vertices, triangles, blas_nodes, blases, instances, tlas_nodes, materials, textures, texels, lights;
+  cl_mem params = nullptr, camera = nullptr, output = nullptr;
+  size_t output_bytes = 0;
+  bool has_scene = false;
+
+  ~Impl() {
+    for (cl_mem m : {params, camera, output})
+      if (m) clReleaseMemObject(m);
+    if (kernel) clReleaseKernel(kernel);
+    if (program) clReleaseProgram(program);
+    if (queue) clReleaseCommandQueue(queue);
+    if (context) clReleaseContext(context);
+  }
+};
+
+std::vector<std::string> OpenCLTracer::list_devices() {
+  std::vector<std::string> out;
+  for (const DeviceEntry& d : all_devices()) out.push_back(d.label);
+  return out;
+}
+
+OpenCLTracer::OpenCLTracer(const Options& options) : impl_(std::make_unique<Impl>()) {
+  std::vector<DeviceEntry> devices = all_devices();
+  if (devices.empty()) throw std::runtime_error("OpenCLTracer: no OpenCL platform/device found");
+  if (options.device < 0 || static_cast<size_t>(options.device) >= devices.size())
+    throw std::runtime_error("OpenCLTracer: device " + std::to_string(options.device) + " requested, " +
+                             std::to_string(devices.size()) + " available");
+  const DeviceEntry& dev = devices[static_cast<size_t>(options.device)];
+  impl_->label = dev.label;
+  cl_int err = CL_SUCCESS;
+  cl_context_properties props[] = {CL_CONTEXT_PLATFORM, reinterpret_cast<cl_context_properties>(dev.platform), 0};
+  impl_->context = clCreateContext(props, 1, &dev.device, nullptr, nullptr, &err);
+  check(err, "clCreateContext");
+#if defined(__GNUC__)
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wdeprecated-declarations"
+#endif
+  impl_->queue = clCreateCommandQueue(impl_->context, dev.device, CL_QUEUE_PROFILING_ENABLE, &err);
+#if defined(__GNUC__)
+#pragma GCC diagnostic pop
+#endif
+  check(err, "clCreateCommandQueue");
+  const char* source = opencl_source::kRenderBand;
+  impl_->program = clCreateProgramWithSource(impl_->context, 1, &source, nullptr, &err);
+  check(err, "clCreateProgramWithSource");
+  std::string build_options = "-cl-std=CL1.2 " + options.build_options;
+  err = clBuildProgram(impl_->program, 1, &dev.device, build_options.c_str(), nullptr, nullptr);
+  if (err != CL_SUCCESS) {
+    size_t n = 0;
+    clGetProgramBuildInfo(impl_->program, dev.device, CL_PROGRAM_BUILD_LOG, 0, nullptr, &n);
+    std::string log(n, '\0');
+    clGetProgramBuildInfo(impl_->program, dev.device, CL_PROGRAM_BUILD_LOG, n, log.data(), nullptr);
+    std::cerr << "OpenCLTracer: kernel build log for " << dev.label << ":\n" << log << "\n";
+    throw std::runtime_error("OpenCLTracer: kernel build failed on " + dev.label + " (error " + std::to_string(err) +
+                             "):\n" + log);
+  }
+  impl_->kernel = clCreateKernel(impl_->program, "cohort_render_band", &err);
+  check(err, "clCreateKernel");
+  impl_->params = clCreateBuffer(impl_->context, CL_MEM_READ_ONLY, sizeof(KFrameParams), nullptr, &err);
+  check(err, "clCreateBuffer(params)");
+  impl_->camera = clCreateBuffer(impl_->context, CL_MEM_READ_ONLY, sizeof(KCamera), nullptr, &err);
+  check(err, "clCreateBuffer(camera)");
+}
+
+OpenCLTracer::~OpenCLTracer() = default;
+
+std::string OpenCLTracer::name() const { return "opencl (" + impl_->label + ")"; }
+
+void OpenCLTracer::apply(const commit::CommitBuffer& commit) {
+  Impl& m = *impl_;
+  commit::ChangeSet changes = commit::apply_commit(commit, m.scene);
+  const bool all = changes.full_resync || !m.has_scene;
+  cl_context c = m.context;
+  cl_command_queue q = m.queue;
+  if (all || changes.geometry) {
+    m.vertices.upload(c, q, m.scene.vertices, "uploading vertices");
+    m.triangles.upload(c, q, m.scene.triangles, "uploading triangles");
+    m.blas_nodes.upload(c, q, m.scene.blas_nodes, "uploading BLAS nodes");
+    m.blases.upload(c, q, m.scene.blases, "uploading BLASes");
+  }
+  if (all || changes.instances || changes.tlas) {
+    m.instances.upload(c, q, m.scene.instances, "uploading instances");
+    m.tlas_nodes.upload(c, q, m.scene.tlas_nodes, "uploading TLAS nodes");
+  }
+  if (all || changes.materials) m.materials.upload(c, q, m.scene.materials, "uploading materials");
+  if (all || changes.textures) {
+    m.textures.upload(c, q, m.scene.textures, "uploading textures");
+    m.texels.upload(c, q, m.scene.texels, "uploading texels");
+  }
+  if (all || changes.lights) m.lights.upload(c, q, m.scene.lights, "uploading lights");
+  m.has_scene = true;
+}
+
+core::BandResult OpenCLTracer::render_band(const core::BandJob& job, core::FrameBuffer& target) {
+  Impl& m = *impl_;
+  if (!m.has_scene) throw std::runtime_error("OpenCLTracer: render_band before any commit was applied");
+  KFrameParams params = job.params;
+  KCamera camera = job.camera;
+  params.row_end = std::min<kuint>(params.row_end, static_cast<kuint>(target.height));
+  camera.width = std::min<kuint>(camera.width, static_cast<kuint>(target.width));
+  if (params.row_end <= params.row_begin || camera.width == 0) return {};
+  params.light_count = static_cast<kuint>(m.scene.lights.size());
+  params.instance_count = static_cast<kuint>(m.scene.instances.size());
+  params.tlas_node_count = static_cast<kuint>(m.scene.tlas_nodes.size());
+  const size_t rows = params.row_end - params.row_begin;
+  const size_t bytes = rows * camera.width * 4 * sizeof(float);
+  cl_int err = CL_SUCCESS;
+  if (bytes > m.output_bytes) {
+    if (m.output) clReleaseMemObject(m.output);
+    m.output = clCreateBuffer(m.context, CL_MEM_WRITE_ONLY, bytes, nullptr, &err);
+    check(err, "clCreateBuffer(output)");
+    m.output_bytes = bytes;
+  }
+  check(clEnqueueWriteBuffer(m.queue, m.params, CL_FALSE, 0, sizeof params, &params, 0, nullptr, nullptr),
+        "writing frame parameters");
+  check(clEnqueueWriteBuffer(m.queue, m.camera, CL_FALSE, 0, sizeof camera, &camera, 0, nullptr, nullptr),
+        "writing the camera");
+  cl_mem args[] = {m.vertices.mem(),  m.triangles.mem(), m.blas_nodes.mem(), m.blases.mem(),
+                   m.instances.mem(), m.tlas_nodes.mem(), m.materials.mem(), m.textures.mem(),
+                   m.texels.mem(),    m.lights.mem(),     m.params,           m.camera,
+                   m.output};
+  for (cl_uint i = 0; i < sizeof(args) / sizeof(args[0]); ++i)
+    check(clSetKernelArg(m.kernel, i, sizeof(cl_mem), &args[i]), "clSetKernelArg");
+  const size_t local[2] = {8, 8};
+  const size_t global[2] = {(camera.width + 7) / 8 * 8, (rows + 7) / 8 * 8};
+  cl_event done = nullptr;
+  check(clEnqueueNDRangeKernel(m.queue, m.kernel, 2, nullptr, global, local, 0, nullptr, &done), "launching the kernel");
+  std::vector<float> band(rows * camera.width * 4);
+  check(clEnqueueReadBuffer(m.queue, m.output, CL_TRUE, 0, bytes, band.data(), 0, nullptr, nullptr), "reading the band");
+  cl_ulong start = 0, end = 0;
+  clGetEventProfilingInfo(done, CL_PROFILING_COMMAND_START, sizeof start, &start, nullptr);
+  clGetEventProfilingInfo(done, CL_PROFILING_COMMAND_END, sizeof end, &end, nullptr);
+  clReleaseEvent(done);
+  for (size_t r = 0; r < rows; ++r)
+    std::memcpy(target.row(static_cast<int>(params.row_begin + r)), band.data() + r * camera.width * 4,
+                camera.width * 4 * sizeof(float));
+  core::BandResult result;
+  result.device_ms = end > start ? double(end - start) * 1e-6 : 0.0;
+  return result;
+}
+
+}  // namespace cohort::tracers
