@@ -10,6 +10,7 @@ void add_render_command(CLI::App& app);
 void add_play_command(CLI::App& app);
 void add_bench_command(CLI::App& app);
 void add_pack_command(CLI::App& app);
+void add_scenario_command(CLI::App& app);
 
 // Exit codes shared by every subcommand.
 constexpr int kExitOk = 0;

@@ -24,6 +24,7 @@ int main(int argc, char** argv) {
   cohort::app::add_play_command(app);
   cohort::app::add_bench_command(app);
   cohort::app::add_pack_command(app);
+  cohort::app::add_scenario_command(app);
 
   app.parse_complete_callback([&] { spdlog::set_level(spdlog::level::from_str(log_level)); });
   try {

@@ -50,6 +50,11 @@ void diff_materials(const std::vector<KMaterial>& before, const std::vector<KMat
              [&](uint32_t i, const KMaterial& v) { out.set_material(i, v); });
 }
 
+void diff_textures(const std::vector<KTexture>& before, const std::vector<KTexture>& after, CommitBuffer& out) {
+  diff_array(before, after, [&](uint32_t n) { out.set_texture_count(n); },
+             [&](uint32_t i, const KTexture& v) { out.set_texture(i, v); });
+}
+
 void diff_tlas(const std::vector<KBvhNode>& before, const std::vector<KBvhNode>& after, CommitBuffer& out) {
   if (!same_array(before, after, "tlas", nullptr)) out.set_tlas(after);
 }

@@ -11,9 +11,7 @@ size_t BlasUpload::bytes() const {
          triangles.size() * sizeof(KTriangle) + nodes.size() * sizeof(KBvhNode);
 }
 
-size_t TextureUpload::bytes() const {
-  return kRecordHeaderBytes + sizeof(texture) + texels.size() * sizeof(uint32_t);
-}
+size_t TexelUpload::bytes() const { return kRecordHeaderBytes + texels.size() * sizeof(uint32_t); }
 
 CommitBuffer CommitBuffer::full(std::shared_ptr<const TracerScene> scene, uint64_t frame) {
   CommitBuffer c;
@@ -46,6 +44,8 @@ void CommitBuffer::set_light_count(uint32_t count) { set_count(lights_, light_co
 void CommitBuffer::set_light(uint32_t index, const KLight& v) { set_element(lights_, light_count_, index, v); }
 void CommitBuffer::set_material_count(uint32_t count) { set_count(materials_, material_count_, count); }
 void CommitBuffer::set_material(uint32_t index, const KMaterial& v) { set_element(materials_, material_count_, index, v); }
+void CommitBuffer::set_texture_count(uint32_t count) { set_count(textures_, texture_count_, count); }
+void CommitBuffer::set_texture(uint32_t index, const KTexture& v) { set_element(textures_, texture_count_, index, v); }
 
 void CommitBuffer::set_tlas(std::vector<KBvhNode> nodes) {
   bytes_ -= tlas_ ? kRecordHeaderBytes + tlas_->size() * sizeof(KBvhNode) : 0;
@@ -58,20 +58,9 @@ void CommitBuffer::add_blas(BlasUpload upload) {
   blas_uploads_.push_back(std::move(upload));
 }
 
-void CommitBuffer::add_texture(TextureUpload upload) {
-  // A texture re-defined before the tracer saw the first version: only the last one matters, but its
-  // texels may live at a different offset, so both stay unless they are the same slot and range.
-  for (auto& earlier : texture_uploads_) {
-    if (earlier.texture_index == upload.texture_index && earlier.texture.offset == upload.texture.offset &&
-        earlier.texels.size() == upload.texels.size()) {
-      bytes_ -= earlier.bytes();
-      bytes_ += upload.bytes();
-      earlier = std::move(upload);
-      return;
-    }
-  }
+void CommitBuffer::add_texels(TexelUpload upload) {
   bytes_ += upload.bytes();
-  texture_uploads_.push_back(std::move(upload));
+  texel_uploads_.push_back(std::move(upload));
 }
 
 void CommitBuffer::set_camera(const KCamera& camera) {
@@ -81,7 +70,8 @@ void CommitBuffer::set_camera(const KCamera& camera) {
 
 size_t CommitBuffer::record_count() const {
   return (instance_count_ ? 1 : 0) + instances_.size() + (tlas_ ? 1 : 0) + (light_count_ ? 1 : 0) + lights_.size() +
-         (material_count_ ? 1 : 0) + materials_.size() + blas_uploads_.size() + texture_uploads_.size() +
+         (material_count_ ? 1 : 0) + materials_.size() + (texture_count_ ? 1 : 0) + textures_.size() +
+         blas_uploads_.size() + texel_uploads_.size() +
          (camera_ ? 1 : 0);
 }
 
@@ -90,12 +80,14 @@ void CommitBuffer::clear() {
   instance_count_.reset();
   light_count_.reset();
   material_count_.reset();
+  texture_count_.reset();
+  textures_.clear();
   instances_.clear();
   lights_.clear();
   materials_.clear();
   tlas_.reset();
   blas_uploads_.clear();
-  texture_uploads_.clear();
+  texel_uploads_.clear();
   camera_.reset();
   bytes_ = 0;
 }
@@ -119,8 +111,10 @@ void CommitBuffer::merge(const CommitBuffer& later) {
   for (const auto& [i, v] : later.lights_) set_light(i, v);
   if (later.material_count_) set_material_count(*later.material_count_);
   for (const auto& [i, v] : later.materials_) set_material(i, v);
+  if (later.texture_count_) set_texture_count(*later.texture_count_);
+  for (const auto& [i, v] : later.textures_) set_texture(i, v);
   for (const auto& upload : later.blas_uploads_) add_blas(upload);
-  for (const auto& upload : later.texture_uploads_) add_texture(upload);
+  for (const auto& upload : later.texel_uploads_) add_texels(upload);
   if (later.camera_) set_camera(*later.camera_);
   frame_ = later.frame_;
 }
@@ -185,11 +179,11 @@ ChangeSet apply_commit(const CommitBuffer& commit, TracerScene& scene) {
   }
   changes.lights = apply_elements(scene.lights, commit.light_count(), commit.lights(), "light");
   changes.materials = apply_elements(scene.materials, commit.material_count(), commit.materials(), "material");
-  for (const TextureUpload& up : commit.texture_uploads()) {
-    write_range(scene.textures, up.texture_index, std::vector<KTexture>{up.texture});
-    write_range(scene.texels, up.texture.offset, up.texels);
+  for (const TexelUpload& up : commit.texel_uploads()) {
+    write_range(scene.texels, up.offset, up.texels);
     changes.textures = true;
   }
+  changes.textures |= apply_elements(scene.textures, commit.texture_count(), commit.textures(), "texture");
   if (commit.camera()) {
     scene.camera = *commit.camera();
     changes.camera = true;

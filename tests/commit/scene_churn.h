@@ -34,6 +34,7 @@ class SceneChurn {
     before_small.lights = master_.lights;
     before_small.materials = master_.materials;
     before_small.tlas_nodes = master_.tlas_nodes;
+    before_small.textures = master_.textures;
     CommitBuffer out;
     out.set_frame(frame);
 
@@ -66,6 +67,7 @@ class SceneChurn {
     diff_tlas(before_small.tlas_nodes, master_.tlas_nodes, out);
     diff_lights(before_small.lights, master_.lights, out);
     diff_materials(before_small.materials, master_.materials, out);
+    diff_textures(before_small.textures, master_.textures, out);
     master_.version = frame;
     return out;
   }
@@ -108,16 +110,21 @@ class SceneChurn {
     if (out) out->add_blas(std::move(up));
   }
 
+  // A texture appended to the table, its texels appended to the buffer; sometimes an existing slot
+  // is pointed at the new texels instead (a redefined texture).
   void add_texture(TracerScene& s, CommitBuffer* out) {
-    TextureUpload up;
-    up.texture_index = uint32_t(s.textures.size());
+    TexelUpload up;
+    up.offset = uint32_t(s.texels.size());
     uint32_t w = uint32_t(pick(1, 8)), h = uint32_t(pick(1, 8));
-    up.texture = {uint32_t(s.texels.size()), w, h, K_TEX_SRGB | (1u << 8)};
     up.texels.resize(size_t(w) * h);
     for (auto& t : up.texels) t = uint32_t(rng_());
-    s.textures.push_back(up.texture);
+    KTexture tex{up.offset, w, h, K_TEX_SRGB | (1u << 8)};
+    if (!s.textures.empty() && pick(0, 2) == 0)
+      s.textures[pick(0, int(s.textures.size()) - 1)] = tex;
+    else
+      s.textures.push_back(tex);
     s.texels.insert(s.texels.end(), up.texels.begin(), up.texels.end());
-    if (out) out->add_texture(std::move(up));
+    if (out) out->add_texels(std::move(up));
   }
 
   std::mt19937 rng_;

@@ -14,6 +14,7 @@ namespace cohort::commit {
 void diff_instances(const std::vector<KInstance>& before, const std::vector<KInstance>& after, CommitBuffer& out);
 void diff_lights(const std::vector<KLight>& before, const std::vector<KLight>& after, CommitBuffer& out);
 void diff_materials(const std::vector<KMaterial>& before, const std::vector<KMaterial>& after, CommitBuffer& out);
+void diff_textures(const std::vector<KTexture>& before, const std::vector<KTexture>& after, CommitBuffer& out);
 // A TLAS record when the node arrays differ.
 void diff_tlas(const std::vector<KBvhNode>& before, const std::vector<KBvhNode>& after, CommitBuffer& out);
 

@@ -1,8 +1,8 @@
 // A commit buffer carries what changed in the scene since the frame a tracer last applied. The core
 // fills one per tracer for frame N+1 while the tracer renders frame N from its own copy (Brigade,
 // Fig. 7-8). The simplest commit is a full resync: the whole TracerScene; the usual one is a handful of
-// incremental records (instance transforms, new BLASes, the new TLAS, lights, materials, new textures,
-// the camera).
+// incremental records (instance transforms, new BLASes, the new TLAS, lights, materials, the texture
+// table and new texels, the camera).
 //
 // Records coalesce: writing the same element twice keeps only the last value, so a buffer that
 // accumulates several frames (a tracer that skipped frames) stays as small as the set of elements that
@@ -34,11 +34,11 @@ struct BlasUpload {
   size_t bytes() const;
 };
 
-// A new or replaced texture and its texels (all mip levels) at texel_offset.
-struct TextureUpload {
-  uint32_t texture_index = 0;
-  KTexture texture{};
-  std::vector<uint32_t> texels;   // written at texture.offset
+// Texels of new or replaced textures (all their mip levels), written at `offset` of the texel buffer
+// (appended at the end normally; a replaced texture's old texels stay unused until a full resync).
+struct TexelUpload {
+  uint32_t offset = 0;
+  std::vector<uint32_t> texels;
   size_t bytes() const;
 };
 
@@ -67,8 +67,10 @@ class CommitBuffer {
   void set_light(uint32_t index, const KLight& light);
   void set_material_count(uint32_t count);
   void set_material(uint32_t index, const KMaterial& material);
+  void set_texture_count(uint32_t count);
+  void set_texture(uint32_t index, const KTexture& texture);
   void add_blas(BlasUpload upload);
-  void add_texture(TextureUpload upload);
+  void add_texels(TexelUpload upload);
   void set_camera(const KCamera& camera);
 
   // Fold a later commit into this one (the later one wins where both write an element). A full
@@ -93,7 +95,9 @@ class CommitBuffer {
   const std::optional<uint32_t>& material_count() const { return material_count_; }
   const std::map<uint32_t, KMaterial>& materials() const { return materials_; }
   const std::vector<BlasUpload>& blas_uploads() const { return blas_uploads_; }
-  const std::vector<TextureUpload>& texture_uploads() const { return texture_uploads_; }
+  const std::optional<uint32_t>& texture_count() const { return texture_count_; }
+  const std::map<uint32_t, KTexture>& textures() const { return textures_; }
+  const std::vector<TexelUpload>& texel_uploads() const { return texel_uploads_; }
   const std::optional<KCamera>& camera() const { return camera_; }
 
  private:
@@ -103,13 +107,14 @@ class CommitBuffer {
 
   std::shared_ptr<const TracerScene> full_;
   uint64_t frame_ = 0;
-  std::optional<uint32_t> instance_count_, light_count_, material_count_;
+  std::optional<uint32_t> instance_count_, light_count_, material_count_, texture_count_;
   std::map<uint32_t, KInstance> instances_;
   std::map<uint32_t, KLight> lights_;
   std::map<uint32_t, KMaterial> materials_;
+  std::map<uint32_t, KTexture> textures_;
   std::optional<std::vector<KBvhNode>> tlas_;
   std::vector<BlasUpload> blas_uploads_;
-  std::vector<TextureUpload> texture_uploads_;
+  std::vector<TexelUpload> texel_uploads_;
   std::optional<KCamera> camera_;
   size_t bytes_ = 0;
 };

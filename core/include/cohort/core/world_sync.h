@@ -1,0 +1,96 @@
+// The glue the frame loop calls once a frame: it takes RenderWorld's change log, updates the core's
+// master TracerScene (instance transforms, new BLASes, the TLAS, lights, materials, textures, camera)
+// and produces the frame's commit records, which it folds into every tracer's pending commit buffer.
+//
+// Index conventions follow compile_scene (gpu_scene.h): entity handle = KInstance::entity, instances
+// are the static world then the entity defs in handle order (so the TLAS is what compile_scene would
+// build for the same state), lights are the live light defs in handle order, textures use
+// texture_slot(). compile_scene puts a default material right after the map's materials; materials
+// defined later go after it, so no triangle's material index ever moves (kmaterial_index()).
+//
+// Replaying a recorded stream (`cohort render --replay FILE`), per frame:
+//   scene::Player player(file);                       // player.header().map_name names the map to load
+//   scene::RenderWorld world(load the map);
+//   WorldSync sync(world, compile_scene(world.scene()), options);
+//   while (player.play_frame(world)) {
+//     renderer.submit_commit(sync.sync(world.TakeChanges(), frame));   // or sync_and_publish + channels
+//     render with sync.master().camera ...
+//   }
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <map>
+#include <memory>
+#include <set>
+#include <vector>
+
+#include "cohort/commit/commit_buffer.h"
+#include "cohort/commit/commit_channel.h"
+#include "cohort/core/gpu_scene.h"
+#include "cohort/scene/render_world.h"
+
+namespace cohort::core {
+
+struct WorldSyncOptions {
+  GpuSceneOptions gpu;
+  uint32_t width = 640, height = 360;      // written into KCamera
+  size_t commit_budget_bytes = 32u << 20;  // per tracer; past it the tracer gets a full resync
+};
+
+struct WorldSyncStats {  // of the last sync()
+  uint64_t frame = 0;
+  size_t record_bytes = 0, records = 0;
+  uint32_t blas_builds = 0;
+  bool tlas_rebuilt = false;
+  double sync_ms = 0.0;
+};
+
+class WorldSync {
+ public:
+  // `compiled` is compile_scene(world.scene()) of the world as seeded, before any call. The world
+  // must outlive this object.
+  WorldSync(const scene::RenderWorld& world, CompiledScene compiled, WorldSyncOptions options = {});
+
+  // Fold the world's changes (world.TakeChanges()) into the master; returns the frame's records.
+  commit::CommitBuffer sync(const scene::ChangeLog& changes, uint64_t frame);
+  // sync() and hand the records to every tracer's channel.
+  commit::CommitBuffer sync_and_publish(const scene::ChangeLog& changes, uint64_t frame);
+
+  // A tracer's channel: its first commit is a full resync to the master as it is now.
+  std::shared_ptr<commit::CommitChannel> add_tracer();
+  const std::vector<std::shared_ptr<commit::CommitChannel>>& channels() const { return channels_; }
+
+  const commit::TracerScene& master() const { return master_; }
+  // An immutable copy of the master, shared by every full resync of the same frame.
+  std::shared_ptr<const commit::TracerScene> snapshot();
+  const WorldSyncStats& last_stats() const { return stats_; }
+
+  uint32_t blas_of_mesh(int mesh) const;
+  // KMaterial index of scene material m (see above); the default material for -1.
+  uint32_t kmaterial_index(int scene_material) const;
+
+ private:
+  uint32_t ensure_blas(int mesh, commit::CommitBuffer& out);
+  uint32_t build_mesh_blas(int mesh, commit::CommitBuffer& out);
+  bool update_textures(const std::set<int>& changed, commit::CommitBuffer& out);
+  void set_material(int scene_material);
+  KInstance entity_instance(int handle, const scene::RenderEntity& def, uint32_t blas) const;
+  KCamera camera_of(const scene::RenderView& view) const;
+
+  const scene::RenderWorld& world_;
+  WorldSyncOptions options_;
+  commit::TracerScene master_;
+  std::vector<uint32_t> blas_of_mesh_;
+  std::vector<KInstance> static_instances_;       // the world: entity == K_NONE
+  std::map<int, KInstance> entity_instances_;     // by entity handle
+  std::map<int, int> mesh_of_entity_;
+  std::map<int, KLight> lights_by_handle_;
+  uint32_t base_material_count_ = 0;              // the map's materials; the default material's index
+  std::vector<std::array<KTexture, kTextureUseCount>> image_textures_;  // per scene image and use
+  std::vector<std::shared_ptr<commit::CommitChannel>> channels_;
+  std::shared_ptr<const commit::TracerScene> snapshot_;
+  WorldSyncStats stats_;
+};
+
+}  // namespace cohort::core

@@ -1,0 +1,316 @@
+#include "cohort/core/world_sync.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <stdexcept>
+#include <string>
+
+#include <fmt/format.h>
+#include <spdlog/spdlog.h>
+
+#include "cohort/commit/array_diff.h"
+#include "cohort/core/bvh.h"
+#include "gpu_scene_textures.h"
+
+namespace cohort::core {
+namespace {
+
+KVertex to_kvertex(const scene::Vertex& v) {
+  KVertex k{};
+  k.pos[0] = v.position.x; k.pos[1] = v.position.y; k.pos[2] = v.position.z;
+  k.u = v.st.x; k.v = v.st.y;
+  k.normal[0] = v.normal.x; k.normal[1] = v.normal.y; k.normal[2] = v.normal.z;
+  k.tangent[0] = v.tangent.x; k.tangent[1] = v.tangent.y; k.tangent[2] = v.tangent.z;
+  k.bitangent_sign = v.tangent.w < 0.0f ? -1.0f : 1.0f;
+  return k;
+}
+
+void store(float* dst, const glm::vec3& v) {
+  dst[0] = v.x;
+  dst[1] = v.y;
+  dst[2] = v.z;
+}
+
+}  // namespace
+
+WorldSync::WorldSync(const scene::RenderWorld& world, CompiledScene compiled, WorldSyncOptions options)
+    : world_(world), options_(options), master_(std::move(compiled.tracer_scene)),
+      blas_of_mesh_(std::move(compiled.blas_of_mesh)) {
+  const scene::Scene& scene = world_.scene();
+  base_material_count_ = static_cast<uint32_t>(scene.materials.size());
+  if (master_.materials.size() != size_t(base_material_count_) + 1)
+    throw std::invalid_argument(fmt::format("WorldSync: the compiled scene has {} materials, expected the map's {} "
+                                            "plus the default one (was it compiled from this world?)",
+                                            master_.materials.size(), base_material_count_));
+  blas_of_mesh_.resize(scene.meshes.size(), K_NONE);
+  for (const KInstance& inst : master_.instances) {
+    if (inst.entity == K_NONE) {
+      static_instances_.push_back(inst);
+    } else {
+      const scene::RenderEntity* def = world_.EntityDef(int(inst.entity));
+      if (!def) throw std::invalid_argument(fmt::format("WorldSync: instance of entity {} that is not live", inst.entity));
+      entity_instances_[int(inst.entity)] = inst;
+      mesh_of_entity_[int(inst.entity)] = def->model;
+    }
+  }
+  // Rebuild the instance list in the order sync() keeps it, so the first TLAS diff is meaningful.
+  master_.instances = static_instances_;
+  for (const auto& [handle, inst] : entity_instances_) master_.instances.push_back(inst);
+  std::vector<KBvhNode> roots;
+  for (const KBlas& b : master_.blases) roots.push_back(master_.blas_nodes.at(b.node_offset));
+  master_.tlas_nodes = master_.instances.empty() ? std::vector<KBvhNode>{} : build_tlas(master_.instances, roots);
+
+  const auto& lights = world_.light_defs();
+  size_t live = 0;
+  for (size_t h = 0; h < lights.size(); ++h) live += lights[h].has_value();
+  if (live != master_.lights.size())
+    throw std::invalid_argument(fmt::format("WorldSync: the compiled scene has {} lights, the world {}",
+                                            master_.lights.size(), live));
+  size_t slot = 0;
+  for (size_t h = 0; h < lights.size(); ++h)
+    if (lights[h]) lights_by_handle_[int(h)] = master_.lights[slot++];
+
+  const size_t images = scene.images.size();
+  if (master_.textures.size() != images * kTextureUseCount)
+    throw std::invalid_argument(fmt::format("WorldSync: the compiled scene has {} textures, expected {} per image",
+                                            master_.textures.size(), kTextureUseCount));
+  image_textures_.resize(images);
+  for (size_t i = 0; i < images; ++i)
+    for (uint32_t use = 0; use < kTextureUseCount; ++use) image_textures_[i][use] = master_.textures[use * images + i];
+  if (world_.view()) master_.camera = camera_of(*world_.view());
+}
+
+uint32_t WorldSync::blas_of_mesh(int mesh) const {
+  return mesh >= 0 && size_t(mesh) < blas_of_mesh_.size() ? blas_of_mesh_[mesh] : K_NONE;
+}
+
+uint32_t WorldSync::kmaterial_index(int m) const {
+  if (m < 0 || size_t(m) >= world_.scene().materials.size()) return base_material_count_;
+  return uint32_t(m) < base_material_count_ ? uint32_t(m) : uint32_t(m) + 1;
+}
+
+uint32_t WorldSync::ensure_blas(int mesh, commit::CommitBuffer& out) {
+  if (size_t(mesh) >= blas_of_mesh_.size()) blas_of_mesh_.resize(world_.scene().meshes.size(), K_NONE);
+  if (blas_of_mesh_[mesh] == K_NONE) blas_of_mesh_[mesh] = build_mesh_blas(mesh, out);
+  return blas_of_mesh_[mesh];
+}
+
+// A new BLAS slot at the end of the pools (a redefined model's old one stays until a full resync).
+uint32_t WorldSync::build_mesh_blas(int mesh_index, commit::CommitBuffer& out) {
+  const scene::Mesh& mesh = world_.scene().meshes.at(size_t(mesh_index));
+  std::vector<KVertex> vertices;
+  vertices.reserve(mesh.vertices.size());
+  for (const scene::Vertex& v : mesh.vertices) vertices.push_back(to_kvertex(v));
+  std::vector<KTriangle> triangles;
+  for (const scene::Surface& s : mesh.surfaces) {
+    uint32_t material = kmaterial_index(s.material);
+    for (uint32_t i = 0; i + 2 < s.index_count; i += 3) {
+      uint32_t first = s.first_index + i;
+      triangles.push_back({mesh.indices.at(first), mesh.indices.at(first + 1), mesh.indices.at(first + 2), material});
+    }
+  }
+  if (triangles.empty()) return K_NONE;
+  BlasBuild build = build_blas(vertices, triangles);
+
+  commit::BlasUpload up;
+  up.blas_index = uint32_t(master_.blases.size());
+  up.vertex_offset = uint32_t(master_.vertices.size());
+  up.triangle_offset = uint32_t(master_.triangles.size());
+  up.node_offset = uint32_t(master_.blas_nodes.size());
+  up.vertices = std::move(vertices);
+  up.triangles = std::move(build.triangles);
+  for (KTriangle& t : up.triangles) {  // built on the mesh's own vertices; the pool is shared
+    t.v0 += up.vertex_offset;
+    t.v1 += up.vertex_offset;
+    t.v2 += up.vertex_offset;
+  }
+  up.nodes = std::move(build.nodes);
+  up.blas = {up.node_offset, uint32_t(up.nodes.size()), up.triangle_offset, uint32_t(up.triangles.size())};
+  master_.vertices.insert(master_.vertices.end(), up.vertices.begin(), up.vertices.end());
+  master_.triangles.insert(master_.triangles.end(), up.triangles.begin(), up.triangles.end());
+  master_.blas_nodes.insert(master_.blas_nodes.end(), up.nodes.begin(), up.nodes.end());
+  master_.blases.push_back(up.blas);
+  ++stats_.blas_builds;
+  uint32_t index = up.blas_index;
+  out.add_blas(std::move(up));
+  return index;
+}
+
+// New or redefined images: their texels (with mips, exactly as compile_scene makes them) are appended
+// and the texture table is rebuilt. Returns true when the image count changed, which moves every
+// light-image and falloff slot (texture_slot), so materials and lights must be converted again.
+bool WorldSync::update_textures(const std::set<int>& changed, commit::CommitBuffer& out) {
+  const scene::Scene& scene = world_.scene();
+  const size_t before = image_textures_.size(), images = scene.images.size();
+  image_textures_.resize(images);
+  for (int i : changed) {
+    scene::Scene one;
+    one.images.push_back(scene.images.at(size_t(i)));
+    commit::TracerScene compiled;
+    compile_textures(one, compiled);
+    commit::TexelUpload up;
+    up.offset = uint32_t(master_.texels.size());
+    up.texels = std::move(compiled.texels);
+    for (uint32_t use = 0; use < kTextureUseCount; ++use) {
+      KTexture t = compiled.textures.at(use);
+      if (t.width != 0) t.offset += up.offset;
+      image_textures_[size_t(i)][use] = t;
+    }
+    master_.texels.insert(master_.texels.end(), up.texels.begin(), up.texels.end());
+    if (!up.texels.empty()) out.add_texels(std::move(up));
+  }
+  std::vector<KTexture> table(images * kTextureUseCount);
+  for (size_t i = 0; i < images; ++i)
+    for (uint32_t use = 0; use < kTextureUseCount; ++use) table[use * images + i] = image_textures_[i][use];
+  commit::diff_textures(master_.textures, table, out);
+  master_.textures = std::move(table);
+  return images != before;
+}
+
+void WorldSync::set_material(int m) {
+  const scene::Scene& scene = world_.scene();
+  uint32_t index = kmaterial_index(m);
+  if (master_.materials.size() <= index) master_.materials.resize(index + 1);
+  master_.materials[index] = to_kmaterial(scene.materials.at(size_t(m)), scene);
+}
+
+KInstance WorldSync::entity_instance(int handle, const scene::RenderEntity& def, uint32_t blas) const {
+  KInstance inst{};
+  set_instance_transform(inst, def.origin, def.axis);
+  inst.blas = blas;
+  inst.mask = K_MASK_PRIMARY | (def.no_shadows ? 0u : K_MASK_SHADOW);
+  inst.entity = uint32_t(handle);
+  inst.material_override = def.custom_shader >= 0 ? kmaterial_index(def.custom_shader) : K_NONE;
+  return inst;
+}
+
+KCamera WorldSync::camera_of(const scene::RenderView& view) const {
+  KCamera cam{};
+  store(cam.origin, view.origin);
+  store(cam.forward, glm::normalize(view.axis[0]));
+  store(cam.right, -glm::normalize(view.axis[1]));  // the axis's second column points left
+  store(cam.up, glm::normalize(view.axis[2]));
+  cam.tan_half_fov_x = std::tan(0.5f * glm::radians(view.fov_x));
+  cam.tan_half_fov_y = std::tan(0.5f * glm::radians(view.fov_y));
+  cam.width = options_.width;
+  cam.height = options_.height;
+  return cam;
+}
+
+commit::CommitBuffer WorldSync::sync(const scene::ChangeLog& changes, uint64_t frame) {
+  const auto start = std::chrono::steady_clock::now();
+  const scene::Scene& scene = world_.scene();
+  stats_ = {};
+  stats_.frame = frame;
+  commit::CommitBuffer out;
+  out.set_frame(frame);
+
+  bool slots_moved = false;
+  if (!changes.textures.empty()) slots_moved = update_textures(changes.textures, out);
+
+  // Materials: new ones go after the default material; all of them again when texture slots moved.
+  const std::vector<KMaterial> materials_before = master_.materials;
+  if (slots_moved) {
+    for (size_t m = 0; m < scene.materials.size(); ++m) set_material(int(m));
+  } else {
+    for (int m : changes.materials) set_material(m);
+  }
+  commit::diff_materials(materials_before, master_.materials, out);
+
+  // Redefined models in use get a new BLAS; their entities are re-instanced below.
+  std::set<int> entities = changes.entities;
+  for (int mesh : changes.models) {
+    if (size_t(mesh) >= blas_of_mesh_.size() || blas_of_mesh_[mesh] == K_NONE) continue;
+    if (std::find(scene.area_meshes.begin(), scene.area_meshes.end(), mesh) != scene.area_meshes.end()) {
+      spdlog::warn("WorldSync: area mesh {} was redefined; the static world BLAS is not rebuilt", mesh);
+      continue;
+    }
+    blas_of_mesh_[mesh] = K_NONE;
+    for (const auto& [handle, m] : mesh_of_entity_)
+      if (m == mesh) entities.insert(handle);
+  }
+
+  bool instances_changed = false;
+  for (int handle : changes.freed_entities) {
+    instances_changed |= entity_instances_.erase(handle) > 0;
+    mesh_of_entity_.erase(handle);
+  }
+  for (int handle : entities) {
+    const scene::RenderEntity* def = world_.EntityDef(handle);
+    uint32_t blas = def && def->model >= 0 ? ensure_blas(def->model, out) : K_NONE;
+    if (blas == K_NONE) {  // freed, no model, or a model without triangles
+      instances_changed |= entity_instances_.erase(handle) > 0;
+      mesh_of_entity_.erase(handle);
+      continue;
+    }
+    entity_instances_[handle] = entity_instance(handle, *def, blas);
+    mesh_of_entity_[handle] = def->model;
+    instances_changed = true;
+  }
+  if (instances_changed) {
+    std::vector<KInstance> instances = static_instances_;
+    instances.reserve(static_instances_.size() + entity_instances_.size());
+    for (const auto& [handle, inst] : entity_instances_) instances.push_back(inst);
+    std::vector<KBvhNode> roots;
+    roots.reserve(master_.blases.size());
+    for (const KBlas& b : master_.blases) roots.push_back(master_.blas_nodes.at(b.node_offset));
+    std::vector<KBvhNode> tlas = instances.empty() ? std::vector<KBvhNode>{} : build_tlas(instances, roots);
+    commit::diff_instances(master_.instances, instances, out);
+    commit::diff_tlas(master_.tlas_nodes, tlas, out);
+    master_.instances = std::move(instances);
+    master_.tlas_nodes = std::move(tlas);
+    stats_.tlas_rebuilt = true;
+  }
+
+  // Lights, in handle order of the live defs.
+  if (slots_moved || !changes.lights.empty() || !changes.freed_lights.empty()) {
+    for (int handle : changes.freed_lights) lights_by_handle_.erase(handle);
+    auto convert = [&](int handle) {
+      if (world_.LightDef(handle))
+        lights_by_handle_[handle] = to_klight(world_.scene_light(handle), scene, options_.gpu);
+      else
+        lights_by_handle_.erase(handle);
+    };
+    if (slots_moved) {
+      for (size_t h = 0; h < world_.light_defs().size(); ++h) convert(int(h));
+    } else {
+      for (int handle : changes.lights) convert(handle);
+    }
+    std::vector<KLight> lights;
+    lights.reserve(lights_by_handle_.size());
+    for (const auto& [handle, light] : lights_by_handle_) lights.push_back(light);
+    commit::diff_lights(master_.lights, lights, out);
+    master_.lights = std::move(lights);
+  }
+
+  if (changes.view && world_.view()) {
+    master_.camera = camera_of(*world_.view());
+    out.set_camera(master_.camera);
+  }
+  master_.version = frame;
+  stats_.record_bytes = out.bytes();
+  stats_.records = out.record_count();
+  stats_.sync_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  snapshot_.reset();
+  return out;
+}
+
+commit::CommitBuffer WorldSync::sync_and_publish(const scene::ChangeLog& changes, uint64_t frame) {
+  commit::CommitBuffer records = sync(changes, frame);
+  for (auto& channel : channels_) channel->publish(records, [this] { return snapshot(); });
+  return records;
+}
+
+std::shared_ptr<commit::CommitChannel> WorldSync::add_tracer() {
+  auto channel = std::make_shared<commit::CommitChannel>(options_.commit_budget_bytes, snapshot(), master_.version);
+  channels_.push_back(channel);
+  return channel;
+}
+
+std::shared_ptr<const commit::TracerScene> WorldSync::snapshot() {
+  if (!snapshot_) snapshot_ = std::make_shared<const commit::TracerScene>(master_);
+  return snapshot_;
+}
+
+}  // namespace cohort::core

@@ -1,0 +1,225 @@
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <unistd.h>
+
+#include "../scene/render_world_fixture.h"
+#include "cohort/commit/array_diff.h"
+#include "cohort/core/gpu_scene.h"
+#include "cohort/core/world_sync.h"
+#include "cohort/scene/render_world_stream.h"
+#include "cohort/scene/scenario.h"
+
+using namespace cohort;
+using namespace cohort::core;
+using scene::RenderWorld;
+
+namespace {
+
+// The world's current state as a plain scene model, for compile_scene to compare against.
+scene::Scene scene_of(const RenderWorld& world) {
+  scene::Scene s = world.scene();
+  s.entities.clear();
+  for (size_t h = 0; h < world.entity_defs().size(); ++h) {
+    scene::Entity e;
+    if (const auto& def = world.entity_defs()[h]) {
+      e.mesh = def->model;
+      e.origin = def->origin;
+      e.axis = def->axis;
+      e.no_shadows = def->no_shadows;
+    }
+    s.entities.push_back(e);
+  }
+  s.lights.clear();
+  for (size_t h = 0; h < world.light_defs().size(); ++h)
+    if (world.light_defs()[h]) s.lights.push_back(world.scene_light(int(h)));
+  return s;
+}
+
+std::string first_difference(const commit::TracerScene& a, const commit::TracerScene& b) {
+  std::string where;
+  return commit::same_tracer_scene(a, b, &where) ? "" : where;
+}
+
+// Calls of every kind beyond the scenario: a texture, material and model defined at run time, an
+// entity using them, an entity and a light freed.
+void define_and_free(scene::RenderWorldApi& world, int frame) {
+  if (frame == 10) {
+    int tex = world.DefineTexture(scene::world_testing::checker("textures/test/crate", 8));
+    scene::Material m;
+    m.name = "textures/test/crate";
+    m.diffuse_image = tex;
+    int mat = world.DefineMaterial(m);
+    world.DefineModel(scene::world_testing::box_mesh("crate", {8, 8, 8}, mat));
+    scene::RenderEntity crate;
+    crate.model_name = "crate";
+    crate.origin = {40, 40, 8};
+    world.AddEntityDef(crate);
+  }
+  if (frame == 20) world.FreeLightDef(world.FindLightDef("light_fill"));
+  if (frame == 30) {
+    scene::RenderEntity moved = *world.EntityDef(3);
+    moved.origin.x += 16;
+    moved.custom_shader = 0;
+    world.UpdateEntityDef(3, moved);
+  }
+}
+
+void run_frames(scene::RenderWorldApi& world, int frames) {
+  scene::Scenario scenario(world);
+  for (int f = 0; f < frames; ++f) {
+    define_and_free(world, f);
+    scenario.frame(f);
+    world.EndFrame();
+  }
+}
+
+}  // namespace
+
+TEST(WorldSync, SyncedMasterEqualsAFreshCompileOfTheSameState) {
+  RenderWorld world(scene::world_testing::small_map());
+  WorldSync sync(world, compile_scene(world.scene()));
+  scene::Scenario scenario(world);
+  for (int f = 0; f < 100; ++f) {
+    scenario.frame(f);
+    world.EndFrame();
+    sync.sync(world.TakeChanges(), uint64_t(f + 1));
+  }
+  CompiledScene fresh = compile_scene(scene_of(world));
+  commit::TracerScene expected = fresh.tracer_scene;
+  expected.camera = sync.master().camera;
+  expected.version = sync.master().version;
+  EXPECT_EQ(first_difference(sync.master(), expected), "");
+  EXPECT_EQ(sync.master().lights.size(), 3u);  // two map lights and the flashlight
+}
+
+TEST(WorldSync, ReplayedStreamGivesTheSameTracerSceneEveryFrame) {
+  const int frames = 60;
+  auto file = std::filesystem::temp_directory_path() / ("cohort_world_sync_" + std::to_string(::getpid()) + ".cds");
+  {
+    RenderWorld recorded(scene::world_testing::small_map());
+    scene::Recorder recorder(recorded, file, "small");
+    run_frames(recorder, frames);
+    recorder.finish();
+  }
+  RenderWorld direct(scene::world_testing::small_map());
+  WorldSync direct_sync(direct, compile_scene(direct.scene()));
+  RenderWorld replayed(scene::world_testing::small_map());
+  WorldSync replay_sync(replayed, compile_scene(replayed.scene()));
+  auto channel = replay_sync.add_tracer();
+  commit::TracerScene tracer;
+
+  scene::Player player(file);
+  scene::Scenario scenario(direct);
+  for (int f = 0; f < frames; ++f) {
+    define_and_free(direct, f);
+    scenario.frame(f);
+    direct.EndFrame();
+    direct_sync.sync(direct.TakeChanges(), uint64_t(f + 1));
+    ASSERT_TRUE(player.play_frame(replayed));
+    replay_sync.sync_and_publish(replayed.TakeChanges(), uint64_t(f + 1));
+    ASSERT_EQ(first_difference(direct_sync.master(), replay_sync.master()), "") << "frame " << f;
+    commit::apply_commit(channel->begin_frame(), tracer);
+    ASSERT_EQ(first_difference(tracer, replay_sync.master()), "") << "tracer copy, frame " << f;
+  }
+  scene::RenderWorld scratch(scene::world_testing::small_map());
+  EXPECT_FALSE(player.play_frame(scratch));
+  std::filesystem::remove(file);
+}
+
+TEST(WorldSync, TracersThatSkipFramesConvergeToTheMaster) {
+  RenderWorld world(scene::world_testing::small_map());
+  WorldSync sync(world, compile_scene(world.scene()));
+  const int periods[] = {1, 4, 7, 1000};
+  std::vector<std::shared_ptr<commit::CommitChannel>> channels;
+  std::vector<commit::TracerScene> tracers(std::size(periods));
+  for (size_t t = 0; t < std::size(periods); ++t) channels.push_back(sync.add_tracer());
+  scene::Scenario scenario(world);
+  const int frames = 80;
+  for (int f = 0; f < frames; ++f) {
+    define_and_free(world, f);
+    scenario.frame(f);
+    world.EndFrame();
+    sync.sync_and_publish(world.TakeChanges(), uint64_t(f + 1));
+    for (size_t t = 0; t < std::size(periods); ++t)
+      if ((f + 1) % periods[t] == 0 || f + 1 == frames) commit::apply_commit(channels[t]->begin_frame(), tracers[t]);
+  }
+  for (size_t t = 0; t < std::size(periods); ++t) {
+    EXPECT_EQ(first_difference(tracers[t], sync.master()), "") << "period " << periods[t];
+    EXPECT_EQ(channels[t]->stats().overflows, 0u);
+  }
+  EXPECT_LT(channels[1]->stats().total_bytes, channels[0]->stats().total_bytes);
+}
+
+TEST(WorldSync, RuntimeModelMaterialAndTextureReachTheTracerScene) {
+  RenderWorld world(scene::world_testing::small_map());
+  WorldSync sync(world, compile_scene(world.scene()));
+  const uint32_t default_material = sync.kmaterial_index(-1);
+  const size_t blases_before = sync.master().blases.size();
+  define_and_free(world, 10);
+  commit::CommitBuffer records = sync.sync(world.TakeChanges(), 1);
+  ASSERT_EQ(records.blas_uploads().size(), 1u);
+  EXPECT_EQ(sync.last_stats().blas_builds, 1u);
+  EXPECT_EQ(sync.master().blases.size(), blases_before + 1);
+
+  const int crate_material = world.scene().find_material("textures/test/crate");
+  const uint32_t kmat = sync.kmaterial_index(crate_material);
+  EXPECT_EQ(kmat, default_material + 1);  // after the default one, which keeps its index
+  const commit::BlasUpload& up = records.blas_uploads()[0];
+  for (const KTriangle& t : up.triangles) {
+    EXPECT_EQ(t.material, kmat);
+    EXPECT_GE(t.v0, up.vertex_offset);
+    EXPECT_LT(t.v2, up.vertex_offset + up.vertices.size());
+  }
+  const KMaterial& m = sync.master().materials.at(kmat);
+  ASSERT_NE(m.diffuse_tex, K_NONE);
+  const KTexture& tex = sync.master().textures.at(m.diffuse_tex);
+  EXPECT_EQ(tex.width, 8u);
+  const scene::Image& image = world.scene().images.back();
+  uint32_t first_texel = uint32_t(image.rgba[0]) | uint32_t(image.rgba[1]) << 8 | uint32_t(image.rgba[2]) << 16 |
+                         uint32_t(image.rgba[3]) << 24;
+  EXPECT_EQ(sync.master().texels.at(tex.offset), first_texel);
+  // The crate is instanced with its handle.
+  bool found = false;
+  for (const KInstance& inst : sync.master().instances) found |= inst.entity == 3 && inst.blas == up.blas_index;
+  EXPECT_TRUE(found);
+}
+
+TEST(WorldSync, OverflowingTheBudgetGivesAFullResyncThatConverges) {
+  RenderWorld world(scene::world_testing::small_map());
+  WorldSyncOptions options;
+  options.commit_budget_bytes = 1024;
+  WorldSync sync(world, compile_scene(world.scene()), options);
+  auto channel = sync.add_tracer();
+  commit::TracerScene tracer;
+  commit::apply_commit(channel->begin_frame(), tracer);
+  scene::Scenario scenario(world);
+  for (int f = 0; f < 12; ++f) {
+    define_and_free(world, f);
+    scenario.frame(f);
+    world.EndFrame();
+    sync.sync_and_publish(world.TakeChanges(), uint64_t(f + 1));
+  }
+  const commit::CommitBuffer& commit = channel->begin_frame();
+  EXPECT_TRUE(commit.is_full_resync());
+  commit::apply_commit(commit, tracer);
+  EXPECT_EQ(first_difference(tracer, sync.master()), "");
+  EXPECT_GE(channel->stats().overflows, 1u);
+}
+
+TEST(WorldSync, OnlyMovedEntitiesAndTheTlasAreSent) {
+  RenderWorld world(scene::world_testing::small_map());
+  WorldSync sync(world, compile_scene(world.scene()));
+  scene::RenderEntity fan = *world.EntityDef(2);
+  fan.origin.z += 1.0f;
+  world.UpdateEntityDef(2, fan);
+  commit::CommitBuffer records = sync.sync(world.TakeChanges(), 1);
+  EXPECT_TRUE(records.tlas().has_value());
+  EXPECT_TRUE(records.lights().empty());
+  EXPECT_TRUE(records.materials().empty());
+  EXPECT_TRUE(records.blas_uploads().empty());
+  EXPECT_GE(records.instances().size(), 1u);
+  EXPECT_LE(records.instances().size(), sync.master().instances.size());
+  commit::CommitBuffer nothing = sync.sync(world.TakeChanges(), 2);
+  EXPECT_TRUE(nothing.empty());
+}
