@@ -13,6 +13,10 @@
 #include "cohort/core/frame_stats.h"
 #include "cohort/core/gpu_scene.h"
 #include "cohort/core/convergence.h"
+#include "cohort/core/world_sync.h"
+#include "cohort/scene/map_loader.h"
+#include "cohort/scene/render_world_stream.h"
+#include <limits>
 #include "cohort/core/image_output.h"
 #include "cohort/core/renderer.h"
 #include "commands.h"
@@ -40,6 +44,8 @@ struct RenderArgs {
   std::vector<float> camera;  // x y z yaw pitch
   std::vector<std::string> bases;
   bool no_convergence = false;
+  std::string replay;
+  bool frames_given = false;
 };
 
 const std::map<std::string, uint32_t>& modes() {
@@ -60,13 +66,34 @@ std::vector<std::string> bases_or_test_map(const std::vector<std::string>& bases
 }
 
 int run_render(const RenderArgs& a) {
-  RenderScene scene = load_render_scene(a.map, bases_or_test_map(a.bases));
+  if (a.map.empty() && a.replay.empty()) throw std::invalid_argument("name a map or scene pack (or --replay FILE)");
+  RenderScene scene = a.replay.empty() ? load_render_scene(a.map, bases_or_test_map(a.bases)) : RenderScene{};
   std::vector<std::unique_ptr<core::Tracer>> tracers = make_tracers(a.tracers);
   core::RendererOptions options;
   options.balancer = a.balancer;
   options.frame_timeout = std::chrono::milliseconds(600000);
   core::Renderer renderer(std::move(tracers), options);
-  renderer.submit_commit(commit::CommitBuffer::full(scene.tracer_scene, 1));
+
+  // --replay: a recorded delta stream drives a RenderWorld over the map; WorldSync turns each frame's
+  // changes into commit records and the recorded view into the camera.
+  std::unique_ptr<scene::Player> player;
+  std::unique_ptr<scene::RenderWorld> world;
+  std::unique_ptr<core::WorldSync> sync;
+  int frames = a.frames;
+  if (!a.replay.empty()) {
+    player = std::make_unique<scene::Player>(a.replay);
+    scene::Vfs vfs;
+    for (const std::string& base : bases_or_test_map(a.bases)) vfs.add_search_path(base);
+    world = std::make_unique<scene::RenderWorld>(scene::load_map(vfs, a.map.empty() ? player->header().map_name : a.map));
+    core::WorldSyncOptions sync_options;
+    sync_options.width = uint32_t(a.width);
+    sync_options.height = uint32_t(a.height);
+    sync = std::make_unique<core::WorldSync>(*world, core::compile_scene(world->scene()), sync_options);
+    renderer.submit_commit(commit::CommitBuffer::full(sync->snapshot(), 0));
+    frames = a.frames_given ? a.frames : std::numeric_limits<int>::max();
+  } else {
+    renderer.submit_commit(commit::CommitBuffer::full(scene.tracer_scene, 1));
+  }
 
   glm::vec3 eye = scene.player_start + glm::vec3(0.0f, 0.0f, 68.0f);
   float yaw = scene.player_yaw, pitch = 0.0f;
@@ -82,10 +109,15 @@ int run_render(const RenderArgs& a) {
   core::AdaptiveConvergence convergence;
   const std::optional<CameraPath> path =
       a.camera_path.empty() ? std::nullopt : std::optional<CameraPath>(parse_camera_path(a.camera_path));
-  ProgressBar progress(a.frames, std::cerr, stderr_is_terminal());
-  for (int f = 0; f < a.frames; ++f) {
+  ProgressBar progress(player ? 0 : a.frames, std::cerr, stderr_is_terminal());
+  int rendered = 0;
+  for (int f = 0; f < frames; ++f) {
     core::BandJob job;
-    if (path) {
+    if (player) {
+      if (!player->play_frame(*world)) break;
+      renderer.submit_commit(sync->sync(world->TakeChanges(), uint64_t(f) + 1));
+      job.camera = sync->master().camera;
+    } else if (path) {
       const CameraPose pose = camera_path_pose(*path, eye, yaw, f);
       job.camera = core::make_camera(pose.origin, pose.yaw, pitch + pose.pitch, a.fov, a.width, a.height);
     } else {
@@ -106,7 +138,8 @@ int run_render(const RenderArgs& a) {
     if (!a.no_convergence) stats.convergence_f = convergence.accumulate(job.camera, frame);
     const core::FrameBuffer& shown = a.no_convergence ? frame : convergence.image();
     progress.frame_done(stats.wall_ms);
-    if (a.write == "last" && f + 1 < a.frames) {
+    ++rendered;
+    if (a.write == "last" && f + 1 < a.frames && !player) {
       stats_json.push_back(nlohmann::json(stats));
       continue;
     }
@@ -128,7 +161,7 @@ int run_render(const RenderArgs& a) {
                            {"spp", a.spp},       {"bounces", a.bounces},    {"mode", a.mode},
                            {"camera_path", a.camera_path}, {"frames", stats_json}};
   std::ofstream(std::filesystem::path(a.out) / "stats.json") << report.dump(2) << "\n";
-  std::cout << "wrote " << a.frames << " frame(s) and stats.json to " << a.out << "\n";
+  std::cout << "wrote " << rendered << " frame(s) and stats.json to " << a.out << "\n";
   return kExitOk;
 }
 
@@ -138,7 +171,10 @@ void add_render_command(CLI::App& app) {
   auto* cmd = app.add_subcommand("render", "Render frames headless on the chosen tracers and write images and a "
                                            "JSON of per-frame stats");
   auto a = std::make_shared<RenderArgs>();
-  cmd->add_option("map", a->map, "scene pack, or map: a .map path, a game path or a bare name")->required();
+  cmd->add_option("map", a->map, "scene pack, or map: a .map path, a game path or a bare name "
+                                 "(with --replay: defaults to the map the stream names)");
+  cmd->add_option("--replay", a->replay, "a recorded delta stream (docs/delta-stream.md, `cohort record-scenario`): "
+                                         "render its frames, camera and changes as recorded");
   cmd->add_option("--base", a->bases, "extra game folder(s) to search (loose files and .pk4s)");
   cmd->add_option("--tracers", a->tracers,
                   "comma-separated: embree, opencl[:N|:all], cuda[:N|:all], or all (Embree on the CPU plus every GPU once)")
@@ -147,7 +183,10 @@ void add_render_command(CLI::App& app) {
   cmd->add_option("--width", a->width, "image width")->capture_default_str()->check(CLI::PositiveNumber);
   cmd->add_option("--height", a->height, "image height")->capture_default_str()->check(CLI::PositiveNumber);
   cmd->add_option("--spp", a->spp, "samples per pixel per frame")->capture_default_str()->check(CLI::PositiveNumber);
-  cmd->add_option("--frames", a->frames, "frames to render")->capture_default_str()->check(CLI::PositiveNumber);
+  auto* frames_option =
+      cmd->add_option("--frames", a->frames, "frames to render (with --replay: at most this many; default all)")
+          ->capture_default_str()
+          ->check(CLI::PositiveNumber);
   cmd->add_option("--bounces", a->bounces, "indirect bounces")->capture_default_str()->check(CLI::NonNegativeNumber);
   cmd->add_option("--light-samples", a->light_samples,
                   "lights sampled per hit, picked by contribution (0: every light reaching the point)")
@@ -180,7 +219,8 @@ void add_render_command(CLI::App& app) {
   cmd->add_option("--soft-shadows", a->soft_shadow_scale, "scale of the lights' soft-shadow extent")
       ->capture_default_str();
   cmd->add_option("--out", a->out, "output folder")->capture_default_str();
-  cmd->callback([a] {
+  cmd->callback([a, frames_option] {
+    a->frames_given = frames_option->count() > 0;
     int code = run_render(*a);
     if (code != kExitOk) std::exit(code);
   });
