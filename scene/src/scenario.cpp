@@ -60,7 +60,7 @@ Scenario::Scenario(RenderWorldApi& world, ScenarioOptions options) : world_(worl
   door_closed_ = *world_.EntityDef(door_);
   fan_rest_ = *world_.EntityDef(fan_);
   flicker_base_ = *world_.LightDef(flicker_);
-  door_travel_ = mesh_height(world_.scene(), door_closed_.model) - 8.0f;  // a lip stays visible, as in the game
+  door_travel_ = mesh_height(world_.scene(), door_closed_.model) - 8.0f;  // func_door's default lip stays visible
 }
 
 RenderView Scenario::camera(double t) const {
@@ -90,7 +90,8 @@ void Scenario::frame(int index) {
   const double t = double(index) / options_.frames_per_second;
 
   RenderEntity door = door_closed_;
-  door.origin += door.axis[2] * float(door_travel_ * ease((t - kDoorOpensAt) / kDoorOpenSeconds));
+  // func_door with movedir -1: straight up in world space, whatever the door's own axis.
+  door.origin.z += float(door_travel_ * ease((t - kDoorOpensAt) / kDoorOpenSeconds));
   world_.UpdateEntityDef(door_, door);
 
   RenderEntity fan = fan_rest_;
@@ -111,6 +112,7 @@ void Scenario::frame(int index) {
   flashlight.target = {768, 0, 0};
   flashlight.right = {0, -318, 0};
   flashlight.up = {0, 0, 318};
+  flashlight.shader = world_.scene().find_material(options_.flashlight_shader);  // -1: the default projected light
   flashlight.shader_parms[kShaderParmRed] = 1.0f;
   flashlight.shader_parms[kShaderParmGreen] = 0.95f;
   flashlight.shader_parms[kShaderParmBlue] = 0.85f;

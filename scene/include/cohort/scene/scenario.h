@@ -18,6 +18,7 @@ struct ScenarioOptions {
   std::string door = "door_main";
   std::string fan = "fan_spin";
   std::string flicker = "light_flicker";
+  std::string flashlight_shader = "lights/testmap_round";  // used when the scene defines it
   float eye_height = 68.0f;          // above player_start, the engine's standing eye height
 };
 
