@@ -11,7 +11,7 @@
 
 #include "cohort/core/frame_buffer.h"
 #include "cohort/core/frame_stats.h"
-#include "kernel/layout.h"
+#include "cohort/kernel/layout.h"
 #include "viewer/fly_camera.h"
 
 namespace cohort::app {

@@ -6,7 +6,7 @@
 #include <glm/glm.hpp>
 
 #include "cohort/scene/render_world.h"
-#include "kernel/layout.h"
+#include "cohort/kernel/layout.h"
 
 namespace cohort::viewer {
 

@@ -1,6 +1,6 @@
 #include "cohort/core/scene_queries.h"
 
-#include "kernel/trace_bvh.h"
+#include "cohort/kernel/trace_bvh.h"
 
 namespace cohort::core {
 namespace {

@@ -8,7 +8,7 @@
 #include <gtest/gtest.h>
 
 #include "cohort/core/bvh.h"
-#include "kernel/vec.h"
+#include "cohort/kernel/vec.h"
 
 namespace {
 // Test materials: 0 opaque, 1 tinted glass (lets some light through), 2 pass-through (invisible).
@@ -22,7 +22,7 @@ float test_passes(const TestMaterials* m, kuint triangle);
 #define K_BVH_CONTEXT const TestMaterials*
 #define K_BVH_HIT_PASSES(ctx, instance, triangle, u, v, shadow_ray) test_passes(ctx, triangle)
 #define K_BVH_SHADOW_TRANSMITTANCE(ctx, instance, triangle, u, v) test_transmittance(ctx, triangle)
-#include "kernel/bvh_traverse.h"
+#include "cohort/kernel/bvh_traverse.h"
 
 using namespace cohort::core;
 

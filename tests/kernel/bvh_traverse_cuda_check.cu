@@ -1,5 +1,5 @@
 // Compile-only check that kernel/bvh_traverse.h is valid CUDA (registered by bvh_traverse_devices.cmake).
-#include "kernel/bvh_traverse.h"
+#include "cohort/kernel/bvh_traverse.h"
 
 __global__ void bvh_traverse_check(KSceneRef scene, const float* rays, int count, KHit* hits, int* occluded,
                                    KVec3* transmittance) {

@@ -9,7 +9,7 @@
 #include <gtest/gtest.h>
 
 #include "cohort/core/bvh.h"
-#include "kernel/bvh_traverse.h"
+#include "cohort/kernel/bvh_traverse.h"
 
 #ifdef COHORT_HAVE_OPENCL
 #include <CL/cl.h>
@@ -20,7 +20,7 @@ using namespace cohort::core;
 namespace {
 
 const char* kProgram = R"CL(
-#include "kernel/bvh_traverse.h"
+#include "cohort/kernel/bvh_traverse.h"
 __kernel void trace(__global const KVertex* vertices, __global const KTriangle* triangles,
                     __global const KBvhNode* blas_nodes, __global const KBlas* blases,
                     __global const KInstance* instances, __global const KBvhNode* tlas_nodes,

@@ -5,8 +5,8 @@
 #include <cmath>
 #include <vector>
 
-#include "kernel/brdf.h"
-#include "kernel/rng.h"
+#include "cohort/kernel/brdf.h"
+#include "cohort/kernel/rng.h"
 
 TEST(KernelRng, SameSeedSameSequenceAndUniform) {
   KRng a = k_rng_seed(3, 4, 5, 6), b = k_rng_seed(3, 4, 5, 6), c = k_rng_seed(4, 3, 5, 6);

@@ -2,8 +2,8 @@
 
 #include <gtest/gtest.h>
 
-#include "kernel/layout.h"
-#include "kernel/vec.h"
+#include "cohort/kernel/layout.h"
+#include "cohort/kernel/vec.h"
 
 // The layouts must not depend on the compiler: fields sit where the OpenCL and CUDA sides expect.
 TEST(KernelLayout, FieldOffsetsArePacked) {

@@ -7,8 +7,8 @@
 __constant__ cudaTextureObject_t cohort_texel_texture;
 #define K_TEXEL_LOAD(texels, index) tex1Dfetch<unsigned int>(cohort_texel_texture, (int)(index))
 
-#include "kernel/trace_bvh.h"
-#include "kernel/integrator.h"
+#include "cohort/kernel/trace_bvh.h"
+#include "cohort/kernel/integrator.h"
 #include "render_band_launch.h"
 
 namespace cohort::tracers {

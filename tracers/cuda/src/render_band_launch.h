@@ -3,7 +3,7 @@
 #include <cuda_runtime.h>
 
 #include "cuda_check.h"
-#include "kernel/scene_view.h"
+#include "cohort/kernel/scene_view.h"
 
 namespace cohort::tracers {
 

@@ -6,7 +6,7 @@
 
 #include <cstdint>
 
-#include "kernel/material.h"
+#include "cohort/kernel/material.h"
 
 namespace cohort::tracers::embree_kernel {
 
@@ -79,4 +79,4 @@ static inline int k_trace_occluded(KTraceCtx* ctx, KVec3 org, KVec3 dir, float t
   return ray.tfar < 0.0f;  // Embree sets tfar to -inf on occlusion
 }
 
-#include "kernel/integrator.h"
+#include "cohort/kernel/integrator.h"

@@ -1,7 +1,7 @@
 /* OpenCL entry point: one work item per pixel of the band, running the shared integrator over the
  * portable two-level BVH. The build inlines the #includes (embed_kernel.cmake). */
-#include "kernel/trace_bvh.h"
-#include "kernel/integrator.h"
+#include "cohort/kernel/trace_bvh.h"
+#include "cohort/kernel/integrator.h"
 
 __kernel void cohort_render_band(__global const KVertex* vertices, __global const KTriangle* triangles,
                                  __global const KBvhNode* blas_nodes, __global const KBlas* blases,

@@ -6,7 +6,7 @@
 #include <cstdint>
 #include <vector>
 
-#include "kernel/layout.h"
+#include "cohort/kernel/layout.h"
 
 namespace cohort::commit {
 

@@ -4,7 +4,7 @@
 #include <cstdint>
 #include <vector>
 
-#include "kernel/layout.h"
+#include "cohort/kernel/layout.h"
 
 namespace cohort::core {
 

@@ -9,7 +9,7 @@
 #include <vector>
 
 #include "cohort/core/frame_buffer.h"
-#include "kernel/layout.h"
+#include "cohort/kernel/layout.h"
 
 namespace cohort::core {
 

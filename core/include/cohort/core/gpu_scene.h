@@ -9,7 +9,7 @@
 
 #include "cohort/commit/tracer_scene.h"
 #include "cohort/scene/scene.h"
-#include "kernel/layout.h"
+#include "cohort/kernel/layout.h"
 
 namespace cohort::core {
 

@@ -7,7 +7,7 @@
 
 #include "cohort/commit/commit_buffer.h"
 #include "cohort/core/frame_buffer.h"
-#include "kernel/layout.h"
+#include "cohort/kernel/layout.h"
 
 namespace cohort::core {
 

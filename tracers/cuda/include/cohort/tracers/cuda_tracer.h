@@ -1,6 +1,6 @@
 // The CUDA tracer: one per GPU. Device buffers mirror the tracer's commit::TracerScene; commits are
 // applied with async copies on the tracer's own stream; the band is rendered by the shared integrator
-// (core/kernel/) compiled as CUDA, and kernel time is measured with CUDA events.
+// (kernel/include/cohort/kernel/) compiled as CUDA, and kernel time is measured with CUDA events.
 #pragma once
 
 #include <memory>

@@ -1,5 +1,5 @@
 // The CPU tracer: Embree 3 two-level scene (one geometry per BLAS, one instance per KInstance) and the
-// shared integrator (core/kernel/integrator.h), multithreaded over the rows of its band.
+// shared integrator (kernel/include/cohort/kernel/integrator.h), multithreaded over the rows of its band.
 #pragma once
 
 #include <cstdint>

@@ -1,5 +1,5 @@
-// The OpenCL tracer: the shared integrator (core/kernel/integrator.h) over the portable two-level BVH
-// (core/kernel/trace_bvh.h), compiled at run time from kernel text embedded at build time.
+// The OpenCL tracer: the shared integrator (kernel/include/cohort/kernel/integrator.h) over the portable two-level BVH
+// (kernel/include/cohort/kernel/trace_bvh.h), compiled at run time from kernel text embedded at build time.
 #pragma once
 
 #include <memory>

@@ -1,5 +1,5 @@
 /* Portability layer: the few qualifiers, types and maths calls that differ between C++, CUDA and
- * OpenCL C. Everything under core/kernel/ is written against these names only. OpenCL C 1.2 is the
+ * OpenCL C. Everything under kernel/include/cohort/kernel/ is written against these names only. OpenCL C 1.2 is the
  * lowest common denominator: no references, no overloading, no templates, explicit __global pointers. */
 #ifndef COHORT_KERNEL_PORTABLE_H
 #define COHORT_KERNEL_PORTABLE_H
