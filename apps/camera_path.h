@@ -18,7 +18,6 @@ struct CameraPath {
 struct CameraPose {
   glm::vec3 origin{0.0f};
   float yaw = 0.0f;    // degrees, Doom 3: 0 looks down +X, turning toward +Y
-  float pitch = 0.0f;  // degrees, positive looks up (core::make_camera's convention)
 };
 
 // "spin", "spin-slow", "spin-fast", "orbit", "orbit-slow", "orbit-fast"; throws std::invalid_argument

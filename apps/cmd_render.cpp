@@ -13,6 +13,8 @@
 #include "cohort/core/frame_stats.h"
 #include "cohort/core/gpu_scene.h"
 #include "cohort/core/convergence.h"
+#include "cohort/core/frame_defaults.h"
+#include "cohort/core/view.h"
 #include "cohort/core/world_sync.h"
 #include "cohort/scene/map_loader.h"
 #include "cohort/scene/render_world_stream.h"
@@ -36,8 +38,8 @@ struct RenderArgs {
   std::string balancer = "perfect-smooth";
   std::string mode = "path";
   std::string out = "render_out";
-  int width = 640, height = 360, spp = 4, frames = 1, bounces = 1, light_samples = 0;
-  float fov = 90.0f, exposure = 1.0f, firefly_clamp = 5.0f, spec_boost = 2.0f, soft_shadow_scale = 0.2f;
+  int width = core::kDefaultWidth, height = core::kDefaultHeight, spp = 4, frames = 1, bounces = 1, light_samples = 0;
+  float fov = core::kDefaultFovX, exposure = 1.0f, firefly_clamp = 5.0f, spec_boost = 2.0f, soft_shadow_scale = 0.2f;
   float yaw_step = 0.0f;
   std::string camera_path;    // spin/orbit[-slow|-fast]; empty: fixed camera (plus --yaw-step)
   std::string write = "all";  // images of every frame, or only the last
@@ -88,19 +90,18 @@ int run_render(const RenderArgs& a) {
     core::WorldSyncOptions sync_options;
     sync_options.width = uint32_t(a.width);
     sync_options.height = uint32_t(a.height);
-    sync = std::make_unique<core::WorldSync>(*world, core::compile_scene(world->scene()), sync_options);
+    sync = std::make_unique<core::WorldSync>(*world, sync_options);
     renderer.submit_commit(commit::CommitBuffer::full(sync->snapshot(), 0));
     frames = a.frames_given ? a.frames : std::numeric_limits<int>::max();
   } else {
     renderer.submit_commit(commit::CommitBuffer::full(scene.tracer_scene, 1));
   }
 
-  glm::vec3 eye = scene.player_start + glm::vec3(0.0f, 0.0f, 68.0f);
-  float yaw = scene.player_yaw, pitch = 0.0f;
+  glm::vec3 eye = scene.player_start + glm::vec3(0.0f, 0.0f, core::kPlayerEyeHeight);
+  core::ViewAngles angles{scene.player_yaw, 0.0f};
   if (!a.camera.empty()) {
     eye = glm::vec3(a.camera[0], a.camera[1], a.camera[2]);
-    yaw = a.camera[3];
-    pitch = a.camera[4];
+    angles = {a.camera[3], a.camera[4]};
   }
   std::filesystem::create_directories(a.out);
   const bool oiio = core::have_image_library();
@@ -118,12 +119,13 @@ int run_render(const RenderArgs& a) {
       renderer.submit_commit(sync->sync(world->TakeChanges(), uint64_t(f) + 1));
       job.camera = sync->master().camera;
     } else if (path) {
-      const CameraPose pose = camera_path_pose(*path, eye, yaw, f);
-      job.camera = core::make_camera(pose.origin, pose.yaw, pitch + pose.pitch, a.fov, a.width, a.height);
+      const CameraPose pose = camera_path_pose(*path, eye, angles.yaw, f);
+      job.camera = core::make_camera(pose.origin, {pose.yaw, angles.pitch}, a.fov, a.width, a.height);
     } else {
-      job.camera = core::make_camera(eye, yaw + a.yaw_step * float(f), pitch, a.fov, a.width, a.height);
+      job.camera = core::make_camera(eye, {angles.yaw + a.yaw_step * float(f), angles.pitch}, a.fov, a.width, a.height);
     }
     KFrameParams& p = job.params;
+    p = core::default_frame_params();
     p.frame_index = static_cast<kuint>(f);
     p.spp = static_cast<kuint>(a.spp);
     p.max_bounces = static_cast<kuint>(a.bounces);
@@ -132,7 +134,6 @@ int run_render(const RenderArgs& a) {
     p.spec_boost = a.spec_boost;
     p.mode = modes().at(a.mode);
     p.soft_shadow_scale = a.soft_shadow_scale;
-    p.rr_start = 2.0f;
     core::FrameStats stats = renderer.render(job, frame);
     // Adaptive convergence: a still camera accumulates every frame; motion raises f (see convergence.h).
     if (!a.no_convergence) stats.convergence_f = convergence.accumulate(job.camera, frame);
@@ -196,7 +197,7 @@ void add_render_command(CLI::App& app) {
       ->capture_default_str()
       ->check(CLI::IsMember({"path", "direct", "albedo", "normals", "specular", "bvh", "triangles"}));
   cmd->add_option("--fov", a->fov, "horizontal field of view in degrees")->capture_default_str();
-  cmd->add_option("--camera", a->camera, "x y z yaw pitch (default: the player start at eye height)")->expected(5);
+  cmd->add_option("--camera", a->camera, "x y z yaw pitch: Doom 3 angles in degrees, positive pitch looks down (default: the player start at eye height)")->expected(5);
   cmd->add_option("--camera-path", a->camera_path, "scripted camera from the start: spin or orbit, -slow (default) or "
                                                    "-fast, e.g. orbit-fast")
       ->check([](const std::string& v) {

@@ -7,9 +7,11 @@
 
 #include "cohort/commit/commit_buffer.h"
 #include "cohort/core/convergence.h"
+#include "cohort/core/frame_defaults.h"
 #include "cohort/core/gpu_scene.h"
 #include "cohort/core/renderer.h"
 #include "cohort/core/tonemap.h"
+#include "cohort/core/view.h"
 #if __has_include("cohort/core/world_sync.h")
 #include "cohort/core/world_sync.h"
 #define COHORT_PLAY_HAS_WORLD_SYNC 1
@@ -23,7 +25,6 @@ namespace cohort::app {
 namespace {
 
 constexpr double kScenarioFramesPerSecond = 60.0;
-constexpr float kEyeHeight = 68.0f;
 
 scene::Scene load_scene(const SessionOptions& options) {
   scene::Vfs vfs;
@@ -78,7 +79,7 @@ PlaySession::PlaySession(const SessionOptions& options) {
   State& s = *state_;
   s.map_name = s.world.scene().name.empty() ? options.map : s.world.scene().name;
 #ifdef COHORT_PLAY_HAS_WORLD_SYNC
-  s.sync = std::make_unique<core::WorldSync>(s.world, core::compile_scene(s.world.scene()));
+  s.sync = std::make_unique<core::WorldSync>(s.world);
   auto initial_scene = s.sync->snapshot();
 #else
   auto initial_scene = std::make_shared<const commit::TracerScene>(core::compile_scene(s.world.scene()).tracer_scene);
@@ -127,7 +128,7 @@ PlaySession::~PlaySession() = default;
 viewer::FlyCamera PlaySession::start_camera() const {
   const scene::Scene& scene = state_->world.scene();
   viewer::FlyCamera cam;
-  cam.position = scene.player_start + glm::vec3(0.0f, 0.0f, kEyeHeight);
+  cam.position = core::player_eye(scene);
   cam.yaw = scene.player_yaw;
   return cam;
 }
@@ -165,15 +166,11 @@ SessionFrame PlaySession::frame(const viewer::FlyCamera& camera, double seconds,
   core::BandJob job;
   job.camera = camera.to_kcamera(settings.width, settings.height);
   KFrameParams& p = job.params;
+  p = core::default_frame_params();
   p.frame_index = static_cast<kuint>(s.frame_index);
   p.spp = static_cast<kuint>(settings.spp);
   p.max_bounces = static_cast<kuint>(settings.max_bounces);
-  p.light_samples = 1;
-  p.firefly_clamp = 5.0f;
-  p.spec_boost = 2.0f;
   p.mode = settings.mode;
-  p.soft_shadow_scale = 0.2f;
-  p.rr_start = 2.0f;
 
   SessionFrame out;
   out.stats = s.renderer->render(job, s.hdr);

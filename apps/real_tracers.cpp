@@ -2,6 +2,7 @@
 
 #include <spdlog/spdlog.h>
 
+#include "cohort/core/view.h"
 #include "render_scene_source.h"
 #include "tracer_factory.h"
 
@@ -18,7 +19,7 @@ RealTracers make_real_tracers(const std::vector<std::string>& names, const std::
     spdlog::info("bench balance: {} loads {}", t->name(), scene.name);
     t->apply(commit);
   }
-  out.eye = scene.player_start + glm::vec3(0.0f, 0.0f, 68.0f);
+  out.eye = scene.player_start + glm::vec3(0.0f, 0.0f, core::kPlayerEyeHeight);
   return out;
 }
 

@@ -86,7 +86,7 @@ size_t scene_bytes(const commit::TracerScene& s) {
 
 Row measure(int count, int frames) {
   scene::RenderWorld world(crate_field(count));
-  core::WorldSync sync(world, core::compile_scene(world.scene()));
+  core::WorldSync sync(world);
   auto every_frame = sync.add_tracer();
   auto every_fourth = sync.add_tracer();
   commit::TracerScene tracer, skipping;

@@ -15,6 +15,7 @@
 
 #include "cohort/core/gpu_scene.h"
 #include "cohort/core/scene_pack.h"
+#include "cohort/core/view.h"
 #ifdef COHORT_HAVE_CUDA
 #include "cohort/tracers/cuda_tracer.h"
 #endif
@@ -81,8 +82,8 @@ int main(int argc, char** argv) {
   }
   core::PackedScene pack = core::read_scene_pack(scene_file);
   auto scene = std::make_shared<commit::TracerScene>(pack.tracer_scene);
-  glm::vec3 eye(pack.player_start[0], pack.player_start[1], pack.player_start[2] + 68.0f);
-  KCamera cam = core::make_camera(eye, pack.player_yaw, 0.0f, 90.0f, width, height);
+  glm::vec3 eye(pack.player_start[0], pack.player_start[1], pack.player_start[2] + core::kPlayerEyeHeight);
+  KCamera cam = core::make_camera(eye, {pack.player_yaw, 0.0f}, core::kDefaultFovX, width, height);
   nlohmann::json out;
   out["scene"] = pack.map_name;
   out["width"] = width;

@@ -18,6 +18,7 @@
 
 #include "cohort/core/gpu_scene.h"
 #include "cohort/core/scene_pack.h"
+#include "cohort/core/view.h"
 #include "cohort/scene/map_loader.h"
 #ifdef COHORT_HAVE_EMBREE
 #include "cohort/tracers/embree_tracer.h"
@@ -103,7 +104,8 @@ int main(int argc, char** argv) {
     yaw = map.player_yaw;
     scene = std::make_shared<commit::TracerScene>(core::compile_scene(map).tracer_scene);
   }
-  camera = core::make_camera(start + glm::vec3(0.0f, 0.0f, 68.0f), yaw, 0.0f, 90.0f, cfg.width, cfg.height);
+  camera = core::make_camera(start + glm::vec3(0.0f, 0.0f, core::kPlayerEyeHeight), {yaw, 0.0f}, core::kDefaultFovX,
+                             cfg.width, cfg.height);
   core::BandJob job;
   job.camera = camera;
   job.params.spp = uint32_t(cfg.spp);

@@ -1,10 +1,11 @@
-// A free-flying camera in Doom 3's conventions: Z is up, yaw 0 looks down +X, yaw turns toward +Y,
-// positive pitch looks down (idAngles), angles in degrees. It produces the kernels' KCamera and the
-// RenderWorld's RenderView, so the viewer can hand either to the core.
+// A free-flying camera: the player's controls over a position and Doom 3 view angles (core/view.h).
+// It produces the kernels' KCamera and the RenderWorld's RenderView, so the viewer can hand either to
+// the core.
 #pragma once
 
 #include <glm/glm.hpp>
 
+#include "cohort/core/view.h"
 #include "cohort/scene/render_world.h"
 #include "cohort/kernel/layout.h"
 
@@ -44,8 +45,5 @@ struct FlyCamera {
   // Take position and angles from a view (axis columns: forward, left, up); roll is dropped.
   static FlyCamera from_render_view(const scene::RenderView& view);
 };
-
-// The kernels' camera for a RenderView (used for scripted cameras: the scenario, a replay).
-KCamera kcamera_from_view(const scene::RenderView& view, int width, int height);
 
 }  // namespace cohort::viewer

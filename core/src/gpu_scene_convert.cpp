@@ -1,5 +1,4 @@
-// Per-object conversions from the scene model to the kernel layouts: materials, lights, transforms,
-// cameras.
+// Per-object conversions from the scene model to the kernel layouts: materials, lights, transforms.
 #include <algorithm>
 #include <cmath>
 
@@ -164,25 +163,6 @@ void set_instance_transform(KInstance& instance, const glm::vec3& origin, const 
     instance.object_to_world[4 * r + 3] = origin[r];
     instance.world_to_object[4 * r + 3] = inv_t[r];
   }
-}
-
-KCamera make_camera(const glm::vec3& origin, float yaw_degrees, float pitch_degrees, float fov_x_degrees, int width,
-                    int height) {
-  float yaw = glm::radians(yaw_degrees), pitch = glm::radians(pitch_degrees);
-  glm::vec3 forward(std::cos(yaw) * std::cos(pitch), std::sin(yaw) * std::cos(pitch), std::sin(pitch));
-  glm::vec3 right = glm::normalize(glm::cross(forward, glm::vec3(0.0f, 0.0f, 1.0f)));
-  if (!std::isfinite(right.x)) right = glm::vec3(0.0f, -1.0f, 0.0f);
-  glm::vec3 up = glm::cross(right, forward);
-  KCamera cam{};
-  store(cam.origin, origin);
-  store(cam.forward, forward);
-  store(cam.right, right);
-  store(cam.up, up);
-  cam.width = static_cast<uint32_t>(width);
-  cam.height = static_cast<uint32_t>(height);
-  cam.tan_half_fov_x = std::tan(0.5f * glm::radians(fov_x_degrees));
-  cam.tan_half_fov_y = cam.tan_half_fov_x * static_cast<float>(height) / static_cast<float>(std::max(width, 1));
-  return cam;
 }
 
 }  // namespace cohort::core

@@ -11,74 +11,87 @@
 
 #include "cohort/commit/array_diff.h"
 #include "cohort/core/bvh.h"
+#include "cohort/core/view.h"
 #include "gpu_scene_textures.h"
 
 namespace cohort::core {
 namespace {
 
-KVertex to_kvertex(const scene::Vertex& v) {
-  KVertex k{};
-  k.pos[0] = v.position.x; k.pos[1] = v.position.y; k.pos[2] = v.position.z;
-  k.u = v.st.x; k.v = v.st.y;
-  k.normal[0] = v.normal.x; k.normal[1] = v.normal.y; k.normal[2] = v.normal.z;
-  k.tangent[0] = v.tangent.x; k.tangent[1] = v.tangent.y; k.tangent[2] = v.tangent.z;
-  k.bitangent_sign = v.tangent.w < 0.0f ? -1.0f : 1.0f;
-  return k;
+KMaterial default_material() {
+  scene::Material m;
+  m.name = "_default";
+  m.diffuse_color = glm::vec4(0.5f, 0.5f, 0.5f, 1.0f);
+  return to_kmaterial(m, scene::Scene{});
 }
 
-void store(float* dst, const glm::vec3& v) {
-  dst[0] = v.x;
-  dst[1] = v.y;
-  dst[2] = v.z;
+template <typename Handles>
+std::set<int> live_handles(const Handles& defs) {
+  std::set<int> live;
+  for (size_t h = 0; h < defs.size(); ++h)
+    if (defs[h]) live.insert(int(h));
+  return live;
+}
+
+std::set<int> all_indices(size_t count) {
+  std::set<int> indices;
+  for (size_t i = 0; i < count; ++i) indices.insert(int(i));
+  return indices;
 }
 
 }  // namespace
 
-WorldSync::WorldSync(const scene::RenderWorld& world, CompiledScene compiled, WorldSyncOptions options)
-    : world_(world), options_(options), master_(std::move(compiled.tracer_scene)),
-      blas_of_mesh_(std::move(compiled.blas_of_mesh)) {
+WorldSync::WorldSync(const scene::RenderWorld& world, WorldSyncOptions options) : world_(world), options_(options) {
   const scene::Scene& scene = world_.scene();
   base_material_count_ = static_cast<uint32_t>(scene.materials.size());
-  if (master_.materials.size() != size_t(base_material_count_) + 1)
-    throw std::invalid_argument(fmt::format("WorldSync: the compiled scene has {} materials, expected the map's {} "
-                                            "plus the default one (was it compiled from this world?)",
-                                            master_.materials.size(), base_material_count_));
-  blas_of_mesh_.resize(scene.meshes.size(), K_NONE);
-  for (const KInstance& inst : master_.instances) {
-    if (inst.entity == K_NONE) {
-      static_instances_.push_back(inst);
-    } else {
-      const scene::RenderEntity* def = world_.EntityDef(int(inst.entity));
-      if (!def) throw std::invalid_argument(fmt::format("WorldSync: instance of entity {} that is not live", inst.entity));
-      entity_instances_[int(inst.entity)] = inst;
-      mesh_of_entity_[int(inst.entity)] = def->model;
-    }
+  blas_of_mesh_.assign(scene.meshes.size(), K_NONE);
+  master_.materials.assign(size_t(base_material_count_) + 1, KMaterial{});
+  master_.materials[base_material_count_] = default_material();
+  build_static_world();
+
+  // Compiling is syncing from an empty world: everything the world holds counts as changed.
+  scene::ChangeLog everything;
+  everything.textures = all_indices(scene.images.size());
+  everything.materials = all_indices(scene.materials.size());
+  everything.entities = live_handles(world_.entity_defs());
+  everything.lights = live_handles(world_.light_defs());
+  everything.view = world_.view().has_value();
+  sync(everything, 0);
+  if (!world_.view())
+    master_.camera = make_camera(player_eye(scene), ViewAngles{scene.player_yaw, 0.0f}, kDefaultFovX,
+                                 int(options_.width), int(options_.height));
+}
+
+// One BLAS over every area of the map, built once; the world's single instance comes first.
+void WorldSync::build_static_world() {
+  const scene::Scene& scene = world_.scene();
+  std::vector<KTriangle> triangles;
+  for (int mesh_index : scene.area_meshes) {
+    const scene::Mesh& mesh = scene.meshes.at(size_t(mesh_index));
+    const uint32_t base = uint32_t(master_.vertices.size());
+    for (const scene::Vertex& v : mesh.vertices) master_.vertices.push_back(to_kvertex(v));
+    std::vector<KTriangle> own = mesh_triangles(mesh, base, [this](int m) { return kmaterial_index(m); });
+    triangles.insert(triangles.end(), own.begin(), own.end());
   }
-  // Rebuild the instance list in the order sync() keeps it, so the first TLAS diff is meaningful.
-  master_.instances = static_instances_;
-  for (const auto& [handle, inst] : entity_instances_) master_.instances.push_back(inst);
-  std::vector<KBvhNode> roots;
-  for (const KBlas& b : master_.blases) roots.push_back(master_.blas_nodes.at(b.node_offset));
-  master_.tlas_nodes = master_.instances.empty() ? std::vector<KBvhNode>{} : build_tlas(master_.instances, roots);
+  if (triangles.empty()) return;
+  BlasBuild build = build_blas(master_.vertices, triangles);
+  world_blas_ = uint32_t(master_.blases.size());
+  master_.blases.push_back({uint32_t(master_.blas_nodes.size()), uint32_t(build.nodes.size()),
+                            uint32_t(master_.triangles.size()), uint32_t(build.triangles.size())});
+  master_.blas_nodes.insert(master_.blas_nodes.end(), build.nodes.begin(), build.nodes.end());
+  master_.triangles.insert(master_.triangles.end(), build.triangles.begin(), build.triangles.end());
+  for (int m : scene.area_meshes) blas_of_mesh_[size_t(m)] = world_blas_;
 
-  const auto& lights = world_.light_defs();
-  size_t live = 0;
-  for (size_t h = 0; h < lights.size(); ++h) live += lights[h].has_value();
-  if (live != master_.lights.size())
-    throw std::invalid_argument(fmt::format("WorldSync: the compiled scene has {} lights, the world {}",
-                                            master_.lights.size(), live));
-  size_t slot = 0;
-  for (size_t h = 0; h < lights.size(); ++h)
-    if (lights[h]) lights_by_handle_[int(h)] = master_.lights[slot++];
+  KInstance world_instance{};
+  set_instance_transform(world_instance, glm::vec3(0.0f), glm::mat3(1.0f));
+  world_instance.blas = world_blas_;
+  world_instance.mask = K_MASK_PRIMARY | K_MASK_SHADOW;
+  world_instance.entity = K_NONE;
+  world_instance.material_override = K_NONE;
+  static_instances_.push_back(world_instance);
+}
 
-  const size_t images = scene.images.size();
-  if (master_.textures.size() != images * kTextureUseCount)
-    throw std::invalid_argument(fmt::format("WorldSync: the compiled scene has {} textures, expected {} per image",
-                                            master_.textures.size(), kTextureUseCount));
-  image_textures_.resize(images);
-  for (size_t i = 0; i < images; ++i)
-    for (uint32_t use = 0; use < kTextureUseCount; ++use) image_textures_[i][use] = master_.textures[use * images + i];
-  if (world_.view()) master_.camera = camera_of(*world_.view());
+CompiledScene WorldSync::release() && {
+  return CompiledScene{std::move(master_), std::move(blas_of_mesh_), world_blas_};
 }
 
 uint32_t WorldSync::blas_of_mesh(int mesh) const {
@@ -92,6 +105,7 @@ uint32_t WorldSync::kmaterial_index(int m) const {
 
 uint32_t WorldSync::ensure_blas(int mesh, commit::CommitBuffer& out) {
   if (size_t(mesh) >= blas_of_mesh_.size()) blas_of_mesh_.resize(world_.scene().meshes.size(), K_NONE);
+  if (size_t(mesh) >= blas_of_mesh_.size()) return K_NONE;
   if (blas_of_mesh_[mesh] == K_NONE) blas_of_mesh_[mesh] = build_mesh_blas(mesh, out);
   return blas_of_mesh_[mesh];
 }
@@ -102,14 +116,7 @@ uint32_t WorldSync::build_mesh_blas(int mesh_index, commit::CommitBuffer& out) {
   std::vector<KVertex> vertices;
   vertices.reserve(mesh.vertices.size());
   for (const scene::Vertex& v : mesh.vertices) vertices.push_back(to_kvertex(v));
-  std::vector<KTriangle> triangles;
-  for (const scene::Surface& s : mesh.surfaces) {
-    uint32_t material = kmaterial_index(s.material);
-    for (uint32_t i = 0; i + 2 < s.index_count; i += 3) {
-      uint32_t first = s.first_index + i;
-      triangles.push_back({mesh.indices.at(first), mesh.indices.at(first + 1), mesh.indices.at(first + 2), material});
-    }
-  }
+  std::vector<KTriangle> triangles = mesh_triangles(mesh, 0, [this](int m) { return kmaterial_index(m); });
   if (triangles.empty()) return K_NONE;
   BlasBuild build = build_blas(vertices, triangles);
 
@@ -185,19 +192,6 @@ KInstance WorldSync::entity_instance(int handle, const scene::RenderEntity& def,
   return inst;
 }
 
-KCamera WorldSync::camera_of(const scene::RenderView& view) const {
-  KCamera cam{};
-  store(cam.origin, view.origin);
-  store(cam.forward, glm::normalize(view.axis[0]));
-  store(cam.right, -glm::normalize(view.axis[1]));  // the axis's second column points left
-  store(cam.up, glm::normalize(view.axis[2]));
-  cam.tan_half_fov_x = std::tan(0.5f * glm::radians(view.fov_x));
-  cam.tan_half_fov_y = std::tan(0.5f * glm::radians(view.fov_y));
-  cam.width = options_.width;
-  cam.height = options_.height;
-  return cam;
-}
-
 commit::CommitBuffer WorldSync::sync(const scene::ChangeLog& changes, uint64_t frame) {
   const auto start = std::chrono::steady_clock::now();
   const scene::Scene& scene = world_.scene();
@@ -231,7 +225,7 @@ commit::CommitBuffer WorldSync::sync(const scene::ChangeLog& changes, uint64_t f
       if (m == mesh) entities.insert(handle);
   }
 
-  bool instances_changed = false;
+  bool instances_changed = instances_stale_;
   for (int handle : changes.freed_entities) {
     instances_changed |= entity_instances_.erase(handle) > 0;
     mesh_of_entity_.erase(handle);
@@ -252,15 +246,13 @@ commit::CommitBuffer WorldSync::sync(const scene::ChangeLog& changes, uint64_t f
     std::vector<KInstance> instances = static_instances_;
     instances.reserve(static_instances_.size() + entity_instances_.size());
     for (const auto& [handle, inst] : entity_instances_) instances.push_back(inst);
-    std::vector<KBvhNode> roots;
-    roots.reserve(master_.blases.size());
-    for (const KBlas& b : master_.blases) roots.push_back(master_.blas_nodes.at(b.node_offset));
-    std::vector<KBvhNode> tlas = instances.empty() ? std::vector<KBvhNode>{} : build_tlas(instances, roots);
+    std::vector<KBvhNode> tlas = build_scene_tlas(instances, master_);
     commit::diff_instances(master_.instances, instances, out);
     commit::diff_tlas(master_.tlas_nodes, tlas, out);
     master_.instances = std::move(instances);
     master_.tlas_nodes = std::move(tlas);
     stats_.tlas_rebuilt = true;
+    instances_stale_ = false;
   }
 
   // Lights, in handle order of the live defs.
@@ -285,7 +277,7 @@ commit::CommitBuffer WorldSync::sync(const scene::ChangeLog& changes, uint64_t f
   }
 
   if (changes.view && world_.view()) {
-    master_.camera = camera_of(*world_.view());
+    master_.camera = make_camera(*world_.view(), int(options_.width), int(options_.height));
     out.set_camera(master_.camera);
   }
   master_.version = frame;

@@ -99,7 +99,7 @@ TEST(FlyCamera, RoundTripsThroughRenderView) {
   EXPECT_NEAR(back.yaw, 135.0f, 1e-3f);
   EXPECT_NEAR(back.pitch, -20.0f, 1e-3f);
   EXPECT_NEAR(back.position.y, -20.0f, 1e-5f);
-  const KCamera a = cam.to_kcamera(320, 240), b = kcamera_from_view(view, 320, 240);
+  const KCamera a = cam.to_kcamera(320, 240), b = core::make_camera(view, 320, 240);
   for (int i = 0; i < 3; ++i) {
     EXPECT_NEAR(a.forward[i], b.forward[i], 1e-5f);
     EXPECT_NEAR(a.right[i], b.right[i], 1e-5f);

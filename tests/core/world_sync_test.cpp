@@ -78,7 +78,7 @@ void run_frames(scene::RenderWorldApi& world, int frames) {
 
 TEST(WorldSync, SyncedMasterEqualsAFreshCompileOfTheSameState) {
   RenderWorld world(scene::world_testing::small_map());
-  WorldSync sync(world, compile_scene(world.scene()));
+  WorldSync sync(world);
   scene::Scenario scenario(world);
   for (int f = 0; f < 100; ++f) {
     scenario.frame(f);
@@ -103,9 +103,9 @@ TEST(WorldSync, ReplayedStreamGivesTheSameTracerSceneEveryFrame) {
     recorder.finish();
   }
   RenderWorld direct(scene::world_testing::small_map());
-  WorldSync direct_sync(direct, compile_scene(direct.scene()));
+  WorldSync direct_sync(direct);
   RenderWorld replayed(scene::world_testing::small_map());
-  WorldSync replay_sync(replayed, compile_scene(replayed.scene()));
+  WorldSync replay_sync(replayed);
   auto channel = replay_sync.add_tracer();
   commit::TracerScene tracer;
 
@@ -129,7 +129,7 @@ TEST(WorldSync, ReplayedStreamGivesTheSameTracerSceneEveryFrame) {
 
 TEST(WorldSync, TracersThatSkipFramesConvergeToTheMaster) {
   RenderWorld world(scene::world_testing::small_map());
-  WorldSync sync(world, compile_scene(world.scene()));
+  WorldSync sync(world);
   const int periods[] = {1, 4, 7, 1000};
   std::vector<std::shared_ptr<commit::CommitChannel>> channels;
   std::vector<commit::TracerScene> tracers(std::size(periods));
@@ -153,7 +153,7 @@ TEST(WorldSync, TracersThatSkipFramesConvergeToTheMaster) {
 
 TEST(WorldSync, RuntimeModelMaterialAndTextureReachTheTracerScene) {
   RenderWorld world(scene::world_testing::small_map());
-  WorldSync sync(world, compile_scene(world.scene()));
+  WorldSync sync(world);
   const uint32_t default_material = sync.kmaterial_index(-1);
   const size_t blases_before = sync.master().blases.size();
   define_and_free(world, 10);
@@ -189,7 +189,7 @@ TEST(WorldSync, OverflowingTheBudgetGivesAFullResyncThatConverges) {
   RenderWorld world(scene::world_testing::small_map());
   WorldSyncOptions options;
   options.commit_budget_bytes = 1024;
-  WorldSync sync(world, compile_scene(world.scene()), options);
+  WorldSync sync(world, options);
   auto channel = sync.add_tracer();
   commit::TracerScene tracer;
   commit::apply_commit(channel->begin_frame(), tracer);
@@ -209,7 +209,7 @@ TEST(WorldSync, OverflowingTheBudgetGivesAFullResyncThatConverges) {
 
 TEST(WorldSync, OnlyMovedEntitiesAndTheTlasAreSent) {
   RenderWorld world(scene::world_testing::small_map());
-  WorldSync sync(world, compile_scene(world.scene()));
+  WorldSync sync(world);
   scene::RenderEntity fan = *world.EntityDef(2);
   fan.origin.z += 1.0f;
   world.UpdateEntityDef(2, fan);

@@ -2,9 +2,10 @@
 // for row bands, hands every tracer its job, and waits; there is no communication with a tracer while
 // it renders. Each tracer renders into its own full-size buffer and the core merges the bands.
 //
-// Commit buffers are double-buffered per tracer: submit_commit() fills the back buffer (for frame N+1)
-// while the tracer renders frame N; at the start of its next job the tracer applies, in order, every
-// commit submitted since its last job (a tracer that missed frames catches up on all of them).
+// Commits: submit_commit() queues a commit for every tracer while they render; at the start of its
+// next job a tracer applies, in order, every commit queued since its last job (a tracer that missed
+// frames catches up on all of them). This queue is unbounded and does not coalesce; the bounded,
+// coalescing commit::CommitChannel that WorldSync feeds (docs/commit-buffers.md) is meant to replace it.
 //
 // Faults: a tracer that throws, or has not finished when the frame timeout expires, is dropped for the
 // frame; its rows are split among the tracers that finished and re-rendered, and the frame is still

@@ -1,17 +1,18 @@
-// The glue the frame loop calls once a frame: it takes RenderWorld's change log, updates the core's
-// master TracerScene (instance transforms, new BLASes, the TLAS, lights, materials, textures, camera)
-// and produces the frame's commit records, which it folds into every tracer's pending commit buffer.
+// The one path from the scene model to the tracers' scene. WorldSync keeps the core's master
+// TracerScene: built from an empty world by a first sync over everything the world holds (that is
+// compile_scene), then updated once a frame from RenderWorld's change log (instance transforms, new
+// BLASes, the TLAS, lights, materials, textures, camera), producing the frame's commit records, which
+// it folds into every tracer's pending commit buffer.
 //
-// Index conventions follow compile_scene (gpu_scene.h): entity handle = KInstance::entity, instances
-// are the static world then the entity defs in handle order (so the TLAS is what compile_scene would
-// build for the same state), lights are the live light defs in handle order, textures use
-// texture_slot(). compile_scene puts a default material right after the map's materials; materials
-// defined later go after it, so no triangle's material index ever moves (kmaterial_index()).
+// Index conventions: entity handle = KInstance::entity; instances are the static world then the entity
+// defs in handle order; lights are the live light defs in handle order; textures use texture_slot().
+// The default material sits right after the map's materials; materials defined later go after it, so
+// no triangle's material index ever moves (kmaterial_index()).
 //
 // Replaying a recorded stream (`cohort render --replay FILE`), per frame:
 //   scene::Player player(file);                       // player.header().map_name names the map to load
 //   scene::RenderWorld world(load the map);
-//   WorldSync sync(world, compile_scene(world.scene()), options);
+//   WorldSync sync(world, options);
 //   while (player.play_frame(world)) {
 //     renderer.submit_commit(sync.sync(world.TakeChanges(), frame));   // or sync_and_publish + channels
 //     render with sync.master().camera ...
@@ -27,6 +28,7 @@
 
 #include "cohort/commit/commit_buffer.h"
 #include "cohort/commit/commit_channel.h"
+#include "cohort/core/frame_defaults.h"
 #include "cohort/core/gpu_scene.h"
 #include "cohort/scene/render_world.h"
 
@@ -34,7 +36,7 @@ namespace cohort::core {
 
 struct WorldSyncOptions {
   GpuSceneOptions gpu;
-  uint32_t width = 640, height = 360;      // written into KCamera
+  uint32_t width = kDefaultWidth, height = kDefaultHeight;  // written into KCamera
   size_t commit_budget_bytes = 32u << 20;  // per tracer; past it the tracer gets a full resync
 };
 
@@ -48,9 +50,9 @@ struct WorldSyncStats {  // of the last sync()
 
 class WorldSync {
  public:
-  // `compiled` is compile_scene(world.scene()) of the world as seeded, before any call. The world
-  // must outlive this object.
-  WorldSync(const scene::RenderWorld& world, CompiledScene compiled, WorldSyncOptions options = {});
+  // Compiles the world as it stands (its pending change log is left for the caller to take). The
+  // world must outlive this object.
+  explicit WorldSync(const scene::RenderWorld& world, WorldSyncOptions options = {});
 
   // Fold the world's changes (world.TakeChanges()) into the master; returns the frame's records.
   commit::CommitBuffer sync(const scene::ChangeLog& changes, uint64_t frame);
@@ -67,6 +69,9 @@ class WorldSync {
   const WorldSyncStats& last_stats() const { return stats_; }
 
   uint32_t blas_of_mesh(int mesh) const;
+  uint32_t world_blas() const { return world_blas_; }
+  // The master with its mesh-to-BLAS map, moved out: what compile_scene returns.
+  CompiledScene release() &&;
   // KMaterial index of scene material m (see above); the default material for -1.
   uint32_t kmaterial_index(int scene_material) const;
 
@@ -75,13 +80,15 @@ class WorldSync {
   uint32_t build_mesh_blas(int mesh, commit::CommitBuffer& out);
   bool update_textures(const std::set<int>& changed, commit::CommitBuffer& out);
   void set_material(int scene_material);
+  void build_static_world();
   KInstance entity_instance(int handle, const scene::RenderEntity& def, uint32_t blas) const;
-  KCamera camera_of(const scene::RenderView& view) const;
 
   const scene::RenderWorld& world_;
   WorldSyncOptions options_;
   commit::TracerScene master_;
   std::vector<uint32_t> blas_of_mesh_;
+  uint32_t world_blas_ = K_NONE;
+  bool instances_stale_ = true;                   // until the first sync lists the static world
   std::vector<KInstance> static_instances_;       // the world: entity == K_NONE
   std::map<int, KInstance> entity_instances_;     // by entity handle
   std::map<int, int> mesh_of_entity_;
