@@ -8,6 +8,8 @@
 #include <stdexcept>
 #include <thread>
 
+#include "cohort/core/view.h"
+
 namespace cohort::core {
 
 namespace {
@@ -75,17 +77,8 @@ double SpinSceneCostModel::band_cost(double yaw, int rows, int row_begin, int ro
 double camera_yaw(const KCamera& camera) { return std::atan2(camera.forward[1], camera.forward[0]); }
 
 KCamera spin_camera(int width, int height, double yaw) {
-  KCamera c{};
-  c.forward[0] = static_cast<float>(std::cos(yaw));
-  c.forward[1] = static_cast<float>(std::sin(yaw));
-  c.right[0] = static_cast<float>(std::sin(yaw));
-  c.right[1] = static_cast<float>(-std::cos(yaw));
-  c.up[2] = 1.0f;
-  c.tan_half_fov_x = 1.0f;
-  c.tan_half_fov_y = static_cast<float>(height) / static_cast<float>(std::max(width, 1));
-  c.width = static_cast<kuint>(width);
-  c.height = static_cast<kuint>(height);
-  return c;
+  return make_camera(glm::vec3(0.0f), ViewAngles{static_cast<float>(yaw * 180.0 / std::numbers::pi), 0.0f},
+                     kDefaultFovX, width, height);
 }
 
 SimulatedTracer::SimulatedTracer(std::shared_ptr<const SpinSceneCostModel> model, SimulatedTracerOptions options)

@@ -15,6 +15,6 @@ endif()
 if(_nvcc)
   add_test(NAME kernel.bvh_traverse_nvcc_compiles
            COMMAND ${_nvcc} -x cu -c ${CMAKE_CURRENT_LIST_DIR}/bvh_traverse_cuda_check.cu
-                   -I ${CMAKE_SOURCE_DIR}/core -o ${CMAKE_BINARY_DIR}/bvh_traverse_cuda_check.o)
+                   -I ${CMAKE_SOURCE_DIR}/kernel/include -o ${CMAKE_BINARY_DIR}/bvh_traverse_cuda_check.o)
   set_tests_properties(kernel.bvh_traverse_nvcc_compiles PROPERTIES LABELS kernel TIMEOUT 300)
 endif()

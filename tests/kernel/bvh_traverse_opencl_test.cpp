@@ -142,7 +142,7 @@ TEST(BvhTraverseOpenCL, ClosestHitsMatchTheCppBuildOfTheSameHeader) {
   ASSERT_EQ(err, CL_SUCCESS);
   cl_program program = clCreateProgramWithSource(context, 1, &kProgram, nullptr, &err);
   ASSERT_EQ(err, CL_SUCCESS);
-  const std::string options = std::string("-cl-std=CL1.2 -I ") + COHORT_SOURCE_DIR + "/core";
+  const std::string options = std::string("-cl-std=CL1.2 -I ") + COHORT_SOURCE_DIR + "/kernel/include";
   err = clBuildProgram(program, 1, &device, options.c_str(), nullptr, nullptr);
   if (err != CL_SUCCESS) {
     size_t size = 0;

@@ -12,6 +12,7 @@
 #include <filesystem>
 
 #include "cohort/core/scene_pack.h"
+#include "cohort/core/view.h"
 #include "cohort/scene/map_loader.h"
 #include "test_scenes.h"
 #include "test_tracers.h"
@@ -137,7 +138,7 @@ TEST(AgreementOnTestMap, EmbreeAndOpenCLImagesMatch) {
   scene::Vfs vfs;
   scene::Scene map = scene::load_map(vfs, std::string(COHORT_SOURCE_DIR) + "/assets/testmap/maps/testmap.map");
   const int w = 64, h = 36;
-  KCamera cam = core::make_camera(map.player_start + glm::vec3(0, 0, 68), map.player_yaw, 0.0f, 90.0f, w, h);
+  KCamera cam = core::make_camera(core::player_eye(map), {map.player_yaw, 0.0f}, core::kDefaultFovX, w, h);
   KFrameParams params = frame_params(K_MODE_PATH, 8, 1, h);
   params.light_samples = 0;
   params.firefly_clamp = 5.0f;

@@ -8,6 +8,7 @@
 
 #include "cohort/core/gpu_scene.h"
 #include "cohort/core/scene_pack.h"
+#include "cohort/core/view.h"
 #include "test_scenes.h"
 #include "test_tracers.h"
 
@@ -133,8 +134,8 @@ TEST(CudaScenePack, PackedSceneMatchesEmbree) {
     core::PackedScene pack = core::read_scene_pack(pack_file);
     scene = pack.tracer_scene;
     // Eye height above the player start, looking along its yaw, as `cohort render` does.
-    glm::vec3 eye(pack.player_start[0], pack.player_start[1], pack.player_start[2] + 68.0f);
-    cam = core::make_camera(eye, pack.player_yaw, 0.0f, 90.0f, w, h);
+    glm::vec3 eye(pack.player_start[0], pack.player_start[1], pack.player_start[2] + core::kPlayerEyeHeight);
+    cam = core::make_camera(eye, {pack.player_yaw, 0.0f}, core::kDefaultFovX, w, h);
   } else {
     scene = core::compile_scene(test_room()).tracer_scene;
     cam = test_room_camera(w, h);

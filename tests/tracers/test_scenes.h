@@ -16,6 +16,7 @@
 #include "cohort/core/gpu_scene.h"
 #include "cohort/core/image_output.h"
 #include "cohort/core/tracer.h"
+#include "cohort/core/view.h"
 #include "cohort/scene/scene.h"
 
 namespace cohort::test {
@@ -316,7 +317,7 @@ inline scene::Scene test_room() {
 
 // A camera inside test_room looking across it.
 inline KCamera test_room_camera(int width, int height) {
-  return core::make_camera({-190, -130, 120}, 35.0f, -20.0f, 90.0f, width, height);
+  return core::make_camera({-190, -130, 120}, {35.0f, 20.0f}, 90.0f, width, height);  // 20 degrees down
 }
 
 

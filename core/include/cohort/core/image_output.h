@@ -1,6 +1,6 @@
 // Writing frames. With OpenImageIO: any format it knows by extension (.png, .exr, .jpg, .tif, ...).
 // Without it (the build that travels to the GPU machine): .ppm (8-bit) and .pfm (float HDR) only,
-// which tools/convert_images.sh turns into PNG/EXR on a machine that has OpenImageIO.
+// which any image tool converts on a machine that has one (e.g. `oiiotool frame.pfm -o frame.exr`).
 #pragma once
 
 #include <cstdint>

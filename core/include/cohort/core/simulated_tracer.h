@@ -36,7 +36,7 @@ class SpinSceneCostModel {
 
 // Yaw of a camera looking along `forward` (Doom: Z up, yaw measured in the XY plane).
 double camera_yaw(const KCamera& camera);
-// A camera of the given size looking horizontally at `yaw_radians`.
+// A camera at the origin of the given size looking horizontally at `yaw_radians` (core/view.h).
 KCamera spin_camera(int width, int height, double yaw_radians);
 
 enum class SimulatedClock { virtual_time, sleep, spin };
