@@ -35,7 +35,9 @@ void to_json(nlohmann::json& j, const FrameStats& s) {
                      {"wall_ms", s.wall_ms},
                      {"dropped", s.dropped},
                      {"convergence_f", s.convergence_f},
-                     {"tracers", s.tracers}};
+                     {"tracers", s.tracers},
+                     {"start_ms", s.start_ms},
+                     {"stages", s.stages}};
 }
 
 }  // namespace cohort::core

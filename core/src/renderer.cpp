@@ -36,6 +36,7 @@ struct Renderer::Worker {
   bool has_job = false;
   uint64_t job_id = 0;
   BandJob job;
+  bool job_is_recovery = false;    // re-rendering rows a dropped tracer did not deliver
   std::vector<commit::CommitBuffer> back_commits;  // filled by the core while the tracer renders
   std::vector<commit::CommitBuffer> job_commits;   // handed over with the next job, applied before it
 
@@ -47,6 +48,7 @@ struct Renderer::Worker {
   double wall_ms = 0.0;
   double reported_ms = 0.0;
   std::vector<float> row_work;
+  std::vector<StageSpan> spans;  // the last job's apply and render stages
 
   // The tracer's private target: only the worker writes it while busy; the core reads its rows after
   // the job's result is posted and before the next job is handed out.
@@ -57,6 +59,7 @@ struct Renderer::Worker {
     for (;;) {
       BandJob current;
       uint64_t current_id = 0;
+      bool recovery = false;
       std::vector<commit::CommitBuffer> front_commits;
       {
         std::unique_lock lock(inbox_mutex);
@@ -64,6 +67,7 @@ struct Renderer::Worker {
         if (quit && !has_job) return;
         current = job;
         current_id = job_id;
+        recovery = job_is_recovery;
         has_job = false;
         front_commits.swap(job_commits);
       }
@@ -71,11 +75,18 @@ struct Renderer::Worker {
       std::string what;
       double wall = 0.0, reported = 0.0;
       std::vector<float> work;
+      std::vector<StageSpan> job_spans;
+      const std::string track = tracer_track(id, name);
       try {
-        for (const commit::CommitBuffer& c : front_commits) tracer->apply(c);
+        if (!front_commits.empty()) {
+          ScopedStage applying(job_spans, track, "apply");
+          for (const commit::CommitBuffer& c : front_commits) tracer->apply(c);
+        }
+        ScopedStage rendering(job_spans, track, recovery ? "re-render" : "render");
         const auto start = Clock::now();
         const BandResult result = tracer->render_band(current, target);
         wall = std::chrono::duration<double, std::milli>(Clock::now() - start).count();
+        rendering.finish();
         reported = result.device_ms;
         if (result.row_work.size() == current.params.row_end - current.params.row_begin) work = result.row_work;
         success = true;
@@ -93,6 +104,7 @@ struct Renderer::Worker {
         wall_ms = wall;
         reported_ms = reported;
         row_work = std::move(work);
+        spans = std::move(job_spans);
       }
       completion->cv.notify_all();
     }
@@ -174,6 +186,7 @@ std::vector<uint64_t> Renderer::assign(const std::vector<Assignment>& assignment
     w.job.params.row_begin = static_cast<kuint>(assignments[i].band.begin);
     w.job.params.row_end = static_cast<kuint>(assignments[i].band.end);
     w.job_id = ids[i];
+    w.job_is_recovery = !with_commits;
     w.has_job = true;
     // The commits queued so far belong to this frame; ones submitted from now on wait for the next.
     // Re-rendering a dropped tracer's rows happens within the same frame, so it takes none.
@@ -188,7 +201,7 @@ std::vector<uint64_t> Renderer::assign(const std::vector<Assignment>& assignment
 }
 
 Renderer::RoundResult Renderer::collect(const std::vector<Assignment>& assignments, const std::vector<uint64_t>& ids,
-                                        FrameBuffer& out, Clock::time_point deadline) {
+                                        FrameBuffer& out, Clock::time_point deadline, std::vector<StageSpan>& stages) {
   RoundResult result;
   if (assignments.empty()) return result;
   Completion& completion = *workers_.front()->completion;
@@ -200,8 +213,13 @@ Renderer::RoundResult Renderer::collect(const std::vector<Assignment>& assignmen
     return true;
   };
   completion.cv.wait_until(lock, deadline, all_done);
+  ScopedStage merging(stages, kCoreTrack, "merge");
   for (size_t i = 0; i < assignments.size(); ++i) {
     Worker& w = *workers_[static_cast<size_t>(assignments[i].worker)];
+    if (w.done_job_id == ids[i]) {
+      stages.insert(stages.end(), std::make_move_iterator(w.spans.begin()), std::make_move_iterator(w.spans.end()));
+      w.spans.clear();
+    }
     if (w.done_job_id != ids[i]) {
       result.timed_out.push_back(w.id);
     } else if (!w.ok) {
@@ -238,6 +256,7 @@ void Renderer::begin_frame(const BandJob& job, FrameBuffer& out, const std::vect
   stats.rows = rows;
   stats.balancer = options_.balancer;
   stats.tracers.resize(workers_.size());
+  stats.start_ms = timeline_ms(frame_start);
 
   // Tracers still finishing late work sit this frame out; the balancer sees them as removed.
   std::vector<int> ready;
@@ -260,7 +279,9 @@ void Renderer::begin_frame(const BandJob& job, FrameBuffer& out, const std::vect
     proxy = row_work_;
   row_work_.assign(static_cast<size_t>(rows), 0.0f);
   row_work_known_.assign(static_cast<size_t>(rows), 0);
+  ScopedStage balancing(stats.stages, kCoreTrack, "balance");
   const std::vector<balance::Band> bands = balancer_->divide({rows, ready, last_measurements_, std::move(proxy)});
+  balancing.finish();
   std::vector<Assignment> assignments;
   for (size_t i = 0; i < ready.size(); ++i) {
     TracerFrameStats& t = stats.tracers[static_cast<size_t>(ready[i])];
@@ -280,7 +301,7 @@ FrameStats Renderer::finish_frame() {
   FrameStats& stats = frame->stats;
   FrameBuffer& out = *frame->out;
   const BandJob& job = frame->job;
-  RoundResult first = collect(frame->assignments, frame->ids, out, frame->start + options_.frame_timeout);
+  RoundResult first = collect(frame->assignments, frame->ids, out, frame->start + options_.frame_timeout, stats.stages);
   last_measurements_.clear();
   for (int id : first.finished) {
     TracerFrameStats& t = stats.tracers[static_cast<size_t>(id)];
@@ -346,7 +367,7 @@ FrameStats Renderer::finish_frame() {
       if (!parts[i].empty()) round.push_back({helpers[i], {band.begin + parts[i].begin, band.begin + parts[i].end}});
     }
     const auto round_start = Clock::now();
-    RoundResult r = collect(round, assign(round, job, out, false), out, round_start + options_.frame_timeout);
+    RoundResult r = collect(round, assign(round, job, out, false), out, round_start + options_.frame_timeout, stats.stages);
     for (const Assignment& a : round) {
       TracerFrameStats& t = stats.tracers[static_cast<size_t>(a.worker)];
       if (std::find(r.finished.begin(), r.finished.end(), a.worker) != r.finished.end()) {

@@ -7,6 +7,8 @@
 
 #include <nlohmann/json_fwd.hpp>
 
+#include "cohort/core/frame_timeline.h"
+
 namespace cohort::core {
 
 enum class TracerOutcome {
@@ -43,6 +45,10 @@ struct FrameStats {
   int dropped = 0;                // tracers dropped this frame (threw or timed out)
   double convergence_f = 1.0;     // blend factor used by adaptive convergence (1 = this frame only)
   std::vector<TracerFrameStats> tracers;
+  // The frame's timeline: the Renderer's stages (balance, each tracer's apply and render, merge) and
+  // what the caller adds around it (world sync, convergence, tone map, output).
+  double start_ms = 0.0;          // timeline_ms() when the frame began
+  std::vector<StageSpan> stages;
 };
 
 void to_json(nlohmann::json& j, const TracerFrameStats& s);

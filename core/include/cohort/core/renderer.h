@@ -99,7 +99,7 @@ class Renderer {
   std::vector<uint64_t> assign(const std::vector<Assignment>& assignments, const BandJob& job, FrameBuffer& out,
                                bool with_commits);
   RoundResult collect(const std::vector<Assignment>& assignments, const std::vector<uint64_t>& ids, FrameBuffer& out,
-                      std::chrono::steady_clock::time_point deadline);
+                      std::chrono::steady_clock::time_point deadline, std::vector<StageSpan>& stages);
   double measured_ms(const Worker& w) const;
 
   RendererOptions options_;

@@ -1,0 +1,126 @@
+#include "cohort/core/frame_timeline.h"
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <set>
+#include <unistd.h>
+
+#include <nlohmann/json.hpp>
+
+#include "cohort/core/renderer.h"
+#include "cohort/core/simulated_tracer.h"
+
+using namespace cohort::core;
+
+namespace {
+
+std::unique_ptr<Tracer> sim(uint64_t tag, SimulatedClock clock = SimulatedClock::sleep) {
+  SimulatedTracerOptions o;
+  o.name = "sim" + std::to_string(tag);
+  o.seed = tag;
+  o.clock = clock;
+  o.time_scale = 0.05;  // a few real milliseconds per band
+  if (tag == 2) o.throw_on_frames = {3};
+  return std::make_unique<SimulatedTracer>(std::make_shared<SpinSceneCostModel>(3), o);
+}
+
+BandJob job_for(uint64_t frame) {
+  BandJob job;
+  job.camera = spin_camera(8, 64, 0.1 * static_cast<double>(frame));
+  job.params.frame_index = static_cast<kuint>(frame);
+  return job;
+}
+
+const StageSpan* find(const std::vector<StageSpan>& spans, const std::string& track, const std::string& stage) {
+  for (const StageSpan& s : spans)
+    if (s.track == track && s.stage == stage) return &s;
+  return nullptr;
+}
+
+}  // namespace
+
+TEST(FrameTimeline, ScopedStageTimesItsScopeOnTheSharedClock) {
+  std::vector<StageSpan> spans;
+  const double before = timeline_now_ms();
+  {
+    ScopedStage stage(spans, kCoreTrack, "tone map");
+    std::this_thread::sleep_for(std::chrono::milliseconds(3));
+  }
+  const double after = timeline_now_ms();
+  ASSERT_EQ(spans.size(), 1u);
+  EXPECT_EQ(spans[0].stage, "tone map");
+  EXPECT_GE(spans[0].start_ms, before);
+  EXPECT_GE(spans[0].ms, 3.0);
+  EXPECT_LE(spans[0].start_ms + spans[0].ms, after + 1e-6);
+}
+
+TEST(FrameTimeline, RendererRecordsEveryTracersApplyAndRenderAndTheCoresStages) {
+  std::vector<std::unique_ptr<Tracer>> tracers;
+  tracers.push_back(sim(1));
+  tracers.push_back(sim(2));
+  Renderer renderer(std::move(tracers), RendererOptions{});
+  FrameBuffer fb;
+  for (uint64_t f = 0; f < 5; ++f) {
+    cohort::commit::CommitBuffer commit;
+    commit.set_frame(f + 1);
+    renderer.submit_commit(commit);
+    const FrameStats stats = renderer.render(job_for(f), fb);
+    const double end = stats.start_ms + stats.wall_ms;
+    EXPECT_NE(find(stats.stages, kCoreTrack, "balance"), nullptr) << "frame " << f;
+    EXPECT_NE(find(stats.stages, kCoreTrack, "merge"), nullptr) << "frame " << f;
+    for (const TracerFrameStats& t : stats.tracers) {
+      const std::string track = tracer_track(t.id, t.name);
+      const StageSpan* apply = find(stats.stages, track, "apply");
+      const StageSpan* render = find(stats.stages, track, "render");
+      if (t.outcome == TracerOutcome::threw) continue;  // its spans arrive with the failure, not the merge
+      ASSERT_NE(apply, nullptr) << track << " frame " << f;
+      ASSERT_NE(render, nullptr) << track << " frame " << f;
+      EXPECT_LE(apply->start_ms + apply->ms, render->start_ms + 1e-3);  // commits first, then the band
+      EXPECT_NEAR(render->ms, t.ms, 1.0);                               // the span is the band time
+    }
+    for (const StageSpan& s : stats.stages) {
+      EXPECT_GE(s.start_ms, stats.start_ms - 1e-3) << s.track << " " << s.stage;
+      EXPECT_LE(s.start_ms + s.ms, end + 1e-3) << s.track << " " << s.stage;
+    }
+    if (f == 3) {  // sim2 threw: the survivor re-renders its rows, and that shows as its own stage
+      EXPECT_NE(find(stats.stages, tracer_track(0, "sim1"), "re-render"), nullptr);
+    }
+  }
+}
+
+TEST(FrameTimeline, ChromeTraceIsAJsonArrayOfCompleteEventsWithNamedThreads) {
+  const auto path = std::filesystem::temp_directory_path() / ("cohort_trace_" + std::to_string(::getpid()) + ".json");
+  {
+    ChromeTraceWriter trace(path.string());
+    trace.add(7, {{kCoreTrack, "balance", 10.0, 0.5}, {tracer_track(0, "embree"), "render", 10.5, 4.0}});
+    trace.add(8, {{tracer_track(1, "cuda:0"), "render", 15.0, 2.0}});
+  }
+  std::ifstream in(path);
+  const nlohmann::json events = nlohmann::json::parse(in);
+  std::filesystem::remove(path);
+  ASSERT_TRUE(events.is_array());
+  std::map<int, std::string> thread_names;
+  std::vector<nlohmann::json> complete;
+  for (const auto& e : events) {
+    if (e["ph"] == "M" && e["name"] == "thread_name") thread_names[e["tid"].get<int>()] = e["args"]["name"];
+    if (e["ph"] == "X") complete.push_back(e);
+  }
+  ASSERT_EQ(complete.size(), 3u);
+  EXPECT_EQ(thread_names[complete[0]["tid"].get<int>()], "core");
+  EXPECT_EQ(thread_names[complete[1]["tid"].get<int>()], "tracer 0 (embree)");
+  EXPECT_EQ(thread_names[complete[2]["tid"].get<int>()], "tracer 1 (cuda:0)");
+  EXPECT_DOUBLE_EQ(complete[1]["ts"].get<double>(), 10500.0);  // microseconds
+  EXPECT_DOUBLE_EQ(complete[1]["dur"].get<double>(), 4000.0);
+  EXPECT_EQ(complete[2]["args"]["frame"], 8);
+}
+
+TEST(FrameTimeline, ChromeTraceWriterNamesAFileItCannotWrite) {
+  try {
+    ChromeTraceWriter trace("/nonexistent-folder/trace.json");
+    FAIL() << "expected an error";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("/nonexistent-folder/trace.json"), std::string::npos);
+  }
+}
