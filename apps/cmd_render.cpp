@@ -116,7 +116,7 @@ int run_render(const RenderArgs& a) {
     core::BandJob job;
     if (player) {
       if (!player->play_frame(*world)) break;
-      renderer.submit_commit(sync->sync(world->TakeChanges(), uint64_t(f) + 1));
+      renderer.submit_commit(sync->sync(world->TakeChanges(), uint64_t(f) + 1), [&] { return sync->snapshot(); });
       job.camera = sync->master().camera;
     } else if (path) {
       const CameraPose pose = camera_path_pose(*path, eye, angles.yaw, f);

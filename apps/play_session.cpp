@@ -157,7 +157,7 @@ SessionFrame PlaySession::frame(const viewer::FlyCamera& camera, double seconds,
   ++s.frame_index;
 #ifdef COHORT_PLAY_HAS_WORLD_SYNC
   const commit::CommitBuffer commit = s.sync->sync(s.world.TakeChanges(), s.frame_index);
-  s.renderer->submit_commit(commit);
+  s.renderer->submit_commit(commit, [&s] { return s.sync->snapshot(); });
 #else
   s.world.TakeChanges();
   const commit::CommitBuffer commit;

@@ -52,6 +52,11 @@ void CommitChannel::request_resync() {
   ++stats_.resyncs_requested;
 }
 
+bool CommitChannel::resync_requested() const {
+  std::lock_guard lock(mutex_);
+  return resync_requested_;
+}
+
 CommitStats CommitChannel::stats() const {
   std::lock_guard lock(mutex_);
   return stats_;

@@ -37,8 +37,15 @@ struct Renderer::Worker {
   uint64_t job_id = 0;
   BandJob job;
   bool job_is_recovery = false;    // re-rendering rows a dropped tracer did not deliver
-  std::vector<commit::CommitBuffer> back_commits;  // filled by the core while the tracer renders
-  std::vector<commit::CommitBuffer> job_commits;   // handed over with the next job, applied before it
+  // Taken from the channel by the core when it hands out a job; the buffer stays valid (and untouched
+  // by the core) until the next hand-over, which happens only once this job has ended.
+  const commit::CommitBuffer* job_commit = nullptr;
+
+  // Created by the first submit_commit; publish and take are the core's, the channel locks itself.
+  std::shared_ptr<commit::CommitChannel> channel;
+  // Worker thread only: an apply threw, so the tracer's scene no longer matches the core's until a
+  // full resync has been applied.
+  bool scene_diverged = false;
 
   // Outcome of the last job, guarded by completion->mutex.
   bool busy = false;
@@ -60,7 +67,7 @@ struct Renderer::Worker {
       BandJob current;
       uint64_t current_id = 0;
       bool recovery = false;
-      std::vector<commit::CommitBuffer> front_commits;
+      const commit::CommitBuffer* to_apply = nullptr;
       {
         std::unique_lock lock(inbox_mutex);
         inbox_cv.wait(lock, [&] { return quit || has_job; });
@@ -69,7 +76,8 @@ struct Renderer::Worker {
         current_id = job_id;
         recovery = job_is_recovery;
         has_job = false;
-        front_commits.swap(job_commits);
+        to_apply = job_commit;
+        job_commit = nullptr;
       }
       bool success = false;
       std::string what;
@@ -78,12 +86,12 @@ struct Renderer::Worker {
       std::vector<StageSpan> job_spans;
       const std::string track = tracer_track(id, name);
       try {
-        if (!front_commits.empty()) {
-          ScopedStage applying(job_spans, track, "apply");
-          for (const commit::CommitBuffer& c : front_commits) tracer->apply(c);
-        }
-        ScopedStage rendering(job_spans, track, recovery ? "re-render" : "render");
+        // Apply time is part of what the tracer costs the frame, so the balancer sees it.
         const auto start = Clock::now();
+        if (to_apply && !to_apply->empty()) apply(*to_apply, job_spans, track);
+        if (scene_diverged)
+          throw std::runtime_error("its scene diverged after a failed commit; waiting for a full resync");
+        ScopedStage rendering(job_spans, track, recovery ? "re-render" : "render");
         const BandResult result = tracer->render_band(current, target);
         wall = std::chrono::duration<double, std::milli>(Clock::now() - start).count();
         rendering.finish();
@@ -108,6 +116,18 @@ struct Renderer::Worker {
       }
       completion->cv.notify_all();
     }
+  }
+
+  void apply(const commit::CommitBuffer& commit, std::vector<StageSpan>& spans, const std::string& track) {
+    ScopedStage applying(spans, track, commit.is_full_resync() ? "apply (full resync)" : "apply");
+    try {
+      tracer->apply(commit);
+    } catch (...) {
+      scene_diverged = true;
+      channel->request_resync();
+      throw;
+    }
+    if (commit.is_full_resync()) scene_diverged = false;
   }
 };
 
@@ -141,14 +161,40 @@ Renderer::~Renderer() {
   }
 }
 
-void Renderer::submit_commit(const commit::CommitBuffer& commit) {
-  for (int i = 0; i < tracer_count(); ++i) submit_commit(i, commit);
+void Renderer::submit_commit(const commit::CommitBuffer& records, commit::CommitChannel::Snapshot snapshot) {
+  if (records.is_full_resync()) {
+    full_scene_ = records.shared_full_scene();
+    records_since_full_ = false;
+    if (!snapshot) snapshot_ = {};
+  } else if (!records.empty()) {
+    records_since_full_ = true;
+  }
+  if (snapshot) snapshot_ = std::move(snapshot);
+  commit_frame_ = records.frame();
+  for (auto& w : workers_) {
+    if (!w->channel) {
+      // The first commit seeds the channel: a full one as its initial resync, else an empty scene
+      // that the records then build on.
+      const bool full = records.is_full_resync();
+      w->channel = std::make_shared<commit::CommitChannel>(
+          options_.commit_budget_bytes, full ? full_scene_ : std::make_shared<const commit::TracerScene>(),
+          records.frame());
+      if (full) continue;
+    }
+    w->channel->publish(records, [this] { return resync_scene(); });
+  }
 }
 
-void Renderer::submit_commit(int tracer, const commit::CommitBuffer& commit) {
-  Worker& w = *workers_.at(static_cast<size_t>(tracer));
-  std::lock_guard lock(w.inbox_mutex);
-  w.back_commits.push_back(commit);
+std::shared_ptr<const commit::TracerScene> Renderer::resync_scene() {
+  if (snapshot_) return snapshot_();
+  if (full_scene_ && !records_since_full_) return full_scene_;
+  throw std::logic_error("Renderer: a tracer needs a full resync, but incremental commits were submitted without a "
+                         "snapshot of the scene they build (pass WorldSync::snapshot to submit_commit)");
+}
+
+commit::CommitStats Renderer::commit_stats(int tracer) const {
+  const Worker& w = *workers_.at(static_cast<size_t>(tracer));
+  return w.channel ? w.channel->stats() : commit::CommitStats{};
 }
 
 int Renderer::tracer_count() const { return static_cast<int>(workers_.size()); }
@@ -188,12 +234,15 @@ std::vector<uint64_t> Renderer::assign(const std::vector<Assignment>& assignment
     w.job_id = ids[i];
     w.job_is_recovery = !with_commits;
     w.has_job = true;
-    // The commits queued so far belong to this frame; ones submitted from now on wait for the next.
-    // Re-rendering a dropped tracer's rows happens within the same frame, so it takes none.
-    if (with_commits) {
-      w.job_commits.insert(w.job_commits.end(), std::make_move_iterator(w.back_commits.begin()),
-                           std::make_move_iterator(w.back_commits.end()));
-      w.back_commits.clear();
+    // What was published so far belongs to this frame; commits submitted from now on wait for the
+    // next. Re-rendering a dropped tracer's rows happens within the same frame, so it takes none.
+    if (with_commits && w.channel) {
+      if (w.channel->resync_requested()) {  // answer a failed apply even when the scene is still
+        commit::CommitBuffer nothing_new;
+        nothing_new.set_frame(commit_frame_);
+        w.channel->publish(nothing_new, [this] { return resync_scene(); });
+      }
+      w.job_commit = &w.channel->begin_frame();
     }
     w.inbox_cv.notify_one();
   }

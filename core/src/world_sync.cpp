@@ -288,18 +288,6 @@ commit::CommitBuffer WorldSync::sync(const scene::ChangeLog& changes, uint64_t f
   return out;
 }
 
-commit::CommitBuffer WorldSync::sync_and_publish(const scene::ChangeLog& changes, uint64_t frame) {
-  commit::CommitBuffer records = sync(changes, frame);
-  for (auto& channel : channels_) channel->publish(records, [this] { return snapshot(); });
-  return records;
-}
-
-std::shared_ptr<commit::CommitChannel> WorldSync::add_tracer() {
-  auto channel = std::make_shared<commit::CommitChannel>(options_.commit_budget_bytes, snapshot(), master_.version);
-  channels_.push_back(channel);
-  return channel;
-}
-
 std::shared_ptr<const commit::TracerScene> WorldSync::snapshot() {
   if (!snapshot_) snapshot_ = std::make_shared<const commit::TracerScene>(master_);
   return snapshot_;

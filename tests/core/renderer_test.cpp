@@ -150,7 +150,7 @@ TEST(Renderer, WhenEveryTracerFailsTheFrameThrowsWithTheReason) {
   EXPECT_NO_THROW(renderer.render(job_for(1), fb));  // it rejoins on the next frame
 }
 
-TEST(Renderer, CommitsReachEveryTracerInOrderIncludingOnesThatMissedFrames) {
+TEST(Renderer, CommitsSubmittedBetweenFramesCoalesceIntoOne) {
   auto m = model();
   auto a = std::make_unique<SimulatedTracer>(m, sim(1));
   SimulatedTracer* a_view = a.get();
@@ -164,10 +164,11 @@ TEST(Renderer, CommitsReachEveryTracerInOrderIncludingOnesThatMissedFrames) {
   renderer.submit_commit(cohort::commit::CommitBuffer::full(scene, 2));
   FrameBuffer fb;
   renderer.render(job_for(0), fb);
-  EXPECT_EQ(a_view->commits_applied(), 2u);
+  EXPECT_EQ(a_view->commits_applied(), 1u);  // frames 1 and 2 arrive as one commit
   EXPECT_EQ(a_view->last_commit_frame(), 2u);
+  EXPECT_EQ(renderer.commit_stats(0).frames_coalesced, 1u);
   renderer.render(job_for(1), fb);
-  EXPECT_EQ(a_view->commits_applied(), 2u);  // nothing new: nothing applied
+  EXPECT_EQ(a_view->commits_applied(), 1u);  // nothing new: nothing applied
 }
 
 TEST(Renderer, RejectsNoTracersAndUnknownBalancers) {
@@ -227,4 +228,88 @@ TEST(Renderer, PerRowWorkCountsReachTheBalancer) {
   const double with_counts = idle_after_one_measured_frame(true), without = idle_after_one_measured_frame(false);
   EXPECT_LT(with_counts, 4.0);  // what is left is rounding to 4-row units
   EXPECT_LT(2.0 * with_counts, without);
+}
+
+namespace {
+
+// A frame's records that a tracer can apply: a camera change.
+cohort::commit::CommitBuffer camera_records(uint64_t frame) {
+  cohort::commit::CommitBuffer c;
+  c.set_frame(frame);
+  c.set_camera(spin_camera(kWidth, kRows, 0.01 * static_cast<double>(frame)));
+  return c;
+}
+
+}  // namespace
+
+TEST(Renderer, ATracerWhoseCommitThrowsSitsOutUntilItsFullResync) {
+  auto m = model();
+  SimulatedTracerOptions failing = sim(2);
+  failing.throw_on_commits = {3};
+  auto b = std::make_unique<SimulatedTracer>(m, failing);
+  SimulatedTracer* b_view = b.get();
+  std::vector<std::unique_ptr<Tracer>> tracers;
+  tracers.push_back(std::make_unique<SimulatedTracer>(m, sim(1)));
+  tracers.push_back(std::move(b));
+  RendererOptions options;
+  options.use_reported_time = true;
+  Renderer renderer(std::move(tracers), options);
+  auto master = std::make_shared<cohort::commit::TracerScene>();
+  renderer.submit_commit(cohort::commit::CommitBuffer::full(master, 0));
+  FrameBuffer fb;
+  for (uint64_t f = 1; f <= 6; ++f) {
+    renderer.submit_commit(camera_records(f), [&] { return master; });
+    const FrameStats stats = renderer.render(job_for(f), fb);
+    expect_complete(fb, f, stats, {1, 2});
+    const TracerFrameStats& t = stats.tracers[1];
+    if (f == 3) {
+      EXPECT_EQ(t.outcome, TracerOutcome::threw) << "frame " << f;
+      EXPECT_NE(t.error.find("does not fit"), std::string::npos) << t.error;
+    } else {
+      EXPECT_EQ(t.outcome, TracerOutcome::rendered) << "frame " << f;
+    }
+  }
+  EXPECT_EQ(b_view->full_resyncs_applied(), 2u);  // the initial one and the one after the failure
+  EXPECT_EQ(renderer.commit_stats(1).resyncs_requested, 1u);
+  EXPECT_EQ(b_view->last_commit_frame(), 6u);
+}
+
+TEST(Renderer, PendingCommitsOverTheBudgetBecomeAFullResync) {
+  auto a = std::make_unique<SimulatedTracer>(model(), sim(1));
+  SimulatedTracer* view = a.get();
+  std::vector<std::unique_ptr<Tracer>> tracers;
+  tracers.push_back(std::move(a));
+  RendererOptions options;
+  options.use_reported_time = true;
+  options.commit_budget_bytes = 200;  // one light record is about 200 bytes
+  Renderer renderer(std::move(tracers), options);
+  auto master = std::make_shared<cohort::commit::TracerScene>();
+  renderer.submit_commit(cohort::commit::CommitBuffer::full(master, 0));
+  FrameBuffer fb;
+  renderer.render(job_for(0), fb);
+  for (uint64_t f = 1; f <= 3; ++f) {  // camera records coalesce, so use lights: each adds bytes
+    cohort::commit::CommitBuffer c;
+    c.set_frame(f);
+    c.set_light_count(static_cast<uint32_t>(f));
+    for (uint32_t i = 0; i < f; ++i) c.set_light(i, KLight{});
+    renderer.submit_commit(c, [&] { return master; });
+  }
+  renderer.render(job_for(1), fb);
+  EXPECT_GE(renderer.commit_stats(0).overflows, 1u);
+  EXPECT_EQ(view->full_resyncs_applied(), 2u);
+  EXPECT_EQ(view->last_commit_frame(), 3u);
+}
+
+TEST(Renderer, AResyncWithoutASnapshotOfIncrementalRecordsIsAnError) {
+  std::vector<std::unique_ptr<Tracer>> tracers;
+  tracers.push_back(std::make_unique<SimulatedTracer>(model(), sim(1)));
+  RendererOptions options;
+  options.commit_budget_bytes = 100;
+  Renderer renderer(std::move(tracers), options);
+  renderer.submit_commit(cohort::commit::CommitBuffer::full(std::make_shared<cohort::commit::TracerScene>(), 0));
+  cohort::commit::CommitBuffer big;
+  big.set_frame(1);
+  big.set_light_count(4);
+  for (uint32_t i = 0; i < 4; ++i) big.set_light(i, KLight{});
+  EXPECT_THROW(renderer.submit_commit(big), std::logic_error);
 }

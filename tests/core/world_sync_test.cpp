@@ -5,6 +5,7 @@
 
 #include "../scene/render_world_fixture.h"
 #include "cohort/commit/array_diff.h"
+#include "cohort/commit/commit_channel.h"
 #include "cohort/core/gpu_scene.h"
 #include "cohort/core/world_sync.h"
 #include "cohort/scene/render_world_stream.h"
@@ -34,6 +35,17 @@ scene::Scene scene_of(const RenderWorld& world) {
   for (size_t h = 0; h < world.light_defs().size(); ++h)
     if (world.light_defs()[h]) s.lights.push_back(world.scene_light(int(h)));
   return s;
+}
+
+// A tracer's channel as the Renderer keeps one: its first commit is a full resync to the master.
+std::shared_ptr<commit::CommitChannel> channel_of(WorldSync& sync, size_t budget = 32u << 20) {
+  return std::make_shared<commit::CommitChannel>(budget, sync.snapshot(), sync.master().version);
+}
+
+// One frame's records to every channel, with the master's snapshot for any full resync.
+void publish(WorldSync& sync, const commit::CommitBuffer& records,
+             const std::vector<std::shared_ptr<commit::CommitChannel>>& channels) {
+  for (const auto& channel : channels) channel->publish(records, [&] { return sync.snapshot(); });
 }
 
 std::string first_difference(const commit::TracerScene& a, const commit::TracerScene& b) {
@@ -106,7 +118,7 @@ TEST(WorldSync, ReplayedStreamGivesTheSameTracerSceneEveryFrame) {
   WorldSync direct_sync(direct);
   RenderWorld replayed(scene::world_testing::small_map());
   WorldSync replay_sync(replayed);
-  auto channel = replay_sync.add_tracer();
+  auto channel = channel_of(replay_sync);
   commit::TracerScene tracer;
 
   scene::Player player(file);
@@ -117,7 +129,7 @@ TEST(WorldSync, ReplayedStreamGivesTheSameTracerSceneEveryFrame) {
     direct.EndFrame();
     direct_sync.sync(direct.TakeChanges(), uint64_t(f + 1));
     ASSERT_TRUE(player.play_frame(replayed));
-    replay_sync.sync_and_publish(replayed.TakeChanges(), uint64_t(f + 1));
+    publish(replay_sync, replay_sync.sync(replayed.TakeChanges(), uint64_t(f + 1)), {channel});
     ASSERT_EQ(first_difference(direct_sync.master(), replay_sync.master()), "") << "frame " << f;
     commit::apply_commit(channel->begin_frame(), tracer);
     ASSERT_EQ(first_difference(tracer, replay_sync.master()), "") << "tracer copy, frame " << f;
@@ -133,14 +145,14 @@ TEST(WorldSync, TracersThatSkipFramesConvergeToTheMaster) {
   const int periods[] = {1, 4, 7, 1000};
   std::vector<std::shared_ptr<commit::CommitChannel>> channels;
   std::vector<commit::TracerScene> tracers(std::size(periods));
-  for (size_t t = 0; t < std::size(periods); ++t) channels.push_back(sync.add_tracer());
+  for (size_t t = 0; t < std::size(periods); ++t) channels.push_back(channel_of(sync));
   scene::Scenario scenario(world);
   const int frames = 80;
   for (int f = 0; f < frames; ++f) {
     define_and_free(world, f);
     scenario.frame(f);
     world.EndFrame();
-    sync.sync_and_publish(world.TakeChanges(), uint64_t(f + 1));
+    publish(sync, sync.sync(world.TakeChanges(), uint64_t(f + 1)), channels);
     for (size_t t = 0; t < std::size(periods); ++t)
       if ((f + 1) % periods[t] == 0 || f + 1 == frames) commit::apply_commit(channels[t]->begin_frame(), tracers[t]);
   }
@@ -187,10 +199,8 @@ TEST(WorldSync, RuntimeModelMaterialAndTextureReachTheTracerScene) {
 
 TEST(WorldSync, OverflowingTheBudgetGivesAFullResyncThatConverges) {
   RenderWorld world(scene::world_testing::small_map());
-  WorldSyncOptions options;
-  options.commit_budget_bytes = 1024;
-  WorldSync sync(world, options);
-  auto channel = sync.add_tracer();
+  WorldSync sync(world);
+  auto channel = channel_of(sync, 1024);
   commit::TracerScene tracer;
   commit::apply_commit(channel->begin_frame(), tracer);
   scene::Scenario scenario(world);
@@ -198,7 +208,7 @@ TEST(WorldSync, OverflowingTheBudgetGivesAFullResyncThatConverges) {
     define_and_free(world, f);
     scenario.frame(f);
     world.EndFrame();
-    sync.sync_and_publish(world.TakeChanges(), uint64_t(f + 1));
+    publish(sync, sync.sync(world.TakeChanges(), uint64_t(f + 1)), {channel});
   }
   const commit::CommitBuffer& commit = channel->begin_frame();
   EXPECT_TRUE(commit.is_full_resync());

@@ -56,6 +56,7 @@ class CommitBuffer {
   bool is_full_resync() const { return full_ != nullptr; }
   uint64_t frame() const { return frame_; }
   const TracerScene* full_scene() const { return full_.get(); }
+  const std::shared_ptr<const TracerScene>& shared_full_scene() const { return full_; }
 
   // ---- Filling (the core side). Each call replaces any earlier record for the same element. ----
   void set_frame(uint64_t frame) { frame_ = frame; }

@@ -48,6 +48,8 @@ class CommitChannel {
 
   // Tracer thread: the last commit could not be applied; the next publish sends a full resync.
   void request_resync();
+  // Whether a resync was requested and no publish has answered it yet.
+  bool resync_requested() const;
 
   CommitStats stats() const;
   size_t byte_budget() const { return byte_budget_; }

@@ -26,7 +26,7 @@ struct TracerFrameStats {
   TracerOutcome outcome = TracerOutcome::rendered;
   std::string error;           // what it threw, for TracerOutcome::threw
   int row_begin = 0, row_end = 0;
-  double ms = 0.0;             // measured band time (virtual time: what the tracer reported)
+  double ms = 0.0;             // measured cost: commit apply + band render (virtual time: what the tracer reported)
   double idle_ms = 0.0;        // frame_ms - ms for tracers that rendered
   int recovery_rows = 0;       // rows it re-rendered for dropped tracers
   double recovery_ms = 0.0;

@@ -2,10 +2,12 @@
 // for row bands, hands every tracer its job, and waits; there is no communication with a tracer while
 // it renders. Each tracer renders into its own full-size buffer and the core merges the bands.
 //
-// Commits: submit_commit() queues a commit for every tracer while they render; at the start of its
-// next job a tracer applies, in order, every commit queued since its last job (a tracer that missed
-// frames catches up on all of them). This queue is unbounded and does not coalesce; the bounded,
-// coalescing commit::CommitChannel that WorldSync feeds (docs/commit-buffers.md) is meant to replace it.
+// Commits travel one way: every tracer has its own commit::CommitChannel (docs/commit-buffers.md), a
+// pair of buffers with a byte budget. submit_commit() folds a frame's records into every tracer's
+// pending buffer while they render; when a job is handed out, the pending buffer becomes the one the
+// tracer applies before rendering (a tracer that missed frames gets them coalesced into one commit).
+// A pending buffer over budget becomes a full resync to the caller's snapshot, and so does the next
+// commit of a tracer whose apply() threw: such a tracer renders nothing until it has its resync.
 //
 // Faults: a tracer that throws, or has not finished when the frame timeout expires, is dropped for the
 // frame; its rows are split among the tracers that finished and re-rendered, and the frame is still
@@ -21,6 +23,7 @@
 
 #include "cohort/balance/balancer.h"
 #include "cohort/commit/commit_buffer.h"
+#include "cohort/commit/commit_channel.h"
 #include "cohort/core/frame_buffer.h"
 #include "cohort/core/frame_stats.h"
 #include "cohort/core/tracer.h"
@@ -36,6 +39,8 @@ struct RendererOptions {
   bool use_reported_time = false;
   // Pass the tracers' per-row work counts (BandResult::row_work) to the balancer as its cost proxy.
   bool use_row_work = true;
+  // Per tracer: past this many bytes of pending records, it gets a full resync instead.
+  size_t commit_budget_bytes = 32u << 20;
 };
 
 class Renderer {
@@ -48,9 +53,14 @@ class Renderer {
   Renderer(const Renderer&) = delete;
   Renderer& operator=(const Renderer&) = delete;
 
-  // Queue a commit for every tracer (or one) for their next job. Thread-safe against running frames.
-  void submit_commit(const commit::CommitBuffer& commit);
-  void submit_commit(int tracer, const commit::CommitBuffer& commit);
+  // Fold a frame's records into every tracer's pending commit, for their next job. `snapshot` returns
+  // the scene with these records applied (WorldSync::snapshot); it is called only when a tracer needs
+  // a full resync, and may be left out for full commits. Submitting incremental records without one
+  // and then needing a resync throws std::logic_error. The first commit seeds the channels: a full
+  // one, or an incremental one over an empty scene. Call from the core's thread.
+  void submit_commit(const commit::CommitBuffer& records, commit::CommitChannel::Snapshot snapshot = {});
+  // Per tracer: the channel's counts (bytes, coalesced frames, overflows, resyncs).
+  commit::CommitStats commit_stats(int tracer) const;
 
   // Render one frame of job.camera.width x job.camera.height into `out` (resized if needed).
   // job.params.row_begin/row_end are set per band. row_cost_proxy (optional, one value per row) is
@@ -101,6 +111,7 @@ class Renderer {
   RoundResult collect(const std::vector<Assignment>& assignments, const std::vector<uint64_t>& ids, FrameBuffer& out,
                       std::chrono::steady_clock::time_point deadline, std::vector<StageSpan>& stages);
   double measured_ms(const Worker& w) const;
+  std::shared_ptr<const commit::TracerScene> resync_scene();
 
   RendererOptions options_;
   std::unique_ptr<balance::Balancer> balancer_;
@@ -109,6 +120,10 @@ class Renderer {
   std::vector<float> row_work_;            // this frame's per-row work counts, as tracers report them
   std::vector<uint8_t> row_work_known_;
   uint64_t next_job_ = 1;
+  commit::CommitChannel::Snapshot snapshot_;                 // the latest submitted records' scene
+  std::shared_ptr<const commit::TracerScene> full_scene_;    // the latest full commit's scene
+  bool records_since_full_ = false;
+  uint64_t commit_frame_ = 0;                                // frame of the latest submitted commit
   std::unique_ptr<PendingFrame> pending_;
 };
 

@@ -54,6 +54,7 @@ struct SimulatedTracerOptions {
   bool report_row_work = false;
   double row_work_error = 0.2;
   std::set<uint64_t> throw_on_frames;  // render_band throws on these frame indices
+  std::set<uint64_t> throw_on_commits; // apply throws on commits of these frames (incremental ones only)
   std::set<uint64_t> hang_on_frames;   // render_band blocks for hang_ms (real time) on these frames
   double hang_ms = 0.0;
 };
@@ -69,12 +70,14 @@ class SimulatedTracer final : public Tracer {
 
   uint64_t commits_applied() const { return commits_applied_; }
   uint64_t last_commit_frame() const { return last_commit_frame_; }
+  uint64_t full_resyncs_applied() const { return full_resyncs_applied_; }
 
  private:
   std::shared_ptr<const SpinSceneCostModel> model_;
   SimulatedTracerOptions options_;
   uint64_t commits_applied_ = 0;
   uint64_t last_commit_frame_ = 0;
+  uint64_t full_resyncs_applied_ = 0;
 };
 
 }  // namespace cohort::core

@@ -14,7 +14,8 @@
 //   scene::RenderWorld world(load the map);
 //   WorldSync sync(world, options);
 //   while (player.play_frame(world)) {
-//     renderer.submit_commit(sync.sync(world.TakeChanges(), frame));   // or sync_and_publish + channels
+//     renderer.submit_commit(sync.sync(world.TakeChanges(), frame), [&] { return sync.snapshot(); });
+//     (the Renderer hands the records to every tracer through its commit channel)
 //     render with sync.master().camera ...
 //   }
 #pragma once
@@ -27,7 +28,6 @@
 #include <vector>
 
 #include "cohort/commit/commit_buffer.h"
-#include "cohort/commit/commit_channel.h"
 #include "cohort/core/frame_defaults.h"
 #include "cohort/core/gpu_scene.h"
 #include "cohort/scene/render_world.h"
@@ -37,7 +37,6 @@ namespace cohort::core {
 struct WorldSyncOptions {
   GpuSceneOptions gpu;
   uint32_t width = kDefaultWidth, height = kDefaultHeight;  // written into KCamera
-  size_t commit_budget_bytes = 32u << 20;  // per tracer; past it the tracer gets a full resync
 };
 
 struct WorldSyncStats {  // of the last sync()
@@ -56,13 +55,6 @@ class WorldSync {
 
   // Fold the world's changes (world.TakeChanges()) into the master; returns the frame's records.
   commit::CommitBuffer sync(const scene::ChangeLog& changes, uint64_t frame);
-  // sync() and hand the records to every tracer's channel.
-  commit::CommitBuffer sync_and_publish(const scene::ChangeLog& changes, uint64_t frame);
-
-  // A tracer's channel: its first commit is a full resync to the master as it is now.
-  std::shared_ptr<commit::CommitChannel> add_tracer();
-  const std::vector<std::shared_ptr<commit::CommitChannel>>& channels() const { return channels_; }
-
   const commit::TracerScene& master() const { return master_; }
   // An immutable copy of the master, shared by every full resync of the same frame.
   std::shared_ptr<const commit::TracerScene> snapshot();
@@ -95,7 +87,6 @@ class WorldSync {
   std::map<int, KLight> lights_by_handle_;
   uint32_t base_material_count_ = 0;              // the map's materials; the default material's index
   std::vector<std::array<KTexture, kTextureUseCount>> image_textures_;  // per scene image and use
-  std::vector<std::shared_ptr<commit::CommitChannel>> channels_;
   std::shared_ptr<const commit::TracerScene> snapshot_;
   WorldSyncStats stats_;
 };
