@@ -147,8 +147,8 @@ int run_play(PlayArgs a) {
           else window->request_close();
           break;
         case Action::toggle_mouse_capture: window->set_mouse_captured(!window->mouse_captured()); break;
-        case Action::next_mode: settings.mode = (settings.mode + 1) % 7; break;
-        case Action::previous_mode: settings.mode = (settings.mode + 6) % 7; break;
+        case Action::next_mode: settings.mode = (settings.mode + 1) % K_MODE_COUNT; break;
+        case Action::previous_mode: settings.mode = (settings.mode + K_MODE_COUNT - 1) % K_MODE_COUNT; break;
         case Action::set_mode_0: case Action::set_mode_1: case Action::set_mode_2: case Action::set_mode_3:
         case Action::set_mode_4: case Action::set_mode_5: case Action::set_mode_6:
           settings.mode = static_cast<kuint>(static_cast<int>(action) - static_cast<int>(Action::set_mode_0));
