@@ -10,10 +10,7 @@
 #include "cohort/core/gpu_scene.h"
 #include "cohort/core/renderer.h"
 #include "cohort/core/tonemap.h"
-#if __has_include("cohort/core/world_sync.h")
 #include "cohort/core/world_sync.h"
-#define COHORT_PLAY_HAS_WORLD_SYNC 1
-#endif
 #include "cohort/scene/map_loader.h"
 #include "cohort/scene/render_world.h"
 #include "cohort/scene/scenario.h"
@@ -59,9 +56,7 @@ struct PlaySession::State {
   explicit State(scene::Scene loaded) : world(std::move(loaded)) {}
 
   scene::RenderWorld world;
-#ifdef COHORT_PLAY_HAS_WORLD_SYNC
   std::unique_ptr<core::WorldSync> sync;
-#endif
   std::unique_ptr<scene::Scenario> scenario;
   std::unique_ptr<core::Renderer> renderer;
   core::AdaptiveConvergence convergence;
@@ -77,12 +72,8 @@ PlaySession::PlaySession(const SessionOptions& options) {
   state_ = std::make_unique<State>(load_scene(options));
   State& s = *state_;
   s.map_name = s.world.scene().name.empty() ? options.map : s.world.scene().name;
-#ifdef COHORT_PLAY_HAS_WORLD_SYNC
   s.sync = std::make_unique<core::WorldSync>(s.world, core::compile_scene(s.world.scene()));
   auto initial_scene = s.sync->snapshot();
-#else
-  auto initial_scene = std::make_shared<const commit::TracerScene>(core::compile_scene(s.world.scene()).tracer_scene);
-#endif
 
   const std::string list = options.tracers.empty() ? std::string("all") : options.tracers;
   std::vector<std::unique_ptr<core::Tracer>> tracers;
@@ -104,15 +95,7 @@ PlaySession::PlaySession(const SessionOptions& options) {
   s.renderer = std::make_unique<core::Renderer>(std::move(tracers), renderer_options);
   s.renderer->submit_commit(commit::CommitBuffer::full(initial_scene, 0));
 
-#ifndef COHORT_PLAY_HAS_WORLD_SYNC
   if (options.scenario) {
-    warnings_.push_back("scenario off: this build has no core world sync (core/world_sync.h), the scene stays still");
-    spdlog::warn("{}", warnings_.back());
-  }
-  if (false) {
-#else
-  if (options.scenario) {
-#endif
     try {
       s.scenario = std::make_unique<scene::Scenario>(s.world);
     } catch (const scene::ScenarioError& e) {
@@ -154,13 +137,8 @@ SessionFrame PlaySession::frame(const viewer::FlyCamera& camera, double seconds,
   s.world.EndFrame();
 
   ++s.frame_index;
-#ifdef COHORT_PLAY_HAS_WORLD_SYNC
   const commit::CommitBuffer commit = s.sync->sync(s.world.TakeChanges(), s.frame_index);
   s.renderer->submit_commit(commit);
-#else
-  s.world.TakeChanges();
-  const commit::CommitBuffer commit;
-#endif
 
   core::BandJob job;
   job.camera = camera.to_kcamera(settings.width, settings.height);
