@@ -5,6 +5,7 @@
 
 #include "balance_bench.h"
 #include "commands.h"
+#include "default_map.h"
 
 namespace cohort::app {
 
@@ -43,7 +44,7 @@ void add_bench_command(CLI::App& app) {
       "results are reproducible.");
   struct Args {
     std::string balancers, tracers = "2,3,4", speeds = "1", path = "both", real, json, plot;
-    std::string scene = "assets/testmap/maps/testmap.map";
+    std::string scene = kTestMapFile;
     double noise = 0.02, row_work_error = 0.2;
     bool row_work = true;
     std::string clock = "virtual";

@@ -2,6 +2,7 @@
 
 #include "cohort/scene/map_loader.h"
 #include "commands.h"
+#include "default_map.h"
 
 namespace cohort::app {
 
@@ -62,14 +63,7 @@ void add_info_command(CLI::App& app) {
                                     "override earlier ones (default: assets/testmap)");
   cmd->add_option("--max-warnings", *max_warnings, "how many warnings to print");
   cmd->callback([map, bases, max_warnings] {
-    std::vector<std::string> folders = *bases;
-    if (folders.empty()) {
-      std::error_code ec;
-      std::filesystem::path fallback = "assets/testmap";
-      if (!std::filesystem::is_directory(fallback, ec)) fallback = std::filesystem::path(COHORT_SOURCE_DIR) / "assets/testmap";
-      if (std::filesystem::is_directory(fallback, ec)) folders.push_back(fallback.string());
-    }
-    std::exit(run_info(*map, folders, *max_warnings));
+    std::exit(run_info(*map, bases_or_test_map(*bases), *max_warnings));
   });
 }
 

@@ -11,6 +11,7 @@
 #include "cohort/balance/balancer.h"
 #include "cohort/core/image_output.h"
 #include "commands.h"
+#include "default_map.h"
 #include "play_session.h"
 #include "viewer/hud.h"
 #include "viewer/viewer_actions.h"
@@ -33,14 +34,6 @@ struct PlayArgs {
   std::string screenshot;    // written from the last frame
   std::string window_shot;   // the last frame as the window showed it, HUD included
 };
-
-std::vector<std::string> default_bases() {
-  std::error_code ec;
-  std::filesystem::path fallback = "assets/testmap";
-  if (!std::filesystem::is_directory(fallback, ec)) fallback = std::filesystem::path(COHORT_SOURCE_DIR) / "assets/testmap";
-  if (std::filesystem::is_directory(fallback, ec)) return {fallback.string()};
-  return {};
-}
 
 std::string key_help() {
   std::string out = "\nKeys:\n";
@@ -93,7 +86,7 @@ struct Notice {
 
 int run_play(PlayArgs a) {
   using clock = std::chrono::steady_clock;
-  if (a.session.bases.empty()) a.session.bases = default_bases();
+  a.session.bases = bases_or_test_map(a.session.bases);
   std::unique_ptr<PlaySession> session;
   try {
     session = std::make_unique<PlaySession>(a.session);

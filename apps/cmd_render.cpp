@@ -21,6 +21,7 @@
 #include "cohort/core/renderer.h"
 #include "commands.h"
 #include "camera_path.h"
+#include "default_map.h"
 #include "progress_bar.h"
 #include "render_scene_source.h"
 #include "tone_map.h"
@@ -53,16 +54,6 @@ const std::map<std::string, uint32_t>& modes() {
       {"path", K_MODE_PATH},         {"direct", K_MODE_DIRECT}, {"albedo", K_MODE_ALBEDO}, {"normals", K_MODE_NORMALS},
       {"specular", K_MODE_SPECULAR}, {"bvh", K_MODE_BVH},       {"triangles", K_MODE_TRIANGLES}};
   return m;
-}
-
-// Like `cohort info` and `cohort play`: with no --base, the bundled test map's folder.
-std::vector<std::string> bases_or_test_map(const std::vector<std::string>& bases) {
-  if (!bases.empty()) return bases;
-  std::error_code ec;
-  std::filesystem::path fallback = "assets/testmap";
-  if (!std::filesystem::is_directory(fallback, ec)) fallback = std::filesystem::path(COHORT_SOURCE_DIR) / "assets/testmap";
-  if (std::filesystem::is_directory(fallback, ec)) return {fallback.string()};
-  return {};
 }
 
 int run_render(const RenderArgs& a) {

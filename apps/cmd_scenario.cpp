@@ -8,6 +8,7 @@
 #include "cohort/scene/render_world_stream.h"
 #include "cohort/scene/scenario.h"
 #include "commands.h"
+#include "default_map.h"
 
 namespace cohort::app {
 namespace {
@@ -20,19 +21,10 @@ struct ScenarioArgs {
   std::string out = "out/scenario.cds";
 };
 
-std::vector<std::string> base_folders(const std::vector<std::string>& given) {
-  if (!given.empty()) return given;
-  std::error_code ec;
-  std::filesystem::path fallback = "assets/testmap";
-  if (!std::filesystem::is_directory(fallback, ec)) fallback = std::filesystem::path(COHORT_SOURCE_DIR) / "assets/testmap";
-  if (std::filesystem::is_directory(fallback, ec)) return {fallback.string()};
-  return {};
-}
-
 int run_record_scenario(const ScenarioArgs& args) {
   try {
     scene::Vfs vfs;
-    for (const std::string& base : base_folders(args.bases)) vfs.add_search_path(base);
+    for (const std::string& base : bases_or_test_map(args.bases)) vfs.add_search_path(base);
     scene::RenderWorld world(scene::load_map(vfs, args.map));
     std::filesystem::path out(args.out);
     if (out.has_parent_path()) std::filesystem::create_directories(out.parent_path());
