@@ -91,9 +91,9 @@ int run_play(PlayArgs a) {
   try {
     session = std::make_unique<PlaySession>(a.session);
   } catch (const std::exception& e) {
-    std::cerr << "cohort play: cannot start on '" << a.session.map << "': " << e.what() << "\n";
+    spdlog::error("cohort play: cannot start on '{}': {}", a.session.map, e.what());
     if (a.session.bases.empty())
-      std::cerr << "  (no --base folder given and assets/testmap not found: point --base at a game's base/ folder)\n";
+      spdlog::error("  (no --base folder given and {} not found: point --base at a game's base/ folder)", kTestMapBase);
     return kExitFailure;
   }
 
@@ -101,7 +101,7 @@ int run_play(PlayArgs a) {
   try {
     window = std::make_unique<viewer::GlWindow>(a.width, a.height, "Cohort - " + session->map_name());
   } catch (const viewer::WindowUnavailable& e) {
-    std::cerr << "cohort play: " << e.what() << "\n";
+    spdlog::error("cohort play: {}", e.what());
     return kExitUnavailable;
   }
   spdlog::info("viewer: OpenGL {}; tracers: {}", window->gl_description(), fmt::join(session->tracer_names(), ", "));
@@ -189,7 +189,7 @@ int run_play(PlayArgs a) {
       last = session->frame(camera, dt, settings);
       have_frame = true;
     } catch (const std::exception& e) {
-      std::cerr << "cohort play: the frame could not be rendered: " << e.what() << "\n";
+      spdlog::error("cohort play: the frame could not be rendered: {}", e.what());
       exit_code = kExitFailure;
       break;
     }
@@ -243,14 +243,14 @@ int run_play(PlayArgs a) {
     try {
       core::write_ldr_image(a.window_shot, window_image.width, window_image.height, window_image.rgba);
     } catch (const std::exception& e) {
-      std::cerr << "cohort play: " << e.what() << "\n";
+      spdlog::error("cohort play: {}", e.what());
       return kExitFailure;
     }
   }
 
   if (!a.screenshot.empty()) {
     if (!have_frame) {
-      std::cerr << "cohort play: no frame was rendered, so no screenshot was written\n";
+      spdlog::error("cohort play: no frame was rendered, so no screenshot was written");
       return kExitFailure;
     }
     try {
@@ -258,7 +258,7 @@ int run_play(PlayArgs a) {
       std::cout << "wrote " << a.screenshot << " (" << last.width << "x" << last.height << ", after " << frames_done
                 << " frames)\n";
     } catch (const std::exception& e) {
-      std::cerr << "cohort play: " << e.what() << "\n";
+      spdlog::error("cohort play: {}", e.what());
       return kExitFailure;
     }
   }
@@ -269,7 +269,7 @@ int run_play(PlayArgs a) {
 
 }  // namespace
 
-void add_play_command(CLI::App& app) {
+void add_play_command(CLI::App& app, int& exit_code) {
   auto* cmd = app.add_subcommand("play", "Open a window and fly through a map rendered live on every tracer");
   cmd->footer(key_help());
   auto a = std::make_shared<PlayArgs>();
@@ -300,16 +300,16 @@ void add_play_command(CLI::App& app) {
   cmd->add_option("--screenshot", a->screenshot, "write the last frame to this image file on exit");
   cmd->add_option("--window-screenshot", a->window_shot, "with --frames: write what the window showed last (the "
                                                          "frame scaled to the window, HUD included)");
-  cmd->callback([a] {
+  cmd->callback([a, &exit_code] {
 #ifdef COHORT_HAVE_VIEWER
-    const int code = run_play(*a);
-    if (code != kExitOk) std::exit(code);
+    exit_code = run_play(*a);
 #else
-    std::cerr << "cohort play: this binary was built without the viewer (GLFW and OpenGL were not found, or "
-                 "COHORT_WITH_VIEWER=OFF).\n  Install them (tools/setup.sh installs libglfw3-dev and the OpenGL "
-                 "headers), then reconfigure with -DCOHORT_WITH_VIEWER=ON and rebuild;\n  `cohort render "
-              << a->session.map << "` writes images without a window.\n";
-    std::exit(kExitUnavailable);
+    spdlog::error("cohort play: this binary was built without the viewer (GLFW and OpenGL were not found, or "
+                  "COHORT_WITH_VIEWER=OFF).\n  Install them (tools/setup.sh installs libglfw3-dev and the OpenGL "
+                  "headers), then reconfigure with -DCOHORT_WITH_VIEWER=ON and rebuild;\n  `cohort render {}` "
+                  "writes images without a window.",
+                  a->session.map);
+    exit_code = kExitUnavailable;
 #endif
   });
 }

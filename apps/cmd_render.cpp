@@ -158,7 +158,7 @@ int run_render(const RenderArgs& a) {
 
 }  // namespace
 
-void add_render_command(CLI::App& app) {
+void add_render_command(CLI::App& app, int& exit_code) {
   auto* cmd = app.add_subcommand("render", "Render frames headless on the chosen tracers and write images and a "
                                            "JSON of per-frame stats");
   auto a = std::make_shared<RenderArgs>();
@@ -210,10 +210,9 @@ void add_render_command(CLI::App& app) {
   cmd->add_option("--soft-shadows", a->soft_shadow_scale, "scale of the lights' soft-shadow extent")
       ->capture_default_str();
   cmd->add_option("--out", a->out, "output folder")->capture_default_str();
-  cmd->callback([a, frames_option] {
+  cmd->callback([a, frames_option, &exit_code] {
     a->frames_given = frames_option->count() > 0;
-    int code = run_render(*a);
-    if (code != kExitOk) std::exit(code);
+    exit_code = run_render(*a);
   });
 }
 

@@ -4,6 +4,8 @@
 #include <filesystem>
 #include <iostream>
 
+#include <spdlog/spdlog.h>
+
 #include "cohort/scene/map_loader.h"
 #include "cohort/scene/render_world_stream.h"
 #include "cohort/scene/scenario.h"
@@ -38,18 +40,15 @@ int run_record_scenario(const ScenarioArgs& args) {
     std::cout << "recorded " << recorder.frames_written() << " frames of '" << world.scene().name << "' to " << args.out
               << " (" << recorder.bytes_written() << " bytes)\n";
     return kExitOk;
-  } catch (const scene::ScenarioError& e) {
-    std::cerr << "cohort record-scenario: " << e.what() << "\n";
-    return kExitFailure;
-  } catch (const std::exception& e) {
-    std::cerr << "cohort record-scenario: " << e.what() << "\n";
+  } catch (const std::exception& e) {  // scene::ScenarioError (entities the map lacks) included
+    spdlog::error("cohort record-scenario: {}", e.what());
     return kExitFailure;
   }
 }
 
 }  // namespace
 
-void add_scenario_command(CLI::App& app) {
+void add_scenario_command(CLI::App& app, int& exit_code) {
   auto* cmd = app.add_subcommand("record-scenario",
                                  "Drive the test map through the scene-delta API (door_main opens, fan_spin spins, "
                                  "light_flicker flickers, a flashlight follows the camera path) and record the "
@@ -64,7 +63,7 @@ void add_scenario_command(CLI::App& app) {
       ->capture_default_str();
   cmd->add_option("--out", args->out, "delta stream file to write (format: docs/delta-stream.md)")
       ->capture_default_str();
-  cmd->callback([args] { std::exit(run_record_scenario(*args)); });
+  cmd->callback([args, &exit_code] { exit_code = run_record_scenario(*args); });
 }
 
 }  // namespace cohort::app

@@ -1,6 +1,3 @@
-#include <cstdlib>
-#include <iostream>
-
 #include <spdlog/spdlog.h>
 
 #include "commands.h"
@@ -19,12 +16,13 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   app.footer("Run 'cohort <command> --help' for a command's options. See README.md for examples.");
 
-  cohort::app::add_info_command(app);
-  cohort::app::add_render_command(app);
-  cohort::app::add_play_command(app);
-  cohort::app::add_bench_command(app);
-  cohort::app::add_pack_command(app);
-  cohort::app::add_scenario_command(app);
+  int exit_code = cohort::app::kExitOk;
+  cohort::app::add_info_command(app, exit_code);
+  cohort::app::add_render_command(app, exit_code);
+  cohort::app::add_play_command(app, exit_code);
+  cohort::app::add_bench_command(app, exit_code);
+  cohort::app::add_pack_command(app, exit_code);
+  cohort::app::add_scenario_command(app, exit_code);
 
   app.parse_complete_callback([&] { spdlog::set_level(spdlog::level::from_str(log_level)); });
   try {
@@ -35,5 +33,5 @@ int main(int argc, char** argv) {
     spdlog::error("{}", e.what());
     return cohort::app::kExitFailure;
   }
-  return cohort::app::kExitOk;
+  return exit_code;
 }
