@@ -1,5 +1,6 @@
 // `cohort render`: headless frames on one or more tracers (rows split by the balancer), written as
 // tone-mapped LDR and linear HDR images plus a JSON of per-frame stats.
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
@@ -19,12 +20,12 @@
 #include <limits>
 #include "cohort/core/image_output.h"
 #include "cohort/core/renderer.h"
+#include "cohort/core/tonemap.h"
 #include "commands.h"
 #include "camera_path.h"
 #include "default_map.h"
 #include "progress_bar.h"
 #include "render_scene_source.h"
-#include "tone_map.h"
 #include "tracer_factory.h"
 
 namespace cohort::app {
@@ -48,6 +49,17 @@ struct RenderArgs {
   std::string replay;
   bool frames_given = false;
 };
+
+// ACES and gamma 2.2 after --exposure (a factor), encoded exactly: the bytes `cohort render` has
+// always written.
+core::ToneMapOptions written_frame_tone_map(float exposure) {
+  core::ToneMapOptions tm;
+  tm.curve = core::ToneCurve::aces;
+  tm.exposure_ev = std::log2(static_cast<double>(exposure));  // exp2 of it gives the float back exactly
+  tm.srgb = false;
+  tm.exact_encoding = true;
+  return tm;
+}
 
 const std::map<std::string, uint32_t>& modes() {
   static const std::map<std::string, uint32_t> m = {
@@ -137,9 +149,8 @@ int run_render(const RenderArgs& a) {
     char stem[32];
     std::snprintf(stem, sizeof stem, "frame_%04d", f);
     std::filesystem::path base = std::filesystem::path(a.out) / stem;
-    ToneMapOptions tm;
-    tm.exposure = a.exposure;
-    core::write_ldr_image(base.string() + (oiio ? ".png" : ".ppm"), shown.width, shown.height, tone_map(shown, tm));
+    core::write_ldr_image(base.string() + (oiio ? ".png" : ".ppm"), shown.width, shown.height,
+                          core::tone_map(shown, written_frame_tone_map(a.exposure)));
     core::write_hdr_image(base.string() + (oiio ? ".exr" : ".pfm"), shown);
     nlohmann::json j = stats;
     stats_json.push_back(j);
