@@ -121,7 +121,7 @@ int run_play(PlayArgs a) {
   };
   const std::vector<std::string> balancers = balance::balancer_names();
 
-  viewer::Image8 frame_image, hud_layer, window_image;
+  raster::Image8 frame_image, hud_layer, window_image;
   SessionFrame last;
   bool have_frame = false;
   int frames_done = 0;
