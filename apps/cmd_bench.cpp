@@ -3,8 +3,11 @@
 #include <iostream>
 #include <sstream>
 
+#include <spdlog/spdlog.h>
+
 #include "balance_bench.h"
 #include "commands.h"
+#include "default_map.h"
 
 namespace cohort::app {
 
@@ -33,7 +36,7 @@ std::string format_fraction(double v) {
 
 }  // namespace
 
-void add_bench_command(CLI::App& app) {
+void add_bench_command(CLI::App& app, int& exit_code) {
   auto* cmd = app.add_subcommand("bench", "Benchmarks (balancer efficiency: 'cohort bench balance')");
   cmd->require_subcommand(1);
   auto* balance = cmd->add_subcommand(
@@ -43,7 +46,7 @@ void add_bench_command(CLI::App& app) {
       "results are reproducible.");
   struct Args {
     std::string balancers, tracers = "2,3,4", speeds = "1", path = "both", real, json, plot;
-    std::string scene = "assets/testmap/maps/testmap.map";
+    std::string scene = kTestMapFile;
     double noise = 0.02, row_work_error = 0.2;
     bool row_work = true;
     std::string clock = "virtual";
@@ -84,7 +87,7 @@ void add_bench_command(CLI::App& app) {
   balance->add_option("--scene", args->scene, "map or scene pack the real tracers render")->capture_default_str();
   balance->add_option("--json", args->json, "write every run (per-frame idle %) as JSON");
   balance->add_option("--plot", args->plot, "write a PNG chart of idle % per frame per balancer");
-  balance->callback([args] {
+  balance->callback([args, &exit_code] {
     BalanceBenchConfig config;
     config.balancers = split_list<std::string>(args->balancers, "--balancers");
     config.tracer_counts = split_list<int>(args->tracers, "--tracers");
@@ -115,8 +118,9 @@ void add_bench_command(CLI::App& app) {
     try {
       runs = run_balance_bench(config);
     } catch (const std::exception& e) {  // unknown names (invalid_argument) as well as missing devices
-      std::cerr << "cohort bench balance: " << e.what() << "\n";
-      std::exit(config.real.empty() ? kExitFailure : kExitUnavailable);
+      spdlog::error("cohort bench balance: {}", e.what());
+      exit_code = config.real.empty() ? kExitFailure : kExitUnavailable;
+      return;
     }
     std::cout << (config.real.empty() ? "simulated tracers, speeds " + args->speeds + ", noise " + format_fraction(config.noise) +
                                             (config.row_work ? ", per-row work counts with error " + format_fraction(config.row_work_error)

@@ -1,7 +1,10 @@
 #include <iostream>
 
+#include <spdlog/spdlog.h>
+
 #include "cohort/scene/map_loader.h"
 #include "commands.h"
+#include "default_map.h"
 
 namespace cohort::app {
 
@@ -14,11 +17,8 @@ int run_info(const std::string& map, std::vector<std::string> bases, size_t max_
   try {
     for (const std::string& base : bases) vfs.add_search_path(base);
     loaded = scene::load_map(vfs, map, &report);
-  } catch (const scene::ParseError& e) {
-    std::cerr << "cohort info: " << e.what() << "\n";
-    return kExitFailure;
-  } catch (const std::exception& e) {
-    std::cerr << "cohort info: " << e.what() << "\n";
+  } catch (const std::exception& e) {  // scene::ParseError included
+    spdlog::error("cohort info: {}", e.what());
     return kExitFailure;
   }
   std::cout << "map        " << loaded.name << "\n"
@@ -50,7 +50,7 @@ int run_info(const std::string& map, std::vector<std::string> bases, size_t max_
 
 }  // namespace
 
-void add_info_command(CLI::App& app) {
+void add_info_command(CLI::App& app, int& exit_code) {
   auto* cmd = app.add_subcommand("info", "Load a map and print what it contains (areas, triangles, materials, "
                                          "textures, lights by type, entities, warnings)");
   auto map = std::make_shared<std::string>();
@@ -61,15 +61,8 @@ void add_info_command(CLI::App& app) {
   cmd->add_option("--base", *bases, "game folder with loose files and .pk4 archives; repeat it, later folders "
                                     "override earlier ones (default: assets/testmap)");
   cmd->add_option("--max-warnings", *max_warnings, "how many warnings to print");
-  cmd->callback([map, bases, max_warnings] {
-    std::vector<std::string> folders = *bases;
-    if (folders.empty()) {
-      std::error_code ec;
-      std::filesystem::path fallback = "assets/testmap";
-      if (!std::filesystem::is_directory(fallback, ec)) fallback = std::filesystem::path(COHORT_SOURCE_DIR) / "assets/testmap";
-      if (std::filesystem::is_directory(fallback, ec)) folders.push_back(fallback.string());
-    }
-    std::exit(run_info(*map, folders, *max_warnings));
+  cmd->callback([map, bases, max_warnings, &exit_code] {
+    exit_code = run_info(*map, bases_or_test_map(*bases), *max_warnings);
   });
 }
 

@@ -61,19 +61,19 @@ int run_pack(const PackArgs& a) {
 
 }  // namespace
 
-void add_pack_command(CLI::App& app) {
+void add_pack_command(CLI::App& app, int& exit_code) {
   auto* cmd = app.add_subcommand("pack", "Compile a map into one self-contained scene pack (geometry, BVHs, materials, "
                                          "lights, decoded mip-mapped textures) that loads without an image library");
   auto a = std::make_shared<PackArgs>();
   cmd->add_option("map", a->map, "a .map path, a game path (maps/x.map) or a bare map name")->required();
   cmd->add_option("-o,--out", a->out, "pack file to write (.cpk)")->required();
   cmd->add_option("--base", a->bases, "game folder(s) to search, loose files and .pk4s (default: the map's own base)");
-  cmd->callback([a] {
+  cmd->callback([a, &exit_code] {
     try {
-      std::exit(run_pack(*a));
+      exit_code = run_pack(*a);
     } catch (const std::exception& e) {
-      std::cerr << "cohort pack: " << e.what() << "\n";
-      std::exit(kExitFailure);
+      spdlog::error("cohort pack: {}", e.what());
+      exit_code = kExitFailure;
     }
   });
 }

@@ -11,6 +11,7 @@
 #include "cohort/balance/balancer.h"
 #include "cohort/core/image_output.h"
 #include "commands.h"
+#include "default_map.h"
 #include "play_session.h"
 #include "viewer/hud.h"
 #include "viewer/viewer_actions.h"
@@ -33,14 +34,6 @@ struct PlayArgs {
   std::string screenshot;    // written from the last frame
   std::string window_shot;   // the last frame as the window showed it, HUD included
 };
-
-std::vector<std::string> default_bases() {
-  std::error_code ec;
-  std::filesystem::path fallback = "assets/testmap";
-  if (!std::filesystem::is_directory(fallback, ec)) fallback = std::filesystem::path(COHORT_SOURCE_DIR) / "assets/testmap";
-  if (std::filesystem::is_directory(fallback, ec)) return {fallback.string()};
-  return {};
-}
 
 std::string key_help() {
   std::string out = "\nKeys:\n";
@@ -93,14 +86,14 @@ struct Notice {
 
 int run_play(PlayArgs a) {
   using clock = std::chrono::steady_clock;
-  if (a.session.bases.empty()) a.session.bases = default_bases();
+  a.session.bases = bases_or_test_map(a.session.bases);
   std::unique_ptr<PlaySession> session;
   try {
     session = std::make_unique<PlaySession>(a.session);
   } catch (const std::exception& e) {
-    std::cerr << "cohort play: cannot start on '" << a.session.map << "': " << e.what() << "\n";
+    spdlog::error("cohort play: cannot start on '{}': {}", a.session.map, e.what());
     if (a.session.bases.empty())
-      std::cerr << "  (no --base folder given and assets/testmap not found: point --base at a game's base/ folder)\n";
+      spdlog::error("  (no --base folder given and {} not found: point --base at a game's base/ folder)", kTestMapBase);
     return kExitFailure;
   }
 
@@ -108,7 +101,7 @@ int run_play(PlayArgs a) {
   try {
     window = std::make_unique<viewer::GlWindow>(a.width, a.height, "Cohort - " + session->map_name());
   } catch (const viewer::WindowUnavailable& e) {
-    std::cerr << "cohort play: " << e.what() << "\n";
+    spdlog::error("cohort play: {}", e.what());
     return kExitUnavailable;
   }
   spdlog::info("viewer: OpenGL {}; tracers: {}", window->gl_description(), fmt::join(session->tracer_names(), ", "));
@@ -128,7 +121,7 @@ int run_play(PlayArgs a) {
   };
   const std::vector<std::string> balancers = balance::balancer_names();
 
-  viewer::Image8 frame_image, hud_layer, window_image;
+  raster::Image8 frame_image, hud_layer, window_image;
   SessionFrame last;
   bool have_frame = false;
   int frames_done = 0;
@@ -147,8 +140,8 @@ int run_play(PlayArgs a) {
           else window->request_close();
           break;
         case Action::toggle_mouse_capture: window->set_mouse_captured(!window->mouse_captured()); break;
-        case Action::next_mode: settings.mode = (settings.mode + 1) % 7; break;
-        case Action::previous_mode: settings.mode = (settings.mode + 6) % 7; break;
+        case Action::next_mode: settings.mode = (settings.mode + 1) % K_MODE_COUNT; break;
+        case Action::previous_mode: settings.mode = (settings.mode + K_MODE_COUNT - 1) % K_MODE_COUNT; break;
         case Action::set_mode_0: case Action::set_mode_1: case Action::set_mode_2: case Action::set_mode_3:
         case Action::set_mode_4: case Action::set_mode_5: case Action::set_mode_6:
           settings.mode = static_cast<kuint>(static_cast<int>(action) - static_cast<int>(Action::set_mode_0));
@@ -196,7 +189,7 @@ int run_play(PlayArgs a) {
       last = session->frame(camera, dt, settings);
       have_frame = true;
     } catch (const std::exception& e) {
-      std::cerr << "cohort play: the frame could not be rendered: " << e.what() << "\n";
+      spdlog::error("cohort play: the frame could not be rendered: {}", e.what());
       exit_code = kExitFailure;
       break;
     }
@@ -250,14 +243,14 @@ int run_play(PlayArgs a) {
     try {
       core::write_ldr_image(a.window_shot, window_image.width, window_image.height, window_image.rgba);
     } catch (const std::exception& e) {
-      std::cerr << "cohort play: " << e.what() << "\n";
+      spdlog::error("cohort play: {}", e.what());
       return kExitFailure;
     }
   }
 
   if (!a.screenshot.empty()) {
     if (!have_frame) {
-      std::cerr << "cohort play: no frame was rendered, so no screenshot was written\n";
+      spdlog::error("cohort play: no frame was rendered, so no screenshot was written");
       return kExitFailure;
     }
     try {
@@ -265,7 +258,7 @@ int run_play(PlayArgs a) {
       std::cout << "wrote " << a.screenshot << " (" << last.width << "x" << last.height << ", after " << frames_done
                 << " frames)\n";
     } catch (const std::exception& e) {
-      std::cerr << "cohort play: " << e.what() << "\n";
+      spdlog::error("cohort play: {}", e.what());
       return kExitFailure;
     }
   }
@@ -276,7 +269,7 @@ int run_play(PlayArgs a) {
 
 }  // namespace
 
-void add_play_command(CLI::App& app) {
+void add_play_command(CLI::App& app, int& exit_code) {
   auto* cmd = app.add_subcommand("play", "Open a window and fly through a map rendered live on every tracer");
   cmd->footer(key_help());
   auto a = std::make_shared<PlayArgs>();
@@ -307,16 +300,16 @@ void add_play_command(CLI::App& app) {
   cmd->add_option("--screenshot", a->screenshot, "write the last frame to this image file on exit");
   cmd->add_option("--window-screenshot", a->window_shot, "with --frames: write what the window showed last (the "
                                                          "frame scaled to the window, HUD included)");
-  cmd->callback([a] {
+  cmd->callback([a, &exit_code] {
 #ifdef COHORT_HAVE_VIEWER
-    const int code = run_play(*a);
-    if (code != kExitOk) std::exit(code);
+    exit_code = run_play(*a);
 #else
-    std::cerr << "cohort play: this binary was built without the viewer (GLFW and OpenGL were not found, or "
-                 "COHORT_WITH_VIEWER=OFF).\n  Install them (tools/setup.sh installs libglfw3-dev and the OpenGL "
-                 "headers), then reconfigure with -DCOHORT_WITH_VIEWER=ON and rebuild;\n  `cohort render "
-              << a->session.map << "` writes images without a window.\n";
-    std::exit(kExitUnavailable);
+    spdlog::error("cohort play: this binary was built without the viewer (GLFW and OpenGL were not found, or "
+                  "COHORT_WITH_VIEWER=OFF).\n  Install them (tools/setup.sh installs libglfw3-dev and the OpenGL "
+                  "headers), then reconfigure with -DCOHORT_WITH_VIEWER=ON and rebuild;\n  `cohort render {}` "
+                  "writes images without a window.",
+                  a->session.map);
+    exit_code = kExitUnavailable;
 #endif
   });
 }

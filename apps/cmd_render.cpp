@@ -1,5 +1,6 @@
 // `cohort render`: headless frames on one or more tracers (rows split by the balancer), written as
 // tone-mapped LDR and linear HDR images plus a JSON of per-frame stats.
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
@@ -21,11 +22,12 @@
 #include <limits>
 #include "cohort/core/image_output.h"
 #include "cohort/core/renderer.h"
+#include "cohort/core/tonemap.h"
 #include "commands.h"
 #include "camera_path.h"
+#include "default_map.h"
 #include "progress_bar.h"
 #include "render_scene_source.h"
-#include "tone_map.h"
 #include "tracer_factory.h"
 
 namespace cohort::app {
@@ -50,21 +52,22 @@ struct RenderArgs {
   bool frames_given = false;
 };
 
+// ACES and gamma 2.2 after --exposure (a factor), encoded exactly: the bytes `cohort render` has
+// always written.
+core::ToneMapOptions written_frame_tone_map(float exposure) {
+  core::ToneMapOptions tm;
+  tm.curve = core::ToneCurve::aces;
+  tm.exposure_ev = std::log2(static_cast<double>(exposure));  // exp2 of it gives the float back exactly
+  tm.srgb = false;
+  tm.exact_encoding = true;
+  return tm;
+}
+
 const std::map<std::string, uint32_t>& modes() {
   static const std::map<std::string, uint32_t> m = {
       {"path", K_MODE_PATH},         {"direct", K_MODE_DIRECT}, {"albedo", K_MODE_ALBEDO}, {"normals", K_MODE_NORMALS},
       {"specular", K_MODE_SPECULAR}, {"bvh", K_MODE_BVH},       {"triangles", K_MODE_TRIANGLES}};
   return m;
-}
-
-// Like `cohort info` and `cohort play`: with no --base, the bundled test map's folder.
-std::vector<std::string> bases_or_test_map(const std::vector<std::string>& bases) {
-  if (!bases.empty()) return bases;
-  std::error_code ec;
-  std::filesystem::path fallback = "assets/testmap";
-  if (!std::filesystem::is_directory(fallback, ec)) fallback = std::filesystem::path(COHORT_SOURCE_DIR) / "assets/testmap";
-  if (std::filesystem::is_directory(fallback, ec)) return {fallback.string()};
-  return {};
 }
 
 int run_render(const RenderArgs& a) {
@@ -147,9 +150,8 @@ int run_render(const RenderArgs& a) {
     char stem[32];
     std::snprintf(stem, sizeof stem, "frame_%04d", f);
     std::filesystem::path base = std::filesystem::path(a.out) / stem;
-    ToneMapOptions tm;
-    tm.exposure = a.exposure;
-    core::write_ldr_image(base.string() + (oiio ? ".png" : ".ppm"), shown.width, shown.height, tone_map(shown, tm));
+    core::write_ldr_image(base.string() + (oiio ? ".png" : ".ppm"), shown.width, shown.height,
+                          core::tone_map(shown, written_frame_tone_map(a.exposure)));
     core::write_hdr_image(base.string() + (oiio ? ".exr" : ".pfm"), shown);
     nlohmann::json j = stats;
     stats_json.push_back(j);
@@ -168,7 +170,7 @@ int run_render(const RenderArgs& a) {
 
 }  // namespace
 
-void add_render_command(CLI::App& app) {
+void add_render_command(CLI::App& app, int& exit_code) {
   auto* cmd = app.add_subcommand("render", "Render frames headless on the chosen tracers and write images and a "
                                            "JSON of per-frame stats");
   auto a = std::make_shared<RenderArgs>();
@@ -220,10 +222,9 @@ void add_render_command(CLI::App& app) {
   cmd->add_option("--soft-shadows", a->soft_shadow_scale, "scale of the lights' soft-shadow extent")
       ->capture_default_str();
   cmd->add_option("--out", a->out, "output folder")->capture_default_str();
-  cmd->callback([a, frames_option] {
+  cmd->callback([a, frames_option, &exit_code] {
     a->frames_given = frames_option->count() > 0;
-    int code = run_render(*a);
-    if (code != kExitOk) std::exit(code);
+    exit_code = run_render(*a);
   });
 }
 

@@ -4,10 +4,13 @@
 #include <filesystem>
 #include <iostream>
 
+#include <spdlog/spdlog.h>
+
 #include "cohort/scene/map_loader.h"
 #include "cohort/scene/render_world_stream.h"
 #include "cohort/scene/scenario.h"
 #include "commands.h"
+#include "default_map.h"
 
 namespace cohort::app {
 namespace {
@@ -20,19 +23,10 @@ struct ScenarioArgs {
   std::string out = "out/scenario.cds";
 };
 
-std::vector<std::string> base_folders(const std::vector<std::string>& given) {
-  if (!given.empty()) return given;
-  std::error_code ec;
-  std::filesystem::path fallback = "assets/testmap";
-  if (!std::filesystem::is_directory(fallback, ec)) fallback = std::filesystem::path(COHORT_SOURCE_DIR) / "assets/testmap";
-  if (std::filesystem::is_directory(fallback, ec)) return {fallback.string()};
-  return {};
-}
-
 int run_record_scenario(const ScenarioArgs& args) {
   try {
     scene::Vfs vfs;
-    for (const std::string& base : base_folders(args.bases)) vfs.add_search_path(base);
+    for (const std::string& base : bases_or_test_map(args.bases)) vfs.add_search_path(base);
     scene::RenderWorld world(scene::load_map(vfs, args.map));
     std::filesystem::path out(args.out);
     if (out.has_parent_path()) std::filesystem::create_directories(out.parent_path());
@@ -46,18 +40,15 @@ int run_record_scenario(const ScenarioArgs& args) {
     std::cout << "recorded " << recorder.frames_written() << " frames of '" << world.scene().name << "' to " << args.out
               << " (" << recorder.bytes_written() << " bytes)\n";
     return kExitOk;
-  } catch (const scene::ScenarioError& e) {
-    std::cerr << "cohort record-scenario: " << e.what() << "\n";
-    return kExitFailure;
-  } catch (const std::exception& e) {
-    std::cerr << "cohort record-scenario: " << e.what() << "\n";
+  } catch (const std::exception& e) {  // scene::ScenarioError (entities the map lacks) included
+    spdlog::error("cohort record-scenario: {}", e.what());
     return kExitFailure;
   }
 }
 
 }  // namespace
 
-void add_scenario_command(CLI::App& app) {
+void add_scenario_command(CLI::App& app, int& exit_code) {
   auto* cmd = app.add_subcommand("record-scenario",
                                  "Drive the test map through the scene-delta API (door_main opens, fan_spin spins, "
                                  "light_flicker flickers, a flashlight follows the camera path) and record the "
@@ -72,7 +63,7 @@ void add_scenario_command(CLI::App& app) {
       ->capture_default_str();
   cmd->add_option("--out", args->out, "delta stream file to write (format: docs/delta-stream.md)")
       ->capture_default_str();
-  cmd->callback([args] { std::exit(run_record_scenario(*args)); });
+  cmd->callback([args, &exit_code] { exit_code = run_record_scenario(*args); });
 }
 
 }  // namespace cohort::app

@@ -1,16 +1,18 @@
-// Each subcommand of `cohort` lives in its own cmd_*.cpp and registers itself here.
+// Each subcommand of `cohort` lives in its own cmd_*.cpp and registers itself here. Its callback leaves
+// the subcommand's exit code (kExit* below) in `exit_code`, which main() returns: no subcommand calls
+// std::exit, so everything it made is destroyed in order.
 #pragma once
 
 #include <CLI/CLI.hpp>
 
 namespace cohort::app {
 
-void add_info_command(CLI::App& app);
-void add_render_command(CLI::App& app);
-void add_play_command(CLI::App& app);
-void add_bench_command(CLI::App& app);
-void add_pack_command(CLI::App& app);
-void add_scenario_command(CLI::App& app);
+void add_info_command(CLI::App& app, int& exit_code);
+void add_render_command(CLI::App& app, int& exit_code);
+void add_play_command(CLI::App& app, int& exit_code);
+void add_bench_command(CLI::App& app, int& exit_code);
+void add_pack_command(CLI::App& app, int& exit_code);
+void add_scenario_command(CLI::App& app, int& exit_code);
 
 // Exit codes shared by every subcommand.
 constexpr int kExitOk = 0;

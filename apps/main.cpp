@@ -1,11 +1,12 @@
-#include <cstdlib>
-#include <iostream>
-
+#include <spdlog/sinks/stdout_color_sinks.h>
 #include <spdlog/spdlog.h>
 
 #include "commands.h"
 
 int main(int argc, char** argv) {
+  // Diagnostics go to stderr, so stdout holds only what a command reports (info, bench tables).
+  spdlog::set_default_logger(spdlog::stderr_color_mt("cohort"));
+  spdlog::set_pattern("[%H:%M:%S.%e] [%^%l%$] %v");
   CLI::App app{
       "Cohort: a multi-device real-time path tracer for Doom 3 (idTech 4) scenes, after the Brigade\n"
       "renderer. Tracers (Embree on the CPU, OpenCL, CUDA) each render a band of rows; a balancer sizes\n"
@@ -19,12 +20,13 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   app.footer("Run 'cohort <command> --help' for a command's options. See README.md for examples.");
 
-  cohort::app::add_info_command(app);
-  cohort::app::add_render_command(app);
-  cohort::app::add_play_command(app);
-  cohort::app::add_bench_command(app);
-  cohort::app::add_pack_command(app);
-  cohort::app::add_scenario_command(app);
+  int exit_code = cohort::app::kExitOk;
+  cohort::app::add_info_command(app, exit_code);
+  cohort::app::add_render_command(app, exit_code);
+  cohort::app::add_play_command(app, exit_code);
+  cohort::app::add_bench_command(app, exit_code);
+  cohort::app::add_pack_command(app, exit_code);
+  cohort::app::add_scenario_command(app, exit_code);
 
   app.parse_complete_callback([&] { spdlog::set_level(spdlog::level::from_str(log_level)); });
   try {
@@ -35,5 +37,5 @@ int main(int argc, char** argv) {
     spdlog::error("{}", e.what());
     return cohort::app::kExitFailure;
   }
-  return cohort::app::kExitOk;
+  return exit_code;
 }

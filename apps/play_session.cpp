@@ -12,10 +12,7 @@
 #include "cohort/core/renderer.h"
 #include "cohort/core/tonemap.h"
 #include "cohort/core/view.h"
-#if __has_include("cohort/core/world_sync.h")
 #include "cohort/core/world_sync.h"
-#define COHORT_PLAY_HAS_WORLD_SYNC 1
-#endif
 #include "cohort/scene/map_loader.h"
 #include "cohort/scene/render_world.h"
 #include "cohort/scene/scenario.h"
@@ -60,9 +57,7 @@ struct PlaySession::State {
   explicit State(scene::Scene loaded) : world(std::move(loaded)) {}
 
   scene::RenderWorld world;
-#ifdef COHORT_PLAY_HAS_WORLD_SYNC
   std::unique_ptr<core::WorldSync> sync;
-#endif
   std::unique_ptr<scene::Scenario> scenario;
   std::unique_ptr<core::Renderer> renderer;
   core::AdaptiveConvergence convergence;
@@ -78,12 +73,8 @@ PlaySession::PlaySession(const SessionOptions& options) {
   state_ = std::make_unique<State>(load_scene(options));
   State& s = *state_;
   s.map_name = s.world.scene().name.empty() ? options.map : s.world.scene().name;
-#ifdef COHORT_PLAY_HAS_WORLD_SYNC
   s.sync = std::make_unique<core::WorldSync>(s.world);
   auto initial_scene = s.sync->snapshot();
-#else
-  auto initial_scene = std::make_shared<const commit::TracerScene>(core::compile_scene(s.world.scene()).tracer_scene);
-#endif
 
   const std::string list = options.tracers.empty() ? std::string("all") : options.tracers;
   std::vector<std::unique_ptr<core::Tracer>> tracers;
@@ -105,15 +96,7 @@ PlaySession::PlaySession(const SessionOptions& options) {
   s.renderer = std::make_unique<core::Renderer>(std::move(tracers), renderer_options);
   s.renderer->submit_commit(commit::CommitBuffer::full(initial_scene, 0));
 
-#ifndef COHORT_PLAY_HAS_WORLD_SYNC
   if (options.scenario) {
-    warnings_.push_back("scenario off: this build has no core world sync (core/world_sync.h), the scene stays still");
-    spdlog::warn("{}", warnings_.back());
-  }
-  if (false) {
-#else
-  if (options.scenario) {
-#endif
     try {
       s.scenario = std::make_unique<scene::Scenario>(s.world);
     } catch (const scene::ScenarioError& e) {
@@ -155,13 +138,8 @@ SessionFrame PlaySession::frame(const viewer::FlyCamera& camera, double seconds,
   s.world.EndFrame();
 
   ++s.frame_index;
-#ifdef COHORT_PLAY_HAS_WORLD_SYNC
   const commit::CommitBuffer commit = s.sync->sync(s.world.TakeChanges(), s.frame_index);
   s.renderer->submit_commit(commit, [&s] { return s.sync->snapshot(); });
-#else
-  s.world.TakeChanges();
-  const commit::CommitBuffer commit;
-#endif
 
   core::BandJob job;
   job.camera = camera.to_kcamera(settings.width, settings.height);

@@ -87,7 +87,7 @@ struct Texture {
   GLuint id = 0;
   int width = 0, height = 0;
 
-  void upload(const Image8& image, GLint filter) {
+  void upload(const raster::Image8& image, GLint filter) {
     if (id == 0) glGenTextures(1, &id);
     glBindTexture(GL_TEXTURE_2D, id);
     glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
@@ -324,7 +324,7 @@ int GlWindow::framebuffer_height() const {
   return h;
 }
 
-void GlWindow::present(const Image8& frame, const Image8* hud, Image8* read_back) {
+void GlWindow::present(const raster::Image8& frame, const raster::Image8* hud, raster::Image8* read_back) {
   glfwMakeContextCurrent(impl_->window);
   glViewport(0, 0, framebuffer_width(), framebuffer_height());
   glClearColor(0.05f, 0.05f, 0.06f, 1.0f);

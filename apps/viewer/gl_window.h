@@ -9,7 +9,7 @@
 #include <string>
 #include <vector>
 
-#include "bitmap_font.h"
+#include "raster/image.h"
 #include "fly_camera.h"
 #include "viewer_actions.h"
 
@@ -43,7 +43,7 @@ class GlWindow {
   int framebuffer_height() const;
   // Upload the frame (stretched over the window) and the HUD layer (window-sized; null: none), swap.
   // With read_back, what was drawn is read back into it first (rows top to bottom).
-  void present(const Image8& frame, const Image8* hud, Image8* read_back = nullptr);
+  void present(const raster::Image8& frame, const raster::Image8* hud, raster::Image8* read_back = nullptr);
   void set_title(const std::string& title);
   // e.g. "OpenGL 3.3 core (Mesa llvmpipe)".
   const std::string& gl_description() const { return gl_description_; }

@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cstdio>
 
+#include "raster/font.h"
+
 namespace cohort::viewer {
 namespace {
 
@@ -49,18 +51,19 @@ std::vector<std::string> hud_lines(const HudState& s) {
   return lines;
 }
 
-void draw_hud(Image8& layer, const HudState& state, int scale) {
+void draw_hud(raster::Image8& layer, const HudState& state, int scale) {
   layer.clear();
   const std::vector<std::string> lines = hud_lines(state);
   const size_t notice_start = lines.size() - state.notices.size();
   int widest = 0;
-  for (const std::string& l : lines) widest = std::max(widest, text_width(l, scale));
+  for (const std::string& l : lines) widest = std::max(widest, raster::text_width(l, scale));
   const int pad = 3 * scale;
-  fill_rect(layer, 0, 0, widest + 2 * pad, static_cast<int>(lines.size()) * kLineAdvance * scale + 2 * pad - 2 * scale,
-            Rgba8{0, 0, 0, 150});
+  raster::fill_rect(layer, 0, 0, widest + 2 * pad,
+                    static_cast<int>(lines.size()) * raster::kLineAdvance * scale + 2 * pad - 2 * scale,
+                    raster::Rgba8{0, 0, 0, 150});
   for (size_t i = 0; i < lines.size(); ++i) {
-    const Rgba8 color = i >= notice_start ? Rgba8{255, 220, 60, 255} : Rgba8{230, 235, 240, 255};
-    draw_text(layer, pad, pad + static_cast<int>(i) * kLineAdvance * scale, lines[i], color, scale);
+    const raster::Rgba8 color = i >= notice_start ? raster::Rgba8{255, 220, 60, 255} : raster::Rgba8{230, 235, 240, 255};
+    raster::draw_text(layer, pad, pad + static_cast<int>(i) * raster::kLineAdvance * scale, lines[i], color, scale);
   }
 }
 

@@ -7,8 +7,8 @@
 #include <string>
 #include <vector>
 
-#include "bitmap_font.h"
 #include "cohort/core/frame_stats.h"
+#include "raster/image.h"
 
 namespace cohort::viewer {
 
@@ -34,6 +34,6 @@ std::vector<std::string> hud_lines(const HudState& state);
 std::string format_bytes(uint64_t bytes);
 
 // Draw onto `layer` (cleared first): a translucent box and the lines, top-left.
-void draw_hud(Image8& layer, const HudState& state, int scale = 1);
+void draw_hud(raster::Image8& layer, const HudState& state, int scale = 1);
 
 }  // namespace cohort::viewer

@@ -85,8 +85,15 @@ std::vector<uint8_t> tone_map(const FrameBuffer& frame, const ToneMapOptions& op
   std::vector<uint8_t> out(pixels * 4);
   for (size_t p = 0; p < pixels; ++p) {
     for (int k = 0; k < 3; ++k) {
-      const float v = apply_tone_curve(options.curve, frame.rgba[p * 4 + static_cast<size_t>(k)] * scale, white);
-      out[p * 4 + static_cast<size_t>(k)] = encode[static_cast<size_t>(std::lround(v * kEncodeSteps))];
+      const size_t i = p * 4 + static_cast<size_t>(k);
+      if (options.exact_encoding) {
+        const float v = std::isfinite(frame.rgba[i]) ? frame.rgba[i] : 0.0f;
+        const float encoded = encode_display(apply_tone_curve(options.curve, v * scale, white), options.srgb);
+        out[i] = static_cast<uint8_t>(encoded * 255.0f + 0.5f);
+      } else {
+        const float v = apply_tone_curve(options.curve, frame.rgba[i] * scale, white);
+        out[i] = encode[static_cast<size_t>(std::lround(v * kEncodeSteps))];
+      }
     }
     out[p * 4 + 3] = 255;
   }

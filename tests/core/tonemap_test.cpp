@@ -1,5 +1,6 @@
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 
@@ -64,6 +65,29 @@ TEST(ToneMap, DarkValuesKeepTheirSteps) {
   const auto px = tone_map(fb, o);
   EXPECT_EQ(px[0], static_cast<uint8_t>(std::lround(255.0 * std::pow(0.0005, 1.0 / 2.2))));
   EXPECT_LT(px[0], px[4]);
+}
+
+TEST(ToneMap, ExactEncodingRoundsEachValueAndBlacksOutNonFinite) {
+  FrameBuffer fb;
+  fb.resize(2, 1);
+  const float inf = std::numeric_limits<float>::infinity();
+  fb.rgba = {0.0005f, 0.3f, 7.0f, 1.0f, inf, std::numeric_limits<float>::quiet_NaN(), -2.0f, 1.0f};
+  ToneMapOptions o;
+  o.exposure_ev = std::log2(1.5);
+  o.exact_encoding = true;
+  const auto px = tone_map(fb, o);
+  auto expected = [](float v) {  // ACES, gamma 2.2, rounded half up: what `cohort render` has always written
+    const float x = v * 1.5f;
+    const float y = std::clamp((x * (2.51f * x + 0.03f)) / (x * (2.43f * x + 0.59f) + 0.14f), 0.0f, 1.0f);
+    return static_cast<uint8_t>(std::pow(y, 1.0f / 2.2f) * 255.0f + 0.5f);
+  };
+  EXPECT_EQ(px[0], expected(0.0005f));
+  EXPECT_EQ(px[1], expected(0.3f));
+  EXPECT_EQ(px[2], expected(7.0f));
+  EXPECT_EQ(px[3], 255);
+  EXPECT_EQ(px[4], 0) << "+infinity is black when encoding exactly";
+  EXPECT_EQ(px[5], 0);
+  EXPECT_EQ(px[6], 0);
 }
 
 TEST(ToneMap, ParsesNames) {

@@ -23,6 +23,11 @@ struct ToneMapOptions {
   double exposure_ev = 0.0;      // scene values are multiplied by 2^exposure_ev first
   double white_point = 11.2;     // reinhard (extended) and uncharted2: input that maps to 1; <= 0: reinhard is x/(1+x)
   bool srgb = false;             // sRGB transfer curve instead of plain gamma 2.2
+  // Encode each value with pow() and round it half up, instead of looking it up in the 2^16-step
+  // table: several times slower, and a step off the table's bytes near some byte boundaries (most in
+  // the darks). `cohort render` writes its frames this way, so the bytes of its images never depend on
+  // the table. Non-finite values (+infinity too) become black.
+  bool exact_encoding = false;
 };
 
 // "gamma", "reinhard", "aces", "uncharted2"; throws std::invalid_argument listing them otherwise.
@@ -34,7 +39,8 @@ float apply_tone_curve(ToneCurve curve, float x, float white_point);
 // Linear display value in [0, 1] -> encoded value in [0, 1].
 float encode_display(float linear, bool srgb);
 
-// RGBA8, rows top to bottom; alpha is 255. NaN and negative values become black.
+// RGBA8, rows top to bottom; alpha is 255. NaN and negative values become black; +infinity white,
+// unless exact_encoding.
 std::vector<uint8_t> tone_map(const FrameBuffer& frame, const ToneMapOptions& options);
 
 }  // namespace cohort::core

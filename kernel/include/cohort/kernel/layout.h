@@ -127,6 +127,7 @@ typedef struct KCamera {
 #define K_MODE_SPECULAR 4u
 #define K_MODE_BVH      5u   /* BVH traversal cost heat map */
 #define K_MODE_TRIANGLES 6u  /* a colour per triangle */
+#define K_MODE_COUNT    7u   /* how many modes: they run from 0 to K_MODE_COUNT - 1 */
 
 typedef struct KFrameParams {
   kuint frame_index;  kuint spp;          kuint max_bounces;   kuint light_samples;

@@ -1,9 +1,8 @@
-#include "bitmap_font.h"
+#include "font.h"
 
-#include <algorithm>
 #include <array>
 
-namespace cohort::viewer {
+namespace cohort::raster {
 namespace {
 
 // One glyph: seven rows of five columns, '#' set. Drawn for this project.
@@ -89,21 +88,6 @@ const Glyph& glyph_for(char c) {
   return kGlyphs[c - kFirst];
 }
 
-void blend_pixel(Image8& image, int x, int y, Rgba8 color) {
-  if (x < 0 || y < 0 || x >= image.width || y >= image.height) return;
-  uint8_t* p = &image.rgba[(static_cast<size_t>(y) * image.width + x) * 4];
-  if (color.a == 255) {
-    p[0] = color.r; p[1] = color.g; p[2] = color.b; p[3] = 255;
-    return;
-  }
-  // "over" compositing onto whatever is there (the HUD layer starts transparent).
-  const int a = color.a, inv = 255 - a;
-  p[0] = static_cast<uint8_t>((color.r * a + p[0] * inv) / 255);
-  p[1] = static_cast<uint8_t>((color.g * a + p[1] * inv) / 255);
-  p[2] = static_cast<uint8_t>((color.b * a + p[2] * inv) / 255);
-  p[3] = static_cast<uint8_t>(a + p[3] * inv / 255);
-}
-
 }  // namespace
 
 bool glyph_pixel(char c, int x, int y) {
@@ -111,29 +95,4 @@ bool glyph_pixel(char c, int x, int y) {
   return glyph_for(c)[y][x] == '#';
 }
 
-int draw_text(Image8& image, int x, int y, std::string_view text, Rgba8 color, int scale) {
-  scale = std::max(scale, 1);
-  for (char c : text) {
-    const Glyph& g = glyph_for(c);
-    for (int gy = 0; gy < kGlyphHeight; ++gy)
-      for (int gx = 0; gx < kGlyphWidth; ++gx)
-        if (g[gy][gx] == '#')
-          for (int sy = 0; sy < scale; ++sy)
-            for (int sx = 0; sx < scale; ++sx) blend_pixel(image, x + gx * scale + sx, y + gy * scale + sy, color);
-    x += kGlyphAdvance * scale;
-  }
-  return x;
-}
-
-void fill_rect(Image8& image, int x, int y, int w, int h, Rgba8 color) {
-  const int x0 = std::max(x, 0), y0 = std::max(y, 0);
-  const int x1 = std::min(x + w, image.width), y1 = std::min(y + h, image.height);
-  for (int py = y0; py < y1; ++py)
-    for (int px = x0; px < x1; ++px) blend_pixel(image, px, py, color);
-}
-
-int text_width(std::string_view text, int scale) {
-  return text.empty() ? 0 : static_cast<int>(text.size()) * kGlyphAdvance * scale - scale;
-}
-
-}  // namespace cohort::viewer
+}  // namespace cohort::raster

@@ -5,6 +5,7 @@
 #include <numbers>
 #include <stdexcept>
 
+#include "cohort/core/frame_defaults.h"
 #include "cohort/core/renderer.h"
 #include "cohort/core/simulated_tracer.h"
 #include "real_tracers.h"
@@ -60,19 +61,14 @@ BalanceBenchRun run_one(const BalanceBenchConfig& config, const std::string& pat
     // Simulated tracers only need rows; real ones get a 16:9 image so the view is not a sliver.
     const int width = config.real.empty() ? config.width : std::max(config.width, config.rows * 16 / 9);
     job.camera = core::spin_camera(width, config.rows, f * step);
+    // Real tracers path-trace the scene from the player start with the default frame (NEE, one
+    // bounce); simulated ones read only the camera and the frame index.
+    job.params = core::default_frame_params();
     job.params.frame_index = static_cast<kuint>(f);
-    job.params.spp = 1;
     if (!config.real.empty()) {
-      // Real tracers path-trace the scene from the player start: NEE, one bounce, as `cohort render`.
       job.camera.origin[0] = eye.x;
       job.camera.origin[1] = eye.y;
       job.camera.origin[2] = eye.z;
-      job.params.max_bounces = 1;
-      job.params.light_samples = 1;
-      job.params.firefly_clamp = 5.0f;
-      job.params.spec_boost = 2.0f;
-      job.params.soft_shadow_scale = 0.2f;
-      job.params.rr_start = 2.0f;
     }
     const core::FrameStats stats = renderer.render(job, frame);
     run.idle_percent.push_back(stats.idle_percent);

@@ -8,6 +8,7 @@
 #include <nlohmann/json.hpp>
 
 #include "cohort/balance/balancer.h"
+#include "default_map.h"
 
 namespace cohort::app {
 
@@ -29,7 +30,7 @@ struct BalanceBenchConfig {
   uint64_t seed = 1;
   balance::BalancerOptions balancer_options;
   std::vector<std::string> real;         // real tracer names; empty: simulated
-  std::string real_scene = "assets/testmap/maps/testmap.map";   // what real tracers render
+  std::string real_scene = kTestMapFile;   // what real tracers render
 };
 
 struct BalanceBenchRun {
