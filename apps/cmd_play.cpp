@@ -9,6 +9,7 @@
 #include <spdlog/spdlog.h>
 
 #include "cohort/balance/balancer.h"
+#include "cohort/core/frame_timeline.h"
 #include "cohort/core/image_output.h"
 #include "commands.h"
 #include "default_map.h"
@@ -33,6 +34,7 @@ struct PlayArgs {
   int frames = 0;            // 0: until the window closes
   std::string screenshot;    // written from the last frame
   std::string window_shot;   // the last frame as the window showed it, HUD included
+  std::string trace;         // Chrome trace event file of every frame's timeline
 };
 
 std::string key_help() {
@@ -129,6 +131,8 @@ int run_play(PlayArgs a) {
   int fps_frames = 0;
   clock::time_point fps_start = clock::now(), previous = clock::now();
   int exit_code = kExitOk;
+  std::unique_ptr<core::ChromeTraceWriter> trace;
+  if (!a.trace.empty()) trace = std::make_unique<core::ChromeTraceWriter>(a.trace);
 
   while (!window->should_close()) {
     window->poll_events();
@@ -188,6 +192,7 @@ int run_play(PlayArgs a) {
     try {
       last = session->frame(camera, dt, settings);
       have_frame = true;
+      if (trace) trace->add(last.stats.frame, last.stats.stages);
     } catch (const std::exception& e) {
       spdlog::error("cohort play: the frame could not be rendered: {}", e.what());
       exit_code = kExitFailure;
@@ -298,6 +303,8 @@ void add_play_command(CLI::App& app, int& exit_code) {
       ->capture_default_str()
       ->check(CLI::NonNegativeNumber);
   cmd->add_option("--screenshot", a->screenshot, "write the last frame to this image file on exit");
+  cmd->add_option("--trace", a->trace, "write every frame's timeline as a Chrome trace event file (open it in "
+                                       "ui.perfetto.dev or chrome://tracing); the HUD draws the last frame's");
   cmd->add_option("--window-screenshot", a->window_shot, "with --frames: write what the window showed last (the "
                                                          "frame scaled to the window, HUD included)");
   cmd->callback([a, &exit_code] {

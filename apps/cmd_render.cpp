@@ -12,6 +12,7 @@
 
 #include "cohort/commit/commit_buffer.h"
 #include "cohort/core/frame_stats.h"
+#include "cohort/core/frame_timeline.h"
 #include "cohort/core/gpu_scene.h"
 #include "cohort/core/convergence.h"
 #include "cohort/core/frame_defaults.h"
@@ -49,6 +50,7 @@ struct RenderArgs {
   std::vector<std::string> bases;
   bool no_convergence = false;
   std::string replay;
+  std::string trace;
   bool frames_given = false;
 };
 
@@ -114,12 +116,18 @@ int run_render(const RenderArgs& a) {
   const std::optional<CameraPath> path =
       a.camera_path.empty() ? std::nullopt : std::optional<CameraPath>(parse_camera_path(a.camera_path));
   ProgressBar progress(player ? 0 : a.frames, std::cerr, stderr_is_terminal());
+  std::unique_ptr<core::ChromeTraceWriter> trace;
+  if (!a.trace.empty()) trace = std::make_unique<core::ChromeTraceWriter>(a.trace);
   int rendered = 0;
   for (int f = 0; f < frames; ++f) {
+    const auto frame_start = core::TimelineClock::now();
+    std::vector<core::StageSpan> stages;  // the core's stages around the Renderer's own
     core::BandJob job;
     if (player) {
       if (!player->play_frame(*world)) break;
+      core::ScopedStage syncing(stages, core::kCoreTrack, "world sync");
       renderer.submit_commit(sync->sync(world->TakeChanges(), uint64_t(f) + 1), [&] { return sync->snapshot(); });
+      syncing.finish();
       job.camera = sync->master().camera;
     } else if (path) {
       const CameraPose pose = camera_path_pose(*path, eye, angles.yaw, f);
@@ -138,23 +146,30 @@ int run_render(const RenderArgs& a) {
     p.mode = modes().at(a.mode);
     p.soft_shadow_scale = a.soft_shadow_scale;
     core::FrameStats stats = renderer.render(job, frame);
+    stats.stages.insert(stats.stages.begin(), stages.begin(), stages.end());
     // Adaptive convergence: a still camera accumulates every frame; motion raises f (see convergence.h).
-    if (!a.no_convergence) stats.convergence_f = convergence.accumulate(job.camera, frame);
-    const core::FrameBuffer& shown = a.no_convergence ? frame : convergence.image();
-    progress.frame_done(stats.wall_ms);
-    ++rendered;
-    if (a.write == "last" && f + 1 < a.frames && !player) {
-      stats_json.push_back(nlohmann::json(stats));
-      continue;
+    if (!a.no_convergence) {
+      core::ScopedStage blending(stats.stages, core::kCoreTrack, "convergence");
+      stats.convergence_f = convergence.accumulate(job.camera, frame);
     }
-    char stem[32];
-    std::snprintf(stem, sizeof stem, "frame_%04d", f);
-    std::filesystem::path base = std::filesystem::path(a.out) / stem;
-    core::write_ldr_image(base.string() + (oiio ? ".png" : ".ppm"), shown.width, shown.height,
-                          core::tone_map(shown, written_frame_tone_map(a.exposure)));
-    core::write_hdr_image(base.string() + (oiio ? ".exr" : ".pfm"), shown);
-    nlohmann::json j = stats;
-    stats_json.push_back(j);
+    const core::FrameBuffer& shown = a.no_convergence ? frame : convergence.image();
+    ++rendered;
+    if (!(a.write == "last" && f + 1 < a.frames && !player)) {
+      char stem[32];
+      std::snprintf(stem, sizeof stem, "frame_%04d", f);
+      std::filesystem::path base = std::filesystem::path(a.out) / stem;
+      core::ScopedStage tone_mapping(stats.stages, core::kCoreTrack, "tone map");
+      const std::vector<uint8_t> display = core::tone_map(shown, written_frame_tone_map(a.exposure));
+      tone_mapping.finish();
+      core::ScopedStage writing(stats.stages, core::kCoreTrack, "output");
+      core::write_ldr_image(base.string() + (oiio ? ".png" : ".ppm"), shown.width, shown.height, display);
+      core::write_hdr_image(base.string() + (oiio ? ".exr" : ".pfm"), shown);
+    }
+    stats.end_to_end_ms = std::chrono::duration<double, std::milli>(core::TimelineClock::now() - frame_start).count();
+    stats.stages.push_back({core::kCoreTrack, "frame", core::timeline_ms(frame_start), stats.end_to_end_ms});
+    if (trace) trace->add(stats.frame, stats.stages);
+    progress.frame_done(stats.end_to_end_ms);
+    stats_json.push_back(nlohmann::json(stats));
     spdlog::debug("frame {}: {:.1f} ms ({} tracers, idle {:.1f}%)", f, stats.frame_ms, stats.tracers.size(),
                   stats.idle_percent);
   }
@@ -179,6 +194,9 @@ void add_render_command(CLI::App& app, int& exit_code) {
   cmd->add_option("--replay", a->replay, "a recorded delta stream (docs/delta-stream.md, `cohort record-scenario`): "
                                          "render its frames, camera and changes as recorded");
   cmd->add_option("--base", a->bases, "extra game folder(s) to search (loose files and .pk4s)");
+  cmd->add_option("--trace", a->trace,
+                  "write every frame's timeline (world sync, each tracer's apply and render, merge, convergence, "
+                  "tone map, output) as a Chrome trace event file: open it in ui.perfetto.dev or chrome://tracing");
   cmd->add_option("--tracers", a->tracers,
                   "comma-separated: embree, opencl[:N|:all], cuda[:N|:all], or all (Embree on the CPU plus every GPU once)")
       ->capture_default_str();

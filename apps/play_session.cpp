@@ -8,6 +8,7 @@
 #include "cohort/commit/commit_buffer.h"
 #include "cohort/core/convergence.h"
 #include "cohort/core/frame_defaults.h"
+#include "cohort/core/frame_timeline.h"
 #include "cohort/core/gpu_scene.h"
 #include "cohort/core/renderer.h"
 #include "cohort/core/tonemap.h"
@@ -138,8 +139,11 @@ SessionFrame PlaySession::frame(const viewer::FlyCamera& camera, double seconds,
   s.world.EndFrame();
 
   ++s.frame_index;
+  std::vector<core::StageSpan> stages;  // the core's stages around the Renderer's own
+  core::ScopedStage syncing(stages, core::kCoreTrack, "world sync");
   const commit::CommitBuffer commit = s.sync->sync(s.world.TakeChanges(), s.frame_index);
   s.renderer->submit_commit(commit, [&s] { return s.sync->snapshot(); });
+  syncing.finish();
 
   core::BandJob job;
   job.camera = camera.to_kcamera(settings.width, settings.height);
@@ -152,6 +156,7 @@ SessionFrame PlaySession::frame(const viewer::FlyCamera& camera, double seconds,
 
   SessionFrame out;
   out.stats = s.renderer->render(job, s.hdr);
+  out.stats.stages.insert(out.stats.stages.begin(), stages.begin(), stages.end());
   out.commit_bytes = commit.bytes();
 
   if (settings.mode != s.last_mode) s.convergence.reset();  // another view of the scene entirely
@@ -163,11 +168,15 @@ SessionFrame PlaySession::frame(const viewer::FlyCamera& camera, double seconds,
     s.moving_mask.assign(static_cast<size_t>(settings.width) * settings.height, 1.0f);
     mask = &s.moving_mask;
   }
+  core::ScopedStage blending(out.stats.stages, core::kCoreTrack, "convergence");
   out.stats.convergence_f = s.convergence.accumulate(job.camera, s.hdr, mask);
+  blending.finish();
 
   core::ToneMapOptions tm;
   tm.curve = core::parse_tone_curve(settings.tone_curve);
+  core::ScopedStage tone_mapping(out.stats.stages, core::kCoreTrack, "tone map");
   out.display = core::tone_map(s.convergence.image(), tm);
+  tone_mapping.finish();
   out.width = s.convergence.image().width;
   out.height = s.convergence.image().height;
   return out;

@@ -51,6 +51,46 @@ std::vector<std::string> hud_lines(const HudState& s) {
   return lines;
 }
 
+raster::Rgba8 stage_color(const std::string& stage) {
+  if (stage.rfind("apply", 0) == 0) return {240, 150, 40, 255};
+  if (stage == "render") return {70, 200, 90, 255};
+  if (stage == "re-render") return {230, 60, 60, 255};
+  if (stage == "world sync") return {170, 110, 230, 255};
+  if (stage == "convergence") return {60, 200, 220, 255};
+  if (stage == "tone map") return {235, 220, 70, 255};
+  return {90, 140, 240, 255};  // balance, merge and anything else the core does
+}
+
+namespace {
+
+// One bar per track at (x, y), `width` pixels for the frame's span; returns the height used.
+int draw_timeline(raster::Image8& layer, const core::FrameStats& stats, int x, int y, int width, int scale) {
+  std::vector<std::string> tracks{core::kCoreTrack};
+  for (const core::TracerFrameStats& t : stats.tracers) tracks.push_back(core::tracer_track(t.id, t.name));
+  double end = stats.start_ms;
+  for (const core::StageSpan& s : stats.stages)
+    if (s.stage != "frame") end = std::max(end, s.start_ms + s.ms);
+  const double span = std::max(end - stats.start_ms, 1e-3);
+  const int label = 11 * raster::kGlyphAdvance * scale;
+  const int bar = 5 * scale, row_height = raster::kLineAdvance * scale + 3 * scale, pad = 3 * scale;
+  raster::fill_rect(layer, x - pad, y - pad, label + width + 2 * pad,
+                    static_cast<int>(tracks.size()) * row_height + pad, {0, 0, 0, 150});
+  for (size_t row = 0; row < tracks.size(); ++row) {
+    const int top = y + static_cast<int>(row) * row_height;
+    raster::draw_text(layer, x, top, tracks[row].substr(0, 10), {200, 205, 210, 255}, scale);
+    raster::fill_rect(layer, x + label, top, width, bar, {40, 40, 40, 200});
+    for (const core::StageSpan& s : stats.stages) {
+      if (s.track != tracks[row] || s.stage == "frame") continue;
+      const int left = static_cast<int>((s.start_ms - stats.start_ms) / span * width);
+      const int right = static_cast<int>((s.start_ms + s.ms - stats.start_ms) / span * width);
+      raster::fill_rect(layer, x + label + left, top, std::max(right - left, 1), bar, stage_color(s.stage));
+    }
+  }
+  return static_cast<int>(tracks.size()) * row_height;
+}
+
+}  // namespace
+
 void draw_hud(raster::Image8& layer, const HudState& state, int scale) {
   layer.clear();
   const std::vector<std::string> lines = hud_lines(state);
@@ -64,6 +104,10 @@ void draw_hud(raster::Image8& layer, const HudState& state, int scale) {
   for (size_t i = 0; i < lines.size(); ++i) {
     const raster::Rgba8 color = i >= notice_start ? raster::Rgba8{255, 220, 60, 255} : raster::Rgba8{230, 235, 240, 255};
     raster::draw_text(layer, pad, pad + static_cast<int>(i) * raster::kLineAdvance * scale, lines[i], color, scale);
+  }
+  if (state.stats && !state.stats->stages.empty()) {
+    const int top = static_cast<int>(lines.size()) * raster::kLineAdvance * scale + 3 * pad;
+    draw_timeline(layer, *state.stats, pad, top, 160 * scale, scale);
   }
 }
 

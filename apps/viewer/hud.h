@@ -33,7 +33,12 @@ struct HudState {
 std::vector<std::string> hud_lines(const HudState& state);
 std::string format_bytes(uint64_t bytes);
 
-// Draw onto `layer` (cleared first): a translucent box and the lines, top-left.
+// The colour a timeline stage is drawn in; the legend under the bars names them.
+raster::Rgba8 stage_color(const std::string& stage);
+
+// Draw onto `layer` (cleared first): a translucent box with the lines, top-left, and under it the
+// last frame's timeline: a bar per track (the core, then each tracer) with its stages along a shared
+// time axis, so a tracer that waits or a serial core stage shows at a glance.
 void draw_hud(raster::Image8& layer, const HudState& state, int scale = 1);
 
 }  // namespace cohort::viewer

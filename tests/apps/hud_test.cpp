@@ -48,6 +48,32 @@ TEST(Hud, LinesCarryTheFrameStats) {
   EXPECT_EQ(layer.rgba[(199 * 400 + 399) * 4 + 3], 0) << "the corner away from the HUD stays transparent";
 }
 
+TEST(Hud, DrawsTheFramesTimelineAsABarPerTrack) {
+  HudState s;
+  core::FrameStats stats;
+  stats.start_ms = 100.0;
+  core::TracerFrameStats t;
+  t.id = 0;
+  t.name = "embree";
+  stats.tracers.push_back(t);
+  // The tracer renders for the whole frame; the core tone-maps in its last quarter.
+  stats.stages.push_back({core::tracer_track(0, "embree"), "render", 100.0, 8.0});
+  stats.stages.push_back({core::kCoreTrack, "tone map", 106.0, 2.0});
+  s.stats = stats;
+  raster::Image8 layer;
+  layer.resize(400, 200);
+  draw_hud(layer, s);
+  auto count = [&](raster::Rgba8 c) {
+    size_t n = 0;
+    for (size_t i = 0; i < layer.rgba.size(); i += 4)
+      n += layer.rgba[i] == c.r && layer.rgba[i + 1] == c.g && layer.rgba[i + 2] == c.b;
+    return n;
+  };
+  const size_t render = count(stage_color("render")), tone = count(stage_color("tone map"));
+  EXPECT_EQ(render, 160u * 5u) << "the render stage spans the whole 160-pixel axis, 5 pixels high";
+  EXPECT_EQ(tone, 40u * 5u) << "tone map: a quarter of the axis";
+}
+
 TEST(Hud, FormatsBytes) {
   EXPECT_EQ(format_bytes(512), "512 B");
   EXPECT_EQ(format_bytes(2048), "2.0 KB");
