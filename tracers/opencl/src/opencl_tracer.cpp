@@ -5,11 +5,11 @@
 #include <algorithm>
 #include <chrono>
 #include <cstring>
-#include <iostream>
 #include <stdexcept>
 #include <string>
 #include <vector>
 
+#include <spdlog/spdlog.h>
 
 namespace cohort::tracers {
 
@@ -156,7 +156,7 @@ OpenCLTracer::OpenCLTracer(const Options& options) : impl_(std::make_unique<Impl
     clGetProgramBuildInfo(impl_->program, dev.device, CL_PROGRAM_BUILD_LOG, 0, nullptr, &n);
     std::string log(n, '\0');
     clGetProgramBuildInfo(impl_->program, dev.device, CL_PROGRAM_BUILD_LOG, n, log.data(), nullptr);
-    std::cerr << "OpenCLTracer: kernel build log for " << dev.label << ":\n" << log << "\n";
+    spdlog::error("OpenCLTracer: kernel build log for {}:\n{}", dev.label, log);
     throw std::runtime_error("OpenCLTracer: kernel build failed on " + dev.label + " (error " + std::to_string(err) +
                              "):\n" + log);
   }
