@@ -6,7 +6,7 @@ void TracerBase::apply(const commit::CommitBuffer& commit) {
   commit::ChangeSet changes = commit::apply_commit(commit, scene_);
   if (!has_scene_) changes.full_resync = true;
   upload(changes);
-  has_scene_ = true;
+  has_scene_ = true;   // only now: after a failed first upload the next commit is sent whole again
 }
 
 KFrameParams TracerBase::frame_params(const core::BandJob& job) const {

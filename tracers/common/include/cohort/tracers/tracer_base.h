@@ -20,7 +20,7 @@ class TracerBase : public core::Tracer {
   bool has_scene() const { return has_scene_; }
 
   // Brings the tracer's own copies (device buffers, acceleration structures) up to date with scene().
-  // The first commit arrives with full_resync set: there is nothing yet to patch.
+  // Until one upload has succeeded, changes arrive with full_resync set: there is nothing yet to patch.
   virtual void upload(const commit::ChangeSet& changes) = 0;
 
   // The band's parameters with the scene's light, instance and TLAS node counts filled in.
