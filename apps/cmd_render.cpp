@@ -20,6 +20,7 @@
 #include "cohort/core/world_sync.h"
 #include "cohort/scene/map_loader.h"
 #include "cohort/scene/render_world_stream.h"
+#include "cohort/tracers/tracer_registry.h"
 #include <limits>
 #include "cohort/core/image_output.h"
 #include "cohort/core/renderer.h"
@@ -29,7 +30,6 @@
 #include "default_map.h"
 #include "progress_bar.h"
 #include "render_scene_source.h"
-#include "tracer_factory.h"
 
 namespace cohort::app {
 
@@ -75,7 +75,7 @@ const std::map<std::string, uint32_t>& modes() {
 int run_render(const RenderArgs& a) {
   if (a.map.empty() && a.replay.empty()) throw std::invalid_argument("name a map or scene pack (or --replay FILE)");
   RenderScene scene = a.replay.empty() ? load_render_scene(a.map, bases_or_test_map(a.bases)) : RenderScene{};
-  std::vector<std::unique_ptr<core::Tracer>> tracers = make_tracers(a.tracers);
+  std::vector<std::unique_ptr<core::Tracer>> tracers = tracers::make_tracers(a.tracers);
   core::RendererOptions options;
   options.balancer = a.balancer;
   options.frame_timeout = std::chrono::milliseconds(600000);

@@ -17,7 +17,7 @@
 #include "cohort/scene/map_loader.h"
 #include "cohort/scene/render_world.h"
 #include "cohort/scene/scenario.h"
-#include "tracer_factory.h"
+#include "cohort/tracers/tracer_registry.h"
 
 namespace cohort::app {
 namespace {
@@ -81,9 +81,9 @@ PlaySession::PlaySession(const SessionOptions& options) {
   std::vector<std::unique_ptr<core::Tracer>> tracers;
   // parse_tracer_list expands "all" and ":all" by probing devices; a device that then fails to open
   // is dropped with a warning and the others carry on.
-  for (const TracerSpec& spec : parse_tracer_list(list)) {
+  for (const tracers::TracerSpec& spec : tracers::parse_tracer_list(list)) {
     try {
-      tracers.push_back(make_tracer(spec));
+      tracers.push_back(tracers::make_tracer(spec));
     } catch (const std::exception& e) {
       warnings_.push_back("tracer " + spec.text + " did not start: " + e.what());
       spdlog::warn("{}; carrying on with the others", warnings_.back());

@@ -26,6 +26,7 @@
 #ifdef COHORT_HAVE_OPENCL
 #include "cohort/tracers/opencl_tracer.h"
 #endif
+#include "cohort/tracers/tracer_registry.h"
 
 using namespace cohort;
 
@@ -160,11 +161,9 @@ int main(int argc, char** argv) {
   {
     std::vector<std::string> devices = tracers::OpenCLTracer::list_devices();
     for (size_t d = 0; d < devices.size(); ++d) {
-      tracers::OpenCLTracer::Options o;
-      o.device = int(d);
-      tracers::OpenCLTracer cl(o);
-      cl.apply(commit);
-      double s = time_render(cl, job, cfg.repeats);
+      std::unique_ptr<core::Tracer> cl = tracers::make_tracer({"opencl", int(d), "opencl:" + std::to_string(d)});
+      cl->apply(commit);
+      double s = time_render(*cl, job, cfg.repeats);
       double mrays = rays_per_path > 0 ? paths * rays_per_path / s * 1e-6 : 0.0;
       std::string label = "opencl:" + std::to_string(d) + " " + devices[d];
       if (label.size() > 44) label.resize(44);

@@ -3,8 +3,8 @@
 #include <spdlog/spdlog.h>
 
 #include "cohort/core/view.h"
+#include "cohort/tracers/tracer_registry.h"
 #include "render_scene_source.h"
-#include "tracer_factory.h"
 
 namespace cohort::app {
 
@@ -12,7 +12,7 @@ RealTracers make_real_tracers(const std::vector<std::string>& names, const std::
   std::string list;
   for (const std::string& n : names) list += (list.empty() ? "" : ",") + n;
   RealTracers out;
-  out.tracers = make_tracers(list);
+  out.tracers = tracers::make_tracers(list);
   RenderScene scene = load_render_scene(scene_path, {});
   auto commit = commit::CommitBuffer::full(scene.tracer_scene, 1);
   for (auto& t : out.tracers) {

@@ -18,10 +18,8 @@ KTraceCtx context_for(const commit::TracerScene& s) {
   ctx.scene.texels = s.texels.data();
   ctx.scene.lights = s.lights.data();
   ctx.scene.instance_count = kuint(s.instances.size());
+  ctx.scene.tlas_node_count = kuint(s.tlas_nodes.size());
   ctx.scene.light_count = kuint(s.lights.size());
-  ctx.scene.material_count = kuint(s.materials.size());
-  ctx.scene.texture_count = kuint(s.textures.size());
-  ctx.tlas_node_count = kuint(s.tlas_nodes.size());
   return ctx;
 }
 

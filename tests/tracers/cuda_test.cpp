@@ -14,6 +14,8 @@
 
 #ifdef COHORT_HAVE_CUDA
 
+#include "cohort/tracers/cuda_tracer.h"
+
 using namespace cohort;
 using namespace cohort::test;
 

@@ -27,8 +27,6 @@ struct CudaTracer::Impl {
   std::string name;
   cudaStream_t stream = nullptr;
   cudaEvent_t start = nullptr, stop = nullptr;
-  commit::TracerScene scene;
-  bool has_scene = false;
   DeviceArray<KVertex> vertices;
   DeviceArray<KTriangle> triangles;
   DeviceArray<KBvhNode> blas_nodes, tlas_nodes;
@@ -77,23 +75,9 @@ struct CudaTracer::Impl {
     set_texel_texture(texel_texture);
   }
 
-  KSceneView view() const {
-    KSceneView v{};
-    v.vertices = vertices.data();
-    v.triangles = triangles.data();
-    v.blas_nodes = blas_nodes.data();
-    v.blases = blases.data();
-    v.instances = instances.data();
-    v.tlas_nodes = tlas_nodes.data();
-    v.materials = materials.data();
-    v.textures = textures.data();
-    v.texels = texels.data();
-    v.lights = lights.data();
-    v.instance_count = kuint(scene.instances.size());
-    v.light_count = kuint(scene.lights.size());
-    v.material_count = kuint(scene.materials.size());
-    v.texture_count = kuint(scene.textures.size());
-    return v;
+  KSceneView view(const KFrameParams& params) const {
+    return k_scene_view(vertices.data(), triangles.data(), blas_nodes.data(), blases.data(), instances.data(),
+                        tlas_nodes.data(), materials.data(), textures.data(), texels.data(), lights.data(), &params);
   }
 };
 
@@ -123,30 +107,30 @@ CudaTracer::~CudaTracer() {
 
 std::string CudaTracer::name() const { return impl_->name; }
 
-void CudaTracer::apply(const commit::CommitBuffer& commit) {
+void CudaTracer::upload(const commit::ChangeSet& changes) {
   Impl& m = *impl_;
   COHORT_CUDA(cudaSetDevice(m.device));
-  commit::ChangeSet changes = commit::apply_commit(commit, m.scene);
-  const bool all = changes.full_resync || !m.has_scene;
-  m.has_scene = true;
+  const commit::TracerScene& scene = this->scene();
+  const bool all = changes.full_resync;
   cudaStream_t s = m.stream;
   if (all || changes.geometry) {
     // Appended BLASes upload only their new tail; anything else re-sends the array.
-    m.vertices.upload(m.scene.vertices, all ? 0 : changes.vertices_from, s);
-    m.triangles.upload(m.scene.triangles, all ? 0 : changes.triangles_from, s);
-    m.blas_nodes.upload(m.scene.blas_nodes, all ? 0 : changes.blas_nodes_from, s);
-    m.blases.upload(m.scene.blases, all ? 0 : changes.blases_from, s);
+    m.vertices.upload(scene.vertices, all ? 0 : changes.vertices_from, s);
+    m.triangles.upload(scene.triangles, all ? 0 : changes.triangles_from, s);
+    m.blas_nodes.upload(scene.blas_nodes, all ? 0 : changes.blas_nodes_from, s);
+    m.blases.upload(scene.blases, all ? 0 : changes.blases_from, s);
   }
   if (all || changes.instances || changes.tlas) {
-    m.instances.upload(m.scene.instances, 0, s);
-    m.tlas_nodes.upload(m.scene.tlas_nodes, 0, s);
+    m.instances.upload(scene.instances, 0, s);
+    m.tlas_nodes.upload(scene.tlas_nodes, 0, s);
   }
-  if (all || changes.materials) m.materials.upload(m.scene.materials, 0, s);
-  if (all || changes.lights) m.lights.upload(m.scene.lights, 0, s);
+  if (all || changes.materials) m.materials.upload(scene.materials, 0, s);
+  if (all || changes.lights) m.lights.upload(scene.lights, 0, s);
   if (all || changes.textures) {
-    m.textures.upload(m.scene.textures, 0, s);
-    if (m.scene.texels.empty()) m.scene.texels.push_back(0xffffffffu);   // a texture object needs storage
-    m.texels.upload(m.scene.texels, 0, s);
+    m.textures.upload(scene.textures, 0, s);
+    // A texture object needs storage: a scene without texels binds one unused white texel instead.
+    static const std::vector<uint32_t> one_white_texel{0xffffffffu};
+    m.texels.upload(scene.texels.empty() ? one_white_texel : scene.texels, 0, s);
     m.rebind_texel_texture();
   }
   COHORT_CUDA(cudaStreamSynchronize(s));
@@ -155,15 +139,12 @@ void CudaTracer::apply(const commit::CommitBuffer& commit) {
 core::BandResult CudaTracer::render_band(const core::BandJob& job, core::FrameBuffer& target) {
   Impl& m = *impl_;
   COHORT_CUDA(cudaSetDevice(m.device));
-  if (!m.has_scene) throw std::runtime_error(m.name + ": render_band before any commit was applied");
-  KFrameParams params = job.params;
+  if (!has_scene()) throw std::runtime_error(m.name + ": render_band before any commit was applied");
+  const KFrameParams params = frame_params(job);
   const KCamera& camera = job.camera;
   if (params.row_end <= params.row_begin) return {};
   if (camera.width != kuint(target.width) || params.row_end > kuint(target.height))
     throw std::invalid_argument(m.name + ": band does not fit the frame buffer");
-  params.light_count = kuint(m.scene.lights.size());
-  params.instance_count = kuint(m.scene.instances.size());
-  params.tlas_node_count = kuint(m.scene.tlas_nodes.size());
   const size_t pixels = size_t(camera.width) * (params.row_end - params.row_begin);
   if (pixels > m.band_capacity) {
     if (m.band) COHORT_CUDA(cudaFree(m.band));
@@ -176,8 +157,7 @@ core::BandResult CudaTracer::render_band(const core::BandJob& job, core::FrameBu
   }
   m.register_target(target);
   COHORT_CUDA(cudaEventRecord(m.start, m.stream));
-  launch_render_band(m.view(), params.tlas_node_count, params, camera, m.band, m.count_rays ? m.ray_counts : nullptr,
-                     m.stream);
+  launch_render_band(m.view(params), params, camera, m.band, m.count_rays ? m.ray_counts : nullptr, m.stream);
   COHORT_CUDA(cudaEventRecord(m.stop, m.stream));
   // The band's rows are contiguous in the frame buffer: one copy straight into place.
   COHORT_CUDA(cudaMemcpyAsync(target.row(int(params.row_begin)), m.band, pixels * sizeof(float4), cudaMemcpyDeviceToHost,

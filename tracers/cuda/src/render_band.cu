@@ -13,16 +13,14 @@ __constant__ cudaTextureObject_t cohort_texel_texture;
 
 namespace cohort::tracers {
 
-__global__ void __launch_bounds__(128) render_band_kernel(KSceneView scene, kuint tlas_node_count, KFrameParams params,
-                                                          KCamera camera, float4* band,
-                                                          unsigned long long* ray_counts) {
+__global__ void __launch_bounds__(128) render_band_kernel(KSceneView scene, KFrameParams params, KCamera camera,
+                                                          float4* band, unsigned long long* ray_counts) {
   const kuint x = blockIdx.x * blockDim.x + threadIdx.x;
   const kuint row = blockIdx.y * blockDim.y + threadIdx.y;
   const kuint y = params.row_begin + row;
   const bool inside = x < camera.width && y < params.row_end;
   KTraceCtx ctx;
   ctx.scene = scene;
-  ctx.tlas_node_count = tlas_node_count;
   ctx.closest_rays = 0u;
   ctx.occlusion_rays = 0u;
   if (inside) {
@@ -44,12 +42,12 @@ void set_texel_texture(cudaTextureObject_t texture) {
   COHORT_CUDA(cudaMemcpyToSymbol(cohort_texel_texture, &texture, sizeof texture));
 }
 
-void launch_render_band(const KSceneView& scene, kuint tlas_node_count, const KFrameParams& params,
-                        const KCamera& camera, float4* band, unsigned long long* ray_counts, cudaStream_t stream) {
+void launch_render_band(const KSceneView& scene, const KFrameParams& params, const KCamera& camera, float4* band,
+                        unsigned long long* ray_counts, cudaStream_t stream) {
   const kuint rows = params.row_end - params.row_begin;
   const dim3 block(16, 8);
   const dim3 grid((camera.width + block.x - 1) / block.x, (rows + block.y - 1) / block.y);
-  render_band_kernel<<<grid, block, 0, stream>>>(scene, tlas_node_count, params, camera, band, ray_counts);
+  render_band_kernel<<<grid, block, 0, stream>>>(scene, params, camera, band, ray_counts);
   COHORT_CUDA(cudaGetLastError());
 }
 

@@ -8,7 +8,8 @@
 namespace cohort::tracers {
 
 void set_texel_texture(cudaTextureObject_t texture);
-void launch_render_band(const KSceneView& scene, kuint tlas_node_count, const KFrameParams& params,
-                        const KCamera& camera, float4* band, unsigned long long* ray_counts, cudaStream_t stream);
+// The scene view holds device pointers (built on the host with k_scene_view, passed by value).
+void launch_render_band(const KSceneView& scene, const KFrameParams& params, const KCamera& camera, float4* band,
+                        unsigned long long* ray_counts, cudaStream_t stream);
 
 }  // namespace cohort::tracers

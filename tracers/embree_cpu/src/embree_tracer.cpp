@@ -11,7 +11,6 @@
 #include <tbb/global_control.h>
 #include <tbb/parallel_for.h>
 
-#include "cohort/commit/tracer_scene.h"
 #include "embree_kernel.h"
 
 namespace cohort::tracers {
@@ -52,7 +51,6 @@ struct EmbreeTracer::Impl {
   RTCDevice device = nullptr;
   RTCScene top = nullptr;
   std::vector<RTCScene> blas_scenes;
-  commit::TracerScene scene;
   std::unique_ptr<tbb::global_control> thread_limit;
   uint64_t rays_traced = 0;
 
@@ -73,7 +71,7 @@ struct EmbreeTracer::Impl {
   }
 
   // One Embree scene per KBlas, sharing the TracerScene's vertex and triangle arrays (no copies).
-  void build_blases() {
+  void build_blases(const commit::TracerScene& scene) {
     release_blases();
     for (const KBlas& b : scene.blases) {
       RTCScene s = rtcNewScene(device);
@@ -95,7 +93,7 @@ struct EmbreeTracer::Impl {
   }
 
   // Instance geometry IDs equal KInstance indices, so instID[0] indexes the instance array directly.
-  void build_top() {
+  void build_top(const commit::TracerScene& scene) {
     release_top();
     top = rtcNewScene(device);
     for (size_t i = 0; i < scene.instances.size(); ++i) {
@@ -112,28 +110,6 @@ struct EmbreeTracer::Impl {
     }
     rtcCommitScene(top);
   }
-
-  embree_kernel::TraceCtx context() const {
-    embree_kernel::TraceCtx ctx{};
-    KSceneView& v = ctx.scene;
-    v.vertices = scene.vertices.data();
-    v.triangles = scene.triangles.data();
-    v.blas_nodes = scene.blas_nodes.data();
-    v.blases = scene.blases.data();
-    v.instances = scene.instances.data();
-    v.tlas_nodes = scene.tlas_nodes.data();
-    v.materials = scene.materials.data();
-    v.textures = scene.textures.data();
-    v.texels = scene.texels.data();
-    v.lights = scene.lights.data();
-    v.instance_count = static_cast<kuint>(scene.instances.size());
-    v.light_count = static_cast<kuint>(scene.lights.size());
-    v.material_count = static_cast<kuint>(scene.materials.size());
-    v.texture_count = static_cast<kuint>(scene.textures.size());
-    ctx.top = top;
-    ctx.rays = 0;
-    return ctx;
-  }
 };
 
 EmbreeTracer::EmbreeTracer(int threads) : impl_(std::make_unique<Impl>()) {
@@ -146,14 +122,13 @@ EmbreeTracer::EmbreeTracer(int threads) : impl_(std::make_unique<Impl>()) {
 
 EmbreeTracer::~EmbreeTracer() = default;
 
-void EmbreeTracer::apply(const commit::CommitBuffer& commit) {
-  commit::ChangeSet changes = commit::apply_commit(commit, impl_->scene);
+void EmbreeTracer::upload(const commit::ChangeSet& changes) {
   if (changes.full_resync || changes.geometry) {
-    impl_->build_blases();
+    impl_->build_blases(scene());
     check_device(impl_->device, "building the BLAS scenes");
-    impl_->build_top();
+    impl_->build_top(scene());
   } else if (changes.instances || changes.tlas || !impl_->top) {
-    impl_->build_top();
+    impl_->build_top(scene());
   }
   check_device(impl_->device, "building the instance scene");
 }
@@ -161,14 +136,12 @@ void EmbreeTracer::apply(const commit::CommitBuffer& commit) {
 core::BandResult EmbreeTracer::render_band(const core::BandJob& job, core::FrameBuffer& target) {
   if (!impl_->top) throw std::runtime_error("EmbreeTracer: render_band before any commit was applied");
   auto start = std::chrono::steady_clock::now();
-  KFrameParams params = job.params;
-  params.light_count = static_cast<kuint>(impl_->scene.lights.size());
-  params.instance_count = static_cast<kuint>(impl_->scene.instances.size());
+  const KFrameParams params = frame_params(job);
   const KCamera camera = job.camera;
   const int row_begin = static_cast<int>(params.row_begin);
   const int row_end = std::min(static_cast<int>(params.row_end), target.height);
   const int width = std::min(static_cast<int>(camera.width), target.width);
-  embree_kernel::TraceCtx base = impl_->context();
+  const embree_kernel::TraceCtx base{host_scene_view(params), impl_->top, 0};
   std::atomic<uint64_t> rays{0};
   tbb::parallel_for(tbb::blocked_range<int>(row_begin, row_end, 1), [&](const tbb::blocked_range<int>& rows) {
     embree_kernel::TraceCtx ctx = base;
@@ -194,10 +167,10 @@ uint64_t EmbreeTracer::rays_traced() const { return impl_->rays_traced; }
 
 uint64_t EmbreeTracer::trace_camera_rays_only(const core::BandJob& job) {
   if (!impl_->top) throw std::runtime_error("EmbreeTracer: trace before any commit was applied");
-  const KFrameParams params = job.params;
+  const KFrameParams params = frame_params(job);
   const KCamera camera = job.camera;
   const kuint spp = params.spp > 0u ? params.spp : 1u;
-  embree_kernel::TraceCtx base = impl_->context();
+  const embree_kernel::TraceCtx base{host_scene_view(params), impl_->top, 0};
   std::atomic<uint64_t> hits{0};
   tbb::parallel_for(tbb::blocked_range<int>(static_cast<int>(params.row_begin), static_cast<int>(params.row_end), 1),
                     [&](const tbb::blocked_range<int>& rows) {

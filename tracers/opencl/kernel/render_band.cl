@@ -17,21 +17,8 @@ __kernel void cohort_render_band(__global const KVertex* vertices, __global cons
   kuint y = params.row_begin + row;
   if (x >= camera.width || y >= params.row_end) return;
   KTraceCtx ctx;
-  ctx.scene.vertices = vertices;
-  ctx.scene.triangles = triangles;
-  ctx.scene.blas_nodes = blas_nodes;
-  ctx.scene.blases = blases;
-  ctx.scene.instances = instances;
-  ctx.scene.tlas_nodes = tlas_nodes;
-  ctx.scene.materials = materials;
-  ctx.scene.textures = textures;
-  ctx.scene.texels = texels;
-  ctx.scene.lights = lights;
-  ctx.scene.instance_count = params.instance_count;
-  ctx.scene.light_count = params.light_count;
-  ctx.scene.material_count = 0u;
-  ctx.scene.texture_count = 0u;
-  ctx.tlas_node_count = params.tlas_node_count;
+  ctx.scene = k_scene_view(vertices, triangles, blas_nodes, blases, instances, tlas_nodes, materials, textures, texels,
+                           lights, &params);
   ctx.closest_rays = 0u;
   ctx.occlusion_rays = 0u;
   KVec3 c = k_render_pixel(&ctx, &params, &camera, x, y);

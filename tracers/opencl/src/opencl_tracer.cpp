@@ -5,12 +5,11 @@
 #include <algorithm>
 #include <chrono>
 #include <cstring>
-#include <iostream>
 #include <stdexcept>
 #include <string>
 #include <vector>
 
-#include "cohort/commit/tracer_scene.h"
+#include <spdlog/spdlog.h>
 
 namespace cohort::tracers {
 
@@ -106,11 +105,9 @@ struct OpenCLTracer::Impl {
   cl_command_queue queue = nullptr;
   cl_program program = nullptr;
   cl_kernel kernel = nullptr;
-  commit::TracerScene scene;
   DeviceBuffer vertices, triangles, blas_nodes, blases, instances, tlas_nodes, materials, textures, texels, lights;
   cl_mem params = nullptr, camera = nullptr, output = nullptr;
   size_t output_bytes = 0;
-  bool has_scene = false;
 
   ~Impl() {
     for (cl_mem m : {params, camera, output})
@@ -159,7 +156,7 @@ OpenCLTracer::OpenCLTracer(const Options& options) : impl_(std::make_unique<Impl
     clGetProgramBuildInfo(impl_->program, dev.device, CL_PROGRAM_BUILD_LOG, 0, nullptr, &n);
     std::string log(n, '\0');
     clGetProgramBuildInfo(impl_->program, dev.device, CL_PROGRAM_BUILD_LOG, n, log.data(), nullptr);
-    std::cerr << "OpenCLTracer: kernel build log for " << dev.label << ":\n" << log << "\n";
+    spdlog::error("OpenCLTracer: kernel build log for {}:\n{}", dev.label, log);
     throw std::runtime_error("OpenCLTracer: kernel build failed on " + dev.label + " (error " + std::to_string(err) +
                              "):\n" + log);
   }
@@ -175,42 +172,38 @@ OpenCLTracer::~OpenCLTracer() = default;
 
 std::string OpenCLTracer::name() const { return "opencl (" + impl_->label + ")"; }
 
-void OpenCLTracer::apply(const commit::CommitBuffer& commit) {
+void OpenCLTracer::upload(const commit::ChangeSet& changes) {
   Impl& m = *impl_;
-  commit::ChangeSet changes = commit::apply_commit(commit, m.scene);
-  const bool all = changes.full_resync || !m.has_scene;
+  const commit::TracerScene& s = scene();
+  const bool all = changes.full_resync;
   cl_context c = m.context;
   cl_command_queue q = m.queue;
   if (all || changes.geometry) {
-    m.vertices.upload(c, q, m.scene.vertices, "uploading vertices");
-    m.triangles.upload(c, q, m.scene.triangles, "uploading triangles");
-    m.blas_nodes.upload(c, q, m.scene.blas_nodes, "uploading BLAS nodes");
-    m.blases.upload(c, q, m.scene.blases, "uploading BLASes");
+    m.vertices.upload(c, q, s.vertices, "uploading vertices");
+    m.triangles.upload(c, q, s.triangles, "uploading triangles");
+    m.blas_nodes.upload(c, q, s.blas_nodes, "uploading BLAS nodes");
+    m.blases.upload(c, q, s.blases, "uploading BLASes");
   }
   if (all || changes.instances || changes.tlas) {
-    m.instances.upload(c, q, m.scene.instances, "uploading instances");
-    m.tlas_nodes.upload(c, q, m.scene.tlas_nodes, "uploading TLAS nodes");
+    m.instances.upload(c, q, s.instances, "uploading instances");
+    m.tlas_nodes.upload(c, q, s.tlas_nodes, "uploading TLAS nodes");
   }
-  if (all || changes.materials) m.materials.upload(c, q, m.scene.materials, "uploading materials");
+  if (all || changes.materials) m.materials.upload(c, q, s.materials, "uploading materials");
   if (all || changes.textures) {
-    m.textures.upload(c, q, m.scene.textures, "uploading textures");
-    m.texels.upload(c, q, m.scene.texels, "uploading texels");
+    m.textures.upload(c, q, s.textures, "uploading textures");
+    m.texels.upload(c, q, s.texels, "uploading texels");
   }
-  if (all || changes.lights) m.lights.upload(c, q, m.scene.lights, "uploading lights");
-  m.has_scene = true;
+  if (all || changes.lights) m.lights.upload(c, q, s.lights, "uploading lights");
 }
 
 core::BandResult OpenCLTracer::render_band(const core::BandJob& job, core::FrameBuffer& target) {
   Impl& m = *impl_;
-  if (!m.has_scene) throw std::runtime_error("OpenCLTracer: render_band before any commit was applied");
-  KFrameParams params = job.params;
+  if (!has_scene()) throw std::runtime_error("OpenCLTracer: render_band before any commit was applied");
+  KFrameParams params = frame_params(job);
   KCamera camera = job.camera;
   params.row_end = std::min<kuint>(params.row_end, static_cast<kuint>(target.height));
   camera.width = std::min<kuint>(camera.width, static_cast<kuint>(target.width));
   if (params.row_end <= params.row_begin || camera.width == 0) return {};
-  params.light_count = static_cast<kuint>(m.scene.lights.size());
-  params.instance_count = static_cast<kuint>(m.scene.instances.size());
-  params.tlas_node_count = static_cast<kuint>(m.scene.tlas_nodes.size());
   const size_t rows = params.row_end - params.row_begin;
   const size_t bytes = rows * camera.width * 4 * sizeof(float);
   cl_int err = CL_SUCCESS;

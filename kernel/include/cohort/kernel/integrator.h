@@ -57,7 +57,7 @@ KFN KVec3 k_direct_lighting(KTraceCtx* ctx, const KFrameParams* params, const KS
   const KSceneView* scene = K_CTX_SCENE(ctx);
   KVec3 sum = v3s(0.0f);
   if (params->light_samples == 0u) {
-    for (kuint i = 0u; i < params->light_count; ++i) {
+    for (kuint i = 0u; i < scene->light_count; ++i) {
       KGLOBAL const KLight* light = &scene->lights[i];
       KVec3 c = k_light_unshadowed(scene, light, sf, wo, params->spec_boost);
       if (v3_max_component(c) <= 0.0f) continue;
@@ -72,7 +72,7 @@ KFN KVec3 k_direct_lighting(KTraceCtx* ctx, const KFrameParams* params, const KS
     kuint chosen = K_NONE;
     KVec3 chosen_contrib = v3s(0.0f);
     float u_pick = k_rng_next(rng);
-    for (kuint i = 0u; i < params->light_count; ++i) {
+    for (kuint i = 0u; i < scene->light_count; ++i) {
       KVec3 c = k_light_unshadowed(scene, &scene->lights[i], sf, wo, params->spec_boost);
       float w = v3_luminance(c);
       if (w <= 0.0f) continue;

@@ -129,6 +129,8 @@ typedef struct KCamera {
 #define K_MODE_TRIANGLES 6u  /* a colour per triangle */
 #define K_MODE_COUNT    7u   /* how many modes: they run from 0 to K_MODE_COUNT - 1 */
 
+/* light_count, instance_count and tlas_node_count are the lengths of the scene's arrays, set by the
+ * host from the tracer's scene copy and read only by k_scene_view (scene_view.h). */
 typedef struct KFrameParams {
   kuint frame_index;  kuint spp;          kuint max_bounces;   kuint light_samples;
   float firefly_clamp; float spec_boost;  kuint mode;          kuint light_count;

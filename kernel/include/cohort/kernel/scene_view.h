@@ -1,5 +1,6 @@
-/* What a kernel sees of a TracerScene: device pointers to its arrays plus counts, and the record of
- * a ray hit. Built by each tracer (host pointers for the CPU tracer, device pointers on GPUs). */
+/* What a kernel sees of a TracerScene: pointers to its arrays plus their counts, and the record of a
+ * ray hit. Every tracer builds it with k_scene_view (host pointers for the CPU tracer, device pointers
+ * on GPUs), so the fields are filled in one place only. */
 #ifndef COHORT_KERNEL_SCENE_VIEW_H
 #define COHORT_KERNEL_SCENE_VIEW_H
 #include "layout.h"
@@ -17,10 +18,34 @@ typedef struct KSceneView {
   KGLOBAL const kuint* texels;
   KGLOBAL const KLight* lights;
   kuint instance_count;
+  kuint tlas_node_count;
   kuint light_count;
-  kuint material_count;
-  kuint texture_count;
 } KSceneView;
+
+/* The view over a scene's arrays, wherever they live. The counts come from the frame parameters,
+ * which the host sets from the tracer's scene copy (tracers/common's TracerBase::frame_params): a
+ * kernel that receives the arrays as separate buffers (OpenCL) learns their lengths that way. */
+KFN KSceneView k_scene_view(KGLOBAL const KVertex* vertices, KGLOBAL const KTriangle* triangles,
+                            KGLOBAL const KBvhNode* blas_nodes, KGLOBAL const KBlas* blases,
+                            KGLOBAL const KInstance* instances, KGLOBAL const KBvhNode* tlas_nodes,
+                            KGLOBAL const KMaterial* materials, KGLOBAL const KTexture* textures,
+                            KGLOBAL const kuint* texels, KGLOBAL const KLight* lights, const KFrameParams* params) {
+  KSceneView v;
+  v.vertices = vertices;
+  v.triangles = triangles;
+  v.blas_nodes = blas_nodes;
+  v.blases = blases;
+  v.instances = instances;
+  v.tlas_nodes = tlas_nodes;
+  v.materials = materials;
+  v.textures = textures;
+  v.texels = texels;
+  v.lights = lights;
+  v.instance_count = params->instance_count;
+  v.tlas_node_count = params->tlas_node_count;
+  v.light_count = params->light_count;
+  return v;
+}
 
 /* A ray hit: triangle is an absolute index into the triangle array; (u, v) are the barycentrics of
  * v1 and v2 (p = (1-u-v) p0 + u p1 + v p2), as Embree and Moller-Trumbore both report them. */

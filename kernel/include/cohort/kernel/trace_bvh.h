@@ -19,7 +19,6 @@
 
 typedef struct KTraceCtx {
   KSceneView scene;
-  kuint tlas_node_count;
   kuint closest_rays, occlusion_rays;   /* counted per thread, for the rays/s benchmarks */
 } KTraceCtx;
 
@@ -32,7 +31,7 @@ KFN KSceneRef k_trace_scene_ref(const KTraceCtx* ctx) {
   r.instances = ctx->scene.instances;
   r.tlas_nodes = ctx->scene.tlas_nodes;
   r.instance_count = ctx->scene.instance_count;
-  r.tlas_node_count = ctx->tlas_node_count;
+  r.tlas_node_count = ctx->scene.tlas_node_count;
   return r;
 }
 

@@ -6,7 +6,7 @@
 #include <memory>
 #include <string>
 
-#include "cohort/core/tracer.h"
+#include "cohort/tracers/tracer_base.h"
 
 namespace cohort::tracers {
 
@@ -14,12 +14,11 @@ namespace cohort::tracers {
 int cuda_device_count();
 std::string cuda_device_name(int device);
 
-class CudaTracer final : public core::Tracer {
+class CudaTracer final : public TracerBase {
  public:
   explicit CudaTracer(int device);
   ~CudaTracer() override;
   std::string name() const override;
-  void apply(const commit::CommitBuffer& commit) override;
   core::BandResult render_band(const core::BandJob& job, core::FrameBuffer& target) override;
 
   // Ray counting for benchmarks (off by default: it costs a reduction per warp).
@@ -31,6 +30,8 @@ class CudaTracer final : public core::Tracer {
   int device() const;
 
  private:
+  void upload(const commit::ChangeSet& changes) override;
+
   struct Impl;
   std::unique_ptr<Impl> impl_;
 };

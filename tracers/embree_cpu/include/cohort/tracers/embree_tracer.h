@@ -6,11 +6,11 @@
 #include <memory>
 #include <string>
 
-#include "cohort/core/tracer.h"
+#include "cohort/tracers/tracer_base.h"
 
 namespace cohort::tracers {
 
-class EmbreeTracer : public core::Tracer {
+class EmbreeTracer : public TracerBase {
  public:
   explicit EmbreeTracer(int threads = 0);  // 0: all hardware threads
   ~EmbreeTracer() override;
@@ -18,7 +18,6 @@ class EmbreeTracer : public core::Tracer {
   EmbreeTracer& operator=(const EmbreeTracer&) = delete;
 
   std::string name() const override { return "embree"; }
-  void apply(const commit::CommitBuffer& commit) override;
   core::BandResult render_band(const core::BandJob& job, core::FrameBuffer& target) override;
 
   // Raw closest-hit throughput: traces exactly the band's camera rays (same jitter as the integrator,
@@ -28,6 +27,8 @@ class EmbreeTracer : public core::Tracer {
   uint64_t rays_traced() const;
 
  private:
+  void upload(const commit::ChangeSet& changes) override;
+
   struct Impl;
   std::unique_ptr<Impl> impl_;
 };

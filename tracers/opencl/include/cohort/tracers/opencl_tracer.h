@@ -6,11 +6,11 @@
 #include <string>
 #include <vector>
 
-#include "cohort/core/tracer.h"
+#include "cohort/tracers/tracer_base.h"
 
 namespace cohort::tracers {
 
-class OpenCLTracer : public core::Tracer {
+class OpenCLTracer : public TracerBase {
  public:
   struct Options {
     int device = 0;         // index into list_devices(): every device of every platform, in order
@@ -24,13 +24,14 @@ class OpenCLTracer : public core::Tracer {
   OpenCLTracer& operator=(const OpenCLTracer&) = delete;
 
   std::string name() const override;
-  void apply(const commit::CommitBuffer& commit) override;
   core::BandResult render_band(const core::BandJob& job, core::FrameBuffer& target) override;
 
   // "platform / device" for every OpenCL device on this machine, in the order Options::device counts.
   static std::vector<std::string> list_devices();
 
  private:
+  void upload(const commit::ChangeSet& changes) override;
+
   struct Impl;
   std::unique_ptr<Impl> impl_;
 };

@@ -1,4 +1,4 @@
-#include "tracer_factory.h"
+#include "cohort/tracers/tracer_registry.h"
 
 #include <stdexcept>
 
@@ -12,7 +12,7 @@
 #include "cohort/tracers/cuda_tracer.h"
 #endif
 
-namespace cohort::app {
+namespace cohort::tracers {
 
 namespace {
 
@@ -24,19 +24,11 @@ TracerSpec spec_of(const std::string& kind, int device) {
   return spec;
 }
 
-int cuda_devices() {
-#ifdef COHORT_HAVE_CUDA
-  return tracers::cuda_device_count();
-#else
-  return 0;
-#endif
-}
-
 // OpenCL devices that are not PoCL's CPU device: the CPU already has the Embree tracer.
 std::vector<int> opencl_accelerators() {
   std::vector<int> found;
 #ifdef COHORT_HAVE_OPENCL
-  auto names = tracers::OpenCLTracer::list_devices();
+  auto names = OpenCLTracer::list_devices();
   for (size_t i = 0; i < names.size(); ++i)
     if (names[i].find("Portable Computing Language") == std::string::npos) found.push_back(int(i));
 #endif
@@ -48,22 +40,19 @@ std::vector<int> opencl_accelerators() {
 std::vector<TracerSpec> expand_all(const std::string& item) {
   std::vector<TracerSpec> specs;
   if (item == "cuda:all") {
-    for (int d = 0; d < cuda_devices(); ++d) specs.push_back(spec_of("cuda", d));
+    for (int d = 0, n = device_count("cuda"); d < n; ++d) specs.push_back(spec_of("cuda", d));
     if (specs.empty()) throw std::invalid_argument("cuda:all: no CUDA device on this machine");
     return specs;
   }
   if (item == "opencl:all") {
-#ifdef COHORT_HAVE_OPENCL
-    auto names = tracers::OpenCLTracer::list_devices();
-    for (size_t d = 0; d < names.size(); ++d) specs.push_back(spec_of("opencl", int(d)));
-#endif
+    for (int d = 0, n = device_count("opencl"); d < n; ++d) specs.push_back(spec_of("opencl", d));
     if (specs.empty()) throw std::invalid_argument("opencl:all: no OpenCL device on this machine");
     return specs;
   }
 #ifdef COHORT_HAVE_EMBREE
   specs.push_back(spec_of("embree", 0));
 #endif
-  if (int n = cuda_devices(); n > 0) {
+  if (int n = device_count("cuda"); n > 0) {
     for (int d = 0; d < n; ++d) specs.push_back(spec_of("cuda", d));
   } else {
     for (int d : opencl_accelerators()) specs.push_back(spec_of("opencl", d));
@@ -111,17 +100,17 @@ std::vector<TracerSpec> parse_tracer_list(const std::string& list) {
 
 std::unique_ptr<core::Tracer> make_tracer(const TracerSpec& spec) {
 #ifdef COHORT_HAVE_EMBREE
-  if (spec.kind == "embree") return std::make_unique<tracers::EmbreeTracer>();
+  if (spec.kind == "embree") return std::make_unique<EmbreeTracer>();
 #endif
 #ifdef COHORT_HAVE_OPENCL
   if (spec.kind == "opencl") {
-    tracers::OpenCLTracer::Options options;
+    OpenCLTracer::Options options;
     options.device = spec.device;
-    return std::make_unique<tracers::OpenCLTracer>(options);
+    return std::make_unique<OpenCLTracer>(options);
   }
 #endif
 #ifdef COHORT_HAVE_CUDA
-  if (spec.kind == "cuda") return std::make_unique<tracers::CudaTracer>(spec.device);
+  if (spec.kind == "cuda") return std::make_unique<CudaTracer>(spec.device);
 #endif
   throw std::runtime_error("tracer '" + spec.text + "' is not built into this binary");
 }
@@ -146,4 +135,17 @@ std::vector<std::string> built_tracer_kinds() {
   return kinds;
 }
 
-}  // namespace cohort::app
+int device_count(const std::string& kind) {
+#ifdef COHORT_HAVE_EMBREE
+  if (kind == "embree") return 1;
+#endif
+#ifdef COHORT_HAVE_OPENCL
+  if (kind == "opencl") return int(OpenCLTracer::list_devices().size());
+#endif
+#ifdef COHORT_HAVE_CUDA
+  if (kind == "cuda") return cuda_device_count();
+#endif
+  return 0;
+}
+
+}  // namespace cohort::tracers

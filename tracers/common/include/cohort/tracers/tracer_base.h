@@ -1,0 +1,36 @@
+// What every tracer shares: its own copy of the scene (commit::TracerScene), brought up to date by
+// applying commit buffers, and the two things its kernel needs from that copy each band: the frame
+// parameters with the scene's counts, and a KSceneView over the arrays wherever the tracer keeps them.
+#pragma once
+
+#include "cohort/commit/tracer_scene.h"
+#include "cohort/core/tracer.h"
+#include "cohort/kernel/scene_view.h"
+
+namespace cohort::tracers {
+
+class TracerBase : public core::Tracer {
+ public:
+  // Applies the commit to the scene copy, then hands the tracer what changed to upload.
+  void apply(const commit::CommitBuffer& commit) final;
+
+ protected:
+  const commit::TracerScene& scene() const { return scene_; }
+  // Whether a commit has been applied (and uploaded) yet: a band needs one.
+  bool has_scene() const { return has_scene_; }
+
+  // Brings the tracer's own copies (device buffers, acceleration structures) up to date with scene().
+  // Until one upload has succeeded, changes arrive with full_resync set: there is nothing yet to patch.
+  virtual void upload(const commit::ChangeSet& changes) = 0;
+
+  // The band's parameters with the scene's light, instance and TLAS node counts filled in.
+  KFrameParams frame_params(const core::BandJob& job) const;
+  // The kernel's view of the scene copy itself, for tracers that trace from host memory.
+  KSceneView host_scene_view(const KFrameParams& params) const;
+
+ private:
+  commit::TracerScene scene_;
+  bool has_scene_ = false;
+};
+
+}  // namespace cohort::tracers

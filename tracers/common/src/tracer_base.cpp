@@ -1,0 +1,26 @@
+#include "cohort/tracers/tracer_base.h"
+
+namespace cohort::tracers {
+
+void TracerBase::apply(const commit::CommitBuffer& commit) {
+  commit::ChangeSet changes = commit::apply_commit(commit, scene_);
+  if (!has_scene_) changes.full_resync = true;
+  upload(changes);
+  has_scene_ = true;   // only now: after a failed first upload the next commit is sent whole again
+}
+
+KFrameParams TracerBase::frame_params(const core::BandJob& job) const {
+  KFrameParams params = job.params;
+  params.light_count = static_cast<kuint>(scene_.lights.size());
+  params.instance_count = static_cast<kuint>(scene_.instances.size());
+  params.tlas_node_count = static_cast<kuint>(scene_.tlas_nodes.size());
+  return params;
+}
+
+KSceneView TracerBase::host_scene_view(const KFrameParams& params) const {
+  return k_scene_view(scene_.vertices.data(), scene_.triangles.data(), scene_.blas_nodes.data(), scene_.blases.data(),
+                      scene_.instances.data(), scene_.tlas_nodes.data(), scene_.materials.data(),
+                      scene_.textures.data(), scene_.texels.data(), scene_.lights.data(), &params);
+}
+
+}  // namespace cohort::tracers

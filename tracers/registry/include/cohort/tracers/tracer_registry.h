@@ -1,0 +1,35 @@
+// Tracers by name, for the apps, the benchmarks and the tests alike: "embree", "opencl" / "opencl:N"
+// (N-th OpenCL device of all platforms), "cuda" / "cuda:N", and the "all" lists. A library of its own
+// above the concrete tracers, so that neither the core nor tracers/common depends on them.
+#pragma once
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "cohort/core/tracer.h"
+
+namespace cohort::tracers {
+
+struct TracerSpec {
+  std::string kind;  // embree, opencl, cuda
+  int device = 0;
+  std::string text;  // as written
+};
+
+// Splits "embree,opencl:1" and expands "all", "cuda:all" and "opencl:all" by probing the devices;
+// throws std::invalid_argument naming a malformed entry.
+std::vector<TracerSpec> parse_tracer_list(const std::string& list);
+
+// Throws std::runtime_error when this build lacks the tracer or the device cannot be opened.
+std::unique_ptr<core::Tracer> make_tracer(const TracerSpec& spec);
+std::vector<std::unique_ptr<core::Tracer>> make_tracers(const std::string& list);
+
+// The tracer kinds this binary was built with.
+std::vector<std::string> built_tracer_kinds();
+
+// How many devices of that kind this machine offers the tracer: 1 for Embree (the CPU), 0 for a kind
+// this build lacks. Never throws.
+int device_count(const std::string& kind);
+
+}  // namespace cohort::tracers
