@@ -8,25 +8,87 @@
 namespace cohort::scene {
 namespace {
 
-template <class T>
-int lowest_free(std::vector<std::optional<T>>& slots, const char* what) {
+// Entity and light defs keep the same handle bookkeeping; `kind` ("Entity", "Light") names the calls
+// in errors (AddEntityDef, FreeLightDef, ...).
+
+template <class Def>
+int lowest_free(std::vector<std::optional<Def>>& slots, const char* kind) {
   auto it = std::find_if(slots.begin(), slots.end(), [](const auto& s) { return !s.has_value(); });
   if (it != slots.end()) return static_cast<int>(it - slots.begin());
   if (slots.size() >= size_t(kMaxHandles))
-    throw RenderWorldError(fmt::format("Add{}Def: all {} handles are in use", what, kMaxHandles));
+    throw RenderWorldError(fmt::format("Add{}Def: all {} handles are in use", kind, kMaxHandles));
   slots.emplace_back();
   return static_cast<int>(slots.size() - 1);
 }
 
-template <class T>
-T& live(std::vector<std::optional<T>>& slots, int handle, const char* call) {
-  if (handle < 0 || size_t(handle) >= slots.size() || !slots[handle])
-    throw RenderWorldError(fmt::format("{}: handle {} is not a live def", call, handle));
-  return *slots[handle];
+template <class Def>
+const Def* live_or_null(const std::vector<std::optional<Def>>& slots, int handle) {
+  if (handle < 0 || size_t(handle) >= slots.size() || !slots[handle]) return nullptr;
+  return &*slots[handle];
+}
+
+template <class Def>
+std::optional<Def>& live(std::vector<std::optional<Def>>& slots, int handle, const char* call, const char* kind) {
+  if (!live_or_null(slots, handle))
+    throw RenderWorldError(fmt::format("{}{}Def: handle {} is not a live def", call, kind, handle));
+  return slots[handle];
+}
+
+template <class Def>
+int add_def(std::vector<std::optional<Def>>& slots, Def def, std::set<int>& changed, const char* kind) {
+  int handle = lowest_free(slots, kind);
+  slots[handle] = std::move(def);
+  changed.insert(handle);
+  return handle;
+}
+
+template <class Def>
+void update_def(std::vector<std::optional<Def>>& slots, int handle, Def def, std::set<int>& changed,
+                const char* kind) {
+  live(slots, handle, "Update", kind) = std::move(def);
+  changed.insert(handle);
+}
+
+// A freed handle loses its seeded name too, so Find*Def cannot return a later def that reuses it.
+template <class Def>
+void free_def(std::vector<std::optional<Def>>& slots, std::vector<std::string>& seeded_names, int handle,
+              std::set<int>& changed, std::set<int>& freed, const char* kind) {
+  live(slots, handle, "Free", kind).reset();
+  if (size_t(handle) < seeded_names.size()) seeded_names[handle].clear();
+  changed.erase(handle);
+  freed.insert(handle);
+}
+
+template <class Def>
+int find_seeded(const std::vector<std::optional<Def>>& slots, const std::vector<std::string>& seeded_names,
+                const std::string& name) {
+  for (size_t i = 0; i < seeded_names.size(); ++i)
+    if (seeded_names[i] == name && slots[i]) return int(i);
+  return -1;
 }
 
 bool finite(const glm::vec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
 bool finite(const glm::mat3& m) { return finite(m[0]) && finite(m[1]) && finite(m[2]); }
+
+// A light as the scene model's Light and as a RenderLight: the same values, but for its type and colour,
+// which the def keeps as the engine does (point/parallel flags, shader parms 0-2). Both conversions
+// walk this one list of the shared fields, `copy` moving each one way or the other.
+template <class SceneLight, class DefLight, class Copy>
+void for_each_shared_light_field(SceneLight& light, DefLight& def, Copy copy) {
+  copy(light.origin, def.origin);
+  copy(light.axis, def.axis);
+  copy(light.radius, def.radius);
+  copy(light.center, def.center);
+  copy(light.target, def.target);
+  copy(light.right, def.right);
+  copy(light.up, def.up);
+  copy(light.start, def.start);
+  copy(light.end, def.end);
+  copy(light.has_start_end, def.has_start_end);
+  copy(light.material, def.shader);
+  copy(light.no_shadows, def.no_shadows);
+  copy(light.no_specular, def.no_specular);
+}
 
 }  // namespace
 
@@ -41,26 +103,14 @@ RenderEntity render_entity_from(const Entity& entity) {
 
 RenderLight render_light_from(const Light& light) {
   RenderLight def;
-  def.origin = light.origin;
-  def.axis = light.axis;
+  for_each_shared_light_field(light, def, [](const auto& from, auto& to) { to = from; });
   def.point_light = light.type != LightType::Projected;
   def.parallel = light.type == LightType::Parallel;
-  def.radius = light.radius;
-  def.center = light.center;
-  def.target = light.target;
-  def.right = light.right;
-  def.up = light.up;
-  def.start = light.start;
-  def.end = light.end;
-  def.has_start_end = light.has_start_end;
-  def.shader = light.material;
   std::copy(std::begin(light.shader_parms), std::end(light.shader_parms), def.shader_parms);
   // _color is what the engine puts in shader parms 0-2.
   def.shader_parms[kShaderParmRed] = light.color.r;
   def.shader_parms[kShaderParmGreen] = light.color.g;
   def.shader_parms[kShaderParmBlue] = light.color.b;
-  def.no_shadows = light.no_shadows;
-  def.no_specular = light.no_specular;
   return def;
 }
 
@@ -109,47 +159,27 @@ RenderLight RenderWorld::resolved(const RenderLight& light) const {
 }
 
 int RenderWorld::AddEntityDef(const RenderEntity& entity) {
-  RenderEntity def = resolved(entity);
-  int handle = lowest_free(entities_, "Entity");
-  entities_[handle] = std::move(def);
-  changes_.entities.insert(handle);
-  return handle;
+  return add_def(entities_, resolved(entity), changes_.entities, "Entity");
 }
 
 void RenderWorld::UpdateEntityDef(int handle, const RenderEntity& entity) {
-  RenderEntity def = resolved(entity);
-  live(entities_, handle, "UpdateEntityDef") = std::move(def);
-  changes_.entities.insert(handle);
+  update_def(entities_, handle, resolved(entity), changes_.entities, "Entity");
 }
 
 void RenderWorld::FreeEntityDef(int handle) {
-  live(entities_, handle, "FreeEntityDef");
-  entities_[handle].reset();
-  if (size_t(handle) < entity_names_.size()) entity_names_[handle].clear();
-  changes_.entities.erase(handle);
-  changes_.freed_entities.insert(handle);
+  free_def(entities_, entity_names_, handle, changes_.entities, changes_.freed_entities, "Entity");
 }
 
 int RenderWorld::AddLightDef(const RenderLight& light) {
-  RenderLight def = resolved(light);
-  int handle = lowest_free(lights_, "Light");
-  lights_[handle] = std::move(def);
-  changes_.lights.insert(handle);
-  return handle;
+  return add_def(lights_, resolved(light), changes_.lights, "Light");
 }
 
 void RenderWorld::UpdateLightDef(int handle, const RenderLight& light) {
-  RenderLight def = resolved(light);
-  live(lights_, handle, "UpdateLightDef") = std::move(def);
-  changes_.lights.insert(handle);
+  update_def(lights_, handle, resolved(light), changes_.lights, "Light");
 }
 
 void RenderWorld::FreeLightDef(int handle) {
-  live(lights_, handle, "FreeLightDef");
-  lights_[handle].reset();
-  if (size_t(handle) < light_names_.size()) light_names_[handle].clear();
-  changes_.lights.erase(handle);
-  changes_.freed_lights.insert(handle);
+  free_def(lights_, light_names_, handle, changes_.lights, changes_.freed_lights, "Light");
 }
 
 int RenderWorld::DefineMaterial(const Material& material) {
@@ -230,27 +260,13 @@ void RenderWorld::EndFrame() {
   ++changes_.frames_ended;
 }
 
-const RenderEntity* RenderWorld::EntityDef(int handle) const {
-  if (handle < 0 || size_t(handle) >= entities_.size() || !entities_[handle]) return nullptr;
-  return &*entities_[handle];
-}
+const RenderEntity* RenderWorld::EntityDef(int handle) const { return live_or_null(entities_, handle); }
 
-const RenderLight* RenderWorld::LightDef(int handle) const {
-  if (handle < 0 || size_t(handle) >= lights_.size() || !lights_[handle]) return nullptr;
-  return &*lights_[handle];
-}
+const RenderLight* RenderWorld::LightDef(int handle) const { return live_or_null(lights_, handle); }
 
-int RenderWorld::FindEntityDef(const std::string& name) const {
-  for (size_t i = 0; i < entity_names_.size(); ++i)
-    if (entity_names_[i] == name && entities_[i]) return int(i);
-  return -1;
-}
+int RenderWorld::FindEntityDef(const std::string& name) const { return find_seeded(entities_, entity_names_, name); }
 
-int RenderWorld::FindLightDef(const std::string& name) const {
-  for (size_t i = 0; i < light_names_.size(); ++i)
-    if (light_names_[i] == name && lights_[i]) return int(i);
-  return -1;
-}
+int RenderWorld::FindLightDef(const std::string& name) const { return find_seeded(lights_, light_names_, name); }
 
 ChangeLog RenderWorld::TakeChanges() {
   ChangeLog taken = std::move(changes_);
@@ -263,23 +279,11 @@ Light RenderWorld::scene_light(int handle) const {
   if (!def) throw RenderWorldError(fmt::format("scene_light: handle {} is not a live light def", handle));
   Light light;
   if (size_t(handle) < light_names_.size()) light.name = light_names_[handle];
+  for_each_shared_light_field(light, *def, [](auto& to, const auto& from) { to = from; });
   light.type = def->parallel ? LightType::Parallel : def->point_light ? LightType::Point : LightType::Projected;
-  light.origin = def->origin;
-  light.axis = def->axis;
-  light.radius = def->radius;
-  light.center = def->center;
   light.color = {def->shader_parms[kShaderParmRed], def->shader_parms[kShaderParmGreen],
                  def->shader_parms[kShaderParmBlue]};
-  light.target = def->target;
-  light.right = def->right;
-  light.up = def->up;
-  light.start = def->start;
-  light.end = def->end;
-  light.has_start_end = def->has_start_end;
-  light.material = def->shader;
   std::copy(std::begin(def->shader_parms), std::end(def->shader_parms), light.shader_parms);
-  light.no_shadows = def->no_shadows;
-  light.no_specular = def->no_specular;
   return light;
 }
 
