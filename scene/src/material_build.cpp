@@ -1,19 +1,10 @@
 #include "cohort/scene/material_build.h"
 
+#include "ascii_case.h"
+
 namespace cohort::scene {
 
 namespace {
-
-bool starts_with_ignoring_case(const std::string& s, const char* prefix) {
-  size_t i = 0;
-  for (; prefix[i]; ++i) {
-    if (i >= s.size()) return false;
-    char c = s[i];
-    if (c >= 'A' && c <= 'Z') c = static_cast<char>(c - 'A' + 'a');
-    if (c != prefix[i]) return false;
-  }
-  return true;
-}
 
 bool draws_image(const MaterialStage& s) { return !s.image.empty() && s.special_map.empty(); }
 

@@ -1,16 +1,11 @@
 #include <set>
 
 #include "cohort/scene/material_file.h"
+#include "ascii_case.h"
 
 namespace cohort::scene {
 
 namespace {
-
-std::string lowercase(std::string s) {
-  for (char& c : s)
-    if (c >= 'A' && c <= 'Z') c = static_cast<char>(c - 'A' + 'a');
-  return s;
-}
 
 std::string at(const std::string& file, int line) { return file + ":" + std::to_string(line) + ": "; }
 
