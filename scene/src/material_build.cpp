@@ -30,6 +30,12 @@ void copy_stage_look(const MaterialStage& s, Material& m) {
   m.vertex_color = m.vertex_color || s.vertex_color;
 }
 
+void glow_with(Material& m, int image, const glm::vec4& color) {
+  m.emitter = true;
+  m.emissive_image = image;
+  m.emissive_color = color;
+}
+
 }  // namespace
 
 Material build_material(const MaterialDecl& decl, ImageLibrary& images, bool as_light) {
@@ -84,9 +90,7 @@ Material build_material(const MaterialDecl& decl, ImageLibrary& images, bool as_
     for (const MaterialStage& s : decl.stages) {
       if (s.role != StageRole::Ambient || !draws_image(s)) continue;
       if (s.blend == StageBlend::Add || s.blend == StageBlend::Replace) {
-        m.emitter = true;
-        m.emissive_image = images.get(s.image, ImageRole::Color, context);
-        m.emissive_color = s.color;
+        glow_with(m, images.get(s.image, ImageRole::Color, context), s.color);
         break;
       }
     }
@@ -101,28 +105,17 @@ Material build_material(const MaterialDecl& decl, ImageLibrary& images, bool as_
   const int image = images.get(s.image, ImageRole::Color, context);
   switch (s.blend) {
     case StageBlend::Add:
-      m.blend = BlendClass::Additive;
-      m.emitter = true;
-      m.emissive_image = image;
-      m.emissive_color = s.color;
-      m.diffuse_color = glm::vec4(0.0f, 0.0f, 0.0f, 1.0f);
-      m.translucent = true;
-      break;
     case StageBlend::Replace:
-      m.blend = BlendClass::Opaque;   // unlit, drawn as is: it shows its image whatever the lighting
-      m.emitter = true;
-      m.emissive_image = image;
-      m.emissive_color = s.color;
+      // Replace is unlit and drawn as is: it shows its image whatever the lighting; Add glows over
+      // what is behind it.
+      m.blend = s.blend == StageBlend::Add ? BlendClass::Additive : BlendClass::Opaque;
+      glow_with(m, image, s.color);
       m.diffuse_color = glm::vec4(0.0f, 0.0f, 0.0f, 1.0f);
+      if (s.blend == StageBlend::Add) m.translucent = true;
       break;
     case StageBlend::Modulate:
-      m.blend = BlendClass::Modulate;
-      m.diffuse_image = image;
-      m.diffuse_color = s.color;
-      m.translucent = true;
-      break;
     case StageBlend::AlphaBlend:
-      m.blend = BlendClass::Alpha;
+      m.blend = s.blend == StageBlend::Modulate ? BlendClass::Modulate : BlendClass::Alpha;
       m.diffuse_image = image;
       m.diffuse_color = s.color;
       m.translucent = true;
