@@ -8,15 +8,27 @@
 namespace cohort::scene {
 namespace {
 
-// Entity and light defs keep the same handle bookkeeping; `kind` ("Entity", "Light") names the calls
-// in errors (AddEntityDef, FreeLightDef, ...).
+// Entity and light defs keep the same handle bookkeeping. DefKind says which change-log sets a kind
+// marks and how the calls name it in errors (AddEntityDef, FreeLightDef, ...).
+template <class Def>
+struct DefKind;
+template <>
+struct DefKind<RenderEntity> {
+  static constexpr const char* name = "Entity";
+  static constexpr auto changed = &ChangeLog::entities, freed = &ChangeLog::freed_entities;
+};
+template <>
+struct DefKind<RenderLight> {
+  static constexpr const char* name = "Light";
+  static constexpr auto changed = &ChangeLog::lights, freed = &ChangeLog::freed_lights;
+};
 
 template <class Def>
-int lowest_free(std::vector<std::optional<Def>>& slots, const char* kind) {
+int lowest_free(std::vector<std::optional<Def>>& slots) {
   auto it = std::find_if(slots.begin(), slots.end(), [](const auto& s) { return !s.has_value(); });
   if (it != slots.end()) return static_cast<int>(it - slots.begin());
   if (slots.size() >= size_t(kMaxHandles))
-    throw RenderWorldError(fmt::format("Add{}Def: all {} handles are in use", kind, kMaxHandles));
+    throw RenderWorldError(fmt::format("Add{}Def: all {} handles are in use", DefKind<Def>::name, kMaxHandles));
   slots.emplace_back();
   return static_cast<int>(slots.size() - 1);
 }
@@ -28,35 +40,34 @@ const Def* live_or_null(const std::vector<std::optional<Def>>& slots, int handle
 }
 
 template <class Def>
-std::optional<Def>& live(std::vector<std::optional<Def>>& slots, int handle, const char* call, const char* kind) {
+std::optional<Def>& live(std::vector<std::optional<Def>>& slots, int handle, const char* call) {
   if (!live_or_null(slots, handle))
-    throw RenderWorldError(fmt::format("{}{}Def: handle {} is not a live def", call, kind, handle));
+    throw RenderWorldError(fmt::format("{}{}Def: handle {} is not a live def", call, DefKind<Def>::name, handle));
   return slots[handle];
 }
 
 template <class Def>
-int add_def(std::vector<std::optional<Def>>& slots, Def def, std::set<int>& changed, const char* kind) {
-  int handle = lowest_free(slots, kind);
+int add_def(std::vector<std::optional<Def>>& slots, Def def, ChangeLog& changes) {
+  int handle = lowest_free(slots);
   slots[handle] = std::move(def);
-  changed.insert(handle);
+  (changes.*DefKind<Def>::changed).insert(handle);
   return handle;
 }
 
 template <class Def>
-void update_def(std::vector<std::optional<Def>>& slots, int handle, Def def, std::set<int>& changed,
-                const char* kind) {
-  live(slots, handle, "Update", kind) = std::move(def);
-  changed.insert(handle);
+void update_def(std::vector<std::optional<Def>>& slots, int handle, Def def, ChangeLog& changes) {
+  live(slots, handle, "Update") = std::move(def);
+  (changes.*DefKind<Def>::changed).insert(handle);
 }
 
 // A freed handle loses its seeded name too, so Find*Def cannot return a later def that reuses it.
 template <class Def>
 void free_def(std::vector<std::optional<Def>>& slots, std::vector<std::string>& seeded_names, int handle,
-              std::set<int>& changed, std::set<int>& freed, const char* kind) {
-  live(slots, handle, "Free", kind).reset();
+              ChangeLog& changes) {
+  live(slots, handle, "Free").reset();
   if (size_t(handle) < seeded_names.size()) seeded_names[handle].clear();
-  changed.erase(handle);
-  freed.insert(handle);
+  (changes.*DefKind<Def>::changed).erase(handle);
+  (changes.*DefKind<Def>::freed).insert(handle);
 }
 
 template <class Def>
@@ -158,29 +169,17 @@ RenderLight RenderWorld::resolved(const RenderLight& light) const {
   return def;
 }
 
-int RenderWorld::AddEntityDef(const RenderEntity& entity) {
-  return add_def(entities_, resolved(entity), changes_.entities, "Entity");
-}
-
+int RenderWorld::AddEntityDef(const RenderEntity& entity) { return add_def(entities_, resolved(entity), changes_); }
 void RenderWorld::UpdateEntityDef(int handle, const RenderEntity& entity) {
-  update_def(entities_, handle, resolved(entity), changes_.entities, "Entity");
+  update_def(entities_, handle, resolved(entity), changes_);
 }
+void RenderWorld::FreeEntityDef(int handle) { free_def(entities_, entity_names_, handle, changes_); }
 
-void RenderWorld::FreeEntityDef(int handle) {
-  free_def(entities_, entity_names_, handle, changes_.entities, changes_.freed_entities, "Entity");
-}
-
-int RenderWorld::AddLightDef(const RenderLight& light) {
-  return add_def(lights_, resolved(light), changes_.lights, "Light");
-}
-
+int RenderWorld::AddLightDef(const RenderLight& light) { return add_def(lights_, resolved(light), changes_); }
 void RenderWorld::UpdateLightDef(int handle, const RenderLight& light) {
-  update_def(lights_, handle, resolved(light), changes_.lights, "Light");
+  update_def(lights_, handle, resolved(light), changes_);
 }
-
-void RenderWorld::FreeLightDef(int handle) {
-  free_def(lights_, light_names_, handle, changes_.lights, changes_.freed_lights, "Light");
-}
+void RenderWorld::FreeLightDef(int handle) { free_def(lights_, light_names_, handle, changes_); }
 
 int RenderWorld::DefineMaterial(const Material& material) {
   auto image_ok = [&](int i) { return i >= -1 && i < int(scene_.images.size()); };
