@@ -78,6 +78,22 @@ int find_seeded(const std::vector<std::optional<Def>>& slots, const std::vector<
   return -1;
 }
 
+// DefineMaterial, DefineTexture and DefineModel replace the one at `found` (the index of the one with
+// the same name, -1 if none) or add a new one at the end, and mark its index changed.
+template <class T>
+int define_by_name(std::vector<T>& items, int found, const T& item, std::set<int>& changed, const char* too_many) {
+  int index = found;
+  if (index < 0) {
+    if (items.size() >= size_t(kMaxHandles)) throw RenderWorldError(too_many);
+    index = int(items.size());
+    items.push_back(item);
+  } else {
+    items[index] = item;
+  }
+  changed.insert(index);
+  return index;
+}
+
 bool finite(const glm::vec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
 bool finite(const glm::mat3& m) { return finite(m[0]) && finite(m[1]) && finite(m[2]); }
 
@@ -188,16 +204,8 @@ int RenderWorld::DefineMaterial(const Material& material) {
     if (!image_ok(i))
       throw RenderWorldError(fmt::format("DefineMaterial '{}': image {} out of range ({} images)", material.name, i,
                                          scene_.images.size()));
-  int index = scene_.find_material(material.name);
-  if (index < 0) {
-    if (scene_.materials.size() >= size_t(kMaxHandles)) throw RenderWorldError("DefineMaterial: too many materials");
-    index = int(scene_.materials.size());
-    scene_.materials.push_back(material);
-  } else {
-    scene_.materials[index] = material;
-  }
-  changes_.materials.insert(index);
-  return index;
+  return define_by_name(scene_.materials, scene_.find_material(material.name), material, changes_.materials,
+                        "DefineMaterial: too many materials");
 }
 
 int RenderWorld::DefineTexture(const Image& image) {
@@ -208,15 +216,8 @@ int RenderWorld::DefineTexture(const Image& image) {
                                        size_t(std::max(image.height, 0)) * 4, image.rgba.size()));
   auto it = std::find_if(scene_.images.begin(), scene_.images.end(),
                          [&](const Image& i) { return i.name == image.name; });
-  int index = int(it - scene_.images.begin());
-  if (it == scene_.images.end()) {
-    if (scene_.images.size() >= size_t(kMaxHandles)) throw RenderWorldError("DefineTexture: too many textures");
-    scene_.images.push_back(image);
-  } else {
-    *it = image;
-  }
-  changes_.textures.insert(index);
-  return index;
+  const int found = it == scene_.images.end() ? -1 : int(it - scene_.images.begin());
+  return define_by_name(scene_.images, found, image, changes_.textures, "DefineTexture: too many textures");
 }
 
 int RenderWorld::DefineModel(const Mesh& mesh) {
@@ -233,16 +234,8 @@ int RenderWorld::DefineModel(const Mesh& mesh) {
     if (size_t(s.first_index) + s.index_count > mesh.indices.size())
       throw RenderWorldError(fmt::format("DefineModel '{}': a surface runs past the index list", mesh.name));
   }
-  int index = scene_.find_mesh(mesh.name);
-  if (index < 0) {
-    if (scene_.meshes.size() >= size_t(kMaxHandles)) throw RenderWorldError("DefineModel: too many models");
-    index = int(scene_.meshes.size());
-    scene_.meshes.push_back(mesh);
-  } else {
-    scene_.meshes[index] = mesh;
-  }
-  changes_.models.insert(index);
-  return index;
+  return define_by_name(scene_.meshes, scene_.find_mesh(mesh.name), mesh, changes_.models,
+                        "DefineModel: too many models");
 }
 
 void RenderWorld::RenderScene(const RenderView& view) {
