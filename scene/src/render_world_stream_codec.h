@@ -2,7 +2,8 @@
 // Private to the stream reader and writer.
 //
 // Encoder and Decoder have the same field(), fields(), flags() and sequence() calls, so each
-// argument's layout is written once (render_world_stream_codec.cpp) and serves both directions.
+// argument's layout is written once (render_world_stream_codec.cpp) and serves both directions. What
+// only reading needs (names for errors, element sizes to check counts against) the Encoder ignores.
 #pragma once
 
 #include <cstdint>
