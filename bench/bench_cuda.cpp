@@ -15,6 +15,7 @@
 
 #include "cohort/core/gpu_scene.h"
 #include "cohort/core/scene_pack.h"
+#include "cohort/core/frame_defaults.h"
 #include "cohort/core/view.h"
 #ifdef COHORT_HAVE_CUDA
 #include "cohort/tracers/cuda_tracer.h"
@@ -32,16 +33,10 @@ double median(std::vector<double> v) {
 }
 
 KFrameParams bench_params(uint32_t mode, uint32_t bounces, int height) {
-  KFrameParams p{};
-  p.spp = 1;
+  KFrameParams p = core::default_frame_params();
   p.max_bounces = bounces;
-  p.light_samples = 1;
-  p.firefly_clamp = 5.0f;
-  p.spec_boost = 2.0f;
   p.mode = mode;
   p.row_end = uint32_t(height);
-  p.soft_shadow_scale = 0.2f;
-  p.rr_start = 2.0f;
   return p;
 }
 

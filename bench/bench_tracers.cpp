@@ -18,6 +18,7 @@
 
 #include "cohort/core/gpu_scene.h"
 #include "cohort/core/scene_pack.h"
+#include "cohort/core/frame_defaults.h"
 #include "cohort/core/view.h"
 #include "cohort/scene/map_loader.h"
 #ifdef COHORT_HAVE_EMBREE
@@ -109,16 +110,12 @@ int main(int argc, char** argv) {
                              cfg.width, cfg.height);
   core::BandJob job;
   job.camera = camera;
+  job.params = core::default_frame_params();
   job.params.spp = uint32_t(cfg.spp);
   job.params.max_bounces = uint32_t(cfg.bounces);
   job.params.light_samples = 0;  // every light reaching a point, as cohort render does by default
-  job.params.spec_boost = 2.0f;
-  job.params.mode = K_MODE_PATH;
   job.params.row_begin = 0;
   job.params.row_end = uint32_t(cfg.height);
-  job.params.firefly_clamp = 5.0f;
-  job.params.soft_shadow_scale = 0.2f;
-  job.params.rr_start = 2.0f;
   const commit::CommitBuffer commit = commit::CommitBuffer::full(scene, 1);
   const double paths = double(cfg.width) * cfg.height * cfg.spp;
 

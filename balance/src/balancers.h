@@ -9,6 +9,15 @@
 
 namespace cohort::balance {
 
+// What a balancer learns belongs to one image height: a frame of another height starts it over.
+// True when it did; `rows_seen` then holds the new height.
+inline bool restarted_for_new_height(Balancer& balancer, int& rows_seen, int rows) {
+  if (rows == rows_seen) return false;
+  balancer.reset();
+  rows_seen = rows;
+  return true;
+}
+
 // Equal rows for everyone, whatever was measured: the baseline.
 class NoneBalancer final : public Balancer {
  public:

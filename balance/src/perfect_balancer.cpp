@@ -7,10 +7,7 @@ namespace cohort::balance {
 std::vector<Band> PerfectBalancer::divide(const DivideInput& in) {
   const size_t count = in.tracers.size();
   if (count == 0) return {};
-  if (in.rows != rows_) {
-    reset();
-    rows_ = in.rows;
-  }
+  restarted_for_new_height(*this, rows_, in.rows);
   speeds_.update(in.previous);
   // Eq. 1: W_i = R * s_i / sum_j s_j with s_i = rows_i / t_i from the previous frame.
   const std::vector<double> speeds = speeds_.speeds_for(in.tracers);

@@ -8,10 +8,7 @@ namespace cohort::balance {
 std::vector<Band> RobinHoodBalancer::divide(const DivideInput& in) {
   const int count = static_cast<int>(in.tracers.size());
   if (count == 0) return {};
-  if (in.rows != rows_) {
-    units_.clear();
-    rows_ = in.rows;
-  }
+  restarted_for_new_height(*this, rows_, in.rows);
   // Tracers that left give their units back; newcomers start with the mean holding; then rescale to
   // the frame's unit count.
   std::map<int, int> kept;

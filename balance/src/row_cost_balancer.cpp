@@ -96,11 +96,7 @@ void RowCostBalancer::learn_from_times(const DivideInput& in) {
 std::vector<Band> RowCostBalancer::divide(const DivideInput& in) {
   const size_t count = in.tracers.size();
   if (count == 0) return {};
-  if (in.rows != rows_) {
-    reset();
-    rows_ = in.rows;
-    cost_.assign(static_cast<size_t>(units_for_rows(in.rows)), 1.0);
-  }
+  if (restarted_for_new_height(*this, rows_, in.rows)) cost_.assign(static_cast<size_t>(units_for_rows(in.rows)), 1.0);
   // With a proxy, speeds are in its work units; without, in units of the normalised map. Switching
   // between the two starts the speeds over.
   const std::vector<double> proxy = unit_proxy(in);

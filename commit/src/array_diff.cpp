@@ -11,11 +11,14 @@ bool same_bytes(const T& a, const T& b) {
   return std::memcmp(&a, &b, sizeof(T)) == 0;
 }
 
-template <class T, class SetCount, class Set>
-void diff_array(const std::vector<T>& before, const std::vector<T>& after, SetCount set_count, Set set) {
-  if (before.size() != after.size()) set_count(static_cast<uint32_t>(after.size()));
+// Records into `out` through its setters for this array: set_count when the size changed, set for each
+// element that is new or whose bytes differ.
+template <class T>
+void diff_array(const std::vector<T>& before, const std::vector<T>& after, CommitBuffer& out,
+                void (CommitBuffer::*set_count)(uint32_t), void (CommitBuffer::*set)(uint32_t, const T&)) {
+  if (before.size() != after.size()) (out.*set_count)(static_cast<uint32_t>(after.size()));
   for (size_t i = 0; i < after.size(); ++i)
-    if (i >= before.size() || !same_bytes(before[i], after[i])) set(static_cast<uint32_t>(i), after[i]);
+    if (i >= before.size() || !same_bytes(before[i], after[i])) (out.*set)(static_cast<uint32_t>(i), after[i]);
 }
 
 template <class T>
@@ -36,23 +39,16 @@ bool same_array(const std::vector<T>& a, const std::vector<T>& b, const char* na
 }  // namespace
 
 void diff_instances(const std::vector<KInstance>& before, const std::vector<KInstance>& after, CommitBuffer& out) {
-  diff_array(before, after, [&](uint32_t n) { out.set_instance_count(n); },
-             [&](uint32_t i, const KInstance& v) { out.set_instance(i, v); });
+  diff_array(before, after, out, &CommitBuffer::set_instance_count, &CommitBuffer::set_instance);
 }
-
 void diff_lights(const std::vector<KLight>& before, const std::vector<KLight>& after, CommitBuffer& out) {
-  diff_array(before, after, [&](uint32_t n) { out.set_light_count(n); },
-             [&](uint32_t i, const KLight& v) { out.set_light(i, v); });
+  diff_array(before, after, out, &CommitBuffer::set_light_count, &CommitBuffer::set_light);
 }
-
 void diff_materials(const std::vector<KMaterial>& before, const std::vector<KMaterial>& after, CommitBuffer& out) {
-  diff_array(before, after, [&](uint32_t n) { out.set_material_count(n); },
-             [&](uint32_t i, const KMaterial& v) { out.set_material(i, v); });
+  diff_array(before, after, out, &CommitBuffer::set_material_count, &CommitBuffer::set_material);
 }
-
 void diff_textures(const std::vector<KTexture>& before, const std::vector<KTexture>& after, CommitBuffer& out) {
-  diff_array(before, after, [&](uint32_t n) { out.set_texture_count(n); },
-             [&](uint32_t i, const KTexture& v) { out.set_texture(i, v); });
+  diff_array(before, after, out, &CommitBuffer::set_texture_count, &CommitBuffer::set_texture);
 }
 
 void diff_tlas(const std::vector<KBvhNode>& before, const std::vector<KBvhNode>& after, CommitBuffer& out) {

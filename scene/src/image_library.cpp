@@ -2,18 +2,13 @@
 
 #include "cohort/scene/image_decode.h"
 #include "cohort/scene/image_ops.h"
+#include "ascii_case.h"
 
 namespace cohort::scene {
 
 namespace {
 
 constexpr const char* kExtensions[] = {".tga", ".png", ".jpg", ".jpeg", ".dds", ".bmp"};
-
-std::string lowercase(std::string s) {
-  for (char& c : s)
-    if (c >= 'A' && c <= 'Z') c = static_cast<char>(c - 'A' + 'a');
-  return s;
-}
 
 std::string strip_extension(const std::string& name) {
   std::string lower = lowercase(name);

@@ -2,17 +2,13 @@
 
 #include <sstream>
 
+#include "ascii_case.h"
+
 namespace cohort::scene {
 
 namespace {
 
 constexpr int kMaxNesting = 16;
-
-std::string lowercase(std::string s) {
-  for (char& c : s)
-    if (c >= 'A' && c <= 'Z') c = static_cast<char>(c - 'A' + 'a');
-  return s;
-}
 
 bool is_function(const std::string& lower_name) {
   static const char* const kFunctions[] = {"heightmap", "addnormals", "smoothnormals", "add", "scale",

@@ -4,6 +4,8 @@
 #include <cmath>
 #include <vector>
 
+#include "ascii_case.h"
+
 namespace cohort::scene {
 
 namespace {
@@ -14,15 +16,6 @@ bool is_name_start(char c) {
 bool is_path_char(char c) { return c == '/' || c == '\\' || c == ':' || c == '.'; }
 bool is_digit(char c) { return c >= '0' && c <= '9'; }
 bool is_name_char(char c) { return is_name_start(c) || is_digit(c) || is_path_char(c); }
-
-char lower(char c) { return (c >= 'A' && c <= 'Z') ? static_cast<char>(c - 'A' + 'a') : c; }
-
-bool equals_ignoring_case(std::string_view a, std::string_view b) {
-  if (a.size() != b.size()) return false;
-  for (size_t i = 0; i < a.size(); ++i)
-    if (lower(a[i]) != lower(b[i])) return false;
-  return true;
-}
 
 constexpr std::string_view kTwoCharPunct[] = {"==", "!=", ">=", "<=", "&&", "||"};
 

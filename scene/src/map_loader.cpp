@@ -11,18 +11,13 @@
 #include "cohort/scene/material_build.h"
 #include "cohort/scene/material_file.h"
 #include "cohort/scene/proc_file.h"
+#include "ascii_case.h"
 
 namespace cohort::scene {
 
 namespace fs = std::filesystem;
 
 namespace {
-
-std::string lowercase(std::string s) {
-  for (char& c : s)
-    if (c >= 'A' && c <= 'Z') c = static_cast<char>(c - 'A' + 'a');
-  return s;
-}
 
 bool ends_with(const std::string& s, const std::string& suffix) {
   return s.size() >= suffix.size() && s.compare(s.size() - suffix.size(), suffix.size(), suffix) == 0;

@@ -1,18 +1,10 @@
 #include "cohort/scene/lexer.h"
 #include "cohort/scene/map_file.h"
+#include "ascii_case.h"
 
 namespace cohort::scene {
 
 namespace {
-
-char lower(char c) { return (c >= 'A' && c <= 'Z') ? static_cast<char>(c - 'A' + 'a') : c; }
-
-bool same_ignoring_case(std::string_view a, std::string_view b) {
-  if (a.size() != b.size()) return false;
-  for (size_t i = 0; i < a.size(); ++i)
-    if (lower(a[i]) != lower(b[i])) return false;
-  return true;
-}
 
 // A primitive after its opening "{": brushDef3 { ... }, patchDef2 { ... }, or an old-style brush of
 // plane lines. Only the nesting is checked; the contents belong to the map compiler.
@@ -40,7 +32,7 @@ void skip_primitive(Lexer& lex, MapEntity& entity, MapFile& map, const Token& op
 
 std::optional<std::string> MapEntity::get(std::string_view key) const {
   for (auto it = keys.rbegin(); it != keys.rend(); ++it)
-    if (same_ignoring_case(it->first, key)) return it->second;
+    if (equals_ignoring_case(it->first, key)) return it->second;
   return std::nullopt;
 }
 

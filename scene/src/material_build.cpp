@@ -1,19 +1,10 @@
 #include "cohort/scene/material_build.h"
 
+#include "ascii_case.h"
+
 namespace cohort::scene {
 
 namespace {
-
-bool starts_with_ignoring_case(const std::string& s, const char* prefix) {
-  size_t i = 0;
-  for (; prefix[i]; ++i) {
-    if (i >= s.size()) return false;
-    char c = s[i];
-    if (c >= 'A' && c <= 'Z') c = static_cast<char>(c - 'A' + 'a');
-    if (c != prefix[i]) return false;
-  }
-  return true;
-}
 
 bool draws_image(const MaterialStage& s) { return !s.image.empty() && s.special_map.empty(); }
 
@@ -37,6 +28,12 @@ void copy_stage_look(const MaterialStage& s, Material& m) {
     m.alpha_ref = s.alpha_ref;
   }
   m.vertex_color = m.vertex_color || s.vertex_color;
+}
+
+void glow_with(Material& m, int image, const glm::vec4& color) {
+  m.emitter = true;
+  m.emissive_image = image;
+  m.emissive_color = color;
 }
 
 }  // namespace
@@ -93,9 +90,7 @@ Material build_material(const MaterialDecl& decl, ImageLibrary& images, bool as_
     for (const MaterialStage& s : decl.stages) {
       if (s.role != StageRole::Ambient || !draws_image(s)) continue;
       if (s.blend == StageBlend::Add || s.blend == StageBlend::Replace) {
-        m.emitter = true;
-        m.emissive_image = images.get(s.image, ImageRole::Color, context);
-        m.emissive_color = s.color;
+        glow_with(m, images.get(s.image, ImageRole::Color, context), s.color);
         break;
       }
     }
@@ -110,28 +105,17 @@ Material build_material(const MaterialDecl& decl, ImageLibrary& images, bool as_
   const int image = images.get(s.image, ImageRole::Color, context);
   switch (s.blend) {
     case StageBlend::Add:
-      m.blend = BlendClass::Additive;
-      m.emitter = true;
-      m.emissive_image = image;
-      m.emissive_color = s.color;
-      m.diffuse_color = glm::vec4(0.0f, 0.0f, 0.0f, 1.0f);
-      m.translucent = true;
-      break;
     case StageBlend::Replace:
-      m.blend = BlendClass::Opaque;   // unlit, drawn as is: it shows its image whatever the lighting
-      m.emitter = true;
-      m.emissive_image = image;
-      m.emissive_color = s.color;
+      // Replace is unlit and drawn as is: it shows its image whatever the lighting; Add glows over
+      // what is behind it.
+      m.blend = s.blend == StageBlend::Add ? BlendClass::Additive : BlendClass::Opaque;
+      glow_with(m, image, s.color);
       m.diffuse_color = glm::vec4(0.0f, 0.0f, 0.0f, 1.0f);
+      if (s.blend == StageBlend::Add) m.translucent = true;
       break;
     case StageBlend::Modulate:
-      m.blend = BlendClass::Modulate;
-      m.diffuse_image = image;
-      m.diffuse_color = s.color;
-      m.translucent = true;
-      break;
     case StageBlend::AlphaBlend:
-      m.blend = BlendClass::Alpha;
+      m.blend = s.blend == StageBlend::Modulate ? BlendClass::Modulate : BlendClass::Alpha;
       m.diffuse_image = image;
       m.diffuse_color = s.color;
       m.translucent = true;

@@ -2,17 +2,13 @@
 
 #include <cmath>
 
+#include "ascii_case.h"
+
 namespace cohort::scene {
 
 namespace {
 
 constexpr int kMaxDepth = 64;   // nested parentheses/brackets; deeper input is rejected, not recursed
-
-std::string lowercase(std::string s) {
-  for (char& c : s)
-    if (c >= 'A' && c <= 'Z') c = static_cast<char>(c - 'A' + 'a');
-  return s;
-}
 
 int precedence(const Token& t) {
   if (t.kind != Token::Kind::Punct) return 0;

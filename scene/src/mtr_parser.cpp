@@ -1,16 +1,12 @@
+#include <map>
 #include <set>
 
 #include "cohort/scene/material_file.h"
+#include "ascii_case.h"
 
 namespace cohort::scene {
 
 namespace {
-
-std::string lowercase(std::string s) {
-  for (char& c : s)
-    if (c >= 'A' && c <= 'Z') c = static_cast<char>(c - 'A' + 'a');
-  return s;
-}
 
 std::string at(const std::string& file, int line) { return file + ":" + std::to_string(line) + ": "; }
 
@@ -66,6 +62,20 @@ const std::set<std::string>& rest_of_line_material_words() {
   return words;
 }
 
+// Global keywords that only switch a flag of the declaration on.
+const std::map<std::string, bool MaterialDecl::*>& material_flag_words() {
+  static const std::map<std::string, bool MaterialDecl::*> words = {
+      {"translucent", &MaterialDecl::translucent},
+      {"noshadows", &MaterialDecl::no_shadows},
+      {"twosided", &MaterialDecl::two_sided},
+      {"nonsolid", &MaterialDecl::nonsolid},
+      {"decal_macro", &MaterialDecl::no_shadows},  // the macro: polygonOffset, discrete, sort decal, noShadows
+      {"foglight", &MaterialDecl::fog_light},
+      {"blendlight", &MaterialDecl::blend_light},
+      {"ambientlight", &MaterialDecl::ambient_light}};
+  return words;
+}
+
 const std::set<std::string>& skipped_decl_types() {
   static const std::set<std::string> types = {"skin", "particle", "fx", "entitydef", "sound", "mapdef",
                                               "articulatedfigure", "pda", "email", "video", "audio", "model",
@@ -92,24 +102,10 @@ class MaterialReader {
         stage.role = word == "diffusemap" ? StageRole::Diffuse : word == "bumpmap" ? StageRole::Bump : StageRole::Specular;
         stage.image = parse_image_program(lex);
         m.stages.push_back(std::move(stage));
-      } else if (word == "translucent") {
-        m.translucent = true;
-      } else if (word == "noshadows") {
-        m.no_shadows = true;
-      } else if (word == "twosided") {
-        m.two_sided = true;
-      } else if (word == "nonsolid") {
-        m.nonsolid = true;
-      } else if (word == "decal_macro") {
-        m.no_shadows = true;   // the macro: polygonOffset, discrete, sort decal, noShadows
+      } else if (auto flag = material_flag_words().find(word); flag != material_flag_words().end()) {
+        m.*flag->second = true;
       } else if (word == "lightfalloffimage") {
         m.falloff_image = parse_image_program(lex);
-      } else if (word == "foglight") {
-        m.fog_light = true;
-      } else if (word == "blendlight") {
-        m.blend_light = true;
-      } else if (word == "ambientlight") {
-        m.ambient_light = true;
       } else if (word == "description") {
         m.description = lex.expect_string("a description");
       } else if (rest_of_line_material_words().count(word)) {

@@ -8,25 +8,114 @@
 namespace cohort::scene {
 namespace {
 
-template <class T>
-int lowest_free(std::vector<std::optional<T>>& slots, const char* what) {
+// Entity and light defs keep the same handle bookkeeping. DefKind says which change-log sets a kind
+// marks and how the calls name it in errors (AddEntityDef, FreeLightDef, ...).
+template <class Def>
+struct DefKind;
+template <>
+struct DefKind<RenderEntity> {
+  static constexpr const char* name = "Entity";
+  static constexpr auto changed = &ChangeLog::entities, freed = &ChangeLog::freed_entities;
+};
+template <>
+struct DefKind<RenderLight> {
+  static constexpr const char* name = "Light";
+  static constexpr auto changed = &ChangeLog::lights, freed = &ChangeLog::freed_lights;
+};
+
+template <class Def>
+int lowest_free(std::vector<std::optional<Def>>& slots) {
   auto it = std::find_if(slots.begin(), slots.end(), [](const auto& s) { return !s.has_value(); });
   if (it != slots.end()) return static_cast<int>(it - slots.begin());
   if (slots.size() >= size_t(kMaxHandles))
-    throw RenderWorldError(fmt::format("Add{}Def: all {} handles are in use", what, kMaxHandles));
+    throw RenderWorldError(fmt::format("Add{}Def: all {} handles are in use", DefKind<Def>::name, kMaxHandles));
   slots.emplace_back();
   return static_cast<int>(slots.size() - 1);
 }
 
+template <class Def>
+const Def* live_or_null(const std::vector<std::optional<Def>>& slots, int handle) {
+  if (handle < 0 || size_t(handle) >= slots.size() || !slots[handle]) return nullptr;
+  return &*slots[handle];
+}
+
+template <class Def>
+std::optional<Def>& live(std::vector<std::optional<Def>>& slots, int handle, const char* call) {
+  if (!live_or_null(slots, handle))
+    throw RenderWorldError(fmt::format("{}{}Def: handle {} is not a live def", call, DefKind<Def>::name, handle));
+  return slots[handle];
+}
+
+template <class Def>
+int add_def(std::vector<std::optional<Def>>& slots, Def def, ChangeLog& changes) {
+  int handle = lowest_free(slots);
+  slots[handle] = std::move(def);
+  (changes.*DefKind<Def>::changed).insert(handle);
+  return handle;
+}
+
+template <class Def>
+void update_def(std::vector<std::optional<Def>>& slots, int handle, Def def, ChangeLog& changes) {
+  live(slots, handle, "Update") = std::move(def);
+  (changes.*DefKind<Def>::changed).insert(handle);
+}
+
+// A freed handle loses its seeded name too, so Find*Def cannot return a later def that reuses it.
+template <class Def>
+void free_def(std::vector<std::optional<Def>>& slots, std::vector<std::string>& seeded_names, int handle,
+              ChangeLog& changes) {
+  live(slots, handle, "Free").reset();
+  if (size_t(handle) < seeded_names.size()) seeded_names[handle].clear();
+  (changes.*DefKind<Def>::changed).erase(handle);
+  (changes.*DefKind<Def>::freed).insert(handle);
+}
+
+template <class Def>
+int find_seeded(const std::vector<std::optional<Def>>& slots, const std::vector<std::string>& seeded_names,
+                const std::string& name) {
+  for (size_t i = 0; i < seeded_names.size(); ++i)
+    if (seeded_names[i] == name && slots[i]) return int(i);
+  return -1;
+}
+
+// DefineMaterial, DefineTexture and DefineModel replace the one at `found` (the index of the one with
+// the same name, -1 if none) or add a new one at the end, and mark its index changed.
 template <class T>
-T& live(std::vector<std::optional<T>>& slots, int handle, const char* call) {
-  if (handle < 0 || size_t(handle) >= slots.size() || !slots[handle])
-    throw RenderWorldError(fmt::format("{}: handle {} is not a live def", call, handle));
-  return *slots[handle];
+int define_by_name(std::vector<T>& items, int found, const T& item, std::set<int>& changed, const char* too_many) {
+  int index = found;
+  if (index < 0) {
+    if (items.size() >= size_t(kMaxHandles)) throw RenderWorldError(too_many);
+    index = int(items.size());
+    items.push_back(item);
+  } else {
+    items[index] = item;
+  }
+  changed.insert(index);
+  return index;
 }
 
 bool finite(const glm::vec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
 bool finite(const glm::mat3& m) { return finite(m[0]) && finite(m[1]) && finite(m[2]); }
+
+// A light as the scene model's Light and as a RenderLight: the same values, but for its type and colour,
+// which the def keeps as the engine does (point/parallel flags, shader parms 0-2). Both conversions
+// walk this one list of the shared fields, `copy` moving each one way or the other.
+template <class SceneLight, class DefLight, class Copy>
+void for_each_shared_light_field(SceneLight& light, DefLight& def, Copy copy) {
+  copy(light.origin, def.origin);
+  copy(light.axis, def.axis);
+  copy(light.radius, def.radius);
+  copy(light.center, def.center);
+  copy(light.target, def.target);
+  copy(light.right, def.right);
+  copy(light.up, def.up);
+  copy(light.start, def.start);
+  copy(light.end, def.end);
+  copy(light.has_start_end, def.has_start_end);
+  copy(light.material, def.shader);
+  copy(light.no_shadows, def.no_shadows);
+  copy(light.no_specular, def.no_specular);
+}
 
 }  // namespace
 
@@ -41,26 +130,14 @@ RenderEntity render_entity_from(const Entity& entity) {
 
 RenderLight render_light_from(const Light& light) {
   RenderLight def;
-  def.origin = light.origin;
-  def.axis = light.axis;
+  for_each_shared_light_field(light, def, [](const auto& from, auto& to) { to = from; });
   def.point_light = light.type != LightType::Projected;
   def.parallel = light.type == LightType::Parallel;
-  def.radius = light.radius;
-  def.center = light.center;
-  def.target = light.target;
-  def.right = light.right;
-  def.up = light.up;
-  def.start = light.start;
-  def.end = light.end;
-  def.has_start_end = light.has_start_end;
-  def.shader = light.material;
   std::copy(std::begin(light.shader_parms), std::end(light.shader_parms), def.shader_parms);
   // _color is what the engine puts in shader parms 0-2.
   def.shader_parms[kShaderParmRed] = light.color.r;
   def.shader_parms[kShaderParmGreen] = light.color.g;
   def.shader_parms[kShaderParmBlue] = light.color.b;
-  def.no_shadows = light.no_shadows;
-  def.no_specular = light.no_specular;
   return def;
 }
 
@@ -108,49 +185,17 @@ RenderLight RenderWorld::resolved(const RenderLight& light) const {
   return def;
 }
 
-int RenderWorld::AddEntityDef(const RenderEntity& entity) {
-  RenderEntity def = resolved(entity);
-  int handle = lowest_free(entities_, "Entity");
-  entities_[handle] = std::move(def);
-  changes_.entities.insert(handle);
-  return handle;
-}
-
+int RenderWorld::AddEntityDef(const RenderEntity& entity) { return add_def(entities_, resolved(entity), changes_); }
 void RenderWorld::UpdateEntityDef(int handle, const RenderEntity& entity) {
-  RenderEntity def = resolved(entity);
-  live(entities_, handle, "UpdateEntityDef") = std::move(def);
-  changes_.entities.insert(handle);
+  update_def(entities_, handle, resolved(entity), changes_);
 }
+void RenderWorld::FreeEntityDef(int handle) { free_def(entities_, entity_names_, handle, changes_); }
 
-void RenderWorld::FreeEntityDef(int handle) {
-  live(entities_, handle, "FreeEntityDef");
-  entities_[handle].reset();
-  if (size_t(handle) < entity_names_.size()) entity_names_[handle].clear();
-  changes_.entities.erase(handle);
-  changes_.freed_entities.insert(handle);
-}
-
-int RenderWorld::AddLightDef(const RenderLight& light) {
-  RenderLight def = resolved(light);
-  int handle = lowest_free(lights_, "Light");
-  lights_[handle] = std::move(def);
-  changes_.lights.insert(handle);
-  return handle;
-}
-
+int RenderWorld::AddLightDef(const RenderLight& light) { return add_def(lights_, resolved(light), changes_); }
 void RenderWorld::UpdateLightDef(int handle, const RenderLight& light) {
-  RenderLight def = resolved(light);
-  live(lights_, handle, "UpdateLightDef") = std::move(def);
-  changes_.lights.insert(handle);
+  update_def(lights_, handle, resolved(light), changes_);
 }
-
-void RenderWorld::FreeLightDef(int handle) {
-  live(lights_, handle, "FreeLightDef");
-  lights_[handle].reset();
-  if (size_t(handle) < light_names_.size()) light_names_[handle].clear();
-  changes_.lights.erase(handle);
-  changes_.freed_lights.insert(handle);
-}
+void RenderWorld::FreeLightDef(int handle) { free_def(lights_, light_names_, handle, changes_); }
 
 int RenderWorld::DefineMaterial(const Material& material) {
   auto image_ok = [&](int i) { return i >= -1 && i < int(scene_.images.size()); };
@@ -159,16 +204,8 @@ int RenderWorld::DefineMaterial(const Material& material) {
     if (!image_ok(i))
       throw RenderWorldError(fmt::format("DefineMaterial '{}': image {} out of range ({} images)", material.name, i,
                                          scene_.images.size()));
-  int index = scene_.find_material(material.name);
-  if (index < 0) {
-    if (scene_.materials.size() >= size_t(kMaxHandles)) throw RenderWorldError("DefineMaterial: too many materials");
-    index = int(scene_.materials.size());
-    scene_.materials.push_back(material);
-  } else {
-    scene_.materials[index] = material;
-  }
-  changes_.materials.insert(index);
-  return index;
+  return define_by_name(scene_.materials, scene_.find_material(material.name), material, changes_.materials,
+                        "DefineMaterial: too many materials");
 }
 
 int RenderWorld::DefineTexture(const Image& image) {
@@ -179,15 +216,8 @@ int RenderWorld::DefineTexture(const Image& image) {
                                        size_t(std::max(image.height, 0)) * 4, image.rgba.size()));
   auto it = std::find_if(scene_.images.begin(), scene_.images.end(),
                          [&](const Image& i) { return i.name == image.name; });
-  int index = int(it - scene_.images.begin());
-  if (it == scene_.images.end()) {
-    if (scene_.images.size() >= size_t(kMaxHandles)) throw RenderWorldError("DefineTexture: too many textures");
-    scene_.images.push_back(image);
-  } else {
-    *it = image;
-  }
-  changes_.textures.insert(index);
-  return index;
+  const int found = it == scene_.images.end() ? -1 : int(it - scene_.images.begin());
+  return define_by_name(scene_.images, found, image, changes_.textures, "DefineTexture: too many textures");
 }
 
 int RenderWorld::DefineModel(const Mesh& mesh) {
@@ -204,16 +234,8 @@ int RenderWorld::DefineModel(const Mesh& mesh) {
     if (size_t(s.first_index) + s.index_count > mesh.indices.size())
       throw RenderWorldError(fmt::format("DefineModel '{}': a surface runs past the index list", mesh.name));
   }
-  int index = scene_.find_mesh(mesh.name);
-  if (index < 0) {
-    if (scene_.meshes.size() >= size_t(kMaxHandles)) throw RenderWorldError("DefineModel: too many models");
-    index = int(scene_.meshes.size());
-    scene_.meshes.push_back(mesh);
-  } else {
-    scene_.meshes[index] = mesh;
-  }
-  changes_.models.insert(index);
-  return index;
+  return define_by_name(scene_.meshes, scene_.find_mesh(mesh.name), mesh, changes_.models,
+                        "DefineModel: too many models");
 }
 
 void RenderWorld::RenderScene(const RenderView& view) {
@@ -230,27 +252,13 @@ void RenderWorld::EndFrame() {
   ++changes_.frames_ended;
 }
 
-const RenderEntity* RenderWorld::EntityDef(int handle) const {
-  if (handle < 0 || size_t(handle) >= entities_.size() || !entities_[handle]) return nullptr;
-  return &*entities_[handle];
-}
+const RenderEntity* RenderWorld::EntityDef(int handle) const { return live_or_null(entities_, handle); }
 
-const RenderLight* RenderWorld::LightDef(int handle) const {
-  if (handle < 0 || size_t(handle) >= lights_.size() || !lights_[handle]) return nullptr;
-  return &*lights_[handle];
-}
+const RenderLight* RenderWorld::LightDef(int handle) const { return live_or_null(lights_, handle); }
 
-int RenderWorld::FindEntityDef(const std::string& name) const {
-  for (size_t i = 0; i < entity_names_.size(); ++i)
-    if (entity_names_[i] == name && entities_[i]) return int(i);
-  return -1;
-}
+int RenderWorld::FindEntityDef(const std::string& name) const { return find_seeded(entities_, entity_names_, name); }
 
-int RenderWorld::FindLightDef(const std::string& name) const {
-  for (size_t i = 0; i < light_names_.size(); ++i)
-    if (light_names_[i] == name && lights_[i]) return int(i);
-  return -1;
-}
+int RenderWorld::FindLightDef(const std::string& name) const { return find_seeded(lights_, light_names_, name); }
 
 ChangeLog RenderWorld::TakeChanges() {
   ChangeLog taken = std::move(changes_);
@@ -263,23 +271,11 @@ Light RenderWorld::scene_light(int handle) const {
   if (!def) throw RenderWorldError(fmt::format("scene_light: handle {} is not a live light def", handle));
   Light light;
   if (size_t(handle) < light_names_.size()) light.name = light_names_[handle];
+  for_each_shared_light_field(light, *def, [](auto& to, const auto& from) { to = from; });
   light.type = def->parallel ? LightType::Parallel : def->point_light ? LightType::Point : LightType::Projected;
-  light.origin = def->origin;
-  light.axis = def->axis;
-  light.radius = def->radius;
-  light.center = def->center;
   light.color = {def->shader_parms[kShaderParmRed], def->shader_parms[kShaderParmGreen],
                  def->shader_parms[kShaderParmBlue]};
-  light.target = def->target;
-  light.right = def->right;
-  light.up = def->up;
-  light.start = def->start;
-  light.end = def->end;
-  light.has_start_end = def->has_start_end;
-  light.material = def->shader;
   std::copy(std::begin(def->shader_parms), std::end(def->shader_parms), light.shader_parms);
-  light.no_shadows = def->no_shadows;
-  light.no_specular = def->no_specular;
   return light;
 }
 

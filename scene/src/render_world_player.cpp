@@ -1,3 +1,6 @@
+#include <tuple>
+#include <type_traits>
+
 #include <fmt/format.h>
 
 #include "cohort/scene/render_world_stream.h"
@@ -20,83 +23,37 @@ void expect_same(int recorded, int replayed, const char* what) {
                                        what, recorded, replayed));
 }
 
+// Reads a record as Recorder::forward wrote it (the handle or index the call returned, if it returns
+// one, then its arguments), checks that nothing is left over, and makes the same call on `world`,
+// which must return what the recorder got (`returned` names it).
+template <class Result, class... Params>
+void replay(Decoder& d, RenderWorldApi& world, Result (RenderWorldApi::*call)(Params...), const char* returned = "") {
+  [[maybe_unused]] int recorded = 0;
+  if constexpr (!std::is_void_v<Result>) recorded = d.i32();
+  const std::tuple<std::decay_t<Params>...> args{d.read<std::decay_t<Params>>()...};
+  if (d.left()) d.fail(fmt::format("{} bytes left over after the record's fields", d.left()));
+  auto make_call = [&] { return std::apply([&](const auto&... a) { return (world.*call)(a...); }, args); };
+  if constexpr (std::is_void_v<Result>)
+    make_call();
+  else
+    expect_same(recorded, make_call(), returned);
+}
+
 void apply_record(DeltaRecord type, Decoder& d, RenderWorldApi& world) {
   switch (type) {
-    case DeltaRecord::AddEntityDef: {
-      int handle = d.i32();
-      RenderEntity def = decode_entity(d);
-      if (d.left()) break;
-      expect_same(handle, world.AddEntityDef(def), "entity handle");
-      return;
-    }
-    case DeltaRecord::UpdateEntityDef: {
-      int handle = d.i32();
-      RenderEntity def = decode_entity(d);
-      if (d.left()) break;
-      world.UpdateEntityDef(handle, def);
-      return;
-    }
-    case DeltaRecord::FreeEntityDef: {
-      int handle = d.i32();
-      if (d.left()) break;
-      world.FreeEntityDef(handle);
-      return;
-    }
-    case DeltaRecord::AddLightDef: {
-      int handle = d.i32();
-      RenderLight def = decode_light(d);
-      if (d.left()) break;
-      expect_same(handle, world.AddLightDef(def), "light handle");
-      return;
-    }
-    case DeltaRecord::UpdateLightDef: {
-      int handle = d.i32();
-      RenderLight def = decode_light(d);
-      if (d.left()) break;
-      world.UpdateLightDef(handle, def);
-      return;
-    }
-    case DeltaRecord::FreeLightDef: {
-      int handle = d.i32();
-      if (d.left()) break;
-      world.FreeLightDef(handle);
-      return;
-    }
-    case DeltaRecord::DefineMaterial: {
-      int index = d.i32();
-      Material m = decode_material(d);
-      if (d.left()) break;
-      expect_same(index, world.DefineMaterial(m), "material index");
-      return;
-    }
-    case DeltaRecord::DefineTexture: {
-      int index = d.i32();
-      Image image = decode_image(d);
-      if (d.left()) break;
-      expect_same(index, world.DefineTexture(image), "texture index");
-      return;
-    }
-    case DeltaRecord::DefineModel: {
-      int index = d.i32();
-      Mesh mesh = decode_mesh(d);
-      if (d.left()) break;
-      expect_same(index, world.DefineModel(mesh), "model index");
-      return;
-    }
-    case DeltaRecord::RenderScene: {
-      RenderView view = decode_view(d);
-      if (d.left()) break;
-      world.RenderScene(view);
-      return;
-    }
-    case DeltaRecord::EndFrame:
-      if (d.left()) break;
-      world.EndFrame();
-      return;
-    default:
-      d.fail("unknown record type");
+    case DeltaRecord::AddEntityDef: return replay(d, world, &RenderWorldApi::AddEntityDef, "entity handle");
+    case DeltaRecord::UpdateEntityDef: return replay(d, world, &RenderWorldApi::UpdateEntityDef);
+    case DeltaRecord::FreeEntityDef: return replay(d, world, &RenderWorldApi::FreeEntityDef);
+    case DeltaRecord::AddLightDef: return replay(d, world, &RenderWorldApi::AddLightDef, "light handle");
+    case DeltaRecord::UpdateLightDef: return replay(d, world, &RenderWorldApi::UpdateLightDef);
+    case DeltaRecord::FreeLightDef: return replay(d, world, &RenderWorldApi::FreeLightDef);
+    case DeltaRecord::DefineMaterial: return replay(d, world, &RenderWorldApi::DefineMaterial, "material index");
+    case DeltaRecord::DefineTexture: return replay(d, world, &RenderWorldApi::DefineTexture, "texture index");
+    case DeltaRecord::DefineModel: return replay(d, world, &RenderWorldApi::DefineModel, "model index");
+    case DeltaRecord::RenderScene: return replay(d, world, &RenderWorldApi::RenderScene);
+    case DeltaRecord::EndFrame: return replay(d, world, &RenderWorldApi::EndFrame);
   }
-  d.fail(fmt::format("{} bytes left over after the record's fields", d.left()));
+  d.fail("unknown record type");
 }
 
 }  // namespace

@@ -1,3 +1,5 @@
+#include <type_traits>
+
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
 
@@ -71,91 +73,51 @@ void Recorder::write_chunk(uint32_t tag, const std::vector<uint8_t>& payload) {
   bytes_written_ += head.size() + payload.size();
 }
 
-// Each call goes to the world first; only a call the world accepted is written down.
+template <class... Fields>
+void Recorder::record(DeltaRecord type, const Fields&... fields) {
+  Encoder(begin_record(type)).fields(fields...);
+  end_record();
+}
+
+// Each call goes to the world first; only a call the world accepted is written down: the handle or
+// index it returned, if it returns one, then its arguments.
+template <class Result, class... Params, class... Args>
+Result Recorder::forward(DeltaRecord type, Result (RenderWorld::*call)(Params...), const Args&... args) {
+  if constexpr (std::is_void_v<Result>) {
+    (world_.*call)(args...);
+    record(type, args...);
+  } else {
+    const Result returned = (world_.*call)(args...);
+    record(type, returned, args...);
+    return returned;
+  }
+}
+
 int Recorder::AddEntityDef(const RenderEntity& entity) {
-  int handle = world_.AddEntityDef(entity);
-  Encoder e(begin_record(DeltaRecord::AddEntityDef));
-  e.i32(handle);
-  encode(e, entity);
-  end_record();
-  return handle;
+  return forward(DeltaRecord::AddEntityDef, &RenderWorld::AddEntityDef, entity);
 }
-
 void Recorder::UpdateEntityDef(int handle, const RenderEntity& entity) {
-  world_.UpdateEntityDef(handle, entity);
-  Encoder e(begin_record(DeltaRecord::UpdateEntityDef));
-  e.i32(handle);
-  encode(e, entity);
-  end_record();
+  forward(DeltaRecord::UpdateEntityDef, &RenderWorld::UpdateEntityDef, handle, entity);
 }
-
-void Recorder::FreeEntityDef(int handle) {
-  world_.FreeEntityDef(handle);
-  Encoder(begin_record(DeltaRecord::FreeEntityDef)).i32(handle);
-  end_record();
-}
-
+void Recorder::FreeEntityDef(int handle) { forward(DeltaRecord::FreeEntityDef, &RenderWorld::FreeEntityDef, handle); }
 int Recorder::AddLightDef(const RenderLight& light) {
-  int handle = world_.AddLightDef(light);
-  Encoder e(begin_record(DeltaRecord::AddLightDef));
-  e.i32(handle);
-  encode(e, light);
-  end_record();
-  return handle;
+  return forward(DeltaRecord::AddLightDef, &RenderWorld::AddLightDef, light);
 }
-
 void Recorder::UpdateLightDef(int handle, const RenderLight& light) {
-  world_.UpdateLightDef(handle, light);
-  Encoder e(begin_record(DeltaRecord::UpdateLightDef));
-  e.i32(handle);
-  encode(e, light);
-  end_record();
+  forward(DeltaRecord::UpdateLightDef, &RenderWorld::UpdateLightDef, handle, light);
 }
-
-void Recorder::FreeLightDef(int handle) {
-  world_.FreeLightDef(handle);
-  Encoder(begin_record(DeltaRecord::FreeLightDef)).i32(handle);
-  end_record();
-}
-
+void Recorder::FreeLightDef(int handle) { forward(DeltaRecord::FreeLightDef, &RenderWorld::FreeLightDef, handle); }
 int Recorder::DefineMaterial(const Material& material) {
-  int index = world_.DefineMaterial(material);
-  Encoder e(begin_record(DeltaRecord::DefineMaterial));
-  e.i32(index);
-  encode(e, material);
-  end_record();
-  return index;
+  return forward(DeltaRecord::DefineMaterial, &RenderWorld::DefineMaterial, material);
 }
-
 int Recorder::DefineTexture(const Image& image) {
-  int index = world_.DefineTexture(image);
-  Encoder e(begin_record(DeltaRecord::DefineTexture));
-  e.i32(index);
-  encode(e, image);
-  end_record();
-  return index;
+  return forward(DeltaRecord::DefineTexture, &RenderWorld::DefineTexture, image);
 }
-
-int Recorder::DefineModel(const Mesh& mesh) {
-  int index = world_.DefineModel(mesh);
-  Encoder e(begin_record(DeltaRecord::DefineModel));
-  e.i32(index);
-  encode(e, mesh);
-  end_record();
-  return index;
-}
-
-void Recorder::RenderScene(const RenderView& view) {
-  world_.RenderScene(view);
-  Encoder e(begin_record(DeltaRecord::RenderScene));
-  encode(e, view);
-  end_record();
-}
+int Recorder::DefineModel(const Mesh& mesh) { return forward(DeltaRecord::DefineModel, &RenderWorld::DefineModel, mesh); }
+void Recorder::RenderScene(const RenderView& view) { forward(DeltaRecord::RenderScene, &RenderWorld::RenderScene, view); }
 
 void Recorder::EndFrame() {
-  world_.EndFrame();
-  begin_record(DeltaRecord::EndFrame);
-  end_record();
+  forward(DeltaRecord::EndFrame, &RenderWorld::EndFrame);
   write_chunk(kFrameTag, frame_);
   frame_.clear();
   ++frames_;

@@ -6,6 +6,8 @@
 #include <fstream>
 #include <stdexcept>
 
+#include "ascii_case.h"
+
 namespace cohort::scene {
 
 namespace fs = std::filesystem;
@@ -14,15 +16,6 @@ namespace {
 
 // Nothing in a Doom 3 game folder comes near this; a larger entry is a damaged or hostile archive.
 constexpr uint64_t kMaxFileBytes = 1ull << 30;
-
-char lower(char c) { return (c >= 'A' && c <= 'Z') ? static_cast<char>(c - 'A' + 'a') : c; }
-
-bool ends_with_ignoring_case(std::string_view s, std::string_view suffix) {
-  if (suffix.size() > s.size()) return false;
-  for (size_t i = 0; i < suffix.size(); ++i)
-    if (lower(s[s.size() - suffix.size() + i]) != lower(suffix[i])) return false;
-  return true;
-}
 
 }  // namespace
 
@@ -40,7 +33,7 @@ Vfs::~Vfs() = default;
 std::string Vfs::normalize(std::string_view name) {
   std::string out;
   out.reserve(name.size());
-  for (char c : name) out.push_back(c == '\\' ? '/' : lower(c));
+  for (char c : name) out.push_back(c == '\\' ? '/' : ascii_lower(c));
   while (out.rfind("./", 0) == 0) out.erase(0, 2);
   while (!out.empty() && out.front() == '/') out.erase(0, 1);
   return out;

@@ -6,7 +6,7 @@
 
 #include "cohort/commit/array_diff.h"
 #include "cohort/commit/commit_channel.h"
-#include "scene_churn.h"
+#include "cohort/test_support/scene_churn.h"
 
 using namespace cohort::commit;
 
@@ -17,7 +17,7 @@ std::shared_ptr<const TracerScene> copy_of(const TracerScene& s) { return std::m
 }  // namespace
 
 TEST(CommitChannel, FirstCommitIsAFullResync) {
-  churn_testing::SceneChurn churn(3);
+  cohort::test::SceneChurn churn(3);
   CommitChannel channel(1 << 20, copy_of(churn.master()), 0);
   TracerScene tracer;
   ChangeSet changes = apply_commit(channel.begin_frame(), tracer);
@@ -40,7 +40,7 @@ TEST(CommitChannel, NothingPublishedGivesAnEmptyCommit) {
 // Tracers that take every frame, every 3rd, every 17th, or only once at the end all end up with the
 // master's arrays, and the skipping ones get fewer, coalesced records.
 TEST(CommitChannel, TracerThatSkipsFramesConvergesToTheMaster) {
-  churn_testing::SceneChurn churn(11);
+  cohort::test::SceneChurn churn(11);
   const int periods[] = {1, 3, 17, 1000};
   std::vector<std::unique_ptr<CommitChannel>> channels;
   std::vector<TracerScene> tracers(std::size(periods));
@@ -65,7 +65,7 @@ TEST(CommitChannel, TracerThatSkipsFramesConvergesToTheMaster) {
 }
 
 TEST(CommitChannel, OverflowBecomesAFullResyncAndIsCounted) {
-  churn_testing::SceneChurn churn(5);
+  cohort::test::SceneChurn churn(5);
   const size_t budget = 4 * sizeof(KInstance);
   CommitChannel channel(budget, copy_of(churn.master()), 0);
   TracerScene tracer;
@@ -85,7 +85,7 @@ TEST(CommitChannel, OverflowBecomesAFullResyncAndIsCounted) {
 }
 
 TEST(CommitChannel, RequestedResyncArrivesWithTheNextPublish) {
-  churn_testing::SceneChurn churn(8);
+  cohort::test::SceneChurn churn(8);
   CommitChannel channel(1 << 20, copy_of(churn.master()), 0);
   TracerScene tracer;
   apply_commit(channel.begin_frame(), tracer);
@@ -101,7 +101,7 @@ TEST(CommitChannel, RequestedResyncArrivesWithTheNextPublish) {
 // The core publishes on one thread while the tracer swaps and applies on another, at its own pace.
 // Run under ThreadSanitizer by the `tsan` preset (ctest label `concurrency`).
 TEST(CommitChannelConcurrency, ConcurrentPublishAndApplyConverge) {
-  churn_testing::SceneChurn churn(21);
+  cohort::test::SceneChurn churn(21);
   auto initial = copy_of(churn.master());
   CommitChannel channel(256 * 1024, initial, 0);
   const uint64_t frames = 1500;

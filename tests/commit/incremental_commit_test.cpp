@@ -2,7 +2,7 @@
 
 #include "cohort/commit/array_diff.h"
 #include "cohort/commit/commit_buffer.h"
-#include "scene_churn.h"
+#include "cohort/test_support/scene_churn.h"
 
 using namespace cohort::commit;
 
@@ -91,7 +91,7 @@ TEST(CommitBuffer, RecordPastTheEndOfTheTracerSceneIsRejected) {
 }
 
 TEST(CommitBuffer, EveryFrameAppliedInTurnMatchesTheMaster) {
-  churn_testing::SceneChurn churn(1);
+  cohort::test::SceneChurn churn(1);
   TracerScene tracer;
   apply_commit(CommitBuffer::full(std::make_shared<TracerScene>(churn.master()), 0), tracer);
   for (uint64_t frame = 1; frame <= 300; ++frame) {
@@ -103,7 +103,7 @@ TEST(CommitBuffer, EveryFrameAppliedInTurnMatchesTheMaster) {
 
 TEST(CommitBuffer, MergedFramesApplyLikeTheFramesInTurn) {
   for (uint32_t seed = 1; seed <= 20; ++seed) {
-    churn_testing::SceneChurn churn(seed);
+    cohort::test::SceneChurn churn(seed);
     TracerScene tracer;
     apply_commit(CommitBuffer::full(std::make_shared<TracerScene>(churn.master()), 0), tracer);
     CommitBuffer accumulated;

@@ -3,13 +3,14 @@
 #include <filesystem>
 #include <unistd.h>
 
-#include "../scene/render_world_fixture.h"
 #include "cohort/commit/array_diff.h"
 #include "cohort/commit/commit_channel.h"
 #include "cohort/core/gpu_scene.h"
 #include "cohort/core/world_sync.h"
 #include "cohort/scene/render_world_stream.h"
 #include "cohort/scene/scenario.h"
+#include "cohort/test_support/scene_builders.h"
+#include "cohort/test_support/test_scenes.h"
 
 using namespace cohort;
 using namespace cohort::core;
@@ -57,12 +58,12 @@ std::string first_difference(const commit::TracerScene& a, const commit::TracerS
 // entity using them, an entity and a light freed.
 void define_and_free(scene::RenderWorldApi& world, int frame) {
   if (frame == 10) {
-    int tex = world.DefineTexture(scene::world_testing::checker("textures/test/crate", 8));
+    int tex = world.DefineTexture(test::checker("textures/test/crate", 8));
     scene::Material m;
     m.name = "textures/test/crate";
     m.diffuse_image = tex;
     int mat = world.DefineMaterial(m);
-    world.DefineModel(scene::world_testing::box_mesh("crate", {8, 8, 8}, mat));
+    world.DefineModel(test::box_mesh("crate", {8, 8, 8}, mat));
     scene::RenderEntity crate;
     crate.model_name = "crate";
     crate.origin = {40, 40, 8};
@@ -89,7 +90,7 @@ void run_frames(scene::RenderWorldApi& world, int frames) {
 }  // namespace
 
 TEST(WorldSync, SyncedMasterEqualsAFreshCompileOfTheSameState) {
-  RenderWorld world(scene::world_testing::small_map());
+  RenderWorld world(test::small_test_map());
   WorldSync sync(world);
   scene::Scenario scenario(world);
   for (int f = 0; f < 100; ++f) {
@@ -109,14 +110,14 @@ TEST(WorldSync, ReplayedStreamGivesTheSameTracerSceneEveryFrame) {
   const int frames = 60;
   auto file = std::filesystem::temp_directory_path() / ("cohort_world_sync_" + std::to_string(::getpid()) + ".cds");
   {
-    RenderWorld recorded(scene::world_testing::small_map());
+    RenderWorld recorded(test::small_test_map());
     scene::Recorder recorder(recorded, file, "small");
     run_frames(recorder, frames);
     recorder.finish();
   }
-  RenderWorld direct(scene::world_testing::small_map());
+  RenderWorld direct(test::small_test_map());
   WorldSync direct_sync(direct);
-  RenderWorld replayed(scene::world_testing::small_map());
+  RenderWorld replayed(test::small_test_map());
   WorldSync replay_sync(replayed);
   auto channel = channel_of(replay_sync);
   commit::TracerScene tracer;
@@ -134,13 +135,13 @@ TEST(WorldSync, ReplayedStreamGivesTheSameTracerSceneEveryFrame) {
     commit::apply_commit(channel->begin_frame(), tracer);
     ASSERT_EQ(first_difference(tracer, replay_sync.master()), "") << "tracer copy, frame " << f;
   }
-  scene::RenderWorld scratch(scene::world_testing::small_map());
+  scene::RenderWorld scratch(test::small_test_map());
   EXPECT_FALSE(player.play_frame(scratch));
   std::filesystem::remove(file);
 }
 
 TEST(WorldSync, TracersThatSkipFramesConvergeToTheMaster) {
-  RenderWorld world(scene::world_testing::small_map());
+  RenderWorld world(test::small_test_map());
   WorldSync sync(world);
   const int periods[] = {1, 4, 7, 1000};
   std::vector<std::shared_ptr<commit::CommitChannel>> channels;
@@ -164,7 +165,7 @@ TEST(WorldSync, TracersThatSkipFramesConvergeToTheMaster) {
 }
 
 TEST(WorldSync, RuntimeModelMaterialAndTextureReachTheTracerScene) {
-  RenderWorld world(scene::world_testing::small_map());
+  RenderWorld world(test::small_test_map());
   WorldSync sync(world);
   const uint32_t default_material = sync.kmaterial_index(-1);
   const size_t blases_before = sync.master().blases.size();
@@ -198,7 +199,7 @@ TEST(WorldSync, RuntimeModelMaterialAndTextureReachTheTracerScene) {
 }
 
 TEST(WorldSync, OverflowingTheBudgetGivesAFullResyncThatConverges) {
-  RenderWorld world(scene::world_testing::small_map());
+  RenderWorld world(test::small_test_map());
   WorldSync sync(world);
   auto channel = channel_of(sync, 1024);
   commit::TracerScene tracer;
@@ -218,7 +219,7 @@ TEST(WorldSync, OverflowingTheBudgetGivesAFullResyncThatConverges) {
 }
 
 TEST(WorldSync, OnlyMovedEntitiesAndTheTlasAreSent) {
-  RenderWorld world(scene::world_testing::small_map());
+  RenderWorld world(test::small_test_map());
   WorldSync sync(world);
   scene::RenderEntity fan = *world.EntityDef(2);
   fan.origin.z += 1.0f;

@@ -6,7 +6,8 @@
 #include <fstream>
 
 #include "cohort/scene/render_world_stream.h"
-#include "render_world_fixture.h"
+#include "cohort/test_support/scene_builders.h"
+#include "cohort/test_support/test_scenes.h"
 
 using namespace cohort::scene;
 namespace fs = std::filesystem;
@@ -55,12 +56,12 @@ void drive(RenderWorldApi& world, int frames) {
       flash.up = {0, 0, 128};
       flash.shader_name = "lights/test/flicker";
       extra_light = world.AddLightDef(flash);
-      int tex = world.DefineTexture(world_testing::checker("textures/test/late", 2));
+      int tex = world.DefineTexture(cohort::test::checker("textures/test/late", 2));
       Material m;
       m.name = "textures/test/late";
       m.diffuse_image = tex;
       int mat = world.DefineMaterial(m);
-      world.DefineModel(world_testing::box_mesh("crate", {8, 8, 8}, mat));
+      world.DefineModel(cohort::test::box_mesh("crate", {8, 8, 8}, mat));
       RenderEntity c;
       c.model_name = "crate";
       c.origin = {10, 20, 30};
@@ -108,7 +109,7 @@ void expect_same_world(const RenderWorld& a, const RenderWorld& b) {
 
 fs::path record_small_stream(const std::string& name, int frames) {
   fs::path file = temp_file(name);
-  RenderWorld world(world_testing::small_map());
+  RenderWorld world(cohort::test::small_test_map());
   Recorder recorder(world, file, "small");
   drive(recorder, frames);
   recorder.finish();
@@ -119,7 +120,7 @@ fs::path record_small_stream(const std::string& name, int frames) {
 std::string play_all(const fs::path& file) {
   try {
     Player player(file);
-    RenderWorld world(world_testing::small_map());
+    RenderWorld world(cohort::test::small_test_map());
     while (player.play_frame(world)) {
     }
     return "";
@@ -132,14 +133,14 @@ std::string play_all(const fs::path& file) {
 
 TEST(DeltaStream, ReplayGivesTheSameStateAsTheDirectCalls) {
   const int frames = 6;
-  RenderWorld direct(world_testing::small_map());
+  RenderWorld direct(cohort::test::small_test_map());
   drive(direct, frames);
 
   fs::path file = record_small_stream("replay.cds", frames);
   Player player(file);
   EXPECT_EQ(player.header().map_name, "small");
   EXPECT_EQ(player.header().version, kDeltaStreamVersion);
-  RenderWorld replayed(world_testing::small_map());
+  RenderWorld replayed(cohort::test::small_test_map());
   int played = 0;
   while (player.play_frame(replayed)) {
     ++played;
@@ -153,7 +154,7 @@ TEST(DeltaStream, ReplayGivesTheSameStateAsTheDirectCalls) {
 TEST(DeltaStream, ReplayKeepsThePerFrameChangeLog) {
   fs::path file = record_small_stream("changelog.cds", 3);
   Player player(file);
-  RenderWorld replayed(world_testing::small_map());
+  RenderWorld replayed(cohort::test::small_test_map());
   // Frame by frame, the replay's change log equals the one of the direct calls.
   for (int f = 0; f < 3; ++f) {
     ASSERT_TRUE(player.play_frame(replayed));
@@ -241,9 +242,9 @@ TEST(DeltaStream, ForgedRecordWithAValidChecksumIsRefusedWithItsOffsetAndType) {
 TEST(DeltaStream, HugeCountsAreRefusedBeforeAllocating) {
   fs::path file = temp_file("huge_src.cds");
   {
-    RenderWorld world(world_testing::small_map());
+    RenderWorld world(cohort::test::small_test_map());
     Recorder recorder(world, file, "small");
-    recorder.DefineModel(world_testing::box_mesh("m", {1, 1, 1}, 0));
+    recorder.DefineModel(cohort::test::box_mesh("m", {1, 1, 1}, 0));
     recorder.EndFrame();
     recorder.finish();
   }
@@ -276,7 +277,7 @@ TEST(DeltaStream, NotAStreamAndWrongVersionAreNamed) {
 
 TEST(DeltaStream, AStreamForAnotherMapGivesAHandleMismatch) {
   fs::path file = record_small_stream("other_map.cds", 3);
-  Scene other = world_testing::small_map();
+  Scene other = cohort::test::small_test_map();
   other.entities.push_back(other.entities[1]);  // one more seeded entity: the crate gets another handle
   other.entities.back().name = "door_copy";
   Player player(file);

@@ -1,12 +1,13 @@
 #include <gtest/gtest.h>
 
 #include "cohort/scene/render_world.h"
-#include "render_world_fixture.h"
+#include "cohort/test_support/scene_builders.h"
+#include "cohort/test_support/test_scenes.h"
 
 using namespace cohort::scene;
 
 TEST(RenderWorld, SeededFromASceneGivesMapEntitiesAndLightsTheirIndexAsHandle) {
-  RenderWorld world(world_testing::small_map());
+  RenderWorld world(cohort::test::small_test_map());
   EXPECT_EQ(world.FindEntityDef("door_main"), 1);
   EXPECT_EQ(world.FindEntityDef("fan_spin"), 2);
   EXPECT_EQ(world.FindLightDef("light_flicker"), 0);
@@ -21,7 +22,7 @@ TEST(RenderWorld, SeededFromASceneGivesMapEntitiesAndLightsTheirIndexAsHandle) {
 }
 
 TEST(RenderWorld, HandlesAreTheLowestFreeOneLikeTheEngine) {
-  RenderWorld world(world_testing::small_map());
+  RenderWorld world(cohort::test::small_test_map());
   RenderEntity box;
   box.model_name = "fan_spin";
   EXPECT_EQ(world.AddEntityDef(box), 3);
@@ -39,7 +40,7 @@ TEST(RenderWorld, HandlesAreTheLowestFreeOneLikeTheEngine) {
 }
 
 TEST(RenderWorld, ChangeLogNamesWhatChangedAndIsClearedWhenTaken) {
-  RenderWorld world(world_testing::small_map());
+  RenderWorld world(cohort::test::small_test_map());
   RenderEntity door = *world.EntityDef(1);
   door.origin.z += 10;
   world.UpdateEntityDef(1, door);
@@ -56,7 +57,7 @@ TEST(RenderWorld, ChangeLogNamesWhatChangedAndIsClearedWhenTaken) {
 }
 
 TEST(RenderWorld, FreedAndReAddedInOneFrameIsInBothSets) {
-  RenderWorld world(world_testing::small_map());
+  RenderWorld world(cohort::test::small_test_map());
   RenderEntity def = *world.EntityDef(2);
   world.FreeEntityDef(2);
   EXPECT_EQ(world.AddEntityDef(def), 2);
@@ -66,14 +67,14 @@ TEST(RenderWorld, FreedAndReAddedInOneFrameIsInBothSets) {
 }
 
 TEST(RenderWorld, DefinitionsByNameReplaceOrAppend) {
-  RenderWorld world(world_testing::small_map());
+  RenderWorld world(cohort::test::small_test_map());
   Material m = world.scene().materials[0];
   m.diffuse_color = glm::vec4(0.5f);
   EXPECT_EQ(world.DefineMaterial(m), 0);
   m.name = "textures/test/new";
   EXPECT_EQ(world.DefineMaterial(m), 2);
-  EXPECT_EQ(world.DefineTexture(world_testing::checker("textures/test/other", 2)), 1);
-  EXPECT_EQ(world.DefineModel(world_testing::box_mesh("crate", {8, 8, 8}, 2)), 3);
+  EXPECT_EQ(world.DefineTexture(cohort::test::checker("textures/test/other", 2)), 1);
+  EXPECT_EQ(world.DefineModel(cohort::test::box_mesh("crate", {8, 8, 8}, 2)), 3);
   ChangeLog log = world.TakeChanges();
   EXPECT_EQ(log.materials, (std::set<int>{0, 2}));
   EXPECT_EQ(log.textures, std::set<int>{1});
@@ -81,7 +82,7 @@ TEST(RenderWorld, DefinitionsByNameReplaceOrAppend) {
 }
 
 TEST(RenderWorld, CallsThatDoNotFitTheStateAreRejectedWithAClearError) {
-  RenderWorld world(world_testing::small_map());
+  RenderWorld world(cohort::test::small_test_map());
   RenderEntity def;
   EXPECT_THROW(world.UpdateEntityDef(42, def), RenderWorldError);
   EXPECT_THROW(world.FreeLightDef(-1), RenderWorldError);
@@ -98,10 +99,10 @@ TEST(RenderWorld, CallsThatDoNotFitTheStateAreRejectedWithAClearError) {
   def.model = 1;
   def.origin.x = std::numeric_limits<float>::quiet_NaN();
   EXPECT_THROW(world.AddEntityDef(def), RenderWorldError);
-  Image bad = world_testing::checker("bad", 4);
+  Image bad = cohort::test::checker("bad", 4);
   bad.rgba.pop_back();
   EXPECT_THROW(world.DefineTexture(bad), RenderWorldError);
-  Mesh broken = world_testing::box_mesh("broken", {1, 1, 1}, 0);
+  Mesh broken = cohort::test::box_mesh("broken", {1, 1, 1}, 0);
   broken.indices.push_back(100);
   EXPECT_THROW(world.DefineModel(broken), RenderWorldError);
   EXPECT_TRUE(world.changes().empty());

@@ -5,12 +5,12 @@
 
 #include "cohort/scene/render_world_stream.h"
 #include "cohort/scene/scenario.h"
-#include "render_world_fixture.h"
+#include "cohort/test_support/test_scenes.h"
 
 using namespace cohort::scene;
 
 TEST(Scenario, DoorOpensFanSpinsLightFlickersFlashlightFollowsTheCamera) {
-  RenderWorld world(world_testing::small_map());
+  RenderWorld world(cohort::test::small_test_map());
   const RenderEntity door0 = *world.EntityDef(1), fan0 = *world.EntityDef(2);
   Scenario scenario(world);
   scenario.frame(0);
@@ -49,16 +49,16 @@ TEST(Scenario, DoorOpensFanSpinsLightFlickersFlashlightFollowsTheCamera) {
 
 TEST(Scenario, RecordedAndReplayedGivesTheSameWorldAsRunningIt) {
   auto file = std::filesystem::temp_directory_path() / ("cohort_scenario_" + std::to_string(::getpid()) + ".cds");
-  RenderWorld direct(world_testing::small_map());
+  RenderWorld direct(cohort::test::small_test_map());
   run_scenario(direct, 90);
   {
-    RenderWorld recorded(world_testing::small_map());
+    RenderWorld recorded(cohort::test::small_test_map());
     Recorder recorder(recorded, file, "small");
     run_scenario(recorder, 90);
     recorder.finish();
   }
   Player player(file);
-  RenderWorld replayed(world_testing::small_map());
+  RenderWorld replayed(cohort::test::small_test_map());
   while (player.play_frame(replayed)) {
   }
   EXPECT_EQ(player.frames_played(), 90u);
@@ -71,7 +71,7 @@ TEST(Scenario, RecordedAndReplayedGivesTheSameWorldAsRunningIt) {
 }
 
 TEST(Scenario, MissingNamesAreListedInOneError) {
-  Scene s = world_testing::small_map();
+  Scene s = cohort::test::small_test_map();
   s.entities[2].name = "something_else";
   s.lights[0].name = "other_light";
   RenderWorld world(std::move(s));

@@ -74,6 +74,10 @@ class Recorder : public RenderWorldApi {
   uint64_t bytes_written() const { return bytes_written_; }
 
  private:
+  template <class Result, class... Params, class... Args>
+  Result forward(DeltaRecord type, Result (RenderWorld::*call)(Params...), const Args&... args);
+  template <class... Fields>
+  void record(DeltaRecord type, const Fields&... fields);
   std::vector<uint8_t>& begin_record(DeltaRecord type);
   void end_record();
   void write_chunk(uint32_t tag, const std::vector<uint8_t>& payload);

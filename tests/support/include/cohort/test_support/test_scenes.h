@@ -1,0 +1,27 @@
+// The scenes the tests build in memory, so that they need no files (the test map on disk is
+// tools/testmap's assets/testmap).
+#pragma once
+
+#include "cohort/scene/scene.h"
+
+namespace cohort::test {
+
+// A small scene in the shape of the test map: a door, a fan and a flickering light, named as the
+// scenario (cohort/scene/scenario.h) expects, plus a fill light and a player start. Entity i and light
+// i get RenderWorld handle i: 0 player start, 1 door, 2 fan; 0 flicker, 1 fill. For the RenderWorld,
+// delta stream, scenario and world sync tests.
+scene::Scene small_test_map();
+
+// A closed room (400 x 300 x 200) exercising most of the material and light paths: a checkered
+// sRGB floor with a normal map and a specular map, an emissive panel, a pillar entity, an
+// alpha-tested grate entity, an additive glow decal, a point light, a projected light with a gel and
+// a falloff image, and a parallel light. For the tracer tests.
+scene::Scene test_room();
+
+// A square floor in z = 0 spanning [-half, half]^2, facing +Z, as the scene's only area.
+scene::Scene floor_scene(float half, glm::vec3 albedo);
+
+// A closed cube [-half, half]^3 whose inside walls all have this albedo and emission.
+scene::Scene furnace_box(float half, float albedo, float emission);
+
+}  // namespace cohort::test
