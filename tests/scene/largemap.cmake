@@ -5,6 +5,11 @@ find_program(COHORT_PYTHON3 python3)
 if(COHORT_PYTHON3)
   set(COHORT_LARGEMAP_DIR ${CMAKE_BINARY_DIR}/assets/largemap)
   set(COHORT_LARGEMAP_TEST ${CMAKE_CURRENT_LIST_DIR}/largemap_test.py)
+  # `cmake --build --preset <p> --target largemap` generates it without running the tests.
+  add_custom_target(largemap
+                    COMMAND ${COHORT_PYTHON3} ${CMAKE_SOURCE_DIR}/tools/gen_testmap.py --large
+                            --out ${COHORT_LARGEMAP_DIR}
+                    COMMENT "Generating the large map into ${COHORT_LARGEMAP_DIR}" VERBATIM)
   add_test(NAME scene.largemap.generate
            COMMAND ${COHORT_PYTHON3} ${COHORT_LARGEMAP_TEST} generate --repo ${CMAKE_SOURCE_DIR}
                    --out ${COHORT_LARGEMAP_DIR})

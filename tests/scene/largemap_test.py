@@ -3,7 +3,8 @@
 
   generate      --repo R --out D            clear D and generate the map into it (the ctest fixture)
   deterministic --repo R --out D            generate again in memory, in a fresh process with another
-                                            hash seed, and compare a digest with the files in D
+                                            hash seed, and compare a digest with the files in D;
+                                            then --seed 2 --size 3x3 must pass the self-checks too
   info          --cohort EXE --out D        `cohort info` on D: no warnings, the generator's counts, and
                                             the targets (>= 40 areas, >= 300k world triangles, >= 256
                                             lights of all three types, >= 100 func_static props)
@@ -65,6 +66,16 @@ def deterministic(args):
     print("on disk: %d files, %d bytes, sha256 %s" % (count, size, on_disk))
     if match.group(1) != on_disk:
         print("FAIL: a second generation differs from the files written by the first")
+        return 1
+    # Another seed on a smaller lattice must pass the same self-checks and differ.
+    result = subprocess.run(generator(args.repo) + ["--check-only", "--digest", "--seed", "2", "--size", "3x3"],
+                            capture_output=True, text=True)
+    print(result.stdout + result.stderr)
+    if result.returncode != 0:
+        print("FAIL: --seed 2 --size 3x3 exited with %d" % result.returncode)
+        return 1
+    if on_disk in result.stdout:
+        print("FAIL: another seed and size gave the same bytes")
         return 1
     return 0
 
