@@ -2,7 +2,8 @@
 # Runs Cohort's CUDA tests and benchmarks on the GPU machine lent by the `device` tool.
 #
 #   tools/gpu_run.sh stage     here: build the gpu-travel preset (CUDA on, no OpenImageIO, no viewer),
-#                              pack the test map, and put binaries + Embree/TBB/libzip beside them in .gpu/
+#                              pack the test map, and put binaries + Embree/TBB/libzip beside them in .gpu/;
+#                              with COHORT_GPU_LARGEMAP=1 also generate and pack the large map (~28 MB more)
 #   tools/gpu_run.sh remote    there (device tool: run command "bash tools/gpu_run.sh remote", carry [".gpu"]):
 #                              registers NVIDIA's OpenCL, runs the GPU tests and benchmarks, writes
 #                              results (logs, JSON, PPM frames) to $OUT
@@ -26,6 +27,10 @@ case "${1:-}" in
     done
     # The travelling binary has no OpenImageIO: the pack carries decoded textures.
     build/gpu/bin/cohort pack assets/testmap/maps/testmap.map --out "$stage/testmap.cpk"
+    if [ "${COHORT_GPU_LARGEMAP:-0}" = 1 ]; then
+      python3 tools/gen_testmap.py --large --out build/gpu/assets/largemap
+      build/gpu/bin/cohort pack build/gpu/assets/largemap/maps/largemap.map --out "$stage/largemap.cpk"
+    fi
     du -sh "$stage"
     ;;
   remote)
@@ -45,6 +50,11 @@ case "${1:-}" in
     # A frame of the test map through the whole app, every GPU tracer: PFM/PPM since no OpenImageIO travels.
     "$stage/bin/cohort" render "$stage/testmap.cpk" --tracers "${COHORT_GPU_TRACERS:-cuda:all}" --width 640 --height 360 \
       --spp 16 --frames 2 --out "$out/render" 2>&1 | tail -n 8 | tee "$out/render.log" || status=1
+    # The large generated map (when staged): 1080p, 1 spp, through the whole app.
+    if [ -f "$stage/largemap.cpk" ]; then
+      "$stage/bin/cohort" render "$stage/largemap.cpk" --tracers "${COHORT_GPU_TRACERS:-cuda:all}" --width 1920 \
+        --height 1080 --spp 1 --frames 8 --out "$out/render_largemap" 2>&1 | tail -n 8 | tee "$out/render_largemap.log" || status=1
+    fi
     # Balancer efficiency with real GPU tracers (the paper's Table 1 metric), both camera paths.
     "$stage/bin/cohort" bench balance --real "${COHORT_GPU_TRACERS:-cuda:all}" --scene "$stage/testmap.cpk" --rows 720 \
       --frames 200 --json "$out/bench_balance_gpu.json" 2>&1 | grep -v "loads" | tee "$out/bench_balance_gpu.log" || status=1

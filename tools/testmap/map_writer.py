@@ -35,14 +35,32 @@ def _patch(out, number, material):
     out.append("  )\n }\n}\n")
 
 
-def map_text(entities):
-    out = ["Version 2\n"]
-    out.append("// entity 0\n{\n\"classname\" \"worldspawn\"\n\"name\" \"world\"\n")
+def _testmap_worldspawn(out):
     # Brushes outlining the hall's floor and west wall, and the atrium floor (editor data only).
     _brush(out, 0, (0, 0, -16), (512, 384, 0), "textures/testmap/floor_tiles")
     _brush(out, 1, (-16, 0, 0), (0, 384, 160), "textures/testmap/wall_bricks")
     _brush(out, 2, (768, 0, -16), (1152, 384, 0), "textures/testmap/floor_tiles")
     _patch(out, 3, "textures/testmap/metal")
+
+
+def patch_text(out, number, material, control):
+    """patchDef2 of a control grid: control[column][row] = (x, y, z, s, t)."""
+    out.append("// primitive %d\n{\n patchDef2\n {\n  \"%s\"\n  ( %d %d 0 0 0 )\n  (\n"
+               % (number, material, len(control), len(control[0])))
+    for column in control:
+        out.append("   ( %s )\n" % " ".join("( %s )" % fmt_vec(point) for point in column))
+    out.append("  )\n }\n}\n")
+
+
+def brush_text(out, number, lo, hi, material):
+    _brush(out, number, lo, hi, material)
+
+
+def map_text(entities, worldspawn=_testmap_worldspawn):
+    """`worldspawn(out)` appends the world entity's primitives (editor data: the .proc has the geometry)."""
+    out = ["Version 2\n"]
+    out.append("// entity 0\n{\n\"classname\" \"worldspawn\"\n\"name\" \"world\"\n")
+    worldspawn(out)
     out.append("}\n")
     for number, (classname, keys) in enumerate(entities, start=1):
         out.append("// entity %d\n{\n\"classname\" \"%s\"\n" % (number, classname))

@@ -4,6 +4,16 @@
 def fmt(value):
     if isinstance(value, str):
         return value
+    text = _CACHE.get(value)
+    if text is None:
+        text = _CACHE[value] = _fmt(value)
+    return text
+
+
+_CACHE = {}
+
+
+def _fmt(value):
     v = round(float(value), 4)
     if v == 0:
         return "0"
@@ -13,4 +23,8 @@ def fmt(value):
 
 
 def fmt_vec(values):
-    return " ".join(fmt(v) for v in values)
+    cache = _CACHE
+    try:
+        return " ".join([cache[v] for v in values])
+    except (KeyError, TypeError):
+        return " ".join([fmt(v) for v in values])
