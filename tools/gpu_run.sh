@@ -50,6 +50,16 @@ case "${1:-}" in
     # A frame of the test map through the whole app, every GPU tracer: PFM/PPM since no OpenImageIO travels.
     "$stage/bin/cohort" render "$stage/testmap.cpk" --tracers "${COHORT_GPU_TRACERS:-cuda:all}" --width 640 --height 360 \
       --spp 16 --frames 2 --out "$out/render" 2>&1 | tail -n 8 | tee "$out/render.log" || status=1
+    # End-to-end frame times and timelines (docs/frame-timeline.md): the test map at 1280x720, 1 spp,
+    # NEE + 1 bounce, 100 frames turning slowly, for each tracer mix; medians over frames 20-99.
+    for mix in ${COHORT_GPU_MIXES:-cuda:0 cuda:all embree,cuda:0 embree,cuda:all}; do
+      name=$(echo "$mix" | tr ',:' '__')
+      "$stage/bin/cohort" render "$stage/testmap.cpk" --tracers "$mix" --width 1280 --height 720 --spp 1 \
+        --light-samples 1 --bounces 1 --frames 100 --camera-path spin-slow --write last --out "$out/e2e_$name" \
+        --trace "$out/e2e_$name/trace.json" >/dev/null 2>&1 || status=1
+      python3 tools/frame_times.py "$out/e2e_$name/stats.json" --json "$out/e2e_$name/summary.json" \
+        | tee -a "$out/e2e.log" || status=1
+    done
     # The large generated map (when staged): 1080p, 1 spp, through the whole app.
     if [ -f "$stage/largemap.cpk" ]; then
       "$stage/bin/cohort" render "$stage/largemap.cpk" --tracers "${COHORT_GPU_TRACERS:-cuda:all}" --width 1920 \

@@ -1,0 +1,64 @@
+#!/usr/bin/env python3
+"""Summarises a `cohort render` stats.json: median and 95th percentile of the end-to-end frame time,
+the Renderer's wall time, and per stage (the frame timeline), over the frames after a warm-up.
+
+    tools/frame_times.py out/run/stats.json [--skip 20] [--json summary.json]
+"""
+import argparse
+import json
+import statistics
+import sys
+
+
+def percentile(values, p):
+    ordered = sorted(values)
+    if not ordered:
+        return float("nan")
+    k = min(len(ordered) - 1, max(0, round(p / 100.0 * (len(ordered) - 1))))
+    return ordered[k]
+
+
+def summarise(stats, skip):
+    frames = stats["frames"][skip:]
+    if not frames:
+        raise SystemExit(f"frame_times: only {len(stats['frames'])} frames, none left after skipping {skip}")
+    out = {"tracers": stats.get("tracers"), "width": stats.get("width"), "height": stats.get("height"),
+           "frames": len(frames)}
+    for key in ("end_to_end_ms", "wall_ms", "frame_ms", "idle_percent"):
+        values = [f[key] for f in frames if key in f]
+        out[key] = {"median": statistics.median(values), "p95": percentile(values, 95),
+                    "mean": statistics.fmean(values)} if values else None
+    per_stage = {}
+    for f in frames:
+        totals = {}
+        for s in f.get("stages", []):
+            name = f"{s['track']}/{s['stage']}"
+            totals[name] = totals.get(name, 0.0) + s["ms"]
+        for name, ms in totals.items():
+            per_stage.setdefault(name, []).append(ms)
+    out["stages_median_ms"] = {name: statistics.median(v) for name, v in sorted(per_stage.items())}
+    return out
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("stats")
+    parser.add_argument("--skip", type=int, default=20, help="warm-up frames left out (default 20)")
+    parser.add_argument("--json", help="also write the summary here")
+    args = parser.parse_args()
+    with open(args.stats) as f:
+        summary = summarise(json.load(f), args.skip)
+    e2e, wall = summary["end_to_end_ms"], summary["wall_ms"]
+    print(f"{summary['tracers']}: {summary['frames']} frames at {summary['width']}x{summary['height']}: "
+          f"end-to-end median {e2e['median']:.2f} ms (p95 {e2e['p95']:.2f}), renderer wall {wall['median']:.2f} ms, "
+          f"idle {summary['idle_percent']['mean']:.1f}% mean")
+    for name, ms in summary["stages_median_ms"].items():
+        print(f"  {name:60s} {ms:8.3f} ms")
+    if args.json:
+        with open(args.json, "w") as f:
+            json.dump(summary, f, indent=2)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
