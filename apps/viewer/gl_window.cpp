@@ -117,18 +117,23 @@ struct GlWindow::Impl {
   bool have_last = false;
   GlWindow* owner = nullptr;
 
+  // Shaders and programs report failure the same way: a status query, then an info log.
+  template <typename GetStatus, typename GetLog>
+  static void require(GLuint object, GLenum status, GetStatus get_status, GetLog get_log, const char* step) {
+    GLint ok = 0;
+    get_status(object, status, &ok);
+    if (ok) return;
+    char log[1024] = {};
+    get_log(object, sizeof(log), nullptr, log);
+    throw WindowUnavailable(std::string("viewer shader failed to ") + step + ": " + log);
+  }
+
   void build_program() {
     auto compile = [&](GLenum type, const char* source) {
       GLuint s = gl.CreateShader(type);
       gl.ShaderSource(s, 1, &source, nullptr);
       gl.CompileShader(s);
-      GLint ok = 0;
-      gl.GetShaderiv(s, GL_COMPILE_STATUS, &ok);
-      if (!ok) {
-        char log[1024] = {};
-        gl.GetShaderInfoLog(s, sizeof(log), nullptr, log);
-        throw WindowUnavailable(std::string("viewer shader failed to compile: ") + log);
-      }
+      require(s, GL_COMPILE_STATUS, gl.GetShaderiv, gl.GetShaderInfoLog, "compile");
       return s;
     };
     GLuint vs = compile(GL_VERTEX_SHADER, kVertexShader), fs = compile(GL_FRAGMENT_SHADER, kFragmentShader);
@@ -138,13 +143,7 @@ struct GlWindow::Impl {
     gl.LinkProgram(program);
     gl.DeleteShader(vs);
     gl.DeleteShader(fs);
-    GLint ok = 0;
-    gl.GetProgramiv(program, GL_LINK_STATUS, &ok);
-    if (!ok) {
-      char log[1024] = {};
-      gl.GetProgramInfoLog(program, sizeof(log), nullptr, log);
-      throw WindowUnavailable(std::string("viewer shader failed to link: ") + log);
-    }
+    require(program, GL_LINK_STATUS, gl.GetProgramiv, gl.GetProgramInfoLog, "link");
     gl.UseProgram(program);
     gl.Uniform1i(gl.GetUniformLocation(program, "image"), 0);
     gl.GenVertexArrays(1, &vao);

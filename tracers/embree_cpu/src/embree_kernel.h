@@ -26,25 +26,37 @@ struct FilterContext {
 
 void filter_hit(const RTCFilterFunctionNArguments* args);
 
+inline FilterContext filter_context(const KSceneView* scene, kuint ray_mask, int shadow_ray) {
+  FilterContext fc;
+  rtcInitIntersectContext(&fc.base);
+  fc.scene = scene;
+  fc.ray_mask = ray_mask;
+  fc.shadow_ray = shadow_ray;
+  return fc;
+}
+
+// A ray from org along dir up to tmax, visible to every geometry (masks are applied by filter_hit).
+inline RTCRay make_ray(KVec3 org, KVec3 dir, float tmax) {
+  RTCRay ray;
+  ray.org_x = org.x; ray.org_y = org.y; ray.org_z = org.z;
+  ray.dir_x = dir.x; ray.dir_y = dir.y; ray.dir_z = dir.z;
+  ray.tnear = 0.0f;
+  ray.tfar = tmax;
+  ray.mask = 0xFFFFFFFFu;
+  ray.time = 0.0f;
+  ray.id = 0;
+  ray.flags = 0;
+  return ray;
+}
+
 }  // namespace cohort::tracers::embree_kernel
 
 typedef cohort::tracers::embree_kernel::TraceCtx KTraceCtx;
 
 static inline int k_trace_closest(KTraceCtx* ctx, KVec3 org, KVec3 dir, float tmax, kuint ray_mask, KHit* hit) {
-  cohort::tracers::embree_kernel::FilterContext fc;
-  rtcInitIntersectContext(&fc.base);
-  fc.scene = &ctx->scene;
-  fc.ray_mask = ray_mask;
-  fc.shadow_ray = 0;
+  cohort::tracers::embree_kernel::FilterContext fc = cohort::tracers::embree_kernel::filter_context(&ctx->scene, ray_mask, 0);
   RTCRayHit rh;
-  rh.ray.org_x = org.x; rh.ray.org_y = org.y; rh.ray.org_z = org.z;
-  rh.ray.dir_x = dir.x; rh.ray.dir_y = dir.y; rh.ray.dir_z = dir.z;
-  rh.ray.tnear = 0.0f;
-  rh.ray.tfar = tmax;
-  rh.ray.mask = 0xFFFFFFFFu;
-  rh.ray.time = 0.0f;
-  rh.ray.id = 0;
-  rh.ray.flags = 0;
+  rh.ray = cohort::tracers::embree_kernel::make_ray(org, dir, tmax);
   rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
   rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
   ++ctx->rays;
@@ -60,20 +72,8 @@ static inline int k_trace_closest(KTraceCtx* ctx, KVec3 org, KVec3 dir, float tm
 }
 
 static inline int k_trace_occluded(KTraceCtx* ctx, KVec3 org, KVec3 dir, float tmax, kuint ray_mask) {
-  cohort::tracers::embree_kernel::FilterContext fc;
-  rtcInitIntersectContext(&fc.base);
-  fc.scene = &ctx->scene;
-  fc.ray_mask = ray_mask;
-  fc.shadow_ray = 1;
-  RTCRay ray;
-  ray.org_x = org.x; ray.org_y = org.y; ray.org_z = org.z;
-  ray.dir_x = dir.x; ray.dir_y = dir.y; ray.dir_z = dir.z;
-  ray.tnear = 0.0f;
-  ray.tfar = tmax;
-  ray.mask = 0xFFFFFFFFu;
-  ray.time = 0.0f;
-  ray.id = 0;
-  ray.flags = 0;
+  cohort::tracers::embree_kernel::FilterContext fc = cohort::tracers::embree_kernel::filter_context(&ctx->scene, ray_mask, 1);
+  RTCRay ray = cohort::tracers::embree_kernel::make_ray(org, dir, tmax);
   ++ctx->rays;
   rtcOccluded1(ctx->top, &fc.base, &ray);
   return ray.tfar < 0.0f;  // Embree sets tfar to -inf on occlusion

@@ -23,23 +23,19 @@ void check(cl_int err, const char* what) {
   if (err != CL_SUCCESS) throw std::runtime_error(std::string("OpenCLTracer: ") + what + " failed (error " + std::to_string(err) + ")");
 }
 
-std::string platform_info(cl_platform_id p, cl_platform_info what) {
+// A string property of a platform or device: OpenCL's query-the-size-then-fill pattern.
+template <typename Object, typename Info>
+std::string info_string(cl_int (*query)(Object, Info, size_t, void*, size_t*), Object object, Info what) {
   size_t n = 0;
-  clGetPlatformInfo(p, what, 0, nullptr, &n);
+  query(object, what, 0, nullptr, &n);
   std::string s(n, '\0');
-  clGetPlatformInfo(p, what, n, s.data(), nullptr);
+  query(object, what, n, s.data(), nullptr);
   while (!s.empty() && s.back() == '\0') s.pop_back();
   return s;
 }
 
-std::string device_info(cl_device_id d, cl_device_info what) {
-  size_t n = 0;
-  clGetDeviceInfo(d, what, 0, nullptr, &n);
-  std::string s(n, '\0');
-  clGetDeviceInfo(d, what, n, s.data(), nullptr);
-  while (!s.empty() && s.back() == '\0') s.pop_back();
-  return s;
-}
+std::string platform_info(cl_platform_id p, cl_platform_info what) { return info_string(&clGetPlatformInfo, p, what); }
+std::string device_info(cl_device_id d, cl_device_info what) { return info_string(&clGetDeviceInfo, d, what); }
 
 struct DeviceEntry {
   cl_platform_id platform;

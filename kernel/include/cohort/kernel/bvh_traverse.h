@@ -90,6 +90,34 @@ KFN float k_bvh_ray_box(KBvhRay r, KGLOBAL const KBvhNode* n, float tmin, float 
   return tnear <= tfar ? tnear : K_INF;
 }
 
+/* An interior node: pushes the far child when the ray enters both (the stack holds one entry per
+ * level, so it cannot overflow) and moves to the nearer one. 0 when the ray misses both: pop. */
+KFN int k_bvh_descend(KBvhRay r, KGLOBAL const KBvhNode* nodes, KGLOBAL const KBvhNode* n, float tmin, float tmax,
+                      kuint* stack, int* sp, kuint* node) {
+  kuint near_child = n->left_first, far_child = n->left_first + 1u;
+  float t_near = k_bvh_ray_box(r, nodes + near_child, tmin, tmax);
+  float t_far = k_bvh_ray_box(r, nodes + far_child, tmin, tmax);
+  if (t_far < t_near) {
+    float tt = t_near; t_near = t_far; t_far = tt;
+    kuint tn = near_child; near_child = far_child; far_child = tn;
+  }
+  if (t_near == K_INF) return 0;
+  if (t_far != K_INF && *sp < K_BVH_MAX_DEPTH) stack[(*sp)++] = far_child;
+  *node = near_child;
+  return 1;
+}
+
+/* The next pushed node the ray still enters (a closer hit found since the push can rule nodes out);
+ * 0 when the stack is empty. */
+KFN int k_bvh_pop(KBvhRay r, KGLOBAL const KBvhNode* nodes, float tmin, float tmax, const kuint* stack, int* sp,
+                  kuint* node) {
+  while (*sp > 0) {
+    *node = stack[--(*sp)];
+    if (k_bvh_ray_box(r, nodes + *node, tmin, tmax) != K_INF) return 1;
+  }
+  return 0;
+}
+
 /* Möller-Trumbore, both-sided: 1 and (t, u, v) when tmin < t < tmax. */
 KFN int k_bvh_ray_triangle(KVec3 o, KVec3 d, KVec3 p0, KVec3 p1, KVec3 p2, float tmin, float tmax,
                            float* t_out, float* u_out, float* v_out) {
@@ -161,26 +189,10 @@ KFN int k_bvh_traverse_blas(KSceneRef scene, K_BVH_CONTEXT ctx, int query, kuint
         if (!k_bvh_hit_triangle(scene, triangle, r.o, r.d, tmin, *tmax, &t, &u, &v)) continue;
         if (k_bvh_accept(ctx, query, instance, triangle, t, u, v, tmax, hit, transmittance)) return 1;
       }
-    } else {
-      kuint near_child = n->left_first, far_child = n->left_first + 1u;
-      float t_near = k_bvh_ray_box(r, nodes + near_child, tmin, *tmax);
-      float t_far = k_bvh_ray_box(r, nodes + far_child, tmin, *tmax);
-      if (t_far < t_near) {
-        float tt = t_near; t_near = t_far; t_far = tt;
-        kuint tn = near_child; near_child = far_child; far_child = tn;
-      }
-      if (t_near != K_INF) {
-        if (t_far != K_INF && sp < K_BVH_MAX_DEPTH) stack[sp++] = far_child;
-        node = near_child;
-        continue;
-      }
+    } else if (k_bvh_descend(r, nodes, n, tmin, *tmax, stack, &sp, &node)) {
+      continue;
     }
-    /* Pop, skipping nodes that a closer hit found since they were pushed has made irrelevant. */
-    for (;;) {
-      if (sp == 0) return 0;
-      node = stack[--sp];
-      if (k_bvh_ray_box(r, nodes + node, tmin, *tmax) != K_INF) break;
-    }
+    if (!k_bvh_pop(r, nodes, tmin, *tmax, stack, &sp, &node)) return 0;
   }
 }
 
@@ -211,25 +223,10 @@ KFN int k_bvh_traverse(KSceneRef scene, K_BVH_CONTEXT ctx, int query, KVec3 o, K
                                        xform_vector_g(inst->world_to_object, d));
         if (k_bvh_traverse_blas(scene, ctx, query, i, object_ray, tmin, &tmax, hit, transmittance)) return 1;
       }
-    } else {
-      kuint near_child = n->left_first, far_child = n->left_first + 1u;
-      float t_near = k_bvh_ray_box(world, scene.tlas_nodes + near_child, tmin, tmax);
-      float t_far = k_bvh_ray_box(world, scene.tlas_nodes + far_child, tmin, tmax);
-      if (t_far < t_near) {
-        float tt = t_near; t_near = t_far; t_far = tt;
-        kuint tn = near_child; near_child = far_child; far_child = tn;
-      }
-      if (t_near != K_INF) {
-        if (t_far != K_INF && sp < K_BVH_MAX_DEPTH) stack[sp++] = far_child;
-        node = near_child;
-        continue;
-      }
+    } else if (k_bvh_descend(world, scene.tlas_nodes, n, tmin, tmax, stack, &sp, &node)) {
+      continue;
     }
-    for (;;) {
-      if (sp == 0) return 0;
-      node = stack[--sp];
-      if (k_bvh_ray_box(world, scene.tlas_nodes + node, tmin, tmax) != K_INF) break;
-    }
+    if (!k_bvh_pop(world, scene.tlas_nodes, tmin, tmax, stack, &sp, &node)) return 0;
   }
 }
 
