@@ -6,6 +6,8 @@
 #include <stdexcept>
 #include <string>
 
+#include "cohort/core/host_threads.h"
+
 namespace cohort::core {
 
 namespace {
@@ -67,13 +69,16 @@ double AdaptiveConvergence::accumulate(const KCamera& camera, const FrameBuffer&
   }
   const float global = static_cast<float>(f);
   const float object_f = static_cast<float>(options_.moving_object_f);
-  for (size_t p = 0; p < pixels; ++p) {
-    float fp = global;
-    if (motion_mask) fp = std::max(fp, std::clamp((*motion_mask)[p], 0.0f, 1.0f) * object_f);
-    float* c = accumulated_.rgba.data() + p * 4;
-    const float* n = fresh.rgba.data() + p * 4;
-    for (int k = 0; k < 4; ++k) c[k] = converge(c[k], n[k], fp);
-  }
+  constexpr size_t kPixelsPerRange = 16384;  // smaller ranges cost more to hand out than they save
+  HostThreads::shared().for_ranges(pixels, kPixelsPerRange, [&](size_t begin, size_t end) {
+    for (size_t p = begin; p < end; ++p) {
+      float fp = global;
+      if (motion_mask) fp = std::max(fp, std::clamp((*motion_mask)[p], 0.0f, 1.0f) * object_f);
+      float* c = accumulated_.rgba.data() + p * 4;
+      const float* n = fresh.rgba.data() + p * 4;
+      for (int k = 0; k < 4; ++k) c[k] = converge(c[k], n[k], fp);
+    }
+  });
   return f;
 }
 

@@ -9,11 +9,15 @@
 
 #include <spdlog/spdlog.h>
 
+#include "cohort/core/host_threads.h"
+
 namespace cohort::core {
 
 using Clock = std::chrono::steady_clock;
 
 namespace {
+
+constexpr size_t kRowsPerCopy = 16;  // a band's rows are copied into the frame in ranges this size or larger
 
 // Signalled by workers when a job ends; the core waits on it.
 struct Completion {
@@ -276,9 +280,11 @@ Renderer::RoundResult Renderer::collect(const std::vector<Assignment>& assignmen
     } else {
       result.finished.push_back(w.id);
       const balance::Band& band = assignments[i].band;
-      const size_t offset = static_cast<size_t>(band.begin) * out.width * 4;
-      const size_t count = static_cast<size_t>(band.rows()) * out.width * 4;
-      std::memcpy(out.rgba.data() + offset, w.target.rgba.data() + offset, count * sizeof(float));
+      const size_t row_floats = static_cast<size_t>(out.width) * 4;
+      HostThreads::shared().for_ranges(static_cast<size_t>(band.rows()), kRowsPerCopy, [&](size_t begin, size_t end) {
+        const size_t offset = (static_cast<size_t>(band.begin) + begin) * row_floats;
+        std::memcpy(out.rgba.data() + offset, w.target.rgba.data() + offset, (end - begin) * row_floats * sizeof(float));
+      });
       if (w.row_work.size() == static_cast<size_t>(band.rows())) {
         std::copy(w.row_work.begin(), w.row_work.end(), row_work_.begin() + band.begin);
         std::fill(row_work_known_.begin() + band.begin, row_work_known_.begin() + band.end, 1);

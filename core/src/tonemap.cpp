@@ -5,9 +5,13 @@
 #include <stdexcept>
 #include <string>
 
+#include "cohort/core/host_threads.h"
+
 namespace cohort::core {
 
 namespace {
+
+constexpr size_t kPixelsPerRange = 16384;  // smaller ranges cost more to hand out than they save
 
 float hable(float x) {
   // Hable's published constants: shoulder, linear, toe strengths and angles.
@@ -83,20 +87,22 @@ std::vector<uint8_t> tone_map(const FrameBuffer& frame, const ToneMapOptions& op
   const float white = static_cast<float>(options.white_point);
   const std::vector<uint8_t>& encode = encode_table(options.srgb);
   std::vector<uint8_t> out(pixels * 4);
-  for (size_t p = 0; p < pixels; ++p) {
-    for (int k = 0; k < 3; ++k) {
-      const size_t i = p * 4 + static_cast<size_t>(k);
-      if (options.exact_encoding) {
-        const float v = std::isfinite(frame.rgba[i]) ? frame.rgba[i] : 0.0f;
-        const float encoded = encode_display(apply_tone_curve(options.curve, v * scale, white), options.srgb);
-        out[i] = static_cast<uint8_t>(encoded * 255.0f + 0.5f);
-      } else {
-        const float v = apply_tone_curve(options.curve, frame.rgba[i] * scale, white);
-        out[i] = encode[static_cast<size_t>(std::lround(v * kEncodeSteps))];
+  HostThreads::shared().for_ranges(pixels, kPixelsPerRange, [&](size_t begin, size_t end) {
+    for (size_t p = begin; p < end; ++p) {
+      for (int k = 0; k < 3; ++k) {
+        const size_t i = p * 4 + static_cast<size_t>(k);
+        if (options.exact_encoding) {
+          const float v = std::isfinite(frame.rgba[i]) ? frame.rgba[i] : 0.0f;
+          const float encoded = encode_display(apply_tone_curve(options.curve, v * scale, white), options.srgb);
+          out[i] = static_cast<uint8_t>(encoded * 255.0f + 0.5f);
+        } else {
+          const float v = apply_tone_curve(options.curve, frame.rgba[i] * scale, white);
+          out[i] = encode[static_cast<size_t>(std::lround(v * kEncodeSteps))];
+        }
       }
+      out[p * 4 + 3] = 255;
     }
-    out[p * 4 + 3] = 255;
-  }
+  });
   return out;
 }
 
