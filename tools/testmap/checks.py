@@ -1,6 +1,7 @@
 """Self-checks run on every generation; any failure aborts with a message naming the problem."""
 from collections import Counter
 
+from . import materials
 from .bsp import point_area
 from .mesh import cross, dot, sub
 from .numbers import fmt_vec
@@ -132,3 +133,19 @@ def check_shell_faces_air(area_meshes, nodes):
             back = tuple(centre[m] - 0.5 * normal[m] for m in range(3))
             if point_area(nodes, front) != index or point_area(nodes, back) == index:
                 raise CheckError("%s: triangle at %s does not face into its area" % (mesh.name, front))
+
+
+def check_level(area_meshes, models, portals, nodes, grid, entity_points, images):
+    """Every check a generated level passes before it is written; returns the edge counts for its stats.
+
+    entity_points: (name, point, expected area) per entity; images: the image paths being written.
+    """
+    stats = {}
+    check_winding(area_meshes + models)
+    stats["shell_edges"] = check_world_closed(area_meshes)
+    stats["portal_rim_edges"] = check_area_shells(area_meshes, portals)
+    check_closed_models(models)
+    check_nodes(nodes, grid, entity_points)
+    check_shell_faces_air(area_meshes, nodes)
+    check_materials(area_meshes + models, materials.material_names(), materials.referenced_images(), images)
+    return stats

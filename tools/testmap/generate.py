@@ -19,11 +19,6 @@ def build():
     ents = layout.entities()
     images = layout_images()
 
-    stats = {}
-    checks.check_winding(area_meshes + models)
-    stats["shell_edges"] = checks.check_world_closed(area_meshes)
-    stats["portal_rim_edges"] = checks.check_area_shells(area_meshes, portals)
-    checks.check_closed_models(models)
     entity_points = []
     for classname, keys in ents:
         values = dict(keys)
@@ -32,10 +27,7 @@ def build():
             raise checks.CheckError("entity %s has no expected area" % values["name"])
         o = values["origin"]
         entity_points.append((values["name"], (o[0], o[1], o[2] + 1), expected))
-    checks.check_nodes(nodes, grid, entity_points)
-    checks.check_shell_faces_air(area_meshes, nodes)
-    checks.check_materials(area_meshes + models, materials.material_names(), materials.referenced_images(),
-                           images.keys())
+    stats = checks.check_level(area_meshes, models, portals, nodes, grid, entity_points, images.keys())
 
     files = {}
     files["maps/testmap.proc"] = proc_text(area_meshes, models, ((400, 16, 0), (448, 64, 48)), portals,

@@ -602,24 +602,16 @@ def build_large(seed=1, cols=6, rows=5, check_targets=True):
     ents, expected, props = entities(layout, models)
     images = build_images()
 
-    stats = {}
     for mesh in area_meshes:
         for material, tags in mesh.tags.items():
             if len(tags) > 1:  # the checks tell shell from detail by material
                 raise checks.CheckError("%s: material %s is used by shell and detail" % (mesh.name, material))
-    checks.check_winding(area_meshes + models)
-    stats["shell_edges"] = checks.check_world_closed(area_meshes)
-    stats["portal_rim_edges"] = checks.check_area_shells(area_meshes, portals)
-    checks.check_closed_models(models)
     entity_points = []
     for classname, keys in ents:
         values = dict(keys)
         o = values["origin"]
         entity_points.append((values["name"], (o[0], o[1], o[2] + 1), expected[values["name"]]))
-    checks.check_nodes(nodes, grid, entity_points)
-    checks.check_shell_faces_air(area_meshes, nodes)
-    checks.check_materials(area_meshes + models, materials.material_names(), materials.referenced_images(),
-                           images.keys())
+    stats = checks.check_level(area_meshes, models, portals, nodes, grid, entity_points, images.keys())
     connected = {0}
     links = [(c["a"].index, c["b"].index) for c in layout.corridors]
     grew = True
