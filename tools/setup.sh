@@ -14,6 +14,7 @@ PACKAGES=(
   libgtest-dev libgmock-dev           # tests
   libcli11-dev nlohmann-json3-dev libzip-dev libspdlog-dev libfmt-dev   # CLI, JSON, .pk4, logging
   python3 xvfb xauth                  # viewer test under a virtual display
+  ccache                              # compile cache (used when present; speeds rebuilds and worktrees)
 )
 
 if [ -r /etc/os-release ]; then . /etc/os-release; else ID=unknown; VERSION_ID=; fi
