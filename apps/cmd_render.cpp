@@ -15,6 +15,7 @@
 #include "cohort/core/frame_timeline.h"
 #include "cohort/core/gpu_scene.h"
 #include "cohort/core/convergence.h"
+#include "cohort/core/oidn_denoiser.h"
 #include "cohort/core/frame_defaults.h"
 #include "cohort/core/view.h"
 #include "cohort/core/world_sync.h"
@@ -51,6 +52,8 @@ struct RenderArgs {
   bool no_convergence = false;
   std::string replay;
   std::string trace;
+  std::string denoise = "none";
+  std::string denoise_quality = "high";
   bool frames_given = false;
 };
 
@@ -118,6 +121,15 @@ int run_render(const RenderArgs& a) {
   ProgressBar progress(player ? 0 : a.frames, std::cerr, stderr_is_terminal());
   std::unique_ptr<core::ChromeTraceWriter> trace;
   if (!a.trace.empty()) trace = std::make_unique<core::ChromeTraceWriter>(a.trace);
+  // The denoiser filters what is shown and written, never the accumulated history.
+  std::unique_ptr<core::OidnDenoiser> denoiser;
+  core::FrameBuffer denoised;
+  if (a.denoise != "none") {
+    denoiser = core::OidnDenoiser::open(core::parse_oidn_device(a.denoise == "oidn-cuda" ? "cuda" : "cpu"),
+                                         core::parse_oidn_quality(a.denoise_quality));
+    spdlog::info("denoising with Open Image Denoise ({} device, {})", core::oidn_device_name(denoiser->device()),
+                 denoiser->library_path());
+  }
   int rendered = 0;
   for (int f = 0; f < frames; ++f) {
     const auto frame_start = core::TimelineClock::now();
@@ -152,9 +164,16 @@ int run_render(const RenderArgs& a) {
       core::ScopedStage blending(stats.stages, core::kCoreTrack, "convergence");
       stats.convergence_f = convergence.accumulate(job.camera, frame);
     }
-    const core::FrameBuffer& shown = a.no_convergence ? frame : convergence.image();
+    const core::FrameBuffer* shown_image = a.no_convergence ? &frame : &convergence.image();
+    const bool writes_frame = !(a.write == "last" && f + 1 < a.frames && !player);
+    if (denoiser && writes_frame) {
+      core::ScopedStage denoising(stats.stages, core::kCoreTrack, "denoise");
+      denoiser->denoise(*shown_image, denoised);
+      shown_image = &denoised;
+    }
+    const core::FrameBuffer& shown = *shown_image;
     ++rendered;
-    if (!(a.write == "last" && f + 1 < a.frames && !player)) {
+    if (writes_frame) {
       char stem[32];
       std::snprintf(stem, sizeof stem, "frame_%04d", f);
       std::filesystem::path base = std::filesystem::path(a.out) / stem;
@@ -177,7 +196,7 @@ int run_render(const RenderArgs& a) {
   nlohmann::json report = {{"map", a.map},       {"scene", scene.name},     {"tracers", a.tracers},
                            {"balancer", a.balancer}, {"width", a.width},     {"height", a.height},
                            {"spp", a.spp},       {"bounces", a.bounces},    {"mode", a.mode},
-                           {"camera_path", a.camera_path}, {"frames", stats_json}};
+                           {"camera_path", a.camera_path}, {"denoise", a.denoise}, {"frames", stats_json}};
   std::ofstream(std::filesystem::path(a.out) / "stats.json") << report.dump(2) << "\n";
   std::cout << "wrote " << rendered << " frame(s) and stats.json to " << a.out << "\n";
   return kExitOk;
@@ -228,6 +247,15 @@ void add_render_command(CLI::App& app, int& exit_code) {
           return std::string(e.what());
         }
       });
+  cmd->add_option("--denoise", a->denoise,
+                  "denoise the shown frame: none, oidn (Intel Open Image Denoise on the CPU) or oidn-cuda (on an "
+                  "NVIDIA GPU); tools/fetch_oidn.sh installs the library")
+      ->capture_default_str()
+      ->check(CLI::IsMember({"none", "oidn", "oidn-cuda"}));
+  cmd->add_option("--denoise-quality", a->denoise_quality,
+                  "Open Image Denoise's filter quality: high, balanced or fast (several times quicker)")
+      ->capture_default_str()
+      ->check(CLI::IsMember({"high", "balanced", "fast"}));
   cmd->add_flag("--no-convergence", a->no_convergence,
                  "write each frame as rendered instead of blending frames with adaptive convergence");
   cmd->add_option("--write", a->write, "images of every frame, or only the last (stats.json always has every frame)")

@@ -13,7 +13,7 @@ PACKAGES=(
   ocl-icd-opencl-dev opencl-headers pocl-opencl-icd clinfo   # OpenCL tracer, PoCL on the CPU
   libgtest-dev libgmock-dev           # tests
   libcli11-dev nlohmann-json3-dev libzip-dev libspdlog-dev libfmt-dev   # CLI, JSON, .pk4, logging
-  python3 xvfb xauth                  # viewer test under a virtual display
+  python3 python3-pip xvfb xauth    # viewer test under a virtual display; pip fetches OIDN
   ccache                              # compile cache (used when present; speeds rebuilds and worktrees)
 )
 
@@ -42,11 +42,14 @@ done
 
 if [ ${#missing[@]} -eq 0 ]; then
   echo "setup.sh: all ${#PACKAGES[@]} packages already installed."
-  exit 0
+else
+  echo "setup.sh: installing ${#missing[@]} package(s): ${missing[*]}"
+  export DEBIAN_FRONTEND=noninteractive
+  $SUDO apt-get update -qq
+  $SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}"
 fi
 
-echo "setup.sh: installing ${#missing[@]} package(s): ${missing[*]}"
-export DEBIAN_FRONTEND=noninteractive
-$SUDO apt-get update -qq
-$SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}"
+# Intel Open Image Denoise (the optional denoiser) is not packaged by Debian: its prebuilt libraries come
+# from PyPI, into third_party/oidn (not committed).
+"$(dirname "$0")/fetch_oidn.sh"
 echo "setup.sh: done."

@@ -1,0 +1,268 @@
+#include "cohort/core/oidn_denoiser.h"
+
+#include <dlfcn.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <mutex>
+#include <stdexcept>
+#include <vector>
+
+namespace cohort::core {
+namespace {
+
+// The part of OIDN's C API (oidn.h, version 2) that Cohort calls. Handles are opaque pointers; the enum
+// values are the library's ABI.
+using OIDNDevice = struct OIDNDeviceImpl*;
+using OIDNBuffer = struct OIDNBufferImpl*;
+using OIDNFilter = struct OIDNFilterImpl*;
+constexpr int kOidnDeviceTypeCpu = 1;
+constexpr int kOidnDeviceTypeCuda = 3;
+constexpr int kOidnFormatFloat3 = 3;
+constexpr int kOidnErrorNone = 0;
+constexpr int kOidnQualityFast = 4, kOidnQualityBalanced = 5, kOidnQualityHigh = 6;
+
+struct OidnApi {
+  std::string path;
+  OIDNDevice (*new_device)(int type);
+  void (*commit_device)(OIDNDevice);
+  void (*release_device)(OIDNDevice);
+  int (*get_device_error)(OIDNDevice, const char**);
+  OIDNBuffer (*new_buffer)(OIDNDevice, size_t);
+  void (*release_buffer)(OIDNBuffer);
+  void (*write_buffer)(OIDNBuffer, size_t, size_t, const void*);
+  void (*read_buffer)(OIDNBuffer, size_t, size_t, void*);
+  OIDNFilter (*new_filter)(OIDNDevice, const char*);
+  void (*release_filter)(OIDNFilter);
+  void (*set_filter_image)(OIDNFilter, const char*, OIDNBuffer, int, size_t, size_t, size_t, size_t, size_t);
+  void (*set_filter_bool)(OIDNFilter, const char*, bool);
+  void (*set_filter_int)(OIDNFilter, const char*, int);
+  void (*commit_filter)(OIDNFilter);
+  void (*execute_filter)(OIDNFilter);
+};
+
+std::vector<std::string> candidate_paths() {
+  std::vector<std::string> paths;
+  if (const char* file = std::getenv("COHORT_OIDN_LIBRARY"); file && *file) paths.emplace_back(file);
+  if (const char* dir = std::getenv("COHORT_OIDN_DIR"); dir && *dir)
+    paths.push_back((std::filesystem::path(dir) / "libOpenImageDenoise.so.2").string());
+#ifdef COHORT_OIDN_DEFAULT_DIR
+  paths.push_back((std::filesystem::path(COHORT_OIDN_DEFAULT_DIR) / "libOpenImageDenoise.so.2").string());
+#endif
+  paths.emplace_back("libOpenImageDenoise.so.2");  // the system's library path
+  return paths;
+}
+
+template <typename Fn>
+void bind(void* lib, const char* name, Fn& fn, std::string& missing) {
+  fn = reinterpret_cast<Fn>(dlsym(lib, name));
+  if (!fn) missing += std::string(missing.empty() ? "" : ", ") + name;
+}
+
+// Loads the library once per process and keeps it loaded (its thread pools outlive any one denoiser).
+const OidnApi* load_api(std::string* failure) {
+  static std::mutex mutex;
+  static std::unique_ptr<OidnApi> api;
+  static std::string reasons;
+  std::lock_guard<std::mutex> lock(mutex);
+  if (api) return api.get();
+  reasons.clear();
+  for (const std::string& path : candidate_paths()) {
+    void* lib = dlopen(path.c_str(), RTLD_NOW | RTLD_LOCAL);
+    if (!lib) {
+      const char* err = dlerror();
+      reasons += "\n  " + path + ": " + (err ? err : "not loadable");
+      continue;
+    }
+    auto loaded = std::make_unique<OidnApi>();
+    loaded->path = path;
+    std::string missing;
+    bind(lib, "oidnNewDevice", loaded->new_device, missing);
+    bind(lib, "oidnCommitDevice", loaded->commit_device, missing);
+    bind(lib, "oidnReleaseDevice", loaded->release_device, missing);
+    bind(lib, "oidnGetDeviceError", loaded->get_device_error, missing);
+    bind(lib, "oidnNewBuffer", loaded->new_buffer, missing);
+    bind(lib, "oidnReleaseBuffer", loaded->release_buffer, missing);
+    bind(lib, "oidnWriteBuffer", loaded->write_buffer, missing);
+    bind(lib, "oidnReadBuffer", loaded->read_buffer, missing);
+    bind(lib, "oidnNewFilter", loaded->new_filter, missing);
+    bind(lib, "oidnReleaseFilter", loaded->release_filter, missing);
+    bind(lib, "oidnSetFilterImage", loaded->set_filter_image, missing);
+    bind(lib, "oidnSetFilterBool", loaded->set_filter_bool, missing);
+    bind(lib, "oidnSetFilterInt", loaded->set_filter_int, missing);
+    bind(lib, "oidnCommitFilter", loaded->commit_filter, missing);
+    bind(lib, "oidnExecuteFilter", loaded->execute_filter, missing);
+    if (!missing.empty()) {
+      reasons += "\n  " + path + ": not Open Image Denoise 2 (missing " + missing + ")";
+      dlclose(lib);
+      continue;
+    }
+    api = std::move(loaded);
+    return api.get();
+  }
+  if (failure) *failure = "Open Image Denoise not found (run tools/fetch_oidn.sh, or set COHORT_OIDN_DIR); tried:" + reasons;
+  return nullptr;
+}
+
+size_t pixel_count(const FrameBuffer& f) { return static_cast<size_t>(f.width) * static_cast<size_t>(f.height); }
+
+// RGBA rows -> packed RGB, the layout the buffers are declared with.
+void pack_rgb(const FrameBuffer& in, std::vector<float>& rgb) {
+  const size_t n = pixel_count(in);
+  rgb.resize(n * 3);
+  for (size_t i = 0; i < n; ++i) {
+    rgb[i * 3 + 0] = in.rgba[i * 4 + 0];
+    rgb[i * 3 + 1] = in.rgba[i * 4 + 1];
+    rgb[i * 3 + 2] = in.rgba[i * 4 + 2];
+  }
+}
+
+}  // namespace
+
+OidnQuality parse_oidn_quality(const std::string& name) {
+  if (name == "high") return OidnQuality::kHigh;
+  if (name == "balanced") return OidnQuality::kBalanced;
+  if (name == "fast") return OidnQuality::kFast;
+  throw std::invalid_argument("unknown denoiser quality '" + name + "' (expected high, balanced or fast)");
+}
+
+OidnDevice parse_oidn_device(const std::string& name) {
+  if (name == "cpu") return OidnDevice::kCpu;
+  if (name == "cuda") return OidnDevice::kCuda;
+  throw std::invalid_argument("unknown denoiser device '" + name + "' (expected cpu or cuda)");
+}
+
+const char* oidn_device_name(OidnDevice device) { return device == OidnDevice::kCuda ? "cuda" : "cpu"; }
+
+struct OidnDenoiser::Impl {
+  const OidnApi* api = nullptr;
+  OIDNDevice device = nullptr;
+  int quality = kOidnQualityHigh;
+  OIDNFilter filter = nullptr;
+  OIDNBuffer color = nullptr, albedo = nullptr, normal = nullptr, output = nullptr;
+  int width = 0, height = 0;
+  bool with_albedo = false, with_normal = false;
+  std::vector<float> staging;
+
+  void check(const char* what) const {
+    const char* message = nullptr;
+    if (api->get_device_error(device, &message) != kOidnErrorNone)
+      throw std::runtime_error(std::string("Open Image Denoise: ") + what + ": " + (message ? message : "unknown error"));
+  }
+
+  void release_buffers() {
+    for (OIDNBuffer* b : {&color, &albedo, &normal, &output}) {
+      if (*b) api->release_buffer(*b);
+      *b = nullptr;
+    }
+  }
+
+  // (Re)creates buffers and the filter when the size or the set of guide images changes: filter setup is
+  // expensive, so it is done once per configuration, not per frame.
+  void configure(int w, int h, bool use_albedo, bool use_normal) {
+    if (filter && w == width && h == height && use_albedo == with_albedo && use_normal == with_normal) return;
+    if (filter) api->release_filter(filter);
+    filter = nullptr;
+    release_buffers();
+    const size_t bytes = static_cast<size_t>(w) * h * 3 * sizeof(float);
+    color = api->new_buffer(device, bytes);
+    output = api->new_buffer(device, bytes);
+    if (use_albedo) albedo = api->new_buffer(device, bytes);
+    if (use_normal) normal = api->new_buffer(device, bytes);
+    check("allocating image buffers");
+    filter = api->new_filter(device, "RT");
+    api->set_filter_image(filter, "color", color, kOidnFormatFloat3, w, h, 0, 0, 0);
+    if (use_albedo) api->set_filter_image(filter, "albedo", albedo, kOidnFormatFloat3, w, h, 0, 0, 0);
+    if (use_normal) api->set_filter_image(filter, "normal", normal, kOidnFormatFloat3, w, h, 0, 0, 0);
+    api->set_filter_image(filter, "output", output, kOidnFormatFloat3, w, h, 0, 0, 0);
+    api->set_filter_bool(filter, "hdr", true);
+    api->set_filter_int(filter, "quality", quality);
+    api->commit_filter(filter);
+    check("creating the RT filter");
+    width = w;
+    height = h;
+    with_albedo = use_albedo;
+    with_normal = use_normal;
+  }
+
+  void upload(OIDNBuffer buffer, const FrameBuffer& image) {
+    pack_rgb(image, staging);
+    api->write_buffer(buffer, 0, staging.size() * sizeof(float), staging.data());
+  }
+
+  ~Impl() {
+    if (!api) return;
+    if (filter) api->release_filter(filter);
+    release_buffers();
+    if (device) api->release_device(device);
+  }
+};
+
+bool OidnDenoiser::library_available(std::string* where) {
+  std::string failure;
+  const OidnApi* api = load_api(&failure);
+  if (where) *where = api ? api->path : failure;
+  return api != nullptr;
+}
+
+std::unique_ptr<OidnDenoiser> OidnDenoiser::open(OidnDevice device, OidnQuality quality) {
+  std::string failure;
+  const OidnApi* api = load_api(&failure);
+  if (!api) throw std::runtime_error(failure);
+  auto impl = std::make_unique<Impl>();
+  impl->api = api;
+  impl->quality = quality == OidnQuality::kFast       ? kOidnQualityFast
+                  : quality == OidnQuality::kBalanced ? kOidnQualityBalanced
+                                                      : kOidnQualityHigh;
+  impl->device = api->new_device(device == OidnDevice::kCuda ? kOidnDeviceTypeCuda : kOidnDeviceTypeCpu);
+  if (!impl->device) {
+    const char* message = nullptr;
+    api->get_device_error(nullptr, &message);
+    throw std::runtime_error(std::string("Open Image Denoise (") + api->path + "): no " + oidn_device_name(device) +
+                             " device: " + (message ? message : "unsupported"));
+  }
+  api->commit_device(impl->device);
+  impl->check("committing the device");
+  return std::unique_ptr<OidnDenoiser>(new OidnDenoiser(std::move(impl), device));
+}
+
+OidnDenoiser::OidnDenoiser(std::unique_ptr<Impl> impl, OidnDevice device) : impl_(std::move(impl)), device_(device) {}
+OidnDenoiser::~OidnDenoiser() = default;
+
+const std::string& OidnDenoiser::library_path() const { return impl_->api->path; }
+
+void OidnDenoiser::denoise(const FrameBuffer& color, FrameBuffer& out, const DenoiseGuides& guides) {
+  if (color.width <= 0 || color.height <= 0) throw std::invalid_argument("denoise: empty image");
+  auto same_size = [&](const FrameBuffer* g) {
+    return g && g->width == color.width && g->height == color.height;
+  };
+  if ((guides.albedo && !same_size(guides.albedo)) || (guides.normal && !same_size(guides.normal)))
+    throw std::invalid_argument("denoise: guide images must match the colour image's size");
+  // OIDN accepts a normal guide only together with an albedo guide.
+  const bool use_albedo = guides.albedo != nullptr;
+  const bool use_normal = use_albedo && guides.normal != nullptr;
+  Impl& m = *impl_;
+  m.configure(color.width, color.height, use_albedo, use_normal);
+  m.upload(m.color, color);
+  if (use_albedo) m.upload(m.albedo, *guides.albedo);
+  if (use_normal) m.upload(m.normal, *guides.normal);
+  m.api->execute_filter(m.filter);
+  m.check("denoising");
+  m.api->read_buffer(m.output, 0, m.staging.size() * sizeof(float), m.staging.data());
+  m.check("reading the result");
+
+  if (&out != &color) {
+    out.width = color.width;
+    out.height = color.height;
+    out.rgba.resize(color.rgba.size());
+  }
+  const size_t n = pixel_count(color);
+  for (size_t i = 0; i < n; ++i) {
+    out.rgba[i * 4 + 0] = m.staging[i * 3 + 0];
+    out.rgba[i * 4 + 1] = m.staging[i * 3 + 1];
+    out.rgba[i * 4 + 2] = m.staging[i * 3 + 2];
+    out.rgba[i * 4 + 3] = color.rgba[i * 4 + 3];
+  }
+}
+
+}  // namespace cohort::core
