@@ -190,7 +190,9 @@ int run_play(PlayArgs a) {
     settings.width = std::max(16, static_cast<int>(std::lround(fb_w * scale)));
     settings.height = std::max(16, static_cast<int>(std::lround(fb_h * scale)));
     try {
-      last = session->frame(camera, dt, settings);
+      SessionFrame next = session->frame(camera, dt, settings);
+      if (!next.ready) continue;  // the pipeline's first frame: it comes back with the next call
+      last = std::move(next);
       have_frame = true;
       if (trace) trace->add(last.stats.frame, last.stats.stages);
     } catch (const std::exception& e) {

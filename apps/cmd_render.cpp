@@ -17,6 +17,7 @@
 #include "cohort/core/convergence.h"
 #include "cohort/core/oidn_denoiser.h"
 #include "cohort/core/frame_defaults.h"
+#include "cohort/core/frame_pipeline.h"
 #include "cohort/core/view.h"
 #include "cohort/core/world_sync.h"
 #include "cohort/scene/map_loader.h"
@@ -114,7 +115,6 @@ int run_render(const RenderArgs& a) {
   std::filesystem::create_directories(a.out);
   const bool oiio = core::have_image_library();
   nlohmann::json stats_json = nlohmann::json::array();
-  core::FrameBuffer frame;
   core::AdaptiveConvergence convergence;
   const std::optional<CameraPath> path =
       a.camera_path.empty() ? std::nullopt : std::optional<CameraPath>(parse_camera_path(a.camera_path));
@@ -131,9 +131,58 @@ int run_render(const RenderArgs& a) {
                  denoiser->library_path());
   }
   int rendered = 0;
+  // The overlapped pipeline (core/frame_pipeline.h): frame f+1 is synced and handed out while frame f
+  // renders; f is then blended, tone-mapped and written while f+1 renders.
+  core::FramePipeline pipeline(renderer);
+  std::map<uint64_t, core::TimelineClock::time_point> started;  // frames in the pipeline: when their world sync began
+  core::TimelineClock::time_point previous_delivery{};
+  auto finish = [&](core::FramePipeline::Delivered done) {
+    core::FrameStats& stats = done.stats;
+    const core::FrameBuffer& frame = pipeline.image();
+    const int f = static_cast<int>(stats.frame);
+    // Adaptive convergence: a still camera accumulates every frame; motion raises f (see convergence.h).
+    if (!a.no_convergence) {
+      core::ScopedStage blending(stats.stages, core::kCoreTrack, "convergence");
+      stats.convergence_f = convergence.accumulate(done.job.camera, frame);
+    }
+    const core::FrameBuffer* shown_image = a.no_convergence ? &frame : &convergence.image();
+    const bool writes_frame = !(a.write == "last" && f + 1 < a.frames && !player);
+    if (denoiser && writes_frame) {
+      core::ScopedStage denoising(stats.stages, core::kCoreTrack, "denoise");
+      denoiser->denoise(*shown_image, denoised);
+      shown_image = &denoised;
+    }
+    const core::FrameBuffer& shown = *shown_image;
+    ++rendered;
+    if (writes_frame) {
+      char stem[32];
+      std::snprintf(stem, sizeof stem, "frame_%04d", f);
+      std::filesystem::path base = std::filesystem::path(a.out) / stem;
+      core::ScopedStage tone_mapping(stats.stages, core::kCoreTrack, "tone map");
+      const std::vector<uint8_t> display = core::tone_map(shown, written_frame_tone_map(a.exposure));
+      tone_mapping.finish();
+      core::ScopedStage writing(stats.stages, core::kCoreTrack, "output");
+      core::write_ldr_image(base.string() + (oiio ? ".png" : ".ppm"), shown.width, shown.height, display);
+      core::write_hdr_image(base.string() + (oiio ? ".exr" : ".pfm"), shown);
+    }
+    const auto now = core::TimelineClock::now();
+    const auto frame_start = started.at(stats.frame);
+    started.erase(stats.frame);
+    stats.end_to_end_ms = std::chrono::duration<double, std::milli>(now - frame_start).count();
+    stats.interval_ms = previous_delivery == core::TimelineClock::time_point{}
+                            ? stats.end_to_end_ms
+                            : std::chrono::duration<double, std::milli>(now - previous_delivery).count();
+    previous_delivery = now;
+    stats.stages.push_back({core::kCoreTrack, "frame", core::timeline_ms(frame_start), stats.end_to_end_ms});
+    if (trace) trace->add(stats.frame, stats.stages);
+    progress.frame_done(stats.interval_ms);
+    spdlog::debug("frame {}: {:.1f} ms ({} tracers, idle {:.1f}%)", f, stats.frame_ms, stats.tracers.size(),
+                  stats.idle_percent);
+    stats_json.push_back(nlohmann::json(stats));
+  };
   for (int f = 0; f < frames; ++f) {
     const auto frame_start = core::TimelineClock::now();
-    std::vector<core::StageSpan> stages;  // the core's stages around the Renderer's own
+    std::vector<core::StageSpan> stages;  // the core's stages before the Renderer's own
     core::BandJob job;
     if (player) {
       if (!player->play_frame(*world)) break;
@@ -157,41 +206,10 @@ int run_render(const RenderArgs& a) {
     p.spec_boost = a.spec_boost;
     p.mode = modes().at(a.mode);
     p.soft_shadow_scale = a.soft_shadow_scale;
-    core::FrameStats stats = renderer.render(job, frame);
-    stats.stages.insert(stats.stages.begin(), stages.begin(), stages.end());
-    // Adaptive convergence: a still camera accumulates every frame; motion raises f (see convergence.h).
-    if (!a.no_convergence) {
-      core::ScopedStage blending(stats.stages, core::kCoreTrack, "convergence");
-      stats.convergence_f = convergence.accumulate(job.camera, frame);
-    }
-    const core::FrameBuffer* shown_image = a.no_convergence ? &frame : &convergence.image();
-    const bool writes_frame = !(a.write == "last" && f + 1 < a.frames && !player);
-    if (denoiser && writes_frame) {
-      core::ScopedStage denoising(stats.stages, core::kCoreTrack, "denoise");
-      denoiser->denoise(*shown_image, denoised);
-      shown_image = &denoised;
-    }
-    const core::FrameBuffer& shown = *shown_image;
-    ++rendered;
-    if (writes_frame) {
-      char stem[32];
-      std::snprintf(stem, sizeof stem, "frame_%04d", f);
-      std::filesystem::path base = std::filesystem::path(a.out) / stem;
-      core::ScopedStage tone_mapping(stats.stages, core::kCoreTrack, "tone map");
-      const std::vector<uint8_t> display = core::tone_map(shown, written_frame_tone_map(a.exposure));
-      tone_mapping.finish();
-      core::ScopedStage writing(stats.stages, core::kCoreTrack, "output");
-      core::write_ldr_image(base.string() + (oiio ? ".png" : ".ppm"), shown.width, shown.height, display);
-      core::write_hdr_image(base.string() + (oiio ? ".exr" : ".pfm"), shown);
-    }
-    stats.end_to_end_ms = std::chrono::duration<double, std::milli>(core::TimelineClock::now() - frame_start).count();
-    stats.stages.push_back({core::kCoreTrack, "frame", core::timeline_ms(frame_start), stats.end_to_end_ms});
-    if (trace) trace->add(stats.frame, stats.stages);
-    progress.frame_done(stats.end_to_end_ms);
-    stats_json.push_back(nlohmann::json(stats));
-    spdlog::debug("frame {}: {:.1f} ms ({} tracers, idle {:.1f}%)", f, stats.frame_ms, stats.tracers.size(),
-                  stats.idle_percent);
+    started[uint64_t(f)] = frame_start;
+    if (std::optional<core::FramePipeline::Delivered> done = pipeline.push(job, std::move(stages))) finish(std::move(*done));
   }
+  if (std::optional<core::FramePipeline::Delivered> done = pipeline.drain()) finish(std::move(*done));
   progress.finish();
   nlohmann::json report = {{"map", a.map},       {"scene", scene.name},     {"tracers", a.tracers},
                            {"balancer", a.balancer}, {"width", a.width},     {"height", a.height},

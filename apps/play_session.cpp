@@ -8,6 +8,7 @@
 #include "cohort/commit/commit_buffer.h"
 #include "cohort/core/convergence.h"
 #include "cohort/core/frame_defaults.h"
+#include "cohort/core/frame_pipeline.h"
 #include "cohort/core/frame_timeline.h"
 #include "cohort/core/gpu_scene.h"
 #include "cohort/core/renderer.h"
@@ -61,8 +62,13 @@ struct PlaySession::State {
   std::unique_ptr<core::WorldSync> sync;
   std::unique_ptr<scene::Scenario> scenario;
   std::unique_ptr<core::Renderer> renderer;
+  std::unique_ptr<core::FramePipeline> pipeline;  // after the renderer: it finishes the frame in flight first
+  // What the frame in flight was prepared with, for when it comes back.
+  struct Prepared {
+    size_t commit_bytes = 0;
+    bool animating = false;
+  } in_flight;
   core::AdaptiveConvergence convergence;
-  core::FrameBuffer hdr;
   std::vector<float> moving_mask;
   double scenario_seconds = 0.0;
   uint64_t frame_index = 0;
@@ -96,6 +102,7 @@ PlaySession::PlaySession(const SessionOptions& options) {
   renderer_options.balancer = options.balancer;
   s.renderer = std::make_unique<core::Renderer>(std::move(tracers), renderer_options);
   s.renderer->submit_commit(commit::CommitBuffer::full(initial_scene, 0));
+  s.pipeline = std::make_unique<core::FramePipeline>(*s.renderer);
 
   if (options.scenario) {
     try {
@@ -154,22 +161,30 @@ SessionFrame PlaySession::frame(const viewer::FlyCamera& camera, double seconds,
   p.max_bounces = static_cast<kuint>(settings.max_bounces);
   p.mode = settings.mode;
 
+  // The pipeline hands this frame out and gives back the one before it, which is blended and tone-mapped
+  // while this one renders.
+  const State::Prepared prepared = s.in_flight;
+  std::optional<core::FramePipeline::Delivered> done = s.pipeline->push(job, std::move(stages));
+  s.in_flight = {commit.bytes(), animating};
   SessionFrame out;
-  out.stats = s.renderer->render(job, s.hdr);
-  out.stats.stages.insert(out.stats.stages.begin(), stages.begin(), stages.end());
-  out.commit_bytes = commit.bytes();
+  if (!done) return out;
+  out.ready = true;
+  out.stats = std::move(done->stats);
+  out.commit_bytes = prepared.commit_bytes;
+  const core::FrameBuffer& hdr = s.pipeline->image();
+  const kuint mode = done->job.params.mode;
 
-  if (settings.mode != s.last_mode) s.convergence.reset();  // another view of the scene entirely
-  s.last_mode = settings.mode;
+  if (mode != s.last_mode) s.convergence.reset();  // another view of the scene entirely
+  s.last_mode = mode;
   // Without per-pixel object ids every pixel counts as possibly moving while the door, fan and
   // flicker animate; pause the scenario (P) to let the image converge.
   const std::vector<float>* mask = nullptr;
-  if (animating) {
-    s.moving_mask.assign(static_cast<size_t>(settings.width) * settings.height, 1.0f);
+  if (prepared.animating) {
+    s.moving_mask.assign(static_cast<size_t>(hdr.width) * hdr.height, 1.0f);
     mask = &s.moving_mask;
   }
   core::ScopedStage blending(out.stats.stages, core::kCoreTrack, "convergence");
-  out.stats.convergence_f = s.convergence.accumulate(job.camera, s.hdr, mask);
+  out.stats.convergence_f = s.convergence.accumulate(done->job.camera, hdr, mask);
   blending.finish();
 
   core::ToneMapOptions tm;

@@ -33,6 +33,7 @@ struct FrameSettings {
 };
 
 struct SessionFrame {
+  bool ready = false;               // false for the first call: its frame comes back with the next one
   core::FrameStats stats;
   size_t commit_bytes = 0;
   std::vector<uint8_t> display;     // tone-mapped RGBA8 of the converged image
@@ -47,7 +48,9 @@ class PlaySession {
   ~PlaySession();
 
   // Advance the scenario by `seconds` (unless paused), put the flashlight on the camera, sync the
-  // world to the tracers and render one frame.
+  // world to the tracers and hand the frame to them; returns the frame handed out by the previous
+  // call, blended and tone-mapped while this one renders (one frame of latency; the first call
+  // returns no image).
   SessionFrame frame(const viewer::FlyCamera& camera, double seconds, const FrameSettings& settings);
 
   // Where the map's player starts, at eye height, looking along its yaw.

@@ -1,6 +1,7 @@
 #!/usr/bin/env python3
-"""Summarises a `cohort render` stats.json: median and 95th percentile of the end-to-end frame time,
-the Renderer's wall time, and per stage (the frame timeline), over the frames after a warm-up.
+"""Summarises a `cohort render` stats.json: median and 95th percentile of the frame interval (time
+between delivered frames: the pipeline overlaps frames, so this is the time per frame), the end-to-end
+latency, the Renderer's wall time, and per stage (the frame timeline), over the frames after a warm-up.
 
     tools/frame_times.py out/run/stats.json [--skip 20] [--json summary.json]
 """
@@ -24,7 +25,7 @@ def summarise(stats, skip):
         raise SystemExit(f"frame_times: only {len(stats['frames'])} frames, none left after skipping {skip}")
     out = {"tracers": stats.get("tracers"), "width": stats.get("width"), "height": stats.get("height"),
            "frames": len(frames)}
-    for key in ("end_to_end_ms", "wall_ms", "frame_ms", "idle_percent"):
+    for key in ("interval_ms", "end_to_end_ms", "wall_ms", "frame_ms", "idle_percent"):
         values = [f[key] for f in frames if key in f]
         out[key] = {"median": statistics.median(values), "p95": percentile(values, 95),
                     "mean": statistics.fmean(values)} if values else None
@@ -49,8 +50,10 @@ def main():
     with open(args.stats) as f:
         summary = summarise(json.load(f), args.skip)
     e2e, wall = summary["end_to_end_ms"], summary["wall_ms"]
+    interval = summary["interval_ms"] or e2e  # stats.json from before the pipeline has no interval
     print(f"{summary['tracers']}: {summary['frames']} frames at {summary['width']}x{summary['height']}: "
-          f"end-to-end median {e2e['median']:.2f} ms (p95 {e2e['p95']:.2f}), renderer wall {wall['median']:.2f} ms, "
+          f"per frame median {interval['median']:.2f} ms (p95 {interval['p95']:.2f}), "
+          f"latency median {e2e['median']:.2f} ms, renderer wall {wall['median']:.2f} ms, "
           f"idle {summary['idle_percent']['mean']:.1f}% mean")
     for name, ms in summary["stages_median_ms"].items():
         print(f"  {name:60s} {ms:8.3f} ms")

@@ -34,6 +34,7 @@ void to_json(nlohmann::json& j, const FrameStats& s) {
                      {"recovery_ms", s.recovery_ms},
                      {"wall_ms", s.wall_ms},
                      {"end_to_end_ms", s.end_to_end_ms},
+                     {"interval_ms", s.interval_ms},
                      {"dropped", s.dropped},
                      {"convergence_f", s.convergence_f},
                      {"tracers", s.tracers},

@@ -41,6 +41,7 @@ struct Renderer::Worker {
   uint64_t job_id = 0;
   BandJob job;
   bool job_is_recovery = false;    // re-rendering rows a dropped tracer did not deliver
+  int job_slot = 0;                // which of the two targets the job renders into
   // Taken from the channel by the core when it hands out a job; the buffer stays valid (and untouched
   // by the core) until the next hand-over, which happens only once this job has ended.
   const commit::CommitBuffer* job_commit = nullptr;
@@ -61,9 +62,10 @@ struct Renderer::Worker {
   std::vector<float> row_work;
   std::vector<StageSpan> spans;  // the last job's apply and render stages
 
-  // The tracer's private target: only the worker writes it while busy; the core reads its rows after
-  // the job's result is posted and before the next job is handed out.
-  FrameBuffer target;
+  // The tracer's private targets, one per frame parity, so that the core merges frame N from one
+  // while the tracer renders N+1 into the other. Only the worker writes a target while its job runs;
+  // the core reads a finished job's rows until it hands out a job for the same slot again.
+  FrameBuffer targets[2];
   std::thread thread;
 
   void loop() {
@@ -71,6 +73,7 @@ struct Renderer::Worker {
       BandJob current;
       uint64_t current_id = 0;
       bool recovery = false;
+      int slot = 0;
       const commit::CommitBuffer* to_apply = nullptr;
       {
         std::unique_lock lock(inbox_mutex);
@@ -79,6 +82,7 @@ struct Renderer::Worker {
         current = job;
         current_id = job_id;
         recovery = job_is_recovery;
+        slot = job_slot;
         has_job = false;
         to_apply = job_commit;
         job_commit = nullptr;
@@ -96,7 +100,7 @@ struct Renderer::Worker {
         if (scene_diverged)
           throw std::runtime_error("its scene diverged after a failed commit; waiting for a full resync");
         ScopedStage rendering(job_spans, track, recovery ? "re-render" : "render");
-        const BandResult result = tracer->render_band(current, target);
+        const BandResult result = tracer->render_band(current, targets[slot]);
         wall = std::chrono::duration<double, std::milli>(Clock::now() - start).count();
         rendering.finish();
         reported = result.device_ms;
@@ -142,26 +146,52 @@ Renderer::Renderer(std::vector<std::unique_ptr<Tracer>> tracers, RendererOptions
   auto completion = std::make_shared<Completion>();
   for (size_t i = 0; i < tracers.size(); ++i) {
     if (!tracers[i]) throw std::invalid_argument("Renderer: tracer " + std::to_string(i) + " is null");
-    auto w = std::make_unique<Worker>();
+    auto w = std::make_shared<Worker>();
     w->id = static_cast<int>(i);
     w->tracer = std::move(tracers[i]);
     w->name = w->tracer->name();
     w->completion = completion;
     workers_.push_back(std::move(w));
   }
-  for (auto& w : workers_) w->thread = std::thread([worker = w.get()] { worker->loop(); });
+  // Each thread shares its worker, so a worker whose tracer never returns can be left behind at
+  // shutdown with its tracer, targets and channel alive; the last owner frees them.
+  for (auto& w : workers_) w->thread = std::thread([worker = w] { worker->loop(); });
 }
 
 Renderer::~Renderer() {
   for (auto& w : workers_) {
+    bool dropped_job = false;
     {
       std::lock_guard lock(w->inbox_mutex);
       w->quit = true;
+      dropped_job = w->has_job;  // handed out but not started: it never will be
+      w->has_job = false;
+      w->job_commit = nullptr;
+    }
+    if (dropped_job) {
+      std::lock_guard lock(w->completion->mutex);
+      w->busy = false;
     }
     w->inbox_cv.notify_all();
   }
+  // A tracer still inside apply() or render_band() gets until the shutdown deadline; one that has not
+  // returned by then (a hung device, a driver that never comes back) must not hang the process too.
+  const auto deadline = Clock::now() + options_.shutdown_timeout;
+  Completion& completion = *workers_.front()->completion;
   for (auto& w : workers_) {
-    if (w->thread.joinable()) w->thread.join();
+    bool returned = false;
+    {
+      std::unique_lock lock(completion.mutex);
+      returned = completion.cv.wait_until(lock, deadline, [&] { return !w->busy; });
+    }
+    if (returned) {
+      w->thread.join();
+    } else {
+      spdlog::error("Renderer shutdown: tracer {} ({}) has not returned from its job after {} ms; leaving its "
+                    "thread behind (its tracer is freed if it ever returns)",
+                    w->id, w->name, options_.shutdown_timeout.count());
+      w->thread.detach();
+    }
   }
 }
 
@@ -220,12 +250,14 @@ double Renderer::measured_ms(const Worker& w) const {
   return options_.use_reported_time && w.reported_ms > 0.0 ? w.reported_ms : w.wall_ms;
 }
 
-std::vector<uint64_t> Renderer::assign(const std::vector<Assignment>& assignments, const BandJob& job, FrameBuffer& out,
+std::vector<uint64_t> Renderer::assign(const std::vector<Assignment>& assignments, const BandJob& job, int slot,
                                        bool with_commits) {
+  const int width = static_cast<int>(job.camera.width), height = static_cast<int>(job.camera.height);
   std::vector<uint64_t> ids(assignments.size());
   for (size_t i = 0; i < assignments.size(); ++i) {
     Worker& w = *workers_[static_cast<size_t>(assignments[i].worker)];
-    if (w.target.width != out.width || w.target.height != out.height) w.target.resize(out.width, out.height);
+    FrameBuffer& target = w.targets[slot];
+    if (target.width != width || target.height != height) target.resize(width, height);
     ids[i] = next_job_++;
     {
       std::lock_guard lock(w.completion->mutex);
@@ -237,6 +269,7 @@ std::vector<uint64_t> Renderer::assign(const std::vector<Assignment>& assignment
     w.job.params.row_end = static_cast<kuint>(assignments[i].band.end);
     w.job_id = ids[i];
     w.job_is_recovery = !with_commits;
+    w.job_slot = slot;
     w.has_job = true;
     // What was published so far belongs to this frame; commits submitted from now on wait for the
     // next. Re-rendering a dropped tracer's rows happens within the same frame, so it takes none.
@@ -254,7 +287,7 @@ std::vector<uint64_t> Renderer::assign(const std::vector<Assignment>& assignment
 }
 
 Renderer::RoundResult Renderer::collect(const std::vector<Assignment>& assignments, const std::vector<uint64_t>& ids,
-                                        FrameBuffer& out, Clock::time_point deadline, std::vector<StageSpan>& stages) {
+                                        Clock::time_point deadline, std::vector<StageSpan>& stages) {
   RoundResult result;
   if (assignments.empty()) return result;
   Completion& completion = *workers_.front()->completion;
@@ -266,7 +299,6 @@ Renderer::RoundResult Renderer::collect(const std::vector<Assignment>& assignmen
     return true;
   };
   completion.cv.wait_until(lock, deadline, all_done);
-  ScopedStage merging(stages, kCoreTrack, "merge");
   for (size_t i = 0; i < assignments.size(); ++i) {
     Worker& w = *workers_[static_cast<size_t>(assignments[i].worker)];
     if (w.done_job_id == ids[i]) {
@@ -279,12 +311,8 @@ Renderer::RoundResult Renderer::collect(const std::vector<Assignment>& assignmen
       result.threw.push_back(w.id);
     } else {
       result.finished.push_back(w.id);
+      result.delivered.push_back(assignments[i]);
       const balance::Band& band = assignments[i].band;
-      const size_t row_floats = static_cast<size_t>(out.width) * 4;
-      HostThreads::shared().for_ranges(static_cast<size_t>(band.rows()), kRowsPerCopy, [&](size_t begin, size_t end) {
-        const size_t offset = (static_cast<size_t>(band.begin) + begin) * row_floats;
-        std::memcpy(out.rgba.data() + offset, w.target.rgba.data() + offset, (end - begin) * row_floats * sizeof(float));
-      });
       if (w.row_work.size() == static_cast<size_t>(band.rows())) {
         std::copy(w.row_work.begin(), w.row_work.end(), row_work_.begin() + band.begin);
         std::fill(row_work_known_.begin() + band.begin, row_work_known_.begin() + band.end, 1);
@@ -294,17 +322,29 @@ Renderer::RoundResult Renderer::collect(const std::vector<Assignment>& assignmen
   return result;
 }
 
+void Renderer::merge(const std::vector<Assignment>& bands, int slot, FrameBuffer& out) const {
+  const size_t row_floats = static_cast<size_t>(out.width) * 4;
+  for (const Assignment& a : bands) {
+    const FrameBuffer& target = workers_[static_cast<size_t>(a.worker)]->targets[slot];
+    HostThreads::shared().for_ranges(static_cast<size_t>(a.band.rows()), kRowsPerCopy, [&](size_t begin, size_t end) {
+      const size_t offset = (static_cast<size_t>(a.band.begin) + begin) * row_floats;
+      std::memcpy(out.rgba.data() + offset, target.rgba.data() + offset, (end - begin) * row_floats * sizeof(float));
+    });
+  }
+}
+
 FrameStats Renderer::render(const BandJob& job, FrameBuffer& out, const std::vector<float>& row_cost_proxy) {
   begin_frame(job, out, row_cost_proxy);
   return finish_frame();
 }
 
 void Renderer::begin_frame(const BandJob& job, FrameBuffer& out, const std::vector<float>& row_cost_proxy) {
-  if (pending_) throw std::logic_error("Renderer::begin_frame: the previous frame was not finished");
+  if (pending_) throw std::logic_error("Renderer::begin_frame: the previous frame was not waited for");
+  if (unmerged_ && unmerged_->slot == next_slot_)
+    throw std::logic_error("Renderer::begin_frame: the frame before the previous one was not merged");
   const auto frame_start = Clock::now();
   const int width = static_cast<int>(job.camera.width), rows = static_cast<int>(job.camera.height);
   if (width <= 0 || rows <= 0) throw std::invalid_argument("Renderer::render: camera has no pixels");
-  if (out.width != width || out.height != rows) out.resize(width, rows);
 
   FrameStats stats;
   stats.frame = job.params.frame_index;
@@ -346,17 +386,45 @@ void Renderer::begin_frame(const BandJob& job, FrameBuffer& out, const std::vect
     else assignments.push_back({ready[i], bands[i]});
   }
 
-  std::vector<uint64_t> ids = assign(assignments, job, out, true);
-  pending_ = std::make_unique<PendingFrame>(PendingFrame{job, &out, std::move(stats), std::move(assignments), std::move(ids), frame_start});
+  const int slot = next_slot_;
+  next_slot_ ^= 1;
+  std::vector<uint64_t> ids = assign(assignments, job, slot, true);
+  pending_ = std::make_unique<PendingFrame>();
+  pending_->job = job;
+  pending_->out = &out;
+  pending_->stats = std::move(stats);
+  pending_->assignments = std::move(assignments);
+  pending_->ids = std::move(ids);
+  pending_->start = frame_start;
+  pending_->slot = slot;
 }
 
 FrameStats Renderer::finish_frame() {
+  FrameStats stats = wait_frame();
+  merge_frame(stats);
+  return stats;
+}
+
+void Renderer::merge_frame(FrameStats& stats) {
+  if (!unmerged_) throw std::logic_error("Renderer::merge_frame: no frame is waiting to be merged");
+  std::unique_ptr<PendingFrame> frame = std::move(unmerged_);
+  FrameBuffer& out = *frame->out;
+  const int width = static_cast<int>(frame->job.camera.width), height = static_cast<int>(frame->job.camera.height);
+  ScopedStage merging(stats.stages, kCoreTrack, "merge");
+  if (out.width != width || out.height != height) out.resize(width, height);
+  merge(frame->delivered, frame->slot, out);
+  merging.finish();
+  stats.wall_ms = std::chrono::duration<double, std::milli>(Clock::now() - frame->start).count();
+}
+
+FrameStats Renderer::wait_frame() {
   if (!pending_) throw std::logic_error("Renderer::finish_frame: no frame was begun");
+  if (unmerged_) throw std::logic_error("Renderer::wait_frame: the previous frame was not merged");
   std::unique_ptr<PendingFrame> frame = std::move(pending_);
   FrameStats& stats = frame->stats;
-  FrameBuffer& out = *frame->out;
   const BandJob& job = frame->job;
-  RoundResult first = collect(frame->assignments, frame->ids, out, frame->start + options_.frame_timeout, stats.stages);
+  RoundResult first = collect(frame->assignments, frame->ids, frame->start + options_.frame_timeout, stats.stages);
+  frame->delivered = first.delivered;
   last_measurements_.clear();
   for (int id : first.finished) {
     TracerFrameStats& t = stats.tracers[static_cast<size_t>(id)];
@@ -422,7 +490,8 @@ FrameStats Renderer::finish_frame() {
       if (!parts[i].empty()) round.push_back({helpers[i], {band.begin + parts[i].begin, band.begin + parts[i].end}});
     }
     const auto round_start = Clock::now();
-    RoundResult r = collect(round, assign(round, job, out, false), out, round_start + options_.frame_timeout, stats.stages);
+    RoundResult r = collect(round, assign(round, job, frame->slot, false), round_start + options_.frame_timeout, stats.stages);
+    frame->delivered.insert(frame->delivered.end(), r.delivered.begin(), r.delivered.end());
     for (const Assignment& a : round) {
       TracerFrameStats& t = stats.tracers[static_cast<size_t>(a.worker)];
       if (std::find(r.finished.begin(), r.finished.end(), a.worker) != r.finished.end()) {
@@ -448,7 +517,9 @@ FrameStats Renderer::finish_frame() {
   if (!options_.use_reported_time && stats.dropped > 0)
     stats.recovery_ms = std::chrono::duration<double, std::milli>(Clock::now() - recovery_start).count();
   stats.wall_ms = std::chrono::duration<double, std::milli>(Clock::now() - frame->start).count();
-  return std::move(stats);
+  FrameStats result = std::move(stats);
+  unmerged_ = std::move(frame);
+  return result;
 }
 
 }  // namespace cohort::core

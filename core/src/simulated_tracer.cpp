@@ -90,6 +90,7 @@ SimulatedTracer::SimulatedTracer(std::shared_ptr<const SpinSceneCostModel> model
 void SimulatedTracer::apply(const commit::CommitBuffer& commit) {
   if (!commit.is_full_resync() && options_.throw_on_commits.count(commit.frame()))
     throw std::runtime_error(options_.name + ": simulated commit that does not fit, frame " + std::to_string(commit.frame()));
+  if (options_.keep_scene) commit::apply_commit(commit, scene_);
   if (commit.is_full_resync()) ++full_resyncs_applied_;
   ++commits_applied_;
   last_commit_frame_ = commit.frame();

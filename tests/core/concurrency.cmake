@@ -2,6 +2,6 @@
 # ctest labelled `concurrency`, which the `tsan` test preset runs under ThreadSanitizer.
 if(TARGET cohort_core_tests)
   add_test(NAME core.concurrency
-           COMMAND cohort_core_tests --gtest_filter=HostThreads.*:Renderer.*:FrameTimeline.*)
+           COMMAND cohort_core_tests --gtest_filter=HostThreads.*:Renderer.*:FrameTimeline.*:FramePipeline.*)
   set_tests_properties(core.concurrency PROPERTIES LABELS "core;concurrency" TIMEOUT 600)
 endif()

@@ -1,5 +1,7 @@
 #include <gtest/gtest.h>
 
+#include <atomic>
+#include <future>
 #include <thread>
 
 #include <nlohmann/json.hpp>
@@ -312,4 +314,51 @@ TEST(Renderer, AResyncWithoutASnapshotOfIncrementalRecordsIsAnError) {
   big.set_light_count(4);
   for (uint32_t i = 0; i < 4; ++i) big.set_light(i, KLight{});
   EXPECT_THROW(renderer.submit_commit(big), std::logic_error);
+}
+
+namespace {
+
+// A tracer stuck in render_band until the test lets it go (a device that never comes back), which
+// says when it is destroyed.
+class StuckTracer final : public Tracer {
+ public:
+  StuckTracer(std::shared_future<void> release, std::shared_ptr<std::atomic<bool>> destroyed)
+      : release_(std::move(release)), destroyed_(std::move(destroyed)) {}
+  ~StuckTracer() override { *destroyed_ = true; }
+  std::string name() const override { return "stuck"; }
+  void apply(const cohort::commit::CommitBuffer&) override {}
+  BandResult render_band(const BandJob& job, FrameBuffer& target) override {
+    release_.wait();
+    for (kuint y = job.params.row_begin; y < job.params.row_end; ++y) target.row(static_cast<int>(y))[0] = 1.0f;
+    return {};
+  }
+
+ private:
+  std::shared_future<void> release_;
+  std::shared_ptr<std::atomic<bool>> destroyed_;
+};
+
+}  // namespace
+
+TEST(Renderer, ATracerThatNeverReturnsDoesNotBlockShutdownAndIsFreedIfItReturns) {
+  std::promise<void> release;
+  auto destroyed = std::make_shared<std::atomic<bool>>(false);
+  {
+    std::vector<std::unique_ptr<Tracer>> tracers;
+    tracers.push_back(std::make_unique<SimulatedTracer>(model(), sim(1)));
+    tracers.push_back(std::make_unique<StuckTracer>(release.get_future().share(), destroyed));
+    RendererOptions options;
+    options.use_reported_time = true;
+    options.frame_timeout = std::chrono::milliseconds(20);
+    options.shutdown_timeout = std::chrono::milliseconds(20);
+    Renderer renderer(std::move(tracers), options);
+    FrameBuffer fb;
+    const FrameStats stats = renderer.render(job_for(0), fb);
+    expect_complete(fb, 0, stats, {1, 99});
+    EXPECT_EQ(stats.tracers[1].outcome, TracerOutcome::timed_out);
+  }  // the destructor returns although the stuck tracer is still inside render_band
+  EXPECT_FALSE(*destroyed) << "the stuck tracer must stay alive while its call runs";
+  release.set_value();
+  for (int i = 0; i < 500 && !*destroyed; ++i) std::this_thread::sleep_for(std::chrono::milliseconds(2));
+  EXPECT_TRUE(*destroyed) << "once it returns, its abandoned worker frees it";
 }

@@ -42,21 +42,27 @@ struct CudaTracer::Impl {
   unsigned long long* ray_counts = nullptr;   // device: closest, occlusion
   RayCounts last_counts;
   size_t band_capacity = 0;   // pixels
-  // The frame buffer the band is copied into, page-locked so the copy runs at full DMA speed instead
-  // of through the driver's pageable staging (about 3 ms of a 1080p frame otherwise).
-  void* registered = nullptr;
-  size_t registered_bytes = 0;
+  // The frame buffers the band is copied into, page-locked so the copy runs at full DMA speed instead
+  // of through the driver's pageable staging (about 3 ms of a 1080p frame otherwise). The Renderer
+  // alternates two targets by frame parity (the pipeline), so the last two stay registered.
+  struct Registered {
+    void* ptr = nullptr;
+    size_t bytes = 0;
+  };
+  Registered registered[2];
+  int next_registration = 0;
 
   void register_target(core::FrameBuffer& target) {
     void* ptr = target.rgba.data();
-    size_t bytes = target.rgba.size() * sizeof(float);
-    if (ptr == registered && bytes == registered_bytes) return;
-    if (registered) cudaHostUnregister(registered);
-    registered = nullptr;
-    registered_bytes = 0;
+    const size_t bytes = target.rgba.size() * sizeof(float);
+    for (const Registered& r : registered)
+      if (r.ptr == ptr && r.bytes == bytes) return;
+    Registered& slot = registered[next_registration];
+    next_registration ^= 1;
+    if (slot.ptr) cudaHostUnregister(slot.ptr);
+    slot = {};
     if (cudaHostRegister(ptr, bytes, cudaHostRegisterPortable) == cudaSuccess) {
-      registered = ptr;
-      registered_bytes = bytes;
+      slot = {ptr, bytes};
     } else {
       cudaGetLastError();   // not fatal: the copy still works from pageable memory, only slower
     }
@@ -97,7 +103,8 @@ CudaTracer::CudaTracer(int device) : impl_(std::make_unique<Impl>()) {
 CudaTracer::~CudaTracer() {
   cudaSetDevice(impl_->device);
   if (impl_->texel_texture) cudaDestroyTextureObject(impl_->texel_texture);
-  if (impl_->registered) cudaHostUnregister(impl_->registered);
+  for (const Impl::Registered& r : impl_->registered)
+    if (r.ptr) cudaHostUnregister(r.ptr);
   if (impl_->band) cudaFree(impl_->band);
   if (impl_->ray_counts) cudaFree(impl_->ray_counts);
   if (impl_->start) cudaEventDestroy(impl_->start);

@@ -42,7 +42,9 @@ struct FrameStats {
   double idle_percent = 0.0;      // idle_ms / summed_tracer_ms * 100: Brigade's Table 1 metric
   double recovery_ms = 0.0;       // extra time spent re-rendering dropped tracers' rows
   double wall_ms = 0.0;           // wall time of the Renderer's frame (bands, merge, recovery)
-  double end_to_end_ms = 0.0;     // the caller's whole frame: world sync to image output (0: not measured)
+  double end_to_end_ms = 0.0;     // the caller's whole frame: world sync to image output (0: not measured);
+                                  // with the pipeline this is the latency, and frames overlap
+  double interval_ms = 0.0;       // time since the caller delivered the previous frame: 1 / frame rate
   int dropped = 0;                // tracers dropped this frame (threw or timed out)
   double convergence_f = 1.0;     // blend factor used by adaptive convergence (1 = this frame only)
   std::vector<TracerFrameStats> tracers;

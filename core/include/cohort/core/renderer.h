@@ -12,7 +12,7 @@
 // Faults: a tracer that throws, or has not finished when the frame timeout expires, is dropped for the
 // frame; its rows are split among the tracers that finished and re-rendered, and the frame is still
 // delivered. A timed-out tracer keeps running on its own thread; it takes part again from the first
-// frame that starts after it has finished.
+// frame that starts after it has finished. One that never returns does not block shutdown.
 #pragma once
 
 #include <chrono>
@@ -34,6 +34,8 @@ struct RendererOptions {
   std::string balancer = "perfect-smooth";
   balance::BalancerOptions balancer_options;
   std::chrono::milliseconds frame_timeout{2000};
+  // How long the destructor waits for tracers still inside a job before leaving them behind.
+  std::chrono::milliseconds shutdown_timeout{2000};
   // Balance on the times tracers report (BandResult::device_ms) instead of wall-clock time. Simulated
   // tracers on a virtual clock need this; real GPU tracers may prefer their kernel times.
   bool use_reported_time = false;
@@ -48,7 +50,9 @@ class Renderer {
   // Takes ownership of the tracers; tracer i gets id i. Throws std::invalid_argument if there are none
   // or the balancer name is unknown.
   Renderer(std::vector<std::unique_ptr<Tracer>> tracers, RendererOptions options);
-  // Waits for every tracer to return from its current job (a hung tracer blocks here).
+  // Waits for every tracer to return from its current job, at most shutdown_timeout; a tracer that has
+  // not returned by then is logged and left behind on its own thread, which keeps it (and what it
+  // renders into) alive until it returns, if ever.
   ~Renderer();
   Renderer(const Renderer&) = delete;
   Renderer& operator=(const Renderer&) = delete;
@@ -67,11 +71,17 @@ class Renderer {
   // passed to the balancer; without one, the per-row work the tracers reported last frame
   // (BandResult::row_work) is passed when it covers every row. Throws std::runtime_error when no tracer could render some rows.
   FrameStats render(const BandJob& job, FrameBuffer& out, const std::vector<float>& row_cost_proxy = {});
-  // render() in two halves, so the caller can update the BVH and fill the next commit buffers while
-  // the tracers work: begin_frame() hands out the bands and returns at once; finish_frame() waits,
-  // re-renders dropped tracers' rows and returns the stats. `out` must stay alive and untouched in
-  // between. Commits submitted after begin_frame() go to the next frame.
+  // render() in pieces, for a pipeline with at most one frame of latency (docs/frame-timeline.md):
+  // begin_frame() hands out the bands and returns at once; wait_frame() waits for them, re-renders
+  // dropped tracers' rows and returns the stats; merge_frame() copies the bands into `out` (resized if
+  // needed). Between wait_frame() and merge_frame() the next frame may be begun: every tracer renders
+  // into one of two targets by frame parity, so frame N is merged while N+1 renders. finish_frame()
+  // is wait_frame() then merge_frame(). Commits submitted after begin_frame() go to the next frame.
+  // `out` must stay alive until merge_frame() returns; only merge_frame() writes it. Calls out of order
+  // throw std::logic_error.
   void begin_frame(const BandJob& job, FrameBuffer& out, const std::vector<float>& row_cost_proxy = {});
+  FrameStats wait_frame();
+  void merge_frame(FrameStats& stats);
   FrameStats finish_frame();
 
   int tracer_count() const;
@@ -91,31 +101,36 @@ class Renderer {
   };
   struct RoundResult {
     std::vector<int> finished;   // workers that rendered their band
+    std::vector<Assignment> delivered;  // their bands, to merge
     std::vector<int> threw;
     std::vector<int> timed_out;
   };
 
   struct PendingFrame {
     BandJob job;
-    FrameBuffer* out;
+    FrameBuffer* out = nullptr;
     FrameStats stats;
     std::vector<Assignment> assignments;
     std::vector<uint64_t> ids;
     std::chrono::steady_clock::time_point start;
+    int slot = 0;                        // the workers' target this frame renders into
+    std::vector<Assignment> delivered;   // bands (and re-rendered rows) waiting to be merged
   };
 
-  // Hands each assignment to its worker (with the queued commits when with_commits) and returns the
-  // job ids; collect() waits for them until the deadline and merges the finished bands into out.
-  std::vector<uint64_t> assign(const std::vector<Assignment>& assignments, const BandJob& job, FrameBuffer& out,
+  // Hands each assignment to its worker (with the queued commits when with_commits), to render into
+  // its target `slot`, and returns the job ids; collect() waits for them until the deadline.
+  std::vector<uint64_t> assign(const std::vector<Assignment>& assignments, const BandJob& job, int slot,
                                bool with_commits);
-  RoundResult collect(const std::vector<Assignment>& assignments, const std::vector<uint64_t>& ids, FrameBuffer& out,
+  RoundResult collect(const std::vector<Assignment>& assignments, const std::vector<uint64_t>& ids,
                       std::chrono::steady_clock::time_point deadline, std::vector<StageSpan>& stages);
+  // Copies delivered bands from the workers' targets `slot` into out.
+  void merge(const std::vector<Assignment>& bands, int slot, FrameBuffer& out) const;
   double measured_ms(const Worker& w) const;
   std::shared_ptr<const commit::TracerScene> resync_scene();
 
   RendererOptions options_;
   std::unique_ptr<balance::Balancer> balancer_;
-  std::vector<std::unique_ptr<Worker>> workers_;
+  std::vector<std::shared_ptr<Worker>> workers_;
   std::vector<balance::TracerMeasurement> last_measurements_;
   std::vector<float> row_work_;            // this frame's per-row work counts, as tracers report them
   std::vector<uint8_t> row_work_known_;
@@ -124,7 +139,9 @@ class Renderer {
   std::shared_ptr<const commit::TracerScene> full_scene_;    // the latest full commit's scene
   bool records_since_full_ = false;
   uint64_t commit_frame_ = 0;                                // frame of the latest submitted commit
-  std::unique_ptr<PendingFrame> pending_;
+  std::unique_ptr<PendingFrame> pending_;    // begun, not yet waited for
+  std::unique_ptr<PendingFrame> unmerged_;   // waited for, bands not yet merged
+  int next_slot_ = 0;
 };
 
 }  // namespace cohort::core

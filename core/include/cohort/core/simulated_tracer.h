@@ -57,6 +57,9 @@ struct SimulatedTracerOptions {
   std::set<uint64_t> throw_on_commits; // apply throws on commits of these frames (incremental ones only)
   std::set<uint64_t> hang_on_frames;   // render_band blocks for hang_ms (real time) on these frames
   double hang_ms = 0.0;
+  // Keep a scene copy like a real tracer: every commit is applied to it (commit::apply_commit), so
+  // tests can compare it with the master.
+  bool keep_scene = false;
 };
 
 class SimulatedTracer final : public Tracer {
@@ -71,6 +74,9 @@ class SimulatedTracer final : public Tracer {
   uint64_t commits_applied() const { return commits_applied_; }
   uint64_t last_commit_frame() const { return last_commit_frame_; }
   uint64_t full_resyncs_applied() const { return full_resyncs_applied_; }
+  // With keep_scene: the scene as the commits applied so far built it. Read it only while the tracer
+  // is not running a job (e.g. between Renderer frames).
+  const commit::TracerScene& scene() const { return scene_; }
 
  private:
   std::shared_ptr<const SpinSceneCostModel> model_;
@@ -78,6 +84,7 @@ class SimulatedTracer final : public Tracer {
   uint64_t commits_applied_ = 0;
   uint64_t last_commit_frame_ = 0;
   uint64_t full_resyncs_applied_ = 0;
+  commit::TracerScene scene_;
 };
 
 }  // namespace cohort::core

@@ -1,0 +1,58 @@
+// The overlapped frame loop (issue 14; docs/frame-timeline.md): while the tracers render frame N the
+// core prepares N+1 (world sync, commits, TLAS), then hands N+1 out and merges, blends, tone-maps and
+// writes N while the tracers render N+1. The cost is at most one frame of latency: push() returns the
+// frame pushed before it.
+//
+//   for each frame:  prepare it (submit its commits)  ->  pipeline.push(job)  ->  post-process what came back
+//   at the end:      pipeline.drain()                  ->  post-process what came back
+#pragma once
+
+#include <optional>
+#include <vector>
+
+#include "cohort/core/frame_buffer.h"
+#include "cohort/core/frame_stats.h"
+#include "cohort/core/renderer.h"
+#include "cohort/core/tracer.h"
+
+namespace cohort::core {
+
+class FramePipeline {
+ public:
+  struct Delivered {
+    BandJob job;        // what the frame was rendered with (its camera, for convergence)
+    FrameStats stats;   // its stages include the preparation spans given to push()
+  };
+
+  explicit FramePipeline(Renderer& renderer) : renderer_(renderer) {}
+  // A frame still in flight is waited for (its tracers' targets belong to the Renderer).
+  ~FramePipeline();
+  FramePipeline(const FramePipeline&) = delete;
+  FramePipeline& operator=(const FramePipeline&) = delete;
+
+  // Hands `job` to the tracers (its commits already submitted) and returns the frame pushed before it,
+  // merged into image(); nothing on the first push. `preparation`: the core's spans for this frame so
+  // far (e.g. world sync), carried into its stats. When the previous frame cannot be rendered
+  // (Renderer::wait_frame throws), `job` is not handed out and the exception propagates; the next push
+  // starts afresh.
+  std::optional<Delivered> push(const BandJob& job, std::vector<StageSpan> preparation = {});
+  // Waits for the frame in flight and returns it merged into image(); nothing when none is.
+  std::optional<Delivered> drain();
+
+  // The last delivered frame, as merged; valid until the next push() or drain().
+  const FrameBuffer& image() const { return image_; }
+  bool in_flight() const { return in_flight_.has_value(); }
+
+ private:
+  struct InFlight {
+    BandJob job;
+    std::vector<StageSpan> preparation;
+  };
+  Delivered delivered(InFlight frame, FrameStats stats);
+
+  Renderer& renderer_;
+  FrameBuffer image_;
+  std::optional<InFlight> in_flight_;
+};
+
+}  // namespace cohort::core

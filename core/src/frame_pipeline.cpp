@@ -1,0 +1,47 @@
+#include "cohort/core/frame_pipeline.h"
+
+#include <spdlog/spdlog.h>
+
+namespace cohort::core {
+
+FramePipeline::~FramePipeline() {
+  if (!in_flight_) return;
+  try {
+    renderer_.finish_frame();
+  } catch (const std::exception& e) {
+    spdlog::warn("frame pipeline: the last frame in flight failed while shutting down: {}", e.what());
+  }
+}
+
+FramePipeline::Delivered FramePipeline::delivered(InFlight frame, FrameStats stats) {
+  stats.stages.insert(stats.stages.begin(), std::make_move_iterator(frame.preparation.begin()),
+                      std::make_move_iterator(frame.preparation.end()));
+  return {std::move(frame.job), std::move(stats)};
+}
+
+std::optional<FramePipeline::Delivered> FramePipeline::push(const BandJob& job, std::vector<StageSpan> preparation) {
+  std::optional<InFlight> previous = std::move(in_flight_);
+  in_flight_.reset();
+  std::optional<FrameStats> stats;
+  if (previous) stats = renderer_.wait_frame();
+  try {
+    renderer_.begin_frame(job, image_);
+  } catch (...) {
+    if (previous) renderer_.merge_frame(*stats);  // leave the Renderer ready for the next begin
+    throw;
+  }
+  in_flight_ = InFlight{job, std::move(preparation)};
+  if (!previous) return std::nullopt;
+  renderer_.merge_frame(*stats);
+  return delivered(std::move(*previous), std::move(*stats));
+}
+
+std::optional<FramePipeline::Delivered> FramePipeline::drain() {
+  if (!in_flight_) return std::nullopt;
+  InFlight frame = std::move(*in_flight_);
+  in_flight_.reset();
+  FrameStats stats = renderer_.finish_frame();
+  return delivered(std::move(frame), std::move(stats));
+}
+
+}  // namespace cohort::core

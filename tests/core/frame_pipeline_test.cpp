@@ -1,0 +1,123 @@
+#include "cohort/core/frame_pipeline.h"
+
+#include <gtest/gtest.h>
+
+#include <map>
+#include <thread>
+
+#include "cohort/core/simulated_tracer.h"
+
+using namespace cohort::core;
+
+namespace {
+
+constexpr int kWidth = 8, kRows = 64;
+
+std::unique_ptr<Tracer> sleeping_tracer(uint64_t tag) {
+  SimulatedTracerOptions o;
+  o.name = "sim" + std::to_string(tag);
+  o.seed = tag;
+  o.clock = SimulatedClock::sleep;
+  o.time_scale = 8.0;  // a band takes some 20 ms of real time
+  return std::make_unique<SimulatedTracer>(std::make_shared<SpinSceneCostModel>(3), o);
+}
+
+BandJob job_for(uint64_t frame) {
+  BandJob job;
+  job.camera = spin_camera(kWidth, kRows, 0.05 * static_cast<double>(frame));
+  job.params.frame_index = static_cast<kuint>(frame);
+  return job;
+}
+
+bool overlap(const StageSpan& a, const StageSpan& b) {
+  return a.start_ms < b.start_ms + b.ms && b.start_ms < a.start_ms + a.ms;
+}
+
+std::vector<StageSpan> spans_of(const FrameStats& stats, const std::string& stage, bool tracers) {
+  std::vector<StageSpan> out;
+  for (const StageSpan& s : stats.stages)
+    if (s.stage == stage && (s.track != kCoreTrack) == tracers) out.push_back(s);
+  return out;
+}
+
+// The core's span of `stage` in a frame overlaps one of the tracers' render spans in another.
+bool core_stage_overlaps_rendering(const FrameStats& core_frame, const std::string& stage, const FrameStats& rendered) {
+  for (const StageSpan& c : spans_of(core_frame, stage, false))
+    for (const StageSpan& r : spans_of(rendered, "render", true))
+      if (overlap(c, r)) return true;
+  return false;
+}
+
+}  // namespace
+
+TEST(FramePipeline, TheCorePreparesTheNextFrameAndFinishesThePreviousOneWhileTheTracersRender) {
+  std::vector<std::unique_ptr<Tracer>> tracers;
+  tracers.push_back(sleeping_tracer(1));
+  tracers.push_back(sleeping_tracer(2));
+  Renderer renderer(std::move(tracers), RendererOptions{});
+  FramePipeline pipeline(renderer);
+  auto scene = std::make_shared<cohort::commit::TracerScene>();
+  renderer.submit_commit(cohort::commit::CommitBuffer::full(scene, 0));
+
+  std::map<uint64_t, FrameStats> frames;
+  auto finish = [&](FramePipeline::Delivered done) {
+    // Everything is delivered whole: every row comes from this frame.
+    for (int y = 0; y < kRows; ++y) ASSERT_EQ(pipeline.image().row(y)[0], static_cast<float>(done.stats.frame));
+    ScopedStage tone_mapping(done.stats.stages, kCoreTrack, "tone map");  // stands for blend, tone map, output
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+    tone_mapping.finish();
+    frames[done.stats.frame] = std::move(done.stats);
+  };
+  constexpr uint64_t kFrames = 6;
+  for (uint64_t f = 0; f < kFrames; ++f) {
+    std::vector<StageSpan> preparation;
+    ScopedStage syncing(preparation, kCoreTrack, "world sync");  // stands for WorldSync folding the changes
+    cohort::commit::CommitBuffer commit;
+    commit.set_frame(f + 1);
+    commit.set_camera(job_for(f).camera);
+    renderer.submit_commit(commit, [&] { return scene; });
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+    syncing.finish();
+    std::optional<FramePipeline::Delivered> done = pipeline.push(job_for(f), std::move(preparation));
+    ASSERT_EQ(done.has_value(), f > 0);
+    if (done) {
+      EXPECT_EQ(done->stats.frame, f - 1) << "one frame of latency";
+      EXPECT_EQ(done->job.params.frame_index, f - 1);
+      finish(std::move(*done));
+    }
+  }
+  std::optional<FramePipeline::Delivered> last = pipeline.drain();
+  ASSERT_TRUE(last.has_value());
+  finish(std::move(*last));
+  EXPECT_FALSE(pipeline.drain().has_value());
+  ASSERT_EQ(frames.size(), kFrames);
+
+  for (uint64_t n = 0; n + 1 < kFrames; ++n) {
+    const FrameStats &now = frames[n], &next = frames[n + 1];
+    EXPECT_TRUE(core_stage_overlaps_rendering(next, "world sync", now)) << "world sync of " << n + 1 << " vs render of " << n;
+    EXPECT_TRUE(core_stage_overlaps_rendering(now, "merge", next)) << "merge of " << n << " vs render of " << n + 1;
+    EXPECT_TRUE(core_stage_overlaps_rendering(now, "tone map", next)) << "tone map of " << n << " vs render of " << n + 1;
+    // The commit submitted while frame n rendered was applied before frame n+1's band, not n's.
+    for (const StageSpan& apply : spans_of(next, "apply", true))
+      EXPECT_GE(apply.start_ms, spans_of(next, "world sync", false).at(0).start_ms);
+  }
+}
+
+TEST(FramePipeline, CallsOutOfOrderAreRefused) {
+  std::vector<std::unique_ptr<Tracer>> tracers;
+  tracers.push_back(sleeping_tracer(1));
+  Renderer renderer(std::move(tracers), RendererOptions{});
+  FrameBuffer a, b;
+  EXPECT_THROW(renderer.wait_frame(), std::logic_error);
+  renderer.begin_frame(job_for(3), a);
+  EXPECT_THROW(renderer.begin_frame(job_for(4), b), std::logic_error);  // frame 3 not waited for
+  FrameStats three = renderer.wait_frame();
+  renderer.begin_frame(job_for(4), b);
+  EXPECT_THROW(renderer.wait_frame(), std::logic_error);  // frame 3 not merged
+  renderer.merge_frame(three);
+  EXPECT_THROW(renderer.merge_frame(three), std::logic_error);
+  FrameStats four = renderer.finish_frame();
+  EXPECT_EQ(a.row(0)[0], 3.0f);
+  EXPECT_EQ(b.row(kRows - 1)[0], 4.0f);
+  EXPECT_EQ(four.frame, 4u);
+}
