@@ -106,10 +106,12 @@ std::vector<KBvhNode> build_tlas(std::vector<KInstance>& instances, const std::v
     prims[i] = build_primitive(boxes[i], uint32_t(i));
   }
   // One instance per leaf keeps instance tests (a ray transform each) to the minimum. A TLAS is rebuilt
-  // every frame, so it takes the fastest build that keeps frame times (bench_bvh compares them).
+  // every frame: Embree's Morton builder takes about a third of the binned SAH's time for an SAH about
+  // 7% higher (bench_bvh, docs/bvh.md), and the thread's build memory is kept for the next frame.
   detail::BuildSettings settings;
-  settings.quality = detail::BuildQuality::binned_sah;
+  settings.quality = detail::BuildQuality::morton;
   settings.max_leaf_size = 1;
+  settings.keep_memory = true;
   detail::FlatBuild built = detail::build_flat_bvh(prims, settings);
   // An instance of an empty BLAS keeps an empty leaf box: rays never test it.
   for (KBvhNode& n : built.nodes)

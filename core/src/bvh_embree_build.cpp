@@ -127,13 +127,29 @@ RTCDevice builder_device() {
   return holder.device;
 }
 
+// An RTCBVH kept per thread, for builds with keep_memory (one build at a time may use an RTCBVH).
+struct ThreadBvh {
+  RTCBVH bvh = nullptr;
+  ~ThreadBvh() {
+    if (bvh) rtcReleaseBVH(bvh);
+  }
+};
+
 FlatBuild build_in_current_arena(std::vector<RTCBuildPrimitive>& primitives, const BuildSettings& settings) {
   RTCDevice device = builder_device();
-  RTCBVH bvh = rtcNewBVH(device);
+  thread_local ThreadBvh kept;
+  if (settings.keep_memory && !kept.bvh) kept.bvh = rtcNewBVH(device);
+  RTCBVH bvh = settings.keep_memory ? kept.bvh : rtcNewBVH(device);
+  auto release = [&] {
+    if (!settings.keep_memory) rtcReleaseBVH(bvh);
+  };
   RTCBuildArguments args = rtcDefaultBuildArguments();
   args.buildQuality = settings.quality == BuildQuality::morton ? RTC_BUILD_QUALITY_LOW : RTC_BUILD_QUALITY_MEDIUM;
   args.maxBranchingFactor = 2;
   args.maxDepth = K_BVH_MAX_DEPTH;   // Embree's root is level 1
+  // Leaves of up to max_leaf_size, where Embree's SAH finds a leaf cheaper than a split. (Forcing every
+  // split down to max_leaf_size, as minLeafSize = maxLeafSize would, builds ~10% faster but gives a
+  // worse SAH than the former hand-written builder.)
   args.minLeafSize = 1;
   args.maxLeafSize = std::clamp<uint32_t>(settings.max_leaf_size, 1, RTC_BUILD_MAX_PRIMITIVES_PER_LEAF);
   // The same unit costs as sah_cost(), so Embree's leaf-or-split choices minimise what we report.
@@ -151,7 +167,7 @@ FlatBuild build_in_current_arena(std::vector<RTCBuildPrimitive>& primitives, con
   const auto* root = static_cast<const TempNode*>(rtcBuildBVH(&args));
   if (!root) {
     const RTCError error = rtcGetDeviceError(device);
-    rtcReleaseBVH(bvh);
+    release();
     throw std::runtime_error("BVH build over " + std::to_string(count) + " primitives failed (Embree error " +
                              std::to_string(int(error)) + ")");
   }
@@ -163,7 +179,7 @@ FlatBuild build_in_current_arena(std::vector<RTCBuildPrimitive>& primitives, con
                            : union_of(static_cast<const TempInner*>(root)->child_bounds[0],
                                       static_cast<const TempInner*>(root)->child_bounds[1]);
   flatten(root, root_bounds, 0, 1, 0, out);
-  rtcReleaseBVH(bvh);
+  release();
   return out;
 }
 

@@ -21,6 +21,9 @@ struct BuildSettings {
   BuildQuality quality = BuildQuality::binned_sah;
   uint32_t max_leaf_size = 4;
   int threads = 0;   // 0: every hardware thread; otherwise the build runs in a TBB arena this wide
+  // Keep Embree's build memory on this thread for the next build: a tree rebuilt every frame then
+  // pays no page faults. Off for one-off builds, whose memory is better returned.
+  bool keep_memory = false;
 };
 
 struct FlatBuild {
