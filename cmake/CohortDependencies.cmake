@@ -28,15 +28,11 @@ if(COHORT_WITH_OIIO AND NOT OIIO_FOUND)
   message(FATAL_ERROR "COHORT_WITH_OIIO=ON but OpenImageIO was not found (install libopenimageio-dev)")
 endif()
 
-find_package(embree 3 QUIET)
-set(_embree_default OFF)
-if(embree_FOUND)
-  set(_embree_default ON)
-endif()
-option(COHORT_WITH_EMBREE "Build the Embree CPU tracer" ${_embree_default})
-if(COHORT_WITH_EMBREE AND NOT embree_FOUND)
-  message(FATAL_ERROR "COHORT_WITH_EMBREE=ON but Embree 3 was not found (install libembree-dev)")
-endif()
+# Embree and TBB: the core builds every BVH through Embree's rtcBuildBVH (multithreaded through TBB),
+# so both are required; COHORT_WITH_EMBREE only chooses whether the Embree CPU tracer is built.
+find_package(embree 3 REQUIRED)
+find_package(TBB REQUIRED)
+option(COHORT_WITH_EMBREE "Build the Embree CPU tracer" ON)
 
 find_package(OpenCL QUIET)
 set(_opencl_default OFF)

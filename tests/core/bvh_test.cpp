@@ -1,3 +1,4 @@
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <random>
@@ -200,6 +201,32 @@ TEST(BlasBuilder, DegenerateInputs) {
   BlasBuild bs = build_blas(same.vertices, same.triangles);
   expect_valid_tree(bs, same.vertices, 100);
   for (const auto& n : bs.nodes) EXPECT_LE(n.count, 4u);
+}
+
+int tree_depth(const std::vector<KBvhNode>& nodes, uint32_t node = 0) {
+  const KBvhNode& n = nodes[node];
+  if (n.count > 0) return 1;
+  return 1 + std::max(tree_depth(nodes, n.left_first), tree_depth(nodes, n.left_first + 1));
+}
+
+TEST(BlasBuilder, DepthStaysWithinTheTraversalStackOnSkewedInput) {
+  // 3000 triangles on one spot and 100 spread over exponentially growing distances: SAH splits peel the
+  // far ones off one level at a time, the worst case for depth.
+  Soup skewed = random_soup(3000, 12, 0.01f, 0.01f);
+  for (int i = 0; i < 100; ++i) {
+    const float x = std::pow(1.6f, float(i));
+    for (int k = 0; k < 3; ++k) {
+      KVertex v{};
+      v.pos[0] = x + float(k);
+      v.pos[1] = float(k == 1);
+      skewed.vertices.push_back(v);
+    }
+    const uint32_t base = uint32_t(skewed.vertices.size()) - 3;
+    skewed.triangles.push_back({base, base + 1, base + 2, 0});
+  }
+  BlasBuild b = build_blas(skewed.vertices, skewed.triangles);
+  expect_valid_tree(b, skewed.vertices, skewed.triangles.size());
+  EXPECT_LE(tree_depth(b.nodes), K_BVH_MAX_DEPTH);
 }
 
 TEST(BlasRefit, StaysCorrectAfterDeformationAndReportsDecay) {

@@ -1,4 +1,5 @@
-// BVH builders producing the portable layout of kernel/layout.h (traversal: kernel/bvh_traverse.h).
+// BVH builders (Embree's rtcBuildBVH) producing the portable layout of kernel/layout.h
+// (traversal: kernel/bvh_traverse.h).
 #pragma once
 
 #include <cstdint>
@@ -15,13 +16,12 @@ struct BlasBuild {
 };
 
 struct BvhBuildOptions {
-  int bins = 16;
   int max_leaf_size = 4;
-  int threads = 0;                    // 0: hardware concurrency
+  int threads = 0;                    // 0: every hardware thread
 };
 
-// Binned-SAH BLAS over triangles whose vertex indices point into `vertices`. The same tree for any
-// thread count. No triangles give no nodes.
+// Binned-SAH BLAS (Embree's rtcBuildBVH, multithreaded) over triangles whose vertex indices point into
+// `vertices`. The same tree for any thread count. No triangles give no nodes.
 BlasBuild build_blas(const std::vector<KVertex>& vertices, const std::vector<KTriangle>& triangles,
                      const BvhBuildOptions& options = {});
 
