@@ -17,6 +17,8 @@
 #include "cohort/scene/map_file.h"
 #include "cohort/scene/material_build.h"
 #include "cohort/scene/material_file.h"
+#include "cohort/scene/md5.h"
+#include "cohort/scene/model_file.h"
 #include "cohort/scene/proc_file.h"
 
 namespace cohort::scene::fuzz {
@@ -74,6 +76,47 @@ inline void fuzz_image(const uint8_t* data, size_t size) {
     make_alpha(*tga);
   }
   is_rxgb_dds(as_text(data, size));
+}
+
+// A model the parser returned must be well formed: whole triangles, indices in range, surfaces covering
+// the index list, one material name per surface, colours (when present) one per vertex.
+inline void check_model(const ModelFile& model) {
+  const Mesh& mesh = model.mesh;
+  if (mesh.indices.size() % 3 != 0 || model.surface_materials.size() != mesh.surfaces.size()) __builtin_trap();
+  if (!model.colors.empty() && model.colors.size() != mesh.vertices.size()) __builtin_trap();
+  for (uint32_t index : mesh.indices)
+    if (index >= mesh.vertices.size()) __builtin_trap();
+  for (const Surface& s : mesh.surfaces)
+    if (size_t(s.first_index) + s.index_count > mesh.indices.size()) __builtin_trap();
+}
+
+inline void fuzz_ase(const uint8_t* data, size_t size) {
+  try {
+    check_model(parse_ase(as_text(data, size), "fuzz.ase"));
+  } catch (const ParseError&) {
+  }
+}
+
+inline void fuzz_lwo(const uint8_t* data, size_t size) {
+  try {
+    check_model(parse_lwo(as_text(data, size), "fuzz.lwo"));
+  } catch (const ParseError&) {
+  }
+}
+
+// Either kind of MD5 file: a mesh is skinned in its bind pose, an animation evaluated at a few times.
+inline void fuzz_md5(const uint8_t* data, size_t size) {
+  try {
+    Md5Mesh mesh = parse_md5mesh(as_text(data, size), "fuzz.md5mesh");
+    check_model(skin_md5(mesh, bind_pose(mesh)));
+  } catch (const ParseError&) {
+  }
+  try {
+    Md5Anim anim = parse_md5anim(as_text(data, size), "fuzz.md5anim");
+    for (int t : {0, 17, 1000, anim.length_ms(), 123456789})
+      if (anim_pose(anim, t).size() != anim.joints.size()) __builtin_trap();
+  } catch (const ParseError&) {
+  }
 }
 
 }  // namespace cohort::scene::fuzz

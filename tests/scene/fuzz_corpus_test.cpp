@@ -41,3 +41,11 @@ TEST(FuzzCorpus, Proc) { EXPECT_GT(replay("proc", cohort::scene::fuzz::fuzz_proc
 TEST(FuzzCorpus, Map) { EXPECT_GT(replay("map", cohort::scene::fuzz::fuzz_map, "assets/testmap/maps", ".map"), 0); }
 TEST(FuzzCorpus, Mtr) { EXPECT_GT(replay("mtr", cohort::scene::fuzz::fuzz_mtr, "assets/testmap/materials", ".mtr"), 0); }
 TEST(FuzzCorpus, Image) { EXPECT_GT(replay("image", cohort::scene::fuzz::fuzz_image), 0); }
+TEST(FuzzCorpus, Ase) { EXPECT_GT(replay("ase", cohort::scene::fuzz::fuzz_ase, "assets/testmap/models/testmap", ".ase"), 0); }
+TEST(FuzzCorpus, Lwo) { EXPECT_GT(replay("lwo", cohort::scene::fuzz::fuzz_lwo, "assets/testmap/models/testmap", ".lwo"), 0); }
+TEST(FuzzCorpus, Md5Mesh) {
+  EXPECT_GT(replay("md5", cohort::scene::fuzz::fuzz_md5, "assets/testmap/models/testmap", ".md5mesh"), 0);
+}
+TEST(FuzzCorpus, Md5Anim) {
+  EXPECT_GT(replay("md5", cohort::scene::fuzz::fuzz_md5, "assets/testmap/models/testmap", ".md5anim"), 0);
+}
