@@ -45,9 +45,9 @@ void add_bench_command(CLI::App& app, int& exit_code) {
       "wait for the slowest one / (tracers x frame time). Simulated tracers run on a virtual clock, so\n"
       "results are reproducible.");
   struct Args {
-    std::string balancers, tracers = "2,3,4", speeds = "1", path = "both", real, json, plot;
+    std::string balancers, tracers = "2,3,4", speeds = "1", fixed_ms = "0", path = "both", real, json, plot;
     std::string scene = kTestMapFile;
-    double noise = 0.02, row_work_error = 0.2;
+    double noise = 0.02, row_work_error = 0.2, ms_per_cost = 0.05;
     bool row_work = true;
     std::string clock = "virtual";
     double time_scale = 1.0;
@@ -57,8 +57,17 @@ void add_bench_command(CLI::App& app, int& exit_code) {
   };
   auto args = std::make_shared<Args>();
   balance->add_option("--balancers", args->balancers, "comma-separated balancers (default: all)");
-  balance->add_option("--tracers", args->tracers, "simulated tracer counts, comma-separated")->capture_default_str();
-  balance->add_option("--speeds", args->speeds, "relative speeds of simulated tracers, cycled (e.g. 1,0.7,1.3)")->capture_default_str();
+  auto* tracers_option = balance->add_option("--tracers", args->tracers,
+                                             "simulated tracer counts, comma-separated (default 2,3,4; with several "
+                                             "--speeds or --fixed-ms: as many tracers as listed)");
+  balance->add_option("--speeds", args->speeds, "relative speed per simulated tracer, cycled (e.g. 1,1,0.02)")->capture_default_str();
+  balance->add_option("--fixed-ms", args->fixed_ms,
+                      "fixed cost per band per simulated tracer in ms, cycled (e.g. 0,0,2): launch, upload and copy "
+                      "overhead that does not shrink with the band")
+      ->capture_default_str();
+  balance->add_option("--ms-per-cost", args->ms_per_cost,
+                      "simulated ms per cost unit at speed 1 (a 720-row frame is about 860 units: 43 ms alone at the default)")
+      ->capture_default_str()->check(CLI::PositiveNumber);
   balance->add_option("--noise", args->noise, "relative standard deviation of each simulated band time")->capture_default_str();
   balance->add_option("--frames", args->frames, "frames per run")->capture_default_str()->check(CLI::PositiveNumber);
   balance->add_option("--warmup", args->warmup, "first frames left out of mean/worst")->capture_default_str()->check(CLI::NonNegativeNumber);
@@ -87,11 +96,18 @@ void add_bench_command(CLI::App& app, int& exit_code) {
   balance->add_option("--scene", args->scene, "map or scene pack the real tracers render")->capture_default_str();
   balance->add_option("--json", args->json, "write every run (per-frame idle %) as JSON");
   balance->add_option("--plot", args->plot, "write a PNG chart of idle % per frame per balancer");
-  balance->callback([args, &exit_code] {
+  balance->callback([args, tracers_option, &exit_code] {
     BalanceBenchConfig config;
     config.balancers = split_list<std::string>(args->balancers, "--balancers");
     config.tracer_counts = split_list<int>(args->tracers, "--tracers");
     config.speeds = split_list<double>(args->speeds, "--speeds");
+    config.fixed_ms = split_list<double>(args->fixed_ms, "--fixed-ms");
+    config.ms_per_cost = args->ms_per_cost;
+    if (config.speeds.empty()) throw CLI::ValidationError("--speeds", "no speeds given");
+    if (config.fixed_ms.empty()) throw CLI::ValidationError("--fixed-ms", "no fixed costs given");
+    // A per-tracer list describes one mix of tracers: run that many unless counts were asked for.
+    const size_t listed = std::max(config.speeds.size(), config.fixed_ms.size());
+    if (tracers_option->count() == 0 && listed > 1) config.tracer_counts = {static_cast<int>(listed)};
     config.noise = args->noise;
     config.row_work = args->row_work;
     config.clock = args->clock;
@@ -106,13 +122,17 @@ void add_bench_command(CLI::App& app, int& exit_code) {
     config.real_scene = args->scene;
     config.paths = args->path == "both" ? std::vector<std::string>{"slow", "fast"} : std::vector<std::string>{args->path};
     const std::vector<std::string> known = balance::balancer_names();
+    std::string known_list;
+    for (const std::string& n : known) known_list += (known_list.empty() ? "" : ", ") + n;
     for (const std::string& b : config.balancers)
       if (std::find(known.begin(), known.end(), b) == known.end())
-        throw CLI::ValidationError("--balancers", "unknown balancer '" + b + "' (known: none, robin-hood, perfect, perfect-smooth, row-cost)");
+        throw CLI::ValidationError("--balancers", "unknown balancer '" + b + "' (known: " + known_list + ")");
     for (int c : config.tracer_counts)
       if (c < 1) throw CLI::ValidationError("--tracers", "counts must be >= 1");
     for (double s : config.speeds)
       if (!(s > 0.0)) throw CLI::ValidationError("--speeds", "speeds must be > 0");
+    for (double f : config.fixed_ms)
+      if (!(f >= 0.0)) throw CLI::ValidationError("--fixed-ms", "fixed costs must be >= 0");
 
     std::vector<BalanceBenchRun> runs;
     try {
@@ -122,7 +142,8 @@ void add_bench_command(CLI::App& app, int& exit_code) {
       exit_code = config.real.empty() ? kExitFailure : kExitUnavailable;
       return;
     }
-    std::cout << (config.real.empty() ? "simulated tracers, speeds " + args->speeds + ", noise " + format_fraction(config.noise) +
+    std::cout << (config.real.empty() ? "simulated tracers, speeds " + args->speeds + ", fixed ms " + args->fixed_ms +
+                                            ", " + format_fraction(config.ms_per_cost) + " ms per cost unit, noise " + format_fraction(config.noise) +
                                             (config.row_work ? ", per-row work counts with error " + format_fraction(config.row_work_error)
                                                              : ", no per-row work counts")
                                       : "real tracers: " + args->real)

@@ -35,6 +35,8 @@ BalanceBenchRun run_one(const BalanceBenchConfig& config, const std::string& pat
       core::SimulatedTracerOptions o;
       o.name = "sim" + std::to_string(i);
       o.speed = config.speeds[static_cast<size_t>(i) % config.speeds.size()];
+      o.fixed_ms = config.fixed_ms[static_cast<size_t>(i) % config.fixed_ms.size()];
+      o.ms_per_cost = config.ms_per_cost;
       o.noise = config.noise;
       o.report_row_work = config.row_work;
       o.clock = config.clock == "sleep"   ? core::SimulatedClock::sleep
@@ -52,7 +54,10 @@ BalanceBenchRun run_one(const BalanceBenchConfig& config, const std::string& pat
   options.use_reported_time = config.real.empty() && config.clock == "virtual";
   core::Renderer renderer(std::move(tracers), options);
 
-  BalanceBenchRun run{path, balancer, renderer.tracer_count(), 0.0, 0.0, {}};
+  BalanceBenchRun run;
+  run.path = path;
+  run.balancer = balancer;
+  run.tracers = renderer.tracer_count();
   const double step = path_degrees_per_frame(path) * std::numbers::pi / 180.0;
   core::FrameBuffer frame;
   int counted = 0;
@@ -75,10 +80,16 @@ BalanceBenchRun run_one(const BalanceBenchConfig& config, const std::string& pat
     if (f >= config.warmup) {
       run.mean_idle_percent += stats.idle_percent;
       run.worst_idle_percent = std::max(run.worst_idle_percent, stats.idle_percent);
+      run.mean_frame_ms += stats.frame_ms;
+      for (const core::TracerFrameStats& t : stats.tracers) run.mean_rendering_tracers += t.outcome == core::TracerOutcome::rendered;
       ++counted;
     }
   }
-  if (counted > 0) run.mean_idle_percent /= counted;
+  if (counted > 0) {
+    run.mean_idle_percent /= counted;
+    run.mean_frame_ms /= counted;
+    run.mean_rendering_tracers /= counted;
+  }
   return run;
 }
 
@@ -86,6 +97,7 @@ BalanceBenchRun run_one(const BalanceBenchConfig& config, const std::string& pat
 
 std::vector<BalanceBenchRun> run_balance_bench(const BalanceBenchConfig& config) {
   if (config.speeds.empty()) throw std::invalid_argument("bench balance: no speeds");
+  if (config.fixed_ms.empty()) throw std::invalid_argument("bench balance: no fixed costs");
   const std::vector<std::string> balancers = config.balancers.empty() ? balance::balancer_names() : config.balancers;
   std::vector<int> counts = config.tracer_counts;
   if (!config.real.empty()) counts = {static_cast<int>(config.real.size())};
@@ -100,7 +112,7 @@ std::vector<BalanceBenchRun> run_balance_bench(const BalanceBenchConfig& config)
 
 nlohmann::json balance_bench_json(const BalanceBenchConfig& config, const std::vector<BalanceBenchRun>& runs) {
   nlohmann::json j;
-  j["config"] = {{"tracer_counts", config.tracer_counts}, {"speeds", config.speeds},  {"noise", config.noise}, {"row_work", config.row_work}, {"row_work_error", config.row_work_error},
+  j["config"] = {{"tracer_counts", config.tracer_counts}, {"speeds", config.speeds}, {"fixed_ms", config.fixed_ms}, {"ms_per_cost", config.ms_per_cost},  {"noise", config.noise}, {"row_work", config.row_work}, {"row_work_error", config.row_work_error},
                  {"frames", config.frames},               {"warmup", config.warmup},  {"paths", config.paths},
                  {"rows", config.rows},                   {"seed", config.seed},      {"alpha", config.balancer_options.alpha},
                  {"robin_hood_units", config.balancer_options.robin_hood_units},
@@ -114,6 +126,8 @@ nlohmann::json balance_bench_json(const BalanceBenchConfig& config, const std::v
                          {"balancer", r.balancer},
                          {"mean_idle_percent", r.mean_idle_percent},
                          {"worst_idle_percent", r.worst_idle_percent},
+                         {"mean_frame_ms", r.mean_frame_ms},
+                         {"mean_rendering_tracers", r.mean_rendering_tracers},
                          {"idle_percent_per_frame", r.idle_percent}});
   }
   return j;
@@ -122,15 +136,16 @@ nlohmann::json balance_bench_json(const BalanceBenchConfig& config, const std::v
 std::string balance_bench_table(const std::vector<BalanceBenchRun>& runs) {
   std::string out;
   char line[256];
-  std::snprintf(line, sizeof line, "%-6s %-8s %-16s %12s %12s\n", "path", "tracers", "balancer", "mean idle %", "worst idle %");
+  std::snprintf(line, sizeof line, "%-6s %-8s %-16s %12s %12s %14s %10s\n", "path", "tracers", "balancer", "mean idle %", "worst idle %",
+                "mean frame ms", "rendering");
   out += line;
   std::string last_group;
   for (const BalanceBenchRun& r : runs) {
     const std::string group = r.path + std::to_string(r.tracers);
     if (!last_group.empty() && group != last_group) out += "\n";
     last_group = group;
-    std::snprintf(line, sizeof line, "%-6s %-8d %-16s %12.2f %12.2f\n", r.path.c_str(), r.tracers, r.balancer.c_str(),
-                  r.mean_idle_percent, r.worst_idle_percent);
+    std::snprintf(line, sizeof line, "%-6s %-8d %-16s %12.2f %12.2f %14.3f %10.2f\n", r.path.c_str(), r.tracers, r.balancer.c_str(),
+                  r.mean_idle_percent, r.worst_idle_percent, r.mean_frame_ms, r.mean_rendering_tracers);
     out += line;
   }
   return out;

@@ -16,6 +16,8 @@ struct BalanceBenchConfig {
   std::vector<std::string> balancers;    // empty: all
   std::vector<int> tracer_counts{2, 3, 4};
   std::vector<double> speeds{1.0};       // speed of simulated tracer i is speeds[i % size]
+  std::vector<double> fixed_ms{0.0};     // fixed cost per band of simulated tracer i: fixed_ms[i % size]
+  double ms_per_cost = 0.05;             // simulated ms per cost unit at speed 1 (a 720-row frame is ~860 units)
   double noise = 0.02;
   bool row_work = true;                  // simulated tracers report per-row work (the Row Cost proxy)
   double row_work_error = 0.2;
@@ -37,6 +39,8 @@ struct BalanceBenchRun {
   std::string path, balancer;
   int tracers = 0;
   double mean_idle_percent = 0.0, worst_idle_percent = 0.0;
+  double mean_frame_ms = 0.0;            // slowest band per frame (what idle % cannot show: a faster frame)
+  double mean_rendering_tracers = 0.0;   // tracers given rows per frame (a balancer may bench a slow one)
   std::vector<double> idle_percent;      // per frame, warm-up included
 };
 

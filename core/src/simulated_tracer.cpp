@@ -85,6 +85,7 @@ SimulatedTracer::SimulatedTracer(std::shared_ptr<const SpinSceneCostModel> model
     : model_(std::move(model)), options_(std::move(options)) {
   if (!model_) throw std::invalid_argument("SimulatedTracer: no cost model");
   if (!(options_.speed > 0.0)) throw std::invalid_argument("SimulatedTracer '" + options_.name + "': speed must be > 0");
+  if (!(options_.fixed_ms >= 0.0)) throw std::invalid_argument("SimulatedTracer '" + options_.name + "': fixed_ms must be >= 0");
 }
 
 void SimulatedTracer::apply(const commit::CommitBuffer& commit) {
@@ -108,7 +109,7 @@ BandResult SimulatedTracer::render_band(const BandJob& job, FrameBuffer& target)
   const std::vector<double> costs = model_->row_costs(camera_yaw(job.camera), rows);
   double band_cost = 0.0;
   for (int r = std::max(begin, 0); r < std::min(end, rows); ++r) band_cost += costs[static_cast<size_t>(r)];
-  double ms = band_cost * options_.ms_per_cost / options_.speed;
+  double ms = end > begin ? options_.fixed_ms + band_cost * options_.ms_per_cost / options_.speed : 0.0;
   if (options_.noise > 0.0) {
     std::mt19937_64 rng(mix(options_.seed * 0x100000001b3ull ^ frame));
     std::normal_distribution<double> gauss(0.0, options_.noise);

@@ -362,3 +362,25 @@ TEST(Renderer, ATracerThatNeverReturnsDoesNotBlockShutdownAndIsFreedIfItReturns)
   for (int i = 0; i < 500 && !*destroyed; ++i) std::this_thread::sleep_for(std::chrono::milliseconds(2));
   EXPECT_TRUE(*destroyed) << "once it returns, its abandoned worker frees it";
 }
+
+TEST(SimulatedTracer, AFixedCostIsPaidPerBandWhateverItsSizeAndNotScaledBySpeed) {
+  auto shared_model = model();
+  SimulatedTracerOptions plain = sim(1, 0.5), fixed = sim(1, 0.5);
+  fixed.fixed_ms = 2.0;
+  SimulatedTracer without(shared_model, plain), with(shared_model, fixed);
+  FrameBuffer target;
+  target.resize(kWidth, kRows);
+  for (auto [begin, end] : {std::pair{0, 1}, std::pair{10, 60}}) {
+    BandJob job = job_for(3);
+    job.params.row_begin = static_cast<kuint>(begin);
+    job.params.row_end = static_cast<kuint>(end);
+    const double base = without.render_band(job, target).device_ms;
+    EXPECT_GT(base, 0.0);
+    EXPECT_NEAR(with.render_band(job, target).device_ms, base + 2.0, 1e-9) << "rows [" << begin << ", " << end << ")";
+  }
+  BandJob empty = job_for(3);
+  empty.params.row_begin = empty.params.row_end = 5;
+  EXPECT_EQ(with.render_band(empty, target).device_ms, 0.0) << "no band, no launch";
+  fixed.fixed_ms = -1.0;
+  EXPECT_THROW(SimulatedTracer(shared_model, fixed), std::invalid_argument);
+}

@@ -47,6 +47,9 @@ struct SimulatedTracerOptions {
   double noise = 0.0;              // relative standard deviation of each band time
   uint64_t seed = 1;
   double ms_per_cost = 0.05;       // milliseconds per cost unit at speed 1
+  // Per rendered band, whatever its size: what a real tracer pays outside the rows themselves (kernel
+  // launch, upload, band copy, synchronisation). Not scaled by speed; noise applies to it too.
+  double fixed_ms = 0.0;
   SimulatedClock clock = SimulatedClock::virtual_time;
   double time_scale = 1.0;         // sleep/spin clocks wait time_scale * band time
   // Report a per-row work count (BandResult::row_work) like a kernel counting rays per row: the true
