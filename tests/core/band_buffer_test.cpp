@@ -5,6 +5,7 @@
 #include <cmath>
 #include <limits>
 #include <random>
+#include <vector>
 
 #include "cohort/core/half_float.h"
 
@@ -78,4 +79,24 @@ TEST(BandBuffer, FloatRowsComeBackExactly) {
   out.resize(2, 2);
   band.copy_rows_to(out, 0, 2);
   for (int i = 0; i < 8; ++i) EXPECT_EQ(out.row(1)[i], row[i]);
+}
+
+TEST(HalfFloat, RowConversionsAgreeWithTheScalarOnes) {
+  // The row conversions may take a faster path (F16C); they must give the same halves and floats.
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<float> exponent(-30.0f, 20.0f);
+  std::vector<float> rgba(4 * 1001);
+  for (size_t i = 0; i < rgba.size(); ++i) rgba[i] = (i % 7 == 0 ? -1.0f : 1.0f) * std::exp2(exponent(rng));
+  rgba[4] = std::numeric_limits<float>::infinity();
+  rgba[9] = 0.0f;
+  std::vector<uint16_t> rgb(3 * 1001);
+  rgba32f_to_rgb16f(rgba.data(), rgb.data(), 1001);
+  for (size_t p = 0; p < 1001; ++p)
+    for (size_t k = 0; k < 3; ++k) ASSERT_EQ(rgb[3 * p + k], float_to_half(rgba[4 * p + k])) << p << "," << k;
+  std::vector<float> back(4 * 1001);
+  rgb16f_to_rgba32f(rgb.data(), back.data(), 1001);
+  for (size_t p = 0; p < 1001; ++p) {
+    for (size_t k = 0; k < 3; ++k) ASSERT_EQ(back[4 * p + k], half_to_float(rgb[3 * p + k])) << p << "," << k;
+    ASSERT_EQ(back[4 * p + 3], 1.0f);
+  }
 }

@@ -6,6 +6,7 @@
 // full 20,000 frames.
 #include <gtest/gtest.h>
 
+#include <cstdio>
 #include <cstdlib>
 #include <fstream>
 #include <random>
@@ -127,6 +128,9 @@ TEST(Soak, ScenarioReplayWithFailingAndStallingTracersLosesNoCommitAndKeepsMemor
   for (uint64_t f : threw) EXPECT_EQ(injected.count(f), 1u) << "the failing tracer threw on frame " << f;
   EXPECT_GE(threw.size() + 1, injected.size());
   EXPECT_GE(stalls, 1);
+  std::printf("soak: %d frames delivered, %zu failures and %d stalls injected, resident memory %.1f MiB after "
+              "warm-up, %.1f MiB at most after\n",
+              delivered, threw.size(), stalls, warm_mib, peak_mib);
   // Flat: what a run adds after warm-up is noise of the allocator, not a leak per frame.
   EXPECT_LT(peak_mib - warm_mib, 16.0) << "resident memory grew from " << warm_mib << " MiB to " << peak_mib << " MiB";
 
