@@ -55,6 +55,7 @@ struct RenderArgs {
   std::string trace;
   std::string denoise = "none";
   std::string denoise_quality = "high";
+  std::string band_format = "rgb16f";
   bool frames_given = false;
 };
 
@@ -82,6 +83,7 @@ int run_render(const RenderArgs& a) {
   std::vector<std::unique_ptr<core::Tracer>> tracers = tracers::make_tracers(a.tracers);
   core::RendererOptions options;
   options.balancer = a.balancer;
+  options.band_format = a.band_format == "rgba32f" ? core::BandFormat::rgba32f : core::BandFormat::rgb16f;
   options.frame_timeout = std::chrono::milliseconds(600000);
   core::Renderer renderer(std::move(tracers), options);
 
@@ -238,6 +240,10 @@ void add_render_command(CLI::App& app, int& exit_code) {
                   "comma-separated: embree, opencl[:N|:all], cuda[:N|:all], or all (Embree on the CPU plus every GPU once)")
       ->capture_default_str();
   cmd->add_option("--balancer", a->balancer, "row balancer when there are several tracers")->capture_default_str();
+  cmd->add_option("--band-format", a->band_format,
+                  "what the tracers hand back: RGB half floats (6 bytes a pixel, merged into float) or RGBA floats")
+      ->capture_default_str()
+      ->check(CLI::IsMember({"rgb16f", "rgba32f"}));
   cmd->add_option("--width", a->width, "image width")->capture_default_str()->check(CLI::PositiveNumber);
   cmd->add_option("--height", a->height, "image height")->capture_default_str()->check(CLI::PositiveNumber);
   cmd->add_option("--spp", a->spp, "samples per pixel per frame")->capture_default_str()->check(CLI::PositiveNumber);

@@ -70,13 +70,18 @@ double AdaptiveConvergence::accumulate(const KCamera& camera, const FrameBuffer&
   const float global = static_cast<float>(f);
   const float object_f = static_cast<float>(options_.moving_object_f);
   constexpr size_t kPixelsPerRange = 16384;  // smaller ranges cost more to hand out than they save
-  HostThreads::shared().for_ranges(pixels, kPixelsPerRange, [&](size_t begin, size_t end) {
+  // Restrict pointers and the mask test outside the loops, so that both loops vectorise.
+  float* __restrict accumulated = accumulated_.rgba.data();
+  const float* __restrict incoming = fresh.rgba.data();
+  const float* __restrict mask = motion_mask ? motion_mask->data() : nullptr;
+  HostThreads::shared().for_ranges(pixels, kPixelsPerRange, [=](size_t begin, size_t end) {
+    if (!mask) {
+      for (size_t i = 4 * begin; i < 4 * end; ++i) accumulated[i] = converge(accumulated[i], incoming[i], global);
+      return;
+    }
     for (size_t p = begin; p < end; ++p) {
-      float fp = global;
-      if (motion_mask) fp = std::max(fp, std::clamp((*motion_mask)[p], 0.0f, 1.0f) * object_f);
-      float* c = accumulated_.rgba.data() + p * 4;
-      const float* n = fresh.rgba.data() + p * 4;
-      for (int k = 0; k < 4; ++k) c[k] = converge(c[k], n[k], fp);
+      const float fp = std::max(global, std::clamp(mask[p], 0.0f, 1.0f) * object_f);
+      for (size_t k = 4 * p; k < 4 * p + 4; ++k) accumulated[k] = converge(accumulated[k], incoming[k], fp);
     }
   });
   return f;

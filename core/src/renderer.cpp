@@ -17,7 +17,7 @@ using Clock = std::chrono::steady_clock;
 
 namespace {
 
-constexpr size_t kRowsPerCopy = 16;  // a band's rows are copied into the frame in ranges this size or larger
+constexpr size_t kRowsPerCopy = 16;  // a band's rows are merged into the frame in ranges this size or larger
 
 // Signalled by workers when a job ends; the core waits on it.
 struct Completion {
@@ -65,7 +65,7 @@ struct Renderer::Worker {
   // The tracer's private targets, one per frame parity, so that the core merges frame N from one
   // while the tracer renders N+1 into the other. Only the worker writes a target while its job runs;
   // the core reads a finished job's rows until it hands out a job for the same slot again.
-  FrameBuffer targets[2];
+  BandBuffer targets[2];
   std::thread thread;
 
   void loop() {
@@ -256,8 +256,7 @@ std::vector<uint64_t> Renderer::assign(const std::vector<Assignment>& assignment
   std::vector<uint64_t> ids(assignments.size());
   for (size_t i = 0; i < assignments.size(); ++i) {
     Worker& w = *workers_[static_cast<size_t>(assignments[i].worker)];
-    FrameBuffer& target = w.targets[slot];
-    if (target.width != width || target.height != height) target.resize(width, height);
+    w.targets[slot].resize(width, height, options_.band_format);
     ids[i] = next_job_++;
     {
       std::lock_guard lock(w.completion->mutex);
@@ -323,12 +322,10 @@ Renderer::RoundResult Renderer::collect(const std::vector<Assignment>& assignmen
 }
 
 void Renderer::merge(const std::vector<Assignment>& bands, int slot, FrameBuffer& out) const {
-  const size_t row_floats = static_cast<size_t>(out.width) * 4;
   for (const Assignment& a : bands) {
-    const FrameBuffer& target = workers_[static_cast<size_t>(a.worker)]->targets[slot];
+    const BandBuffer& target = workers_[static_cast<size_t>(a.worker)]->targets[slot];
     HostThreads::shared().for_ranges(static_cast<size_t>(a.band.rows()), kRowsPerCopy, [&](size_t begin, size_t end) {
-      const size_t offset = (static_cast<size_t>(a.band.begin) + begin) * row_floats;
-      std::memcpy(out.rgba.data() + offset, target.rgba.data() + offset, (end - begin) * row_floats * sizeof(float));
+      target.copy_rows_to(out, a.band.begin + static_cast<int>(begin), a.band.begin + static_cast<int>(end));
     });
   }
 }

@@ -97,7 +97,7 @@ void SimulatedTracer::apply(const commit::CommitBuffer& commit) {
   last_commit_frame_ = commit.frame();
 }
 
-BandResult SimulatedTracer::render_band(const BandJob& job, FrameBuffer& target) {
+BandResult SimulatedTracer::render_band(const BandJob& job, BandBuffer& target) {
   const uint64_t frame = job.params.frame_index;
   if (options_.throw_on_frames.count(frame))
     throw std::runtime_error(options_.name + ": simulated device fault on frame " + std::to_string(frame));
@@ -115,15 +115,14 @@ BandResult SimulatedTracer::render_band(const BandJob& job, FrameBuffer& target)
     std::normal_distribution<double> gauss(0.0, options_.noise);
     ms *= std::max(0.05, 1.0 + gauss(rng));
   }
-  for (int r = std::max(begin, 0); r < std::min(end, target.height); ++r) {
-    float* p = target.row(r);
-    for (int x = 0; x < target.width; ++x, p += 4) {
-      p[0] = static_cast<float>(frame);
-      p[1] = static_cast<float>(options_.seed);
-      p[2] = 1.0f;
-      p[3] = 1.0f;
-    }
+  std::vector<float> row(static_cast<size_t>(target.width()) * 4);
+  for (size_t x = 0; x < row.size(); x += 4) {
+    row[x + 0] = static_cast<float>(frame);
+    row[x + 1] = static_cast<float>(options_.seed);
+    row[x + 2] = 1.0f;
+    row[x + 3] = 1.0f;
   }
+  for (int r = std::max(begin, 0); r < std::min(end, target.height()); ++r) target.store(r, 0, row.data(), static_cast<size_t>(target.width()));
   const auto wait = std::chrono::duration<double, std::milli>(ms * options_.time_scale);
   if (options_.clock == SimulatedClock::sleep) {
     std::this_thread::sleep_for(wait);

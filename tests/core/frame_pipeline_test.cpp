@@ -69,7 +69,7 @@ TEST(FramePipeline, TheCorePreparesTheNextFrameAndFinishesThePreviousOneWhileThe
     // Everything is delivered whole: every row comes from this frame.
     for (int y = 0; y < kRows; ++y) ASSERT_EQ(pipeline.image().row(y)[0], static_cast<float>(done.stats.frame));
     ScopedStage tone_mapping(done.stats.stages, kCoreTrack, "tone map");  // stands for blend, tone map, output
-    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+    std::this_thread::sleep_for(std::chrono::milliseconds(15));
     tone_mapping.finish();
     frames[done.stats.frame] = std::move(done.stats);
   };
@@ -81,7 +81,7 @@ TEST(FramePipeline, TheCorePreparesTheNextFrameAndFinishesThePreviousOneWhileThe
     commit.set_frame(f + 1);
     commit.set_camera(job_for(f).camera);
     renderer.submit_commit(commit, [&] { return scene; });
-    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+    std::this_thread::sleep_for(std::chrono::milliseconds(15));
     syncing.finish();
     std::optional<FramePipeline::Delivered> done = pipeline.push(job_for(f), std::move(preparation));
     ASSERT_EQ(done.has_value(), f > 0);

@@ -38,13 +38,15 @@ struct CudaTracer::Impl {
   DeviceArray<KLight> lights;
   cudaTextureObject_t texel_texture = 0;
   float4* band = nullptr;
+  unsigned short* band_rgb16f = nullptr;   // the band as RGB halves, for RGB16F targets
   bool count_rays = false;
   unsigned long long* ray_counts = nullptr;   // device: closest, occlusion
   RayCounts last_counts;
   size_t band_capacity = 0;   // pixels
-  // The frame buffers the band is copied into, page-locked so the copy runs at full DMA speed instead
-  // of through the driver's pageable staging (about 3 ms of a 1080p frame otherwise). The Renderer
-  // alternates two targets by frame parity (the pipeline), so the last two stay registered.
+  // The targets the band is copied into, page-locked (cudaHostRegister) so that the copy is a true
+  // asynchronous DMA on the tracer's stream instead of going through the driver's pageable staging
+  // (about 3 ms of a 1080p frame otherwise). The Renderer alternates two targets by frame parity (the
+  // pipeline), so the last two stay registered.
   struct Registered {
     void* ptr = nullptr;
     size_t bytes = 0;
@@ -52,9 +54,9 @@ struct CudaTracer::Impl {
   Registered registered[2];
   int next_registration = 0;
 
-  void register_target(core::FrameBuffer& target) {
-    void* ptr = target.rgba.data();
-    const size_t bytes = target.rgba.size() * sizeof(float);
+  void register_target(core::BandBuffer& target) {
+    void* ptr = target.data();
+    const size_t bytes = target.bytes();
     for (const Registered& r : registered)
       if (r.ptr == ptr && r.bytes == bytes) return;
     Registered& slot = registered[next_registration];
@@ -106,6 +108,7 @@ CudaTracer::~CudaTracer() {
   for (const Impl::Registered& r : impl_->registered)
     if (r.ptr) cudaHostUnregister(r.ptr);
   if (impl_->band) cudaFree(impl_->band);
+  if (impl_->band_rgb16f) cudaFree(impl_->band_rgb16f);
   if (impl_->ray_counts) cudaFree(impl_->ray_counts);
   if (impl_->start) cudaEventDestroy(impl_->start);
   if (impl_->stop) cudaEventDestroy(impl_->stop);
@@ -143,21 +146,25 @@ void CudaTracer::upload(const commit::ChangeSet& changes) {
   COHORT_CUDA(cudaStreamSynchronize(s));
 }
 
-core::BandResult CudaTracer::render_band(const core::BandJob& job, core::FrameBuffer& target) {
+core::BandResult CudaTracer::render_band(const core::BandJob& job, core::BandBuffer& target) {
   Impl& m = *impl_;
   COHORT_CUDA(cudaSetDevice(m.device));
   if (!has_scene()) throw std::runtime_error(m.name + ": render_band before any commit was applied");
   const KFrameParams params = frame_params(job);
   const KCamera& camera = job.camera;
   if (params.row_end <= params.row_begin) return {};
-  if (camera.width != kuint(target.width) || params.row_end > kuint(target.height))
+  if (camera.width != kuint(target.width()) || params.row_end > kuint(target.height()))
     throw std::invalid_argument(m.name + ": band does not fit the frame buffer");
   const size_t pixels = size_t(camera.width) * (params.row_end - params.row_begin);
   if (pixels > m.band_capacity) {
     if (m.band) COHORT_CUDA(cudaFree(m.band));
+    if (m.band_rgb16f) COHORT_CUDA(cudaFree(m.band_rgb16f));
+    m.band_rgb16f = nullptr;
     COHORT_CUDA(cudaMalloc(&m.band, pixels * sizeof(float4)));
     m.band_capacity = pixels;
   }
+  const bool half = target.format() == core::BandFormat::rgb16f;
+  if (half && !m.band_rgb16f) COHORT_CUDA(cudaMalloc(&m.band_rgb16f, m.band_capacity * 3 * sizeof(unsigned short)));
   if (m.count_rays) {
     if (!m.ray_counts) COHORT_CUDA(cudaMalloc(&m.ray_counts, 2 * sizeof(unsigned long long)));
     COHORT_CUDA(cudaMemsetAsync(m.ray_counts, 0, 2 * sizeof(unsigned long long), m.stream));
@@ -166,9 +173,14 @@ core::BandResult CudaTracer::render_band(const core::BandJob& job, core::FrameBu
   COHORT_CUDA(cudaEventRecord(m.start, m.stream));
   launch_render_band(m.view(params), params, camera, m.band, m.count_rays ? m.ray_counts : nullptr, m.stream);
   COHORT_CUDA(cudaEventRecord(m.stop, m.stream));
-  // The band's rows are contiguous in the frame buffer: one copy straight into place.
-  COHORT_CUDA(cudaMemcpyAsync(target.row(int(params.row_begin)), m.band, pixels * sizeof(float4), cudaMemcpyDeviceToHost,
-                              m.stream));
+  // The band's rows are contiguous in the target: one copy straight into place, in its format.
+  const void* source = m.band;
+  if (half) {
+    launch_band_to_rgb16f(m.band, m.band_rgb16f, pixels, m.stream);
+    source = m.band_rgb16f;
+  }
+  COHORT_CUDA(cudaMemcpyAsync(target.row(int(params.row_begin)), source, pixels * core::bytes_per_pixel(target.format()),
+                              cudaMemcpyDeviceToHost, m.stream));
   unsigned long long counts[2] = {0, 0};
   if (m.count_rays)
     COHORT_CUDA(cudaMemcpyAsync(counts, m.ray_counts, sizeof counts, cudaMemcpyDeviceToHost, m.stream));

@@ -133,20 +133,20 @@ void EmbreeTracer::upload(const commit::ChangeSet& changes) {
   check_device(impl_->device, "building the instance scene");
 }
 
-core::BandResult EmbreeTracer::render_band(const core::BandJob& job, core::FrameBuffer& target) {
+core::BandResult EmbreeTracer::render_band(const core::BandJob& job, core::BandBuffer& target) {
   if (!impl_->top) throw std::runtime_error("EmbreeTracer: render_band before any commit was applied");
   auto start = std::chrono::steady_clock::now();
   const KFrameParams params = frame_params(job);
   const KCamera camera = job.camera;
   const int row_begin = static_cast<int>(params.row_begin);
-  const int row_end = std::min(static_cast<int>(params.row_end), target.height);
-  const int width = std::min(static_cast<int>(camera.width), target.width);
+  const int row_end = std::min(static_cast<int>(params.row_end), target.height());
+  const int width = std::min(static_cast<int>(camera.width), target.width());
   const embree_kernel::TraceCtx base{host_scene_view(params), impl_->top, 0};
   std::atomic<uint64_t> rays{0};
   tbb::parallel_for(tbb::blocked_range<int>(row_begin, row_end, 1), [&](const tbb::blocked_range<int>& rows) {
     embree_kernel::TraceCtx ctx = base;
+    std::vector<float> out(static_cast<size_t>(width) * 4);  // one row, stored in the target's format
     for (int y = rows.begin(); y < rows.end(); ++y) {
-      float* out = target.row(y);
       for (int x = 0; x < width; ++x) {
         KVec3 c = k_render_pixel(&ctx, &params, &camera, static_cast<kuint>(x), static_cast<kuint>(y));
         out[4 * x + 0] = c.x;
@@ -154,6 +154,7 @@ core::BandResult EmbreeTracer::render_band(const core::BandJob& job, core::Frame
         out[4 * x + 2] = c.z;
         out[4 * x + 3] = 1.0f;
       }
+      target.store(y, 0, out.data(), static_cast<size_t>(width));
     }
     rays += ctx.rays;
   });

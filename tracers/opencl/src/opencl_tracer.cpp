@@ -192,13 +192,13 @@ void OpenCLTracer::upload(const commit::ChangeSet& changes) {
   if (all || changes.lights) m.lights.upload(c, q, s.lights, "uploading lights");
 }
 
-core::BandResult OpenCLTracer::render_band(const core::BandJob& job, core::FrameBuffer& target) {
+core::BandResult OpenCLTracer::render_band(const core::BandJob& job, core::BandBuffer& target) {
   Impl& m = *impl_;
   if (!has_scene()) throw std::runtime_error("OpenCLTracer: render_band before any commit was applied");
   KFrameParams params = frame_params(job);
   KCamera camera = job.camera;
-  params.row_end = std::min<kuint>(params.row_end, static_cast<kuint>(target.height));
-  camera.width = std::min<kuint>(camera.width, static_cast<kuint>(target.width));
+  params.row_end = std::min<kuint>(params.row_end, static_cast<kuint>(target.height()));
+  camera.width = std::min<kuint>(camera.width, static_cast<kuint>(target.width()));
   if (params.row_end <= params.row_begin || camera.width == 0) return {};
   const size_t rows = params.row_end - params.row_begin;
   const size_t bytes = rows * camera.width * 4 * sizeof(float);
@@ -230,8 +230,7 @@ core::BandResult OpenCLTracer::render_band(const core::BandJob& job, core::Frame
   clGetEventProfilingInfo(done, CL_PROFILING_COMMAND_END, sizeof end, &end, nullptr);
   clReleaseEvent(done);
   for (size_t r = 0; r < rows; ++r)
-    std::memcpy(target.row(static_cast<int>(params.row_begin + r)), band.data() + r * camera.width * 4,
-                camera.width * 4 * sizeof(float));
+    target.store(static_cast<int>(params.row_begin + r), 0, band.data() + r * camera.width * 4, camera.width);
   core::BandResult result;
   result.device_ms = end > start ? double(end - start) * 1e-6 : 0.0;
   return result;

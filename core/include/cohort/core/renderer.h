@@ -24,6 +24,7 @@
 #include "cohort/balance/balancer.h"
 #include "cohort/commit/commit_buffer.h"
 #include "cohort/commit/commit_channel.h"
+#include "cohort/core/band_buffer.h"
 #include "cohort/core/frame_buffer.h"
 #include "cohort/core/frame_stats.h"
 #include "cohort/core/tracer.h"
@@ -43,6 +44,9 @@ struct RendererOptions {
   bool use_row_work = true;
   // Per tracer: past this many bytes of pending records, it gets a full resync instead.
   size_t commit_budget_bytes = 32u << 20;
+  // What the tracers render their bands into (core/band_buffer.h); the merge converts to the float
+  // frame. The apps take RGB16F; RGBA32F keeps values exact.
+  BandFormat band_format = BandFormat::rgba32f;
 };
 
 class Renderer {

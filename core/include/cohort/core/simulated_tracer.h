@@ -72,7 +72,8 @@ class SimulatedTracer final : public Tracer {
   void apply(const commit::CommitBuffer& commit) override;
   // Writes every pixel of its rows as (frame_index, tag, 1, 1), tag = seed, so tests can see who
   // delivered each row; returns the simulated time as device_ms.
-  BandResult render_band(const BandJob& job, FrameBuffer& target) override;
+  using Tracer::render_band;
+  BandResult render_band(const BandJob& job, BandBuffer& target) override;
 
   uint64_t commits_applied() const { return commits_applied_; }
   uint64_t last_commit_frame() const { return last_commit_frame_; }

@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "cohort/commit/commit_buffer.h"
+#include "cohort/core/band_buffer.h"
 #include "cohort/core/frame_buffer.h"
 #include "cohort/kernel/layout.h"
 
@@ -29,8 +30,13 @@ class Tracer {
   virtual std::string name() const = 0;
   // Bring the tracer's scene copy (and device buffers) up to date. Called on the tracer's thread.
   virtual void apply(const commit::CommitBuffer& commit) = 0;
-  // Render rows [row_begin, row_end) of the frame into target (full frame size; only those rows are written).
-  virtual BandResult render_band(const BandJob& job, FrameBuffer& target) = 0;
+  // Render rows [row_begin, row_end) of the frame into target (full frame size, in the format it
+  // has; only those rows are written).
+  virtual BandResult render_band(const BandJob& job, BandBuffer& target) = 0;
+  // The same into a float frame (tests, benches): rendered as RGBA32F and copied into those rows of
+  // target, which is resized to the camera's size when it differs. Derived classes say
+  // `using core::Tracer::render_band;` so that it is not hidden.
+  BandResult render_band(const BandJob& job, FrameBuffer& target);
 };
 
 }  // namespace cohort::core

@@ -19,7 +19,8 @@ class CudaTracer final : public TracerBase {
   explicit CudaTracer(int device);
   ~CudaTracer() override;
   std::string name() const override;
-  core::BandResult render_band(const core::BandJob& job, core::FrameBuffer& target) override;
+  using core::Tracer::render_band;
+  core::BandResult render_band(const core::BandJob& job, core::BandBuffer& target) override;
 
   // Ray counting for benchmarks (off by default: it costs a reduction per warp).
   struct RayCounts {

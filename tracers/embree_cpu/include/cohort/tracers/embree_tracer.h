@@ -18,7 +18,8 @@ class EmbreeTracer : public TracerBase {
   EmbreeTracer& operator=(const EmbreeTracer&) = delete;
 
   std::string name() const override { return "embree"; }
-  core::BandResult render_band(const core::BandJob& job, core::FrameBuffer& target) override;
+  using core::Tracer::render_band;
+  core::BandResult render_band(const core::BandJob& job, core::BandBuffer& target) override;
 
   // Raw closest-hit throughput: traces exactly the band's camera rays (same jitter as the integrator,
   // params.spp per pixel) with rtcIntersect1 and nothing else. Returns the number of rays that hit.

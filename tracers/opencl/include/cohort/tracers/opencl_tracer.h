@@ -24,7 +24,8 @@ class OpenCLTracer : public TracerBase {
   OpenCLTracer& operator=(const OpenCLTracer&) = delete;
 
   std::string name() const override;
-  core::BandResult render_band(const core::BandJob& job, core::FrameBuffer& target) override;
+  using core::Tracer::render_band;
+  core::BandResult render_band(const core::BandJob& job, core::BandBuffer& target) override;
 
   // "platform / device" for every OpenCL device on this machine, in the order Options::device counts.
   static std::vector<std::string> list_devices();

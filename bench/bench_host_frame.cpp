@@ -1,0 +1,115 @@
+// The core's per-pixel host work per frame (merge of the tracers' bands, the convergence blend, the
+// tone map) at a given size, for each band format: what `cohort render` and `cohort play` spend on the
+// host besides the tracers. Two simulated tracers (virtual clock) split the rows; the camera stays
+// still, so every frame blends into the accumulated image.
+//
+//   bench_host_frame [--width 1920] [--height 1080] [--frames 40] [--json FILE]   (out/bench_host_frame.json)
+#include <algorithm>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "cohort/core/convergence.h"
+#include "cohort/core/frame_pipeline.h"
+#include "cohort/core/host_threads.h"
+#include "cohort/core/renderer.h"
+#include "cohort/core/simulated_tracer.h"
+#include "cohort/core/tonemap.h"
+
+using namespace cohort;
+using namespace cohort::core;
+
+namespace {
+
+double median(std::vector<double> v) {
+  if (v.empty()) return 0.0;
+  std::sort(v.begin(), v.end());
+  return v[v.size() / 2];
+}
+
+double stage_ms(const FrameStats& stats, const std::string& stage) {
+  double ms = 0.0;
+  for (const StageSpan& s : stats.stages)
+    if (s.track == kCoreTrack && s.stage == stage) ms += s.ms;
+  return ms;
+}
+
+nlohmann::json run(BandFormat format, int width, int height, int frames) {
+  std::vector<std::unique_ptr<Tracer>> tracers;
+  for (uint64_t tag : {1u, 2u}) {
+    SimulatedTracerOptions o;
+    o.name = "sim" + std::to_string(tag);
+    o.seed = tag;
+    tracers.push_back(std::make_unique<SimulatedTracer>(std::make_shared<SpinSceneCostModel>(3), o));
+  }
+  RendererOptions options;
+  options.use_reported_time = true;
+  options.band_format = format;
+  Renderer renderer(std::move(tracers), options);
+  FramePipeline pipeline(renderer);
+  AdaptiveConvergence convergence;
+  ToneMapOptions tone_options;
+  std::vector<double> merge, blend, tone;
+  auto finish = [&](FramePipeline::Delivered done) {
+    ScopedStage blending(done.stats.stages, kCoreTrack, "convergence");
+    convergence.accumulate(done.job.camera, pipeline.image());
+    blending.finish();
+    ScopedStage mapping(done.stats.stages, kCoreTrack, "tone map");
+    const std::vector<uint8_t> display = tone_map(convergence.image(), tone_options);
+    mapping.finish();
+    if (done.stats.frame < 5) return;  // warm-up: first-touch page faults, thread start
+    merge.push_back(stage_ms(done.stats, "merge"));
+    blend.push_back(stage_ms(done.stats, "convergence"));
+    tone.push_back(stage_ms(done.stats, "tone map"));
+  };
+  for (int f = 0; f < frames; ++f) {
+    BandJob job;
+    job.camera = spin_camera(width, height, 0.0);
+    job.params.frame_index = static_cast<kuint>(f);
+    if (auto done = pipeline.push(job)) finish(std::move(*done));
+  }
+  if (auto done = pipeline.drain()) finish(std::move(*done));
+  const double m = median(merge), c = median(blend), t = median(tone);
+  return {{"band_format", to_string(format)}, {"band_bytes_per_pixel", bytes_per_pixel(format)},
+          {"merge_ms", m}, {"convergence_ms", c}, {"tone_map_ms", t}, {"host_ms", m + c + t}};
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  int width = 1920, height = 1080, frames = 40;
+  std::string json_path = "out/bench_host_frame.json";
+  for (int i = 1; i + 1 < argc; i += 2) {
+    const std::string arg = argv[i];
+    if (arg == "--width") width = std::stoi(argv[i + 1]);
+    else if (arg == "--height") height = std::stoi(argv[i + 1]);
+    else if (arg == "--frames") frames = std::max(6, std::stoi(argv[i + 1]));
+    else if (arg == "--json") json_path = argv[i + 1];
+    else {
+      std::fprintf(stderr, "bench_host_frame: unknown option %s\n", arg.c_str());
+      return 2;
+    }
+  }
+  std::printf("host work per frame at %dx%d, %u host threads, median of %d frames\n", width, height,
+              HostThreads::shared().threads(), frames - 5);
+  std::printf("%-8s %10s %10s %14s %12s %10s\n", "band", "bytes/px", "merge ms", "convergence ms", "tone map ms", "host ms");
+  nlohmann::json results = nlohmann::json::array();
+  for (BandFormat format : {BandFormat::rgba32f, BandFormat::rgb16f}) {
+    const nlohmann::json r = run(format, width, height, frames);
+    std::printf("%-8s %10zu %10.2f %14.2f %12.2f %10.2f\n", to_string(format), bytes_per_pixel(format),
+                r["merge_ms"].get<double>(), r["convergence_ms"].get<double>(), r["tone_map_ms"].get<double>(),
+                r["host_ms"].get<double>());
+    results.push_back(r);
+  }
+  const std::filesystem::path path(json_path);
+  if (path.has_parent_path()) std::filesystem::create_directories(path.parent_path());
+  std::ofstream(path) << nlohmann::json{{"width", width}, {"height", height}, {"host_threads", HostThreads::shared().threads()},
+                                        {"results", results}}.dump(2)
+                      << "\n";
+  std::printf("wrote %s\n", json_path.c_str());
+  return 0;
+}
