@@ -159,6 +159,7 @@ class SceneBuilder {
       }
       scene_.meshes.push_back(std::move(model.mesh));
     }
+    proc_mesh_count_ = static_cast<int>(scene_.meshes.size());
     std::sort(areas.begin(), areas.end());
     for (size_t i = 0; i < areas.size(); ++i) {
       if (areas[i].first != static_cast<int>(i))
@@ -213,9 +214,9 @@ class SceneBuilder {
         scene_.player_yaw = yaw ? (*yaw)[0] : 0.0f;
       }
       auto model = e.get("model");
-      if (model) entity.mesh = scene_.find_mesh(*model);
+      if (model) entity.mesh = find_inline_model(*model);
       if (entity.mesh < 0 && !entity.name.empty() && (!model || *model == entity.name))
-        entity.mesh = scene_.find_mesh(entity.name);
+        entity.mesh = find_inline_model(entity.name);
       if (entity.mesh < 0 && model)
         entity.mesh = models.mesh_for(*model, e.get_or("skin", ""), e.get_or("anim", ""), entity, where);
       if (entity.mesh < 0 && model) {
@@ -239,7 +240,7 @@ class SceneBuilder {
     fixture.origin = light.origin;
     fixture.axis = light.axis;
     for (const auto& [key, value] : e.keys) fixture.keys[key] = value;
-    fixture.mesh = scene_.find_mesh(model);
+    fixture.mesh = find_inline_model(model);
     if (fixture.mesh < 0) fixture.mesh = models.mesh_for(model, e.get_or("skin", ""), "", fixture, where);
     if (fixture.mesh < 0) {
       scene_.warnings.push_back(where + ": light " + light.name + ": model '" + model +
@@ -252,6 +253,12 @@ class SceneBuilder {
     report_.entity_triangles += scene_.meshes[static_cast<size_t>(fixture.mesh)].triangle_count();
     ++report_.entities_by_class["(light model)"];
     scene_.entities.push_back(std::move(fixture));
+  }
+
+  // A .proc model by name (the meshes the model files add later are found by EntityModels).
+  int find_inline_model(const std::string& name) const {
+    int mesh = scene_.find_mesh(name);
+    return mesh >= 0 && mesh < proc_mesh_count_ ? mesh : -1;
   }
 
   void finish() {
@@ -269,6 +276,7 @@ class SceneBuilder {
   std::map<std::string, MaterialDecl> decls_;
   std::map<std::string, int> used_;
   DeclLibrary decls_lib_;
+  int proc_mesh_count_ = 0;
 };
 
 }  // namespace
