@@ -8,6 +8,7 @@
 #include <tuple>
 
 #include "cohort/scene/map_loader.h"
+#include "cohort/scene/md5.h"
 #include "test_files.h"
 
 using namespace cohort::scene;
@@ -245,5 +246,36 @@ TEST_F(TestMap, ModelMeshesAreClosedAndFaceOutwards) {
     }
     for (const auto& [edge, count] : edges) EXPECT_EQ(count, 0) << name;
     EXPECT_GT(volume, 0.0) << name;
+  }
+}
+
+TEST_F(TestMap, WalkerAnimationLoopsAndMovesTheLegs) {
+  Vfs vfs;
+  vfs.add_search_path(testmap_dir());
+  Md5Mesh mesh = parse_md5mesh(*vfs.read("models/testmap/walker.md5mesh"), "walker.md5mesh");
+  Md5Anim anim = parse_md5anim(*vfs.read("models/testmap/walker_walk.md5anim"), "walker_walk.md5anim");
+  check_anim_matches(mesh, anim);
+  EXPECT_EQ(anim.length_ms(), 1000);
+  auto positions = [&](int ms) {
+    std::vector<glm::vec3> out;
+    for (const Vertex& v : skin_md5(mesh, anim_pose(anim, ms)).mesh.vertices) out.push_back(v.position);
+    return out;
+  };
+  std::vector<glm::vec3> start = positions(0), quarter = positions(250), looped = positions(1000);
+  float moved = 0.0f, loop_error = 0.0f;
+  for (size_t i = 0; i < start.size(); ++i) {
+    moved = std::max(moved, glm::length(quarter[i] - start[i]));
+    loop_error = std::max(loop_error, glm::length(looped[i] - start[i]));
+  }
+  EXPECT_GT(moved, 5.0f);          // a thigh swung by 30 degrees moves the foot by several units
+  EXPECT_LT(loop_error, 1e-3f);    // one second later it is back where it started
+  // Every frame stays inside the animation's bounds.
+  for (int frame = 0; frame < anim.frame_count(); ++frame) {
+    for (const Vertex& v : skin_md5(mesh, anim_frame_pose(anim, frame)).mesh.vertices) {
+      for (int axis = 0; axis < 3; ++axis) {
+        EXPECT_GE(v.position[axis], anim.bounds[size_t(frame)].first[axis] - 1e-3f) << frame;
+        EXPECT_LE(v.position[axis], anim.bounds[size_t(frame)].second[axis] + 1e-3f) << frame;
+      }
+    }
   }
 }
