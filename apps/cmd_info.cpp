@@ -40,7 +40,7 @@ int run_info(const std::string& map, std::vector<std::string> bases, size_t max_
     std::cout << "  " << classname << " " << count << "\n";
   std::cout << "decls      " << report.entity_defs << " entityDefs, " << report.model_defs << " modelDefs, "
             << report.skins << " skins in " << report.def_files << " .def/.skin files\n"
-            << "models     " << report.model_files_loaded << " model files loaded\n"
+            << "models     " << report.model_files_loaded << " model meshes loaded (one per model file and skin)\n"
             << "unresolved " << report.unresolved_classes.size() << " classes, " << report.unresolved_models.size()
             << " models\n";
   for (const auto& [classname, count] : report.unresolved_classes)

@@ -172,7 +172,7 @@ TEST(AseParser, CornersWeldWithinAnObject) {
     *MESH_VERTEX 3 0 1 0
     }
     *MESH_FACE_LIST { *MESH_FACE 0: A: 0 B: 1 C: 2
-    *MESH_FACE 1: A: 0 B: 2 C: 3
+    *MESH_FACE 1: A:0 B:2 C:3
     }
   } })";
   ModelFile m = parse_ase(quad, "quad.ase");
