@@ -38,6 +38,15 @@ int run_info(const std::string& map, std::vector<std::string> bases, size_t max_
             << "entities   " << loaded.entities.size() << "\n";
   for (const auto& [classname, count] : report.entities_by_class)
     std::cout << "  " << classname << " " << count << "\n";
+  std::cout << "decls      " << report.entity_defs << " entityDefs, " << report.model_defs << " modelDefs, "
+            << report.skins << " skins in " << report.def_files << " .def/.skin files\n"
+            << "models     " << report.model_files_loaded << " model meshes loaded (one per model file and skin)\n"
+            << "unresolved " << report.unresolved_classes.size() << " classes, " << report.unresolved_models.size()
+            << " models\n";
+  for (const auto& [classname, count] : report.unresolved_classes)
+    std::cout << "  class " << classname << " (" << count << " entities)\n";
+  for (const auto& [model, count] : report.unresolved_models)
+    std::cout << "  model " << model << " (" << count << " entities)\n";
   std::cout << "player     (" << loaded.player_start.x << " " << loaded.player_start.y << " " << loaded.player_start.z
             << ") yaw " << loaded.player_yaw << "\n"
             << "warnings   " << report.warnings.size() << "\n";

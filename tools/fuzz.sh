@@ -1,13 +1,13 @@
 #!/usr/bin/env bash
 # Builds the scene parsers' libFuzzer targets with clang (ASan+UBSan) in build/fuzz and runs each for a
-# bounded time. Usage: tools/fuzz.sh [seconds per target, default 30] [targets: proc map mtr image ase lwo md5].
+# bounded time. Usage: tools/fuzz.sh [seconds per target, default 30] [targets: proc map mtr image ase lwo md5 def].
 # New interesting inputs go to build/fuzz/corpus/<target>; crashes to build/fuzz/artifacts/<target>/ —
 # copy a crash input into scene/fuzz/corpus/<target>/ once fixed, so the corpus replay test keeps it.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 seconds=${1:-30}
 shift || true
-targets=${*:-proc map mtr image ase lwo md5}
+targets=${*:-proc map mtr image ase lwo md5 def}
 jobs=${JOBS:-2}
 
 command -v clang++ >/dev/null || { echo "fuzz.sh: clang++ is needed for libFuzzer" >&2; exit 3; }
@@ -25,6 +25,7 @@ seeds_from_testmap() {
     mtr) [ -d assets/testmap/materials ] && echo assets/testmap/materials ;;
     image) [ -d assets/testmap/lights ] && echo assets/testmap/lights ;;
     ase|lwo|md5) [ -d assets/testmap/models ] && echo assets/testmap/models ;;
+    def) [ -d assets/testmap/def ] && echo assets/testmap/def assets/testmap/skins ;;
   esac
   return 0
 }

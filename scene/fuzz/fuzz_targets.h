@@ -10,6 +10,7 @@
 #include <string_view>
 #include <vector>
 
+#include "cohort/scene/decl_file.h"
 #include "cohort/scene/image_decode.h"
 #include "cohort/scene/image_library.h"
 #include "cohort/scene/image_ops.h"
@@ -115,6 +116,31 @@ inline void fuzz_md5(const uint8_t* data, size_t size) {
     Md5Anim anim = parse_md5anim(as_text(data, size), "fuzz.md5anim");
     for (int t : {0, 17, 1000, anim.length_ms(), 123456789})
       if (anim_pose(anim, t).size() != anim.joints.size()) __builtin_trap();
+  } catch (const ParseError&) {
+  }
+}
+
+// def/*.def or skins/*.skin text: parsed, then every class, modelDef and skin resolved (cycles and deep
+// chains must end in DeclError, never in unbounded recursion).
+inline void fuzz_def(const uint8_t* data, size_t size) {
+  try {
+    DeclFile file = parse_decls(as_text(data, size), "fuzz.def", "entityDef");
+    DeclLibrary library;
+    std::vector<std::string> warnings;
+    library.add(file, warnings);
+    for (const EntityDefDecl& def : file.entity_defs) {
+      try {
+        library.entity_def(def.name, warnings);
+      } catch (const DeclError&) {
+      }
+    }
+    for (const ModelDefDecl& def : file.model_defs) {
+      try {
+        library.model_def(def.name);
+      } catch (const DeclError&) {
+      }
+    }
+    for (const SkinDecl& skin : file.skins) apply_skin(skin, "textures/a");
   } catch (const ParseError&) {
   }
 }

@@ -1,5 +1,6 @@
 // ASE reader after the engine's Model_ase.cpp: see docs in model_file.h and doom3-content.md section 4.
 #include <cctype>
+#include <charconv>
 #include <cmath>
 
 #include "cohort/scene/lexer.h"
@@ -219,8 +220,17 @@ class AseParser {
       lex_.next();
       if (t.kind != Token::Kind::Name || t.text.size() < 2 || t.text[1] != ':') continue;
       int k = ascii_lower(t.text[0]) - 'a';
-      if (k < 0 || k > 2 || t.text.size() != 2) continue;
-      abc[k] = index_in("*MESH_FACE vertex", object.vertices.size());
+      if (k < 0 || k > 2) continue;
+      if (t.text.size() == 2) {
+        abc[k] = index_in("*MESH_FACE vertex", object.vertices.size());
+      } else {   // "A:12" written without a blank
+        unsigned long long v = 0;
+        auto [end, ec] = std::from_chars(t.text.data() + 2, t.text.data() + t.text.size(), v);
+        if (ec != std::errc() || end != t.text.data() + t.text.size() || v >= object.vertices.size())
+          lex_.fail(t, "*MESH_FACE vertex '" + t.text + "' is not a vertex number below " +
+                           std::to_string(object.vertices.size()));
+        abc[k] = static_cast<uint32_t>(v);
+      }
       seen[k] = true;
     }
     lex_.skip_rest_of_line();   // edge flags, *MESH_SMOOTHING, *MESH_MTLID: the engine ignores them

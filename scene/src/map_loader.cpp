@@ -4,7 +4,9 @@
 #include <filesystem>
 #include <fstream>
 #include <sstream>
+#include <tuple>
 
+#include "cohort/scene/decl_file.h"
 #include "cohort/scene/image_library.h"
 #include "cohort/scene/map_entities.h"
 #include "cohort/scene/map_file.h"
@@ -12,6 +14,7 @@
 #include "cohort/scene/material_file.h"
 #include "cohort/scene/proc_file.h"
 #include "ascii_case.h"
+#include "entity_models.h"
 
 namespace cohort::scene {
 
@@ -125,6 +128,23 @@ class SceneBuilder {
     return index;
   }
 
+  // def/*.def (entityDefs, modelDefs, skins inside) and skins/*.skin, in sorted order: the first
+  // definition of a name wins.
+  void read_decls(Vfs& vfs) {
+    for (const auto& [folder, extension, type] :
+         {std::tuple{"def", ".def", "entityDef"}, std::tuple{"skins", ".skin", "skin"}}) {
+      for (const std::string& file : vfs.list(folder, extension)) {
+        auto text = vfs.read(file);
+        if (!text) continue;
+        decls_lib_.add(parse_decls(*text, vfs.describe(file), type), scene_.warnings);
+        ++report_.def_files;
+      }
+    }
+    report_.entity_defs = static_cast<int>(decls_lib_.entity_def_count());
+    report_.model_defs = static_cast<int>(decls_lib_.model_def_count());
+    report_.skins = static_cast<int>(decls_lib_.skin_count());
+  }
+
   void add_proc(ProcFile& proc) {
     std::vector<std::pair<int, int>> areas;  // area number, mesh index
     for (ProcModel& model : proc.models) {
@@ -139,6 +159,7 @@ class SceneBuilder {
       }
       scene_.meshes.push_back(std::move(model.mesh));
     }
+    proc_mesh_count_ = static_cast<int>(scene_.meshes.size());
     std::sort(areas.begin(), areas.end());
     for (size_t i = 0; i < areas.size(); ++i) {
       if (areas[i].first != static_cast<int>(i))
@@ -154,14 +175,24 @@ class SceneBuilder {
     scene_.nodes = std::move(proc.nodes);
   }
 
-  void add_entities(const MapFile& map, const std::string& map_where) {
+  void add_entities(const MapFile& map, const std::string& map_where, const Vfs& vfs) {
+    EntityModels models(vfs, scene_, decls_lib_, report_, [this](const std::string& name) { return material(name, false); });
     for (const std::string& w : map.warnings) scene_.warnings.push_back(w);
     for (size_t index = 0; index < map.entities.size(); ++index) {
-      const MapEntity& e = map.entities[index];
-      const std::string where = map_where + ":" + std::to_string(e.line);
-      const std::string classname = e.classname();
+      const std::string where = map_where + ":" + std::to_string(map.entities[index].line);
+      const std::string classname = map.entities[index].classname();
       if (classname == "worldspawn") continue;
-      if (is_light_entity(e)) {
+      // The map's keys, then the entityDef's for the keys the map lacks (SetDefaults).
+      MapEntity e = map.entities[index];
+      bool light_class = is_light_entity(e);
+      if (const ResolvedEntityDef* def = classname.empty() ? nullptr : decls_lib_.entity_def(classname, scene_.warnings)) {
+        for (const auto& [key, value] : def->keys)
+          if (!e.get(key)) e.keys.emplace_back(key, value);
+        light_class = light_class || def->ancestors.count("light") > 0;
+      } else {
+        ++report_.unresolved_classes[classname.empty() ? "(no classname)" : classname];
+      }
+      if (light_class) {
         MapLight light = light_from_entity(e, where, scene_.warnings);
         if (light.light.name.empty()) light.light.name = "light_" + std::to_string(index);  // as the engine names them
         if (!light.texture.empty()) light.light.material = material(light.texture, true);
@@ -170,6 +201,7 @@ class SceneBuilder {
           case LightType::Projected: ++report_.lights_projected; break;
           case LightType::Parallel: ++report_.lights_parallel; break;
         }
+        if (auto model = e.get("model")) add_light_model(e, light.light, *model, where, models);
         scene_.lights.push_back(std::move(light.light));
         continue;
       }
@@ -182,16 +214,51 @@ class SceneBuilder {
         scene_.player_yaw = yaw ? (*yaw)[0] : 0.0f;
       }
       auto model = e.get("model");
-      if (model) entity.mesh = scene_.find_mesh(*model);
+      if (model) entity.mesh = find_inline_model(*model);
       if (entity.mesh < 0 && !entity.name.empty() && (!model || *model == entity.name))
-        entity.mesh = scene_.find_mesh(entity.name);
+        entity.mesh = find_inline_model(entity.name);
       if (entity.mesh < 0 && model)
+        entity.mesh = models.mesh_for(*model, e.get_or("skin", ""), e.get_or("anim", ""), entity, where);
+      if (entity.mesh < 0 && model) {
         scene_.warnings.push_back(where + ": entity " + entity.name + ": model '" + *model +
-                                  "' is not an inline model of the .proc (model files are not loaded)");
+                                  "' is no inline model of the .proc, modelDef or model file (.ase, .lwo, .md5mesh)");
+        ++report_.unresolved_models[*model];
+      }
       if (entity.mesh >= 0) report_.entity_triangles += scene_.meshes[static_cast<size_t>(entity.mesh)].triangle_count();
       ++report_.entities_by_class[classname.empty() ? "(no classname)" : classname];
       scene_.entities.push_back(std::move(entity));
     }
+  }
+
+  // A light's `model` is its visible fixture (Light.cpp Spawn); Cohort shows it as an entity of its own
+  // at the light's place.
+  void add_light_model(const MapEntity& e, const Light& light, const std::string& model, const std::string& where,
+                       EntityModels& models) {
+    Entity fixture;
+    fixture.name = light.name + "_model";
+    fixture.classname = e.classname();
+    fixture.origin = light.origin;
+    fixture.axis = light.axis;
+    for (const auto& [key, value] : e.keys) fixture.keys[key] = value;
+    fixture.mesh = find_inline_model(model);
+    if (fixture.mesh < 0) fixture.mesh = models.mesh_for(model, e.get_or("skin", ""), "", fixture, where);
+    if (fixture.mesh < 0) {
+      scene_.warnings.push_back(where + ": light " + light.name + ": model '" + model +
+                                "' is no inline model, modelDef or model file; the light has no fixture");
+      ++report_.unresolved_models[model];
+      return;
+    }
+    scene_.warnings.push_back(where + ": light " + light.name + " has a model ('" + model +
+                              "'): shown as entity " + fixture.name + " (its materials do not follow the light's parms)");
+    report_.entity_triangles += scene_.meshes[static_cast<size_t>(fixture.mesh)].triangle_count();
+    ++report_.entities_by_class["(light model)"];
+    scene_.entities.push_back(std::move(fixture));
+  }
+
+  // A .proc model by name (the meshes the model files add later are found by EntityModels).
+  int find_inline_model(const std::string& name) const {
+    int mesh = scene_.find_mesh(name);
+    return mesh >= 0 && mesh < proc_mesh_count_ ? mesh : -1;
   }
 
   void finish() {
@@ -208,6 +275,8 @@ class SceneBuilder {
   MaterialTables tables_;
   std::map<std::string, MaterialDecl> decls_;
   std::map<std::string, int> used_;
+  DeclLibrary decls_lib_;
+  int proc_mesh_count_ = 0;
 };
 
 }  // namespace
@@ -224,8 +293,9 @@ Scene load_map(Vfs& vfs, const std::string& map, LoadReport* report_out) {
   scene.name = src.name;
   SceneBuilder builder(vfs, scene, report);
   builder.read_materials(vfs);
+  builder.read_decls(vfs);
   builder.add_proc(proc);
-  builder.add_entities(parsed_map, src.map_where);
+  builder.add_entities(parsed_map, src.map_where, vfs);
   builder.finish();
   report.warnings = scene.warnings;
   if (report_out) *report_out = std::move(report);

@@ -7,6 +7,7 @@
 #include "cohort/commit/commit_channel.h"
 #include "cohort/core/gpu_scene.h"
 #include "cohort/core/world_sync.h"
+#include "cohort/scene/map_loader.h"
 #include "cohort/scene/render_world_stream.h"
 #include "cohort/scene/scenario.h"
 #include "cohort/test_support/scene_builders.h"
@@ -233,4 +234,28 @@ TEST(WorldSync, OnlyMovedEntitiesAndTheTlasAreSent) {
   EXPECT_LE(records.instances().size(), sync.master().instances.size());
   commit::CommitBuffer nothing = sync.sync(world.TakeChanges(), 2);
   EXPECT_TRUE(nothing.empty());
+}
+
+// Model files reach the tracers' scene as entity instances; instances of one model (and skin) share
+// one BLAS, another skin gets its own.
+TEST(WorldSync, ModelFileInstancesShareOneBlas) {
+  const std::filesystem::path base = std::filesystem::path(COHORT_SOURCE_DIR) / "assets/testmap";
+  if (!std::filesystem::exists(base / "maps/testmap.map")) GTEST_SKIP() << "assets/testmap is not generated";
+  scene::Vfs vfs;
+  vfs.add_search_path(base);
+  RenderWorld world(scene::load_map(vfs, "testmap"));
+  WorldSync sync(world);
+  auto blas_of = [&](const char* name) {
+    int handle = world.FindEntityDef(name);
+    EXPECT_GE(handle, 0) << name;
+    for (const KInstance& instance : sync.master().instances)
+      if (instance.entity == uint32_t(handle)) return instance.blas;
+    ADD_FAILURE() << name << " has no instance";
+    return K_NONE;
+  };
+  EXPECT_NE(blas_of("lamp_1"), K_NONE);
+  EXPECT_EQ(blas_of("lamp_1"), blas_of("lamp_2"));
+  EXPECT_EQ(blas_of("wedge_1"), blas_of("wedge_2"));
+  EXPECT_NE(blas_of("walker_1"), blas_of("walker_2"));
+  EXPECT_NE(blas_of("lamp_1"), blas_of("wedge_1"));
 }

@@ -46,6 +46,8 @@ TEST(FuzzCorpus, Lwo) { EXPECT_GT(replay("lwo", cohort::scene::fuzz::fuzz_lwo, "
 TEST(FuzzCorpus, Md5Mesh) {
   EXPECT_GT(replay("md5", cohort::scene::fuzz::fuzz_md5, "assets/testmap/models/testmap", ".md5mesh"), 0);
 }
+TEST(FuzzCorpus, Def) { EXPECT_GT(replay("def", cohort::scene::fuzz::fuzz_def, "assets/testmap/def", ".def"), 0); }
+TEST(FuzzCorpus, Skin) { EXPECT_GT(replay("def", cohort::scene::fuzz::fuzz_def, "assets/testmap/skins", ".skin"), 0); }
 TEST(FuzzCorpus, Md5Anim) {
   EXPECT_GT(replay("md5", cohort::scene::fuzz::fuzz_md5, "assets/testmap/models/testmap", ".md5anim"), 0);
 }

@@ -8,6 +8,7 @@
 
 #include "cohort/scene/md5.h"
 #include "cohort/scene/model_file.h"
+#include "test_files.h"
 
 using namespace cohort::scene;
 
@@ -171,7 +172,7 @@ TEST(AseParser, CornersWeldWithinAnObject) {
     *MESH_VERTEX 3 0 1 0
     }
     *MESH_FACE_LIST { *MESH_FACE 0: A: 0 B: 1 C: 2
-    *MESH_FACE 1: A: 0 B: 2 C: 3
+    *MESH_FACE 1: A:0 B:2 C:3
     }
   } })";
   ModelFile m = parse_ase(quad, "quad.ase");
@@ -464,6 +465,27 @@ TEST(CanonicalDeclName, LowerCaseSlashesNoExtension) {
   EXPECT_EQ(canonical_decl_name("Models\\Foo\\Bar.TGA"), "models/foo/bar");
   EXPECT_EQ(canonical_decl_name("a.b/c"), "a.b/c");
   EXPECT_EQ(canonical_decl_name("x.y.z"), "x.y");
+}
+
+}  // namespace
+
+namespace {
+
+TEST(LwoParser, LwobSurfacesFromSrfsDetailPolygonsAndByteColours) {
+  std::string bytes = cohort::scene::test::read_text(std::filesystem::path(COHORT_SOURCE_DIR) /
+                                                     "scene/fuzz/corpus/lwo/square.lwob.lwo");
+  ModelFile m = parse_lwo(bytes, "square.lwo");
+  EXPECT_EQ(m.surface_materials, std::vector<std::string>{"textures/lwob"});
+  EXPECT_EQ(m.mesh.triangle_count(), 3u);   // the detail polygon is read as an ordinary one
+  glm::vec4 c = m.colors.at(0);
+  EXPECT_NEAR(c.r, 1.0f, 1e-6f);
+  EXPECT_NEAR(c.g, 128.0f / 255.0f, 1e-6f);
+  EXPECT_NEAR(c.b, 0.0f, 1e-6f);
+  ASSERT_EQ(m.warnings.size(), 1u);   // LWOB has no UVs
+  // LightWave's z = 0 plane is idTech's y = 0: the first polygon's normal (0 0 1) in LW becomes (0 1 0);
+  // the third is wound the other way, and at 180 degrees apart FLAG's smoothing does not mix them.
+  for (size_t k = 0; k < 3; ++k) expect_vec(m.mesh.vertices[m.mesh.indices[k]].normal, {0, 1, 0});
+  for (size_t k = 6; k < 9; ++k) expect_vec(m.mesh.vertices[m.mesh.indices[k]].normal, {0, -1, 0});
 }
 
 }  // namespace

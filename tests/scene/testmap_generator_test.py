@@ -214,7 +214,7 @@ class MapAndMaterials(unittest.TestCase):
         with open(os.path.join(root, "materials", "testmap.mtr")) as handle:
             cls.mtr = handle.read()
         cls.root = root
-        cls.materials = set(re.findall(r"^((?:textures|lights)/\S+)\s*$", cls.mtr, re.M))
+        cls.materials = set(re.findall(r"^((?:textures|models|lights)/\S+)\s*$", cls.mtr, re.M))
         ProcFile.setUpClass()
         cls.models = ProcFile.models
 
@@ -251,13 +251,40 @@ class MapAndMaterials(unittest.TestCase):
             self.assertEqual(sum(a * b for a, b in zip(target, right)), 0, light["name"])
             self.assertEqual(sum(a * b for a, b in zip(target, up)), 0, light["name"])
 
-    def test_movers_and_props_name_proc_models(self):
+    def test_movers_and_props_name_proc_models_or_model_files(self):
         self.assertEqual(self.by_name("door_main")["classname"], "func_door")
         self.assertEqual(self.by_name("fan_spin")["classname"], "func_rotating")
         for entity in self.entities:
             if entity["classname"] in ("func_static", "func_door", "func_rotating"):
-                self.assertIn(entity["model"], self.models, entity["name"])
+                model = entity["model"]
+                if model.endswith((".ase", ".lwo", ".md5mesh")):
+                    self.assertTrue(os.path.isfile(os.path.join(ARGS.repo, "assets", "testmap", model)), model)
+                else:
+                    self.assertIn(model, self.models, entity["name"])
                 self.assertIn("origin", entity)
+
+    def test_model_props_classes_and_skins(self):
+        root = os.path.join(ARGS.repo, "assets", "testmap")
+        with open(os.path.join(root, "def", "testmap.def")) as handle:
+            defs = handle.read()
+        with open(os.path.join(root, "skins", "testmap.skin")) as handle:
+            skins = handle.read()
+        classes = set(re.findall(r"^entityDef (\S+)", defs, re.M))
+        for entity in self.entities:
+            self.assertIn(entity["classname"], classes | {"worldspawn"}, entity.get("name"))
+        for path in re.findall(r'(models/\S+\.(?:ase|lwo|md5mesh|md5anim))', defs + skins):
+            self.assertTrue(os.path.isfile(os.path.join(root, path)), path)
+        for entity in self.entities:
+            if "skin" in entity:
+                self.assertRegex(skins, r"(?m)^skin %s$" % re.escape(entity["skin"]))
+        # The ASE's bitmaps and the LWO's surface names are materials of the .mtr (or remapped by a skin).
+        with open(os.path.join(root, "models", "testmap", "lamp.ase")) as handle:
+            for bitmap in re.findall(r'\*BITMAP "[^"]*\\base\\([^"]*)\.tga"', handle.read()):
+                self.assertIn(bitmap.replace("\\", "/"), self.materials)
+        with open(os.path.join(root, "models", "testmap", "wedge.lwo"), "rb") as handle:
+            data = handle.read()
+        self.assertEqual(data[:4] + data[8:12], b"FORMLWO2")
+        self.assertEqual(int.from_bytes(data[4:8], "big"), len(data) - 8)
 
     def test_every_used_material_defined_and_every_image_present(self):
         for name, surfaces in self.models.items():

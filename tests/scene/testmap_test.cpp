@@ -2,9 +2,13 @@
 // counts taken from the files by plain text scanning, independent of the parsers.
 #include <gtest/gtest.h>
 
+#include <map>
+#include <set>
 #include <sstream>
+#include <tuple>
 
 #include "cohort/scene/map_loader.h"
+#include "cohort/scene/md5.h"
 #include "test_files.h"
 
 using namespace cohort::scene;
@@ -48,12 +52,21 @@ TextCounts count_from_text() {
     if (in_area && indexes > 0) counts.world_triangles += static_cast<size_t>(indexes / 3);
     if (line.rfind("shadowModel", 0) == 0 || line.rfind("interAreaPortals", 0) == 0) in_area = false;
   }
+  // Classes that are lights: `light` and the .def's entityDefs whose "inherit" line names "light".
+  std::set<std::string> light_classes{"light"};
+  std::istringstream def(read_text(testmap_dir() / "def/testmap.def"));
+  std::string current_def;
+  for (std::string line; std::getline(def, line);) {
+    if (line.rfind("entityDef ", 0) == 0) current_def = line.substr(10);
+    if (line.find("\"inherit\"") != std::string::npos && line.find("\"light\"") != std::string::npos)
+      light_classes.insert(current_def);
+  }
   std::istringstream map(read_text(testmap_dir() / "maps/testmap.map"));
   bool in_light = false;
   for (std::string line; std::getline(map, line);) {
     if (line.rfind("\"classname\"", 0) == 0) {
       std::string classname = quoted_after(line, 11);
-      in_light = classname == "light";
+      in_light = light_classes.count(classname) > 0;
       if (in_light) ++counts.lights;
       else if (classname != "worldspawn") ++counts.classes[classname];
     }
@@ -174,4 +187,95 @@ TEST_F(TestMap, MaterialClasses) {
   EXPECT_GE(m("textures/testmap/floor_tiles").normal_image, 0);
   EXPECT_TRUE(scene.images[static_cast<size_t>(m("textures/testmap/floor_tiles").normal_image)].is_normal_map);
   EXPECT_FLOAT_EQ(m("textures/testmap/concrete").tex_transform[0], 2.0f);
+}
+
+const Entity& entity_named(const Scene& s, const std::string& name) {
+  for (const Entity& e : s.entities)
+    if (e.name == name) return e;
+  throw std::runtime_error("no entity " + name);
+}
+
+std::string material_of(const Scene& s, const Entity& e, size_t surface = 0) {
+  const Mesh& mesh = s.meshes.at(static_cast<size_t>(e.mesh));
+  return s.materials.at(static_cast<size_t>(mesh.surfaces.at(surface).material)).name;
+}
+
+TEST_F(TestMap, ModelPropsResolveThroughClassesAndShareMeshes) {
+  EXPECT_TRUE(report.unresolved_classes.empty()) << ::testing::PrintToString(report.unresolved_classes);
+  EXPECT_TRUE(report.unresolved_models.empty());
+  const Entity &lamp1 = entity_named(scene, "lamp_1"), &lamp2 = entity_named(scene, "lamp_2");
+  EXPECT_EQ(lamp1.mesh, lamp2.mesh);   // one mesh, so one BLAS, for both instances
+  EXPECT_EQ(entity_value("lamp_1", "model"), "");   // the model comes from the class testmap_lamp
+  EXPECT_EQ(lamp1.model_file, "models/testmap/lamp.ase");
+  EXPECT_EQ(lamp1.keys.at("spawnclass"), "idStaticEntity");   // from func_static, two levels up
+  for (const auto& [key, value] : lamp1.keys) EXPECT_NE(key.rfind("editor_", 0), 0u) << key;
+  const Mesh& lamp = scene.meshes.at(static_cast<size_t>(lamp1.mesh));
+  ASSERT_EQ(lamp.surfaces.size(), 2u);
+  EXPECT_EQ(material_of(scene, lamp1, 0), "textures/testmap/metal");
+  EXPECT_EQ(material_of(scene, lamp1, 1), "textures/testmap/wood");   // the last sub-material's bitmap
+  EXPECT_EQ(entity_named(scene, "wedge_1").mesh, entity_named(scene, "wedge_2").mesh);
+  const Entity &walker1 = entity_named(scene, "walker_1"), &walker2 = entity_named(scene, "walker_2");
+  EXPECT_NE(walker1.mesh, walker2.mesh);   // another skin, another mesh
+  EXPECT_EQ(material_of(scene, walker1), "models/testmap/walker");
+  EXPECT_EQ(material_of(scene, walker2), "textures/testmap/door");
+  EXPECT_EQ(walker1.anim_file, "models/testmap/walker_walk.md5anim");
+  EXPECT_EQ(walker2.skin, "skins/testmap/walker_metal");
+  // The lamp's bulb is a light because its class inherits from `light`; its keys come from the def.
+  const Light& bulb = light_named(scene, "light_lamp");
+  EXPECT_EQ(bulb.radius, glm::vec3(96.0f));
+  EXPECT_EQ(bulb.color, glm::vec3(1.0f, 0.8f, 0.55f));
+  EXPECT_GE(bulb.material, 0);
+}
+
+TEST_F(TestMap, ModelMeshesAreClosedAndFaceOutwards) {
+  // Every prop is built of closed solids: each directed edge is matched by its reverse, and the mesh's
+  // signed volume (clockwise fronts, so -1/6 sum p0.(p1 x p2)) is positive.
+  for (const char* name : {"lamp_1", "wedge_1", "walker_1"}) {
+    const Mesh& mesh = scene.meshes.at(static_cast<size_t>(entity_named(scene, name).mesh));
+    std::map<std::tuple<float, float, float, float, float, float>, int> edges;
+    double volume = 0.0;
+    for (size_t t = 0; t < mesh.triangle_count(); ++t) {
+      glm::vec3 p[3];
+      for (int k = 0; k < 3; ++k) p[k] = mesh.vertices[mesh.indices[t * 3 + static_cast<size_t>(k)]].position;
+      volume -= glm::dot(p[0], glm::cross(p[1], p[2])) / 6.0;
+      for (int k = 0; k < 3; ++k) {
+        const glm::vec3 &a = p[k], &b = p[(k + 1) % 3];
+        ++edges[{a.x, a.y, a.z, b.x, b.y, b.z}];
+        --edges[{b.x, b.y, b.z, a.x, a.y, a.z}];
+      }
+    }
+    for (const auto& [edge, count] : edges) EXPECT_EQ(count, 0) << name;
+    EXPECT_GT(volume, 0.0) << name;
+  }
+}
+
+TEST_F(TestMap, WalkerAnimationLoopsAndMovesTheLegs) {
+  Vfs vfs;
+  vfs.add_search_path(testmap_dir());
+  Md5Mesh mesh = parse_md5mesh(*vfs.read("models/testmap/walker.md5mesh"), "walker.md5mesh");
+  Md5Anim anim = parse_md5anim(*vfs.read("models/testmap/walker_walk.md5anim"), "walker_walk.md5anim");
+  check_anim_matches(mesh, anim);
+  EXPECT_EQ(anim.length_ms(), 1000);
+  auto positions = [&](int ms) {
+    std::vector<glm::vec3> out;
+    for (const Vertex& v : skin_md5(mesh, anim_pose(anim, ms)).mesh.vertices) out.push_back(v.position);
+    return out;
+  };
+  std::vector<glm::vec3> start = positions(0), quarter = positions(250), looped = positions(1000);
+  float moved = 0.0f, loop_error = 0.0f;
+  for (size_t i = 0; i < start.size(); ++i) {
+    moved = std::max(moved, glm::length(quarter[i] - start[i]));
+    loop_error = std::max(loop_error, glm::length(looped[i] - start[i]));
+  }
+  EXPECT_GT(moved, 5.0f);          // a thigh swung by 30 degrees moves the foot by several units
+  EXPECT_LT(loop_error, 1e-3f);    // one second later it is back where it started
+  // Every frame stays inside the animation's bounds.
+  for (int frame = 0; frame < anim.frame_count(); ++frame) {
+    for (const Vertex& v : skin_md5(mesh, anim_frame_pose(anim, frame)).mesh.vertices) {
+      for (int axis = 0; axis < 3; ++axis) {
+        EXPECT_GE(v.position[axis], anim.bounds[size_t(frame)].first[axis] - 1e-3f) << frame;
+        EXPECT_LE(v.position[axis], anim.bounds[size_t(frame)].second[axis] + 1e-3f) << frame;
+      }
+    }
+  }
 }

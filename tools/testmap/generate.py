@@ -1,5 +1,5 @@
 """Builds the whole test map in memory, runs the self-checks, returns {relative path: bytes}."""
-from . import checks, layout, materials
+from . import checks, layout, materials, models as model_files
 from .bsp import build_nodes
 from .map_writer import map_text
 from .portals import merge_portals
@@ -36,8 +36,10 @@ def build():
     files["materials/testmap.mtr"] = materials.MTR.encode("ascii")
     for path, (rows, channels, rle) in images.items():
         files[path] = encode_tga(rows, channels, rle)
+    files.update(model_files.model_files())
+    files.update(model_files.decl_files())
 
-    lights = [dict(keys) for classname, keys in ents if classname == "light"]
+    lights = [dict(keys) for classname, keys in ents if classname in model_files.light_classes()]
     stats.update({
         "areas": len(area_meshes),
         "portals": len(portals),
@@ -50,7 +52,8 @@ def build():
         "lights_point": sum(1 for l in lights if "light_target" not in l and "parallel" not in l),
         "lights_projected": sum(1 for l in lights if "light_target" in l),
         "lights_parallel": sum(1 for l in lights if "parallel" in l),
-        "entities": [(classname, dict(keys)["name"]) for classname, keys in ents],
+        "entities": [(classname, dict(keys)["name"]) for classname, keys in ents
+                     if classname not in model_files.light_classes()],
         "area_names": [a.name for a in layout.AREAS],
         "area_boxes": [(a.name, a.lo, a.hi, layout.AREA_NOTES[a.name]) for a in layout.AREAS],
         "views": layout.VIEWS,

@@ -190,6 +190,17 @@ def entities():
     ents.append(("func_static", [("name", "table_1"), ("model", "testmap_table"), ("origin", (160, 192, 0)),
                                  ("rotation", yaw_rotation(90))]))
 
+    # Model props (tools/testmap/models.py): classes from def/testmap.def, one prop per model format.
+    ents.append(("testmap_lamp", [("name", "lamp_1"), ("origin", (40, 40, 0))]))
+    ents.append(("testmap_lamp", [("name", "lamp_2"), ("origin", (472, 344, 0)), ("angle", 45)]))
+    ents.append(("testmap_light_lamp", [("name", "light_lamp"), ("origin", (40, 40, 72))]))
+    ents.append(("testmap_wedge", [("name", "wedge_1"), ("origin", (820, 330, 0)), ("angle", 90)]))
+    ents.append(("func_static", [("name", "wedge_2"), ("model", "models/testmap/wedge.lwo"),
+                                 ("origin", (1480, 300, 96))]))
+    ents.append(("testmap_walker", [("name", "walker_1"), ("origin", (1000, 80, 0)), ("angle", 90)]))
+    ents.append(("testmap_walker", [("name", "walker_2"), ("origin", (1700, 120, 96)), ("angle", 180),
+                                    ("skin", "skins/testmap/walker_metal")]))
+
     lights = [
         ("light_hall", [("origin", (224, 192, 150)), ("light_radius", (320, 288, 200)), ("_color", (1, 0.9, 0.75)),
                         ("light_center", (0, 0, -20)), ("texture", "lights/testmap_round")]),
@@ -220,4 +231,5 @@ def expected_area_of_entity(name):
         "info_player_start_1": 0, "door_main": 1, "fan_spin": 0, "crate_1": 0, "crate_2": 0, "crate_3": 5,
         "crate_4": 2, "table_1": 0, "light_hall": 0, "light_hall_fill": 0, "light_flicker": 1, "light_beam": 2,
         "light_sun": 3, "light_stairs": 4, "light_gallery": 5, "light_gel": 5,
+        "lamp_1": 0, "lamp_2": 0, "light_lamp": 0, "wedge_1": 2, "wedge_2": 5, "walker_1": 2, "walker_2": 5,
     }.get(name)

@@ -229,6 +229,15 @@ textures/testmap/sky
 	}
 }
 
+// ---- model surfaces (tools/testmap/models.py) ------------------------------------------------
+
+models/testmap/walker
+{
+	diffusemap	textures/testmap/wood_d.tga
+	bumpmap		textures/testmap/wood_local.tga
+	specularmap	textures/testmap/metal_s.tga
+}
+
 // ---- light shaders -------------------------------------------------------------------------
 
 lights/testmap_round
@@ -254,7 +263,7 @@ lights/testmap_gel
 
 
 def material_names():
-    return re.findall(r"^((?:textures|lights)/[A-Za-z0-9_/]+)\s*$", MTR, re.MULTILINE)
+    return re.findall(r"^((?:textures|models|lights)/[A-Za-z0-9_/]+)\s*$", MTR, re.MULTILINE)
 
 
 def referenced_images():

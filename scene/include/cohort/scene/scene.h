@@ -85,7 +85,10 @@ struct Entity {
   glm::vec3 origin{0.0f};
   glm::mat3 axis{1.0f};         // columns: the entity's x, y, z axes in world space
   bool no_shadows = false;
-  std::map<std::string, std::string> keys;
+  std::map<std::string, std::string> keys;   // the map's keys, then its entityDef's for keys it lacks
+  // Where a model file's mesh came from (empty for inline .proc models), the skin applied to it, and
+  // for MD5 models the animation the entity plays (empty: none); the mesh is the bind pose.
+  std::string model_file, skin, anim_file;
 };
 
 struct Portal {
