@@ -9,7 +9,8 @@ namespace cohort::tracers {
 
 void set_texel_texture(cudaTextureObject_t texture);
 // The scene view holds device pointers (built on the host with k_scene_view, passed by value).
+// ray_counts (closest, occlusion) and row_rays (one per band row, zeroed by the caller) may be null.
 void launch_render_band(const KSceneView& scene, const KFrameParams& params, const KCamera& camera, float4* band,
-                        unsigned long long* ray_counts, cudaStream_t stream);
+                        unsigned long long* ray_counts, unsigned* row_rays, cudaStream_t stream);
 
 }  // namespace cohort::tracers
