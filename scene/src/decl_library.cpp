@@ -82,6 +82,7 @@ const ResolvedEntityDef& DeclLibrary::resolve(const std::string& key, std::vecto
   for (const std::string& parent : parents) {
     std::string parent_key = lowercase(parent);
     if (entity_defs_.find(parent_key) == entity_defs_.end()) {
+      out.ancestors.insert(parent_key);   // still named: a class inheriting an undefined `light` is a light
       warnings.push_back(decl.file + ":" + std::to_string(decl.line) + ": entityDef " + decl.name + " inherits '" +
                          parent + "', which is not defined");
       continue;

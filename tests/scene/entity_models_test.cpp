@@ -79,7 +79,8 @@ TEST(Decls, InheritChainsChildFirstEditorKeysDropped) {
   EXPECT_EQ(box->ancestors, (std::set<std::string>{"prop_box", "mid_prop", "base_prop"}));
   EXPECT_TRUE(lib.entity_def("light_fixture", warnings)->ancestors.count("light"));
   EXPECT_EQ(lib.entity_def("no_such_class", warnings), nullptr);
-  EXPECT_NE(lib.entity_def("orphan", warnings), nullptr);
+  ASSERT_NE(lib.entity_def("orphan", warnings), nullptr);
+  EXPECT_TRUE(lib.entity_def("orphan", warnings)->ancestors.count("nowhere"));   // named, though undefined
   auto has = [&](const std::string& part) {
     for (const auto& w : warnings)
       if (w.find(part) != std::string::npos) return true;

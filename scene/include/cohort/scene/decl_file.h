@@ -61,7 +61,7 @@ class DeclError : public std::runtime_error {
 // dropped, classname = the def's own name), and every class it inherits from.
 struct ResolvedEntityDef {
   KeyValues keys;
-  std::set<std::string> ancestors;      // lower case, the def itself included
+  std::set<std::string> ancestors;      // lower case, the def itself and undefined parents included
   std::string file;
   int line = 0;
   // The value of a key (case-insensitive), or nullptr.
