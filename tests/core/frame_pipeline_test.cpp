@@ -3,7 +3,9 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <condition_variable>
 #include <map>
+#include <mutex>
 #include <thread>
 
 #include "cohort/core/simulated_tracer.h"
@@ -30,6 +32,48 @@ BandJob job_for(uint64_t frame) {
   return job;
 }
 
+// Lets the test decide when a frame's bands may finish: a tracer rendering frame f waits until the test
+// opens frame f's gate. The test opens it only after it has done the core's work that must overlap that
+// frame, so the overlap is certain by construction, whatever the scheduler does; a serial pipeline would
+// wait on a gate that opens only later, and the tracer would give up after kPatience.
+struct FrameGates {
+  static constexpr auto kPatience = std::chrono::seconds(5);
+  std::mutex mutex;
+  std::condition_variable opened;
+  int64_t open_through = -1;
+  bool gave_up = false;
+
+  void open(uint64_t frame) {
+    std::lock_guard lock(mutex);
+    open_through = std::max(open_through, static_cast<int64_t>(frame));
+    opened.notify_all();
+  }
+  void wait(uint64_t frame) {
+    std::unique_lock lock(mutex);
+    if (!opened.wait_for(lock, kPatience, [&] { return open_through >= static_cast<int64_t>(frame); })) gave_up = true;
+  }
+};
+
+// Fills its band with the frame index once the frame's gate is open.
+class GatedTracer final : public Tracer {
+ public:
+  GatedTracer(std::string name, std::shared_ptr<FrameGates> gates) : name_(std::move(name)), gates_(std::move(gates)) {}
+  std::string name() const override { return name_; }
+  void apply(const cohort::commit::CommitBuffer&) override {}
+  using Tracer::render_band;
+  BandResult render_band(const BandJob& job, BandBuffer& target) override {
+    gates_->wait(job.params.frame_index);
+    std::vector<float> row(static_cast<size_t>(target.width()) * 4, static_cast<float>(job.params.frame_index));
+    for (kuint y = job.params.row_begin; y < job.params.row_end; ++y)
+      target.store(static_cast<int>(y), 0, row.data(), static_cast<size_t>(target.width()));
+    return {};
+  }
+
+ private:
+  std::string name_;
+  std::shared_ptr<FrameGates> gates_;
+};
+
 std::vector<StageSpan> spans_of(const FrameStats& stats, const std::string& stage, bool tracers) {
   std::vector<StageSpan> out;
   for (const StageSpan& s : stats.stages)
@@ -38,9 +82,7 @@ std::vector<StageSpan> spans_of(const FrameStats& stats, const std::string& stag
 }
 
 // The core's span of `stage` in a frame starts while another frame is in flight: after that frame's bands
-// were handed out ("balance") and before its last band finished rendering. (A short stage such as the
-// merge may end before a tracer thread has even woken up for its band, so plain overlap with a render
-// span would depend on the scheduler.)
+// were handed out ("balance") and before its last band finished rendering.
 bool core_stage_starts_while_in_flight(const FrameStats& core_frame, const std::string& stage,
                                        const FrameStats& in_flight) {
   const std::vector<StageSpan> handout = spans_of(in_flight, "balance", false);
@@ -56,9 +98,10 @@ bool core_stage_starts_while_in_flight(const FrameStats& core_frame, const std::
 }  // namespace
 
 TEST(FramePipeline, TheCorePreparesTheNextFrameAndFinishesThePreviousOneWhileTheTracersRender) {
+  auto gates = std::make_shared<FrameGates>();
   std::vector<std::unique_ptr<Tracer>> tracers;
-  tracers.push_back(sleeping_tracer(1));
-  tracers.push_back(sleeping_tracer(2));
+  tracers.push_back(std::make_unique<GatedTracer>("gated1", gates));
+  tracers.push_back(std::make_unique<GatedTracer>("gated2", gates));
   Renderer renderer(std::move(tracers), RendererOptions{});
   FramePipeline pipeline(renderer);
   auto scene = std::make_shared<cohort::commit::TracerScene>();
@@ -69,7 +112,7 @@ TEST(FramePipeline, TheCorePreparesTheNextFrameAndFinishesThePreviousOneWhileThe
     // Everything is delivered whole: every row comes from this frame.
     for (int y = 0; y < kRows; ++y) ASSERT_EQ(pipeline.image().row(y)[0], static_cast<float>(done.stats.frame));
     ScopedStage tone_mapping(done.stats.stages, kCoreTrack, "tone map");  // stands for blend, tone map, output
-    std::this_thread::sleep_for(std::chrono::milliseconds(15));
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
     tone_mapping.finish();
     frames[done.stats.frame] = std::move(done.stats);
   };
@@ -81,8 +124,9 @@ TEST(FramePipeline, TheCorePreparesTheNextFrameAndFinishesThePreviousOneWhileThe
     commit.set_frame(f + 1);
     commit.set_camera(job_for(f).camera);
     renderer.submit_commit(commit, [&] { return scene; });
-    std::this_thread::sleep_for(std::chrono::milliseconds(15));
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
     syncing.finish();
+    if (f > 0) gates->open(f - 1);  // frame f-1 may finish now that frame f's world sync has run
     std::optional<FramePipeline::Delivered> done = pipeline.push(job_for(f), std::move(preparation));
     ASSERT_EQ(done.has_value(), f > 0);
     if (done) {
@@ -91,8 +135,10 @@ TEST(FramePipeline, TheCorePreparesTheNextFrameAndFinishesThePreviousOneWhileThe
       finish(std::move(*done));
     }
   }
+  gates->open(kFrames - 1);
   std::optional<FramePipeline::Delivered> last = pipeline.drain();
   ASSERT_TRUE(last.has_value());
+  EXPECT_FALSE(gates->gave_up) << "a tracer waited for core work that the pipeline did not let run alongside it";
   finish(std::move(*last));
   EXPECT_FALSE(pipeline.drain().has_value());
   ASSERT_EQ(frames.size(), kFrames);
