@@ -6,7 +6,7 @@ set -euo pipefail
 
 PACKAGES=(
   build-essential cmake ninja-build pkg-config git
-  libembree-dev libtbb-dev            # Embree 3 CPU tracer
+  libembree-dev libtbb-dev            # BVH builds (rtcBuildBVH) and the Embree 3 CPU tracer
   libopenimageio-dev openimageio-tools  # texture loading, EXR/PNG output, oiiotool
   libglfw3-dev libgl-dev              # gameplay viewer (optional at build time)
   libglm-dev                          # host-side vector maths
