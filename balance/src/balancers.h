@@ -4,6 +4,7 @@
 #include <map>
 #include <vector>
 
+#include "affine_time_fit.h"
 #include "cohort/balance/balancer.h"
 #include "speed_book.h"
 
@@ -86,6 +87,47 @@ class RowCostBalancer final : public Balancer {
   std::vector<double> cost_;      // per work unit, mean 1
   std::map<int, double> speed_;   // tracer id -> cost units per ms
   bool proxy_mode_ = false;       // costs and speeds are in the proxy's work units
+};
+
+// Balancing that sees the whole cost of a band: each tracer's time is fit as fixed + work x cost
+// (AffineTimeFit, from every band it rendered, commit apply included), and the frame is cut so that
+// every tracer taking part is predicted to finish at the same time. Work is the per-row work proxy
+// when there is one (as Row Cost), else rows. A tracer whose fixed cost leaves it nothing useful to do
+// -- the frame is predicted less than min_gain faster with it than without -- gets no rows (it is
+// benched: it still applies every commit) and is probed with a small unwaited band every
+// probe_interval frames, alternating two sizes so that its fit separates fixed from per-row cost.
+// Small bands are cut on single rows (fine_cuts), large ones on the paper's 4-row units.
+class WholeCostBalancer final : public Balancer {
+ public:
+  explicit WholeCostBalancer(const BalancerOptions& options) : options_(options) {}
+  std::string name() const override { return "whole-cost"; }
+  std::vector<Band> divide(const DivideInput& in) override;
+  BandRules band_rules() const override { return {options_.fine_cuts ? 1 : kRowsPerUnit, true}; }
+  std::vector<Band> probe_bands() const override { return probes_; }
+  void reset() override {
+    fits_.clear();
+    benched_.clear();
+    probes_.clear();
+    rows_ = -1;
+    proxy_mode_ = false;
+  }
+
+ private:
+  struct Benched {
+    int frames = 0;    // since it was benched or last probed
+    int probes = 0;    // probes sent, to alternate their size
+  };
+  // Prefix sums of the per-row work map of this frame: work of rows [0, r) is prefix[r].
+  std::vector<double> work_prefix(const DivideInput& in, bool& from_proxy) const;
+  std::vector<bool> choose_takers(const std::vector<double>& fixed, const std::vector<double>& cost, double total_work) const;
+  std::vector<Band> cut(const std::vector<double>& prefix, const std::vector<double>& shares, int rows) const;
+
+  BalancerOptions options_;
+  int rows_ = -1;
+  bool proxy_mode_ = false;
+  std::map<int, AffineTimeFit> fits_;
+  std::map<int, Benched> benched_;
+  std::vector<Band> probes_;
 };
 
 }  // namespace cohort::balance

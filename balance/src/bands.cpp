@@ -61,19 +61,23 @@ std::vector<Band> equal_bands(int rows, int count) {
   return bands_from_shares(rows, shares);
 }
 
-std::string check_bands(int rows, std::span<const Band> bands) {
+std::string check_bands(int rows, std::span<const Band> bands, const BandRules& rules) {
   if (bands.empty()) return rows > 0 ? "no bands" : "";
-  const int units = units_for_rows(rows);
+  if (rules.row_unit < 1) return "row unit " + std::to_string(rules.row_unit) + " is not positive";
+  const int units = rules.allow_empty ? 0 : (rows + rules.row_unit - 1) / rules.row_unit;
+  bool any_rows = false;
   int expected_begin = 0;
   for (size_t i = 0; i < bands.size(); ++i) {
     const Band& b = bands[i];
     const std::string where = "band " + std::to_string(i) + " [" + std::to_string(b.begin) + "," + std::to_string(b.end) + ")";
     if (b.begin != expected_begin) return where + " does not start where the previous ended (" + std::to_string(expected_begin) + ")";
     if (b.end < b.begin) return where + " is reversed";
-    if (b.end != rows && b.end % kRowsPerUnit != 0) return where + " does not end on a unit boundary";
+    if (b.end != rows && b.end % rules.row_unit != 0) return where + " does not end on a unit boundary";
     if (b.empty() && static_cast<int>(i) < units) return where + " is empty although there are enough units";
+    any_rows = any_rows || !b.empty();
     expected_begin = b.end;
   }
+  if (rows > 0 && !any_rows) return "every band is empty";
   if (expected_begin != rows) return "bands end at row " + std::to_string(expected_begin) + ", frame has " + std::to_string(rows);
   return "";
 }

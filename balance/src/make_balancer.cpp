@@ -4,7 +4,7 @@
 
 namespace cohort::balance {
 
-std::vector<std::string> balancer_names() { return {"none", "robin-hood", "perfect", "perfect-smooth", "row-cost"}; }
+std::vector<std::string> balancer_names() { return {"none", "robin-hood", "perfect", "perfect-smooth", "row-cost", "whole-cost"}; }
 
 std::unique_ptr<Balancer> make_balancer(std::string_view name, const BalancerOptions& options) {
   if (name == "none") return std::make_unique<NoneBalancer>();
@@ -18,6 +18,14 @@ std::unique_ptr<Balancer> make_balancer(std::string_view name, const BalancerOpt
     if (!(options.cost_rate > 0.0 && options.cost_rate <= 1.0) || !(options.speed_rate > 0.0 && options.speed_rate <= 1.0))
       throw std::invalid_argument("row-cost: cost_rate and speed_rate must be in (0, 1]");
     return std::make_unique<RowCostBalancer>(options.cost_rate, options.speed_rate);
+  }
+  if (name == "whole-cost") {
+    if (!(options.alpha > 0.0 && options.alpha <= 1.0) || !(options.speed_rate > 0.0 && options.speed_rate <= 1.0))
+      throw std::invalid_argument("whole-cost: alpha and speed_rate must be in (0, 1]");
+    if (!(options.min_gain >= 0.0 && options.min_gain < 1.0)) throw std::invalid_argument("whole-cost: min_gain must be in [0, 1)");
+    if (options.probe_interval < 1) throw std::invalid_argument("whole-cost: probe_interval must be >= 1");
+    if (options.fine_below_rows < 0) throw std::invalid_argument("whole-cost: fine_below_rows must be >= 0");
+    return std::make_unique<WholeCostBalancer>(options);
   }
   std::string known;
   for (const std::string& n : balancer_names()) known += (known.empty() ? "" : ", ") + n;

@@ -20,6 +20,7 @@ void to_json(nlohmann::json& j, const TracerFrameStats& s) {
                      {"row_begin", s.row_begin}, {"row_end", s.row_end}, {"rows", s.row_end - s.row_begin},
                      {"ms", s.ms},           {"idle_ms", s.idle_ms}, {"recovery_rows", s.recovery_rows},
                      {"recovery_ms", s.recovery_ms}};
+  if (s.probe_rows > 0) j["probe_rows"] = s.probe_rows;
   if (!s.error.empty()) j["error"] = s.error;
 }
 

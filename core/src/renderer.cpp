@@ -42,6 +42,7 @@ struct Renderer::Worker {
   BandJob job;
   bool job_is_recovery = false;    // re-rendering rows a dropped tracer did not deliver
   int job_slot = 0;                // which of the two targets the job renders into
+  bool job_is_probe = false;       // rendering rows only to be measured (a benched tracer)
   // Taken from the channel by the core when it hands out a job; the buffer stays valid (and untouched
   // by the core) until the next hand-over, which happens only once this job has ended.
   const commit::CommitBuffer* job_commit = nullptr;
@@ -51,6 +52,11 @@ struct Renderer::Worker {
   // Worker thread only: an apply threw, so the tracer's scene no longer matches the core's until a
   // full resync has been applied.
   bool scene_diverged = false;
+  // Core thread only: the unwaited job of a benched tracer (0: none) and its probe band, and the rows
+  // per ms this tracer showed last (how much of a dropped tracer's rows it is given).
+  uint64_t side_job = 0;
+  balance::Band side_band;
+  double rows_per_ms = 0.0;
 
   // Outcome of the last job, guarded by completion->mutex.
   bool busy = false;
@@ -59,6 +65,7 @@ struct Renderer::Worker {
   std::string error;
   double wall_ms = 0.0;
   double reported_ms = 0.0;
+  double apply_ms = 0.0;
   std::vector<float> row_work;
   std::vector<StageSpan> spans;  // the last job's apply and render stages
 
@@ -72,7 +79,7 @@ struct Renderer::Worker {
     for (;;) {
       BandJob current;
       uint64_t current_id = 0;
-      bool recovery = false;
+      bool recovery = false, probe = false;
       int slot = 0;
       const commit::CommitBuffer* to_apply = nullptr;
       {
@@ -83,13 +90,14 @@ struct Renderer::Worker {
         current_id = job_id;
         recovery = job_is_recovery;
         slot = job_slot;
+        probe = job_is_probe;
         has_job = false;
         to_apply = job_commit;
         job_commit = nullptr;
       }
       bool success = false;
       std::string what;
-      double wall = 0.0, reported = 0.0;
+      double wall = 0.0, reported = 0.0, applied = 0.0;
       std::vector<float> work;
       std::vector<StageSpan> job_spans;
       const std::string track = tracer_track(id, name);
@@ -97,14 +105,19 @@ struct Renderer::Worker {
         // Apply time is part of what the tracer costs the frame, so the balancer sees it.
         const auto start = Clock::now();
         if (to_apply && !to_apply->empty()) apply(*to_apply, job_spans, track);
+        applied = std::chrono::duration<double, std::milli>(Clock::now() - start).count();
         if (scene_diverged)
           throw std::runtime_error("its scene diverged after a failed commit; waiting for a full resync");
-        ScopedStage rendering(job_spans, track, recovery ? "re-render" : "render");
-        const BandResult result = tracer->render_band(current, targets[slot]);
-        wall = std::chrono::duration<double, std::milli>(Clock::now() - start).count();
-        rendering.finish();
-        reported = result.device_ms;
-        if (result.row_work.size() == current.params.row_end - current.params.row_begin) work = result.row_work;
+        if (current.params.row_end > current.params.row_begin) {  // a benched tracer may only apply
+          ScopedStage rendering(job_spans, track, recovery ? "re-render" : probe ? "probe" : "render");
+          const BandResult result = tracer->render_band(current, targets[slot]);
+          wall = std::chrono::duration<double, std::milli>(Clock::now() - start).count();
+          rendering.finish();
+          reported = result.device_ms;
+          if (result.row_work.size() == current.params.row_end - current.params.row_begin) work = result.row_work;
+        } else {
+          wall = applied;
+        }
         success = true;
       } catch (const std::exception& e) {
         what = e.what();
@@ -119,6 +132,7 @@ struct Renderer::Worker {
         error = std::move(what);
         wall_ms = wall;
         reported_ms = reported;
+        apply_ms = applied;
         row_work = std::move(work);
         spans = std::move(job_spans);
       }
@@ -247,7 +261,24 @@ void Renderer::reset_balancer() {
 }
 
 double Renderer::measured_ms(const Worker& w) const {
-  return options_.use_reported_time && w.reported_ms > 0.0 ? w.reported_ms : w.wall_ms;
+  // Reported times are the tracer's own (kernel time); its commit apply is part of its cost too.
+  return options_.use_reported_time && w.reported_ms > 0.0 ? w.reported_ms + w.apply_ms : w.wall_ms;
+}
+
+void Renderer::harvest_side_job(Worker& w, std::vector<StageSpan>& stages) {
+  if (w.side_job == 0 || w.done_job_id != w.side_job) return;
+  w.side_job = 0;
+  stages.insert(stages.end(), std::make_move_iterator(w.spans.begin()), std::make_move_iterator(w.spans.end()));
+  w.spans.clear();
+  if (!w.ok) {
+    spdlog::warn("tracer {} ({}) failed while benched{}: {}", w.id, w.name, w.side_band.empty() ? "" : " on its probe band", w.error);
+    return;
+  }
+  if (w.side_band.empty()) return;
+  const double ms = measured_ms(w);
+  std::erase_if(last_measurements_, [&](const balance::TracerMeasurement& m) { return m.tracer == w.id; });
+  last_measurements_.push_back({w.id, w.side_band, ms});
+  if (ms > 0.0) w.rows_per_ms = w.side_band.rows() / ms;
 }
 
 std::vector<uint64_t> Renderer::assign(const std::vector<Assignment>& assignments, const BandJob& job, int slot,
@@ -269,6 +300,7 @@ std::vector<uint64_t> Renderer::assign(const std::vector<Assignment>& assignment
     w.job_id = ids[i];
     w.job_is_recovery = !with_commits;
     w.job_slot = slot;
+    w.job_is_probe = assignments[i].probe;
     w.has_job = true;
     // What was published so far belongs to this frame; commits submitted from now on wait for the
     // next. Re-rendering a dropped tracer's rows happens within the same frame, so it takes none.
@@ -355,6 +387,7 @@ void Renderer::begin_frame(const BandJob& job, FrameBuffer& out, const std::vect
   {
     std::lock_guard lock(workers_.front()->completion->mutex);
     for (auto& w : workers_) {
+      harvest_side_job(*w, stats.stages);
       TracerFrameStats& t = stats.tracers[static_cast<size_t>(w->id)];
       t.id = w->id;
       t.name = w->name;
@@ -373,19 +406,34 @@ void Renderer::begin_frame(const BandJob& job, FrameBuffer& out, const std::vect
   row_work_known_.assign(static_cast<size_t>(rows), 0);
   ScopedStage balancing(stats.stages, kCoreTrack, "balance");
   const std::vector<balance::Band> bands = balancer_->divide({rows, ready, last_measurements_, std::move(proxy)});
+  const std::vector<balance::Band> probes = balancer_->probe_bands();
   balancing.finish();
-  std::vector<Assignment> assignments;
+  std::vector<Assignment> assignments, side_jobs;
   for (size_t i = 0; i < ready.size(); ++i) {
     TracerFrameStats& t = stats.tracers[static_cast<size_t>(ready[i])];
     t.row_begin = bands[i].begin;
     t.row_end = bands[i].end;
-    if (bands[i].empty()) t.outcome = TracerOutcome::no_rows;
-    else assignments.push_back({ready[i], bands[i]});
+    if (bands[i].empty()) {
+      // Benched: it keeps its scene current (and maybe renders a probe), and nobody waits for it.
+      t.outcome = TracerOutcome::no_rows;
+      const balance::Band probe = probes.size() == ready.size() ? probes[i] : balance::Band{};
+      t.probe_rows = probe.rows();
+      side_jobs.push_back({ready[i], probe, !probe.empty()});
+    } else {
+      assignments.push_back({ready[i], bands[i]});
+    }
   }
 
   const int slot = next_slot_;
   next_slot_ ^= 1;
   std::vector<uint64_t> ids = assign(assignments, job, slot, true);
+  // A probe renders into this frame's slot, which the frame never merges from a benched tracer.
+  const std::vector<uint64_t> side_ids = assign(side_jobs, job, slot, true);
+  for (size_t i = 0; i < side_jobs.size(); ++i) {
+    Worker& w = *workers_[static_cast<size_t>(side_jobs[i].worker)];
+    w.side_job = side_ids[i];
+    w.side_band = side_jobs[i].band;
+  }
   pending_ = std::make_unique<PendingFrame>();
   pending_->job = job;
   pending_->out = &out;
@@ -429,10 +477,11 @@ FrameStats Renderer::wait_frame() {
     t.outcome = TracerOutcome::rendered;
     stats.frame_ms = std::max(stats.frame_ms, t.ms);
     last_measurements_.push_back({id, balance::Band{t.row_begin, t.row_end}, t.ms});
+    if (t.ms > 0.0) workers_[static_cast<size_t>(id)]->rows_per_ms = (t.row_end - t.row_begin) / t.ms;
   }
   int taking_part = 0;
   for (TracerFrameStats& t : stats.tracers) {
-    if (t.outcome == TracerOutcome::rendered || t.outcome == TracerOutcome::no_rows) {
+    if (t.outcome == TracerOutcome::rendered) {
       t.idle_ms = stats.frame_ms - t.ms;
       stats.idle_ms += t.idle_ms;
       ++taking_part;
@@ -467,7 +516,28 @@ FrameStats Renderer::wait_frame() {
   drop(first.threw, TracerOutcome::threw, band_of(first.threw));
   drop(first.timed_out, TracerOutcome::timed_out, band_of(first.timed_out));
 
-  std::vector<int> helpers = first.finished;
+  std::vector<int> helpers = first.finished, needs_commits;
+  if (!missing.empty()) {
+    // Benched tracers that are done with their commits help too (with their probe, if any, harvested
+    // first: a helper's job replaces its result). With nobody else left, they are waited for.
+    Completion& completion = *workers_.front()->completion;
+    std::unique_lock lock(completion.mutex);
+    const auto deadline = Clock::now() + options_.frame_timeout;
+    // One still on an earlier frame's side job missed this frame's commits: it gets them with its rows.
+    for (const TracerFrameStats& t : stats.tracers) {
+      Worker& w = *workers_[static_cast<size_t>(t.id)];
+      const bool behind = t.outcome == TracerOutcome::busy && w.side_job != 0;
+      if (t.outcome != TracerOutcome::no_rows && !behind) continue;
+      if (first.finished.empty() && w.side_job != 0)
+        completion.cv.wait_until(lock, deadline, [&] { return w.done_job_id == w.side_job; });
+      if (w.busy) continue;
+      const bool side_job_failed = w.side_job != 0 && !w.ok;
+      harvest_side_job(w, stats.stages);
+      if (side_job_failed || w.side_job != 0) continue;
+      helpers.push_back(t.id);
+      if (behind) needs_commits.push_back(t.id);
+    }
+  }
   const auto recovery_start = Clock::now();
   while (!missing.empty()) {
     if (helpers.empty()) {
@@ -478,16 +548,28 @@ FrameStats Renderer::wait_frame() {
     missing.pop_back();
     std::vector<double> speeds;
     for (int id : helpers) {
-      const TracerFrameStats& t = stats.tracers[static_cast<size_t>(id)];
-      speeds.push_back(t.ms > 0.0 && t.row_end > t.row_begin ? (t.row_end - t.row_begin) / t.ms : 1.0);
+      const double rows_per_ms = workers_[static_cast<size_t>(id)]->rows_per_ms;
+      speeds.push_back(rows_per_ms > 0.0 ? rows_per_ms : 1.0);
     }
     std::vector<balance::Band> parts = balance::bands_from_shares(band.rows(), speeds);
     std::vector<Assignment> round;
     for (size_t i = 0; i < helpers.size(); ++i) {
       if (!parts[i].empty()) round.push_back({helpers[i], {band.begin + parts[i].begin, band.begin + parts[i].end}});
     }
+    // Helpers that have not had this frame's commits yet get them first (their assignments lead).
+    std::stable_partition(round.begin(), round.end(), [&](const Assignment& a) {
+      return std::find(needs_commits.begin(), needs_commits.end(), a.worker) != needs_commits.end();
+    });
+    const auto with_commits = std::find_if(round.begin(), round.end(), [&](const Assignment& a) {
+      return std::find(needs_commits.begin(), needs_commits.end(), a.worker) == needs_commits.end();
+    });
+    const std::vector<Assignment> first_part(round.begin(), with_commits), second_part(with_commits, round.end());
+    std::vector<uint64_t> round_ids = assign(first_part, job, frame->slot, true);
+    const std::vector<uint64_t> rest_ids = assign(second_part, job, frame->slot, false);
+    round_ids.insert(round_ids.end(), rest_ids.begin(), rest_ids.end());
+    for (const Assignment& a : first_part) std::erase(needs_commits, a.worker);
     const auto round_start = Clock::now();
-    RoundResult r = collect(round, assign(round, job, frame->slot, false), round_start + options_.frame_timeout, stats.stages);
+    RoundResult r = collect(round, round_ids, round_start + options_.frame_timeout, stats.stages);
     frame->delivered.insert(frame->delivered.end(), r.delivered.begin(), r.delivered.end());
     for (const Assignment& a : round) {
       TracerFrameStats& t = stats.tracers[static_cast<size_t>(a.worker)];

@@ -40,7 +40,7 @@ std::vector<std::vector<TracerMeasurement>> run(Balancer& b, const SyntheticFram
   const int rows = static_cast<int>(f.row_cost.size());
   for (int i = 0; i < frames; ++i) {
     const auto bands = b.divide({rows, ids, previous, {}});
-    EXPECT_EQ(check_bands(rows, bands), "") << b.name() << " frame " << i;
+    EXPECT_EQ(check_bands(rows, bands, b.band_rules()), "") << b.name() << " frame " << i;
     previous = f.measure(ids, bands);
     history.push_back(previous);
   }
@@ -164,23 +164,23 @@ TEST_P(EveryBalancer, ConvergesOnTwoToOneSpeeds) {
 TEST_P(EveryBalancer, SurvivesZeroTimesNewAndRemovedTracers) {
   auto b = make_balancer(GetParam());
   auto bands = b->divide({100, {0, 1}, {}, {}});
-  ASSERT_EQ(check_bands(100, bands), "");
+  ASSERT_EQ(check_bands(100, bands, b->band_rules()), "");
   // Tracer 1 reports no time (it was dropped); tracer 7 joins.
   std::vector<TracerMeasurement> prev{{0, bands[0], 4.0}, {1, bands[1], 0.0}};
   bands = b->divide({100, {0, 1, 7}, prev, {}});
   ASSERT_EQ(bands.size(), 3u);
-  ASSERT_EQ(check_bands(100, bands), "");
+  ASSERT_EQ(check_bands(100, bands, b->band_rules()), "");
   // Tracer 0 leaves; a measurement for it is still in the list and must be ignored for banding.
   prev = {{0, bands[0], 1.0}, {1, bands[1], 3.0}, {7, bands[2], 3.0}};
   bands = b->divide({100, {1, 7}, prev, {}});
   ASSERT_EQ(bands.size(), 2u);
-  EXPECT_EQ(check_bands(100, bands), "");
+  EXPECT_EQ(check_bands(100, bands, b->band_rules()), "");
   // All zero times, then a resolution change.
   prev = {{1, bands[0], 0.0}, {7, bands[1], 0.0}};
   bands = b->divide({100, {1, 7}, prev, {}});
-  EXPECT_EQ(check_bands(100, bands), "");
+  EXPECT_EQ(check_bands(100, bands, b->band_rules()), "");
   bands = b->divide({37, {1, 7}, prev, {}});
-  EXPECT_EQ(check_bands(37, bands), "");
+  EXPECT_EQ(check_bands(37, bands, b->band_rules()), "");
   // A single tracer takes everything; no tracers gives no bands.
   bands = b->divide({37, {7}, {}, {}});
   EXPECT_EQ(bands, (std::vector<Band>{{0, 37}}));
@@ -193,3 +193,115 @@ INSTANTIATE_TEST_SUITE_P(All, EveryBalancer, ::testing::ValuesIn(balancer_names(
                            std::replace(n.begin(), n.end(), '-', '_');
                            return n;
                          });
+
+namespace {
+
+// Tracers with a fixed cost per band: ms = fixed + rows * ms_per_row (uniform rows).
+struct FixedCostFrame {
+  int rows;
+  std::vector<double> ms_per_row, fixed_ms;
+  double time(int id, const Band& b) const {
+    return b.empty() ? 0.0 : fixed_ms[static_cast<size_t>(id)] + b.rows() * ms_per_row[static_cast<size_t>(id)];
+  }
+};
+
+// Runs whole-cost frames: bands are measured, probes are measured too and reported a frame later,
+// as the renderer does. Returns the last frame's bands; `probes` counts the probe bands sent per id.
+std::vector<Band> run_whole_cost(Balancer& b, const FixedCostFrame& f, const std::vector<int>& ids, int frames,
+                                 std::vector<int>* probes = nullptr, std::vector<TracerMeasurement>* last = nullptr) {
+  std::vector<TracerMeasurement> previous, probed;
+  std::vector<Band> bands;
+  for (int i = 0; i < frames; ++i) {
+    bands = b.divide({f.rows, ids, previous, {}});
+    EXPECT_EQ(check_bands(f.rows, bands, b.band_rules()), "") << "frame " << i;
+    previous = probed;
+    probed.clear();
+    const std::vector<Band> probe_bands = b.probe_bands();
+    for (size_t t = 0; t < ids.size(); ++t) {
+      if (!bands[t].empty()) previous.push_back({ids[t], bands[t], f.time(ids[t], bands[t])});
+      if (t < probe_bands.size() && !probe_bands[t].empty()) {
+        EXPECT_TRUE(bands[t].empty()) << "only a benched tracer is probed";
+        probed.push_back({ids[t], probe_bands[t], f.time(ids[t], probe_bands[t])});
+        if (probes) ++(*probes)[static_cast<size_t>(ids[t])];
+      }
+    }
+  }
+  if (last) *last = previous;
+  return bands;
+}
+
+double slowest(const std::vector<TracerMeasurement>& m) {
+  double worst = 0.0;
+  for (const auto& x : m) worst = std::max(worst, x.ms);
+  return worst;
+}
+
+}  // namespace
+
+TEST(Balancer, WholeCostEqualisesFinishTimesWithAFixedCost) {
+  // Equal finish time T: (T - 0) / 0.05 + (T - 3) / 0.1 = 720 rows, so T = 25 ms and the slow tracer
+  // gets 220 rows. Perfect, blind to the fixed cost, is biased and keeps oscillating around it.
+  const FixedCostFrame f{720, {0.05, 0.1}, {0.0, 3.0}};
+  auto b = make_balancer("whole-cost");
+  std::vector<TracerMeasurement> last;
+  const std::vector<Band> bands = run_whole_cost(*b, f, {0, 1}, 40, nullptr, &last);
+  EXPECT_NEAR(bands[1].rows(), 220, 2);
+  EXPECT_LT(idle_fraction(last), 0.01);
+  EXPECT_NEAR(slowest(last), 25.0, 0.2);
+}
+
+TEST(Balancer, WholeCostBenchesATracerThatOnlySlowsTheFrameAndProbesIt) {
+  // The fast tracer alone: 720 x 0.006 = 4.3 ms. The slow one (50x slower, 2 ms fixed) could take
+  // about 7 rows for a 1 % faster frame: not worth its noise at the frame's end, so it is benched.
+  const FixedCostFrame f{720, {0.006, 0.3}, {0.0, 2.0}};
+  BalancerOptions options;
+  options.probe_interval = 10;
+  auto b = make_balancer("whole-cost", options);
+  std::vector<int> probes(2, 0);
+  std::vector<TracerMeasurement> last;
+  const std::vector<Band> bands = run_whole_cost(*b, f, {0, 1}, 60, &probes, &last);
+  EXPECT_EQ(bands[0], (Band{0, 720}));
+  EXPECT_TRUE(bands[1].empty());
+  EXPECT_GE(probes[1], 4) << "probed every " << options.probe_interval << " frames once benched";
+  EXPECT_EQ(probes[0], 0);
+  EXPECT_NEAR(slowest(last), 720 * 0.006, 1e-9);
+}
+
+TEST(Balancer, WholeCostBringsABenchedTracerBackWhenItHelps) {
+  // Tracer 1 first looks hopeless (its fixed cost outlasts the frame), then turns fast: the probes
+  // see it and it gets rows again.
+  FixedCostFrame f{720, {0.006, 0.3}, {0.0, 5.0}};
+  BalancerOptions options;
+  options.probe_interval = 5;
+  auto b = make_balancer("whole-cost", options);
+  ASSERT_TRUE(run_whole_cost(*b, f, {0, 1}, 30)[1].empty());
+  f.ms_per_row[1] = 0.006;
+  f.fixed_ms[1] = 0.1;
+  std::vector<TracerMeasurement> last;
+  const std::vector<Band> bands = run_whole_cost(*b, f, {0, 1}, 40, nullptr, &last);
+  EXPECT_NEAR(bands[1].rows(), 352, 16);
+  EXPECT_LT(idle_fraction(last), 0.03);
+}
+
+TEST(Balancer, WholeCostCutsSmallSharesFinerThanAUnitUnlessAskedNotTo) {
+  // A tracer 100x slower with no fixed cost is worth about 7 rows (min_gain 0: take any gain).
+  const FixedCostFrame f{720, {0.01, 1.0}, {0.0, 0.0}};
+  BalancerOptions options;
+  options.min_gain = 0.0;
+  auto fine = make_balancer("whole-cost", options);
+  const int fine_rows = run_whole_cost(*fine, f, {0, 1}, 20)[1].rows();
+  EXPECT_EQ(fine_rows, 7);
+  options.fine_cuts = false;
+  auto coarse = make_balancer("whole-cost", options);
+  EXPECT_EQ(run_whole_cost(*coarse, f, {0, 1}, 20)[1].rows() % kRowsPerUnit, 0);
+  EXPECT_EQ(coarse->band_rules().row_unit, kRowsPerUnit);
+}
+
+TEST(Balancer, WholeCostRejectsBadOptions) {
+  BalancerOptions bad;
+  bad.min_gain = 1.0;
+  EXPECT_THROW(make_balancer("whole-cost", bad), std::invalid_argument);
+  bad = {};
+  bad.probe_interval = 0;
+  EXPECT_THROW(make_balancer("whole-cost", bad), std::invalid_argument);
+}

@@ -56,3 +56,15 @@ TEST(Bands, CheckerNamesTheProblem) {
   const std::vector<Band> short_cover{{0, 8}};
   EXPECT_NE(check_bands(16, short_cover).find("frame has 16"), std::string::npos);
 }
+
+TEST(Bands, RelaxedRulesAllowEmptyBandsAndFineCutsButNotAnAllEmptyDivision) {
+  const BandRules fine{1, true};
+  const std::vector<Band> benched{{0, 0}, {0, 13}, {13, 13}, {13, 16}};
+  EXPECT_EQ(check_bands(16, benched, fine), "");
+  EXPECT_NE(check_bands(16, benched), "") << "the paper's rules still hold by default";
+  EXPECT_NE(check_bands(16, std::vector<Band>{{0, 13}, {13, 16}}).find("unit boundary"), std::string::npos);
+  EXPECT_EQ(check_bands(16, std::vector<Band>{{0, 0}, {0, 12}, {12, 16}}, BandRules{kRowsPerUnit, true}), "");
+  EXPECT_NE(check_bands(16, std::vector<Band>{{0, 16}, {16, 16}}, BandRules{kRowsPerUnit, false}).find("empty"), std::string::npos);
+  EXPECT_NE(check_bands(16, std::vector<Band>{{0, 0}, {0, 0}}, fine).find("every band is empty"), std::string::npos);
+  EXPECT_NE(check_bands(16, std::vector<Band>{{0, 8}, {8, 16}}, BandRules{0, true}).find("row unit"), std::string::npos);
+}

@@ -384,3 +384,97 @@ TEST(SimulatedTracer, AFixedCostIsPaidPerBandWhateverItsSizeAndNotScaledBySpeed)
   fixed.fixed_ms = -1.0;
   EXPECT_THROW(SimulatedTracer(shared_model, fixed), std::invalid_argument);
 }
+
+namespace {
+
+// A simulated tracer that also publishes the last commit frame it applied, readable from any thread
+// (a benched tracer applies its commits on its own thread while the core goes on).
+class CommitWatchingTracer final : public Tracer {
+ public:
+  CommitWatchingTracer(std::unique_ptr<SimulatedTracer> inner, std::shared_ptr<std::atomic<uint64_t>> last)
+      : inner_(std::move(inner)), last_(std::move(last)) {}
+  std::string name() const override { return inner_->name(); }
+  void apply(const cohort::commit::CommitBuffer& commit) override {
+    inner_->apply(commit);
+    last_->store(commit.frame());
+  }
+  using Tracer::render_band;
+  BandResult render_band(const BandJob& job, BandBuffer& target) override { return inner_->render_band(job, target); }
+
+ private:
+  std::unique_ptr<SimulatedTracer> inner_;
+  std::shared_ptr<std::atomic<uint64_t>> last_;
+};
+
+// Fast tracer 1 and tracer 2, 50x slower with a 2 ms fixed cost per band: on 96 rows (about 6 ms
+// for the fast one alone) the slow one can only slow the frame down.
+std::vector<std::unique_ptr<Tracer>> fast_and_hopeless(std::shared_ptr<std::atomic<uint64_t>> slow_commit,
+                                                      SimulatedTracerOptions fast = sim(1, 1.0)) {
+  SimulatedTracerOptions slow = sim(2, 0.02);
+  slow.fixed_ms = 2.0;
+  std::vector<std::unique_ptr<Tracer>> tracers;
+  tracers.push_back(std::make_unique<SimulatedTracer>(model(), fast));
+  tracers.push_back(std::make_unique<CommitWatchingTracer>(std::make_unique<SimulatedTracer>(model(), slow), std::move(slow_commit)));
+  return tracers;
+}
+
+RendererOptions whole_cost_options() {
+  RendererOptions options;
+  options.balancer = "whole-cost";
+  options.balancer_options.probe_interval = 5;
+  options.use_reported_time = true;
+  return options;
+}
+
+}  // namespace
+
+TEST(Renderer, ABenchedTracerKeepsApplyingCommitsAndIsProbedOnTheSide) {
+  auto slow_commit = std::make_shared<std::atomic<uint64_t>>(0);
+  Renderer renderer(fast_and_hopeless(slow_commit), whole_cost_options());
+  auto scene = std::make_shared<cohort::commit::TracerScene>();
+  FrameBuffer fb;
+  int benched = 0, probes = 0;
+  for (uint64_t f = 0; f < 40; ++f) {
+    renderer.submit_commit(cohort::commit::CommitBuffer::full(scene, f + 1));
+    const FrameStats stats = renderer.render(job_for(f), fb);
+    expect_complete(fb, f, stats, {1, 2});
+    EXPECT_EQ(stats.dropped, 0);
+    const TracerFrameStats& slow = stats.tracers[1];
+    if (f >= 10) {
+      EXPECT_NE(slow.outcome, TracerOutcome::rendered) << "frame " << f;
+      EXPECT_EQ(stats.tracers[0].row_end - stats.tracers[0].row_begin, kRows) << "frame " << f;
+      EXPECT_EQ(stats.idle_percent, 0.0) << "a benched tracer is not waited for, so not idle";
+    }
+    benched += slow.outcome == TracerOutcome::no_rows;
+    probes += slow.probe_rows > 0;
+    // Frames on the virtual clock take no time: let its side job (this frame's commit) land first,
+    // else it is still busy at the next frame and sits it out.
+    for (int i = 0; i < 2000 && slow.outcome == TracerOutcome::no_rows && slow_commit->load() != f + 1; ++i)
+      std::this_thread::sleep_for(std::chrono::microseconds(100));
+  }
+  // Benched, or still on its last side job when a frame began (it then sits the frame out).
+  EXPECT_GE(benched, 10);
+  EXPECT_GE(probes, 3);
+  // The last commit reaches it with the next side job it is ready for; wait for that event.
+  for (uint64_t f = 40; f < 400 && slow_commit->load() != 40; ++f) {
+    renderer.render(job_for(f), fb);
+    std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  }
+  EXPECT_EQ(slow_commit->load(), 40u);
+}
+
+TEST(Renderer, ABenchedTracerReRendersTheRowsOfATracerThatFailed) {
+  SimulatedTracerOptions fast = sim(1, 1.0);
+  fast.throw_on_frames = {20};
+  Renderer renderer(fast_and_hopeless(std::make_shared<std::atomic<uint64_t>>(0), fast), whole_cost_options());
+  FrameBuffer fb;
+  for (uint64_t f = 0; f < 24; ++f) {
+    const FrameStats stats = renderer.render(job_for(f), fb);
+    expect_complete(fb, f, stats, {1, 2});
+    if (f == 20) {
+      EXPECT_EQ(stats.dropped, 1);
+      EXPECT_EQ(stats.tracers[0].outcome, TracerOutcome::threw);
+      EXPECT_EQ(stats.tracers[1].recovery_rows, kRows) << "the benched tracer was the only one left";
+    }
+  }
+}

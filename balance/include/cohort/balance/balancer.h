@@ -30,8 +30,16 @@ class Balancer {
  public:
   virtual ~Balancer() = default;
   virtual std::string name() const = 0;
-  // One band per entry of in.tracers, in that order, covering [0, in.rows) (see check_bands()).
+  // One band per entry of in.tracers, in that order, covering [0, in.rows) (see check_bands() with
+  // band_rules()).
   virtual std::vector<Band> divide(const DivideInput& in) = 0;
+  // The rules divide() keeps: the paper's 4-row units and non-empty bands unless a balancer says otherwise.
+  virtual BandRules band_rules() const { return {}; }
+  // After divide(): for each entry of in.tracers, rows it should render on the side, unwaited and
+  // thrown away, only to be measured (a tracer the balancer benched, probed now and then to see
+  // whether it is worth rows again); its time comes back in a later DivideInput::previous with that
+  // band. Empty (or all bands empty) when nothing is to be probed.
+  virtual std::vector<Band> probe_bands() const { return {}; }
   // Forget everything learnt (a cut, a resolution change). Balancers also reset themselves when the
   // row count changes.
   virtual void reset() = 0;
@@ -49,9 +57,17 @@ struct BalancerOptions {
   // `cohort bench balance` sweeps (see docs/balancing.md).
   double cost_rate = 0.5;
   double speed_rate = 0.1;
+  // Whole Cost: a tracer is benched (zero rows) when the frame is predicted less than this fraction
+  // faster with it than without (a tiny share buys little and adds its timing noise and hand-over
+  // at the end of the frame); a benched tracer is probed every probe_interval frames; bands smaller
+  // than fine_below_rows are cut on single rows instead of 4-row units (false: 4-row units always).
+  double min_gain = 0.03;
+  int probe_interval = 30;
+  int fine_below_rows = 32;
+  bool fine_cuts = true;
 };
 
-// "none", "robin-hood", "perfect", "perfect-smooth", "row-cost". Throws std::invalid_argument naming
+// "none", "robin-hood", "perfect", "perfect-smooth", "row-cost", "whole-cost". Throws std::invalid_argument naming
 // the known balancers for any other name.
 std::unique_ptr<Balancer> make_balancer(std::string_view name, const BalancerOptions& options = {});
 std::vector<std::string> balancer_names();

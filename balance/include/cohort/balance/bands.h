@@ -35,8 +35,15 @@ std::vector<Band> bands_from_cuts(int rows, std::span<const double> cumulative_u
 // Equal split.
 std::vector<Band> equal_bands(int rows, int count);
 
-// Empty when `bands` is a valid division of `rows` rows (contiguous, covering, unit-aligned cuts,
-// non-empty while units allow); otherwise says what is wrong.
-std::string check_bands(int rows, std::span<const Band> bands);
+// What a division may look like. The paper's rules (the default): cuts on kRowsPerUnit boundaries and
+// every band non-empty while units allow. A balancer that benches tracers or cuts finer relaxes them.
+struct BandRules {
+  int row_unit = kRowsPerUnit;  // cuts fall on multiples of this (the last band ends at the frame's end)
+  bool allow_empty = false;     // a band may be empty (its tracer gets no rows); one band at least is not
+};
+
+// Empty when `bands` is a valid division of `rows` rows under `rules` (contiguous, covering, cuts on
+// the rules' boundaries, non-empty as the rules ask); otherwise says what is wrong.
+std::string check_bands(int rows, std::span<const Band> bands, const BandRules& rules = {});
 
 }  // namespace cohort::balance

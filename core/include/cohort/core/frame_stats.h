@@ -13,7 +13,8 @@ namespace cohort::core {
 
 enum class TracerOutcome {
   rendered,   // finished its band in time
-  no_rows,    // took part but got an empty band (more tracers than work units)
+  no_rows,    // got an empty band (benched by the balancer, or more tracers than work units): it applied
+              // its commits on the side, unwaited, and may have rendered a probe band (probe_rows)
   threw,      // render_band or apply threw: dropped for this frame
   timed_out,  // missed the frame timeout: dropped; it rejoins once it has finished the late work
   busy,       // still finishing late work from an earlier frame: not asked this frame
@@ -28,6 +29,7 @@ struct TracerFrameStats {
   int row_begin = 0, row_end = 0;
   double ms = 0.0;             // measured cost: commit apply + band render (virtual time: what the tracer reported)
   double idle_ms = 0.0;        // frame_ms - ms for tracers that rendered
+  int probe_rows = 0;          // no_rows: rows it renders unwaited to be measured (the balancer's probe)
   int recovery_rows = 0;       // rows it re-rendered for dropped tracers
   double recovery_ms = 0.0;
 };
@@ -37,7 +39,8 @@ struct FrameStats {
   int rows = 0;
   std::string balancer;
   double frame_ms = 0.0;          // slowest rendering tracer's band time (first round)
-  double summed_tracer_ms = 0.0;  // tracers * frame_ms: every tracer is occupied for the whole frame
+  double summed_tracer_ms = 0.0;  // rendering tracers * frame_ms: each of them is occupied for the whole frame
+                                  // (a tracer with no rows is not waited for and not counted)
   double idle_ms = 0.0;           // sum of idle_ms
   double idle_percent = 0.0;      // idle_ms / summed_tracer_ms * 100: Brigade's Table 1 metric
   double recovery_ms = 0.0;       // extra time spent re-rendering dropped tracers' rows

@@ -9,8 +9,12 @@
 // A pending buffer over budget becomes a full resync to the caller's snapshot, and so does the next
 // commit of a tracer whose apply() threw: such a tracer renders nothing until it has its resync.
 //
+// A tracer the balancer gives no rows (benched) still gets its commits: it applies them on the side,
+// with the probe band the balancer may ask for, and the frame does not wait for it; what it measured
+// reaches the balancer at the next frame that finds it done.
+//
 // Faults: a tracer that throws, or has not finished when the frame timeout expires, is dropped for the
-// frame; its rows are split among the tracers that finished and re-rendered, and the frame is still
+// frame; its rows are split among the tracers that finished (and benched ones that are idle) and re-rendered, and the frame is still
 // delivered. A timed-out tracer keeps running on its own thread; it takes part again from the first
 // frame that starts after it has finished. One that never returns does not block shutdown.
 #pragma once
@@ -102,6 +106,7 @@ class Renderer {
   struct Assignment {
     int worker;
     balance::Band band;
+    bool probe = false;  // rendered to be measured only: nobody waits for it, its rows are not merged
   };
   struct RoundResult {
     std::vector<int> finished;   // workers that rendered their band
@@ -130,6 +135,9 @@ class Renderer {
   // Copies delivered bands from the workers' targets `slot` into out.
   void merge(const std::vector<Assignment>& bands, int slot, FrameBuffer& out) const;
   double measured_ms(const Worker& w) const;
+  // A benched tracer's unwaited job (commits, maybe a probe) that has ended: its measurement joins
+  // last_measurements_ and its stages the frame's. Call with the completion mutex held.
+  void harvest_side_job(Worker& w, std::vector<StageSpan>& stages);
   std::shared_ptr<const commit::TracerScene> resync_scene();
 
   RendererOptions options_;
