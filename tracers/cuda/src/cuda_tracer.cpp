@@ -2,6 +2,8 @@
 
 #include <cuda_runtime.h>
 
+#include <vector>
+
 #include "device_array.h"
 #include "render_band_launch.h"
 
@@ -41,6 +43,9 @@ struct CudaTracer::Impl {
   unsigned short* band_rgb16f = nullptr;   // the band as RGB halves, for RGB16F targets
   bool count_rays = false;
   unsigned long long* ray_counts = nullptr;   // device: closest, occlusion
+  unsigned* row_rays = nullptr;                // device: rays per band row (the balancer's per-row work)
+  size_t row_rays_capacity = 0;                // rows
+  std::vector<unsigned> host_row_rays;
   RayCounts last_counts;
   size_t band_capacity = 0;   // pixels
   // The targets the band is copied into, page-locked (cudaHostRegister) so that the copy is a true
@@ -110,6 +115,7 @@ CudaTracer::~CudaTracer() {
   if (impl_->band) cudaFree(impl_->band);
   if (impl_->band_rgb16f) cudaFree(impl_->band_rgb16f);
   if (impl_->ray_counts) cudaFree(impl_->ray_counts);
+  if (impl_->row_rays) cudaFree(impl_->row_rays);
   if (impl_->start) cudaEventDestroy(impl_->start);
   if (impl_->stop) cudaEventDestroy(impl_->stop);
   if (impl_->stream) cudaStreamDestroy(impl_->stream);
@@ -165,13 +171,20 @@ core::BandResult CudaTracer::render_band(const core::BandJob& job, core::BandBuf
   }
   const bool half = target.format() == core::BandFormat::rgb16f;
   if (half && !m.band_rgb16f) COHORT_CUDA(cudaMalloc(&m.band_rgb16f, m.band_capacity * 3 * sizeof(unsigned short)));
+  const size_t rows = params.row_end - params.row_begin;
+  if (rows > m.row_rays_capacity) {
+    if (m.row_rays) COHORT_CUDA(cudaFree(m.row_rays));
+    COHORT_CUDA(cudaMalloc(&m.row_rays, rows * sizeof(unsigned)));
+    m.row_rays_capacity = rows;
+  }
+  COHORT_CUDA(cudaMemsetAsync(m.row_rays, 0, rows * sizeof(unsigned), m.stream));
   if (m.count_rays) {
     if (!m.ray_counts) COHORT_CUDA(cudaMalloc(&m.ray_counts, 2 * sizeof(unsigned long long)));
     COHORT_CUDA(cudaMemsetAsync(m.ray_counts, 0, 2 * sizeof(unsigned long long), m.stream));
   }
   m.register_target(target);
   COHORT_CUDA(cudaEventRecord(m.start, m.stream));
-  launch_render_band(m.view(params), params, camera, m.band, m.count_rays ? m.ray_counts : nullptr, m.stream);
+  launch_render_band(m.view(params), params, camera, m.band, m.count_rays ? m.ray_counts : nullptr, m.row_rays, m.stream);
   COHORT_CUDA(cudaEventRecord(m.stop, m.stream));
   // The band's rows are contiguous in the target: one copy straight into place, in its format.
   const void* source = m.band;
@@ -181,6 +194,8 @@ core::BandResult CudaTracer::render_band(const core::BandJob& job, core::BandBuf
   }
   COHORT_CUDA(cudaMemcpyAsync(target.row(int(params.row_begin)), source, pixels * core::bytes_per_pixel(target.format()),
                               cudaMemcpyDeviceToHost, m.stream));
+  m.host_row_rays.resize(rows);
+  COHORT_CUDA(cudaMemcpyAsync(m.host_row_rays.data(), m.row_rays, rows * sizeof(unsigned), cudaMemcpyDeviceToHost, m.stream));
   unsigned long long counts[2] = {0, 0};
   if (m.count_rays)
     COHORT_CUDA(cudaMemcpyAsync(counts, m.ray_counts, sizeof counts, cudaMemcpyDeviceToHost, m.stream));
@@ -190,6 +205,7 @@ core::BandResult CudaTracer::render_band(const core::BandJob& job, core::BandBuf
   COHORT_CUDA(cudaEventElapsedTime(&kernel_ms, m.start, m.stop));
   core::BandResult result;
   result.device_ms = kernel_ms;
+  result.row_work.assign(m.host_row_rays.begin(), m.host_row_rays.end());
   return result;
 }
 

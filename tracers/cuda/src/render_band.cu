@@ -14,7 +14,8 @@ __constant__ cudaTextureObject_t cohort_texel_texture;
 namespace cohort::tracers {
 
 __global__ void __launch_bounds__(128) render_band_kernel(KSceneView scene, KFrameParams params, KCamera camera,
-                                                          float4* band, unsigned long long* ray_counts) {
+                                                          float4* band, unsigned long long* ray_counts,
+                                                          unsigned* row_rays) {
   const kuint x = blockIdx.x * blockDim.x + threadIdx.x;
   const kuint row = blockIdx.y * blockDim.y + threadIdx.y;
   const kuint y = params.row_begin + row;
@@ -36,6 +37,16 @@ __global__ void __launch_bounds__(128) render_band_kernel(KSceneView scene, KFra
       atomicAdd(&ray_counts[1], (unsigned long long)occlusion);
     }
   }
+  if (row_rays) {
+    // Rays per row of the band (the balancer's per-row work). With 16-wide blocks a warp holds two
+    // rows: lanes 0-15 one, 16-31 the next; each half adds once.
+    const unsigned mine = inside ? ctx.closest_rays + ctx.occlusion_rays : 0u;
+    const unsigned lane = (threadIdx.x + threadIdx.y * blockDim.x) % 32u;
+    const unsigned low = __reduce_add_sync(0xffffffffu, lane < 16u ? mine : 0u);
+    const unsigned high = __reduce_add_sync(0xffffffffu, lane >= 16u ? mine : 0u);
+    const unsigned half = lane < 16u ? low : high;
+    if ((lane == 0u || lane == 16u) && y < params.row_end && half != 0u) atomicAdd(&row_rays[row], half);
+  }
 }
 
 void set_texel_texture(cudaTextureObject_t texture) {
@@ -43,11 +54,11 @@ void set_texel_texture(cudaTextureObject_t texture) {
 }
 
 void launch_render_band(const KSceneView& scene, const KFrameParams& params, const KCamera& camera, float4* band,
-                        unsigned long long* ray_counts, cudaStream_t stream) {
+                        unsigned long long* ray_counts, unsigned* row_rays, cudaStream_t stream) {
   const kuint rows = params.row_end - params.row_begin;
-  const dim3 block(16, 8);
+  const dim3 block(16, 8);  // 16 wide: the row ray counts rely on two rows per warp
   const dim3 grid((camera.width + block.x - 1) / block.x, (rows + block.y - 1) / block.y);
-  render_band_kernel<<<grid, block, 0, stream>>>(scene, params, camera, band, ray_counts);
+  render_band_kernel<<<grid, block, 0, stream>>>(scene, params, camera, band, ray_counts, row_rays);
   COHORT_CUDA(cudaGetLastError());
 }
 

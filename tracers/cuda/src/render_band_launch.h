@@ -9,8 +9,9 @@ namespace cohort::tracers {
 
 void set_texel_texture(cudaTextureObject_t texture);
 // The scene view holds device pointers (built on the host with k_scene_view, passed by value).
+// ray_counts (closest, occlusion) and row_rays (one per band row, zeroed by the caller) may be null.
 void launch_render_band(const KSceneView& scene, const KFrameParams& params, const KCamera& camera, float4* band,
-                        unsigned long long* ray_counts, cudaStream_t stream);
+                        unsigned long long* ray_counts, unsigned* row_rays, cudaStream_t stream);
 // Converts a rendered band (float4 per pixel) to RGB halves (3 x 16 bits per pixel) on the stream.
 void launch_band_to_rgb16f(const float4* band, unsigned short* rgb, size_t pixels, cudaStream_t stream);
 

@@ -143,10 +143,13 @@ core::BandResult EmbreeTracer::render_band(const core::BandJob& job, core::BandB
   const int width = std::min(static_cast<int>(camera.width), target.width());
   const embree_kernel::TraceCtx base{host_scene_view(params), impl_->top, 0};
   std::atomic<uint64_t> rays{0};
+  // Rays traced per row: the balancer's per-row work proxy (BandResult::row_work), as the GPU tracers count it.
+  std::vector<float> row_rays(static_cast<size_t>(std::max(row_end - row_begin, 0)), 0.0f);
   tbb::parallel_for(tbb::blocked_range<int>(row_begin, row_end, 1), [&](const tbb::blocked_range<int>& rows) {
     embree_kernel::TraceCtx ctx = base;
     std::vector<float> out(static_cast<size_t>(width) * 4);  // one row, stored in the target's format
     for (int y = rows.begin(); y < rows.end(); ++y) {
+      const uint64_t rays_before = ctx.rays;
       for (int x = 0; x < width; ++x) {
         KVec3 c = k_render_pixel(&ctx, &params, &camera, static_cast<kuint>(x), static_cast<kuint>(y));
         out[4 * x + 0] = c.x;
@@ -155,12 +158,14 @@ core::BandResult EmbreeTracer::render_band(const core::BandJob& job, core::BandB
         out[4 * x + 3] = 1.0f;
       }
       target.store(y, 0, out.data(), static_cast<size_t>(width));
+      row_rays[static_cast<size_t>(y - row_begin)] = static_cast<float>(ctx.rays - rays_before);
     }
     rays += ctx.rays;
   });
   impl_->rays_traced += rays.load();
   core::BandResult result;
   result.device_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  if (row_end == static_cast<int>(params.row_end)) result.row_work = std::move(row_rays);
   return result;
 }
 

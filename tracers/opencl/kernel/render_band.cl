@@ -9,22 +9,32 @@ __kernel void cohort_render_band(__global const KVertex* vertices, __global cons
                                  __global const KMaterial* materials, __global const KTexture* textures,
                                  __global const kuint* texels, __global const KLight* lights,
                                  __global const KFrameParams* params_in, __global const KCamera* camera_in,
-                                 __global float* band_rgba) {
+                                 __global float* band_rgba, __global uint* row_rays) {
+  /* Rays traced per row of the band (the balancer's per-row work), summed in local memory first so
+   * that each work group adds once per row. The host launches 8x8 work groups. */
+  __local uint group_row_rays[8];
   KFrameParams params = *params_in;
   KCamera camera = *camera_in;
   kuint x = (kuint)get_global_id(0);
   kuint row = (kuint)get_global_id(1);
   kuint y = params.row_begin + row;
-  if (x >= camera.width || y >= params.row_end) return;
-  KTraceCtx ctx;
-  ctx.scene = k_scene_view(vertices, triangles, blas_nodes, blases, instances, tlas_nodes, materials, textures, texels,
-                           lights, &params);
-  ctx.closest_rays = 0u;
-  ctx.occlusion_rays = 0u;
-  KVec3 c = k_render_pixel(&ctx, &params, &camera, x, y);
-  __global float* out = band_rgba + ((size_t)row * camera.width + x) * 4u;
-  out[0] = c.x;
-  out[1] = c.y;
-  out[2] = c.z;
-  out[3] = 1.0f;
+  kuint lx = (kuint)get_local_id(0), ly = (kuint)get_local_id(1);
+  if (lx == 0u) group_row_rays[ly] = 0u;
+  barrier(CLK_LOCAL_MEM_FENCE);
+  if (x < camera.width && y < params.row_end) {
+    KTraceCtx ctx;
+    ctx.scene = k_scene_view(vertices, triangles, blas_nodes, blases, instances, tlas_nodes, materials, textures, texels,
+                             lights, &params);
+    ctx.closest_rays = 0u;
+    ctx.occlusion_rays = 0u;
+    KVec3 c = k_render_pixel(&ctx, &params, &camera, x, y);
+    __global float* out = band_rgba + ((size_t)row * camera.width + x) * 4u;
+    out[0] = c.x;
+    out[1] = c.y;
+    out[2] = c.z;
+    out[3] = 1.0f;
+    atomic_add(&group_row_rays[ly], ctx.closest_rays + ctx.occlusion_rays);
+  }
+  barrier(CLK_LOCAL_MEM_FENCE);
+  if (lx == 0u && y < params.row_end && group_row_rays[ly] != 0u) atomic_add(&row_rays[row], group_row_rays[ly]);
 }

@@ -102,11 +102,11 @@ struct OpenCLTracer::Impl {
   cl_program program = nullptr;
   cl_kernel kernel = nullptr;
   DeviceBuffer vertices, triangles, blas_nodes, blases, instances, tlas_nodes, materials, textures, texels, lights;
-  cl_mem params = nullptr, camera = nullptr, output = nullptr;
-  size_t output_bytes = 0;
+  cl_mem params = nullptr, camera = nullptr, output = nullptr, row_rays = nullptr;
+  size_t output_bytes = 0, row_rays_rows = 0;
 
   ~Impl() {
-    for (cl_mem m : {params, camera, output})
+    for (cl_mem m : {params, camera, output, row_rays})
       if (m) clReleaseMemObject(m);
     if (kernel) clReleaseKernel(kernel);
     if (program) clReleaseProgram(program);
@@ -209,6 +209,15 @@ core::BandResult OpenCLTracer::render_band(const core::BandJob& job, core::BandB
     check(err, "clCreateBuffer(output)");
     m.output_bytes = bytes;
   }
+  if (rows > m.row_rays_rows) {
+    if (m.row_rays) clReleaseMemObject(m.row_rays);
+    m.row_rays = clCreateBuffer(m.context, CL_MEM_READ_WRITE, rows * sizeof(cl_uint), nullptr, &err);
+    check(err, "clCreateBuffer(row rays)");
+    m.row_rays_rows = rows;
+  }
+  const cl_uint zero = 0;
+  check(clEnqueueFillBuffer(m.queue, m.row_rays, &zero, sizeof zero, 0, rows * sizeof(cl_uint), 0, nullptr, nullptr),
+        "clearing the row ray counts");
   check(clEnqueueWriteBuffer(m.queue, m.params, CL_FALSE, 0, sizeof params, &params, 0, nullptr, nullptr),
         "writing frame parameters");
   check(clEnqueueWriteBuffer(m.queue, m.camera, CL_FALSE, 0, sizeof camera, &camera, 0, nullptr, nullptr),
@@ -216,7 +225,7 @@ core::BandResult OpenCLTracer::render_band(const core::BandJob& job, core::BandB
   cl_mem args[] = {m.vertices.mem(),  m.triangles.mem(), m.blas_nodes.mem(), m.blases.mem(),
                    m.instances.mem(), m.tlas_nodes.mem(), m.materials.mem(), m.textures.mem(),
                    m.texels.mem(),    m.lights.mem(),     m.params,           m.camera,
-                   m.output};
+                   m.output,          m.row_rays};
   for (cl_uint i = 0; i < sizeof(args) / sizeof(args[0]); ++i)
     check(clSetKernelArg(m.kernel, i, sizeof(cl_mem), &args[i]), "clSetKernelArg");
   const size_t local[2] = {8, 8};
@@ -225,6 +234,9 @@ core::BandResult OpenCLTracer::render_band(const core::BandJob& job, core::BandB
   check(clEnqueueNDRangeKernel(m.queue, m.kernel, 2, nullptr, global, local, 0, nullptr, &done), "launching the kernel");
   std::vector<float> band(rows * camera.width * 4);
   check(clEnqueueReadBuffer(m.queue, m.output, CL_TRUE, 0, bytes, band.data(), 0, nullptr, nullptr), "reading the band");
+  std::vector<cl_uint> row_rays(rows);
+  check(clEnqueueReadBuffer(m.queue, m.row_rays, CL_TRUE, 0, rows * sizeof(cl_uint), row_rays.data(), 0, nullptr, nullptr),
+        "reading the row ray counts");
   cl_ulong start = 0, end = 0;
   clGetEventProfilingInfo(done, CL_PROFILING_COMMAND_START, sizeof start, &start, nullptr);
   clGetEventProfilingInfo(done, CL_PROFILING_COMMAND_END, sizeof end, &end, nullptr);
@@ -233,6 +245,7 @@ core::BandResult OpenCLTracer::render_band(const core::BandJob& job, core::BandB
     target.store(static_cast<int>(params.row_begin + r), 0, band.data() + r * camera.width * 4, camera.width);
   core::BandResult result;
   result.device_ms = end > start ? double(end - start) * 1e-6 : 0.0;
+  if (params.row_end == frame_params(job).row_end) result.row_work.assign(row_rays.begin(), row_rays.end());
   return result;
 }
 
