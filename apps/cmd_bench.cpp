@@ -6,7 +6,9 @@
 #include <spdlog/spdlog.h>
 
 #include "balance_bench.h"
+#include "camera_path.h"
 #include "commands.h"
+#include "devices_bench.h"
 #include "default_map.h"
 
 namespace cohort::app {
@@ -37,7 +39,7 @@ std::string format_fraction(double v) {
 }  // namespace
 
 void add_bench_command(CLI::App& app, int& exit_code) {
-  auto* cmd = app.add_subcommand("bench", "Benchmarks (balancer efficiency: 'cohort bench balance')");
+  auto* cmd = app.add_subcommand("bench", "Benchmarks (balancer efficiency: 'cohort bench balance'; device mixes: 'cohort bench devices')");
   cmd->require_subcommand(1);
   auto* balance = cmd->add_subcommand(
       "balance",
@@ -157,6 +159,72 @@ void add_bench_command(CLI::App& app, int& exit_code) {
     }
     if (!args->plot.empty()) {
       write_balance_plot(args->plot, runs);
+      std::cout << "wrote " << args->plot << "\n";
+    }
+  });
+
+  add_bench_devices_command(*cmd, exit_code);
+}
+
+void add_bench_devices_command(CLI::App& bench, int& exit_code) {
+  auto* devices = bench.add_subcommand(
+      "devices",
+      "Does every device add speed? The same camera path on each tracer alone and on mixes of them: median and\n"
+      "p95 wall ms per frame, fps, idle % and scaling efficiency = (1/T_mix) / sum of (1/T_alone) over the mix.\n"
+      "Default mixes: Embree and every GPU alone, each GPU with Embree, all GPUs without and with Embree.");
+  struct Args {
+    std::vector<std::string> mixes;
+    std::string json, plot;
+    DevicesBenchConfig config;
+  };
+  auto args = std::make_shared<Args>();
+  devices->add_option("--mix", args->mixes, "a tracer mix, e.g. embree,cuda:0 (repeat for several; default: see above)");
+  devices->add_option("--scene", args->config.scene, "map or scene pack to render")->capture_default_str();
+  devices->add_option("--width", args->config.width, "image width")->capture_default_str()->check(CLI::PositiveNumber);
+  devices->add_option("--height", args->config.height, "image height")->capture_default_str()->check(CLI::PositiveNumber);
+  devices->add_option("--frames", args->config.frames, "frames per mix")->capture_default_str()->check(CLI::PositiveNumber);
+  devices->add_option("--warmup", args->config.warmup, "first frames not counted")->capture_default_str()->check(CLI::NonNegativeNumber);
+  devices->add_option("--camera-path", args->config.camera_path, "spin or orbit, -slow or -fast, from the player start")
+      ->capture_default_str()
+      ->check([](const std::string& v) {
+        try {
+          parse_camera_path(v);
+          return std::string();
+        } catch (const std::exception& e) {
+          return std::string(e.what());
+        }
+      });
+  devices->add_option("--balancer", args->config.balancer, "row balancer")
+      ->capture_default_str()->check(CLI::IsMember(balance::balancer_names()));
+  devices->add_option("--json", args->json, "write every run (per-frame wall ms) as JSON");
+  devices->add_option("--plot", args->plot, "write a PNG bar chart of median wall ms per mix");
+  devices->callback([args, &exit_code] {
+    DevicesBenchConfig config = args->config;
+    if (config.warmup >= config.frames) throw CLI::ValidationError("--warmup", "must be less than --frames");
+    for (const std::string& mix : args->mixes) {
+      std::vector<std::string> names = split_list<std::string>(mix, "--mix");
+      if (names.empty()) throw CLI::ValidationError("--mix", "empty mix");
+      config.mixes.push_back(std::move(names));
+    }
+    std::vector<DevicesBenchRun> runs;
+    try {
+      runs = run_devices_bench(config);
+    } catch (const std::exception& e) {  // a tracer not built or a device absent
+      spdlog::error("cohort bench devices: {}", e.what());
+      exit_code = kExitUnavailable;
+      return;
+    }
+    std::cout << config.scene << ", " << config.width << "x" << config.height << ", " << config.camera_path << ", "
+              << config.frames << " frames (first " << config.warmup << " not counted), balancer " << config.balancer << "\n"
+              << devices_bench_table(runs);
+    if (!args->json.empty()) {
+      std::ofstream out(args->json);
+      out << devices_bench_json(config, runs).dump(1) << "\n";
+      if (!out) throw std::runtime_error("cannot write " + args->json);
+      std::cout << "wrote " << args->json << "\n";
+    }
+    if (!args->plot.empty()) {
+      write_devices_plot(args->plot, runs);
       std::cout << "wrote " << args->plot << "\n";
     }
   });

@@ -11,6 +11,8 @@ void add_info_command(CLI::App& app, int& exit_code);
 void add_render_command(CLI::App& app, int& exit_code);
 void add_play_command(CLI::App& app, int& exit_code);
 void add_bench_command(CLI::App& app, int& exit_code);
+// `cohort bench devices`, under the bench command (called by add_bench_command).
+void add_bench_devices_command(CLI::App& bench, int& exit_code);
 void add_pack_command(CLI::App& app, int& exit_code);
 void add_scenario_command(CLI::App& app, int& exit_code);
 

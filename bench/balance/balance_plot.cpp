@@ -5,6 +5,7 @@
 
 #include "balance_bench.h"
 #include "cohort/core/image_output.h"
+#include "devices_bench.h"
 #include "raster/image.h"
 
 namespace cohort::app {
@@ -115,6 +116,54 @@ void write_balance_plot(const std::string& file, const std::vector<BalanceBenchR
       raster::draw_line(image, x0, y0 + panel_h, x0 + panel_w, y0 + panel_h, kInk, 2);
     }
   }
+  core::write_ldr_image(file, image.width, image.height, image.rgba);
+}
+
+void write_devices_plot(const std::string& file, const std::vector<DevicesBenchRun>& runs) {
+  if (runs.empty()) throw std::runtime_error("--plot " + file + ": no runs to plot");
+  // One horizontal bar per mix (its name to the left): median wall ms, p95 as a whisker, and fps and
+  // scaling efficiency written after it. Colour by the number of tracers in the mix.
+  std::vector<std::string> labels;
+  int label_w = 0;
+  double x_max = 0.0;
+  for (const DevicesBenchRun& r : runs) {
+    std::string label;
+    for (const std::string& t : r.tracers) label += (label.empty() ? "" : "+") + t;
+    labels.push_back(label);
+    label_w = std::max(label_w, raster::text_advance(label, kTextScale));
+    x_max = std::max(x_max, r.p95_ms);
+  }
+  x_max = nice_ceiling(x_max);
+  const int bar_h = 22, row_h = 36, margin_top = 60, margin_bottom = 50, bar_w = 640, note_w = 380;
+  const int x0 = label_w + 30, width = x0 + bar_w + note_w, height = margin_top + static_cast<int>(runs.size()) * row_h + margin_bottom;
+  raster::Image8 image;
+  image.resize(width, height);
+  raster::fill_rect(image, 0, 0, width, height, kBackground);
+  auto text = [&](int x, int y, const std::string& str, Rgba8 c) { raster::draw_text(image, x, y, str, c, kTextScale); };
+  text(x0, 14, "median wall ms per frame (whisker: p95); fps, scaling efficiency", kInk);
+  const int y_axis = margin_top + static_cast<int>(runs.size()) * row_h;
+  for (int t = 0; t <= 4; ++t) {
+    const int x = x0 + t * bar_w / 4;
+    raster::draw_line(image, x, margin_top - 6, x, y_axis, kGrid);
+    const std::string label = format_number(x_max * t / 4);
+    text(x - raster::text_advance(label, kTextScale) / 2, y_axis + 10, label, kInk);
+  }
+  text(x0 + bar_w / 2 - raster::text_advance("ms", kTextScale) / 2, y_axis + 30, "ms", kInk);
+  auto px = [&](double ms) { return x0 + static_cast<int>(std::lround(std::clamp(ms / x_max, 0.0, 1.0) * bar_w)); };
+  for (size_t i = 0; i < runs.size(); ++i) {
+    const DevicesBenchRun& r = runs[i];
+    const int y = margin_top + static_cast<int>(i) * row_h;
+    const Rgba8 c = kPalette[(r.tracers.size() + 1) % std::size(kPalette)];
+    text(x0 - 12 - raster::text_advance(labels[i], kTextScale), y + bar_h / 2 - raster::text_height(kTextScale) / 2, labels[i], kInk);
+    raster::fill_rect(image, x0, y, std::max(px(r.median_ms) - x0, 1), bar_h, c);
+    raster::draw_line(image, px(r.median_ms), y + bar_h / 2, px(r.p95_ms), y + bar_h / 2, kInk, 2);
+    raster::draw_line(image, px(r.p95_ms), y + 4, px(r.p95_ms), y + bar_h - 4, kInk, 2);
+    char note[96];
+    std::snprintf(note, sizeof note, "%.2f ms  %.0f fps  eff %.0f%%", r.median_ms, r.fps, 100.0 * r.efficiency);
+    text(x0 + bar_w + 14, y + bar_h / 2 - raster::text_height(kTextScale) / 2, note, kInk);
+  }
+  raster::draw_line(image, x0, margin_top - 6, x0, y_axis, kInk, 2);
+  raster::draw_line(image, x0, y_axis, x0 + bar_w, y_axis, kInk, 2);
   core::write_ldr_image(file, image.width, image.height, image.rgba);
 }
 

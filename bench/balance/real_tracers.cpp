@@ -16,10 +16,11 @@ RealTracers make_real_tracers(const std::vector<std::string>& names, const std::
   RenderScene scene = load_render_scene(scene_path, {});
   auto commit = commit::CommitBuffer::full(scene.tracer_scene, 1);
   for (auto& t : out.tracers) {
-    spdlog::info("bench balance: {} loads {}", t->name(), scene.name);
+    spdlog::info("bench: {} loads {}", t->name(), scene.name);
     t->apply(commit);
   }
   out.eye = scene.player_start + glm::vec3(0.0f, 0.0f, core::kPlayerEyeHeight);
+  out.yaw = scene.player_yaw;
   return out;
 }
 

@@ -15,6 +15,7 @@ namespace cohort::app {
 struct RealTracers {
   std::vector<std::unique_ptr<core::Tracer>> tracers;
   glm::vec3 eye{0.0f};   // where the spinning camera stands: the scene's player start at eye height
+  float yaw = 0.0f;      // the player start's view direction, degrees
 };
 
 // names: tracer specs as `--tracers` takes them ("embree", "opencl:0", "cuda:1", "all", ...).

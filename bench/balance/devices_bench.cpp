@@ -1,0 +1,161 @@
+#include "devices_bench.h"
+
+#include <algorithm>
+#include <cstdio>
+#include <map>
+#include <stdexcept>
+
+#include <spdlog/spdlog.h>
+
+#include "camera_path.h"
+#include "cohort/core/frame_defaults.h"
+#include "cohort/core/renderer.h"
+#include "cohort/core/view.h"
+#include "cohort/tracers/tracer_registry.h"
+#include "real_tracers.h"
+
+namespace cohort::app {
+
+namespace {
+
+std::string join(const std::vector<std::string>& names) {
+  std::string out;
+  for (const std::string& n : names) out += (out.empty() ? "" : "+") + n;
+  return out;
+}
+
+double percentile(std::vector<double> values, double p) {
+  if (values.empty()) return 0.0;
+  std::sort(values.begin(), values.end());
+  const double at = p * static_cast<double>(values.size() - 1);
+  const size_t lo = static_cast<size_t>(at);
+  const size_t hi = std::min(lo + 1, values.size() - 1);
+  return values[lo] + (at - static_cast<double>(lo)) * (values[hi] - values[lo]);
+}
+
+DevicesBenchRun run_mix(const DevicesBenchConfig& config, const std::vector<std::string>& names) {
+  std::string list;
+  for (const std::string& n : names) list += (list.empty() ? "" : ",") + n;
+  RealTracers real = make_real_tracers(names, config.scene);
+  core::RendererOptions options;
+  options.balancer = config.balancer;
+  core::Renderer renderer(std::move(real.tracers), options);
+  const CameraPath path = parse_camera_path(config.camera_path);
+
+  DevicesBenchRun run;
+  run.tracers = names;
+  core::FrameBuffer frame;
+  int counted = 0;
+  for (int f = 0; f < config.frames; ++f) {
+    const CameraPose pose = camera_path_pose(path, real.eye, real.yaw, f);
+    core::BandJob job;
+    job.camera = core::make_camera(pose.origin, {pose.yaw, 0.0f}, core::kDefaultFovX, config.width, config.height);
+    job.params = core::default_frame_params();
+    job.params.frame_index = static_cast<kuint>(f);
+    const core::FrameStats stats = renderer.render(job, frame);
+    if (f < config.warmup) continue;
+    run.wall_ms.push_back(stats.wall_ms);
+    run.mean_idle_percent += stats.idle_percent;
+    run.worst_idle_percent = std::max(run.worst_idle_percent, stats.idle_percent);
+    for (const core::TracerFrameStats& t : stats.tracers) run.mean_rendering_tracers += t.outcome == core::TracerOutcome::rendered;
+    ++counted;
+  }
+  if (counted == 0) throw std::invalid_argument("bench devices: --frames must exceed --warmup");
+  run.mean_idle_percent /= counted;
+  run.mean_rendering_tracers /= counted;
+  run.median_ms = percentile(run.wall_ms, 0.5);
+  run.p95_ms = percentile(run.wall_ms, 0.95);
+  run.fps = run.median_ms > 0.0 ? 1000.0 / run.median_ms : 0.0;
+  spdlog::info("bench devices: {}: median {:.3f} ms, p95 {:.3f} ms, mean idle {:.2f} %", join(names), run.median_ms,
+               run.p95_ms, run.mean_idle_percent);
+  return run;
+}
+
+}  // namespace
+
+std::vector<std::vector<std::string>> default_device_mixes() {
+  std::vector<std::string> gpus;
+  for (const tracers::TracerSpec& s : tracers::parse_tracer_list("all"))
+    if (s.kind != "embree") gpus.push_back(s.text);
+  if (gpus.empty() && tracers::device_count("opencl") > 0)
+    for (const tracers::TracerSpec& s : tracers::parse_tracer_list("opencl:all")) gpus.push_back(s.text);
+  const bool embree = tracers::device_count("embree") > 0;
+  std::vector<std::vector<std::string>> mixes;
+  if (embree) mixes.push_back({"embree"});
+  for (const std::string& g : gpus) mixes.push_back({g});
+  if (embree)
+    for (const std::string& g : gpus) mixes.push_back({"embree", g});
+  if (gpus.size() > 1) {
+    mixes.push_back(gpus);
+    if (embree) {
+      std::vector<std::string> all{"embree"};
+      all.insert(all.end(), gpus.begin(), gpus.end());
+      mixes.push_back(all);
+    }
+  }
+  if (mixes.empty()) throw std::runtime_error("bench devices: no tracer can run on this machine");
+  return mixes;
+}
+
+std::vector<DevicesBenchRun> run_devices_bench(const DevicesBenchConfig& config) {
+  const std::vector<std::vector<std::string>> mixes = config.mixes.empty() ? default_device_mixes() : config.mixes;
+  // Each tracer alone first: the efficiencies need its time.
+  std::map<std::string, double> alone_ms;
+  std::vector<DevicesBenchRun> runs;
+  auto already = [&](const std::vector<std::string>& mix) {
+    return std::any_of(runs.begin(), runs.end(), [&](const DevicesBenchRun& r) { return r.tracers == mix; });
+  };
+  for (const auto& mix : mixes) {
+    for (const std::string& name : mix) {
+      if (alone_ms.count(name)) continue;
+      runs.push_back(run_mix(config, {name}));
+      alone_ms[name] = runs.back().median_ms;
+    }
+  }
+  for (const auto& mix : mixes)
+    if (!already(mix)) runs.push_back(run_mix(config, mix));
+  for (DevicesBenchRun& r : runs) {
+    double summed_speed = 0.0;
+    for (const std::string& name : r.tracers) summed_speed += 1.0 / alone_ms.at(name);
+    r.efficiency = r.median_ms > 0.0 && summed_speed > 0.0 ? (1.0 / r.median_ms) / summed_speed : 0.0;
+  }
+  return runs;
+}
+
+std::string devices_bench_table(const std::vector<DevicesBenchRun>& runs) {
+  std::string out;
+  char line[512];
+  std::snprintf(line, sizeof line, "%-36s %10s %10s %9s %11s %12s %10s %11s\n", "tracers", "median ms", "p95 ms", "fps",
+                "mean idle %", "worst idle %", "rendering", "efficiency");
+  out += line;
+  for (const DevicesBenchRun& r : runs) {
+    std::snprintf(line, sizeof line, "%-36s %10.3f %10.3f %9.1f %11.2f %12.2f %10.2f %10.1f%%\n", join(r.tracers).c_str(),
+                  r.median_ms, r.p95_ms, r.fps, r.mean_idle_percent, r.worst_idle_percent, r.mean_rendering_tracers,
+                  100.0 * r.efficiency);
+    out += line;
+  }
+  return out;
+}
+
+nlohmann::json devices_bench_json(const DevicesBenchConfig& config, const std::vector<DevicesBenchRun>& runs) {
+  nlohmann::json j;
+  j["config"] = {{"scene", config.scene},   {"width", config.width},         {"height", config.height},
+                 {"frames", config.frames}, {"warmup", config.warmup},       {"camera_path", config.camera_path},
+                 {"balancer", config.balancer},
+                 {"metric", "wall ms = Renderer frame (bands, merge, recovery); efficiency = (1/T_mix) / sum(1/T_alone)"}};
+  j["runs"] = nlohmann::json::array();
+  for (const DevicesBenchRun& r : runs) {
+    j["runs"].push_back({{"tracers", r.tracers},
+                         {"median_ms", r.median_ms},
+                         {"p95_ms", r.p95_ms},
+                         {"fps", r.fps},
+                         {"mean_idle_percent", r.mean_idle_percent},
+                         {"worst_idle_percent", r.worst_idle_percent},
+                         {"mean_rendering_tracers", r.mean_rendering_tracers},
+                         {"efficiency", r.efficiency},
+                         {"wall_ms", r.wall_ms}});
+  }
+  return j;
+}
+
+}  // namespace cohort::app

@@ -1,0 +1,46 @@
+// `cohort bench devices`: does every device add speed? The same camera path rendered by each tracer
+// alone and by mixes of them, with median / p95 wall ms per frame, fps, idle % and the scaling
+// efficiency of each mix: (1 / T_mix) / sum over its tracers of (1 / T_alone), 1 when the mix is as
+// fast as its tracers' speeds added up.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "default_map.h"
+
+namespace cohort::app {
+
+struct DevicesBenchConfig {
+  std::vector<std::vector<std::string>> mixes;   // tracer specs per mix; empty: default_device_mixes()
+  std::string scene = kTestMapFile;
+  int width = 1280, height = 720;
+  int frames = 60, warmup = 10;                  // the first `warmup` frames are not counted
+  std::string camera_path = "spin-slow";
+  std::string balancer = "whole-cost";
+};
+
+struct DevicesBenchRun {
+  std::vector<std::string> tracers;
+  double median_ms = 0.0, p95_ms = 0.0, fps = 0.0;
+  double mean_idle_percent = 0.0, worst_idle_percent = 0.0;
+  double mean_rendering_tracers = 0.0;  // tracers given rows per frame (a balancer may bench one)
+  double efficiency = 0.0;              // scaling efficiency; 1 for a tracer alone
+  std::vector<double> wall_ms;          // per counted frame
+};
+
+// Every GPU alone (CUDA devices, else OpenCL accelerators, else every OpenCL device), Embree alone,
+// each GPU with Embree, and all GPUs without and with Embree.
+std::vector<std::vector<std::string>> default_device_mixes();
+
+// Runs every mix, and every tracer of a mix alone first (for the efficiencies). Throws what the
+// registry throws for a tracer that is not built or not present.
+std::vector<DevicesBenchRun> run_devices_bench(const DevicesBenchConfig& config);
+std::string devices_bench_table(const std::vector<DevicesBenchRun>& runs);
+nlohmann::json devices_bench_json(const DevicesBenchConfig& config, const std::vector<DevicesBenchRun>& runs);
+// Bar chart: median wall ms per mix, p95 as a whisker, efficiency and fps written beside each bar.
+void write_devices_plot(const std::string& file, const std::vector<DevicesBenchRun>& runs);
+
+}  // namespace cohort::app
