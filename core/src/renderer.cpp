@@ -427,6 +427,7 @@ void Renderer::begin_frame(const BandJob& job, FrameBuffer& out, const std::vect
   const int slot = next_slot_;
   next_slot_ ^= 1;
   std::vector<uint64_t> ids = assign(assignments, job, slot, true);
+  // A probe renders into this frame's slot, which the frame never merges from a benched tracer.
   const std::vector<uint64_t> side_ids = assign(side_jobs, job, slot, true);
   for (size_t i = 0; i < side_jobs.size(); ++i) {
     Worker& w = *workers_[static_cast<size_t>(side_jobs[i].worker)];

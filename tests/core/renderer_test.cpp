@@ -398,6 +398,7 @@ class CommitWatchingTracer final : public Tracer {
     inner_->apply(commit);
     last_->store(commit.frame());
   }
+  using Tracer::render_band;
   BandResult render_band(const BandJob& job, BandBuffer& target) override { return inner_->render_band(job, target); }
 
  private:
