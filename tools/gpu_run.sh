@@ -17,9 +17,11 @@ stage=.gpu
 case "${1:-}" in
   stage)
     cmake --preset gpu-travel
-    cmake --build --preset gpu-travel -j2 --target cohort cohort_tracers_tests bench_cuda bench_tracers
+    cmake --build --preset gpu-travel -j2 --target cohort cohort_tracers_tests bench_cuda bench_tracers bench_bvh \
+      bench_scaling bench_host_frame
     rm -rf "$stage" && mkdir -p "$stage/bin" "$stage/lib"
-    for exe in build/gpu/bin/cohort build/gpu/bin/cohort_tracers_tests build/gpu/bin/bench_cuda build/gpu/bin/bench_tracers; do
+    for exe in build/gpu/bin/cohort build/gpu/bin/cohort_tracers_tests build/gpu/bin/bench_cuda build/gpu/bin/bench_tracers \
+               build/gpu/bin/bench_bvh build/gpu/bin/bench_scaling build/gpu/bin/bench_host_frame; do
       [ -x "$exe" ] && [ -f "$exe" ] && strip -o "$stage/bin/$(basename "$exe")" "$exe"
     done
     for lib in libembree3.so.3 libtbb.so.12 libzip.so.4; do
@@ -40,6 +42,7 @@ case "${1:-}" in
     export OCL_ICD_VENDORS=/tmp/icd
     out="${OUT:-/tmp/cohort-out}"; mkdir -p "$out"
     nvidia-smi --query-gpu=index,name,memory.total,driver_version --format=csv | tee "$out/gpus.csv"
+    (clinfo -l 2>&1 || true) | tee "$out/opencl_devices.txt"
     status=0
     mkdir -p "$out/images"
     COHORT_PACK="$stage/testmap.cpk" COHORT_TEST_IMAGES="$out/images" \
@@ -60,7 +63,28 @@ case "${1:-}" in
       python3 tools/frame_times.py "$out/e2e_$name/stats.json" --json "$out/e2e_$name/summary.json" \
         | tee -a "$out/e2e.log" || status=1
     done
-    # The large generated map (when staged): 1080p, 1 spp, through the whole app.
+    # The large generated map: staged, or generated and packed here (COHORT_GPU_LARGEMAP=remote).
+    if [ "${COHORT_GPU_LARGEMAP:-0}" = remote ] && [ ! -f "$stage/largemap.cpk" ]; then
+      python3 tools/gen_testmap.py --large --out /tmp/largemap >/dev/null 2>&1 &&
+        "$stage/bin/cohort" pack /tmp/largemap/maps/largemap.map --out "$stage/largemap.cpk" 2>&1 | tail -n 2 || status=1
+    fi
+    # BVH builds on this machine's cores: BLAS Mtris/s (test map, large map, 1M-triangle terrain), TLAS ms.
+    if [ -x "$stage/bin/bench_bvh" ]; then
+      maps=(--map assets/testmap/maps/testmap.map)
+      [ -f /tmp/largemap/maps/largemap.map ] && maps+=(--map /tmp/largemap/maps/largemap.map)
+      timeout 300 "$stage/bin/bench_bvh" "${maps[@]}" --json "$out/bench_bvh.json" 2>&1 | tee "$out/bench_bvh.log" || status=1
+    fi
+    # Host work per frame at 1080p (merge, convergence, tone map) on this machine's cores.
+    [ -x "$stage/bin/bench_host_frame" ] && (cd "$out" && timeout 120 "$OLDPWD/$stage/bin/bench_host_frame" 2>&1 | tee "$out/bench_host_frame.log") || true
+    # Light and triangle scaling on the GPU (issue 16), 1920x1080, 1 spp, NEE + 1 bounce.
+    if [ -x "$stage/bin/bench_scaling" ]; then
+      timeout 400 "$stage/bin/bench_scaling" --tracer cuda:0 --width 1920 --height 1080 --spp 1 --bounces 1 --light-samples 1 \
+        --frames 10 --json "$out/bench_scaling_cuda.json" --plot "$out/bench_scaling_cuda.png" 2>&1 | tee "$out/bench_scaling_cuda.log" || status=1
+    fi
+    # Does every device add speed (issue 14): each tracer alone and mixes, end to end.
+    timeout 400 "$stage/bin/cohort" bench devices --scene "$stage/testmap.cpk" \
+      ${COHORT_GPU_DEVICE_MIXES:---mix cuda:0 --mix embree --mix opencl:0 --mix embree,cuda:0 --mix cuda:0,opencl:0 --mix embree,cuda:0,opencl:0} \
+      --frames 60 --json "$out/bench_devices.json" --plot "$out/bench_devices.png" 2>&1 | tee "$out/bench_devices.log" || status=1
     if [ -f "$stage/largemap.cpk" ]; then
       "$stage/bin/cohort" render "$stage/largemap.cpk" --tracers "${COHORT_GPU_TRACERS:-cuda:all}" --width 1920 \
         --height 1080 --spp 1 --frames 8 --out "$out/render_largemap" 2>&1 | tail -n 8 | tee "$out/render_largemap.log" || status=1
