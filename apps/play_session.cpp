@@ -152,6 +152,7 @@ SessionFrame PlaySession::frame(const viewer::FlyCamera& camera, double seconds,
   p.frame_index = static_cast<kuint>(s.frame_index);
   p.spp = static_cast<kuint>(settings.spp);
   p.max_bounces = static_cast<kuint>(settings.max_bounces);
+  p.light_sampling = settings.light_sampling;
   p.mode = settings.mode;
 
   SessionFrame out;
