@@ -9,6 +9,7 @@
 #include <spdlog/spdlog.h>
 
 #include "cohort/balance/balancer.h"
+#include "cohort/core/frame_defaults.h"
 #include "cohort/core/frame_timeline.h"
 #include "cohort/core/image_output.h"
 #include "commands.h"
@@ -29,6 +30,7 @@ struct PlayArgs {
   float scale = 0.5f;
   int spp = 1;
   int bounces = 1;
+  std::string light_sampling = "tree";
   std::string mode = "path";
   std::string tone = "aces";
   int frames = 0;            // 0: until the window closes
@@ -112,6 +114,7 @@ int run_play(PlayArgs a) {
   FrameSettings settings;
   settings.spp = a.spp;
   settings.max_bounces = a.bounces;
+  settings.light_sampling = core::light_sampling_mode(a.light_sampling);
   settings.mode = debug_mode_from_name(a.mode).value_or(K_MODE_PATH);
   settings.tone_curve = a.tone;
   float scale = a.scale;
@@ -296,6 +299,11 @@ void add_play_command(CLI::App& app, int& exit_code) {
       ->check(CLI::Range(0.05f, 1.0f));
   cmd->add_option("--spp", a->spp, "samples per pixel per frame")->capture_default_str()->check(CLI::Range(1, 256));
   cmd->add_option("--bounces", a->bounces, "indirect bounces")->capture_default_str()->check(CLI::Range(0, 16));
+  cmd->add_option("--light-sampling", a->light_sampling,
+                  "how each hit picks the map's lights: tree (the light tree), all or every (references; see "
+                  "`cohort render --help`)")
+      ->capture_default_str()
+      ->check(CLI::IsMember(core::light_sampling_names()));
   cmd->add_option("--mode", a->mode, "debug mode at start")
       ->capture_default_str()
       ->check(CLI::IsMember(debug_mode_names()));

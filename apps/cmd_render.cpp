@@ -43,7 +43,9 @@ struct RenderArgs {
   std::string balancer = "perfect-smooth";
   std::string mode = "path";
   std::string out = "render_out";
-  int width = core::kDefaultWidth, height = core::kDefaultHeight, spp = 4, frames = 1, bounces = 1, light_samples = 0;
+  int width = core::kDefaultWidth, height = core::kDefaultHeight, spp = 4, frames = 1, bounces = 1, light_samples = 1,
+      emissive_samples = 1;
+  std::string light_sampling = "tree";
   float fov = core::kDefaultFovX, exposure = 1.0f, firefly_clamp = 5.0f, spec_boost = 2.0f, soft_shadow_scale = 0.2f;
   float yaw_step = 0.0f;
   std::string camera_path;    // spin/orbit[-slow|-fast]; empty: fixed camera (plus --yaw-step)
@@ -204,6 +206,8 @@ int run_render(const RenderArgs& a) {
     p.spp = static_cast<kuint>(a.spp);
     p.max_bounces = static_cast<kuint>(a.bounces);
     p.light_samples = static_cast<kuint>(a.light_samples);
+    p.light_sampling = core::light_sampling_mode(a.light_sampling);
+    p.emissive_samples = static_cast<kuint>(a.emissive_samples);
     p.firefly_clamp = a.firefly_clamp;
     p.spec_boost = a.spec_boost;
     p.mode = modes().at(a.mode);
@@ -215,7 +219,8 @@ int run_render(const RenderArgs& a) {
   progress.finish();
   nlohmann::json report = {{"map", a.map},       {"scene", scene.name},     {"tracers", a.tracers},
                            {"balancer", a.balancer}, {"width", a.width},     {"height", a.height},
-                           {"spp", a.spp},       {"bounces", a.bounces},    {"mode", a.mode},
+                           {"spp", a.spp},       {"bounces", a.bounces},
+                           {"light_sampling", a.light_sampling}, {"light_samples", a.light_samples},    {"mode", a.mode},
                            {"camera_path", a.camera_path}, {"denoise", a.denoise}, {"frames", stats_json}};
   std::ofstream(std::filesystem::path(a.out) / "stats.json") << report.dump(2) << "\n";
   std::cout << "wrote " << rendered << " frame(s) and stats.json to " << a.out << "\n";
@@ -252,10 +257,21 @@ void add_render_command(CLI::App& app, int& exit_code) {
           ->capture_default_str()
           ->check(CLI::PositiveNumber);
   cmd->add_option("--bounces", a->bounces, "indirect bounces")->capture_default_str()->check(CLI::NonNegativeNumber);
+  cmd->add_option("--light-sampling", a->light_sampling,
+                  "how each hit picks the map's lights: tree (among the lights whose volume holds the point, "
+                  "through the light tree: cost independent of the light count), all (reference: a pick by "
+                  "contribution over every light), every (reference: every light, one shadow ray each)")
+      ->capture_default_str()
+      ->check(CLI::IsMember(core::light_sampling_names()));
   cmd->add_option("--light-samples", a->light_samples,
-                  "lights sampled per hit, picked by contribution (0: every light reaching the point)")
+                  "lights sampled per hit with --light-sampling tree or all (0: every light, as --light-sampling every)")
       ->capture_default_str()
       ->check(CLI::NonNegativeNumber);
+  cmd->add_option("--emissive-samples", a->emissive_samples,
+                  "emissive triangles sampled per hit, combined with the bounce by multiple importance sampling "
+                  "(0: emissive surfaces are found by bounce rays only)")
+      ->capture_default_str()
+      ->check(CLI::Range(0, 1));
   cmd->add_option("--mode", a->mode, "path, direct, albedo, normals, specular, bvh, triangles")
       ->capture_default_str()
       ->check(CLI::IsMember({"path", "direct", "albedo", "normals", "specular", "bvh", "triangles"}));

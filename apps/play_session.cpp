@@ -160,6 +160,7 @@ SessionFrame PlaySession::frame(const viewer::FlyCamera& camera, double seconds,
   p.frame_index = static_cast<kuint>(s.frame_index);
   p.spp = static_cast<kuint>(settings.spp);
   p.max_bounces = static_cast<kuint>(settings.max_bounces);
+  p.light_sampling = settings.light_sampling;
   p.mode = settings.mode;
 
   // The pipeline hands this frame out and gives back the one before it, which is blended and tone-mapped

@@ -29,6 +29,7 @@ struct FrameSettings {
   int spp = 1;
   kuint mode = K_MODE_PATH;
   int max_bounces = 1;
+  kuint light_sampling = K_LIGHTS_TREE;
   std::string tone_curve = "aces";
 };
 

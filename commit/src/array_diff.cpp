@@ -55,6 +55,15 @@ void diff_tlas(const std::vector<KBvhNode>& before, const std::vector<KBvhNode>&
   if (!same_array(before, after, "tlas", nullptr)) out.set_tlas(after);
 }
 
+void diff_light_tree(const std::vector<KLightNode>& before, const std::vector<KLightNode>& after, CommitBuffer& out) {
+  if (!same_array(before, after, "light_nodes", nullptr)) out.set_light_tree(after);
+}
+
+void diff_emissive_triangles(const std::vector<KEmissiveTriangle>& before, const std::vector<KEmissiveTriangle>& after,
+                             CommitBuffer& out) {
+  if (!same_array(before, after, "emissive_triangles", nullptr)) out.set_emissive_triangles(after);
+}
+
 bool same_tracer_scene(const TracerScene& a, const TracerScene& b, std::string* where) {
   return same_array(a.vertices, b.vertices, "vertices", where) &&
          same_array(a.triangles, b.triangles, "triangles", where) &&
@@ -66,6 +75,8 @@ bool same_tracer_scene(const TracerScene& a, const TracerScene& b, std::string* 
          same_array(a.textures, b.textures, "textures", where) &&
          same_array(a.texels, b.texels, "texels", where) &&
          same_array(a.lights, b.lights, "lights", where) &&
+         same_array(a.light_nodes, b.light_nodes, "light_nodes", where) &&
+         same_array(a.emissive_triangles, b.emissive_triangles, "emissive_triangles", where) &&
          same_array(std::vector<KCamera>{a.camera}, std::vector<KCamera>{b.camera}, "camera", where);
 }
 

@@ -53,6 +53,19 @@ void CommitBuffer::set_tlas(std::vector<KBvhNode> nodes) {
   tlas_ = std::move(nodes);
 }
 
+// A whole-array record: replaces an earlier one and counts its bytes once.
+template <class T>
+static void set_whole_array(std::optional<std::vector<T>>& slot, std::vector<T> values, size_t& bytes) {
+  bytes -= slot ? kRecordHeaderBytes + slot->size() * sizeof(T) : 0;
+  bytes += kRecordHeaderBytes + values.size() * sizeof(T);
+  slot = std::move(values);
+}
+
+void CommitBuffer::set_light_tree(std::vector<KLightNode> nodes) { set_whole_array(light_tree_, std::move(nodes), bytes_); }
+void CommitBuffer::set_emissive_triangles(std::vector<KEmissiveTriangle> triangles) {
+  set_whole_array(emissive_, std::move(triangles), bytes_);
+}
+
 void CommitBuffer::add_blas(BlasUpload upload) {
   bytes_ += upload.bytes();
   blas_uploads_.push_back(std::move(upload));
@@ -70,6 +83,7 @@ void CommitBuffer::set_camera(const KCamera& camera) {
 
 size_t CommitBuffer::record_count() const {
   return (instance_count_ ? 1 : 0) + instances_.size() + (tlas_ ? 1 : 0) + (light_count_ ? 1 : 0) + lights_.size() +
+         (light_tree_ ? 1 : 0) + (emissive_ ? 1 : 0) +
          (material_count_ ? 1 : 0) + materials_.size() + (texture_count_ ? 1 : 0) + textures_.size() +
          blas_uploads_.size() + texel_uploads_.size() +
          (camera_ ? 1 : 0);
@@ -84,6 +98,8 @@ void CommitBuffer::clear() {
   textures_.clear();
   instances_.clear();
   lights_.clear();
+  light_tree_.reset();
+  emissive_.reset();
   materials_.clear();
   tlas_.reset();
   blas_uploads_.clear();
@@ -109,6 +125,8 @@ void CommitBuffer::merge(const CommitBuffer& later) {
   if (later.tlas_) set_tlas(*later.tlas_);
   if (later.light_count_) set_light_count(*later.light_count_);
   for (const auto& [i, v] : later.lights_) set_light(i, v);
+  if (later.light_tree_) set_light_tree(*later.light_tree_);
+  if (later.emissive_) set_emissive_triangles(*later.emissive_);
   if (later.material_count_) set_material_count(*later.material_count_);
   for (const auto& [i, v] : later.materials_) set_material(i, v);
   if (later.texture_count_) set_texture_count(*later.texture_count_);
@@ -178,6 +196,14 @@ ChangeSet apply_commit(const CommitBuffer& commit, TracerScene& scene) {
     changes.tlas = true;
   }
   changes.lights = apply_elements(scene.lights, commit.light_count(), commit.lights(), "light");
+  if (commit.light_tree()) {
+    scene.light_nodes = *commit.light_tree();
+    changes.light_tree = true;
+  }
+  if (commit.emissive_triangles()) {
+    scene.emissive_triangles = *commit.emissive_triangles();
+    changes.emissive = true;
+  }
   changes.materials = apply_elements(scene.materials, commit.material_count(), commit.materials(), "material");
   for (const TexelUpload& up : commit.texel_uploads()) {
     write_range(scene.texels, up.offset, up.texels);

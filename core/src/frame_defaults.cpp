@@ -1,5 +1,7 @@
 #include "cohort/core/frame_defaults.h"
 
+#include <stdexcept>
+
 namespace cohort::core {
 
 KFrameParams default_frame_params() {
@@ -7,12 +9,26 @@ KFrameParams default_frame_params() {
   p.spp = 1;
   p.max_bounces = 1;
   p.light_samples = 1;
+  p.light_sampling = K_LIGHTS_TREE;
+  p.emissive_samples = 1;
   p.firefly_clamp = 5.0f;
   p.spec_boost = 2.0f;
   p.mode = K_MODE_PATH;
   p.soft_shadow_scale = 0.2f;
   p.rr_start = 2.0f;
   return p;
+}
+
+const std::vector<std::string>& light_sampling_names() {
+  static const std::vector<std::string> names = {"tree", "all", "every"};
+  return names;
+}
+
+kuint light_sampling_mode(const std::string& name) {
+  if (name == "tree") return K_LIGHTS_TREE;
+  if (name == "all") return K_LIGHTS_ALL;
+  if (name == "every") return K_LIGHTS_EVERY;
+  throw std::invalid_argument("light sampling '" + name + "': choose tree, all or every");
 }
 
 }  // namespace cohort::core

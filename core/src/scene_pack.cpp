@@ -5,6 +5,8 @@
 
 #include <fmt/format.h>
 
+#include "cohort/core/light_sampling.h"
+
 namespace cohort::core {
 namespace {
 
@@ -203,6 +205,8 @@ PackedScene read_scene_pack(const std::filesystem::path& file) {
   for (const KTexture& t : s.textures)
     if (uint64_t(t.offset) + uint64_t(t.width) * t.height > s.texels.size())
       throw PackError(file.string(), 0, "a texture points outside the texel array");
+  // The light tree and the emissive triangles are derived from the arrays above, so packs do not carry them.
+  rebuild_light_sampling(s);
   return pack;
 }
 

@@ -11,6 +11,7 @@
 
 #include "cohort/commit/array_diff.h"
 #include "cohort/core/bvh.h"
+#include "cohort/core/light_sampling.h"
 #include "cohort/core/view.h"
 #include "gpu_scene_textures.h"
 
@@ -259,10 +260,14 @@ commit::CommitBuffer WorldSync::sync(const scene::ChangeLog& changes, uint64_t f
   if (slots_moved || !changes.lights.empty() || !changes.freed_lights.empty()) {
     for (int handle : changes.freed_lights) lights_by_handle_.erase(handle);
     auto convert = [&](int handle) {
-      if (world_.LightDef(handle))
-        lights_by_handle_[handle] = to_klight(world_.scene_light(handle), scene, options_.gpu);
-      else
-        lights_by_handle_.erase(handle);
+      lights_by_handle_.erase(handle);
+      if (!world_.LightDef(handle)) return;
+      const scene::Light light = world_.scene_light(handle);
+      if (std::optional<std::string> defect = light_defect(light, scene, options_.gpu)) {
+        warn_bad_light(handle, light, *defect);
+        return;
+      }
+      lights_by_handle_[handle] = to_klight(light, scene, options_.gpu);
     };
     if (slots_moved) {
       for (size_t h = 0; h < world_.light_defs().size(); ++h) convert(int(h));
@@ -274,6 +279,16 @@ commit::CommitBuffer WorldSync::sync(const scene::ChangeLog& changes, uint64_t f
     for (const auto& [handle, light] : lights_by_handle_) lights.push_back(light);
     commit::diff_lights(master_.lights, lights, out);
     master_.lights = std::move(lights);
+    std::vector<KLightNode> tree = build_light_tree(master_.lights);
+    commit::diff_light_tree(master_.light_nodes, tree, out);
+    master_.light_nodes = std::move(tree);
+  }
+
+  // Emissive triangles move with their instances and appear or go with materials.
+  if (instances_changed || slots_moved || !changes.materials.empty()) {
+    std::vector<KEmissiveTriangle> emissive = build_emissive_triangles(master_);
+    commit::diff_emissive_triangles(master_.emissive_triangles, emissive, out);
+    master_.emissive_triangles = std::move(emissive);
   }
 
   if (changes.view && world_.view()) {
@@ -286,6 +301,19 @@ commit::CommitBuffer WorldSync::sync(const scene::ChangeLog& changes, uint64_t f
   stats_.sync_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
   snapshot_.reset();
   return out;
+}
+
+// Once per light def and defect, so a bad light that the game keeps updating does not flood the log.
+void WorldSync::warn_bad_light(int handle, const scene::Light& light, const std::string& defect) {
+  const std::string key = std::to_string(handle) + " " + defect;
+  if (!warned_lights_.insert(key).second) return;
+  const scene::Scene& scene = world_.scene();
+  std::string where = light.source;
+  if (where.empty() && size_t(handle) < scene.lights.size() && scene.lights[size_t(handle)].name == light.name)
+    where = scene.lights[size_t(handle)].source;
+  spdlog::warn("{}light '{}' (map '{}') skipped: {}", where.empty() ? "" : where + ": ", light.name, scene.name,
+               defect);
+  ++stats_.lights_skipped;
 }
 
 std::shared_ptr<const commit::TracerScene> WorldSync::snapshot() {

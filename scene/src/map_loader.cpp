@@ -195,6 +195,7 @@ class SceneBuilder {
       if (light_class) {
         MapLight light = light_from_entity(e, where, scene_.warnings);
         if (light.light.name.empty()) light.light.name = "light_" + std::to_string(index);  // as the engine names them
+        light.light.source = where;
         if (!light.texture.empty()) light.light.material = material(light.texture, true);
         switch (light.light.type) {
           case LightType::Point: ++report_.lights_point; break;

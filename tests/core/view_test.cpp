@@ -87,8 +87,19 @@ TEST(FrameDefaults, PathTracingWithNeeAndOneBounceAndDoom3SpecularBoost) {
   EXPECT_EQ(p.spp, 1u);
   EXPECT_EQ(p.max_bounces, 1u);
   EXPECT_EQ(p.light_samples, 1u);
+  EXPECT_EQ(p.light_sampling, K_LIGHTS_TREE);
+  EXPECT_EQ(p.emissive_samples, 1u);
   EXPECT_FLOAT_EQ(p.spec_boost, 2.0f);
   EXPECT_EQ(p.row_begin, p.row_end);  // no band until the balancer names one
+}
+
+TEST(FrameDefaults, LightSamplingNamesRoundTrip) {
+  const std::vector<std::string>& names = light_sampling_names();
+  ASSERT_EQ(names.size(), 3u);
+  EXPECT_EQ(light_sampling_mode(names[0]), K_LIGHTS_TREE);
+  EXPECT_EQ(light_sampling_mode("all"), K_LIGHTS_ALL);
+  EXPECT_EQ(light_sampling_mode("every"), K_LIGHTS_EVERY);
+  EXPECT_THROW(light_sampling_mode("bvh"), std::invalid_argument);
 }
 
 }  // namespace

@@ -1,11 +1,14 @@
 #include <gtest/gtest.h>
 
+#include <cstring>
 #include <filesystem>
+#include <limits>
 #include <unistd.h>
 
 #include "cohort/commit/array_diff.h"
 #include "cohort/commit/commit_channel.h"
 #include "cohort/core/gpu_scene.h"
+#include "cohort/core/light_sampling.h"
 #include "cohort/core/world_sync.h"
 #include "cohort/scene/map_loader.h"
 #include "cohort/scene/render_world_stream.h"
@@ -258,4 +261,53 @@ TEST(WorldSync, ModelFileInstancesShareOneBlas) {
   EXPECT_EQ(blas_of("wedge_1"), blas_of("wedge_2"));
   EXPECT_NE(blas_of("walker_1"), blas_of("walker_2"));
   EXPECT_NE(blas_of("lamp_1"), blas_of("wedge_1"));
+}
+
+// A light moved through the world reaches the tracers as its light record plus a new light tree whose
+// leaf box for it moved with it; the tree stays the one a fresh build gives.
+TEST(WorldSync, MovedLightSendsItsLightAndANewLightTree) {
+  RenderWorld world(test::small_test_map());
+  WorldSync sync(world);
+  ASSERT_EQ(sync.master().light_nodes.size(), 2 * sync.master().lights.size() - 1);
+  const int fill = world.FindLightDef("light_fill");
+  ASSERT_GE(fill, 0);
+  scene::RenderLight moved = *world.LightDef(fill);
+  moved.origin.x += 500.0f;
+  world.UpdateLightDef(fill, moved);
+  const std::vector<KLightNode> before = sync.master().light_nodes;
+  commit::CommitBuffer records = sync.sync(world.TakeChanges(), 1);
+  ASSERT_TRUE(records.light_tree().has_value());
+  EXPECT_EQ(records.lights().size(), 1u);
+  EXPECT_EQ(records.light_tree()->size(), before.size());
+  EXPECT_NE(std::memcmp(records.light_tree()->data(), before.data(), before.size() * sizeof(KLightNode)), 0);
+  const std::vector<KLightNode> fresh = build_light_tree(sync.master().lights);
+  EXPECT_EQ(std::memcmp(fresh.data(), sync.master().light_nodes.data(), fresh.size() * sizeof(KLightNode)), 0);
+  // Moving nothing sends no tree.
+  EXPECT_FALSE(sync.sync(world.TakeChanges(), 2).light_tree().has_value());
+}
+
+// A light def turned bad by the game (zero radius, an origin far outside any map; RenderWorld itself
+// refuses NaN) is left out with a warning, and comes
+// back when it is fixed.
+TEST(WorldSync, LightWithADefectIsSkippedUntilFixed) {
+  RenderWorld world(test::small_test_map());
+  WorldSync sync(world);
+  const size_t lights = sync.master().lights.size();
+  const int fill = world.FindLightDef("light_fill");
+  const scene::RenderLight good = *world.LightDef(fill);
+  scene::RenderLight bad = good;
+  bad.radius = glm::vec3(0.0f, 200.0f, 200.0f);
+  world.UpdateLightDef(fill, bad);
+  sync.sync(world.TakeChanges(), 1);
+  EXPECT_EQ(sync.master().lights.size(), lights - 1);
+  EXPECT_EQ(sync.last_stats().lights_skipped, 1u);
+  EXPECT_EQ(sync.master().light_nodes.size(), 2 * (lights - 1) - 1);
+  bad = good;
+  bad.origin.y = 1e12f;
+  world.UpdateLightDef(fill, bad);
+  sync.sync(world.TakeChanges(), 2);
+  EXPECT_EQ(sync.master().lights.size(), lights - 1);
+  world.UpdateLightDef(fill, good);
+  sync.sync(world.TakeChanges(), 3);
+  EXPECT_EQ(sync.master().lights.size(), lights);
 }

@@ -12,6 +12,20 @@ TEST(KernelLayout, FieldOffsetsArePacked) {
   EXPECT_EQ(offsetof(KInstance, blas), 96u);
   EXPECT_EQ(offsetof(KLight, plane_s), 112u);
   EXPECT_EQ(offsetof(KFrameParams, row_begin), 32u);
+  EXPECT_EQ(offsetof(KFrameParams, light_sampling), 56u);
+  EXPECT_EQ(offsetof(KFrameParams, light_node_count), 60u);
+  EXPECT_EQ(offsetof(KFrameParams, emissive_count), 64u);
+  EXPECT_EQ(offsetof(KFrameParams, emissive_samples), 68u);
+  EXPECT_EQ(sizeof(KFrameParams), 80u);
+  EXPECT_EQ(offsetof(KLightNode, left_first), 12u);
+  EXPECT_EQ(offsetof(KLightNode, count), 28u);
+  EXPECT_EQ(offsetof(KLightNode, power), 32u);
+  EXPECT_EQ(offsetof(KLightNode, light_count), 36u);
+  EXPECT_EQ(sizeof(KLightNode), 48u);
+  EXPECT_EQ(offsetof(KEmissiveTriangle, instance), 12u);
+  EXPECT_EQ(offsetof(KEmissiveTriangle, triangle), 28u);
+  EXPECT_EQ(offsetof(KEmissiveTriangle, power_cdf), 44u);
+  EXPECT_EQ(sizeof(KEmissiveTriangle), 48u);
 }
 
 TEST(KernelVec, CrossFollowsRightHandRule) {

@@ -41,6 +41,8 @@ struct Case {
   uint32_t bounces;
   const char* name;
   uint32_t light_samples = 1;
+  uint32_t light_sampling = K_LIGHTS_TREE;
+  uint32_t emissive_samples = 1;
 };
 
 }  // namespace
@@ -61,6 +63,8 @@ TEST_P(Agreement, EmbreeAndOpenCLImagesMatch) {
   params.rr_start = 2.0f;
   params.frame_index = 7;
   params.light_samples = c.light_samples;
+  params.light_sampling = c.light_sampling;
+  params.emissive_samples = c.emissive_samples;
   auto embree = make_test_tracer("embree");
   auto opencl = make_test_tracer("opencl");
   core::FrameBuffer a = render(*embree, room, cam, params);
@@ -93,9 +97,32 @@ TEST_P(Agreement, EmbreeAndOpenCLImagesMatch) {
 INSTANTIATE_TEST_SUITE_P(Modes, Agreement,
                          ::testing::Values(Case{K_MODE_PATH, 1, "path"}, Case{K_MODE_PATH, 3, "path3"},
                                            Case{K_MODE_PATH, 1, "path_all_lights", 0},
+                                           Case{K_MODE_PATH, 1, "path_all_pick", 1, K_LIGHTS_ALL},
+                                           Case{K_MODE_PATH, 1, "path_no_emissive_nee", 1, K_LIGHTS_TREE, 0},
                                            Case{K_MODE_DIRECT, 0, "direct"}, Case{K_MODE_ALBEDO, 0, "albedo"},
                                            Case{K_MODE_NORMALS, 0, "normals"}),
                          [](const auto& info) { return std::string(info.param.name); });
+
+// The light tree's descent (more lights than K_LIGHT_TREE_GATHER overlap) and the emissive-triangle
+// sampling give the same image on both tracers.
+TEST(AgreementManyLights, EmbreeAndOpenCLImagesMatch) {
+  std::vector<std::string> names = built_tracers();
+  if (names.size() < 2 || !tracer_runs_here("opencl")) GTEST_SKIP() << "needs both the Embree and the OpenCL tracer";
+  scene::Scene s = many_lights_floor(88, 8);
+  const int w = 48, h = 36;
+  const KCamera cam = camera_looking_down({0, 0, 1400}, 0.7f, w, h);
+  KFrameParams params = frame_params(K_MODE_PATH, 8, 1, h);
+  params.soft_shadow_scale = 1.0f;
+  auto embree = make_test_tracer("embree");
+  auto opencl = make_test_tracer("opencl");
+  core::FrameBuffer a = render(*embree, s, cam, params);
+  core::FrameBuffer b = render(*opencl, s, cam, params);
+  double mean = 0.0;
+  double error = rmse(a, b, &mean);
+  std::cout << "many lights, tree: RMSE embree/opencl " << error << ", mean " << mean << "\n";
+  EXPECT_GT(mean, 0.05);
+  EXPECT_LT(error, 0.005 * mean);
+}
 
 // A scene pack read back renders exactly like the scene it was written from.
 TEST(ScenePack, RendersLikeTheCompiledScene) {

@@ -191,20 +191,30 @@ TEST_P(Lighting, SoftShadowsHaveAPenumbra) {
 }
 
 // Closed box, every wall emitting E with albedo a, no lights: with B bounces the radiance everywhere is
-// E * (1 + a + ... + a^B), whatever the sampling, Russian roulette included.
+// E * (1 + a + ... + a^B) when emitters are found by bounces only, whatever the sampling, Russian
+// roulette included. Emissive triangles sampled as lights (the default) light every hit directly, one
+// term more: E * (1 + a + ... + a^(B+1)).
 TEST_P(Lighting, FurnaceConvergesToAnalyticRadiance) {
   const float a = 0.5f, e = 0.5f;
   scene::Scene s = furnace_box(100.0f, a, e);
   const int n = 24;
   KCamera cam = camera_looking_down({10, -20, 30}, 1.0f, n, n);
   KFrameParams direct = frame_params(K_MODE_PATH, 1, 0, n);
+  direct.emissive_samples = 0;
   core::FrameBuffer fb0 = render(*tracer_, s, cam, direct);
   EXPECT_NEAR(mean_luminance(fb0), e, 1e-4);
   KFrameParams params = frame_params(K_MODE_PATH, 64, 3, n);
   params.rr_start = 1.0f;
+  params.emissive_samples = 0;
   core::FrameBuffer fb = render(*tracer_, s, cam, params);
   const double expected = e * (1.0 + a + a * a + a * a * a);
   EXPECT_NEAR(mean_luminance(fb), expected, 0.01 * expected);
+  params.emissive_samples = 1;
+  core::FrameBuffer with_nee = render(*tracer_, s, cam, params);
+  EXPECT_NEAR(mean_luminance(with_nee), expected + e * a * a * a * a, 0.01 * expected);
+  KFrameParams nee_only = frame_params(K_MODE_PATH, 64, 0, n);
+  core::FrameBuffer direct_nee = render(*tracer_, s, cam, nee_only);
+  EXPECT_NEAR(mean_luminance(direct_nee), e * (1.0 + a), 0.01 * e * (1.0 + a));
 }
 
 INSTANTIATE_TEST_SUITE_P(Tracers, Lighting, ::testing::ValuesIn(built_tracers()),

@@ -14,13 +14,16 @@ KFrameParams TracerBase::frame_params(const core::BandJob& job) const {
   params.light_count = static_cast<kuint>(scene_.lights.size());
   params.instance_count = static_cast<kuint>(scene_.instances.size());
   params.tlas_node_count = static_cast<kuint>(scene_.tlas_nodes.size());
+  params.light_node_count = static_cast<kuint>(scene_.light_nodes.size());
+  params.emissive_count = static_cast<kuint>(scene_.emissive_triangles.size());
   return params;
 }
 
 KSceneView TracerBase::host_scene_view(const KFrameParams& params) const {
   return k_scene_view(scene_.vertices.data(), scene_.triangles.data(), scene_.blas_nodes.data(), scene_.blases.data(),
                       scene_.instances.data(), scene_.tlas_nodes.data(), scene_.materials.data(),
-                      scene_.textures.data(), scene_.texels.data(), scene_.lights.data(), &params);
+                      scene_.textures.data(), scene_.texels.data(), scene_.lights.data(), scene_.light_nodes.data(),
+                      scene_.emissive_triangles.data(), &params);
 }
 
 }  // namespace cohort::tracers

@@ -38,6 +38,8 @@ struct CudaTracer::Impl {
   DeviceArray<KTexture> textures;
   DeviceArray<uint32_t> texels;
   DeviceArray<KLight> lights;
+  DeviceArray<KLightNode> light_nodes;
+  DeviceArray<KEmissiveTriangle> emissive;
   cudaTextureObject_t texel_texture = 0;
   float4* band = nullptr;
   unsigned short* band_rgb16f = nullptr;   // the band as RGB halves, for RGB16F targets
@@ -90,7 +92,8 @@ struct CudaTracer::Impl {
 
   KSceneView view(const KFrameParams& params) const {
     return k_scene_view(vertices.data(), triangles.data(), blas_nodes.data(), blases.data(), instances.data(),
-                        tlas_nodes.data(), materials.data(), textures.data(), texels.data(), lights.data(), &params);
+                        tlas_nodes.data(), materials.data(), textures.data(), texels.data(), lights.data(), light_nodes.data(),
+                        emissive.data(), &params);
   }
 };
 
@@ -142,6 +145,8 @@ void CudaTracer::upload(const commit::ChangeSet& changes) {
   }
   if (all || changes.materials) m.materials.upload(scene.materials, 0, s);
   if (all || changes.lights) m.lights.upload(scene.lights, 0, s);
+  if (all || changes.light_tree) m.light_nodes.upload(scene.light_nodes, 0, s);
+  if (all || changes.emissive) m.emissive.upload(scene.emissive_triangles, 0, s);
   if (all || changes.textures) {
     m.textures.upload(scene.textures, 0, s);
     // A texture object needs storage: a scene without texels binds one unused white texel instead.

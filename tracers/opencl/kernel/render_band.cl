@@ -8,6 +8,7 @@ __kernel void cohort_render_band(__global const KVertex* vertices, __global cons
                                  __global const KInstance* instances, __global const KBvhNode* tlas_nodes,
                                  __global const KMaterial* materials, __global const KTexture* textures,
                                  __global const kuint* texels, __global const KLight* lights,
+                                 __global const KLightNode* light_nodes, __global const KEmissiveTriangle* emissive,
                                  __global const KFrameParams* params_in, __global const KCamera* camera_in,
                                  __global float* band_rgba, __global uint* row_rays) {
   /* Rays traced per row of the band (the balancer's per-row work), summed in local memory first so
@@ -24,7 +25,7 @@ __kernel void cohort_render_band(__global const KVertex* vertices, __global cons
   if (x < camera.width && y < params.row_end) {
     KTraceCtx ctx;
     ctx.scene = k_scene_view(vertices, triangles, blas_nodes, blases, instances, tlas_nodes, materials, textures, texels,
-                             lights, &params);
+                             lights, light_nodes, emissive, &params);
     ctx.closest_rays = 0u;
     ctx.occlusion_rays = 0u;
     KVec3 c = k_render_pixel(&ctx, &params, &camera, x, y);

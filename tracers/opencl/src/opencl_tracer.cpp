@@ -101,7 +101,8 @@ struct OpenCLTracer::Impl {
   cl_command_queue queue = nullptr;
   cl_program program = nullptr;
   cl_kernel kernel = nullptr;
-  DeviceBuffer vertices, triangles, blas_nodes, blases, instances, tlas_nodes, materials, textures, texels, lights;
+  DeviceBuffer vertices, triangles, blas_nodes, blases, instances, tlas_nodes, materials, textures, texels, lights, light_nodes,
+      emissive;
   cl_mem params = nullptr, camera = nullptr, output = nullptr, row_rays = nullptr;
   size_t output_bytes = 0, row_rays_rows = 0;
 
@@ -190,6 +191,8 @@ void OpenCLTracer::upload(const commit::ChangeSet& changes) {
     m.texels.upload(c, q, s.texels, "uploading texels");
   }
   if (all || changes.lights) m.lights.upload(c, q, s.lights, "uploading lights");
+  if (all || changes.light_tree) m.light_nodes.upload(c, q, s.light_nodes, "uploading the light tree");
+  if (all || changes.emissive) m.emissive.upload(c, q, s.emissive_triangles, "uploading emissive triangles");
 }
 
 core::BandResult OpenCLTracer::render_band(const core::BandJob& job, core::BandBuffer& target) {
@@ -224,8 +227,8 @@ core::BandResult OpenCLTracer::render_band(const core::BandJob& job, core::BandB
         "writing the camera");
   cl_mem args[] = {m.vertices.mem(),  m.triangles.mem(), m.blas_nodes.mem(), m.blases.mem(),
                    m.instances.mem(), m.tlas_nodes.mem(), m.materials.mem(), m.textures.mem(),
-                   m.texels.mem(),    m.lights.mem(),     m.params,           m.camera,
-                   m.output,          m.row_rays};
+                   m.texels.mem(),    m.lights.mem(),     m.light_nodes.mem(), m.emissive.mem(),
+                   m.params,          m.camera,           m.output,           m.row_rays};
   for (cl_uint i = 0; i < sizeof(args) / sizeof(args[0]); ++i)
     check(clSetKernelArg(m.kernel, i, sizeof(cl_mem), &args[i]), "clSetKernelArg");
   const size_t local[2] = {8, 8};

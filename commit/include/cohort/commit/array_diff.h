@@ -17,6 +17,10 @@ void diff_materials(const std::vector<KMaterial>& before, const std::vector<KMat
 void diff_textures(const std::vector<KTexture>& before, const std::vector<KTexture>& after, CommitBuffer& out);
 // A TLAS record when the node arrays differ.
 void diff_tlas(const std::vector<KBvhNode>& before, const std::vector<KBvhNode>& after, CommitBuffer& out);
+// Whole-array records for the light tree and the emissive triangles when they differ.
+void diff_light_tree(const std::vector<KLightNode>& before, const std::vector<KLightNode>& after, CommitBuffer& out);
+void diff_emissive_triangles(const std::vector<KEmissiveTriangle>& before, const std::vector<KEmissiveTriangle>& after,
+                             CommitBuffer& out);
 
 // Byte-exact equality of two scenes' arrays, for tests and consistency checks; names the first
 // difference in `where` (e.g. "instances[3]") when there is one.

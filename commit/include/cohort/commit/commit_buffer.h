@@ -66,6 +66,9 @@ class CommitBuffer {
   void set_tlas(std::vector<KBvhNode> nodes);
   void set_light_count(uint32_t count);
   void set_light(uint32_t index, const KLight& light);
+  // The derived light-sampling arrays, replaced whole (they are small and rebuilt together).
+  void set_light_tree(std::vector<KLightNode> nodes);
+  void set_emissive_triangles(std::vector<KEmissiveTriangle> triangles);
   void set_material_count(uint32_t count);
   void set_material(uint32_t index, const KMaterial& material);
   void set_texture_count(uint32_t count);
@@ -93,6 +96,8 @@ class CommitBuffer {
   const std::optional<std::vector<KBvhNode>>& tlas() const { return tlas_; }
   const std::optional<uint32_t>& light_count() const { return light_count_; }
   const std::map<uint32_t, KLight>& lights() const { return lights_; }
+  const std::optional<std::vector<KLightNode>>& light_tree() const { return light_tree_; }
+  const std::optional<std::vector<KEmissiveTriangle>>& emissive_triangles() const { return emissive_; }
   const std::optional<uint32_t>& material_count() const { return material_count_; }
   const std::map<uint32_t, KMaterial>& materials() const { return materials_; }
   const std::vector<BlasUpload>& blas_uploads() const { return blas_uploads_; }
@@ -114,6 +119,8 @@ class CommitBuffer {
   std::map<uint32_t, KMaterial> materials_;
   std::map<uint32_t, KTexture> textures_;
   std::optional<std::vector<KBvhNode>> tlas_;
+  std::optional<std::vector<KLightNode>> light_tree_;
+  std::optional<std::vector<KEmissiveTriangle>> emissive_;
   std::vector<BlasUpload> blas_uploads_;
   std::vector<TexelUpload> texel_uploads_;
   std::optional<KCamera> camera_;

@@ -23,6 +23,9 @@ struct TracerScene {
   std::vector<KTexture> textures;
   std::vector<uint32_t> texels;       // RGBA8, all textures and their mip levels
   std::vector<KLight> lights;
+  // Derived by the core from the arrays above (core/light_sampling.h), sent whole when they change.
+  std::vector<KLightNode> light_nodes;                // the light tree over `lights`
+  std::vector<KEmissiveTriangle> emissive_triangles;  // every emitting triangle, world space
   KCamera camera{};
   uint64_t version = 0;               // frame number of the last commit applied
 };
@@ -33,7 +36,11 @@ struct ChangeSet {
   bool geometry = false;              // vertices/triangles/blas_nodes/blases grew or changed
   size_t vertices_from = 0, triangles_from = 0, blas_nodes_from = 0, blases_from = 0;  // first changed element
   bool instances = false, tlas = false, materials = false, textures = false, lights = false, camera = false;
-  bool any() const { return full_resync || geometry || instances || tlas || materials || textures || lights || camera; }
+  bool light_tree = false, emissive = false;
+  bool any() const {
+    return full_resync || geometry || instances || tlas || materials || textures || lights || light_tree || emissive ||
+           camera;
+  }
 };
 
 }  // namespace cohort::commit

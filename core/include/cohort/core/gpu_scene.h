@@ -4,6 +4,7 @@
 
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -36,6 +37,11 @@ KMaterial to_kmaterial(const scene::Material& material, const scene::Scene& scen
 // light (light_center rotated by the axis). extent: soft-shadow jitter radius in world units (parallel:
 // tangent of the cone's half-angle), scaled by KFrameParams::soft_shadow_scale in the kernel.
 KLight to_klight(const scene::Light& light, const scene::Scene& scene, const GpuSceneOptions& options = {});
+// Why a light cannot be rendered (zero or negative radius, a degenerate projection, a non-finite or huge
+// origin, colour or axis, a volume that does not close), or nullopt when it can. WorldSync skips such
+// lights with a warning naming them.
+std::optional<std::string> light_defect(const scene::Light& light, const scene::Scene& scene,
+                                        const GpuSceneOptions& options = {});
 void set_instance_transform(KInstance& instance, const glm::vec3& origin, const glm::mat3& axis);
 inline uint32_t default_material_index(const scene::Scene& scene) { return static_cast<uint32_t>(scene.materials.size()); }
 

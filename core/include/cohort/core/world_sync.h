@@ -25,6 +25,7 @@
 #include <map>
 #include <memory>
 #include <set>
+#include <string>
 #include <vector>
 
 #include "cohort/commit/commit_buffer.h"
@@ -44,6 +45,7 @@ struct WorldSyncStats {  // of the last sync()
   size_t record_bytes = 0, records = 0;
   uint32_t blas_builds = 0;
   bool tlas_rebuilt = false;
+  uint32_t lights_skipped = 0;  // lights left out for a defect (light_defect), warned once each
   double sync_ms = 0.0;
 };
 
@@ -74,6 +76,7 @@ class WorldSync {
   void set_material(int scene_material);
   void build_static_world();
   KInstance entity_instance(int handle, const scene::RenderEntity& def, uint32_t blas) const;
+  void warn_bad_light(int handle, const scene::Light& light, const std::string& defect);
 
   const scene::RenderWorld& world_;
   WorldSyncOptions options_;
@@ -85,6 +88,7 @@ class WorldSync {
   std::map<int, KInstance> entity_instances_;     // by entity handle
   std::map<int, int> mesh_of_entity_;
   std::map<int, KLight> lights_by_handle_;
+  std::set<std::string> warned_lights_;           // "handle defect" already warned about
   uint32_t base_material_count_ = 0;              // the map's materials; the default material's index
   std::vector<std::array<KTexture, kTextureUseCount>> image_textures_;  // per scene image and use
   std::shared_ptr<const commit::TracerScene> snapshot_;

@@ -13,7 +13,8 @@
  * Entry point: k_render_pixel(ctx, params, camera, x, y) -> linear RGB averaged over params->spp. */
 #ifndef COHORT_KERNEL_INTEGRATOR_H
 #define COHORT_KERNEL_INTEGRATOR_H
-#include "lights.h"
+#include "emitters.h"
+#include "light_tree.h"
 #include "rng.h"
 
 #ifndef K_CTX_SCENE
@@ -49,14 +50,17 @@ KFN int k_light_visible(KTraceCtx* ctx, const KFrameParams* params, const KSurfa
   return tmax <= 0.0f || !k_trace_occluded(ctx, org, dir, tmax, K_RAY_SHADOW);
 }
 
-/* Next-event estimation. light_samples == 0: every light that reaches the point, one shadow ray each
- * (as Doom 3 draws every interaction; lowest noise where few lights overlap). Otherwise, per light
- * sample, one light picked in proportion to its unshadowed contribution (so the many lights that
- * cannot reach this point cost no rays) and one shadow ray toward it. */
+/* Next-event estimation toward the Doom 3 lights, three ways (KFrameParams.light_sampling):
+ * - K_LIGHTS_EVERY (or light_samples == 0): every light that reaches the point, one shadow ray each
+ *   (as Doom 3 draws every interaction; lowest noise where few lights overlap, cost grows with them).
+ * - K_LIGHTS_TREE (default): per light sample, one light picked through the light tree among those
+ *   whose volume holds the point (light_tree.h has the pdf), one shadow ray toward it.
+ * - K_LIGHTS_ALL: per light sample, one light picked over every light of the map in proportion to its
+ *   unshadowed contribution (the reference for the tree: same pick, cost grows with the map). */
 KFN KVec3 k_direct_lighting(KTraceCtx* ctx, const KFrameParams* params, const KSurface* sf, KVec3 wo, KRng* rng) {
   const KSceneView* scene = K_CTX_SCENE(ctx);
   KVec3 sum = v3s(0.0f);
-  if (params->light_samples == 0u) {
+  if (params->light_samples == 0u || params->light_sampling == K_LIGHTS_EVERY) {
     for (kuint i = 0u; i < scene->light_count; ++i) {
       KGLOBAL const KLight* light = &scene->lights[i];
       KVec3 c = k_light_unshadowed(scene, light, sf, wo, params->spec_boost);
@@ -68,31 +72,116 @@ KFN KVec3 k_direct_lighting(KTraceCtx* ctx, const KFrameParams* params, const KS
   }
   kuint samples = params->light_samples;
   for (kuint k = 0u; k < samples; ++k) {
-    float total = 0.0f, chosen_weight = 0.0f;
     kuint chosen = K_NONE;
     KVec3 chosen_contrib = v3s(0.0f);
+    float pdf = 0.0f;
     float u_pick = k_rng_next(rng);
-    for (kuint i = 0u; i < scene->light_count; ++i) {
-      KVec3 c = k_light_unshadowed(scene, &scene->lights[i], sf, wo, params->spec_boost);
-      float w = v3_luminance(c);
-      if (w <= 0.0f) continue;
-      total += w;
-      /* Single-slot reservoir: keep light i with probability w / total. */
-      if (u_pick * total < w) {
-        chosen = i;
-        chosen_weight = w;
-        chosen_contrib = c;
-        u_pick = u_pick * total / w;
-      } else {
-        u_pick = (u_pick * total - w) / (total - w);
+    if (params->light_sampling == K_LIGHTS_TREE) {
+      float u_descend = k_rng_next(rng);
+      chosen = k_light_tree_pick(scene, sf, wo, params->spec_boost, u_descend, u_pick, &chosen_contrib, &pdf);
+    } else {
+      float total = 0.0f, chosen_weight = 0.0f;
+      for (kuint i = 0u; i < scene->light_count; ++i) {
+        KVec3 c = k_light_unshadowed(scene, &scene->lights[i], sf, wo, params->spec_boost);
+        float w = v3_luminance(c);
+        if (w <= 0.0f) continue;
+        total += w;
+        /* Single-slot reservoir: keep light i with probability w / total. */
+        if (u_pick * total < w) {
+          chosen = i;
+          chosen_weight = w;
+          chosen_contrib = c;
+          u_pick = u_pick * total / w;
+        } else {
+          u_pick = (u_pick * total - w) / (total - w);
+        }
       }
+      pdf = chosen != K_NONE ? chosen_weight / total : 0.0f;
     }
     float u1 = k_rng_next(rng), u2 = k_rng_next(rng);
-    if (chosen == K_NONE) continue;
+    if (chosen == K_NONE || !(pdf > 0.0f)) continue;
     if (!k_light_visible(ctx, params, sf, &scene->lights[chosen], u1, u2)) continue;
-    sum = v3_add(sum, v3_scale(chosen_contrib, total / chosen_weight));
+    sum = v3_add(sum, v3_scale(chosen_contrib, 1.0f / pdf));
   }
   return v3_scale(sum, 1.0f / (float)samples);
+}
+
+/* Power-heuristic weight (exponent 2) of a sample drawn with pdf `own` against the other strategy's pdf. */
+KFN float k_power_heuristic(float own, float other) {
+  float a = own * own, b = other * other;
+  return a + b > 0.0f ? a / (a + b) : 0.0f;
+}
+
+/* The density per solid angle, seen from a point dist2 away and at cosine cos_light on the emitter, with
+ * which emissive-triangle sampling (k_emissive_lighting) proposes this point of this triangle: pick
+ * probability area x power density / total power, times 1 / area, converted to solid angle. It is the
+ * same formula on both sides of the MIS, so the two weights of a path sum to one. */
+KFN float k_emissive_pdf(const KSceneView* scene, kuint instance, kuint triangle, float dist2, float cos_light) {
+  if (scene->emissive_count == 0u || !(cos_light > 0.0f)) return 0.0f;
+  float density = k_emitter_power_density(&scene->materials[k_hit_material(scene, instance, triangle)]);
+  float total = scene->emissive[scene->emissive_count - 1u].power_cdf;
+  if (!(density > 0.0f) || !(total > 0.0f)) return 0.0f;
+  return density / total * dist2 / cos_light;
+}
+
+/* One emissive-triangle sample for next-event estimation: a triangle picked by power (binary search of
+ * the running sum), a uniform point on it, its emission there, one shadow ray. With a bounce to follow
+ * from this vertex the result is weighted by the power heuristic against BRDF sampling, which weighs the
+ * emission it finds the same way (k_trace_path); without one it stands alone (weight 1). */
+KFN KVec3 k_emissive_lighting(KTraceCtx* ctx, const KSurface* sf, KVec3 wo, int bounce_follows, KRng* rng) {
+  const KSceneView* scene = K_CTX_SCENE(ctx);
+  float u_pick = k_rng_next(rng), u1 = k_rng_next(rng), u2 = k_rng_next(rng);
+  kuint count = scene->emissive_count;
+  if (count == 0u) return v3s(0.0f);
+  float total = scene->emissive[count - 1u].power_cdf;
+  float target = u_pick * total;
+  kuint lo = 0u, hi = count - 1u;
+  while (lo < hi) {
+    kuint mid = (lo + hi) / 2u;
+    if (scene->emissive[mid].power_cdf > target) hi = mid; else lo = mid + 1u;
+  }
+  KGLOBAL const KEmissiveTriangle* e = &scene->emissive[lo];
+  float pick = (e->power_cdf - (lo > 0u ? scene->emissive[lo - 1u].power_cdf : 0.0f)) / total;
+  if (!(pick > 0.0f)) return v3s(0.0f);
+
+  float su = k_sqrt(u1);
+  float bu = su * (1.0f - u2), bv = su * u2;   /* barycentrics of p1 and p2 */
+  KVec3 p0 = v3_load_g(e->p0), p1 = v3_load_g(e->p1), p2 = v3_load_g(e->p2);
+  KVec3 x = v3_add(v3_scale(p0, 1.0f - bu - bv), v3_add(v3_scale(p1, bu), v3_scale(p2, bv)));
+  KVec3 cr = v3_cross(v3_sub(p1, p0), v3_sub(p2, p0));
+  float double_area = v3_length(cr);
+  if (!(double_area > 0.0f)) return v3s(0.0f);
+  KVec3 to_light = v3_sub(x, sf->position);
+  float dist2 = v3_dot(to_light, to_light);
+  if (!(dist2 > 0.0f)) return v3s(0.0f);
+  float dist = k_sqrt(dist2);
+  KVec3 wi = v3_scale(to_light, 1.0f / dist);
+  float cos_light = k_fabs(v3_dot(cr, wi)) / double_area;   /* emitters shine from both faces */
+  if (cos_light <= 1e-6f) return v3s(0.0f);
+  KVec3 f = k_brdf_eval_cos(sf, wo, wi, 1.0f);
+  if (v3_max_component(f) <= 0.0f) return v3s(0.0f);
+
+  KGLOBAL const KMaterial* m = &scene->materials[k_hit_material(scene, e->instance, e->triangle)];
+  KVec3 le = v3(m->emissive_color[0], m->emissive_color[1], m->emissive_color[2]);
+  if (m->emissive_tex != K_NONE) {
+    float s, t;
+    k_hit_st(scene, e->triangle, bu, bv, m, &s, &t);
+    le = v3_mul(le, v4_rgb(k_texture_sample(scene, m->emissive_tex, s, t)));
+  }
+  if (v3_max_component(le) <= 0.0f) return v3s(0.0f);
+
+  float eps = k_ray_epsilon(sf->position);
+  KVec3 org = v3_madd(sf->position, sf->geo_normal, eps);
+  KVec3 seg = v3_sub(x, org);
+  float seg_len = v3_length(seg);
+  float tmax = seg_len - 2.0f * k_ray_epsilon(x);
+  if (tmax > 0.0f && k_trace_occluded(ctx, org, v3_scale(seg, 1.0f / seg_len), tmax, K_RAY_SHADOW)) return v3s(0.0f);
+
+  float pdf = pick * 2.0f / double_area * dist2 / cos_light;
+  float weight = 1.0f;
+  if (bounce_follows)
+    weight = k_power_heuristic(k_emissive_pdf(scene, e->instance, e->triangle, dist2, cos_light), k_brdf_pdf(sf, wo, wi));
+  return v3_scale(v3_mul(le, f), weight / pdf);
 }
 
 KFN KVec3 k_clamp_radiance(KVec3 c, float limit) {
@@ -119,6 +208,10 @@ KFN KVec3 k_trace_path(KTraceCtx* ctx, const KFrameParams* params, KVec3 org, KV
   float cone_width = 0.0f, spread = pixel_spread;
   kuint bounce = 0u, layers = 0u;
   float tmax = K_INF;
+  /* The last opaque vertex, for weighing emission that a bounce from it finds (MIS). */
+  int emissive_nee = params->emissive_samples > 0u && scene->emissive_count > 0u;
+  KVec3 vertex_position = org;
+  float vertex_brdf_pdf = 0.0f;
   for (;;) {
     KHit hit;
     hit.cost = 0u;
@@ -159,7 +252,16 @@ KFN KVec3 k_trace_path(KTraceCtx* ctx, const KFrameParams* params, KVec3 org, KV
       vertex_params.spec_boost = 1.0f;
     }
     KVec3 contribution = sf.emission;
+    if (bounce > 0u && emissive_nee && v3_max_component(sf.emission) > 0.0f) {
+      KVec3 d = v3_sub(sf.position, vertex_position);
+      float light_pdf = k_emissive_pdf(scene, hit.instance, hit.triangle, v3_dot(d, d), k_fabs(v3_dot(sf.geo_normal, dir)));
+      contribution = v3_scale(contribution, k_power_heuristic(vertex_brdf_pdf, light_pdf));
+    }
     contribution = v3_add(contribution, k_direct_lighting(ctx, &vertex_params, &sf, wo, rng));
+    if (emissive_nee) {
+      int bounce_follows = params->mode != K_MODE_DIRECT && bounce < params->max_bounces;
+      contribution = v3_add(contribution, k_emissive_lighting(ctx, &sf, wo, bounce_follows, rng));
+    }
     contribution = v3_mul(throughput, contribution);
     if (bounce > 0u) contribution = k_clamp_radiance(contribution, params->firefly_clamp);
     radiance = v3_add(radiance, contribution);
@@ -171,6 +273,8 @@ KFN KVec3 k_trace_path(KTraceCtx* ctx, const KFrameParams* params, KVec3 org, KV
     KVec3 weight = k_brdf_sample(&sf, wo, u_lobe, u1, u2, &wi);
     if (v3_max_component(weight) <= 0.0f || v3_dot(wi, sf.geo_normal) <= 0.0f) break;
     throughput = v3_mul(throughput, weight);
+    vertex_position = sf.position;
+    vertex_brdf_pdf = k_brdf_pdf(&sf, wo, wi);
     spread += K_BOUNCE_SPREAD;
     ++bounce;
     if ((float)bounce >= params->rr_start) {

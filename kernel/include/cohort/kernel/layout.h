@@ -111,6 +111,26 @@ typedef struct KLight {
   float extent;     float pad[3];       /* soft-shadow jitter radius in world units */
 } KLight;
 
+/* ---- Light tree: which lights can reach a point, at a cost that does not grow with the light count.
+ * A binary tree over the lights' world-space bounding boxes (the finite volume outside which a Doom 3
+ * light is zero), built by the core (core/light_tree.h); node 0 is the root. count == 0: interior node,
+ * children at left_first and left_first + 1. count == 1: a leaf holding light left_first (one light
+ * per leaf). power: the summed luminance of the colours of the lights below; light_count: how many. */
+typedef struct KLightNode {
+  float bmin[3]; kuint left_first;
+  float bmax[3]; kuint count;
+  float power;   kuint light_count; kuint pad0; kuint pad1;
+} KLightNode;
+
+/* ---- Emissive triangles: every triangle whose material emits, in world space, with the running sum of
+ * the triangles' powers (area x luminance of the material's emissive colour) for picking by power. The
+ * last entry's power_cdf is the total. */
+typedef struct KEmissiveTriangle {
+  float p0[3]; kuint instance;   /* p0..p2: world positions of the triangle's v0, v1, v2 */
+  float p1[3]; kuint triangle;   /* absolute index into the triangle array */
+  float p2[3]; float power_cdf;
+} KEmissiveTriangle;
+
 /* ---- Camera and per-frame parameters ------------------------------------------------------------- */
 typedef struct KCamera {
   float origin[3];  float tan_half_fov_x;
@@ -129,13 +149,22 @@ typedef struct KCamera {
 #define K_MODE_TRIANGLES 6u  /* a colour per triangle */
 #define K_MODE_COUNT    7u   /* how many modes: they run from 0 to K_MODE_COUNT - 1 */
 
-/* light_count, instance_count and tlas_node_count are the lengths of the scene's arrays, set by the
- * host from the tracer's scene copy and read only by k_scene_view (scene_view.h). */
+/* How next-event estimation picks Doom 3 lights (KFrameParams.light_sampling). light_samples == 0
+ * means K_LIGHTS_EVERY whatever this says. */
+#define K_LIGHTS_TREE  0u   /* the light tree: only lights whose volume holds the point (default) */
+#define K_LIGHTS_ALL   1u   /* reference: a pick by contribution over every light of the map */
+#define K_LIGHTS_EVERY 2u   /* reference: every light, one shadow ray each */
+
+/* light_count, instance_count, tlas_node_count, light_node_count and emissive_count are the lengths of
+ * the scene's arrays, set by the host from the tracer's scene copy and read only by k_scene_view
+ * (scene_view.h). emissive_samples: emissive triangles sampled per hit (0: emitters are found only by
+ * bounce rays; 1: one sample, combined with the bounce by MIS). */
 typedef struct KFrameParams {
   kuint frame_index;  kuint spp;          kuint max_bounces;   kuint light_samples;
   float firefly_clamp; float spec_boost;  kuint mode;          kuint light_count;
   kuint row_begin;    kuint row_end;      kuint instance_count; kuint tlas_node_count;
-  float soft_shadow_scale; float rr_start; float pad0;         float pad1;
+  float soft_shadow_scale; float rr_start; kuint light_sampling; kuint light_node_count;
+  kuint emissive_count; kuint emissive_samples; kuint pad0;    kuint pad1;
 } KFrameParams;
 
 #if defined(__cplusplus) && !defined(__CUDACC_RTC__)
@@ -148,7 +177,9 @@ static_assert(sizeof(KMaterial) == 112, "KMaterial layout");
 static_assert(sizeof(KTexture) == 16, "KTexture layout");
 static_assert(sizeof(KLight) == 192, "KLight layout");
 static_assert(sizeof(KCamera) == 64, "KCamera layout");
-static_assert(sizeof(KFrameParams) == 64, "KFrameParams layout");
+static_assert(sizeof(KLightNode) == 48, "KLightNode layout");
+static_assert(sizeof(KEmissiveTriangle) == 48, "KEmissiveTriangle layout");
+static_assert(sizeof(KFrameParams) == 80, "KFrameParams layout");
 #endif
 
 #endif

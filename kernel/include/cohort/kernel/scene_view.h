@@ -17,9 +17,13 @@ typedef struct KSceneView {
   KGLOBAL const KTexture* textures;
   KGLOBAL const kuint* texels;
   KGLOBAL const KLight* lights;
+  KGLOBAL const KLightNode* light_nodes;
+  KGLOBAL const KEmissiveTriangle* emissive;
   kuint instance_count;
   kuint tlas_node_count;
   kuint light_count;
+  kuint light_node_count;
+  kuint emissive_count;
 } KSceneView;
 
 /* The view over a scene's arrays, wherever they live. The counts come from the frame parameters,
@@ -29,7 +33,9 @@ KFN KSceneView k_scene_view(KGLOBAL const KVertex* vertices, KGLOBAL const KTria
                             KGLOBAL const KBvhNode* blas_nodes, KGLOBAL const KBlas* blases,
                             KGLOBAL const KInstance* instances, KGLOBAL const KBvhNode* tlas_nodes,
                             KGLOBAL const KMaterial* materials, KGLOBAL const KTexture* textures,
-                            KGLOBAL const kuint* texels, KGLOBAL const KLight* lights, const KFrameParams* params) {
+                            KGLOBAL const kuint* texels, KGLOBAL const KLight* lights,
+                            KGLOBAL const KLightNode* light_nodes, KGLOBAL const KEmissiveTriangle* emissive,
+                            const KFrameParams* params) {
   KSceneView v;
   v.vertices = vertices;
   v.triangles = triangles;
@@ -41,9 +47,13 @@ KFN KSceneView k_scene_view(KGLOBAL const KVertex* vertices, KGLOBAL const KTria
   v.textures = textures;
   v.texels = texels;
   v.lights = lights;
+  v.light_nodes = light_nodes;
+  v.emissive = emissive;
   v.instance_count = params->instance_count;
   v.tlas_node_count = params->tlas_node_count;
   v.light_count = params->light_count;
+  v.light_node_count = params->light_node_count;
+  v.emissive_count = params->emissive_count;
   return v;
 }
 

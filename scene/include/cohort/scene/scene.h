@@ -65,6 +65,7 @@ enum class LightType : uint8_t { Point, Parallel, Projected };
 
 struct Light {
   std::string name;
+  std::string source;           // "file:line" of its map entity, for messages; empty for lights made in code
   LightType type = LightType::Point;
   glm::vec3 origin{0.0f};
   glm::mat3 axis{1.0f};         // columns: the light's x, y, z axes in world space

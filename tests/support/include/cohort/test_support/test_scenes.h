@@ -24,4 +24,9 @@ scene::Scene floor_scene(float half, glm::vec3 albedo);
 // A closed cube [-half, half]^3 whose inside walls all have this albedo and emission.
 scene::Scene furnace_box(float half, float albedo, float emission);
 
+// A 2000 x 2000 floor (z = 0, albedo 0.7) under randomly placed point lights (radii 150-450, 30-160
+// units up) and projected lights shining down from 300 units, of random colours, overlapping a few deep
+// everywhere: for light-sampling tests and benchmarks.
+scene::Scene many_lights_floor(int point_lights, int projected_lights, unsigned seed = 11);
+
 }  // namespace cohort::test

@@ -1,0 +1,181 @@
+// The light tree: each light's finite volume as a world-space box, and a median-split tree over them.
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <numeric>
+
+#include <glm/gtc/matrix_inverse.hpp>
+
+#include "cohort/core/light_sampling.h"
+#include "cohort/kernel/vec.h"
+
+namespace cohort::core {
+namespace {
+
+// Beyond this a light's box is treated as unbounded (no map is this large; Doom 3's is +-65536).
+constexpr double kLargestCoordinate = 1.0e7;
+
+glm::dvec4 plane(const float* p) { return {p[0], p[1], p[2], p[3]}; }
+glm::dvec3 xyz(const glm::dvec4& p) { return {p.x, p.y, p.z}; }
+double eval(const glm::dvec4& p, const glm::dvec3& x) { return glm::dot(xyz(p), x) + p.w; }
+
+// The point where three planes (rows) meet: rows . x = rhs. nullopt when they do not meet in one point.
+std::optional<glm::dvec3> meet(const glm::dvec3& a, const glm::dvec3& b, const glm::dvec3& c, const glm::dvec3& rhs) {
+  const double det = glm::dot(a, glm::cross(b, c));
+  const double scale = glm::length(a) * glm::length(b) * glm::length(c);
+  if (!(std::fabs(det) > 1e-12 * scale)) return std::nullopt;
+  // Cramer's rule with the rows as a, b, c.
+  const glm::dvec3 x = (rhs.x * glm::cross(b, c) + rhs.y * glm::cross(c, a) + rhs.z * glm::cross(a, b)) / det;
+  return x;
+}
+
+// Box lights: 0 <= S, T, F <= 1 is a parallelepiped, the hull of its 8 corners.
+bool box_light_corners(const KLight& light, std::vector<glm::dvec3>& points) {
+  const glm::dvec4 s = plane(light.plane_s), t = plane(light.plane_t), f = plane(light.plane_f);
+  for (int corner = 0; corner < 8; ++corner) {
+    const double a = corner & 1, b = (corner >> 1) & 1, c = (corner >> 2) & 1;
+    auto x = meet(xyz(s), xyz(t), xyz(f), {a - s.w, b - t.w, c - f.w});
+    if (!x) return false;
+    points.push_back(*x);
+  }
+  return true;
+}
+
+// Projected lights: the pyramid 0 <= S/Q, T/Q <= 1 (Q > 0) from its apex, cut by the slab 0 <= F <= 1.
+// Along each of the pyramid's four edge rays F must change in the same direction, or the slab leaves
+// the volume open. The volume's corners are then the apex (when inside the slab) and the points where
+// the edge rays cross F = 0 and F = 1 ahead of the apex.
+bool projected_light_corners(const KLight& light, std::vector<glm::dvec3>& points) {
+  const glm::dvec4 s = plane(light.plane_s), t = plane(light.plane_t), q = plane(light.plane_q),
+                   f = plane(light.plane_f);
+  auto apex = meet(xyz(s), xyz(t), xyz(q), {-s.w, -t.w, -q.w});
+  if (!apex) return false;
+  const double f_apex = eval(f, *apex);
+  if (f_apex >= 0.0 && f_apex <= 1.0) points.push_back(*apex);
+  int sign = 0;
+  for (int edge = 0; edge < 4; ++edge) {
+    const double a = edge & 1, b = (edge >> 1) & 1;
+    glm::dvec3 ray = glm::cross(xyz(s) - a * xyz(q), xyz(t) - b * xyz(q));
+    const double q_rate = glm::dot(xyz(q), ray);
+    if (!(std::fabs(q_rate) > 1e-12 * glm::length(ray) * glm::length(xyz(q)))) return false;
+    if (q_rate < 0.0) ray = -ray;
+    const double f_rate = glm::dot(xyz(f), ray);
+    const int s_rate = f_rate > 1e-12 * glm::length(ray) * glm::length(xyz(f))    ? 1
+                       : f_rate < -1e-12 * glm::length(ray) * glm::length(xyz(f)) ? -1
+                                                                                   : 0;
+    if (s_rate == 0 || (sign != 0 && s_rate != sign)) return false;
+    sign = s_rate;
+    for (double level : {0.0, 1.0}) {
+      const double along = (level - f_apex) / f_rate;
+      if (along >= 0.0) points.push_back(*apex + along * ray);
+    }
+  }
+  return true;
+}
+
+float luminance(const float* c) { return v3_luminance(v3(c[0], c[1], c[2])); }
+
+struct Item {
+  uint32_t light = 0;
+  LightBounds box;
+  glm::vec3 centre{0.0f};
+  float power = 0.0f;
+};
+
+class TreeBuilder {
+ public:
+  explicit TreeBuilder(std::vector<Item> items) : items_(std::move(items)) {}
+  std::vector<KLightNode> build() {
+    if (items_.empty()) return {};
+    nodes_.reserve(2 * items_.size() - 1);
+    nodes_.emplace_back();
+    build(0, 0, items_.size());
+    return std::move(nodes_);
+  }
+
+ private:
+  void build(size_t node, size_t begin, size_t end) {
+    KLightNode n{};
+    glm::vec3 lo(INFINITY), hi(-INFINITY), centre_lo(INFINITY), centre_hi(-INFINITY);
+    float power = 0.0f;
+    for (size_t i = begin; i < end; ++i) {
+      lo = glm::min(lo, items_[i].box.min);
+      hi = glm::max(hi, items_[i].box.max);
+      centre_lo = glm::min(centre_lo, items_[i].centre);
+      centre_hi = glm::max(centre_hi, items_[i].centre);
+      power += items_[i].power;
+    }
+    for (int k = 0; k < 3; ++k) {
+      n.bmin[k] = lo[k];
+      n.bmax[k] = hi[k];
+    }
+    n.power = power;
+    n.light_count = uint32_t(end - begin);
+    if (end - begin == 1) {
+      n.count = 1;
+      n.left_first = items_[begin].light;
+      nodes_[node] = n;
+      return;
+    }
+    const glm::vec3 extent = centre_hi - centre_lo;
+    const int axis = extent.x >= extent.y && extent.x >= extent.z ? 0 : extent.y >= extent.z ? 1 : 2;
+    const size_t mid = begin + (end - begin) / 2;
+    std::nth_element(items_.begin() + long(begin), items_.begin() + long(mid), items_.begin() + long(end),
+                     [axis](const Item& a, const Item& b) {
+                       return a.centre[axis] < b.centre[axis] || (a.centre[axis] == b.centre[axis] && a.light < b.light);
+                     });
+    const size_t left = nodes_.size();
+    nodes_.emplace_back();
+    nodes_.emplace_back();
+    n.count = 0;
+    n.left_first = uint32_t(left);
+    nodes_[node] = n;
+    build(left, begin, mid);
+    build(left + 1, mid, end);
+  }
+
+  std::vector<Item> items_;
+  std::vector<KLightNode> nodes_;
+};
+
+}  // namespace
+
+std::optional<LightBounds> light_bounds(const KLight& light) {
+  for (const float* p : {light.plane_s, light.plane_t, light.plane_q, light.plane_f})
+    for (int k = 0; k < 4; ++k)
+      if (!std::isfinite(p[k])) return std::nullopt;
+  std::vector<glm::dvec3> points;
+  const bool closed = light.type == K_LIGHT_PROJECTED ? projected_light_corners(light, points)
+                                                      : box_light_corners(light, points);
+  if (!closed || points.empty()) return std::nullopt;
+  glm::dvec3 lo(INFINITY), hi(-INFINITY);
+  for (const glm::dvec3& p : points) {
+    lo = glm::min(lo, p);
+    hi = glm::max(hi, p);
+  }
+  for (int k = 0; k < 3; ++k)
+    if (!std::isfinite(lo[k]) || !std::isfinite(hi[k]) || std::fabs(lo[k]) > kLargestCoordinate ||
+        std::fabs(hi[k]) > kLargestCoordinate)
+      return std::nullopt;
+  // A margin for the kernel's float plane tests at the volume's faces.
+  const glm::dvec3 margin = 1e-4 * (hi - lo) + glm::dvec3(1e-2);
+  return LightBounds{glm::vec3(lo - margin), glm::vec3(hi + margin)};
+}
+
+std::vector<KLightNode> build_light_tree(const std::vector<KLight>& lights) {
+  std::vector<Item> items;
+  items.reserve(lights.size());
+  for (size_t i = 0; i < lights.size(); ++i) {
+    std::optional<LightBounds> box = light_bounds(lights[i]);
+    if (!box) continue;
+    Item item;
+    item.light = uint32_t(i);
+    item.box = *box;
+    item.centre = 0.5f * (box->min + box->max);
+    item.power = std::max(luminance(lights[i].color), 0.0f);
+    items.push_back(item);
+  }
+  return TreeBuilder(std::move(items)).build();
+}
+
+}  // namespace cohort::core

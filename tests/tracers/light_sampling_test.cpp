@@ -1,0 +1,191 @@
+// Light sampling at a cost that does not grow with the light count, checked for bias against the
+// references: the light tree (the default) and the all-lights pick converge to the every-light image
+// on a floor under 96 overlapping lights; emissive triangles sampled with MIS converge to the
+// bounce-only estimate with less noise; lights with defects are skipped and no pixel goes NaN.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <iostream>
+#include <limits>
+#include <random>
+
+#include "cohort/kernel/light_tree.h"
+#include "test_scenes.h"
+#include "test_tracers.h"
+
+using namespace cohort;
+using namespace cohort::test;
+
+namespace {
+
+scene::Light point_light(glm::vec3 origin, glm::vec3 radius, glm::vec3 colour) {
+  scene::Light l;
+  l.name = "light";
+  l.origin = origin;
+  l.radius = radius;
+  l.color = colour;
+  return l;
+}
+
+// Means of size x size pixel blocks (luminance): bias shows there, pixel noise averages out.
+std::vector<double> block_means(const core::FrameBuffer& fb, int size) {
+  std::vector<double> out;
+  for (int by = 0; by + size <= fb.height; by += size)
+    for (int bx = 0; bx + size <= fb.width; bx += size) {
+      double sum = 0.0;
+      for (int y = by; y < by + size; ++y)
+        for (int x = bx; x < bx + size; ++x) {
+          glm::vec3 c = pixel(fb, x, y);
+          sum += 0.2126 * c.x + 0.7152 * c.y + 0.0722 * c.z;
+        }
+      out.push_back(sum / double(size * size));
+    }
+  return out;
+}
+
+double rms_difference(const std::vector<double>& a, const std::vector<double>& b) {
+  double sum = 0.0;
+  for (size_t i = 0; i < a.size(); ++i) sum += (a[i] - b[i]) * (a[i] - b[i]);
+  return std::sqrt(sum / double(a.size()));
+}
+
+double pixel_rmse(const core::FrameBuffer& a, const core::FrameBuffer& b) {
+  double sum = 0.0;
+  for (size_t i = 0; i < a.rgba.size(); ++i)
+    if (i % 4 != 3) sum += (double(a.rgba[i]) - b.rgba[i]) * (double(a.rgba[i]) - b.rgba[i]);
+  return std::sqrt(sum / double(a.rgba.size() * 3 / 4));
+}
+
+void expect_finite(const core::FrameBuffer& fb, const std::string& what) {
+  for (size_t i = 0; i < fb.rgba.size(); ++i)
+    ASSERT_TRUE(std::isfinite(fb.rgba[i])) << what << ": pixel " << (i / 4) % size_t(fb.width) << ","
+                                            << (i / 4) / size_t(fb.width) << " is " << fb.rgba[i];
+}
+
+}  // namespace
+
+// Direct lighting only, hard shadows: the every-light image has no light-selection noise, so a biased
+// pick shows as block means that differ from it by more than the pick's own noise (measured as the
+// difference between two renders with different random numbers).
+TEST(LightSampling, TreeAndAllLightsPicksMatchEveryLight) {
+  if (!tracer_runs_here("embree")) GTEST_SKIP();
+  scene::Scene s = many_lights_floor(88, 8);
+  auto compiled = core::compile_scene(s);
+  ASSERT_EQ(compiled.tracer_scene.lights.size(), 96u);
+  ASSERT_GT(compiled.tracer_scene.light_nodes[0].light_count, K_LIGHT_TREE_GATHER) << "the descent must be exercised";
+  const int w = 64, h = 48;
+  const KCamera cam = camera_looking_down({0, 0, 1400}, 0.7f, w, h);
+  KFrameParams params = frame_params(K_MODE_DIRECT, 64, 0, h);
+  auto tracer = make_test_tracer("embree");
+  auto render_with = [&](kuint sampling, kuint frame) {
+    KFrameParams p = params;
+    p.light_sampling = sampling;
+    p.frame_index = frame;
+    return render(*tracer, s, cam, p);
+  };
+  const core::FrameBuffer every = render_with(K_LIGHTS_EVERY, 1);
+  const std::vector<double> reference = block_means(every, 8);
+  const double mean = mean_luminance(every);
+  ASSERT_GT(mean, 0.05) << "the floor should be lit";
+  for (kuint sampling : {K_LIGHTS_TREE, K_LIGHTS_ALL}) {
+    const core::FrameBuffer a = render_with(sampling, 1), b = render_with(sampling, 2);
+    expect_finite(a, "light sampling");
+    const double bias = rms_difference(block_means(a, 8), reference);
+    const double noise = rms_difference(block_means(a, 8), block_means(b, 8));
+    const double mean_error = std::fabs(mean_luminance(a) - mean) / mean;
+    std::cout << (sampling == K_LIGHTS_TREE ? "tree" : "all") << ": block RMS vs every light " << bias
+              << ", between two seeds " << noise << ", mean error " << 100.0 * mean_error << "%\n";
+    // Unbiased: the difference to the reference is the sample's own noise, 1/sqrt(2) of two samples'.
+    EXPECT_LT(bias, 0.95 * noise + 1e-4 * mean);
+    EXPECT_LT(mean_error, 0.01);
+    EXPECT_GT(noise, 0.0) << "two seeds must differ, or the test cannot see bias";
+  }
+}
+
+// An emissive panel over a floor, no lights: one bounce finds the panel by chance, NEE with MIS aims at
+// it. Both estimate the same radiance; MIS with far less noise.
+TEST(LightSampling, EmissiveTrianglesWithMisMatchBounceOnly) {
+  if (!tracer_runs_here("embree")) GTEST_SKIP();
+  scene::Scene s = floor_scene(600.0f, {0.8f, 0.8f, 0.8f});
+  scene::Material panel;
+  panel.name = "panel";
+  panel.diffuse_color = glm::vec4(0.0f, 0.0f, 0.0f, 1.0f);
+  panel.emitter = true;
+  panel.emissive_color = glm::vec4(4.0f, 3.5f, 3.0f, 1.0f);
+  s.materials.push_back(panel);
+  const int panel_material = int(s.materials.size() - 1);
+  scene::Mesh lamp;
+  lamp.name = "_area1";
+  add_quad(lamp, panel_material, {-60, -60, 150}, {-60, 60, 150}, {60, 60, 150}, {60, -60, 150}, {0, 0, -1});
+  add_world_mesh(s, std::move(lamp));
+  auto compiled = core::compile_scene(s);
+  ASSERT_EQ(compiled.tracer_scene.emissive_triangles.size(), 2u);
+
+  const int w = 48, h = 36;
+  const KCamera cam = camera_looking_down({200, 0, 900}, 0.5f, w, h);  // beside the panel: only the floor
+  KFrameParams params = frame_params(K_MODE_PATH, 64, 1, h);
+  auto tracer = make_test_tracer("embree");
+  auto render_with = [&](kuint emissive_samples, kuint frame) {
+    KFrameParams p = params;
+    p.emissive_samples = emissive_samples;
+    p.frame_index = frame;
+    return render(*tracer, s, cam, p);
+  };
+  const core::FrameBuffer mis_a = render_with(1, 1), mis_b = render_with(1, 2);
+  const core::FrameBuffer bounce_a = render_with(0, 1), bounce_b = render_with(0, 2);
+  expect_finite(mis_a, "MIS");
+  const double mis_mean = mean_luminance(mis_a), bounce_mean = mean_luminance(bounce_a);
+  const double mis_noise = pixel_rmse(mis_a, mis_b), bounce_noise = pixel_rmse(bounce_a, bounce_b);
+  std::cout << "mean with MIS " << mis_mean << ", bounce only " << bounce_mean << "; pixel noise with MIS "
+            << mis_noise << ", bounce only " << bounce_noise << "\n";
+  ASSERT_GT(bounce_mean, 0.01) << "the panel should light the floor";
+  // The bounce-only mean carries its own noise: about bounce_noise / sqrt(2 pixels) per image.
+  const double tolerance = 4.0 * bounce_noise / std::sqrt(2.0 * w * h) + 0.005 * bounce_mean;
+  EXPECT_NEAR(mis_mean, bounce_mean, tolerance);
+  EXPECT_LT(mis_noise, 0.6 * bounce_noise);  // about 0.46 here: a fifth of the variance
+}
+
+// Lights with a defect (zero or negative radius, NaN or huge origin, degenerate projection vectors) are
+// skipped with a warning; every pixel of every light-sampling mode stays finite and the good light shows.
+TEST(LightSampling, LightsWithDefectsAreSkippedAndNoPixelIsNaN) {
+  scene::Scene s = floor_scene(500.0f, {0.7f, 0.7f, 0.7f});
+  s.lights.push_back(point_light({0, 0, 100}, {400, 400, 400}, {1, 1, 1}));
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  s.lights.push_back(point_light({0, 0, 100}, {0, 0, 0}, {1, 1, 1}));
+  s.lights.push_back(point_light({0, 0, 100}, {-300, 300, 300}, {1, 1, 1}));
+  s.lights.push_back(point_light({nan, 0, 100}, {300, 300, 300}, {1, 1, 1}));
+  s.lights.push_back(point_light({0, 0, 1e30f}, {300, 300, 300}, {1, 1, 1}));
+  s.lights.push_back(point_light({0, 0, 100}, {300, 300, 300}, {nan, 1, 1}));
+  scene::Light flat;
+  flat.name = "flat_projected";
+  flat.type = scene::LightType::Projected;
+  flat.origin = {0, 0, 200};
+  flat.target = {0, 0, -300};
+  flat.right = {0, -100, 0};
+  flat.up = {0, 100, 0};  // parallel to right: no frustum
+  s.lights.push_back(flat);
+  scene::Light nan_target = flat;
+  nan_target.name = "nan_projected";
+  nan_target.up = {100, 0, 0};
+  nan_target.target = {nan, 0, -300};
+  s.lights.push_back(nan_target);
+  auto compiled = core::compile_scene(s);
+  EXPECT_EQ(compiled.tracer_scene.lights.size(), 1u) << "only the good light remains";
+
+  const int w = 32, h = 24;
+  const KCamera cam = camera_looking_down({0, 0, 600}, 0.6f, w, h);
+  for (const std::string& kind : built_tracers()) {
+    if (!tracer_runs_here(kind)) continue;
+    auto tracer = make_test_tracer(kind);
+    for (kuint sampling : {K_LIGHTS_TREE, K_LIGHTS_ALL, K_LIGHTS_EVERY}) {
+      for (kuint frame = 0; frame < 3; ++frame) {
+        KFrameParams p = frame_params(K_MODE_PATH, 2, 2, h);
+        p.light_sampling = sampling;
+        p.frame_index = frame;
+        const core::FrameBuffer fb = render(*tracer, s, cam, p);
+        expect_finite(fb, kind + " sampling " + std::to_string(sampling));
+        EXPECT_GT(mean_luminance(fb), 0.01) << kind << ": the good light should light the floor";
+      }
+    }
+  }
+}
