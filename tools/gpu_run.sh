@@ -17,10 +17,10 @@ stage=.gpu
 case "${1:-}" in
   stage)
     cmake --preset gpu-travel
-    cmake --build --preset gpu-travel -j2 --target cohort cohort_tracers_tests bench_cuda bench_tracers bench_bvh \
+    cmake --build --preset gpu-travel -j2 --target cohort cohort_tracers_tests bench_cuda bench_bvh \
       bench_scaling bench_host_frame
     rm -rf "$stage" && mkdir -p "$stage/bin" "$stage/lib"
-    for exe in build/gpu/bin/cohort build/gpu/bin/cohort_tracers_tests build/gpu/bin/bench_cuda build/gpu/bin/bench_tracers \
+    for exe in build/gpu/bin/cohort build/gpu/bin/cohort_tracers_tests build/gpu/bin/bench_cuda \
                build/gpu/bin/bench_bvh build/gpu/bin/bench_scaling build/gpu/bin/bench_host_frame; do
       [ -x "$exe" ] && [ -f "$exe" ] && strip -o "$stage/bin/$(basename "$exe")" "$exe"
     done
@@ -45,6 +45,7 @@ case "${1:-}" in
     (clinfo -l 2>&1 || true) | tee "$out/opencl_devices.txt"
     status=0
     mkdir -p "$out/images"
+    # Frames and plots are PPM/PFM here (no OpenImageIO travels); the archive at the end must stay small.
     COHORT_PACK="$stage/testmap.cpk" COHORT_TEST_IMAGES="$out/images" \
       "$stage/bin/cohort_tracers_tests" --gtest_output=json:"$out/tracers_tests.json" 2>&1 | tee "$out/tracers_tests.log" || status=1
     if [ -x "$stage/bin/bench_cuda" ]; then
@@ -79,12 +80,12 @@ case "${1:-}" in
     # Light and triangle scaling on the GPU (issue 16), 1920x1080, 1 spp, NEE + 1 bounce.
     if [ -x "$stage/bin/bench_scaling" ]; then
       timeout 400 "$stage/bin/bench_scaling" --tracer cuda:0 --width 1920 --height 1080 --spp 1 --bounces 1 --light-samples 1 \
-        --frames 10 --json "$out/bench_scaling_cuda.json" --plot "$out/bench_scaling_cuda.png" 2>&1 | tee "$out/bench_scaling_cuda.log" || status=1
+        --frames 10 --json "$out/bench_scaling_cuda.json" --plot "$out/bench_scaling_cuda.ppm" 2>&1 | tee "$out/bench_scaling_cuda.log" || status=1
     fi
     # Does every device add speed (issue 14): each tracer alone and mixes, end to end.
     timeout 400 "$stage/bin/cohort" bench devices --scene "$stage/testmap.cpk" \
       ${COHORT_GPU_DEVICE_MIXES:---mix cuda:0 --mix embree --mix opencl:0 --mix embree,cuda:0 --mix cuda:0,opencl:0 --mix embree,cuda:0,opencl:0} \
-      --frames 60 --json "$out/bench_devices.json" --plot "$out/bench_devices.png" 2>&1 | tee "$out/bench_devices.log" || status=1
+      --frames 60 --json "$out/bench_devices.json" --plot "$out/bench_devices.ppm" 2>&1 | tee "$out/bench_devices.log" || status=1
     if [ -f "$stage/largemap.cpk" ]; then
       "$stage/bin/cohort" render "$stage/largemap.cpk" --tracers "${COHORT_GPU_TRACERS:-cuda:all}" --width 1920 \
         --height 1080 --spp 1 --frames 8 --out "$out/render_largemap" 2>&1 | tail -n 8 | tee "$out/render_largemap.log" || status=1
