@@ -40,7 +40,7 @@ namespace {
 struct RenderArgs {
   std::string map;
   std::string tracers = "all";
-  std::string balancer = "perfect-smooth";
+  std::string balancer = "whole-cost";  // benches a tracer that would slow the frame (docs/balancing.md)
   std::string mode = "path";
   std::string out = "render_out";
   int width = core::kDefaultWidth, height = core::kDefaultHeight, spp = 4, frames = 1, bounces = 1, light_samples = 1,

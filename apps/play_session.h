@@ -20,7 +20,7 @@ struct SessionOptions {
   std::string map;
   std::vector<std::string> bases;
   std::string tracers;              // empty: "all" (parse_tracer_list: Embree plus every GPU once)
-  std::string balancer = "perfect-smooth";
+  std::string balancer = "whole-cost";  // benches a tracer that would slow the frame (docs/balancing.md)
   bool scenario = true;
 };
 
