@@ -6,31 +6,16 @@
 #include <stdexcept>
 
 #include "cohort/core/image_output.h"
+#include "raster/chart.h"
 #include "raster/image.h"
 
 namespace cohort::bench {
 namespace {
 
 using raster::Rgba8;
+using namespace raster::chart;
 
-const Rgba8 kBackground{255, 255, 255}, kInk{30, 30, 30}, kGrid{225, 225, 225};
 const Rgba8 kPalette[] = {{40, 90, 200}, {230, 140, 20}, {200, 40, 40}, {20, 150, 60}, {140, 60, 170}, {0, 160, 170}};
-constexpr int kTextScale = 2;
-
-std::string format_number(double v) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, v == std::floor(v) ? "%.0f" : "%.1f", v);
-  return buf;
-}
-
-// A round axis maximum at or above v: 1, 2, 5 x 10^k.
-double nice_ceiling(double v) {
-  if (!(v > 0.0)) return 1.0;
-  const double p = std::pow(10.0, std::floor(std::log10(v)));
-  for (double m : {1.0, 2.0, 5.0, 10.0})
-    if (m * p >= v) return m * p;
-  return 10.0 * p;
-}
 
 }  // namespace
 
