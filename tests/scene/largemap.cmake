@@ -26,5 +26,11 @@ if(COHORT_PYTHON3)
                      --out ${COHORT_LARGEMAP_DIR})
     set_tests_properties(scene.largemap.cohort_info PROPERTIES FIXTURES_REQUIRED largemap LABELS scene
                          TIMEOUT 120)
+    # Issue 16's bad-input rule: no NaN or Inf pixel in any frame of the large map.
+    add_test(NAME scene.largemap.frames_finite
+             COMMAND ${COHORT_PYTHON3} ${COHORT_LARGEMAP_TEST} frames --cohort $<TARGET_FILE:cohort>
+                     --out ${COHORT_LARGEMAP_DIR})
+    set_tests_properties(scene.largemap.frames_finite PROPERTIES FIXTURES_REQUIRED largemap LABELS scene
+                         TIMEOUT 300)
   endif()
 endif()

@@ -8,14 +8,18 @@
   info          --cohort EXE --out D        `cohort info` on D: no warnings, the generator's counts, and
                                             the targets (>= 40 areas, >= 300k world triangles, >= 256
                                             lights of all three types, >= 100 func_static props)
+  frames        --cohort EXE --out D        `cohort render` of D on Embree along a fast spin, every frame
+                                            written as HDR: every pixel of every frame is finite
 """
 import argparse
 import hashlib
 import os
 import re
 import shutil
+import struct
 import subprocess
 import sys
+import tempfile
 import time
 
 
@@ -133,14 +137,68 @@ def info(args):
     return 1 if failures else 0
 
 
+def nonfinite_in_pfm(path):
+    """Non-finite values in a PFM (the HDR `cohort render` writes without OpenImageIO)."""
+    with open(path, "rb") as f:
+        kind = f.readline().strip()
+        width, height = (int(v) for v in f.readline().split())
+        scale = float(f.readline())
+        channels = 3 if kind == b"PF" else 1
+        count = width * height * channels
+        values = struct.unpack(("<" if scale < 0 else ">") + "%df" % count, f.read(4 * count))
+    return sum(1 for v in values if v != v or v in (float("inf"), float("-inf")))
+
+
+def nonfinite_in_exr(path):
+    """Non-finite values in an EXR, counted by oiiotool --stats (NanCount and InfCount per channel)."""
+    oiiotool = shutil.which("oiiotool")
+    if not oiiotool:
+        raise RuntimeError("oiiotool is needed to read %s" % path)
+    text = subprocess.run([oiiotool, "--stats", path], capture_output=True, text=True, check=True).stdout
+    counts = re.findall(r"(?:NanCount|InfCount):((?:\s+\d+)+)", text)
+    if len(counts) != 2:
+        raise RuntimeError("oiiotool --stats gave no NaN/Inf counts for %s:\n%s" % (path, text))
+    return sum(int(v) for line in counts for v in line.split())
+
+
+def frames(args):
+    out = tempfile.mkdtemp(prefix="largemap_frames_")
+    try:
+        cmd = [args.cohort, "render", "largemap", "--base", args.out, "--tracers", "embree", "--width", "96",
+               "--height", "54", "--spp", "1", "--bounces", "1", "--frames", "4", "--camera-path", "spin-fast",
+               "--no-convergence", "--band-format", "rgba32f", "--out", out]
+        result = subprocess.run(cmd, capture_output=True, text=True)
+        if result.returncode != 0:
+            print(result.stdout + result.stderr)
+            print("FAIL: cohort render exited with %d" % result.returncode)
+            return 1
+        images = sorted(f for f in os.listdir(out) if f.endswith((".exr", ".pfm")))
+        if len(images) != 4:
+            print("FAIL: expected 4 HDR frames, found %s" % images)
+            return 1
+        bad = 0
+        for name in images:
+            path = os.path.join(out, name)
+            n = nonfinite_in_exr(path) if name.endswith(".exr") else nonfinite_in_pfm(path)
+            print("%s: %d non-finite values" % (name, n))
+            bad += n
+        if bad:
+            print("FAIL: %d non-finite values in the large map's frames" % bad)
+            return 1
+        print("PASS: every pixel of %d frames is finite" % len(images))
+        return 0
+    finally:
+        shutil.rmtree(out, ignore_errors=True)
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    parser.add_argument("mode", choices=("generate", "deterministic", "info"))
+    parser.add_argument("mode", choices=("generate", "deterministic", "info", "frames"))
     parser.add_argument("--repo", default=os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)))))
     parser.add_argument("--out", required=True, help="the large map's base folder")
-    parser.add_argument("--cohort", help="the cohort executable (info)")
+    parser.add_argument("--cohort", help="the cohort executable (info, frames)")
     args = parser.parse_args()
-    return {"generate": generate, "deterministic": deterministic, "info": info}[args.mode](args)
+    return {"generate": generate, "deterministic": deterministic, "info": info, "frames": frames}[args.mode](args)
 
 
 if __name__ == "__main__":
