@@ -122,6 +122,24 @@ std::vector<KBvhNode> build_tlas(std::vector<KInstance>& instances, const std::v
   return std::move(built.nodes);
 }
 
+float refit_tlas(const std::vector<KInstance>& instances, const std::vector<KBvhNode>& blas_roots,
+                 std::vector<KBvhNode>& nodes) {
+  // Children are always stored after their parent, so a reverse sweep sees children first.
+  for (size_t i = nodes.size(); i-- > 0;) {
+    KBvhNode& n = nodes[i];
+    Box b;
+    if (n.count > 0) {
+      for (uint32_t j = n.left_first; j < n.left_first + n.count; ++j)
+        if (instances[j].blas < blas_roots.size()) b.grow(instance_world_box(instances[j], blas_roots[instances[j].blas]));
+    } else {
+      b = detail::node_box(nodes[n.left_first]);
+      b.grow(detail::node_box(nodes[n.left_first + 1]));
+    }
+    detail::set_node_box(n, b);
+  }
+  return sah_cost(nodes);
+}
+
 float sah_cost(const std::vector<KBvhNode>& nodes) {
   if (nodes.empty()) return 0.0f;
   const float root_area = detail::node_box(nodes[0]).half_area();

@@ -15,12 +15,25 @@ KVertex to_kvertex(const scene::Vertex& v) {
   return k;
 }
 
-std::vector<KBvhNode> build_scene_tlas(std::vector<KInstance>& instances, const commit::TracerScene& ts) {
-  if (instances.empty()) return {};
+namespace {
+
+std::vector<KBvhNode> blas_roots(const commit::TracerScene& ts) {
   std::vector<KBvhNode> roots;
   roots.reserve(ts.blases.size());
   for (const KBlas& b : ts.blases) roots.push_back(ts.blas_nodes.at(b.node_offset));
-  return build_tlas(instances, roots);
+  return roots;
+}
+
+}  // namespace
+
+std::vector<KBvhNode> build_scene_tlas(std::vector<KInstance>& instances, const commit::TracerScene& ts) {
+  if (instances.empty()) return {};
+  return build_tlas(instances, blas_roots(ts));
+}
+
+float refit_scene_tlas(const std::vector<KInstance>& instances, const commit::TracerScene& ts,
+                       std::vector<KBvhNode>& tlas_nodes) {
+  return refit_tlas(instances, blas_roots(ts), tlas_nodes);
 }
 
 CompiledScene compile_scene(const scene::RenderWorld& world, const GpuSceneOptions& options) {

@@ -36,6 +36,12 @@ bool blas_needs_rebuild(float built_sah, float refit_sah, float threshold = 1.5f
 // (its object-space box). No instances give no nodes; traversal treats that as an empty scene.
 std::vector<KBvhNode> build_tlas(std::vector<KInstance>& instances, const std::vector<KBvhNode>& blas_roots);
 
+// Refit a TLAS from build_tlas in place after instances moved: the same instances in the same (leaf)
+// order on the same BLASes, only their transforms changed. Returns the new SAH cost; as with BLASes,
+// rebuild once tlas quality has decayed (blas_needs_rebuild with the built SAH).
+float refit_tlas(const std::vector<KInstance>& instances, const std::vector<KBvhNode>& blas_roots,
+                 std::vector<KBvhNode>& nodes);
+
 // SAH cost of a built tree (traversal cost 1, intersection cost 1 per primitive), for quality checks.
 float sah_cost(const std::vector<KBvhNode>& nodes);
 

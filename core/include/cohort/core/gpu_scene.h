@@ -56,6 +56,9 @@ std::vector<KTriangle> mesh_triangles(const scene::Mesh& mesh, uint32_t vertex_b
 
 // The TLAS over `instances` (reordered to leaf order) for the BLASes of `tracer_scene`.
 std::vector<KBvhNode> build_scene_tlas(std::vector<KInstance>& instances, const commit::TracerScene& tracer_scene);
+// refit_tlas over the scene's BLAS roots; returns the new SAH cost.
+float refit_scene_tlas(const std::vector<KInstance>& instances, const commit::TracerScene& tracer_scene,
+                       std::vector<KBvhNode>& tlas_nodes);
 
 // The whole world as it stands, compiled for the tracers: what WorldSync holds after syncing from an
 // empty world (compiling is that sync; there is no second path). One BLAS for the static world (all

@@ -45,6 +45,7 @@ struct WorldSyncStats {  // of the last sync()
   size_t record_bytes = 0, records = 0;
   uint32_t blas_builds = 0;
   bool tlas_rebuilt = false;
+  bool tlas_refit = false;      // only instance transforms changed: the TLAS was refit, not rebuilt
   uint32_t lights_skipped = 0;  // lights left out for a defect (light_defect), warned once each
   double sync_ms = 0.0;
 };
@@ -71,6 +72,9 @@ class WorldSync {
 
  private:
   uint32_t ensure_blas(int mesh, commit::CommitBuffer& out);
+  // The moved entities' instances updated in place and the TLAS refit; false (nothing changed) when
+  // the refit tree has decayed past the rebuild threshold.
+  bool refit_moved_instances(const std::vector<int>& moved, commit::CommitBuffer& out);
   uint32_t build_mesh_blas(int mesh, commit::CommitBuffer& out);
   bool update_textures(const std::set<int>& changed, commit::CommitBuffer& out);
   void set_material(int scene_material);
@@ -84,6 +88,7 @@ class WorldSync {
   std::vector<uint32_t> blas_of_mesh_;
   uint32_t world_blas_ = K_NONE;
   bool instances_stale_ = true;                   // until the first sync lists the static world
+  float tlas_built_sah_ = 0.0f;                   // the TLAS's SAH when last rebuilt, to judge refits
   std::vector<KInstance> static_instances_;       // the world: entity == K_NONE
   std::map<int, KInstance> entity_instances_;     // by entity handle
   std::map<int, int> mesh_of_entity_;
