@@ -80,4 +80,13 @@ int add_world_mesh(scene::Scene& scene, scene::Mesh mesh) {
   return static_cast<int>(scene.meshes.size() - 1);
 }
 
+scene::Light point_light(glm::vec3 origin, glm::vec3 radius, glm::vec3 colour) {
+  scene::Light l;
+  l.name = "light";
+  l.origin = origin;
+  l.radius = radius;
+  l.color = colour;
+  return l;
+}
+
 }  // namespace cohort::test

@@ -225,26 +225,13 @@ scene::Scene furnace_box(float half, float albedo, float emission) {
   return s;
 }
 
-namespace {
-
-scene::Light colored_point_light(glm::vec3 origin, glm::vec3 radius, glm::vec3 colour) {
-  scene::Light l;
-  l.name = "light";
-  l.origin = origin;
-  l.radius = radius;
-  l.color = colour;
-  return l;
-}
-
-}  // namespace
-
 scene::Scene many_lights_floor(int point_lights, int projected_lights, unsigned seed) {
   scene::Scene s = floor_scene(1000.0f, {0.7f, 0.7f, 0.7f});
   std::mt19937 rng(seed);
   std::uniform_real_distribution<float> pos(-950.0f, 950.0f), radius(150.0f, 450.0f), height(30.0f, 160.0f),
       colour(0.05f, 1.0f);
   for (int i = 0; i < point_lights; ++i)
-    s.lights.push_back(colored_point_light({pos(rng), pos(rng), height(rng)}, {radius(rng), radius(rng), radius(rng)},
+    s.lights.push_back(point_light({pos(rng), pos(rng), height(rng)}, {radius(rng), radius(rng), radius(rng)},
                                    {colour(rng), colour(rng), colour(rng)}));
   for (int i = 0; i < projected_lights; ++i) {
     scene::Light l;

@@ -18,15 +18,6 @@ using namespace cohort::test;
 
 namespace {
 
-scene::Light point_light(glm::vec3 origin, glm::vec3 radius, glm::vec3 colour) {
-  scene::Light l;
-  l.name = "light";
-  l.origin = origin;
-  l.radius = radius;
-  l.color = colour;
-  return l;
-}
-
 // Means of size x size pixel blocks (luminance): bias shows there, pixel noise averages out.
 std::vector<double> block_means(const core::FrameBuffer& fb, int size) {
   std::vector<double> out;

@@ -26,4 +26,7 @@ int add_image(scene::Scene& scene, const std::string& name, int w, int h,
               const std::function<glm::u8vec4(int, int)>& texel);
 int add_world_mesh(scene::Scene& scene, scene::Mesh mesh);  // also an area of the static world
 
+// A point light named "light": a box of half-size `radius` around `origin`.
+scene::Light point_light(glm::vec3 origin, glm::vec3 radius, glm::vec3 colour = glm::vec3(1.0f));
+
 }  // namespace cohort::test
