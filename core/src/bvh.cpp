@@ -51,6 +51,23 @@ RTCBuildPrimitive build_primitive(const Box& b, uint32_t id) {
   return p;
 }
 
+// Refit in place: leaves get the union of primitive_box(j) over their primitives, inner nodes the union of
+// their children. Children are always stored after their parent, so a reverse sweep sees children first.
+template <typename PrimitiveBox>
+void refit_bottom_up(std::vector<KBvhNode>& nodes, PrimitiveBox primitive_box) {
+  for (size_t i = nodes.size(); i-- > 0;) {
+    KBvhNode& n = nodes[i];
+    Box b;
+    if (n.count > 0) {
+      for (uint32_t j = n.left_first; j < n.left_first + n.count; ++j) b.grow(primitive_box(j));
+    } else {
+      b = detail::node_box(nodes[n.left_first]);
+      b.grow(detail::node_box(nodes[n.left_first + 1]));
+    }
+    detail::set_node_box(n, b);
+  }
+}
+
 }  // namespace
 
 BlasBuild build_blas(const std::vector<KVertex>& vertices, const std::vector<KTriangle>& triangles,
@@ -76,18 +93,7 @@ BlasBuild build_blas(const std::vector<KVertex>& vertices, const std::vector<KTr
 }
 
 float refit_blas(const std::vector<KVertex>& vertices, BlasBuild& blas) {
-  // Children are always stored after their parent, so a reverse sweep sees children first.
-  for (size_t i = blas.nodes.size(); i-- > 0;) {
-    KBvhNode& n = blas.nodes[i];
-    Box b;
-    if (n.count > 0) {
-      for (uint32_t t = n.left_first; t < n.left_first + n.count; ++t) b.grow(triangle_box(vertices, blas.triangles[t]));
-    } else {
-      b = detail::node_box(blas.nodes[n.left_first]);
-      b.grow(detail::node_box(blas.nodes[n.left_first + 1]));
-    }
-    detail::set_node_box(n, b);
-  }
+  refit_bottom_up(blas.nodes, [&](uint32_t t) { return triangle_box(vertices, blas.triangles[t]); });
   blas.sah_cost = sah_cost(blas.nodes);
   return blas.sah_cost;
 }
@@ -124,19 +130,10 @@ std::vector<KBvhNode> build_tlas(std::vector<KInstance>& instances, const std::v
 
 float refit_tlas(const std::vector<KInstance>& instances, const std::vector<KBvhNode>& blas_roots,
                  std::vector<KBvhNode>& nodes) {
-  // Children are always stored after their parent, so a reverse sweep sees children first.
-  for (size_t i = nodes.size(); i-- > 0;) {
-    KBvhNode& n = nodes[i];
-    Box b;
-    if (n.count > 0) {
-      for (uint32_t j = n.left_first; j < n.left_first + n.count; ++j)
-        if (instances[j].blas < blas_roots.size()) b.grow(instance_world_box(instances[j], blas_roots[instances[j].blas]));
-    } else {
-      b = detail::node_box(nodes[n.left_first]);
-      b.grow(detail::node_box(nodes[n.left_first + 1]));
-    }
-    detail::set_node_box(n, b);
-  }
+  refit_bottom_up(nodes, [&](uint32_t j) {
+    const KInstance& inst = instances[j];
+    return inst.blas < blas_roots.size() ? instance_world_box(inst, blas_roots[inst.blas]) : Box();
+  });
   return sah_cost(nodes);
 }
 
