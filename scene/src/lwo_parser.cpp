@@ -190,26 +190,19 @@ class LwoReader {
     if (in_.pos() > in_.end()) in_.seek(in_.end());
   }
 
-  uint32_t point_index(const char* what) {
+  // A VX index below `count`; an error at the index's offset names what it indexes.
+  uint32_t checked_index(const char* what, const char* kind, size_t count) {
     size_t at = in_.pos();
     uint32_t p = in_.vx(what);
-    if (p >= layer_.points.size()) {
+    if (p >= count) {
       in_.seek(at);
-      in_.fail(std::string(what) + ": point " + std::to_string(p) + " out of range (" +
-               std::to_string(layer_.points.size()) + " points)");
+      in_.fail(std::string(what) + ": " + kind + " " + std::to_string(p) + " out of range (" + std::to_string(count) +
+               " " + kind + "s)");
     }
     return p;
   }
-  uint32_t polygon_index(const char* what) {
-    size_t at = in_.pos();
-    uint32_t p = in_.vx(what);
-    if (p >= layer_.polygons.size()) {
-      in_.seek(at);
-      in_.fail(std::string(what) + ": polygon " + std::to_string(p) + " out of range (" +
-               std::to_string(layer_.polygons.size()) + " polygons)");
-    }
-    return p;
-  }
+  uint32_t point_index(const char* what) { return checked_index(what, "point", layer_.points.size()); }
+  uint32_t polygon_index(const char* what) { return checked_index(what, "polygon", layer_.polygons.size()); }
 
   void read_pols2() {
     in_.u4("POLS type");   // FACE, PTCH, ...: the converter does not check it
