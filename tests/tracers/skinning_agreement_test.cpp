@@ -1,5 +1,5 @@
 // The walking character on every tracer: the test map's walker is posed through commits carrying only its
-// joints; the Embree tracer skins it on the host, the OpenCL tracer on its device, and their images of it
+// joints; the Embree tracer skins it on the host, OpenCL and CUDA on their devices, and their images of it
 // agree (the same bound as agreement_test.cpp), while the pose visibly changes the image.
 #include <gtest/gtest.h>
 
@@ -46,8 +46,11 @@ core::FrameBuffer render_frame(core::Tracer& tracer, const KCamera& camera, cons
 
 }  // namespace
 
-TEST(SkinningAgreement, WalkerPosedOnEmbreeAndOpenCLMatches) {
-  if (built_tracers().size() < 2 || !tracer_runs_here("opencl")) GTEST_SKIP() << "needs the Embree and OpenCL tracers";
+class SkinningAgreement : public ::testing::TestWithParam<std::string> {};
+
+TEST_P(SkinningAgreement, WalkerPosedMatchesEmbree) {
+  const std::string device = GetParam();
+  if (!tracer_runs_here("embree") || !tracer_runs_here(device)) GTEST_SKIP() << "needs the Embree and " << device << " tracers here";
   scene::Vfs vfs;
   scene::Scene map = scene::load_map(vfs, std::string(COHORT_SOURCE_DIR) + "/assets/testmap/maps/testmap.map");
   scene::RenderWorld world(map);
@@ -74,7 +77,7 @@ TEST(SkinningAgreement, WalkerPosedOnEmbreeAndOpenCLMatches) {
   params.rr_start = 2.0f;
 
   auto embree = make_test_tracer("embree");
-  auto opencl = make_test_tracer("opencl");
+  auto opencl = make_test_tracer(device);
   embree->apply(commit::CommitBuffer::full(sync.snapshot(), 0));
   opencl->apply(commit::CommitBuffer::full(sync.snapshot(), 0));
   const core::FrameBuffer bind = render_frame(*embree, camera, params);
@@ -94,14 +97,17 @@ TEST(SkinningAgreement, WalkerPosedOnEmbreeAndOpenCLMatches) {
     double mean = 0.0, moved_mean = 0.0;
     const double error = rmse(a, b, &mean);
     const double moved = rmse(a, bind, &moved_mean);
-    std::cout << "walker at " << time_ms << " ms: RMSE embree/opencl " << error << ", against the bind pose " << moved
+    std::cout << "walker at " << time_ms << " ms: RMSE embree/" << device << " " << error << ", against the bind pose " << moved
               << ", mean " << mean << "\n";
     EXPECT_GT(mean, 0.01);
     EXPECT_LT(error, 0.005 * mean) << "at " << time_ms << " ms";
     EXPECT_GT(moved, 10.0 * error) << "the pose should change the image far more than the tracers differ";
     if (const char* dir = std::getenv("COHORT_TEST_IMAGES")) {
       write_preview(std::string(dir) + "/walker_" + std::to_string(time_ms) + "_embree.png", a);
-      write_preview(std::string(dir) + "/walker_" + std::to_string(time_ms) + "_opencl.png", b);
+      write_preview(std::string(dir) + "/walker_" + std::to_string(time_ms) + "_" + device + ".png", b);
     }
   }
 }
+
+INSTANTIATE_TEST_SUITE_P(Devices, SkinningAgreement, ::testing::Values("opencl", "cuda"),
+                         [](const auto& info) { return info.param; });
