@@ -240,6 +240,13 @@ ChangeSet apply_commit(const CommitBuffer& commit, TracerScene& scene, Skinning 
     write_range(scene.skins, up.skin_index, std::vector<KSkin>{up.skin});
     changes.skin_data = true;
   }
+  for (const SkinUpload& up : commit.skin_uploads()) {
+    try {
+      check_skin(scene, up.skin_index);
+    } catch (const std::out_of_range& e) {
+      throw std::invalid_argument(std::string("commit: ") + e.what());
+    }
+  }
   for (const auto& [index, joints] : commit.skin_joints()) {
     if (index >= scene.skins.size() || joints.size() != scene.skins[index].joint_count)
       throw std::invalid_argument("commit poses skin " + std::to_string(index) + " with " +
@@ -250,7 +257,13 @@ ChangeSet apply_commit(const CommitBuffer& commit, TracerScene& scene, Skinning 
     changes.posed_skins.push_back(index);
   }
   if (skinning == Skinning::on_host)
-    for (uint32_t skin : changes.posed_skins) skin_on_host(scene, skin);
+    for (uint32_t skin : changes.posed_skins) {
+      try {
+        skin_on_host(scene, skin);
+      } catch (const std::out_of_range& e) {
+        throw std::invalid_argument(std::string("commit: ") + e.what());
+      }
+    }
   if (commit.camera()) {
     scene.camera = *commit.camera();
     changes.camera = true;

@@ -1,5 +1,6 @@
 #include "cohort/commit/host_skinning.h"
 
+#include <algorithm>
 #include <stdexcept>
 #include <string>
 
@@ -17,18 +18,41 @@ void check_range(size_t first, size_t count, size_t size, uint32_t skin, const c
 
 }  // namespace
 
-void skin_on_host(TracerScene& scene, uint32_t index) {
+void check_skin(const TracerScene& scene, uint32_t index) {
   if (index >= scene.skins.size()) throw std::out_of_range("skin " + std::to_string(index) + " is not in the scene");
   const KSkin skin = scene.skins[index];
   check_range(skin.vertex_offset, skin.vertex_count, scene.vertices.size(), index, "vertices");
   check_range(skin.skin_vertex_offset, skin.vertex_count, scene.skin_vertices.size(), index, "skin vertices");
-  check_range(skin.joint_offset, skin.joint_count, scene.joints.size(), index, "joints");
   check_range(skin.blas, 1, scene.blases.size(), index, "BLAS");
+  const KBlas blas = scene.blases[skin.blas];
+  check_range(blas.node_offset, blas.node_count, scene.blas_nodes.size(), index, "BLAS nodes");
+  check_range(blas.tri_offset, blas.tri_count, scene.triangles.size(), index, "BLAS triangles");
+  for (uint32_t t = blas.tri_offset; t < blas.tri_offset + blas.tri_count; ++t) {
+    const KTriangle& tri = scene.triangles[t];
+    if (std::max({tri.v0, tri.v1, tri.v2}) >= scene.vertices.size())
+      throw std::out_of_range("skin " + std::to_string(index) + ": its BLAS indexes past the vertices");
+  }
   for (uint32_t i = 0; i < skin.vertex_count; ++i) {
     const KSkinVertex& v = scene.skin_vertices[skin.skin_vertex_offset + i];
     check_range(v.first_weight, v.weight_count, scene.skin_weights.size(), index, "weights");
     check_range(v.first_adjacent, v.adjacent_count, scene.skin_adjacency.size(), index, "adjacency");
+    for (uint32_t a = v.first_adjacent; a < v.first_adjacent + v.adjacent_count; ++a) {
+      const KSkinTriangle& t = scene.skin_adjacency[a];
+      if (std::max({t.v0, t.v1, t.v2}) >= skin.vertex_count)
+        throw std::out_of_range("skin " + std::to_string(index) + ": an adjacent triangle names a vertex past its " +
+                                std::to_string(skin.vertex_count));
+    }
   }
+}
+
+void skin_on_host(TracerScene& scene, uint32_t index) {
+  if (index >= scene.skins.size()) throw std::out_of_range("skin " + std::to_string(index) + " is not in the scene");
+  const KSkin skin = scene.skins[index];
+  // The per-vertex ranges were checked when the skin arrived (check_skin); these may change per commit.
+  check_range(skin.vertex_offset, skin.vertex_count, scene.vertices.size(), index, "vertices");
+  check_range(skin.skin_vertex_offset, skin.vertex_count, scene.skin_vertices.size(), index, "skin vertices");
+  check_range(skin.joint_offset, skin.joint_count, scene.joints.size(), index, "joints");
+  check_range(skin.blas, 1, scene.blases.size(), index, "BLAS");
   const KBlas blas = scene.blases[skin.blas];
   check_range(blas.node_offset, blas.node_count, scene.blas_nodes.size(), index, "BLAS nodes");
   check_range(blas.tri_offset, blas.tri_count, scene.triangles.size(), index, "BLAS triangles");

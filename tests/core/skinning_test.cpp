@@ -228,3 +228,30 @@ TEST(Skinning, WrongJointCountIsNotDrawn) {
   for (const KInstance& inst : sync.master().instances) drawn |= inst.entity == 0u;
   EXPECT_TRUE(drawn);
 }
+
+// A skin whose data points outside the pools is refused when the commit is applied (the tracer then asks
+// for a full resync), before any skinning routine follows it.
+TEST(Skinning, BrokenSkinUploadIsRefused) {
+  const scene::Md5Mesh md5 = walker_mesh();
+  scene::RenderWorld world(character_scene(md5));
+  core::WorldSync sync(world);
+  commit::TracerScene copy = *sync.snapshot();
+  world.TakeChanges();
+  world.UpdateEntityDef(0, posed(world, scene::bind_pose(md5)));
+  const commit::CommitBuffer records = sync.sync(world.TakeChanges(), 1);
+  ASSERT_EQ(records.skin_uploads().size(), 1u);
+  for (int breakage = 0; breakage < 3; ++breakage) {
+    commit::CommitBuffer broken;
+    for (const commit::BlasUpload& b : records.blas_uploads()) broken.add_blas(b);
+    commit::SkinUpload up = records.skin_uploads()[0];
+    if (breakage == 0) up.adjacency[3].v1 = up.skin.vertex_count;       // a vertex past the skin's
+    if (breakage == 1) up.vertices[5].first_weight = uint32_t(up.weights.size());  // weights past the pool
+    if (breakage == 2) up.skin.blas = 99;                                // no such BLAS
+    broken.add_skin(up);
+    broken.set_skin_joints(up.skin_index, records.skin_joints().begin()->second);
+    commit::TracerScene target = copy;
+    EXPECT_THROW(commit::apply_commit(broken, target), std::invalid_argument) << "breakage " << breakage;
+  }
+  commit::TracerScene target = copy;
+  EXPECT_NO_THROW(commit::apply_commit(records, target));
+}

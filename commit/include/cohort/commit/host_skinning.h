@@ -10,8 +10,12 @@
 
 namespace cohort::commit {
 
+// Every index a skin's routines will follow stays inside the scene's pools (its vertices, weights,
+// adjacency, BLAS); throws std::out_of_range naming what does not. Run once when a skin arrives.
+void check_skin(const TracerScene& scene, uint32_t skin);
+
 // Writes skin `skin`'s vertices from its joints and refits its BLAS's nodes. Throws std::out_of_range
-// when the skin's ranges run past the scene's pools.
+// when the skin's own ranges run past the scene's pools (per-vertex ranges are check_skin's).
 void skin_on_host(TracerScene& scene, uint32_t skin);
 
 }  // namespace cohort::commit
