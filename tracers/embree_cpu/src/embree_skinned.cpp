@@ -9,7 +9,10 @@ bool is_skinned(const commit::TracerScene& scene, uint32_t blas) {
 }
 
 void prepare(RTCScene blas_scene, RTCGeometry geometry) {
+  // Embree honours a geometry's build quality only in a scene of low build quality (its two-level
+  // structure); the geometry's own BVH is then built once and refit when its vertex buffer changes.
   rtcSetSceneFlags(blas_scene, RTC_SCENE_FLAG_DYNAMIC);
+  rtcSetSceneBuildQuality(blas_scene, RTC_BUILD_QUALITY_LOW);
   rtcSetGeometryBuildQuality(geometry, RTC_BUILD_QUALITY_REFIT);
 }
 
