@@ -7,6 +7,11 @@
 #   tools/gpu_run.sh remote    there (device tool: run command "bash tools/gpu_run.sh remote", carry [".gpu"]):
 #                              registers NVIDIA's OpenCL, runs the GPU tests and benchmarks, writes
 #                              results (logs, JSON, PPM frames) to $OUT
+#   tools/gpu_run.sh frametimes  there: only the end-to-end frame times (large map 1080p generated there,
+#                              test map 720p; cuda:0, 1 spp, NEE + 1 bounce; with and without emissive NEE)
+#
+# The binaries and libraries travel compressed (.gpu/payload.tar.xz, ~11 MB instead of ~60 MB): the device
+# tool carries at most 64 MiB with the working tree.
 #
 # The GPU machine (Ubuntu 24.04, newer glibc) lacks Embree, TBB, OpenImageIO, GLFW and GLM; binaries built
 # here run there with the three shared libraries below carried beside them. See README, "GPU machine".
@@ -33,9 +38,27 @@ case "${1:-}" in
       python3 tools/gen_testmap.py --large --out build/gpu/assets/largemap
       build/gpu/bin/cohort pack build/gpu/assets/largemap/maps/largemap.map --out "$stage/largemap.cpk"
     fi
+    tar -C "$stage" -cJf "$stage/payload.tar.xz" bin lib && rm -rf "$stage/bin" "$stage/lib"
     du -sh "$stage"
     ;;
+  frametimes)
+    [ -d "$stage/bin" ] || tar -C "$stage" -xJf "$stage/payload.tar.xz"
+    export LD_LIBRARY_PATH="$PWD/$stage/lib${LD_LIBRARY_PATH:+:$LD_LIBRARY_PATH}"
+    nvidia-smi --query-gpu=index,name --format=csv,noheader
+    [ -f /tmp/largemap.cpk ] || { python3 tools/gen_testmap.py --large --out /tmp/largemap >/dev/null &&
+      "$stage/bin/cohort" pack /tmp/largemap/maps/largemap.map --out /tmp/largemap.cpk | tail -n 1; }
+    for emissive in 1 0; do
+      for map in large test; do
+        if [ $map = large ]; then args=(/tmp/largemap.cpk --width 1920 --height 1080 --camera 1690 300 80 5 -12)
+        else args=("$stage/testmap.cpk" --width 1280 --height 720); fi
+        "$stage/bin/cohort" render "${args[@]}" --tracers "${COHORT_GPU_TRACERS:-cuda:0}" --spp 1 --bounces 1 \
+          --emissive-samples $emissive --frames 60 --camera-path spin-slow --write last --out /tmp/ft_$map$emissive >/dev/null
+        echo "$map map, emissive samples $emissive: $(python3 tools/frame_times.py /tmp/ft_$map$emissive/stats.json --skip 10 | head -n 1)"
+      done
+    done
+    ;;
   remote)
+    [ -d "$stage/bin" ] || tar -C "$stage" -xJf "$stage/payload.tar.xz"
     export LD_LIBRARY_PATH="$PWD/$stage/lib${LD_LIBRARY_PATH:+:$LD_LIBRARY_PATH}"
     mkdir -p /tmp/icd && echo libnvidia-opencl.so.1 > /tmp/icd/nvidia.icd
     cp /etc/OpenCL/vendors/pocl.icd /tmp/icd/ 2>/dev/null || true
@@ -98,5 +121,5 @@ case "${1:-}" in
     exit $status
     ;;
   *)
-    sed -n '2,12p' "$0"; exit 2 ;;
+    sed -n '2,17p' "$0"; exit 2 ;;
 esac

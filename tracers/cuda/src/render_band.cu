@@ -13,7 +13,10 @@ __constant__ cudaTextureObject_t cohort_texel_texture;
 
 namespace cohort::tracers {
 
-__global__ void __launch_bounds__(128) render_band_kernel(KSceneView scene, KFrameParams params, KCamera camera,
+// At least 4 blocks of 128 threads per SM: caps the kernel at 128 registers (25% occupancy) instead of
+// 164. Measured on one H100 (docs/integrator.md, "CUDA kernel shape"): 3 blocks 15.8 ms, 4 blocks 13.7 ms,
+// 5-6 blocks 13.2-13.4 ms on the large map at 1080p but slower on the test map, where spills cost more.
+__global__ void __launch_bounds__(128, 4) render_band_kernel(KSceneView scene, KFrameParams params, KCamera camera,
                                                           float4* band, unsigned long long* ray_counts,
                                                           unsigned* row_rays) {
   const kuint x = blockIdx.x * blockDim.x + threadIdx.x;

@@ -197,7 +197,7 @@ KFN int k_bvh_traverse_blas(KSceneRef scene, K_BVH_CONTEXT ctx, int query, kuint
 }
 
 /* Walks the TLAS; per instance leaf whose mask matches, the instance's BLAS in object space. */
-KFN int k_bvh_traverse(KSceneRef scene, K_BVH_CONTEXT ctx, int query, KVec3 o, KVec3 d, float tmin, float tmax,
+KFN_OUTLINED int k_bvh_traverse(KSceneRef scene, K_BVH_CONTEXT ctx, int query, KVec3 o, KVec3 d, float tmin, float tmax,
                        kuint mask, KHit* hit, KVec3* transmittance) {
   hit->t = tmax;
   hit->u = 0.0f;
