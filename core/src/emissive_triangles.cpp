@@ -1,4 +1,4 @@
-// The emissive-triangle list and the one call that refreshes both derived light-sampling arrays.
+// The emissive-triangle list and the one call that refreshes the derived light-sampling arrays.
 #include <cmath>
 
 #include "cohort/core/light_sampling.h"
@@ -19,8 +19,8 @@ void store(float* dst, KVec3 v) {
 
 }  // namespace
 
-std::vector<KEmissiveTriangle> build_emissive_triangles(const commit::TracerScene& scene) {
-  std::vector<KEmissiveTriangle> out;
+EmissiveList list_emissive_triangles(const commit::TracerScene& scene) {
+  EmissiveList out;
   // Which materials emit, once, so the scan of every instance's triangles is a table lookup each.
   std::vector<float> density(scene.materials.size());
   bool any = false;
@@ -29,7 +29,6 @@ std::vector<KEmissiveTriangle> build_emissive_triangles(const commit::TracerScen
     any |= density[m] > 0.0f;
   }
   if (!any) return out;
-  double total = 0.0;
   for (uint32_t i = 0; i < scene.instances.size(); ++i) {
     const KInstance& inst = scene.instances[i];
     if (!(inst.mask & K_MASK_PRIMARY) || inst.blas >= scene.blases.size()) continue;
@@ -54,17 +53,18 @@ std::vector<KEmissiveTriangle> build_emissive_triangles(const commit::TracerScen
       store(e.p2, p2);
       e.instance = i;
       e.triangle = t;
-      total += power;
-      e.power_cdf = float(total);
-      out.push_back(e);
+      e.leaf = K_NONE;
+      out.triangles.push_back(e);
+      out.power.push_back(power);
     }
   }
   return out;
 }
 
 void rebuild_light_sampling(commit::TracerScene& scene) {
-  scene.light_nodes = build_light_tree(scene.lights);
-  scene.emissive_triangles = build_emissive_triangles(scene);
+  EmissiveList emissive = list_emissive_triangles(scene);
+  scene.light_nodes = build_light_nodes(scene.lights, emissive);
+  scene.emissive_triangles = std::move(emissive.triangles);
 }
 
 }  // namespace cohort::core

@@ -82,20 +82,23 @@ struct Item {
   float power = 0.0f;
 };
 
+// Median splits along the longest axis of the items' box centres, one item per leaf, children adjacent.
+// Node indices are absolute: the tree's nodes will sit at `first_node` onwards of the node array.
 class TreeBuilder {
  public:
-  explicit TreeBuilder(std::vector<Item> items) : items_(std::move(items)) {}
+  TreeBuilder(std::vector<Item> items, uint32_t first_node) : items_(std::move(items)), first_node_(first_node) {}
   std::vector<KLightNode> build() {
     if (items_.empty()) return {};
     nodes_.reserve(2 * items_.size() - 1);
     nodes_.emplace_back();
-    build(0, 0, items_.size());
+    build(0, K_NONE, 0, items_.size());
     return std::move(nodes_);
   }
 
  private:
-  void build(size_t node, size_t begin, size_t end) {
+  void build(size_t node, uint32_t parent, size_t begin, size_t end) {
     KLightNode n{};
+    n.parent = parent;
     glm::vec3 lo(INFINITY), hi(-INFINITY), centre_lo(INFINITY), centre_hi(-INFINITY);
     float power = 0.0f;
     for (size_t i = begin; i < end; ++i) {
@@ -128,13 +131,14 @@ class TreeBuilder {
     nodes_.emplace_back();
     nodes_.emplace_back();
     n.count = 0;
-    n.left_first = uint32_t(left);
+    n.left_first = first_node_ + uint32_t(left);
     nodes_[node] = n;
-    build(left, begin, mid);
-    build(left + 1, mid, end);
+    build(left, first_node_ + uint32_t(node), begin, mid);
+    build(left + 1, first_node_ + uint32_t(node), mid, end);
   }
 
   std::vector<Item> items_;
+  uint32_t first_node_;
   std::vector<KLightNode> nodes_;
 };
 
@@ -175,7 +179,32 @@ std::vector<KLightNode> build_light_tree(const std::vector<KLight>& lights) {
     item.power = std::max(luminance(lights[i].color), 0.0f);
     items.push_back(item);
   }
-  return TreeBuilder(std::move(items)).build();
+  return TreeBuilder(std::move(items), 0).build();
+}
+
+std::vector<KLightNode> build_light_nodes(const std::vector<KLight>& lights, EmissiveList& emissive) {
+  std::vector<KLightNode> nodes = build_light_tree(lights);
+  std::vector<Item> items;
+  items.reserve(emissive.triangles.size());
+  for (size_t i = 0; i < emissive.triangles.size(); ++i) {
+    const KEmissiveTriangle& e = emissive.triangles[i];
+    Item item;
+    item.light = uint32_t(i);
+    item.box.min = item.box.max = glm::vec3(e.p0[0], e.p0[1], e.p0[2]);
+    for (const float* p : {e.p1, e.p2}) {
+      item.box.min = glm::min(item.box.min, glm::vec3(p[0], p[1], p[2]));
+      item.box.max = glm::max(item.box.max, glm::vec3(p[0], p[1], p[2]));
+    }
+    item.centre = 0.5f * (item.box.min + item.box.max);
+    item.power = emissive.power[i];
+    items.push_back(item);
+  }
+  const uint32_t first = uint32_t(nodes.size());
+  std::vector<KLightNode> tree = TreeBuilder(std::move(items), first).build();
+  for (uint32_t n = 0; n < tree.size(); ++n)
+    if (tree[n].count > 0) emissive.triangles[tree[n].left_first].leaf = first + n;
+  nodes.insert(nodes.end(), tree.begin(), tree.end());
+  return nodes;
 }
 
 }  // namespace cohort::core

@@ -7,6 +7,7 @@
 #include <stdexcept>
 #include <string>
 #include <unordered_map>
+#include <unordered_set>
 
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
@@ -407,8 +408,17 @@ commit::CommitBuffer WorldSync::sync(const scene::ChangeLog& changes, uint64_t f
     mesh_of_entity_[handle] = def->model;
     instances_changed = true;
   }
+  bool emitters_moved = false;  // a refit moved instances whose triangles emit: their world positions change
   if (instances_changed && only_moved && !master_.tlas_nodes.empty() && refit_moved_instances(moved, out)) {
     instances_changed = false;
+    const std::unordered_set<int> moved_handles(moved.begin(), moved.end());
+    for (const KEmissiveTriangle& e : master_.emissive_triangles) {
+      const kuint entity = master_.instances[e.instance].entity;
+      if (entity != K_NONE && moved_handles.count(int(entity))) {
+        emitters_moved = true;
+        break;
+      }
+    }
   }
   if (instances_changed) {
     std::vector<KInstance> instances = static_instances_;
@@ -425,6 +435,7 @@ commit::CommitBuffer WorldSync::sync(const scene::ChangeLog& changes, uint64_t f
   }
 
   // Lights, in handle order of the live defs.
+  bool light_sources_changed = false;
   if (slots_moved || !changes.lights.empty() || !changes.freed_lights.empty()) {
     for (int handle : changes.freed_lights) lights_by_handle_.erase(handle);
     auto convert = [&](int handle) {
@@ -447,16 +458,18 @@ commit::CommitBuffer WorldSync::sync(const scene::ChangeLog& changes, uint64_t f
     for (const auto& [handle, light] : lights_by_handle_) lights.push_back(light);
     commit::diff_lights(master_.lights, lights, out);
     master_.lights = std::move(lights);
-    std::vector<KLightNode> tree = build_light_tree(master_.lights);
-    commit::diff_light_tree(master_.light_nodes, tree, out);
-    master_.light_nodes = std::move(tree);
+    light_sources_changed = true;
   }
 
-  // Emissive triangles move with their instances and appear or go with materials.
-  if (instances_changed || slots_moved || !changes.materials.empty() || stats_.skins_posed > 0) {
-    std::vector<KEmissiveTriangle> emissive = build_emissive_triangles(master_);
-    commit::diff_emissive_triangles(master_.emissive_triangles, emissive, out);
-    master_.emissive_triangles = std::move(emissive);
+  // Emissive triangles move with their instances and appear or go with materials; the light node array
+  // holds the trees over both kinds of source, so either change rebuilds it.
+  if (light_sources_changed || instances_changed || emitters_moved || slots_moved || !changes.materials.empty()) {
+    EmissiveList emissive = list_emissive_triangles(master_);
+    std::vector<KLightNode> nodes = build_light_nodes(master_.lights, emissive);
+    commit::diff_light_tree(master_.light_nodes, nodes, out);
+    commit::diff_emissive_triangles(master_.emissive_triangles, emissive.triangles, out);
+    master_.light_nodes = std::move(nodes);
+    master_.emissive_triangles = std::move(emissive.triangles);
   }
 
   if (changes.view && world_.view()) {

@@ -164,6 +164,40 @@ TEST(WorldSync, MovingEntitiesRefitTheTlasAndNewOnesRebuildIt) {
   EXPECT_FALSE(sync.last_stats().tlas_refit);
 }
 
+// An emitting entity that only moves takes the TLAS refit path; its emissive triangles (world space)
+// and the emissive tree must still follow it.
+TEST(WorldSync, MovingAnEmittingEntityMovesItsEmissiveTriangles) {
+  scene::Scene map = test::small_test_map();
+  scene::Material panel;
+  panel.name = "panel";
+  panel.emitter = true;
+  panel.emissive_color = glm::vec4(2.0f, 1.5f, 0.8f, 1.0f);
+  map.materials.push_back(panel);
+  RenderWorld world(map);
+  scene::RenderEntity fan = *world.EntityDef(2);
+  fan.custom_shader = int(map.materials.size()) - 1;
+  world.UpdateEntityDef(2, fan);
+  WorldSync sync(world);
+  const auto emitters_of_fan = [&] {
+    std::vector<KEmissiveTriangle> out;
+    for (const KEmissiveTriangle& e : sync.master().emissive_triangles)
+      if (sync.master().instances[e.instance].entity == 2u) out.push_back(e);
+    return out;
+  };
+  const std::vector<KEmissiveTriangle> before = emitters_of_fan();
+  ASSERT_FALSE(before.empty());
+  fan.origin.z += 5.0f;
+  world.UpdateEntityDef(2, fan);
+  sync.sync(world.TakeChanges(), 1);
+  ASSERT_TRUE(sync.last_stats().tlas_refit);
+  const std::vector<KEmissiveTriangle> after = emitters_of_fan();
+  ASSERT_EQ(after.size(), before.size());
+  for (size_t i = 0; i < after.size(); ++i) EXPECT_NEAR(after[i].p0[2], before[i].p0[2] + 5.0f, 1e-3f);
+  commit::TracerScene fresh = sync.master();
+  rebuild_light_sampling(fresh);
+  EXPECT_EQ(first_difference(fresh, sync.master()), "");
+}
+
 TEST(WorldSync, ReplayedStreamGivesTheSameTracerSceneEveryFrame) {
   const int frames = 60;
   auto file = std::filesystem::temp_directory_path() / ("cohort_world_sync_" + std::to_string(::getpid()) + ".cds");

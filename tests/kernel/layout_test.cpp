@@ -24,7 +24,7 @@ TEST(KernelLayout, FieldOffsetsArePacked) {
   EXPECT_EQ(sizeof(KLightNode), 48u);
   EXPECT_EQ(offsetof(KEmissiveTriangle, instance), 12u);
   EXPECT_EQ(offsetof(KEmissiveTriangle, triangle), 28u);
-  EXPECT_EQ(offsetof(KEmissiveTriangle, power_cdf), 44u);
+  EXPECT_EQ(offsetof(KEmissiveTriangle, leaf), 44u);
   EXPECT_EQ(sizeof(KEmissiveTriangle), 48u);
 }
 

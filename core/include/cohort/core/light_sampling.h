@@ -1,6 +1,7 @@
-// What next-event estimation samples, derived from a TracerScene: the light tree over the Doom 3 lights'
-// finite volumes (KLightNode, kernel/light_tree.h) and the list of emissive triangles in world space
-// (KEmissiveTriangle). WorldSync rebuilds both when lights, instances or materials change and sends
+// What next-event estimation samples, derived from a TracerScene: the light node array (KLightNode) with
+// the tree over the Doom 3 lights' finite volumes (kernel/light_tree.h) and the tree over the emissive
+// triangles (kernel/emissive_tree.h), and the list of emissive triangles in world space
+// (KEmissiveTriangle). WorldSync rebuilds them when lights, instances or materials change and sends
 // them as whole-array commit records; a scene pack's are rebuilt on reading.
 #pragma once
 
@@ -29,11 +30,20 @@ std::optional<LightBounds> light_bounds(const KLight& light);
 std::vector<KLightNode> build_light_tree(const std::vector<KLight>& lights);
 
 // Every triangle of every primary-visible instance whose material (the instance's override, else the
-// triangle's) has k_emitter_power_density > 0 and whose area is nonzero, in TLAS instance order, with the
-// running sum of area x power density.
-std::vector<KEmissiveTriangle> build_emissive_triangles(const commit::TracerScene& scene);
+// triangle's) has k_emitter_power_density > 0 and whose area is nonzero, sorted by (instance, triangle),
+// with its power (area x power density). The triangles' `leaf` is set by build_light_nodes.
+struct EmissiveList {
+  std::vector<KEmissiveTriangle> triangles;
+  std::vector<float> power;
+};
+EmissiveList list_emissive_triangles(const commit::TracerScene& scene);
 
-// Both derived arrays of `scene` rebuilt from its other arrays.
+// The light node array: build_light_tree(lights), then the emissive tree over `emissive` in its last
+// 2E - 1 nodes (same median splits, one triangle per leaf; E = its triangle count). Sets the
+// triangles' `leaf`.
+std::vector<KLightNode> build_light_nodes(const std::vector<KLight>& lights, EmissiveList& emissive);
+
+// The derived arrays of `scene` (light nodes, emissive triangles) rebuilt from its other arrays.
 void rebuild_light_sampling(commit::TracerScene& scene);
 
 }  // namespace cohort::core

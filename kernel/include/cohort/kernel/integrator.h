@@ -13,6 +13,7 @@
  * Entry point: k_render_pixel(ctx, params, camera, x, y) -> linear RGB averaged over params->spp. */
 #ifndef COHORT_KERNEL_INTEGRATOR_H
 #define COHORT_KERNEL_INTEGRATOR_H
+#include "emissive_tree.h"
 #include "emitters.h"
 #include "light_tree.h"
 #include "rng.h"
@@ -112,37 +113,31 @@ KFN float k_power_heuristic(float own, float other) {
   return a + b > 0.0f ? a / (a + b) : 0.0f;
 }
 
-/* The density per solid angle, seen from a point dist2 away and at cosine cos_light on the emitter, with
- * which emissive-triangle sampling (k_emissive_lighting) proposes this point of this triangle: pick
- * probability area x power density / total power, times 1 / area, converted to solid angle. It is the
- * same formula on both sides of the MIS, so the two weights of a path sum to one. */
-KFN float k_emissive_pdf(const KSceneView* scene, kuint instance, kuint triangle, float dist2, float cos_light) {
+/* The density per solid angle with which emissive-triangle sampling (k_emissive_lighting) from the point
+ * p proposes a point of this triangle seen dist2 away at cosine cos_light on the emitter: the tree's pick
+ * probability at p times 1 / area, converted to solid angle. It is the same formula on both sides of the
+ * MIS, so the two weights of a path sum to one. */
+KFN float k_emissive_pdf(const KSceneView* scene, KVec3 p, kuint instance, kuint triangle, float dist2, float cos_light) {
   if (scene->emissive_count == 0u || !(cos_light > 0.0f)) return 0.0f;
-  float density = k_emitter_power_density(&scene->materials[k_hit_material(scene, instance, triangle)]);
-  float total = scene->emissive[scene->emissive_count - 1u].power_cdf;
-  if (!(density > 0.0f) || !(total > 0.0f)) return 0.0f;
-  return density / total * dist2 / cos_light;
+  kuint index = k_emissive_find(scene, instance, triangle);
+  if (index == K_NONE) return 0.0f;
+  KGLOBAL const KEmissiveTriangle* e = &scene->emissive[index];
+  float double_area = k_triangle_double_area(v3_load_g(e->p0), v3_load_g(e->p1), v3_load_g(e->p2));
+  if (!(double_area > 0.0f)) return 0.0f;
+  return k_emissive_tree_pdf(scene, p, index) * 2.0f / double_area * dist2 / cos_light;
 }
 
-/* One emissive-triangle sample for next-event estimation: a triangle picked by power (binary search of
- * the running sum), a uniform point on it, its emission there, one shadow ray. With a bounce to follow
- * from this vertex the result is weighted by the power heuristic against BRDF sampling, which weighs the
- * emission it finds the same way (k_trace_path); without one it stands alone (weight 1). */
+/* One emissive-triangle sample for next-event estimation: a triangle picked through the emissive tree
+ * (near and bright ones first), a uniform point on it, its emission there, one shadow ray. With a bounce
+ * to follow from this vertex the result is weighted by the power heuristic against BRDF sampling, which
+ * weighs the emission it finds the same way (k_trace_path); without one it stands alone (weight 1). */
 KFN KVec3 k_emissive_lighting(KTraceCtx* ctx, const KSurface* sf, KVec3 wo, int bounce_follows, KRng* rng) {
   const KSceneView* scene = K_CTX_SCENE(ctx);
   float u_pick = k_rng_next(rng), u1 = k_rng_next(rng), u2 = k_rng_next(rng);
-  kuint count = scene->emissive_count;
-  if (count == 0u) return v3s(0.0f);
-  float total = scene->emissive[count - 1u].power_cdf;
-  float target = u_pick * total;
-  kuint lo = 0u, hi = count - 1u;
-  while (lo < hi) {
-    kuint mid = (lo + hi) / 2u;
-    if (scene->emissive[mid].power_cdf > target) hi = mid; else lo = mid + 1u;
-  }
-  KGLOBAL const KEmissiveTriangle* e = &scene->emissive[lo];
-  float pick = (e->power_cdf - (lo > 0u ? scene->emissive[lo - 1u].power_cdf : 0.0f)) / total;
-  if (!(pick > 0.0f)) return v3s(0.0f);
+  float pick = 0.0f;
+  kuint index = k_emissive_tree_pick(scene, sf->position, u_pick, &pick);
+  if (index == K_NONE || !(pick > 0.0f)) return v3s(0.0f);
+  KGLOBAL const KEmissiveTriangle* e = &scene->emissive[index];
 
   float su = k_sqrt(u1);
   float bu = su * (1.0f - u2), bv = su * u2;   /* barycentrics of p1 and p2 */
@@ -180,7 +175,7 @@ KFN KVec3 k_emissive_lighting(KTraceCtx* ctx, const KSurface* sf, KVec3 wo, int 
   float pdf = pick * 2.0f / double_area * dist2 / cos_light;
   float weight = 1.0f;
   if (bounce_follows)
-    weight = k_power_heuristic(k_emissive_pdf(scene, e->instance, e->triangle, dist2, cos_light), k_brdf_pdf(sf, wo, wi));
+    weight = k_power_heuristic(pdf, k_brdf_pdf(sf, wo, wi));
   return v3_scale(v3_mul(le, f), weight / pdf);
 }
 
@@ -254,7 +249,8 @@ KFN KVec3 k_trace_path(KTraceCtx* ctx, const KFrameParams* params, KVec3 org, KV
     KVec3 contribution = sf.emission;
     if (bounce > 0u && emissive_nee && v3_max_component(sf.emission) > 0.0f) {
       KVec3 d = v3_sub(sf.position, vertex_position);
-      float light_pdf = k_emissive_pdf(scene, hit.instance, hit.triangle, v3_dot(d, d), k_fabs(v3_dot(sf.geo_normal, dir)));
+      float light_pdf = k_emissive_pdf(scene, vertex_position, hit.instance, hit.triangle, v3_dot(d, d),
+                                       k_fabs(v3_dot(sf.geo_normal, dir)));
       contribution = v3_scale(contribution, k_power_heuristic(vertex_brdf_pdf, light_pdf));
     }
     contribution = v3_add(contribution, k_direct_lighting(ctx, &vertex_params, &sf, wo, rng));

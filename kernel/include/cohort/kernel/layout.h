@@ -111,24 +111,27 @@ typedef struct KLight {
   float extent;     float pad[3];       /* soft-shadow jitter radius in world units */
 } KLight;
 
-/* ---- Light tree: which lights can reach a point, at a cost that does not grow with the light count.
- * A binary tree over the lights' world-space bounding boxes (the finite volume outside which a Doom 3
- * light is zero), built by the core (core/light_tree.h); node 0 is the root. count == 0: interior node,
- * children at left_first and left_first + 1. count == 1: a leaf holding light left_first (one light
- * per leaf). power: the summed luminance of the colours of the lights below; light_count: how many. */
+/* ---- Light trees: which light sources to sample at a point, at a cost that does not grow with their
+ * number. The node array holds two binary trees, built by the core (core/light_sampling.h):
+ *   - from node 0, the tree over the Doom 3 lights' world-space boxes (the finite volume outside which a
+ *     light is zero); a leaf (count == 1) holds light left_first;
+ *   - in the last 2E - 1 nodes (E = the emissive triangle count), root first, the tree over the emissive
+ *     triangles' boxes; a leaf holds emissive triangle left_first (an index into KEmissiveTriangle).
+ * count == 0: interior node, children at left_first and left_first + 1 (absolute indices). power: the
+ * summed power of the sources below (light colour luminance; emissive area x power density);
+ * light_count: how many; parent: the parent node, K_NONE at a root. */
 typedef struct KLightNode {
   float bmin[3]; kuint left_first;
   float bmax[3]; kuint count;
-  float power;   kuint light_count; kuint pad0; kuint pad1;
+  float power;   kuint light_count; kuint parent; kuint pad1;
 } KLightNode;
 
-/* ---- Emissive triangles: every triangle whose material emits, in world space, with the running sum of
- * the triangles' powers (area x luminance of the material's emissive colour) for picking by power. The
- * last entry's power_cdf is the total. */
+/* ---- Emissive triangles: every triangle whose material emits, in world space, sorted by (instance,
+ * triangle) so that a hit finds its entry by binary search; leaf: its leaf in the emissive tree. */
 typedef struct KEmissiveTriangle {
   float p0[3]; kuint instance;   /* p0..p2: world positions of the triangle's v0, v1, v2 */
   float p1[3]; kuint triangle;   /* absolute index into the triangle array */
-  float p2[3]; float power_cdf;
+  float p2[3]; kuint leaf;
 } KEmissiveTriangle;
 
 /* ---- Camera and per-frame parameters ------------------------------------------------------------- */

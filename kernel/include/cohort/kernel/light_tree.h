@@ -37,7 +37,7 @@ KFN float k_light_node_importance(KGLOBAL const KLightNode* n, KVec3 p) {
 KFN kuint k_light_tree_pick(const KSceneView* scene, const KSurface* sf, KVec3 wo, float spec_boost, float u_descend,
                             float u_pick, KVec3* contribution, float* pdf) {
   KVec3 p = sf->position;
-  if (scene->light_node_count == 0u || !k_light_node_holds(&scene->light_nodes[0], p)) return K_NONE;
+  if (k_light_tree_nodes(scene) == 0u || !k_light_node_holds(&scene->light_nodes[0], p)) return K_NONE;
   kuint node = 0u;
   float prob = 1.0f;
   while (scene->light_nodes[node].count == 0u && scene->light_nodes[node].light_count > K_LIGHT_TREE_GATHER) {

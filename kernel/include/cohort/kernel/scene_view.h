@@ -57,6 +57,17 @@ KFN KSceneView k_scene_view(KGLOBAL const KVertex* vertices, KGLOBAL const KTria
   return v;
 }
 
+/* The light node array holds two trees (layout.h, KLightNode): the Doom 3 lights' tree from node 0, then
+ * the emissive triangles' tree in the last 2E - 1 nodes (E = emissive_count; none when E = 0). */
+KFN kuint k_emissive_tree_nodes(const KSceneView* scene) {
+  kuint e = scene->emissive_count;
+  return e > 0u && scene->light_node_count >= 2u * e - 1u ? 2u * e - 1u : 0u;
+}
+
+KFN kuint k_light_tree_nodes(const KSceneView* scene) {
+  return scene->light_node_count - k_emissive_tree_nodes(scene);
+}
+
 /* A ray hit: triangle is an absolute index into the triangle array; (u, v) are the barycentrics of
  * v1 and v2 (p = (1-u-v) p0 + u p1 + v p2), as Embree and Moller-Trumbore both report them. */
 typedef struct KHit {
