@@ -18,7 +18,7 @@ ProgressBar::ProgressBar(int total, std::ostream& out, bool interactive)
     : total_(std::max(total, 1)), out_(out), interactive_(interactive) {}
 
 std::string ProgressBar::line() const {
-  const int filled = done_ * kBarWidth / total_;
+  const int filled = std::min(done_, total_) * kBarWidth / total_;  // a replay of unknown length passes its total
   std::string bar = "[" + std::string(static_cast<size_t>(filled), '#') +
                     std::string(static_cast<size_t>(kBarWidth - filled), '.') + "]";
   const double per_frame = done_ > 0 ? total_ms_ / done_ : 0.0;

@@ -23,10 +23,11 @@ case "${1:-}" in
   stage)
     cmake --preset gpu-travel
     cmake --build --preset gpu-travel -j2 --target cohort cohort_tracers_tests bench_cuda bench_bvh \
-      bench_scaling bench_host_frame
+      bench_scaling bench_host_frame bench_skinning
     rm -rf "$stage" && mkdir -p "$stage/bin" "$stage/lib"
     for exe in build/gpu/bin/cohort build/gpu/bin/cohort_tracers_tests build/gpu/bin/bench_cuda \
-               build/gpu/bin/bench_bvh build/gpu/bin/bench_scaling build/gpu/bin/bench_host_frame; do
+               build/gpu/bin/bench_bvh build/gpu/bin/bench_scaling build/gpu/bin/bench_host_frame \
+               build/gpu/bin/bench_skinning; do
       [ -x "$exe" ] && [ -f "$exe" ] && strip -o "$stage/bin/$(basename "$exe")" "$exe"
     done
     for lib in libembree3.so.3 libtbb.so.12 libzip.so.4; do
@@ -100,6 +101,11 @@ case "${1:-}" in
     fi
     # Host work per frame at 1080p (merge, convergence, tone map) on this machine's cores.
     [ -x "$stage/bin/bench_host_frame" ] && (cd "$out" && timeout 120 "$OLDPWD/$stage/bin/bench_host_frame" 2>&1 | tee "$out/bench_host_frame.log") || true
+    # Skinned characters (docs/skinning.md): skin + refit per character per frame on the CPU tracer and CUDA.
+    if [ -x "$stage/bin/bench_skinning" ]; then
+      timeout 200 "$stage/bin/bench_skinning" --characters 16 --tracers embree,cuda:0 \
+        --json "$out/bench_skinning.json" 2>&1 | tee "$out/bench_skinning.log" || status=1
+    fi
     # Light and triangle scaling on the GPU (issue 16), 1920x1080, 1 spp, NEE + 1 bounce.
     if [ -x "$stage/bin/bench_scaling" ]; then
       timeout 400 "$stage/bin/bench_scaling" --tracer cuda:0 --width 1920 --height 1080 --spp 1 --bounces 1 --light-samples 1 \

@@ -77,6 +77,11 @@ bool same_tracer_scene(const TracerScene& a, const TracerScene& b, std::string* 
          same_array(a.lights, b.lights, "lights", where) &&
          same_array(a.light_nodes, b.light_nodes, "light_nodes", where) &&
          same_array(a.emissive_triangles, b.emissive_triangles, "emissive_triangles", where) &&
+         same_array(a.skins, b.skins, "skins", where) &&
+         same_array(a.skin_vertices, b.skin_vertices, "skin_vertices", where) &&
+         same_array(a.skin_weights, b.skin_weights, "skin_weights", where) &&
+         same_array(a.skin_adjacency, b.skin_adjacency, "skin_adjacency", where) &&
+         same_array(a.joints, b.joints, "joints", where) &&
          same_array(std::vector<KCamera>{a.camera}, std::vector<KCamera>{b.camera}, "camera", where);
 }
 

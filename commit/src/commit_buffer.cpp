@@ -1,5 +1,7 @@
 #include "cohort/commit/commit_buffer.h"
 
+#include "cohort/commit/host_skinning.h"
+
 #include <algorithm>
 #include <stdexcept>
 #include <string>
@@ -9,6 +11,11 @@ namespace cohort::commit {
 size_t BlasUpload::bytes() const {
   return kRecordHeaderBytes + sizeof(blas) + 3 * sizeof(uint32_t) + vertices.size() * sizeof(KVertex) +
          triangles.size() * sizeof(KTriangle) + nodes.size() * sizeof(KBvhNode);
+}
+
+size_t SkinUpload::bytes() const {
+  return kRecordHeaderBytes + sizeof(skin) + 2 * sizeof(uint32_t) + vertices.size() * sizeof(KSkinVertex) +
+         weights.size() * sizeof(KSkinWeight) + adjacency.size() * sizeof(KSkinTriangle);
 }
 
 size_t TexelUpload::bytes() const { return kRecordHeaderBytes + texels.size() * sizeof(uint32_t); }
@@ -76,6 +83,18 @@ void CommitBuffer::add_texels(TexelUpload upload) {
   texel_uploads_.push_back(std::move(upload));
 }
 
+void CommitBuffer::add_skin(SkinUpload upload) {
+  bytes_ += upload.bytes();
+  skin_uploads_.push_back(std::move(upload));
+}
+
+void CommitBuffer::set_skin_joints(uint32_t skin, std::vector<KJoint> joints) {
+  auto existing = skin_joints_.find(skin);
+  if (existing != skin_joints_.end()) bytes_ -= kRecordHeaderBytes + existing->second.size() * sizeof(KJoint);
+  bytes_ += kRecordHeaderBytes + joints.size() * sizeof(KJoint);
+  skin_joints_[skin] = std::move(joints);
+}
+
 void CommitBuffer::set_camera(const KCamera& camera) {
   if (!camera_) bytes_ += kRecordHeaderBytes + sizeof(KCamera);
   camera_ = camera;
@@ -85,7 +104,7 @@ size_t CommitBuffer::record_count() const {
   return (instance_count_ ? 1 : 0) + instances_.size() + (tlas_ ? 1 : 0) + (light_count_ ? 1 : 0) + lights_.size() +
          (light_tree_ ? 1 : 0) + (emissive_ ? 1 : 0) +
          (material_count_ ? 1 : 0) + materials_.size() + (texture_count_ ? 1 : 0) + textures_.size() +
-         blas_uploads_.size() + texel_uploads_.size() +
+         blas_uploads_.size() + texel_uploads_.size() + skin_uploads_.size() + skin_joints_.size() +
          (camera_ ? 1 : 0);
 }
 
@@ -104,6 +123,8 @@ void CommitBuffer::clear() {
   tlas_.reset();
   blas_uploads_.clear();
   texel_uploads_.clear();
+  skin_uploads_.clear();
+  skin_joints_.clear();
   camera_.reset();
   bytes_ = 0;
 }
@@ -133,6 +154,8 @@ void CommitBuffer::merge(const CommitBuffer& later) {
   for (const auto& [i, v] : later.textures_) set_texture(i, v);
   for (const auto& upload : later.blas_uploads_) add_blas(upload);
   for (const auto& upload : later.texel_uploads_) add_texels(upload);
+  for (const auto& upload : later.skin_uploads_) add_skin(upload);
+  for (const auto& [skin, joints] : later.skin_joints_) set_skin_joints(skin, joints);
   if (later.camera_) set_camera(*later.camera_);
   frame_ = later.frame_;
 }
@@ -167,7 +190,7 @@ bool apply_elements(std::vector<T>& array, const std::optional<uint32_t>& count,
 
 }  // namespace
 
-ChangeSet apply_commit(const CommitBuffer& commit, TracerScene& scene) {
+ChangeSet apply_commit(const CommitBuffer& commit, TracerScene& scene, Skinning skinning) {
   ChangeSet changes;
   if (commit.is_full_resync()) {
     scene = *commit.full_scene();
@@ -210,6 +233,37 @@ ChangeSet apply_commit(const CommitBuffer& commit, TracerScene& scene) {
     changes.textures = true;
   }
   changes.textures |= apply_elements(scene.textures, commit.texture_count(), commit.textures(), "texture");
+  for (const SkinUpload& up : commit.skin_uploads()) {
+    write_range(scene.skin_vertices, up.skin.skin_vertex_offset, up.vertices);
+    write_range(scene.skin_weights, up.weight_offset, up.weights);
+    write_range(scene.skin_adjacency, up.adjacency_offset, up.adjacency);
+    write_range(scene.skins, up.skin_index, std::vector<KSkin>{up.skin});
+    changes.skin_data = true;
+  }
+  for (const SkinUpload& up : commit.skin_uploads()) {
+    try {
+      check_skin(scene, up.skin_index);
+    } catch (const std::out_of_range& e) {
+      throw std::invalid_argument(std::string("commit: ") + e.what());
+    }
+  }
+  for (const auto& [index, joints] : commit.skin_joints()) {
+    if (index >= scene.skins.size() || joints.size() != scene.skins[index].joint_count)
+      throw std::invalid_argument("commit poses skin " + std::to_string(index) + " with " +
+                                  std::to_string(joints.size()) + " joints but the tracer scene has " +
+                                  (index < scene.skins.size() ? std::to_string(scene.skins[index].joint_count) + " joints there"
+                                                              : "only " + std::to_string(scene.skins.size()) + " skins"));
+    write_range(scene.joints, scene.skins[index].joint_offset, joints);
+    changes.posed_skins.push_back(index);
+  }
+  if (skinning == Skinning::on_host)
+    for (uint32_t skin : changes.posed_skins) {
+      try {
+        skin_on_host(scene, skin);
+      } catch (const std::out_of_range& e) {
+        throw std::invalid_argument(std::string("commit: ") + e.what());
+      }
+    }
   if (commit.camera()) {
     scene.camera = *commit.camera();
     changes.camera = true;

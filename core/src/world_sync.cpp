@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstring>
 #include <stdexcept>
 #include <string>
 #include <unordered_map>
@@ -12,10 +13,12 @@
 #include <spdlog/spdlog.h>
 
 #include "cohort/commit/array_diff.h"
+#include "cohort/commit/host_skinning.h"
 #include "cohort/core/bvh.h"
 #include "cohort/core/light_sampling.h"
 #include "cohort/core/view.h"
 #include "gpu_scene_textures.h"
+#include "skin_data.h"
 
 namespace cohort::core {
 namespace {
@@ -195,6 +198,130 @@ KInstance WorldSync::entity_instance(int handle, const scene::RenderEntity& def,
   return inst;
 }
 
+WorldSync::SkinnedEntity WorldSync::add_skinned_blas(int mesh_index, commit::CommitBuffer& out) {
+  const scene::Mesh& mesh = world_.scene().meshes.at(size_t(mesh_index));
+  SkinnedEntity entity;
+  entity.mesh = mesh_index;
+  std::vector<KVertex> vertices;
+  vertices.reserve(mesh.vertices.size());
+  for (const scene::Vertex& v : mesh.vertices) vertices.push_back(to_kvertex(v));
+  std::vector<KTriangle> triangles = mesh_triangles(mesh, 0, [this](int m) { return kmaterial_index(m); });
+  if (triangles.empty()) return entity;
+
+  commit::SkinUpload skin_up;
+  auto shared = skin_vertices_of_mesh_.find(mesh_index);
+  if (shared == skin_vertices_of_mesh_.end()) {  // the mesh's weights and adjacency, once for all its characters
+    MeshSkinData data = mesh_skin_data(mesh);
+    skin_up.weight_offset = uint32_t(master_.skin_weights.size());
+    skin_up.adjacency_offset = uint32_t(master_.skin_adjacency.size());
+    for (KSkinVertex& v : data.vertices) {
+      v.first_weight += skin_up.weight_offset;
+      v.first_adjacent += skin_up.adjacency_offset;
+    }
+    shared = skin_vertices_of_mesh_.emplace(mesh_index, uint32_t(master_.skin_vertices.size())).first;
+    skin_up.vertices = std::move(data.vertices);
+    skin_up.weights = std::move(data.weights);
+    skin_up.adjacency = std::move(data.adjacency);
+    master_.skin_vertices.insert(master_.skin_vertices.end(), skin_up.vertices.begin(), skin_up.vertices.end());
+    master_.skin_weights.insert(master_.skin_weights.end(), skin_up.weights.begin(), skin_up.weights.end());
+    master_.skin_adjacency.insert(master_.skin_adjacency.end(), skin_up.adjacency.begin(), skin_up.adjacency.end());
+  }
+
+  BlasBuild build = build_blas(vertices, triangles);
+  entity.built_sah = build.sah_cost;
+  commit::BlasUpload up;
+  up.blas_index = uint32_t(master_.blases.size());
+  up.vertex_offset = uint32_t(master_.vertices.size());
+  up.triangle_offset = uint32_t(master_.triangles.size());
+  up.node_offset = uint32_t(master_.blas_nodes.size());
+  up.vertices = std::move(vertices);
+  up.triangles = std::move(build.triangles);
+  for (KTriangle& t : up.triangles) {
+    t.v0 += up.vertex_offset;
+    t.v1 += up.vertex_offset;
+    t.v2 += up.vertex_offset;
+  }
+  up.blas = {up.node_offset, uint32_t(build.nodes.size()), up.triangle_offset, uint32_t(up.triangles.size())};
+  // Room for any binary tree over these triangles, so a rebuild after the refit decays stays in place.
+  up.nodes = std::move(build.nodes);
+  up.nodes.resize(std::max<size_t>(up.nodes.size(), 2 * up.triangles.size() - 1), KBvhNode{});
+  master_.vertices.insert(master_.vertices.end(), up.vertices.begin(), up.vertices.end());
+  master_.triangles.insert(master_.triangles.end(), up.triangles.begin(), up.triangles.end());
+  master_.blas_nodes.insert(master_.blas_nodes.end(), up.nodes.begin(), up.nodes.end());
+  master_.blases.push_back(up.blas);
+  entity.blas = up.blas_index;
+  ++stats_.blas_builds;
+
+  skin_up.skin_index = uint32_t(master_.skins.size());
+  skin_up.skin = KSkin{entity.blas, up.vertex_offset, uint32_t(up.vertices.size()), shared->second,
+                       uint32_t(master_.joints.size()), uint32_t(mesh.skin->joint_count), 0u, 0u};
+  master_.joints.resize(master_.joints.size() + size_t(mesh.skin->joint_count), KJoint{});
+  master_.skins.push_back(skin_up.skin);
+  entity.skin = skin_up.skin_index;
+  out.add_blas(std::move(up));
+  out.add_skin(std::move(skin_up));
+  return entity;
+}
+
+// The refit tree has decayed: a new tree over the posed vertices, written in place of the old one (its
+// node range has room for any tree), sent as a BLAS upload without vertices.
+void WorldSync::rebuild_skinned_blas(SkinnedEntity& entity, commit::CommitBuffer& out) {
+  KBlas blas = master_.blases[entity.blas];
+  const std::vector<KTriangle> triangles(master_.triangles.begin() + blas.tri_offset,
+                                         master_.triangles.begin() + blas.tri_offset + blas.tri_count);
+  BlasBuild build = build_blas(master_.vertices, triangles);
+  if (build.nodes.size() > 2 * size_t(blas.tri_count) - 1) throw std::logic_error("WorldSync: a BLAS outgrew its node range");
+  blas.node_count = uint32_t(build.nodes.size());
+  master_.blases[entity.blas] = blas;
+  std::copy(build.nodes.begin(), build.nodes.end(), master_.blas_nodes.begin() + blas.node_offset);
+  std::copy(build.triangles.begin(), build.triangles.end(), master_.triangles.begin() + blas.tri_offset);
+  commit::skin_on_host(master_, entity.skin);  // the refit every tracer does after this upload
+  entity.built_sah = sah_cost(std::vector<KBvhNode>(master_.blas_nodes.begin() + blas.node_offset,
+                                                    master_.blas_nodes.begin() + blas.node_offset + blas.node_count));
+  commit::BlasUpload up;
+  up.blas_index = entity.blas;
+  up.blas = blas;
+  up.vertex_offset = master_.skins[entity.skin].vertex_offset;
+  up.triangle_offset = blas.tri_offset;
+  up.triangles = std::move(build.triangles);
+  up.node_offset = blas.node_offset;
+  up.nodes = std::move(build.nodes);
+  out.add_blas(std::move(up));
+  ++stats_.blas_builds;
+  ++stats_.skin_rebuilds;
+}
+
+uint32_t WorldSync::pose_skinned_entity(int handle, const scene::RenderEntity& def, commit::CommitBuffer& out) {
+  constexpr float kSkinRebuildThreshold = 1.5f;
+  const scene::Mesh& mesh = world_.scene().meshes.at(size_t(def.model));
+  if (def.joints.size() != size_t(mesh.skin->joint_count)) {
+    if (warned_joint_counts_.insert(handle).second)
+      spdlog::warn("WorldSync: entity {} has {} joints for model '{}' of {}; not drawn", handle, def.joints.size(),
+                   mesh.name, mesh.skin->joint_count);
+    skinned_.erase(handle);
+    return K_NONE;
+  }
+  auto it = skinned_.find(handle);
+  if (it == skinned_.end() || it->second.mesh != def.model)
+    it = skinned_.insert_or_assign(handle, add_skinned_blas(def.model, out)).first;
+  SkinnedEntity& entity = it->second;
+  if (entity.blas == K_NONE) return K_NONE;
+  const KSkin skin = master_.skins[entity.skin];
+  std::vector<KJoint> joints = to_kjoints(def.joints);
+  KJoint* current = master_.joints.data() + skin.joint_offset;
+  if (entity.posed && std::memcmp(current, joints.data(), joints.size() * sizeof(KJoint)) == 0) return entity.blas;
+  std::copy(joints.begin(), joints.end(), current);
+  commit::skin_on_host(master_, entity.skin);
+  out.set_skin_joints(entity.skin, std::move(joints));
+  entity.posed = true;
+  ++stats_.skins_posed;
+  const KBlas& blas = master_.blases[entity.blas];
+  const float refit_sah = sah_cost(std::vector<KBvhNode>(master_.blas_nodes.begin() + blas.node_offset,
+                                                         master_.blas_nodes.begin() + blas.node_offset + blas.node_count));
+  if (blas_needs_rebuild(entity.built_sah, refit_sah, kSkinRebuildThreshold)) rebuild_skinned_blas(entity, out);
+  return entity.blas;
+}
+
 bool WorldSync::refit_moved_instances(const std::vector<int>& moved, commit::CommitBuffer& out) {
   constexpr float kTlasRebuildThreshold = 1.3f;  // a rebuild costs ~0.3 ms per 1,000 instances (docs/bvh.md)
   std::unordered_map<uint32_t, size_t> slot_of_entity;
@@ -245,8 +372,9 @@ commit::CommitBuffer WorldSync::sync(const scene::ChangeLog& changes, uint64_t f
       continue;
     }
     blas_of_mesh_[mesh] = K_NONE;
+    skin_vertices_of_mesh_.erase(mesh);
     for (const auto& [handle, m] : mesh_of_entity_)
-      if (m == mesh) entities.insert(handle);
+      if (m == mesh) entities.insert(handle), skinned_.erase(handle);
   }
 
   bool instances_changed = instances_stale_;
@@ -258,10 +386,14 @@ commit::CommitBuffer WorldSync::sync(const scene::ChangeLog& changes, uint64_t f
     instances_changed |= erased;
     only_moved &= !erased;
     mesh_of_entity_.erase(handle);
+    skinned_.erase(handle);
   }
   for (int handle : entities) {
     const scene::RenderEntity* def = world_.EntityDef(handle);
-    uint32_t blas = def && def->model >= 0 ? ensure_blas(def->model, out) : K_NONE;
+    const bool skinned = def && def->model >= 0 && !def->joints.empty() && scene.meshes.at(size_t(def->model)).skin;
+    if (!skinned) skinned_.erase(handle);
+    uint32_t blas = skinned ? pose_skinned_entity(handle, *def, out)
+                            : def && def->model >= 0 ? ensure_blas(def->model, out) : K_NONE;
     if (blas == K_NONE) {  // freed, no model, or a model without triangles
       const bool erased = entity_instances_.erase(handle) > 0;
       instances_changed |= erased;

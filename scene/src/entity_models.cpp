@@ -46,12 +46,13 @@ int EntityModels::mesh_for(const std::string& model, std::string skin, const std
   entity.model_file = file;
   entity.skin = skin;
   entity.anim_file = anim_file;
+  entity.anim = loaded.anim;
   return loaded.mesh;
 }
 
 EntityModels::Loaded EntityModels::load(const std::string& file, const std::string& skin, const std::string& anim_file,
                                         const std::string& where) {
-  const std::string key = Vfs::normalize(file) + "|" + canonical_decl_name(skin);
+  const std::string key = Vfs::normalize(file) + "|" + canonical_decl_name(skin) + "|" + Vfs::normalize(anim_file);
   auto cached = loaded_.find(key);
   if (cached != loaded_.end()) return cached->second;
 
@@ -63,12 +64,15 @@ EntityModels::Loaded EntityModels::load(const std::string& file, const std::stri
       if (!text) throw std::runtime_error(file + ": model file not found");
       Md5Mesh mesh = parse_md5mesh(*text, vfs_.describe(file));
       model = skin_md5(mesh, bind_pose(mesh));
+      model.mesh.skin = std::make_shared<const MeshSkin>(md5_mesh_skin(mesh));
       if (!anim_file.empty()) {
         // The animation must fit the skeleton; a mismatch is reported but the mesh still shows.
         try {
           auto anim_text = vfs_.read(anim_file);
           if (!anim_text) throw std::runtime_error(anim_file + ": animation file not found");
-          check_anim_matches(mesh, parse_md5anim(*anim_text, vfs_.describe(anim_file)));
+          auto anim = std::make_shared<Md5Anim>(parse_md5anim(*anim_text, vfs_.describe(anim_file)));
+          check_anim_matches(mesh, *anim);
+          out.anim = std::move(anim);
         } catch (const std::exception& e) {
           scene_.warnings.push_back(where + ": " + e.what());
         }

@@ -5,6 +5,7 @@
 
 #include <functional>
 #include <map>
+#include <memory>
 #include <string>
 
 #include "cohort/scene/decl_file.h"
@@ -30,6 +31,7 @@ class EntityModels {
   struct Loaded {
     int mesh = -1;
     std::string error;   // non-empty: the mesh is the placeholder box
+    std::shared_ptr<const Md5Anim> anim;   // the md5anim, when it fits the mesh
   };
   Loaded load(const std::string& file, const std::string& skin, const std::string& anim_file, const std::string& where);
 

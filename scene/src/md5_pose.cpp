@@ -147,4 +147,18 @@ ModelFile skin_md5(const Md5Mesh& mesh, const std::vector<JointTransform>& pose,
   return out;
 }
 
+MeshSkin md5_mesh_skin(const Md5Mesh& mesh) {
+  MeshSkin skin;
+  skin.joint_count = static_cast<int>(mesh.joints.size());
+  for (const Md5MeshPart& part : mesh.parts) {
+    const uint32_t base = static_cast<uint32_t>(skin.weights.size());
+    for (const Md5Vert& v : part.verts) {
+      skin.first_weight.push_back(base + static_cast<uint32_t>(v.first_weight));
+      skin.weight_count.push_back(static_cast<uint32_t>(v.weight_count));
+    }
+    for (const Md5Weight& w : part.weights) skin.weights.push_back({w.joint, w.bias, w.offset});
+  }
+  return skin;
+}
+
 }  // namespace cohort::scene

@@ -165,6 +165,11 @@ RenderEntity RenderWorld::resolved(const RenderEntity& entity) const {
     throw RenderWorldError(fmt::format("entity def: custom shader {} out of range ({} materials)", def.custom_shader,
                                        scene_.materials.size()));
   if (!finite(def.origin) || !finite(def.axis)) throw RenderWorldError("entity def: origin or axis is not finite");
+  if (def.joints.size() > kMaxEntityJoints)
+    throw RenderWorldError(fmt::format("entity def: {} joints (at most {})", def.joints.size(), kMaxEntityJoints));
+  for (const JointTransform& j : def.joints)
+    if (!finite(j.position) || !std::isfinite(j.rotation.x + j.rotation.y + j.rotation.z + j.rotation.w))
+      throw RenderWorldError("entity def: a joint is not finite");
   def.model_name.clear();  // the state holds the resolved index only
   return def;
 }

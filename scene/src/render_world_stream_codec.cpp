@@ -45,6 +45,7 @@ namespace {
 
 constexpr size_t kVertexBytes = 12 * 4;
 constexpr size_t kSurfaceBytes = 3 * 4;
+constexpr size_t kJointBytes = 7 * 4;
 
 // Each argument's layout, as docs/delta-stream.md gives it: one list for both directions, with
 // Codec an Encoder (and a const argument) or a Decoder.
@@ -54,6 +55,9 @@ void entity_layout(Codec& c, Entity& v) {
   c.fields(v.model, v.model_name, v.origin, v.axis, v.shader_parms, v.custom_shader);
   c.flags("entity", v.no_shadows, v.no_self_shadow);
   c.fields(v.suppress_surface_in_view_id, v.allow_surface_in_view_id);
+  c.sequence(v.joints, kJointBytes, "joint", [&](auto& j) {
+    c.fields(j.rotation.x, j.rotation.y, j.rotation.z, j.rotation.w, j.position);
+  });
 }
 
 template <class Codec, class Light>

@@ -7,6 +7,8 @@
 #include <fmt/format.h>
 #include <glm/gtc/matrix_transform.hpp>
 
+#include "cohort/scene/md5.h"
+
 namespace cohort::scene {
 namespace {
 
@@ -61,6 +63,32 @@ Scenario::Scenario(RenderWorldApi& world, ScenarioOptions options) : world_(worl
   fan_rest_ = *world_.EntityDef(fan_);
   flicker_base_ = *world_.LightDef(flicker_);
   door_travel_ = mesh_height(world_.scene(), door_closed_.model) - 8.0f;  // func_door's default lip stays visible
+  const Scene& scene = world_.scene();
+  for (size_t e = 0; e < scene.entities.size(); ++e) {
+    const Entity& entity = scene.entities[e];
+    if (!entity.anim || entity.mesh < 0 || !scene.meshes[size_t(entity.mesh)].skin) continue;
+    const RenderEntity* def = world_.EntityDef(int(e));
+    if (def) walkers_.push_back({int(e), *def, entity.anim});
+  }
+}
+
+std::vector<int> Scenario::walker_handles() const {
+  std::vector<int> handles;
+  for (const Walker& w : walkers_) handles.push_back(w.handle);
+  return handles;
+}
+
+RenderEntity Scenario::walker(size_t index, double t) const {
+  const Walker& w = walkers_.at(index);
+  RenderEntity def = w.start;
+  def.joints = anim_pose(*w.anim, int(std::lround(t * 1000.0)));
+  // Around a circle to the walker's left, facing along it.
+  const double radius = std::max(double(options_.walk_radius), 1.0);
+  const double turned = double(options_.walk_speed) * t / radius;
+  const glm::vec3 forward = w.start.axis[0], left = w.start.axis[1];
+  def.origin = w.start.origin + forward * float(radius * std::sin(turned)) + left * float(radius * (1.0 - std::cos(turned)));
+  def.axis = w.start.axis * rotation_z(turned);
+  return def;
 }
 
 RenderView Scenario::camera(double t) const {
@@ -102,6 +130,8 @@ void Scenario::frame(int index) {
   float f = flicker_factor(t);
   for (int c = kShaderParmRed; c <= kShaderParmBlue; ++c) flicker.shader_parms[c] = flicker_base_.shader_parms[c] * f;
   world_.UpdateLightDef(flicker_, flicker);
+
+  for (size_t w = 0; w < walkers_.size(); ++w) world_.UpdateEntityDef(walkers_[w].handle, walker(w, t));
 
   RenderView view = camera(t);
   RenderLight flashlight;

@@ -3,6 +3,7 @@
 #include <filesystem>
 #include <unistd.h>
 
+#include "cohort/scene/map_loader.h"
 #include "cohort/scene/render_world_stream.h"
 #include "cohort/scene/scenario.h"
 #include "cohort/test_support/test_scenes.h"
@@ -84,4 +85,40 @@ TEST(Scenario, MissingNamesAreListedInOneError) {
     EXPECT_NE(what.find("light_flicker"), std::string::npos) << what;
     EXPECT_EQ(what.find("door_main"), std::string::npos) << what;
   }
+}
+
+// The test map's walkers play their walk anim and walk a circle; a recording carries their joints.
+TEST(Scenario, WalkersPlayTheirAnimAndTheStreamCarriesTheirJoints) {
+  Vfs vfs;
+  const Scene map = load_map(vfs, std::string(COHORT_SOURCE_DIR) + "/assets/testmap/maps/testmap.map");
+  RenderWorld direct(map);
+  Scenario scenario(direct);
+  ASSERT_EQ(scenario.walker_handles().size(), 2u);
+  const int walker = scenario.walker_handles()[0];
+  const RenderEntity start = *direct.EntityDef(walker);
+  EXPECT_TRUE(start.joints.empty());  // the map seeds the bind pose
+  scenario.frame(0);
+  const RenderEntity at0 = *direct.EntityDef(walker);
+  for (int i = 1; i <= 30; ++i) scenario.frame(i);
+  const RenderEntity at30 = *direct.EntityDef(walker);
+  ASSERT_EQ(at0.joints.size(), map.meshes[size_t(start.model)].skin->joint_count);
+  ASSERT_EQ(at30.joints.size(), at0.joints.size());
+  EXPECT_NE(at0.joints, at30.joints) << "the anim plays";
+  EXPECT_EQ(at0.origin, start.origin);
+  EXPECT_GT(glm::length(at30.origin - start.origin), 10.0f) << "it walks (0.5 s at 40 units/s)";
+  EXPECT_NEAR(glm::length(at30.origin - (start.origin + start.axis[1] * 40.0f)), 40.0f, 1e-3f) << "on its circle";
+
+  auto file = std::filesystem::temp_directory_path() / ("cohort_walkers_" + std::to_string(::getpid()) + ".cds");
+  {
+    RenderWorld recorded(map);
+    Recorder recorder(recorded, file, "testmap");
+    run_scenario(recorder, 31);
+    recorder.finish();
+  }
+  Player player(file);
+  RenderWorld replayed(map);
+  while (player.play_frame(replayed)) {
+  }
+  EXPECT_EQ(*replayed.EntityDef(walker), at30);
+  std::filesystem::remove(file);
 }

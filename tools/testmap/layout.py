@@ -197,7 +197,8 @@ def entities():
     ents.append(("testmap_wedge", [("name", "wedge_1"), ("origin", (820, 330, 0)), ("angle", 90)]))
     ents.append(("func_static", [("name", "wedge_2"), ("model", "models/testmap/wedge.lwo"),
                                  ("origin", (1480, 300, 96))]))
-    ents.append(("testmap_walker", [("name", "walker_1"), ("origin", (1000, 80, 0)), ("angle", 90)]))
+    # In the hall, facing the player start: the scenario walks it around a circle in the camera's view.
+    ents.append(("testmap_walker", [("name", "walker_1"), ("origin", (352, 264, 0)), ("angle", 180)]))
     ents.append(("testmap_walker", [("name", "walker_2"), ("origin", (1700, 120, 96)), ("angle", 180),
                                     ("skin", "skins/testmap/walker_metal")]))
 
@@ -231,5 +232,5 @@ def expected_area_of_entity(name):
         "info_player_start_1": 0, "door_main": 1, "fan_spin": 0, "crate_1": 0, "crate_2": 0, "crate_3": 5,
         "crate_4": 2, "table_1": 0, "light_hall": 0, "light_hall_fill": 0, "light_flicker": 1, "light_beam": 2,
         "light_sun": 3, "light_stairs": 4, "light_gallery": 5, "light_gel": 5,
-        "lamp_1": 0, "lamp_2": 0, "light_lamp": 0, "wedge_1": 2, "wedge_2": 5, "walker_1": 2, "walker_2": 5,
+        "lamp_1": 0, "lamp_2": 0, "light_lamp": 0, "wedge_1": 2, "wedge_2": 5, "walker_1": 0, "walker_2": 5,
     }.get(name)

@@ -3,7 +3,8 @@
 namespace cohort::tracers {
 
 void TracerBase::apply(const commit::CommitBuffer& commit) {
-  commit::ChangeSet changes = commit::apply_commit(commit, scene_);
+  commit::ChangeSet changes = commit::apply_commit(
+      commit, scene_, skins_on_device() ? commit::Skinning::by_tracer : commit::Skinning::on_host);
   if (!has_scene_) changes.full_resync = true;
   upload(changes);
   has_scene_ = true;   // only now: after a failed first upload the next commit is sent whole again

@@ -6,6 +6,7 @@
 
 #include "device_array.h"
 #include "render_band_launch.h"
+#include "skinning_launch.h"
 
 namespace cohort::tracers {
 
@@ -40,6 +41,11 @@ struct CudaTracer::Impl {
   DeviceArray<KLight> lights;
   DeviceArray<KLightNode> light_nodes;
   DeviceArray<KEmissiveTriangle> emissive;
+  DeviceArray<KSkin> skins;
+  DeviceArray<KSkinVertex> skin_vertices;
+  DeviceArray<KSkinWeight> skin_weights;
+  DeviceArray<KSkinTriangle> skin_adjacency;
+  DeviceArray<KJoint> joints;
   cudaTextureObject_t texel_texture = 0;
   float4* band = nullptr;
   unsigned short* band_rgb16f = nullptr;   // the band as RGB halves, for RGB16F targets
@@ -153,6 +159,27 @@ void CudaTracer::upload(const commit::ChangeSet& changes) {
     static const std::vector<uint32_t> one_white_texel{0xffffffffu};
     m.texels.upload(scene.texels.empty() ? one_white_texel : scene.texels, 0, s);
     m.rebind_texel_texture();
+  }
+  if (all || changes.skin_data) {
+    m.skins.upload(scene.skins, 0, s);
+    m.skin_vertices.upload(scene.skin_vertices, 0, s);
+    m.skin_weights.upload(scene.skin_weights, 0, s);
+    m.skin_adjacency.upload(scene.skin_adjacency, 0, s);
+  }
+  if (all || !changes.posed_skins.empty()) m.joints.upload(scene.joints, 0, s);
+  // The host copy keeps only the joints: after vertices came from it every skin runs again, otherwise
+  // only those whose joints changed.
+  std::vector<uint32_t> to_pose = changes.posed_skins;
+  if (all || changes.geometry) {
+    to_pose.resize(scene.skins.size());
+    for (size_t i = 0; i < to_pose.size(); ++i) to_pose[i] = uint32_t(i);
+  }
+  for (uint32_t index : to_pose) {
+    if (index >= scene.skins.size()) continue;
+    const KSkin& skin = scene.skins[index];
+    if (size_t(skin.joint_offset) + skin.joint_count > scene.joints.size() || skin.blas >= scene.blases.size()) continue;
+    launch_skinning(m.vertices.data(), m.skin_vertices.data(), m.skin_weights.data(), m.skin_adjacency.data(),
+                    m.joints.data(), skin, m.blas_nodes.data(), m.triangles.data(), scene.blases[skin.blas], s);
   }
   COHORT_CUDA(cudaStreamSynchronize(s));
 }

@@ -12,6 +12,7 @@
 #include <tbb/parallel_for.h>
 
 #include "embree_kernel.h"
+#include "embree_skinned.h"
 
 namespace cohort::tracers {
 
@@ -73,7 +74,8 @@ struct EmbreeTracer::Impl {
   // One Embree scene per KBlas, sharing the TracerScene's vertex and triangle arrays (no copies).
   void build_blases(const commit::TracerScene& scene) {
     release_blases();
-    for (const KBlas& b : scene.blases) {
+    for (size_t index = 0; index < scene.blases.size(); ++index) {
+      const KBlas& b = scene.blases[index];
       RTCScene s = rtcNewScene(device);
       if (b.tri_count > 0) {
         RTCGeometry g = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_TRIANGLE);
@@ -83,6 +85,7 @@ struct EmbreeTracer::Impl {
                                    size_t(b.tri_offset) * sizeof(KTriangle), sizeof(KTriangle), b.tri_count);
         rtcSetGeometryIntersectFilterFunction(g, embree_kernel::filter_hit);
         rtcSetGeometryOccludedFilterFunction(g, embree_kernel::filter_hit);
+        if (embree_skinned::is_skinned(scene, uint32_t(index))) embree_skinned::prepare(s, g);
         rtcCommitGeometry(g);
         rtcAttachGeometryByID(s, g, 0);
         rtcReleaseGeometry(g);
@@ -127,7 +130,8 @@ void EmbreeTracer::upload(const commit::ChangeSet& changes) {
     impl_->build_blases(scene());
     check_device(impl_->device, "building the BLAS scenes");
     impl_->build_top(scene());
-  } else if (changes.instances || changes.tlas || !impl_->top) {
+  } else if (changes.instances || changes.tlas || !changes.posed_skins.empty() || !impl_->top) {
+    embree_skinned::refit(scene(), changes.posed_skins, impl_->blas_scenes);
     impl_->build_top(scene());
   }
   check_device(impl_->device, "building the instance scene");

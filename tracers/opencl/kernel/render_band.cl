@@ -39,3 +39,6 @@ __kernel void cohort_render_band(__global const KVertex* vertices, __global cons
   barrier(CLK_LOCAL_MEM_FENCE);
   if (lx == 0u && y < params.row_end && group_row_rays[ly] != 0u) atomic_add(&row_rays[row], group_row_rays[ly]);
 }
+
+/* Skinned characters: the skinning kernels share the program. */
+#include "skinning.cl"

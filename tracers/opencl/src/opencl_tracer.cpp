@@ -78,7 +78,8 @@ class DeviceBuffer {
     if (bytes > bytes_) {
       reset();
       cl_int err = CL_SUCCESS;
-      mem_ = clCreateBuffer(context, CL_MEM_READ_ONLY, bytes, nullptr, &err);
+      // Read-write: the skinning kernels write vertices and BLAS nodes in place.
+      mem_ = clCreateBuffer(context, CL_MEM_READ_WRITE, bytes, nullptr, &err);
       check(err, what);
       bytes_ = bytes;
     }
@@ -103,13 +104,43 @@ struct OpenCLTracer::Impl {
   cl_kernel kernel = nullptr;
   DeviceBuffer vertices, triangles, blas_nodes, blases, instances, tlas_nodes, materials, textures, texels, lights, light_nodes,
       emissive;
+  DeviceBuffer skins, skin_vertices, skin_weights, skin_adjacency, joints;
+  cl_kernel skin_positions = nullptr, skin_normals = nullptr, refit_blas = nullptr;
+
+  // Poses the given skins on the device: positions, then normals, then the BLAS refit (in queue order).
+  void run_skinning(const commit::TracerScene& s, const std::vector<uint32_t>& which) {
+    for (uint32_t index : which) {
+      if (index >= s.skins.size()) continue;
+      const KSkin& skin = s.skins[index];
+      if (skin.vertex_count == 0 || size_t(skin.joint_offset) + skin.joint_count > s.joints.size()) continue;
+      const cl_uint skin_index = index;
+      const size_t local = 64, global = (size_t(skin.vertex_count) + local - 1) / local * local;
+      const cl_mem position_args[] = {vertices.mem(), skin_vertices.mem(), skin_weights.mem(), joints.mem(), skins.mem()};
+      for (cl_uint a = 0; a < 5; ++a) check(clSetKernelArg(skin_positions, a, sizeof(cl_mem), &position_args[a]), "clSetKernelArg");
+      check(clSetKernelArg(skin_positions, 5, sizeof skin_index, &skin_index), "clSetKernelArg");
+      check(clEnqueueNDRangeKernel(queue, skin_positions, 1, nullptr, &global, &local, 0, nullptr, nullptr),
+            "launching the skinning kernel");
+      const cl_mem normal_args[] = {vertices.mem(), skin_vertices.mem(), skin_adjacency.mem(), skins.mem()};
+      for (cl_uint a = 0; a < 4; ++a) check(clSetKernelArg(skin_normals, a, sizeof(cl_mem), &normal_args[a]), "clSetKernelArg");
+      check(clSetKernelArg(skin_normals, 4, sizeof skin_index, &skin_index), "clSetKernelArg");
+      check(clEnqueueNDRangeKernel(queue, skin_normals, 1, nullptr, &global, &local, 0, nullptr, nullptr),
+            "launching the skinned-normals kernel");
+      const cl_mem refit_args[] = {blas_nodes.mem(), triangles.mem(), vertices.mem(), blases.mem(), skins.mem()};
+      for (cl_uint a = 0; a < 5; ++a) check(clSetKernelArg(refit_blas, a, sizeof(cl_mem), &refit_args[a]), "clSetKernelArg");
+      check(clSetKernelArg(refit_blas, 5, sizeof skin_index, &skin_index), "clSetKernelArg");
+      const size_t one = 1;
+      check(clEnqueueNDRangeKernel(queue, refit_blas, 1, nullptr, &one, &one, 0, nullptr, nullptr),
+            "launching the BLAS refit kernel");
+    }
+  }
   cl_mem params = nullptr, camera = nullptr, output = nullptr, row_rays = nullptr;
   size_t output_bytes = 0, row_rays_rows = 0;
 
   ~Impl() {
     for (cl_mem m : {params, camera, output, row_rays})
       if (m) clReleaseMemObject(m);
-    if (kernel) clReleaseKernel(kernel);
+    for (cl_kernel k : {kernel, skin_positions, skin_normals, refit_blas})
+      if (k) clReleaseKernel(k);
     if (program) clReleaseProgram(program);
     if (queue) clReleaseCommandQueue(queue);
     if (context) clReleaseContext(context);
@@ -159,6 +190,12 @@ OpenCLTracer::OpenCLTracer(const Options& options) : impl_(std::make_unique<Impl
   }
   impl_->kernel = clCreateKernel(impl_->program, "cohort_render_band", &err);
   check(err, "clCreateKernel");
+  impl_->skin_positions = clCreateKernel(impl_->program, "cohort_skin_positions", &err);
+  check(err, "clCreateKernel(cohort_skin_positions)");
+  impl_->skin_normals = clCreateKernel(impl_->program, "cohort_skin_normals", &err);
+  check(err, "clCreateKernel(cohort_skin_normals)");
+  impl_->refit_blas = clCreateKernel(impl_->program, "cohort_refit_blas", &err);
+  check(err, "clCreateKernel(cohort_refit_blas)");
   impl_->params = clCreateBuffer(impl_->context, CL_MEM_READ_ONLY, sizeof(KFrameParams), nullptr, &err);
   check(err, "clCreateBuffer(params)");
   impl_->camera = clCreateBuffer(impl_->context, CL_MEM_READ_ONLY, sizeof(KCamera), nullptr, &err);
@@ -193,6 +230,22 @@ void OpenCLTracer::upload(const commit::ChangeSet& changes) {
   if (all || changes.lights) m.lights.upload(c, q, s.lights, "uploading lights");
   if (all || changes.light_tree) m.light_nodes.upload(c, q, s.light_nodes, "uploading the light tree");
   if (all || changes.emissive) m.emissive.upload(c, q, s.emissive_triangles, "uploading emissive triangles");
+  if (all || changes.skin_data) {
+    m.skins.upload(c, q, s.skins, "uploading skins");
+    m.skin_vertices.upload(c, q, s.skin_vertices, "uploading skin vertices");
+    m.skin_weights.upload(c, q, s.skin_weights, "uploading skin weights");
+    m.skin_adjacency.upload(c, q, s.skin_adjacency, "uploading skin adjacency");
+  }
+  if (all || !changes.posed_skins.empty()) m.joints.upload(c, q, s.joints, "uploading joints");
+  // Vertices just uploaded from the host copy are not posed there (the host keeps only the joints), so
+  // every skin runs again after a geometry upload; otherwise only the skins whose joints changed.
+  if (all || changes.geometry) {
+    std::vector<uint32_t> every(s.skins.size());
+    for (size_t i = 0; i < every.size(); ++i) every[i] = uint32_t(i);
+    m.run_skinning(s, every);
+  } else {
+    m.run_skinning(s, changes.posed_skins);
+  }
 }
 
 core::BandResult OpenCLTracer::render_band(const core::BandJob& job, core::BandBuffer& target) {

@@ -34,6 +34,18 @@ struct BlasUpload {
   size_t bytes() const;
 };
 
+// A new skinned character's bind-pose data (kernel/skinning.h), appended to the skin pools; its BLAS
+// (the vertices it writes) comes as a BlasUpload and its pose as set_skin_joints.
+struct SkinUpload {
+  uint32_t skin_index = 0;
+  KSkin skin{};
+  uint32_t weight_offset = 0, adjacency_offset = 0;   // skin.skin_vertex_offset places the vertices
+  std::vector<KSkinVertex> vertices;
+  std::vector<KSkinWeight> weights;
+  std::vector<KSkinTriangle> adjacency;
+  size_t bytes() const;
+};
+
 // Texels of new or replaced textures (all their mip levels), written at `offset` of the texel buffer
 // (appended at the end normally; a replaced texture's old texels stay unused until a full resync).
 struct TexelUpload {
@@ -75,6 +87,9 @@ class CommitBuffer {
   void set_texture(uint32_t index, const KTexture& texture);
   void add_blas(BlasUpload upload);
   void add_texels(TexelUpload upload);
+  void add_skin(SkinUpload upload);
+  // A skin's pose (its joint_count joints): the per-frame record of a character.
+  void set_skin_joints(uint32_t skin, std::vector<KJoint> joints);
   void set_camera(const KCamera& camera);
 
   // Fold a later commit into this one (the later one wins where both write an element). A full
@@ -104,6 +119,8 @@ class CommitBuffer {
   const std::optional<uint32_t>& texture_count() const { return texture_count_; }
   const std::map<uint32_t, KTexture>& textures() const { return textures_; }
   const std::vector<TexelUpload>& texel_uploads() const { return texel_uploads_; }
+  const std::vector<SkinUpload>& skin_uploads() const { return skin_uploads_; }
+  const std::map<uint32_t, std::vector<KJoint>>& skin_joints() const { return skin_joints_; }
   const std::optional<KCamera>& camera() const { return camera_; }
 
  private:
@@ -123,6 +140,8 @@ class CommitBuffer {
   std::optional<std::vector<KEmissiveTriangle>> emissive_;
   std::vector<BlasUpload> blas_uploads_;
   std::vector<TexelUpload> texel_uploads_;
+  std::vector<SkinUpload> skin_uploads_;
+  std::map<uint32_t, std::vector<KJoint>> skin_joints_;
   std::optional<KCamera> camera_;
   size_t bytes_ = 0;
 };
@@ -130,6 +149,11 @@ class CommitBuffer {
 // Apply a commit to a tracer's scene copy; says what changed. Throws std::invalid_argument when a
 // record does not fit the scene (an element index past the array's end), leaving `scene` partly
 // updated: the caller must then ask for a full resync.
-ChangeSet apply_commit(const CommitBuffer& commit, TracerScene& scene);
+//
+// Skinning: by default the posed skins' vertices and BLASes are brought up to date here on the host
+// (skin_on_host), so the scene equals the core's; a tracer that skins on its device passes
+// Skinning::by_tracer, keeps the joints and finds the skins to run in ChangeSet::posed_skins.
+enum class Skinning { on_host, by_tracer };
+ChangeSet apply_commit(const CommitBuffer& commit, TracerScene& scene, Skinning skinning = Skinning::on_host);
 
 }  // namespace cohort::commit

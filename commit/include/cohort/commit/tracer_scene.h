@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "cohort/kernel/layout.h"
+#include "cohort/kernel/skinning.h"
 
 namespace cohort::commit {
 
@@ -26,6 +27,13 @@ struct TracerScene {
   // Derived by the core from the arrays above (core/light_sampling.h), sent whole when they change.
   std::vector<KLightNode> light_nodes;                // the light tree over `lights`
   std::vector<KEmissiveTriangle> emissive_triangles;  // every emitting triangle, world space
+  // Skinned characters (kernel/skinning.h): the bind-pose data is appended once per skin; each frame
+  // only a skin's joints change, and the tracer writes that skin's vertices and refits its BLAS.
+  std::vector<KSkin> skins;
+  std::vector<KSkinVertex> skin_vertices;
+  std::vector<KSkinWeight> skin_weights;
+  std::vector<KSkinTriangle> skin_adjacency;
+  std::vector<KJoint> joints;
   KCamera camera{};
   uint64_t version = 0;               // frame number of the last commit applied
 };
@@ -37,9 +45,11 @@ struct ChangeSet {
   size_t vertices_from = 0, triangles_from = 0, blas_nodes_from = 0, blases_from = 0;  // first changed element
   bool instances = false, tlas = false, materials = false, textures = false, lights = false, camera = false;
   bool light_tree = false, emissive = false;
+  bool skin_data = false;             // skins / skin vertices / weights / adjacency grew or changed
+  std::vector<uint32_t> posed_skins;  // skins whose joints changed: their vertices and BLAS follow them
   bool any() const {
     return full_resync || geometry || instances || tlas || materials || textures || lights || light_tree || emissive ||
-           camera;
+           camera || skin_data || !posed_skins.empty();
   }
 };
 

@@ -44,6 +44,8 @@ struct WorldSyncStats {  // of the last sync()
   uint64_t frame = 0;
   size_t record_bytes = 0, records = 0;
   uint32_t blas_builds = 0;
+  uint32_t skins_posed = 0;     // skinned characters whose joints changed (skinned and refit here too)
+  uint32_t skin_rebuilds = 0;   // of those, BLASes rebuilt because the refit tree had decayed
   bool tlas_rebuilt = false;
   bool tlas_refit = false;      // only instance transforms changed: the TLAS was refit, not rebuilt
   uint32_t lights_skipped = 0;  // lights left out for a defect (light_defect), warned once each
@@ -76,6 +78,17 @@ class WorldSync {
   // the refit tree has decayed past the rebuild threshold.
   bool refit_moved_instances(const std::vector<int>& moved, commit::CommitBuffer& out);
   uint32_t build_mesh_blas(int mesh, commit::CommitBuffer& out);
+  // A character drawn with a skinned mesh and joints: its own BLAS (its own vertices), posed by its
+  // joints. Returns the BLAS, or K_NONE when the joints do not fit the skin (not drawn, as in the engine).
+  uint32_t pose_skinned_entity(int handle, const scene::RenderEntity& def, commit::CommitBuffer& out);
+  struct SkinnedEntity {
+    int mesh = -1;
+    uint32_t skin = K_NONE, blas = K_NONE;
+    float built_sah = 0.0f;
+    bool posed = false;
+  };
+  SkinnedEntity add_skinned_blas(int mesh, commit::CommitBuffer& out);
+  void rebuild_skinned_blas(SkinnedEntity& entity, commit::CommitBuffer& out);
   bool update_textures(const std::set<int>& changed, commit::CommitBuffer& out);
   void set_material(int scene_material);
   void build_static_world();
@@ -92,6 +105,9 @@ class WorldSync {
   std::vector<KInstance> static_instances_;       // the world: entity == K_NONE
   std::map<int, KInstance> entity_instances_;     // by entity handle
   std::map<int, int> mesh_of_entity_;
+  std::map<int, SkinnedEntity> skinned_;          // by entity handle
+  std::map<int, uint32_t> skin_vertices_of_mesh_; // a skinned mesh's shared weights: its first KSkinVertex
+  std::set<int> warned_joint_counts_;             // entity handles
   std::map<int, KLight> lights_by_handle_;
   std::set<std::string> warned_lights_;           // "handle defect" already warned about
   uint32_t base_material_count_ = 0;              // the map's materials; the default material's index

@@ -15,12 +15,6 @@
 
 namespace cohort::scene {
 
-// A joint's rotation and position, either parent-relative or in model space.
-struct JointTransform {
-  glm::quat rotation{1.0f, 0.0f, 0.0f, 0.0f};   // column form: v' = rotation * v
-  glm::vec3 position{0.0f};
-};
-
 struct Md5Joint {
   std::string name;
   int parent = -1;
@@ -92,5 +86,8 @@ std::vector<JointTransform> anim_frame_pose(const Md5Anim& anim, int frame);
 // over each vertex's weights, normals regenerated from the skinned triangles, tangents derived; one
 // surface per md5 mesh part with its shader as material. `scale` != 0 scales the mesh (entity parm8).
 ModelFile skin_md5(const Md5Mesh& mesh, const std::vector<JointTransform>& pose, float scale = 0.0f);
+// The mesh's weights in the order skin_md5 lays its vertices out (parts one after another), for skinning
+// elsewhere (the tracers): skin_md5's positions are the sum over these weights.
+MeshSkin md5_mesh_skin(const Md5Mesh& mesh);
 
 }  // namespace cohort::scene

@@ -38,6 +38,10 @@ struct RenderEntity {
   bool no_self_shadow = false;
   int suppress_surface_in_view_id = 0;  // not drawn in the view with this id (0: none)
   int allow_surface_in_view_id = 0;     // drawn only in the view with this id (0: every view)
+  // The skeleton's pose in model space, one per joint of the model's skin (the engine's renderEntity
+  // joints): a skinned model is drawn in this pose. Empty: the model as loaded (an MD5 in bind pose).
+  // A count other than the skin's joint count is not drawn, as in the engine.
+  std::vector<JointTransform> joints;
   bool operator==(const RenderEntity&) const = default;
 };
 
@@ -172,5 +176,6 @@ RenderLight render_light_from(const Light& light);
 
 // Largest definitions RenderWorld accepts (so a corrupt stream cannot ask for unbounded memory).
 constexpr int kMaxHandles = 1 << 20;
+constexpr size_t kMaxEntityJoints = 4096;
 
 }  // namespace cohort::scene

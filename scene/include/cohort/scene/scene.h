@@ -4,10 +4,12 @@
 
 #include <cstdint>
 #include <map>
+#include <memory>
 #include <string>
 #include <vector>
 
 #include <glm/glm.hpp>
+#include <glm/gtc/quaternion.hpp>
 
 namespace cohort::scene {
 
@@ -47,6 +49,30 @@ struct Vertex {
   glm::vec4 tangent{1.0f, 0.0f, 0.0f, 1.0f};  // xyz tangent, w bitangent sign
 };
 
+// A joint's rotation and position, either parent-relative or in model space (an MD5 skeleton's pose).
+struct JointTransform {
+  glm::quat rotation{1.0f, 0.0f, 0.0f, 0.0f};   // column form: v' = rotation * v
+  glm::vec3 position{0.0f};
+  bool operator==(const JointTransform&) const = default;
+};
+
+// One influence of a joint on a vertex: the vertex gets bias * (R_joint * offset + T_joint).
+struct SkinWeight {
+  int joint = 0;
+  float bias = 0.0f;
+  glm::vec3 offset{0.0f};
+};
+
+// How an MD5 mesh's vertices follow its skeleton (Mesh::vertices is then the bind pose): vertex v sums
+// weights [first_weight[v], first_weight[v] + weight_count[v]).
+struct MeshSkin {
+  int joint_count = 0;
+  std::vector<uint32_t> first_weight, weight_count;
+  std::vector<SkinWeight> weights;
+};
+
+struct Md5Anim;
+
 // A run of triangles sharing one material, indices into Mesh::indices.
 struct Surface {
   int material = -1;
@@ -58,6 +84,7 @@ struct Mesh {
   std::vector<Vertex> vertices;
   std::vector<uint32_t> indices;  // three per triangle, winding as in the .proc
   std::vector<Surface> surfaces;
+  std::shared_ptr<const MeshSkin> skin;   // MD5 meshes: an entity with joints is skinned by it
   size_t triangle_count() const { return indices.size() / 3; }
 };
 
@@ -90,6 +117,7 @@ struct Entity {
   // Where a model file's mesh came from (empty for inline .proc models), the skin applied to it, and
   // for MD5 models the animation the entity plays (empty: none); the mesh is the bind pose.
   std::string model_file, skin, anim_file;
+  std::shared_ptr<const Md5Anim> anim;       // anim_file as loaded, when it fits the mesh's skeleton
 };
 
 struct Portal {

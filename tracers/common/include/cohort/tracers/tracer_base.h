@@ -22,6 +22,9 @@ class TracerBase : public core::Tracer {
   // Brings the tracer's own copies (device buffers, acceleration structures) up to date with scene().
   // Until one upload has succeeded, changes arrive with full_resync set: there is nothing yet to patch.
   virtual void upload(const commit::ChangeSet& changes) = 0;
+  // Whether the tracer runs the skinning routines (kernel/skinning.h) itself, on its device, for the
+  // skins in ChangeSet::posed_skins; otherwise they run on the host while the commit is applied.
+  virtual bool skins_on_device() const { return false; }
 
   // The band's parameters with the scene's light, instance and TLAS node counts filled in.
   KFrameParams frame_params(const core::BandJob& job) const;

@@ -32,6 +32,7 @@ class CudaTracer final : public TracerBase {
 
  private:
   void upload(const commit::ChangeSet& changes) override;
+  bool skins_on_device() const override { return true; }
 
   struct Impl;
   std::unique_ptr<Impl> impl_;
