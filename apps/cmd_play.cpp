@@ -31,7 +31,7 @@ struct PlayArgs {
   int spp = 1;
   int bounces = 1;
   std::string light_sampling = "tree";
-  std::string convergence = "brigade";
+  std::string convergence = "reproject";  // measured better than brigade (docs/denoising.md)
   std::string mode = "path";
   std::string tone = "aces";
   int frames = 0;            // 0: until the window closes
@@ -307,8 +307,8 @@ void add_play_command(CLI::App& app, int& exit_code) {
       ->capture_default_str()
       ->check(CLI::IsMember(core::light_sampling_names()));
   cmd->add_option("--convergence", a->convergence,
-                  "how frames accumulate: brigade (whole-frame blend) or reproject (per-pixel history through "
-                  "motion vectors; see `cohort render --help`)")
+                  "how frames accumulate: reproject (per-pixel history through motion vectors) or brigade "
+                  "(whole-frame blend); see `cohort render --help`")
       ->capture_default_str()
       ->check(CLI::IsMember({"brigade", "reproject"}));
   cmd->add_option("--mode", a->mode, "debug mode at start")

@@ -54,7 +54,7 @@ struct RenderArgs {
   std::vector<float> camera;  // x y z yaw pitch
   std::vector<std::string> bases;
   bool no_convergence = false;
-  std::string convergence = "brigade";
+  std::string convergence = "reproject";  // measured better than brigade (docs/denoising.md)
   std::string replay;
   std::string trace;
   std::string denoise = "none";
@@ -323,9 +323,9 @@ void add_render_command(CLI::App& app, int& exit_code) {
       ->capture_default_str()
       ->check(CLI::IsMember({"high", "balanced", "fast"}));
   cmd->add_option("--convergence", a->convergence,
-                  "how frames accumulate: brigade (whole-frame blend, f from camera motion; the paper's) or "
-                  "reproject (per-pixel history through motion vectors, with disocclusion tests and "
-                  "neighbourhood clamping; the tracers also write depth, normal, albedo, id and motion)")
+                  "how frames accumulate: reproject (per-pixel history through motion vectors, with disocclusion "
+                  "tests and neighbourhood clamping; the tracers also write depth, normal, albedo, id and motion) "
+                  "or brigade (whole-frame blend, f from camera motion; the paper's)")
       ->capture_default_str()
       ->check(CLI::IsMember({"brigade", "reproject"}));
   cmd->add_flag("--no-convergence", a->no_convergence,

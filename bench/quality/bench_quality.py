@@ -29,9 +29,9 @@ except ImportError as e:  # pragma: no cover - environment check
 
 METHODS = {
     "none": ["--no-convergence"],
-    "brigade": [],
+    "brigade": ["--convergence", "brigade"],
     "oidn": ["--no-convergence", "--denoise", "oidn"],
-    "brigade+oidn": ["--denoise", "oidn"],
+    "brigade+oidn": ["--convergence", "brigade", "--denoise", "oidn"],
     "reproject": ["--convergence", "reproject"],
     "reproject+oidn": ["--convergence", "reproject", "--denoise", "oidn"],
 }

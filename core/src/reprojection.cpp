@@ -54,28 +54,44 @@ void TemporalReprojection::accumulate(const FrameBuffer& fresh, const GBuffer& g
   const ReprojectionOptions& o = options_;
   const float max_history = static_cast<float>(std::max(o.max_history, 1));
 
+  // The fresh frame in YCoCg once, for the neighbourhood moments (non-finite samples flagged).
+  ycocg_.resize(3 * pixels);
+  finite_.resize(pixels);
+  HostThreads::shared().for_ranges(pixels, 4096, [&](size_t begin, size_t end) {
+    for (size_t p = begin; p < end; ++p) {
+      const float* c = fresh.rgba.data() + 4 * p;
+      const bool ok = finite_rgb(c);
+      const YCoCg v = ok ? to_ycocg(c) : YCoCg{0.0f, 0.0f, 0.0f};
+      ycocg_[3 * p] = v.y, ycocg_[3 * p + 1] = v.co, ycocg_[3 * p + 2] = v.cg;
+      finite_[p] = ok ? 1 : 0;
+    }
+  });
   HostThreads::shared().for_ranges(static_cast<size_t>(height), kRowsPerTask, [&](size_t row_begin, size_t row_end) {
     for (int y = static_cast<int>(row_begin); y < static_cast<int>(row_end); ++y) {
       for (int x = 0; x < width; ++x) {
         const size_t p = static_cast<size_t>(y) * width + x;
         const float* sample = fresh.rgba.data() + 4 * p;
-        // Neighbourhood moments of the fresh frame in YCoCg (finite samples only).
+        // Neighbourhood moments of the fresh frame in YCoCg (finite samples only), when needed.
         float m1[3] = {0, 0, 0}, m2[3] = {0, 0, 0};
         int count = 0;
-        for (int dy = -1; dy <= 1; ++dy) {
-          const int ny = y + dy;
-          if (ny < 0 || ny >= height) continue;
-          for (int dx = -1; dx <= 1; ++dx) {
-            const int nx = x + dx;
-            if (nx < 0 || nx >= width) continue;
-            const float* c = fresh.rgba.data() + 4 * (static_cast<size_t>(ny) * width + nx);
-            if (!finite_rgb(c)) continue;
-            const YCoCg v = to_ycocg(c);
-            m1[0] += v.y, m1[1] += v.co, m1[2] += v.cg;
-            m2[0] += v.y * v.y, m2[1] += v.co * v.co, m2[2] += v.cg * v.cg;
-            ++count;
+        auto moments = [&] {
+          for (int dy = -1; dy <= 1; ++dy) {
+            const int ny = y + dy;
+            if (ny < 0 || ny >= height) continue;
+            for (int dx = -1; dx <= 1; ++dx) {
+              const int nx = x + dx;
+              if (nx < 0 || nx >= width) continue;
+              const size_t q = static_cast<size_t>(ny) * width + nx;
+              if (!finite_[q]) continue;
+              const float* v = ycocg_.data() + 3 * q;
+              for (int k = 0; k < 3; ++k) {
+                m1[k] += v[k];
+                m2[k] += v[k] * v[k];
+              }
+              ++count;
+            }
           }
-        }
+        };
         // The history, reprojected: bilinear over the taps that saw the same surface.
         float history[3] = {0, 0, 0};
         float history_length = 0.0f;
@@ -112,6 +128,7 @@ void TemporalReprojection::accumulate(const FrameBuffer& fresh, const GBuffer& g
             history_length = length_sum * inv;
           }
         }
+        if (history_length > 0.0f && moved) moments();
         if (history_length > 0.0f && moved && count > 0) {
           const float inv = 1.0f / static_cast<float>(count);
           YCoCg h = to_ycocg(history);
@@ -135,6 +152,7 @@ void TemporalReprojection::accumulate(const FrameBuffer& fresh, const GBuffer& g
           next_length_[p] = history_length;
         } else {
           // No usable sample and no history: show the neighbourhood's mean, keep no history.
+          moments();
           const float inv = count > 0 ? 1.0f / static_cast<float>(count) : 0.0f;
           YCoCg mean{m1[0] * inv, m1[1] * inv, m1[2] * inv};
           from_ycocg(mean, out);

@@ -12,6 +12,7 @@
 // history: the pixel keeps its history (or shows its neighbourhood's mean when it has none).
 #pragma once
 
+#include <cstdint>
 #include <vector>
 
 #include "cohort/core/frame_buffer.h"
@@ -48,6 +49,9 @@ class TemporalReprojection {
   // The previous frame's surfaces, to test history taps against.
   std::vector<float> depth_, normal_;
   std::vector<uint32_t> id_;
+  // The fresh frame in YCoCg and which of its samples are finite (scratch).
+  std::vector<float> ycocg_;
+  std::vector<uint8_t> finite_;
 };
 
 }  // namespace cohort::core
