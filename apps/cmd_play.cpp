@@ -31,6 +31,7 @@ struct PlayArgs {
   int spp = 1;
   int bounces = 1;
   std::string light_sampling = "tree";
+  std::string convergence = "reproject";  // measured better than brigade (docs/denoising.md)
   std::string mode = "path";
   std::string tone = "aces";
   int frames = 0;            // 0: until the window closes
@@ -117,6 +118,7 @@ int run_play(PlayArgs a) {
   settings.light_sampling = core::light_sampling_mode(a.light_sampling);
   settings.mode = debug_mode_from_name(a.mode).value_or(K_MODE_PATH);
   settings.tone_curve = a.tone;
+  settings.reproject = a.convergence == "reproject";
   float scale = a.scale;
   bool show_hud = true;
   std::vector<Notice> notices;
@@ -304,6 +306,11 @@ void add_play_command(CLI::App& app, int& exit_code) {
                   "`cohort render --help`)")
       ->capture_default_str()
       ->check(CLI::IsMember(core::light_sampling_names()));
+  cmd->add_option("--convergence", a->convergence,
+                  "how frames accumulate: reproject (per-pixel history through motion vectors) or brigade "
+                  "(whole-frame blend); see `cohort render --help`")
+      ->capture_default_str()
+      ->check(CLI::IsMember({"brigade", "reproject"}));
   cmd->add_option("--mode", a->mode, "debug mode at start")
       ->capture_default_str()
       ->check(CLI::IsMember(debug_mode_names()));

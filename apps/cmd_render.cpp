@@ -15,6 +15,7 @@
 #include "cohort/core/frame_timeline.h"
 #include "cohort/core/gpu_scene.h"
 #include "cohort/core/convergence.h"
+#include "cohort/core/reprojection.h"
 #include "cohort/core/oidn_denoiser.h"
 #include "cohort/core/frame_defaults.h"
 #include "cohort/core/frame_pipeline.h"
@@ -53,6 +54,7 @@ struct RenderArgs {
   std::vector<float> camera;  // x y z yaw pitch
   std::vector<std::string> bases;
   bool no_convergence = false;
+  std::string convergence = "reproject";  // measured better than brigade (docs/denoising.md)
   std::string replay;
   std::string trace;
   std::string denoise = "none";
@@ -120,6 +122,10 @@ int run_render(const RenderArgs& a) {
   const bool oiio = core::have_image_library();
   nlohmann::json stats_json = nlohmann::json::array();
   core::AdaptiveConvergence convergence;
+  core::TemporalReprojection reprojection;
+  const bool reproject = a.convergence == "reproject" && !a.no_convergence;
+  core::FrameBuffer albedo_guide, normal_guide;
+  KCamera previous_camera{};  // none yet: the first frame is its own previous
   const std::optional<CameraPath> path =
       a.camera_path.empty() ? std::nullopt : std::optional<CameraPath>(parse_camera_path(a.camera_path));
   ProgressBar progress(player ? 0 : a.frames, std::cerr, stderr_is_terminal());
@@ -145,15 +151,29 @@ int run_render(const RenderArgs& a) {
     const core::FrameBuffer& frame = pipeline.image();
     const int f = static_cast<int>(stats.frame);
     // Adaptive convergence: a still camera accumulates every frame; motion raises f (see convergence.h).
-    if (!a.no_convergence) {
+    // Reprojection (--convergence reproject): per-pixel history through the frame's motion vectors.
+    const core::GBuffer& gbuffer = pipeline.gbuffer();
+    if (reproject) {
+      core::ScopedStage blending(stats.stages, core::kCoreTrack, "convergence");
+      reprojection.accumulate(frame, gbuffer);
+      stats.convergence_f = 1.0 / std::max(reprojection.mean_history_length(), 1.0);
+    } else if (!a.no_convergence) {
       core::ScopedStage blending(stats.stages, core::kCoreTrack, "convergence");
       stats.convergence_f = convergence.accumulate(done.job.camera, frame);
     }
-    const core::FrameBuffer* shown_image = a.no_convergence ? &frame : &convergence.image();
+    const core::FrameBuffer* shown_image =
+        a.no_convergence ? &frame : reproject ? &reprojection.image() : &convergence.image();
     const bool writes_frame = !(a.write == "last" && f + 1 < a.frames && !player);
     if (denoiser && writes_frame) {
       core::ScopedStage denoising(stats.stages, core::kCoreTrack, "denoise");
-      denoiser->denoise(*shown_image, denoised);
+      core::DenoiseGuides guides;
+      if (!gbuffer.empty()) {  // the aux planes guide the filter where the frame has them
+        core::plane_to_frame(gbuffer.albedo, gbuffer.width, gbuffer.height, albedo_guide);
+        core::plane_to_frame(gbuffer.normal, gbuffer.width, gbuffer.height, normal_guide);
+        guides.albedo = &albedo_guide;
+        guides.normal = &normal_guide;
+      }
+      denoiser->denoise(*shown_image, denoised, guides);
       shown_image = &denoised;
     }
     const core::FrameBuffer& shown = *shown_image;
@@ -212,6 +232,11 @@ int run_render(const RenderArgs& a) {
     p.spec_boost = a.spec_boost;
     p.mode = modes().at(a.mode);
     p.soft_shadow_scale = a.soft_shadow_scale;
+    if (reproject) {
+      p.aux_outputs = 1u;
+      job.previous_camera = previous_camera;
+      previous_camera = job.camera;
+    }
     started[uint64_t(f)] = frame_start;
     if (std::optional<core::FramePipeline::Delivered> done = pipeline.push(job, std::move(stages))) finish(std::move(*done));
   }
@@ -221,7 +246,8 @@ int run_render(const RenderArgs& a) {
                            {"balancer", a.balancer}, {"width", a.width},     {"height", a.height},
                            {"spp", a.spp},       {"bounces", a.bounces},
                            {"light_sampling", a.light_sampling}, {"light_samples", a.light_samples},    {"mode", a.mode},
-                           {"camera_path", a.camera_path}, {"denoise", a.denoise}, {"frames", stats_json}};
+                           {"camera_path", a.camera_path}, {"denoise", a.denoise},
+                           {"convergence", a.no_convergence ? "none" : a.convergence}, {"frames", stats_json}};
   std::ofstream(std::filesystem::path(a.out) / "stats.json") << report.dump(2) << "\n";
   std::cout << "wrote " << rendered << " frame(s) and stats.json to " << a.out << "\n";
   return kExitOk;
@@ -296,6 +322,12 @@ void add_render_command(CLI::App& app, int& exit_code) {
                   "Open Image Denoise's filter quality: high, balanced or fast (several times quicker)")
       ->capture_default_str()
       ->check(CLI::IsMember({"high", "balanced", "fast"}));
+  cmd->add_option("--convergence", a->convergence,
+                  "how frames accumulate: reproject (per-pixel history through motion vectors, with disocclusion "
+                  "tests and neighbourhood clamping; the tracers also write depth, normal, albedo, id and motion) "
+                  "or brigade (whole-frame blend, f from camera motion; the paper's)")
+      ->capture_default_str()
+      ->check(CLI::IsMember({"brigade", "reproject"}));
   cmd->add_flag("--no-convergence", a->no_convergence,
                  "write each frame as rendered instead of blending frames with adaptive convergence");
   cmd->add_option("--write", a->write, "images of every frame, or only the last (stats.json always has every frame)")

@@ -1,5 +1,6 @@
 #include "play_session.h"
 
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 
@@ -7,6 +8,7 @@
 
 #include "cohort/commit/commit_buffer.h"
 #include "cohort/core/convergence.h"
+#include "cohort/core/reprojection.h"
 #include "cohort/core/frame_defaults.h"
 #include "cohort/core/frame_pipeline.h"
 #include "cohort/core/frame_timeline.h"
@@ -69,6 +71,8 @@ struct PlaySession::State {
     bool animating = false;
   } in_flight;
   core::AdaptiveConvergence convergence;
+  core::TemporalReprojection reprojection;
+  KCamera previous_camera{};   // of the frame handed out last, for motion vectors
   std::vector<float> moving_mask;
   double scenario_seconds = 0.0;
   uint64_t frame_index = 0;
@@ -162,6 +166,11 @@ SessionFrame PlaySession::frame(const viewer::FlyCamera& camera, double seconds,
   p.max_bounces = static_cast<kuint>(settings.max_bounces);
   p.light_sampling = settings.light_sampling;
   p.mode = settings.mode;
+  if (settings.reproject) {
+    p.aux_outputs = 1u;
+    job.previous_camera = s.previous_camera;
+  }
+  s.previous_camera = job.camera;
 
   // The pipeline hands this frame out and gives back the one before it, which is blended and tone-mapped
   // while this one renders.
@@ -176,8 +185,27 @@ SessionFrame PlaySession::frame(const viewer::FlyCamera& camera, double seconds,
   const core::FrameBuffer& hdr = s.pipeline->image();
   const kuint mode = done->job.params.mode;
 
-  if (mode != s.last_mode) s.convergence.reset();  // another view of the scene entirely
+  if (mode != s.last_mode) {  // another view of the scene entirely
+    s.convergence.reset();
+    s.reprojection.reset();
+  }
   s.last_mode = mode;
+  const core::GBuffer& gbuffer = s.pipeline->gbuffer();
+  if (done->job.params.aux_outputs != 0u && !gbuffer.empty()) {
+    // Per-pixel history: moving objects carry their own motion, so no mask is needed.
+    core::ScopedStage blending(out.stats.stages, core::kCoreTrack, "convergence");
+    s.reprojection.accumulate(hdr, gbuffer);
+    out.stats.convergence_f = 1.0 / std::max(s.reprojection.mean_history_length(), 1.0);
+    blending.finish();
+    core::ToneMapOptions tm;
+    tm.curve = core::parse_tone_curve(settings.tone_curve);
+    core::ScopedStage tone_mapping(out.stats.stages, core::kCoreTrack, "tone map");
+    out.display = core::tone_map(s.reprojection.image(), tm);
+    tone_mapping.finish();
+    out.width = s.reprojection.image().width;
+    out.height = s.reprojection.image().height;
+    return out;
+  }
   // Without per-pixel object ids every pixel counts as possibly moving while the door, fan and
   // flicker animate; pause the scenario (P) to let the image converge.
   const std::vector<float>* mask = nullptr;

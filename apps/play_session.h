@@ -31,6 +31,7 @@ struct FrameSettings {
   int max_bounces = 1;
   kuint light_sampling = K_LIGHTS_TREE;
   std::string tone_curve = "aces";
+  bool reproject = false;           // per-pixel reprojection (core/reprojection.h) instead of Brigade's blend
 };
 
 struct SessionFrame {

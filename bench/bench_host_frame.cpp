@@ -1,7 +1,9 @@
 // The core's per-pixel host work per frame (merge of the tracers' bands, the convergence blend, the
 // tone map) at a given size, for each band format: what `cohort render` and `cohort play` spend on the
 // host besides the tracers. Two simulated tracers (virtual clock) split the rows; the camera stays
-// still, so every frame blends into the accumulated image.
+// still, so every frame blends into the accumulated image. The reprojection (core/reprojection.h) is
+// timed beside the blend on a synthetic G-buffer in which every pixel moves (0.3 pixels a frame, the
+// costly case: bilinear history and neighbourhood clamp everywhere).
 //
 //   bench_host_frame [--width 1920] [--height 1080] [--frames 40] [--json FILE]   (out/bench_host_frame.json)
 #include <algorithm>
@@ -17,6 +19,7 @@
 #include "cohort/core/frame_pipeline.h"
 #include "cohort/core/host_threads.h"
 #include "cohort/core/renderer.h"
+#include "cohort/core/reprojection.h"
 #include "cohort/core/simulated_tracer.h"
 #include "cohort/core/tonemap.h"
 
@@ -53,11 +56,23 @@ nlohmann::json run(BandFormat format, int width, int height, int frames) {
   FramePipeline pipeline(renderer);
   AdaptiveConvergence convergence;
   ToneMapOptions tone_options;
-  std::vector<double> merge, blend, tone;
+  TemporalReprojection reprojection;
+  GBuffer moving;
+  moving.resize(width, height);
+  for (size_t p = 0; p < moving.pixels(); ++p) {
+    moving.depth[p] = moving.prev_depth[p] = 100.0f;
+    moving.normal[3 * p + 2] = 1.0f;
+    moving.id[p] = 0;
+    moving.motion[2 * p] = 0.3f;
+  }
+  std::vector<double> merge, blend, tone, reproject;
   auto finish = [&](FramePipeline::Delivered done) {
     ScopedStage blending(done.stats.stages, kCoreTrack, "convergence");
     convergence.accumulate(done.job.camera, pipeline.image());
     blending.finish();
+    ScopedStage reprojecting(done.stats.stages, kCoreTrack, "reproject");
+    reprojection.accumulate(pipeline.image(), moving);
+    reprojecting.finish();
     ScopedStage mapping(done.stats.stages, kCoreTrack, "tone map");
     const std::vector<uint8_t> display = tone_map(convergence.image(), tone_options);
     mapping.finish();
@@ -65,6 +80,7 @@ nlohmann::json run(BandFormat format, int width, int height, int frames) {
     merge.push_back(stage_ms(done.stats, "merge"));
     blend.push_back(stage_ms(done.stats, "convergence"));
     tone.push_back(stage_ms(done.stats, "tone map"));
+    reproject.push_back(stage_ms(done.stats, "reproject"));
   };
   for (int f = 0; f < frames; ++f) {
     BandJob job;
@@ -75,7 +91,8 @@ nlohmann::json run(BandFormat format, int width, int height, int frames) {
   if (auto done = pipeline.drain()) finish(std::move(*done));
   const double m = median(merge), c = median(blend), t = median(tone);
   return {{"band_format", to_string(format)}, {"band_bytes_per_pixel", bytes_per_pixel(format)},
-          {"merge_ms", m}, {"convergence_ms", c}, {"tone_map_ms", t}, {"host_ms", m + c + t}};
+          {"merge_ms", m}, {"convergence_ms", c}, {"tone_map_ms", t}, {"host_ms", m + c + t},
+          {"reproject_ms", median(reproject)}};
 }
 
 }  // namespace
@@ -96,13 +113,14 @@ int main(int argc, char** argv) {
   }
   std::printf("host work per frame at %dx%d, %u host threads, median of %d frames\n", width, height,
               HostThreads::shared().threads(), frames - 5);
-  std::printf("%-8s %10s %10s %14s %12s %10s\n", "band", "bytes/px", "merge ms", "convergence ms", "tone map ms", "host ms");
+  std::printf("%-8s %10s %10s %14s %12s %10s %13s\n", "band", "bytes/px", "merge ms", "convergence ms", "tone map ms",
+              "host ms", "reproject ms");
   nlohmann::json results = nlohmann::json::array();
   for (BandFormat format : {BandFormat::rgba32f, BandFormat::rgb16f}) {
     const nlohmann::json r = run(format, width, height, frames);
-    std::printf("%-8s %10zu %10.2f %14.2f %12.2f %10.2f\n", to_string(format), bytes_per_pixel(format),
+    std::printf("%-8s %10zu %10.2f %14.2f %12.2f %10.2f %13.2f\n", to_string(format), bytes_per_pixel(format),
                 r["merge_ms"].get<double>(), r["convergence_ms"].get<double>(), r["tone_map_ms"].get<double>(),
-                r["host_ms"].get<double>());
+                r["host_ms"].get<double>(), r["reproject_ms"].get<double>());
     results.push_back(r);
   }
   const std::filesystem::path path(json_path);

@@ -5,7 +5,9 @@ Renders the same camera path with `cohort render` once at high spp (the referenc
 afresh) and once per method at the interactive sample count, then compares each written frame with the
 reference frame: NVIDIA's FLIP (flip-evaluator, LDR, on the tone-mapped PNGs a viewer sees) and PSNR.
 Methods: none (each frame as rendered), brigade (adaptive convergence, Brigade's blend), oidn (each frame
-denoised by Open Image Denoise), brigade+oidn (the blended frame denoised). Reports a table, JSON, a
+denoised by Open Image Denoise), brigade+oidn (the blended frame denoised), reproject (per-pixel history
+through motion vectors, core/reprojection.h), reproject+oidn (the reprojected frame denoised, with the
+albedo and normal planes as the denoiser's guides). Reports a table, JSON, a
 per-frame FLIP plot and the milliseconds each method's extra stages took (from stats.json).
 
 Setup once: bench/quality/setup_env.sh, then
@@ -27,9 +29,11 @@ except ImportError as e:  # pragma: no cover - environment check
 
 METHODS = {
     "none": ["--no-convergence"],
-    "brigade": [],
+    "brigade": ["--convergence", "brigade"],
     "oidn": ["--no-convergence", "--denoise", "oidn"],
-    "brigade+oidn": ["--denoise", "oidn"],
+    "brigade+oidn": ["--convergence", "brigade", "--denoise", "oidn"],
+    "reproject": ["--convergence", "reproject"],
+    "reproject+oidn": ["--convergence", "reproject", "--denoise", "oidn"],
 }
 EXTRA_STAGES = ("convergence", "denoise")
 

@@ -94,6 +94,53 @@ void BandBuffer::resize(int width, int height, BandFormat format) {
   height_ = height;
   format_ = format;
   storage_.assign(static_cast<size_t>(width) * static_cast<size_t>(height) * bytes_per_pixel(format), 0);
+  if (!aux_.empty()) aux_.assign(static_cast<size_t>(width) * static_cast<size_t>(height), AuxTexel{});
+}
+
+void BandBuffer::enable_aux(bool on) {
+  const size_t pixels = static_cast<size_t>(width_) * static_cast<size_t>(height_);
+  if (!on) std::vector<AuxTexel>().swap(aux_);
+  else if (aux_.size() != pixels) aux_.assign(pixels, AuxTexel{});
+}
+
+void BandBuffer::store_aux(int y, int x, const KAux* aux, size_t pixels) {
+  if (aux_.empty()) throw std::logic_error("BandBuffer::store_aux: aux planes are not enabled");
+  if (y < 0 || y >= height_ || x < 0 || static_cast<size_t>(x) + pixels > static_cast<size_t>(width_))
+    throw std::out_of_range("BandBuffer::store_aux: pixels outside the buffer");
+  AuxTexel* to = aux_.data() + static_cast<size_t>(y) * static_cast<size_t>(width_) + static_cast<size_t>(x);
+  for (size_t p = 0; p < pixels; ++p) {
+    const KAux& a = aux[p];
+    AuxTexel& t = to[p];
+    t.depth = a.depth;
+    t.prev_depth = a.prev_depth;
+    t.motion[0] = a.motion[0];
+    t.motion[1] = a.motion[1];
+    for (int k = 0; k < 3; ++k) {
+      t.normal[k] = float_to_half(a.normal[k]);
+      t.albedo[k] = float_to_half(a.albedo[k]);
+    }
+    t.id = a.id;
+  }
+}
+
+void BandBuffer::copy_aux_rows_to(GBuffer& out, int row_begin, int row_end) const {
+  if (aux_.empty()) throw std::logic_error("BandBuffer::copy_aux_rows_to: aux planes are not enabled");
+  if (out.width != width_ || out.height != height_) throw std::invalid_argument("BandBuffer::copy_aux_rows_to: size mismatch");
+  if (row_begin < 0 || row_end > height_ || row_begin > row_end) throw std::out_of_range("BandBuffer::copy_aux_rows_to: rows");
+  const size_t first = static_cast<size_t>(row_begin) * static_cast<size_t>(width_);
+  const size_t last = static_cast<size_t>(row_end) * static_cast<size_t>(width_);
+  for (size_t i = first; i < last; ++i) {
+    const AuxTexel& t = aux_[i];
+    out.depth[i] = t.depth;
+    out.prev_depth[i] = t.prev_depth;
+    out.motion[2 * i] = t.motion[0];
+    out.motion[2 * i + 1] = t.motion[1];
+    for (size_t k = 0; k < 3; ++k) {
+      out.normal[3 * i + k] = half_to_float(t.normal[k]);
+      out.albedo[3 * i + k] = half_to_float(t.albedo[k]);
+    }
+    out.id[i] = t.id;
+  }
 }
 
 void BandBuffer::store(int y, int x, const float* rgba, size_t pixels) {

@@ -288,6 +288,7 @@ std::vector<uint64_t> Renderer::assign(const std::vector<Assignment>& assignment
   for (size_t i = 0; i < assignments.size(); ++i) {
     Worker& w = *workers_[static_cast<size_t>(assignments[i].worker)];
     w.targets[slot].resize(width, height, options_.band_format);
+    w.targets[slot].enable_aux(job.params.aux_outputs != 0u);
     ids[i] = next_job_++;
     {
       std::lock_guard lock(w.completion->mutex);
@@ -458,6 +459,17 @@ void Renderer::merge_frame(FrameStats& stats) {
   ScopedStage merging(stats.stages, kCoreTrack, "merge");
   if (out.width != width || out.height != height) out.resize(width, height);
   merge(frame->delivered, frame->slot, out);
+  if (frame->job.params.aux_outputs != 0u) {
+    if (gbuffer_.width != width || gbuffer_.height != height) gbuffer_.resize(width, height);
+    for (const Assignment& a : frame->delivered) {
+      const BandBuffer& target = workers_[static_cast<size_t>(a.worker)]->targets[frame->slot];
+      HostThreads::shared().for_ranges(static_cast<size_t>(a.band.rows()), kRowsPerCopy, [&](size_t begin, size_t end) {
+        target.copy_aux_rows_to(gbuffer_, a.band.begin + static_cast<int>(begin), a.band.begin + static_cast<int>(end));
+      });
+    }
+  } else if (!gbuffer_.empty()) {
+    gbuffer_.clear();
+  }
   merging.finish();
   stats.wall_ms = std::chrono::duration<double, std::milli>(Clock::now() - frame->start).count();
 }

@@ -181,3 +181,33 @@ TEST(AgreementOnTestMap, EmbreeAndOpenCLImagesMatch) {
   EXPECT_GT(mean, 0.01);
   EXPECT_LT(error, 0.005 * mean);
 }
+
+// Every tracer this machine runs writes the same planes as Embree for the test room (a known scene with
+// entities, textures, layers and an alpha-tested grate).
+TEST(AgreementAux, EveryTracerWritesEmbreesAuxPlanes) {
+  const KCamera cam = test_room_camera(64, 40);
+  KCamera prev = core::make_camera({-180, -130, 125}, {33.0f, 21.0f}, 90.0f, 64, 40);
+  auto room = std::make_shared<commit::TracerScene>(core::compile_scene(test_room()).tracer_scene);
+  auto embree = make_test_tracer("embree");
+  const core::GBuffer a = render_aux(*embree, room, 1, cam, prev);
+  int checked = 0;
+  for (const std::string& kind : built_tracers()) {
+    if (kind == "embree" || !tracer_runs_here(kind)) continue;
+    auto other = make_test_tracer(kind);
+    const core::GBuffer b = render_aux(*other, room, 1, cam, prev);
+    size_t id_mismatch = 0;
+    for (size_t p = 0; p < a.pixels(); ++p) {
+      if (a.id[p] != b.id[p]) { ++id_mismatch; continue; }  // a silhouette pixel may go either way
+      EXPECT_NEAR(a.depth[p], b.depth[p], 1e-2f * std::max(1.0f, a.depth[p])) << kind << " pixel " << p;
+      EXPECT_NEAR(a.motion[2 * p], b.motion[2 * p], 1e-2f) << kind << " pixel " << p;
+      EXPECT_NEAR(a.motion[2 * p + 1], b.motion[2 * p + 1], 1e-2f) << kind << " pixel " << p;
+      for (int k = 0; k < 3; ++k) {
+        EXPECT_NEAR(a.normal[3 * p + k], b.normal[3 * p + k], 1e-2f) << kind << " pixel " << p;
+        EXPECT_NEAR(a.albedo[3 * p + k], b.albedo[3 * p + k], 1e-2f) << kind << " pixel " << p;
+      }
+    }
+    EXPECT_LE(id_mismatch, a.pixels() / 100) << kind;
+    ++checked;
+  }
+  if (checked == 0) GTEST_SKIP() << "no tracer besides Embree runs here";
+}

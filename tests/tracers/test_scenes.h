@@ -11,7 +11,9 @@
 #include <glm/glm.hpp>
 
 #include "cohort/commit/commit_buffer.h"
+#include "cohort/core/band_buffer.h"
 #include "cohort/core/frame_buffer.h"
+#include "cohort/core/gbuffer.h"
 #include "cohort/core/gpu_scene.h"
 #include "cohort/core/image_output.h"
 #include "cohort/core/tracer.h"
@@ -62,6 +64,24 @@ inline core::FrameBuffer render(core::Tracer& tracer, const scene::Scene& scene,
   job.camera = camera;
   tracer.render_band(job, fb);
   return fb;
+}
+
+// Renders one frame's auxiliary planes (kernel/aux_outputs.h) after a full commit of `scene` at `frame`.
+inline core::GBuffer render_aux(core::Tracer& tracer, const std::shared_ptr<commit::TracerScene>& scene, uint64_t frame,
+                         const KCamera& camera, const KCamera& previous) {
+  tracer.apply(commit::CommitBuffer::full(scene, frame));
+  core::BandBuffer band(static_cast<int>(camera.width), static_cast<int>(camera.height), core::BandFormat::rgba32f);
+  band.enable_aux(true);
+  core::BandJob job;
+  job.params = frame_params(K_MODE_PATH, 1, 1, static_cast<int>(camera.height));
+  job.params.aux_outputs = 1u;
+  job.camera = camera;
+  job.previous_camera = previous;
+  tracer.render_band(job, band);
+  core::GBuffer g;
+  g.resize(band.width(), band.height());
+  band.copy_aux_rows_to(g, 0, band.height());
+  return g;
 }
 
 // Where the ray through image point (px, py) of a camera_looking_down meets z = 0.

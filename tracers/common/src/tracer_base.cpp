@@ -1,13 +1,33 @@
 #include "cohort/tracers/tracer_base.h"
 
+#include <algorithm>
+#include <cstdint>
+#include <unordered_map>
+
 namespace cohort::tracers {
 
 void TracerBase::apply(const commit::CommitBuffer& commit) {
+  const std::vector<KInstance> before = scene_.instances;
   commit::ChangeSet changes = commit::apply_commit(
       commit, scene_, skins_on_device() ? commit::Skinning::by_tracer : commit::Skinning::on_host);
+  remember_previous_transforms(before);
   if (!has_scene_) changes.full_resync = true;
   upload(changes);
   has_scene_ = true;   // only now: after a failed first upload the next commit is sent whole again
+}
+
+void TracerBase::remember_previous_transforms(const std::vector<KInstance>& before) {
+  auto key = [](const KInstance& inst) { return (static_cast<uint64_t>(inst.entity) << 32) | inst.blas; };
+  std::unordered_map<uint64_t, const KInstance*> old;
+  old.reserve(before.size());
+  for (const KInstance& inst : before) old.emplace(key(inst), &inst);
+  previous_transforms_.resize(scene_.instances.size() * 12);
+  for (size_t i = 0; i < scene_.instances.size(); ++i) {
+    const KInstance& inst = scene_.instances[i];
+    auto found = old.find(key(inst));
+    const float* from = found != old.end() ? found->second->object_to_world : inst.object_to_world;
+    std::copy(from, from + 12, previous_transforms_.begin() + static_cast<std::ptrdiff_t>(12 * i));
+  }
 }
 
 KFrameParams TracerBase::frame_params(const core::BandJob& job) const {

@@ -47,6 +47,9 @@ struct CudaTracer::Impl {
   DeviceArray<KSkinTriangle> skin_adjacency;
   DeviceArray<KJoint> joints;
   cudaTextureObject_t texel_texture = 0;
+  DeviceArray<float> previous_transforms;
+  DeviceArray<KAux> aux;
+  std::vector<KAux> host_aux;
   float4* band = nullptr;
   unsigned short* band_rgb16f = nullptr;   // the band as RGB halves, for RGB16F targets
   bool count_rays = false;
@@ -226,6 +229,17 @@ core::BandResult CudaTracer::render_band(const core::BandJob& job, core::BandBuf
   }
   COHORT_CUDA(cudaMemcpyAsync(target.row(int(params.row_begin)), source, pixels * core::bytes_per_pixel(target.format()),
                               cudaMemcpyDeviceToHost, m.stream));
+  const bool write_aux = params.aux_outputs != 0u && target.has_aux();
+  if (write_aux) {
+    // Only frames that ask pay for it: a second kernel after the band's, on the same stream.
+    const KCamera previous = job.previous_camera.width > 0 ? job.previous_camera : camera;
+    m.previous_transforms.upload(previous_transforms(), 0, m.stream);
+    m.host_aux.resize(pixels);
+    m.aux.upload(m.host_aux, pixels, m.stream);   // sizes the device array; nothing to copy
+    launch_aux_band(m.view(params), params, camera, previous,
+                    previous_transforms().empty() ? nullptr : m.previous_transforms.data(), m.aux.data(), m.stream);
+    COHORT_CUDA(cudaMemcpyAsync(m.host_aux.data(), m.aux.data(), pixels * sizeof(KAux), cudaMemcpyDeviceToHost, m.stream));
+  }
   m.host_row_rays.resize(rows);
   COHORT_CUDA(cudaMemcpyAsync(m.host_row_rays.data(), m.row_rays, rows * sizeof(unsigned), cudaMemcpyDeviceToHost, m.stream));
   unsigned long long counts[2] = {0, 0};
@@ -233,6 +247,9 @@ core::BandResult CudaTracer::render_band(const core::BandJob& job, core::BandBuf
     COHORT_CUDA(cudaMemcpyAsync(counts, m.ray_counts, sizeof counts, cudaMemcpyDeviceToHost, m.stream));
   COHORT_CUDA(cudaStreamSynchronize(m.stream));
   m.last_counts = RayCounts{counts[0], counts[1]};
+  if (write_aux)
+    for (size_t r = 0; r < rows; ++r)
+      target.store_aux(int(params.row_begin + r), 0, m.host_aux.data() + r * camera.width, camera.width);
   float kernel_ms = 0.0f;
   COHORT_CUDA(cudaEventElapsedTime(&kernel_ms, m.start, m.stop));
   core::BandResult result;

@@ -9,6 +9,7 @@ __constant__ cudaTextureObject_t cohort_texel_texture;
 
 #include "cohort/kernel/trace_bvh.h"
 #include "cohort/kernel/integrator.h"
+#include "cohort/kernel/aux_outputs.h"
 #include "render_band_launch.h"
 
 namespace cohort::tracers {
@@ -50,6 +51,32 @@ __global__ void __launch_bounds__(128, 4) render_band_kernel(KSceneView scene, K
     const unsigned half = lane < 16u ? low : high;
     if ((lane == 0u || lane == 16u) && y < params.row_end && half != 0u) atomicAdd(&row_rays[row], half);
   }
+}
+
+// Auxiliary outputs (aux_outputs.h), launched only for frames that ask for them.
+__global__ void aux_band_kernel(KSceneView scene, KFrameParams params, KCamera camera, KCamera previous_camera,
+                                const float* previous_transforms, KAux* band_aux) {
+  const kuint x = blockIdx.x * blockDim.x + threadIdx.x;
+  const kuint row = blockIdx.y * blockDim.y + threadIdx.y;
+  const kuint y = params.row_begin + row;
+  if (x >= camera.width || y >= params.row_end) return;
+  KTraceCtx ctx;
+  ctx.scene = scene;
+  ctx.closest_rays = 0u;
+  ctx.occlusion_rays = 0u;
+  KAux a;
+  k_pixel_aux(&ctx, &camera, &previous_camera, previous_transforms, x, y, &a);
+  band_aux[size_t(row) * camera.width + x] = a;
+}
+
+void launch_aux_band(const KSceneView& scene, const KFrameParams& params, const KCamera& camera,
+                     const KCamera& previous_camera, const float* previous_transforms, KAux* band_aux,
+                     cudaStream_t stream) {
+  const kuint rows = params.row_end - params.row_begin;
+  const dim3 block(16, 8);
+  const dim3 grid((camera.width + block.x - 1) / block.x, (rows + block.y - 1) / block.y);
+  aux_band_kernel<<<grid, block, 0, stream>>>(scene, params, camera, previous_camera, previous_transforms, band_aux);
+  COHORT_CUDA(cudaGetLastError());
 }
 
 void set_texel_texture(cudaTextureObject_t texture) {

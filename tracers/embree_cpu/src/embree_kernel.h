@@ -80,3 +80,4 @@ static inline int k_trace_occluded(KTraceCtx* ctx, KVec3 org, KVec3 dir, float t
 }
 
 #include "cohort/kernel/integrator.h"
+#include "cohort/kernel/aux_outputs.h"

@@ -146,12 +146,16 @@ core::BandResult EmbreeTracer::render_band(const core::BandJob& job, core::BandB
   const int row_end = std::min(static_cast<int>(params.row_end), target.height());
   const int width = std::min(static_cast<int>(camera.width), target.width());
   const embree_kernel::TraceCtx base{host_scene_view(params), impl_->top, 0};
+  const bool write_aux = params.aux_outputs != 0u && target.has_aux();
+  const KCamera previous_camera = job.previous_camera.width > 0 ? job.previous_camera : camera;
+  const float* object_history = previous_transforms().empty() ? nullptr : previous_transforms().data();
   std::atomic<uint64_t> rays{0};
   // Rays traced per row: the balancer's per-row work proxy (BandResult::row_work), as the GPU tracers count it.
   std::vector<float> row_rays(static_cast<size_t>(std::max(row_end - row_begin, 0)), 0.0f);
   tbb::parallel_for(tbb::blocked_range<int>(row_begin, row_end, 1), [&](const tbb::blocked_range<int>& rows) {
     embree_kernel::TraceCtx ctx = base;
     std::vector<float> out(static_cast<size_t>(width) * 4);  // one row, stored in the target's format
+    std::vector<KAux> aux(write_aux ? static_cast<size_t>(width) : 0u);
     for (int y = rows.begin(); y < rows.end(); ++y) {
       const uint64_t rays_before = ctx.rays;
       for (int x = 0; x < width; ++x) {
@@ -162,6 +166,12 @@ core::BandResult EmbreeTracer::render_band(const core::BandJob& job, core::BandB
         out[4 * x + 3] = 1.0f;
       }
       target.store(y, 0, out.data(), static_cast<size_t>(width));
+      if (write_aux) {
+        for (int x = 0; x < width; ++x)
+          k_pixel_aux(&ctx, &camera, &previous_camera, object_history, static_cast<kuint>(x),
+                      static_cast<kuint>(y), &aux[static_cast<size_t>(x)]);
+        target.store_aux(y, 0, aux.data(), static_cast<size_t>(width));
+      }
       row_rays[static_cast<size_t>(y - row_begin)] = static_cast<float>(ctx.rays - rays_before);
     }
     rays += ctx.rays;

@@ -2,6 +2,7 @@
  * portable two-level BVH. The build inlines the #includes (embed_kernel.cmake). */
 #include "cohort/kernel/trace_bvh.h"
 #include "cohort/kernel/integrator.h"
+#include "cohort/kernel/aux_outputs.h"
 
 __kernel void cohort_render_band(__global const KVertex* vertices, __global const KTriangle* triangles,
                                  __global const KBvhNode* blas_nodes, __global const KBlas* blases,
@@ -38,6 +39,35 @@ __kernel void cohort_render_band(__global const KVertex* vertices, __global cons
   }
   barrier(CLK_LOCAL_MEM_FENCE);
   if (lx == 0u && y < params.row_end && group_row_rays[ly] != 0u) atomic_add(&row_rays[row], group_row_rays[ly]);
+}
+
+/* Auxiliary outputs (aux_outputs.h), launched only for frames that ask for them: one work item per
+ * pixel of the band, writing a KAux each. prev_transforms: 12 floats per instance (the host always
+ * passes one; with no instance moved it equals the current transforms). */
+__kernel void cohort_aux_band(__global const KVertex* vertices, __global const KTriangle* triangles,
+                              __global const KBvhNode* blas_nodes, __global const KBlas* blases,
+                              __global const KInstance* instances, __global const KBvhNode* tlas_nodes,
+                              __global const KMaterial* materials, __global const KTexture* textures,
+                              __global const kuint* texels, __global const KLight* lights,
+                              __global const KLightNode* light_nodes, __global const KEmissiveTriangle* emissive,
+                              __global const KFrameParams* params_in, __global const KCamera* camera_in,
+                              __global const KCamera* prev_camera_in, __global const float* prev_transforms,
+                              __global KAux* band_aux) {
+  KFrameParams params = *params_in;
+  KCamera camera = *camera_in;
+  KCamera prev_camera = *prev_camera_in;
+  kuint x = (kuint)get_global_id(0);
+  kuint row = (kuint)get_global_id(1);
+  kuint y = params.row_begin + row;
+  if (x >= camera.width || y >= params.row_end) return;
+  KTraceCtx ctx;
+  ctx.scene = k_scene_view(vertices, triangles, blas_nodes, blases, instances, tlas_nodes, materials, textures, texels,
+                           lights, light_nodes, emissive, &params);
+  ctx.closest_rays = 0u;
+  ctx.occlusion_rays = 0u;
+  KAux a;
+  k_pixel_aux(&ctx, &camera, &prev_camera, params.instance_count > 0u ? prev_transforms : 0, x, y, &a);
+  band_aux[(size_t)row * camera.width + x] = a;
 }
 
 /* Skinned characters: the skinning kernels share the program. */

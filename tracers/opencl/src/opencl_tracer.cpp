@@ -101,7 +101,8 @@ struct OpenCLTracer::Impl {
   cl_context context = nullptr;
   cl_command_queue queue = nullptr;
   cl_program program = nullptr;
-  cl_kernel kernel = nullptr;
+  cl_kernel kernel = nullptr, aux_kernel = nullptr;
+  DeviceBuffer previous_transforms;
   DeviceBuffer vertices, triangles, blas_nodes, blases, instances, tlas_nodes, materials, textures, texels, lights, light_nodes,
       emissive;
   DeviceBuffer skins, skin_vertices, skin_weights, skin_adjacency, joints;
@@ -133,13 +134,14 @@ struct OpenCLTracer::Impl {
             "launching the BLAS refit kernel");
     }
   }
-  cl_mem params = nullptr, camera = nullptr, output = nullptr, row_rays = nullptr;
-  size_t output_bytes = 0, row_rays_rows = 0;
+  cl_mem params = nullptr, camera = nullptr, previous_camera = nullptr, output = nullptr, row_rays = nullptr,
+         aux = nullptr;
+  size_t output_bytes = 0, row_rays_rows = 0, aux_bytes = 0;
 
   ~Impl() {
-    for (cl_mem m : {params, camera, output, row_rays})
+    for (cl_mem m : {params, camera, previous_camera, output, row_rays, aux})
       if (m) clReleaseMemObject(m);
-    for (cl_kernel k : {kernel, skin_positions, skin_normals, refit_blas})
+    for (cl_kernel k : {kernel, aux_kernel, skin_positions, skin_normals, refit_blas})
       if (k) clReleaseKernel(k);
     if (program) clReleaseProgram(program);
     if (queue) clReleaseCommandQueue(queue);
@@ -196,6 +198,10 @@ OpenCLTracer::OpenCLTracer(const Options& options) : impl_(std::make_unique<Impl
   check(err, "clCreateKernel(cohort_skin_normals)");
   impl_->refit_blas = clCreateKernel(impl_->program, "cohort_refit_blas", &err);
   check(err, "clCreateKernel(cohort_refit_blas)");
+  impl_->aux_kernel = clCreateKernel(impl_->program, "cohort_aux_band", &err);
+  check(err, "clCreateKernel(aux)");
+  impl_->previous_camera = clCreateBuffer(impl_->context, CL_MEM_READ_ONLY, sizeof(KCamera), nullptr, &err);
+  check(err, "clCreateBuffer(previous camera)");
   impl_->params = clCreateBuffer(impl_->context, CL_MEM_READ_ONLY, sizeof(KFrameParams), nullptr, &err);
   check(err, "clCreateBuffer(params)");
   impl_->camera = clCreateBuffer(impl_->context, CL_MEM_READ_ONLY, sizeof(KCamera), nullptr, &err);
@@ -299,10 +305,43 @@ core::BandResult OpenCLTracer::render_band(const core::BandJob& job, core::BandB
   clReleaseEvent(done);
   for (size_t r = 0; r < rows; ++r)
     target.store(static_cast<int>(params.row_begin + r), 0, band.data() + r * camera.width * 4, camera.width);
+  if (params.aux_outputs != 0u && target.has_aux()) render_aux(job, params, camera, rows, target);
   core::BandResult result;
   result.device_ms = end > start ? double(end - start) * 1e-6 : 0.0;
   if (params.row_end == frame_params(job).row_end) result.row_work.assign(row_rays.begin(), row_rays.end());
   return result;
+}
+
+void OpenCLTracer::render_aux(const core::BandJob& job, const KFrameParams& params, const KCamera& camera, size_t rows,
+                              core::BandBuffer& target) {
+  Impl& m = *impl_;
+  const size_t bytes = rows * camera.width * sizeof(KAux);
+  cl_int err = CL_SUCCESS;
+  if (bytes > m.aux_bytes) {
+    if (m.aux) clReleaseMemObject(m.aux);
+    m.aux = clCreateBuffer(m.context, CL_MEM_WRITE_ONLY, bytes, nullptr, &err);
+    check(err, "clCreateBuffer(aux)");
+    m.aux_bytes = bytes;
+  }
+  const KCamera previous = job.previous_camera.width > 0 ? job.previous_camera : job.camera;
+  check(clEnqueueWriteBuffer(m.queue, m.previous_camera, CL_FALSE, 0, sizeof previous, &previous, 0, nullptr, nullptr),
+        "writing the previous camera");
+  m.previous_transforms.upload(m.context, m.queue, previous_transforms(), "uploading previous transforms");
+  cl_mem args[] = {m.vertices.mem(),  m.triangles.mem(),  m.blas_nodes.mem(),  m.blases.mem(),
+                   m.instances.mem(), m.tlas_nodes.mem(), m.materials.mem(),   m.textures.mem(),
+                   m.texels.mem(),    m.lights.mem(),     m.light_nodes.mem(), m.emissive.mem(),
+                   m.params,          m.camera,           m.previous_camera,   m.previous_transforms.mem(),
+                   m.aux};
+  for (cl_uint i = 0; i < sizeof(args) / sizeof(args[0]); ++i)
+    check(clSetKernelArg(m.aux_kernel, i, sizeof(cl_mem), &args[i]), "clSetKernelArg(aux)");
+  const size_t local[2] = {8, 8};
+  const size_t global[2] = {(camera.width + 7) / 8 * 8, (rows + 7) / 8 * 8};
+  check(clEnqueueNDRangeKernel(m.queue, m.aux_kernel, 2, nullptr, global, local, 0, nullptr, nullptr),
+        "launching the aux kernel");
+  std::vector<KAux> aux(rows * camera.width);
+  check(clEnqueueReadBuffer(m.queue, m.aux, CL_TRUE, 0, bytes, aux.data(), 0, nullptr, nullptr), "reading the aux band");
+  for (size_t r = 0; r < rows; ++r)
+    target.store_aux(static_cast<int>(params.row_begin + r), 0, aux.data() + r * camera.width, camera.width);
 }
 
 }  // namespace cohort::tracers

@@ -11,6 +11,8 @@
 #include <vector>
 
 #include "cohort/core/frame_buffer.h"
+#include "cohort/core/gbuffer.h"
+#include "cohort/kernel/layout.h"
 
 namespace cohort::core {
 
@@ -40,10 +42,26 @@ class BandBuffer {
   // Reads rows [row_begin, row_end) into the same rows of `out` (which must have this size) as RGBA floats.
   void copy_rows_to(FrameBuffer& out, int row_begin, int row_end) const;
 
+  // Auxiliary planes (kernel/aux_outputs.h), kept only for frames that ask for them: 32 bytes a pixel
+  // (depths, motion and id as 32-bit values, normal and albedo as half floats). Off frees them.
+  void enable_aux(bool on);
+  bool has_aux() const { return !aux_.empty(); }
+  // Writes `pixels` aux records at (x, y) onwards.
+  void store_aux(int y, int x, const KAux* aux, size_t pixels);
+  // Reads rows [row_begin, row_end) into the same rows of `out` (which must have this size).
+  void copy_aux_rows_to(GBuffer& out, int row_begin, int row_end) const;
+
  private:
   int width_ = 0, height_ = 0;
   BandFormat format_ = BandFormat::rgba32f;
   std::vector<unsigned char> storage_;
+  struct AuxTexel {
+    float depth, prev_depth, motion[2];
+    uint16_t normal[3], albedo[3];
+    uint32_t id;
+  };
+  static_assert(sizeof(AuxTexel) == 32, "AuxTexel layout");
+  std::vector<AuxTexel> aux_;
 };
 
 }  // namespace cohort::core

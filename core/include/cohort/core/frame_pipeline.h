@@ -41,6 +41,8 @@ class FramePipeline {
 
   // The last delivered frame, as merged; valid until the next push() or drain().
   const FrameBuffer& image() const { return image_; }
+  // Its auxiliary planes, when its job asked for them (KFrameParams::aux_outputs); else empty.
+  const GBuffer& gbuffer() const { return renderer_.gbuffer(); }
   bool in_flight() const { return in_flight_.has_value(); }
 
  private:

@@ -31,6 +31,7 @@
 #include "cohort/core/band_buffer.h"
 #include "cohort/core/frame_buffer.h"
 #include "cohort/core/frame_stats.h"
+#include "cohort/core/gbuffer.h"
 #include "cohort/core/tracer.h"
 
 namespace cohort::core {
@@ -91,6 +92,8 @@ class Renderer {
   FrameStats wait_frame();
   void merge_frame(FrameStats& stats);
   FrameStats finish_frame();
+  // The auxiliary planes of the last merged frame, when its job set params.aux_outputs (else empty).
+  const GBuffer& gbuffer() const { return gbuffer_; }
 
   int tracer_count() const;
   std::string tracer_name(int tracer) const;
@@ -154,6 +157,7 @@ class Renderer {
   std::unique_ptr<PendingFrame> pending_;    // begun, not yet waited for
   std::unique_ptr<PendingFrame> unmerged_;   // waited for, bands not yet merged
   int next_slot_ = 0;
+  GBuffer gbuffer_;
 };
 
 }  // namespace cohort::core

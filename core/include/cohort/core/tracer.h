@@ -15,6 +15,9 @@ namespace cohort::core {
 struct BandJob {
   KFrameParams params{};   // row_begin/row_end name the band, in full-resolution rows
   KCamera camera{};
+  // The previous frame's camera, for motion vectors when params.aux_outputs is set; a width of 0 means
+  // none (the frame is its own previous: camera motion 0).
+  KCamera previous_camera{};
 };
 
 struct BandResult {

@@ -161,16 +161,25 @@ typedef struct KCamera {
 /* light_count, instance_count, tlas_node_count, light_node_count and emissive_count are the lengths of
  * the scene's arrays, set by the host from the tracer's scene copy and read only by k_scene_view
  * (scene_view.h). emissive_samples: emissive triangles sampled per hit (0: emitters are found only by
- * bounce rays; 1: one sample, combined with the bounce by MIS). */
+ * bounce rays; 1: one sample, combined with the bounce by MIS). aux_outputs: 1 = the tracer also writes
+ * the band's auxiliary planes (aux_outputs.h: depth, normal, albedo, id, motion), 0 = it does not (no cost). */
 typedef struct KFrameParams {
   kuint frame_index;  kuint spp;          kuint max_bounces;   kuint light_samples;
   float firefly_clamp; float spec_boost;  kuint mode;          kuint light_count;
   kuint row_begin;    kuint row_end;      kuint instance_count; kuint tlas_node_count;
   float soft_shadow_scale; float rr_start; kuint light_sampling; kuint light_node_count;
-  kuint emissive_count; kuint emissive_samples; kuint pad0;    kuint pad1;
+  kuint emissive_count; kuint emissive_samples; kuint aux_outputs; kuint pad1;
 } KFrameParams;
 
+/* One pixel's auxiliary outputs (aux_outputs.h says what each field means). */
+#define K_AUX_NO_MOTION 1.0e9f   /* motion of a point that was behind the previous camera */
+typedef struct KAux {
+  float depth;     float prev_depth; float motion[2];
+  float normal[3]; float albedo[3];  kuint id;       kuint pad;
+} KAux;
+
 #if defined(__cplusplus) && !defined(__CUDACC_RTC__)
+static_assert(sizeof(KAux) == 48, "KAux layout");
 static_assert(sizeof(KBvhNode) == 32, "KBvhNode layout");
 static_assert(sizeof(KBlas) == 16, "KBlas layout");
 static_assert(sizeof(KInstance) == 112, "KInstance layout");

@@ -3,6 +3,8 @@
 // parameters with the scene's counts, and a KSceneView over the arrays wherever the tracer keeps them.
 #pragma once
 
+#include <vector>
+
 #include "cohort/commit/tracer_scene.h"
 #include "cohort/core/tracer.h"
 #include "cohort/kernel/scene_view.h"
@@ -30,9 +32,17 @@ class TracerBase : public core::Tracer {
   KFrameParams frame_params(const core::BandJob& job) const;
   // The kernel's view of the scene copy itself, for tracers that trace from host memory.
   KSceneView host_scene_view(const KFrameParams& params) const;
+  // Per instance (the scene's instance order), its object-to-world transform before the last applied
+  // commit (12 floats each): the previous frame's, for object motion vectors (kernel/aux_outputs.h).
+  // Instances are matched across commits by (entity, BLAS), since TLAS rebuilds reorder them; a new
+  // one gets its current transform (no motion).
+  const std::vector<float>& previous_transforms() const { return previous_transforms_; }
 
  private:
+  void remember_previous_transforms(const std::vector<KInstance>& before);
+
   commit::TracerScene scene_;
+  std::vector<float> previous_transforms_;
   bool has_scene_ = false;
 };
 

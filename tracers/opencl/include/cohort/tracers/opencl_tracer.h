@@ -33,6 +33,9 @@ class OpenCLTracer : public TracerBase {
  private:
   void upload(const commit::ChangeSet& changes) override;
   bool skins_on_device() const override { return true; }
+  // The band's auxiliary planes (kernel/aux_outputs.h), by a second kernel, into target.
+  void render_aux(const core::BandJob& job, const KFrameParams& params, const KCamera& camera, size_t rows,
+                  core::BandBuffer& target);
 
   struct Impl;
   std::unique_ptr<Impl> impl_;

@@ -1,0 +1,57 @@
+// Temporal accumulation with reprojection (issue 17), the per-pixel successor of Brigade's whole-frame
+// blend (core/convergence.h). Each pixel keeps its own history and history length. A new frame's pixel
+// finds its history where its surface was in the previous frame (the motion vectors of the frame's
+// G-buffer, kernel/aux_outputs.h), fetched bilinearly from the four history pixels around that point;
+// a tap counts only if it saw the same object (id), at the depth the point had then (prev_depth, within
+// depth_tolerance) and with a similar normal, so surfaces a moving object uncovers start afresh
+// (disocclusion). Where the pixel moved, the history is clamped to the fresh frame's 3x3 neighbourhood
+// box in YCoCg (mean +- clamp_sigma standard deviations), which bounds the ghosting of lighting that
+// reprojection cannot follow; a pixel that did not move keeps its history untouched, so a still view
+// is exactly the running average of its frames (up to max_history). Blend: C = H + (S - H) / n, n the
+// history length (capped at max_history). Samples that are not finite (NaN, Inf) never enter the
+// history: the pixel keeps its history (or shows its neighbourhood's mean when it has none).
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "cohort/core/frame_buffer.h"
+#include "cohort/core/gbuffer.h"
+
+namespace cohort::core {
+
+struct ReprojectionOptions {
+  int max_history = 64;           // frames; 1/max_history is the least blend weight of a new frame
+  float depth_tolerance = 0.05f;  // relative depth difference above which a history tap is another surface
+  float normal_cos = 0.8f;        // least cosine between the normals of a pixel and its history tap
+  float clamp_sigma = 1.5f;       // neighbourhood box half-width in standard deviations (moving pixels)
+  float still_motion = 0.01f;     // pixels: motion below this counts as no motion (no clamp)
+};
+
+class TemporalReprojection {
+ public:
+  explicit TemporalReprojection(ReprojectionOptions options = {}) : options_(options) {}
+
+  // Blends `fresh` (the merged frame) into the history through `gbuffer` (the same frame's auxiliary
+  // planes, same size). A size change restarts the history.
+  void accumulate(const FrameBuffer& fresh, const GBuffer& gbuffer);
+  const FrameBuffer& image() const { return image_; }
+  // Per pixel, the number of frames its colour is worth.
+  const std::vector<float>& history_length() const { return length_; }
+  // Mean history length over the frame (a scalar for stats: 1 = nothing reused).
+  double mean_history_length() const;
+  void reset();
+
+ private:
+  ReprojectionOptions options_;
+  FrameBuffer image_, next_image_;
+  std::vector<float> length_, next_length_;
+  // The previous frame's surfaces, to test history taps against.
+  std::vector<float> depth_, normal_;
+  std::vector<uint32_t> id_;
+  // The fresh frame in YCoCg and which of its samples are finite (scratch).
+  std::vector<float> ycocg_;
+  std::vector<uint8_t> finite_;
+};
+
+}  // namespace cohort::core

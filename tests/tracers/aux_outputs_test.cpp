@@ -1,0 +1,109 @@
+// Auxiliary outputs (kernel/aux_outputs.h): depth, normal, albedo and id of the first opaque hit, and
+// motion vectors, checked against the analytic reprojection of known points of a floor, for camera
+// motion and for an object's own motion (agreement between tracers: agreement_test.cpp).
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <memory>
+
+#include "test_scenes.h"
+#include "test_tracers.h"
+
+using namespace cohort;
+using namespace cohort::test;
+
+namespace {
+
+constexpr int kW = 48, kH = 32;
+constexpr float kHeight = 100.0f, kTan = 0.5f;
+
+std::shared_ptr<commit::TracerScene> compiled_floor() {
+  return std::make_shared<commit::TracerScene>(core::compile_scene(floor_scene(1000.0f, {0.25f, 0.5f, 0.75f})).tracer_scene);
+}
+
+// Where a world point appears in a camera's image, in pixels (the camera convention of core/view.h).
+glm::vec2 project(const KCamera& c, glm::vec3 p) {
+  glm::vec3 d = p - glm::vec3(c.origin[0], c.origin[1], c.origin[2]);
+  glm::vec3 f(c.forward[0], c.forward[1], c.forward[2]), r(c.right[0], c.right[1], c.right[2]), u(c.up[0], c.up[1], c.up[2]);
+  float z = glm::dot(d, f);
+  return {(glm::dot(d, r) / (z * c.tan_half_fov_x) + 1.0f) * 0.5f * float(c.width),
+          (1.0f - glm::dot(d, u) / (z * c.tan_half_fov_y)) * 0.5f * float(c.height)};
+}
+
+// Checks every pixel's motion against the projection of its floor point (moved by `object_offset`
+// back to where it was) into the previous camera.
+void expect_floor_motion(const core::GBuffer& g, const KCamera& cam, const KCamera& prev, glm::vec3 object_offset) {
+  for (int y = 0; y < kH; ++y)
+    for (int x = 0; x < kW; ++x) {
+      const size_t p = static_cast<size_t>(y) * kW + x;
+      const glm::vec3 point = floor_point(cam, x + 0.5f, y + 0.5f);
+      const glm::vec2 was = project(prev, point - object_offset);
+      ASSERT_NEAR(g.motion[2 * p], was.x - (x + 0.5f), 2e-3f) << x << "," << y;
+      ASSERT_NEAR(g.motion[2 * p + 1], was.y - (y + 0.5f), 2e-3f) << x << "," << y;
+    }
+}
+
+}  // namespace
+
+TEST(AuxOutputs, FloorGBufferUnderAStillCamera) {
+  auto tracer = make_test_tracer("embree");
+  const KCamera cam = camera_looking_down({0, 0, kHeight}, kTan, kW, kH);
+  const core::GBuffer g = render_aux(*tracer, compiled_floor(), 1, cam, cam);
+  for (size_t p = 0; p < g.pixels(); ++p) {
+    ASSERT_NEAR(g.depth[p], kHeight, 1e-2f);
+    ASSERT_NEAR(g.prev_depth[p], kHeight, 1e-2f);
+    ASSERT_NEAR(g.normal[3 * p + 2], 1.0f, 1e-3f);
+    ASSERT_NEAR(g.albedo[3 * p + 0], 0.25f, 2e-3f);
+    ASSERT_NEAR(g.albedo[3 * p + 1], 0.5f, 2e-3f);
+    ASSERT_NEAR(g.albedo[3 * p + 2], 0.75f, 2e-3f);
+    ASSERT_EQ(g.id[p], 0u);  // the world
+    ASSERT_NEAR(g.motion[2 * p], 0.0f, 1e-3f);
+    ASSERT_NEAR(g.motion[2 * p + 1], 0.0f, 1e-3f);
+  }
+}
+
+TEST(AuxOutputs, CameraTranslationMatchesTheAnalyticReprojection) {
+  auto tracer = make_test_tracer("embree");
+  const KCamera cam = camera_looking_down({0, 0, kHeight}, kTan, kW, kH);
+  const KCamera prev = camera_looking_down({7.0f, -4.0f, kHeight + 10.0f}, kTan, kW, kH);
+  const core::GBuffer g = render_aux(*tracer, compiled_floor(), 1, cam, prev);
+  expect_floor_motion(g, cam, prev, glm::vec3(0.0f));
+  EXPECT_NEAR(g.prev_depth[0], kHeight + 10.0f, 1e-2f);
+}
+
+TEST(AuxOutputs, CameraRotationMatchesTheAnalyticReprojection) {
+  auto tracer = make_test_tracer("embree");
+  const KCamera cam = camera_looking_down({0, 0, kHeight}, kTan, kW, kH);
+  KCamera prev = cam;  // rolled 10 degrees about the view axis and tilted 3 degrees
+  const float roll = 10.0f * 3.14159265f / 180.0f, tilt = 3.0f * 3.14159265f / 180.0f;
+  glm::vec3 right(std::cos(roll), std::sin(roll), 0.0f), up(-std::sin(roll), std::cos(roll), 0.0f);
+  glm::vec3 forward(0.0f, 0.0f, -1.0f);
+  glm::vec3 f2 = std::cos(tilt) * forward + std::sin(tilt) * up, u2 = std::cos(tilt) * up - std::sin(tilt) * forward;
+  for (int k = 0; k < 3; ++k) {
+    prev.right[k] = right[k];
+    prev.up[k] = u2[k];
+    prev.forward[k] = f2[k];
+  }
+  const core::GBuffer g = render_aux(*tracer, compiled_floor(), 1, cam, prev);
+  expect_floor_motion(g, cam, prev, glm::vec3(0.0f));
+}
+
+// The floor instance moves by a known offset between two commits: its points were `offset` back, so
+// with a still camera each pixel's motion is that offset in pixels.
+TEST(AuxOutputs, ObjectMotionFollowsTheInstanceTransform) {
+  auto tracer = make_test_tracer("embree");
+  const KCamera cam = camera_looking_down({0, 0, kHeight}, kTan, kW, kH);
+  auto before = compiled_floor();
+  render_aux(*tracer, before, 1, cam, cam);
+  auto after = std::make_shared<commit::TracerScene>(*before);
+  const glm::vec3 offset(6.0f, -3.0f, 0.0f);
+  for (KInstance& inst : after->instances) {
+    inst.object_to_world[3] += offset.x;
+    inst.object_to_world[7] += offset.y;
+    inst.world_to_object[3] -= offset.x;
+    inst.world_to_object[7] -= offset.y;
+  }
+  const core::GBuffer g = render_aux(*tracer, after, 2, cam, cam);
+  expect_floor_motion(g, cam, cam, offset);
+  EXPECT_NEAR(g.motion[0], -offset.x / (kHeight * kTan) * 0.5f * kW, 1e-3f);
+}
