@@ -100,7 +100,8 @@ KMaterial to_kmaterial(const scene::Material& material, const scene::Scene& scen
   return k;
 }
 
-KLight to_klight(const scene::Light& light, const scene::Scene& scene, const GpuSceneOptions& options) {
+KLight to_klight(const scene::Light& light, const scene::Scene& scene, const GpuSceneOptions& options,
+                 const glm::vec3* evaluated_stage_color) {
   KLight k{};
   int material = light.material;
   if (material < 0)
@@ -111,7 +112,7 @@ KLight to_klight(const scene::Light& light, const scene::Scene& scene, const Gpu
   k.falloff_tex = K_NONE;
   if (material >= 0) {
     const scene::Material& m = scene.materials[static_cast<size_t>(material)];
-    stage_color = m.light_stage_color;
+    stage_color = evaluated_stage_color ? *evaluated_stage_color : m.light_stage_color;
     k.light_tex = texture_slot(m.light_image, TextureUse::LightImage, scene);
     k.falloff_tex = texture_slot(m.falloff_image, TextureUse::Falloff, scene);
   }

@@ -49,6 +49,7 @@ std::set<int> all_indices(size_t count) {
 WorldSync::WorldSync(const scene::RenderWorld& world, WorldSyncOptions options) : world_(world), options_(options) {
   const scene::Scene& scene = world_.scene();
   base_material_count_ = static_cast<uint32_t>(scene.materials.size());
+  next_material_slot_ = base_material_count_ + 1;
   blas_of_mesh_.assign(scene.meshes.size(), K_NONE);
   master_.materials.assign(size_t(base_material_count_) + 1, KMaterial{});
   master_.materials[base_material_count_] = default_material();
@@ -106,7 +107,30 @@ uint32_t WorldSync::blas_of_mesh(int mesh) const {
 
 uint32_t WorldSync::kmaterial_index(int m) const {
   if (m < 0 || size_t(m) >= world_.scene().materials.size()) return base_material_count_;
-  return uint32_t(m) < base_material_count_ ? uint32_t(m) : uint32_t(m) + 1;
+  if (uint32_t(m) < base_material_count_) return uint32_t(m);
+  auto [slot, added] = late_material_slots_.try_emplace(m, next_material_slot_);
+  if (added) ++next_material_slot_;
+  return slot->second;
+}
+
+uint32_t WorldSync::new_material_slot() {
+  if (!free_material_slots_.empty()) {
+    const uint32_t slot = free_material_slots_.back();
+    free_material_slots_.pop_back();
+    return slot;
+  }
+  return next_material_slot_++;
+}
+
+double WorldSync::material_time() const {
+  if (time_override_) return *time_override_;
+  return world_.view() ? world_.view()->time_ms * 0.001 : 0.0;
+}
+
+scene::RegisterInputs WorldSync::world_registers() const {
+  scene::RegisterInputs r;   // parms as the engine gives world surfaces; globals as the game starts them
+  r.time = float(material_time());
+  return r;
 }
 
 uint32_t WorldSync::ensure_blas(int mesh, commit::CommitBuffer& out) {
@@ -117,12 +141,16 @@ uint32_t WorldSync::ensure_blas(int mesh, commit::CommitBuffer& out) {
 }
 
 // A new BLAS slot at the end of the pools (a redefined model's old one stays until a full resync).
-uint32_t WorldSync::build_mesh_blas(int mesh_index, commit::CommitBuffer& out) {
+uint32_t WorldSync::build_mesh_blas(int mesh_index, commit::CommitBuffer& out, const std::map<int, uint32_t>* instance_slots) {
   const scene::Mesh& mesh = world_.scene().meshes.at(size_t(mesh_index));
   std::vector<KVertex> vertices;
   vertices.reserve(mesh.vertices.size());
   for (const scene::Vertex& v : mesh.vertices) vertices.push_back(to_kvertex(v));
-  std::vector<KTriangle> triangles = mesh_triangles(mesh, 0, [this](int m) { return kmaterial_index(m); });
+  std::vector<KTriangle> triangles = mesh_triangles(mesh, 0, [this, instance_slots](int m) {
+    if (instance_slots)
+      if (auto slot = instance_slots->find(m); slot != instance_slots->end()) return slot->second;
+    return kmaterial_index(m);
+  });
   if (triangles.empty()) return K_NONE;
   BlasBuild build = build_blas(vertices, triangles);
 
@@ -185,7 +213,107 @@ void WorldSync::set_material(int m) {
   const scene::Scene& scene = world_.scene();
   uint32_t index = kmaterial_index(m);
   if (master_.materials.size() <= index) master_.materials.resize(index + 1);
-  master_.materials[index] = to_kmaterial(scene.materials.at(size_t(m)), scene);
+  const scene::Material& base = scene.materials.at(size_t(m));
+  const bool animated = base.registers && (base.registers->depends & (scene::kDependsTime | scene::kDependsGlobals));
+  auto listed = std::lower_bound(animated_materials_.begin(), animated_materials_.end(), m);
+  const bool was_listed = listed != animated_materials_.end() && *listed == m;
+  if (animated && !was_listed) animated_materials_.insert(listed, m);
+  if (!animated && was_listed) animated_materials_.erase(listed);
+  scene::Material evaluated;
+  scene::evaluate_material(base, world_registers(), evaluated);
+  master_.materials[index] = to_kmaterial(evaluated, scene);
+}
+
+namespace {
+
+// The materials an entity draws with: its customShader, else its model's surfaces' materials.
+std::set<int> entity_material_set(const scene::Scene& scene, const scene::RenderEntity& def) {
+  std::set<int> used;
+  if (def.custom_shader >= 0) {
+    used.insert(def.custom_shader);
+  } else if (def.model >= 0 && size_t(def.model) < scene.meshes.size()) {
+    for (const scene::Surface& surface : scene.meshes[size_t(def.model)].surfaces) used.insert(surface.material);
+  }
+  return used;
+}
+
+const scene::MaterialRegisters* registers_of(const scene::Scene& scene, int m) {
+  return m >= 0 && size_t(m) < scene.materials.size() ? scene.materials[size_t(m)].registers.get() : nullptr;
+}
+
+}  // namespace
+
+bool WorldSync::needs_material_instances(const scene::RenderEntity& def) const {
+  const scene::Scene& scene = world_.scene();
+  const scene::RegisterInputs world_parms;
+  for (int m : entity_material_set(scene, def)) {
+    const scene::MaterialRegisters* r = registers_of(scene, m);
+    if (!r || !(r->depends & scene::kDependsParms)) continue;
+    for (int p = 0; p < scene::kMaterialParms; ++p)
+      if ((r->parms_read >> p & 1u) && def.shader_parms[p] != world_parms.parms[p]) return true;
+  }
+  return false;
+}
+
+void WorldSync::update_entity_materials(int, const scene::RenderEntity& def, EntityMaterials& em) {
+  const scene::Scene& scene = world_.scene();
+  scene::RegisterInputs r = world_registers();
+  std::copy(std::begin(def.shader_parms), std::end(def.shader_parms), r.parms);
+  for (int m : entity_material_set(scene, def)) {
+    const scene::MaterialRegisters* regs = registers_of(scene, m);
+    if (!regs || !(regs->depends & scene::kDependsParms)) continue;
+    auto [slot, added] = em.slots.try_emplace(m, 0u);
+    if (added) slot->second = new_material_slot();
+    if (master_.materials.size() <= slot->second) master_.materials.resize(slot->second + 1);
+    scene::Material evaluated;
+    scene::evaluate_material(scene.materials[size_t(m)], r, evaluated);
+    master_.materials[slot->second] = to_kmaterial(evaluated, scene);
+    ++stats_.materials_evaluated;
+  }
+}
+
+void WorldSync::release_entity_materials(int handle) {
+  auto it = entity_materials_.find(handle);
+  if (it == entity_materials_.end()) return;
+  for (const auto& [m, slot] : it->second.slots) free_material_slots_.push_back(slot);
+  entity_materials_.erase(it);
+}
+
+uint32_t WorldSync::entity_blas(int handle, const scene::RenderEntity& def, uint32_t shared_blas,
+                                commit::CommitBuffer& out) {
+  if (!needs_material_instances(def)) {
+    release_entity_materials(handle);
+    return shared_blas;
+  }
+  EntityMaterials& em = entity_materials_[handle];
+  if (em.mesh != def.model) {   // another model: its own set of instances
+    for (const auto& [m, slot] : em.slots) free_material_slots_.push_back(slot);
+    em = EntityMaterials{};
+    em.mesh = def.model;
+  }
+  update_entity_materials(handle, def, em);
+  if (def.custom_shader >= 0 || entity_material_set(world_.scene(), def).size() == 1) return shared_blas;
+  if (em.own_blas == K_NONE) em.own_blas = build_mesh_blas(def.model, out, &em.slots);
+  return em.own_blas == K_NONE ? shared_blas : em.own_blas;
+}
+
+// Every frame: animated materials at this frame's time, and entity instances of materials that read
+// time or globals. The caller's diff sends only the KMaterials that changed.
+bool WorldSync::evaluate_animated(commit::CommitBuffer&) {
+  for (int m : std::vector<int>(animated_materials_)) {
+    set_material(m);
+    ++stats_.materials_evaluated;
+  }
+  const scene::Scene& scene = world_.scene();
+  for (auto& [handle, em] : entity_materials_) {
+    bool animated = false;
+    for (const auto& [m, slot] : em.slots)
+      if (const scene::MaterialRegisters* r = registers_of(scene, m))
+        animated |= (r->depends & (scene::kDependsTime | scene::kDependsGlobals)) != 0;
+    const scene::RenderEntity* def = world_.EntityDef(handle);
+    if (animated && def) update_entity_materials(handle, *def, em);
+  }
+  return true;
 }
 
 KInstance WorldSync::entity_instance(int handle, const scene::RenderEntity& def, uint32_t blas) const {
@@ -195,6 +323,10 @@ KInstance WorldSync::entity_instance(int handle, const scene::RenderEntity& def,
   inst.mask = K_MASK_PRIMARY | (def.no_shadows ? 0u : K_MASK_SHADOW);
   inst.entity = uint32_t(handle);
   inst.material_override = def.custom_shader >= 0 ? kmaterial_index(def.custom_shader) : K_NONE;
+  // A model drawn with one instanced material: the instance replaces it.
+  auto em = entity_materials_.find(handle);
+  if (em != entity_materials_.end() && em->second.own_blas == K_NONE && em->second.slots.size() == 1 && blas != K_NONE)
+    inst.material_override = em->second.slots.begin()->second;
   return inst;
 }
 
@@ -361,7 +493,7 @@ commit::CommitBuffer WorldSync::sync(const scene::ChangeLog& changes, uint64_t f
   } else {
     for (int m : changes.materials) set_material(m);
   }
-  commit::diff_materials(materials_before, master_.materials, out);
+  evaluate_animated(out);
 
   // Redefined models in use get a new BLAS; their entities are re-instanced below.
   std::set<int> entities = changes.entities;
@@ -382,6 +514,7 @@ commit::CommitBuffer WorldSync::sync(const scene::ChangeLog& changes, uint64_t f
   bool only_moved = !instances_stale_;
   std::vector<int> moved;
   for (int handle : changes.freed_entities) {
+    release_entity_materials(handle);
     const bool erased = entity_instances_.erase(handle) > 0;
     instances_changed |= erased;
     only_moved &= !erased;
@@ -394,6 +527,11 @@ commit::CommitBuffer WorldSync::sync(const scene::ChangeLog& changes, uint64_t f
     if (!skinned) skinned_.erase(handle);
     uint32_t blas = skinned ? pose_skinned_entity(handle, *def, out)
                             : def && def->model >= 0 ? ensure_blas(def->model, out) : K_NONE;
+    if (def && blas != K_NONE && !skinned) {
+      blas = entity_blas(handle, *def, blas, out);
+    } else {
+      release_entity_materials(handle);
+    }
     if (blas == K_NONE) {  // freed, no model, or a model without triangles
       const bool erased = entity_instances_.erase(handle) > 0;
       instances_changed |= erased;
@@ -420,6 +558,12 @@ commit::CommitBuffer WorldSync::sync(const scene::ChangeLog& changes, uint64_t f
       }
     }
   }
+  // After the entities: their material instances were brought to their parms above.
+  commit::diff_materials(materials_before, master_.materials, out);
+  const bool materials_changed = materials_before.size() != master_.materials.size() ||
+                                 std::memcmp(materials_before.data(), master_.materials.data(),
+                                             materials_before.size() * sizeof(KMaterial)) != 0;
+
   if (instances_changed) {
     std::vector<KInstance> instances = static_instances_;
     instances.reserve(static_instances_.size() + entity_instances_.size());
@@ -436,8 +580,8 @@ commit::CommitBuffer WorldSync::sync(const scene::ChangeLog& changes, uint64_t f
 
   // Lights, in handle order of the live defs.
   bool light_sources_changed = false;
-  if (slots_moved || !changes.lights.empty() || !changes.freed_lights.empty()) {
-    for (int handle : changes.freed_lights) lights_by_handle_.erase(handle);
+  if (slots_moved || !changes.lights.empty() || !changes.freed_lights.empty() || !animated_lights_.empty()) {
+    for (int handle : changes.freed_lights) lights_by_handle_.erase(handle), animated_lights_.erase(handle);
     auto convert = [&](int handle) {
       lights_by_handle_.erase(handle);
       if (!world_.LightDef(handle)) return;
@@ -446,24 +590,27 @@ commit::CommitBuffer WorldSync::sync(const scene::ChangeLog& changes, uint64_t f
         warn_bad_light(handle, light, *defect);
         return;
       }
-      lights_by_handle_[handle] = to_klight(light, scene, options_.gpu);
+      lights_by_handle_[handle] = to_klight_at_time(handle, light);
     };
     if (slots_moved) {
       for (size_t h = 0; h < world_.light_defs().size(); ++h) convert(int(h));
     } else {
-      for (int handle : changes.lights) convert(handle);
+      std::set<int> handles = changes.lights;
+      handles.insert(animated_lights_.begin(), animated_lights_.end());
+      for (int handle : handles) convert(handle);
     }
     std::vector<KLight> lights;
     lights.reserve(lights_by_handle_.size());
     for (const auto& [handle, light] : lights_by_handle_) lights.push_back(light);
+    light_sources_changed = lights.size() != master_.lights.size() ||
+                            std::memcmp(lights.data(), master_.lights.data(), lights.size() * sizeof(KLight)) != 0;
     commit::diff_lights(master_.lights, lights, out);
     master_.lights = std::move(lights);
-    light_sources_changed = true;
   }
 
   // Emissive triangles move with their instances and appear or go with materials; the light node array
   // holds the trees over both kinds of source, so either change rebuilds it.
-  if (light_sources_changed || instances_changed || emitters_moved || slots_moved || !changes.materials.empty()) {
+  if (light_sources_changed || instances_changed || emitters_moved || slots_moved || materials_changed) {
     EmissiveList emissive = list_emissive_triangles(master_);
     std::vector<KLightNode> nodes = build_light_nodes(master_.lights, emissive);
     commit::diff_light_tree(master_.light_nodes, nodes, out);
@@ -482,6 +629,33 @@ commit::CommitBuffer WorldSync::sync(const scene::ChangeLog& changes, uint64_t f
   stats_.sync_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
   snapshot_.reset();
   return out;
+}
+
+// The light with its shader's stage colour evaluated at this frame's time with the light's parms
+// (parm0-2 = 1: to_klight multiplies by _color itself); remembered as animated when that reads time.
+KLight WorldSync::to_klight_at_time(int handle, const scene::Light& light) {
+  const scene::Scene& scene = world_.scene();
+  int material = light.material;
+  if (material < 0)
+    material = scene.find_material(light.type == scene::LightType::Projected ? "lights/defaultProjectedLight"
+                                                                              : "lights/defaultPointLight");
+  const scene::MaterialRegisters* regs = registers_of(scene, material);
+  if (!regs || !regs->light) {
+    animated_lights_.erase(handle);
+    return to_klight(light, scene, options_.gpu);
+  }
+  if (regs->depends & (scene::kDependsTime | scene::kDependsGlobals)) {
+    animated_lights_.insert(handle);
+    ++stats_.lights_animated;
+  } else {
+    animated_lights_.erase(handle);
+  }
+  scene::RegisterInputs r = world_registers();
+  std::copy(std::begin(light.shader_parms), std::end(light.shader_parms), r.parms);
+  r.parms[0] = r.parms[1] = r.parms[2] = 1.0f;
+  scene::Material evaluated;
+  scene::evaluate_material(scene.materials[size_t(material)], r, evaluated);
+  return to_klight(light, scene, options_.gpu, &evaluated.light_stage_color);
 }
 
 // Once per light def and defect, so a bad light that the game keeps updating does not flood the log.

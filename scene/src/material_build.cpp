@@ -1,6 +1,7 @@
 #include "cohort/scene/material_build.h"
 
 #include "ascii_case.h"
+#include "cohort/scene/material_registers.h"
 
 namespace cohort::scene {
 
@@ -8,20 +9,40 @@ namespace {
 
 bool draws_image(const MaterialStage& s) { return !s.image.empty() && s.special_map.empty(); }
 
-void build_light_material(const MaterialDecl& decl, ImageLibrary& images, Material& m) {
+// Collects the stages whose registers feed the Material; kept only if something in them animates.
+struct RegisterSources {
+  MaterialRegisters r;
+  void set(std::optional<StageRegisters>& slot, const MaterialStage& s) { slot = s.registers; }
+  void attach(Material& m) {
+    for (auto* slot : {&r.diffuse, &r.specular, &r.emissive, &r.look, &r.light}) {
+      if (!*slot) continue;
+      if ((*slot)->depends() == 0) {
+        slot->reset();
+        continue;
+      }
+      r.depends |= (*slot)->depends();
+      r.parms_read |= (*slot)->parms_read();
+    }
+    if (r.depends != 0) m.registers = std::make_shared<const MaterialRegisters>(std::move(r));
+  }
+};
+
+void build_light_material(const MaterialDecl& decl, ImageLibrary& images, Material& m, RegisterSources& sources) {
   m.is_light_material = true;
   const std::string context = "light material " + decl.name;
   for (const MaterialStage& s : decl.stages) {
     if (!draws_image(s)) continue;
     m.light_image = images.get(s.image, ImageRole::LightProjection, context);
     m.light_stage_color = glm::vec3(s.color);
+    sources.set(sources.r.light, s);
     break;
   }
   if (!decl.falloff_image.empty()) m.falloff_image = images.get(decl.falloff_image, ImageRole::LightFalloff, context);
   if (decl.fog_light || decl.blend_light) m.blend = BlendClass::PassThrough;
 }
 
-void copy_stage_look(const MaterialStage& s, Material& m) {
+void copy_stage_look(const MaterialStage& s, Material& m, RegisterSources& sources) {
+  sources.set(sources.r.look, s);
   std::copy(std::begin(s.tex_transform), std::end(s.tex_transform), m.tex_transform);
   if (s.alpha_test) {
     m.alpha_test = true;
@@ -30,16 +51,28 @@ void copy_stage_look(const MaterialStage& s, Material& m) {
   m.vertex_color = m.vertex_color || s.vertex_color;
 }
 
-void glow_with(Material& m, int image, const glm::vec4& color) {
+void glow_with(Material& m, int image, const MaterialStage& s, RegisterSources& sources) {
   m.emitter = true;
   m.emissive_image = image;
-  m.emissive_color = color;
+  m.emissive_color = s.color;
+  sources.set(sources.r.emissive, s);
 }
 
 }  // namespace
 
+static Material build_material_look(const MaterialDecl& decl, ImageLibrary& images, bool as_light, Material& m,
+                                    RegisterSources& sources);
+
 Material build_material(const MaterialDecl& decl, ImageLibrary& images, bool as_light) {
   Material m;
+  RegisterSources sources;
+  Material built = build_material_look(decl, images, as_light, m, sources);
+  sources.attach(built);
+  return built;
+}
+
+static Material build_material_look(const MaterialDecl& decl, ImageLibrary& images, bool as_light, Material& m,
+                                    RegisterSources& sources) {
   m.name = decl.name;
   m.source_file = decl.file;
   m.source_line = decl.line;
@@ -50,7 +83,7 @@ Material build_material(const MaterialDecl& decl, ImageLibrary& images, bool as_
   const bool light_like = as_light || !decl.falloff_image.empty() || decl.fog_light || decl.blend_light ||
                           decl.ambient_light || starts_with_ignoring_case(decl.name, "lights/");
   if (light_like) {
-    build_light_material(decl, images, m);
+    build_light_material(decl, images, m, sources);
     if (as_light || m.blend == BlendClass::PassThrough) return m;
   }
 
@@ -64,7 +97,8 @@ Material build_material(const MaterialDecl& decl, ImageLibrary& images, bool as_
         if (m.diffuse_image >= 0 || !draws_image(s)) break;
         m.diffuse_image = images.get(s.image, ImageRole::Color, context);
         m.diffuse_color = s.color;
-        copy_stage_look(s, m);
+        sources.set(sources.r.diffuse, s);
+        copy_stage_look(s, m, sources);
         break;
       case StageRole::Bump:
         lit = true;
@@ -76,6 +110,7 @@ Material build_material(const MaterialDecl& decl, ImageLibrary& images, bool as_
         has_specular = true;
         m.specular_image = images.get(s.image, ImageRole::Specular, context);
         m.specular_color = s.color;
+        sources.set(sources.r.specular, s);
         break;
       case StageRole::Ambient:
         if (!first_ambient && draws_image(s) && s.blend != StageBlend::None) first_ambient = &s;
@@ -90,7 +125,7 @@ Material build_material(const MaterialDecl& decl, ImageLibrary& images, bool as_
     for (const MaterialStage& s : decl.stages) {
       if (s.role != StageRole::Ambient || !draws_image(s)) continue;
       if (s.blend == StageBlend::Add || s.blend == StageBlend::Replace) {
-        glow_with(m, images.get(s.image, ImageRole::Color, context), s.color);
+        glow_with(m, images.get(s.image, ImageRole::Color, context), s, sources);
         break;
       }
     }
@@ -101,7 +136,7 @@ Material build_material(const MaterialDecl& decl, ImageLibrary& images, bool as_
     return m;
   }
   const MaterialStage& s = *first_ambient;
-  copy_stage_look(s, m);
+  copy_stage_look(s, m, sources);
   const int image = images.get(s.image, ImageRole::Color, context);
   switch (s.blend) {
     case StageBlend::Add:
@@ -109,7 +144,7 @@ Material build_material(const MaterialDecl& decl, ImageLibrary& images, bool as_
       // Replace is unlit and drawn as is: it shows its image whatever the lighting; Add glows over
       // what is behind it.
       m.blend = s.blend == StageBlend::Add ? BlendClass::Additive : BlendClass::Opaque;
-      glow_with(m, image, s.color);
+      glow_with(m, image, s, sources);
       m.diffuse_color = glm::vec4(0.0f, 0.0f, 0.0f, 1.0f);
       if (s.blend == StageBlend::Add) m.translucent = true;
       break;
@@ -118,6 +153,7 @@ Material build_material(const MaterialDecl& decl, ImageLibrary& images, bool as_
       m.blend = s.blend == StageBlend::Modulate ? BlendClass::Modulate : BlendClass::Alpha;
       m.diffuse_image = image;
       m.diffuse_color = s.color;
+      sources.set(sources.r.diffuse, s);
       m.translucent = true;
       break;
     case StageBlend::None:

@@ -10,18 +10,6 @@ namespace {
 
 std::string at(const std::string& file, int line) { return file + ":" + std::to_string(line) + ": "; }
 
-// st' = old(reg(st)): the engine multiplies each new transform on the right of the stage's matrix.
-void multiply_transform(float (&old)[6], const float (&reg)[6]) {
-  float r[6];
-  r[0] = old[0] * reg[0] + old[1] * reg[3];
-  r[1] = old[0] * reg[1] + old[1] * reg[4];
-  r[2] = old[0] * reg[2] + old[1] * reg[5] + old[2];
-  r[3] = old[3] * reg[0] + old[4] * reg[3];
-  r[4] = old[3] * reg[1] + old[4] * reg[4];
-  r[5] = old[3] * reg[2] + old[4] * reg[5] + old[5];
-  for (int i = 0; i < 6; ++i) old[i] = r[i];
-}
-
 StageBlend gl_blend_pair(Lexer& lex, const Token& src_token) {
   lex.expect(",");
   Token dst_token = lex.expect_any("a destination blend factor");
@@ -39,7 +27,7 @@ const std::set<std::string>& ignored_stage_words() {
   static const std::set<std::string> words = {
       "maskred", "maskgreen", "maskblue", "maskalpha", "maskcolor", "maskdepth", "ignorealphatest",
       "nearest", "linear", "clamp", "zeroclamp", "alphazeroclamp", "noclamp", "uncompressed", "highquality",
-      "forcehighquality", "nopicmip", "ignoredepth", "colored"};
+      "forcehighquality", "nopicmip", "ignoredepth"};
   return words;
 }
 
@@ -91,6 +79,7 @@ class MaterialReader {
   void read_body(Lexer& lex, MaterialDecl& m) {
     ExpressionContext context;
     context.tables = &tables_;
+    
     while (!lex.at_end()) {
       Token t = lex.next();
       std::string word = lowercase(t.text);
@@ -116,9 +105,6 @@ class MaterialReader {
         lex.skip_rest_of_line();
       }
     }
-    if (context.approximated)
-      warnings_.push_back(at(file_, m.line) + "material " + m.name + ": '" + context.approximation +
-                          "' evaluated once at time 0 (animated expressions are not supported)");
   }
 
  private:
@@ -133,6 +119,11 @@ class MaterialReader {
       warnings_.push_back(std::string(e.what()) + " (stage of material " + m.name + " dropped)");
       return;
     }
+    const RegisterInputs at_load;
+    for (int c = 0; c < 4; ++c) stage.color[c] = stage.registers.color[c].evaluate(at_load);
+    stage.alpha_test = stage.registers.alpha_test;
+    stage.alpha_ref = stage.registers.alpha_ref.evaluate(at_load);
+    compose_texture_matrix(stage.registers.tex_ops, at_load, stage.tex_transform);
     m.stages.push_back(std::move(stage));
   }
 
@@ -161,49 +152,42 @@ class MaterialReader {
     } else if (word == "vertexparm" || word == "fragmentmap" || word == "texgen" || word == "privatepolygonoffset") {
       lex.skip_rest_of_line();
     } else if (word == "alphatest") {
-      stage.alpha_test = true;
-      stage.alpha_ref = parse_expression(lex, context);
+      stage.registers.alpha_test = true;
+      stage.registers.alpha_ref = parse_expression(lex, context);
     } else if (word == "vertexcolor" || word == "inversevertexcolor") {
       stage.vertex_color = true;
     } else if (word == "red" || word == "green" || word == "blue" || word == "alpha") {
       int c = word == "red" ? 0 : word == "green" ? 1 : word == "blue" ? 2 : 3;
-      stage.color[c] = parse_expression(lex, context);
+      stage.registers.color[c] = parse_expression(lex, context);
     } else if (word == "rgb") {
-      float v = parse_expression(lex, context);
-      stage.color = glm::vec4(v, v, v, stage.color.a);
+      Expression v = parse_expression(lex, context);
+      for (int c = 0; c < 3; ++c) stage.registers.color[c] = v;
     } else if (word == "rgba") {
-      stage.color = glm::vec4(parse_expression(lex, context));
+      Expression v = parse_expression(lex, context);
+      for (int c = 0; c < 4; ++c) stage.registers.color[c] = v;
+    } else if (word == "colored") {   // the entity's (or light's) colour: parm0-3
+      for (int c = 0; c < 4; ++c) stage.registers.color[c] = Expression::parm(c);
     } else if (word == "color") {
       for (int c = 0; c < 4; ++c) {
         if (c > 0) lex.expect(",");
-        stage.color[c] = parse_expression(lex, context);
+        stage.registers.color[c] = parse_expression(lex, context);
       }
     } else if (word == "scale" || word == "centerscale" || word == "scroll" || word == "translate" ||
                word == "shear") {
-      float a = parse_expression(lex, context);
+      TextureOp op;
+      op.kind = word == "scale"         ? TextureOp::Kind::Scale
+                : word == "centerscale" ? TextureOp::Kind::CenterScale
+                : word == "shear"       ? TextureOp::Kind::Shear
+                                        : TextureOp::Kind::Translate;
+      op.a = parse_expression(lex, context);
       lex.expect(",");
-      float b = parse_expression(lex, context);
-      float reg[6];
-      if (word == "scale") {
-        float r[6] = {a, 0, 0, 0, b, 0};
-        std::copy(r, r + 6, reg);
-      } else if (word == "centerscale") {
-        float r[6] = {a, 0, 0.5f - 0.5f * a, 0, b, 0.5f - 0.5f * b};
-        std::copy(r, r + 6, reg);
-      } else if (word == "shear") {
-        float r[6] = {1, a, -0.5f * a, b, 1, -0.5f * b};
-        std::copy(r, r + 6, reg);
-      } else {
-        float r[6] = {1, 0, a, 0, 1, b};
-        std::copy(r, r + 6, reg);
-      }
-      multiply_transform(stage.tex_transform, reg);
+      op.b = parse_expression(lex, context);
+      stage.registers.tex_ops.push_back(std::move(op));
     } else if (word == "rotate") {
-      float turns = parse_expression(lex, context);   // the engine's rotate is in full turns
-      float angle = turns * 6.28318530718f;
-      float c = std::cos(angle), s = std::sin(angle);
-      float reg[6] = {c, -s, 0.5f - 0.5f * c + 0.5f * s, s, c, 0.5f - 0.5f * s - 0.5f * c};
-      multiply_transform(stage.tex_transform, reg);
+      TextureOp op;
+      op.kind = TextureOp::Kind::Rotate;
+      op.a = parse_expression(lex, context);   // the engine's rotate is in full turns
+      stage.registers.tex_ops.push_back(std::move(op));
     } else if (word == "if") {
       parse_expression(lex, context);   // conditions are evaluated per frame by the engine; the stage is kept
     } else if (ignored_stage_words().count(word)) {

@@ -36,7 +36,9 @@ KMaterial to_kmaterial(const scene::Material& material, const scene::Scene& scen
 // light shines from (origin + axis * light_center); for parallel lights the unit direction toward the
 // light (light_center rotated by the axis). extent: soft-shadow jitter radius in world units (parallel:
 // tangent of the cone's half-angle), scaled by KFrameParams::soft_shadow_scale in the kernel.
-KLight to_klight(const scene::Light& light, const scene::Scene& scene, const GpuSceneOptions& options = {});
+// stage_color: the light shader's stage colour evaluated for this frame (WorldSync); null: as loaded.
+KLight to_klight(const scene::Light& light, const scene::Scene& scene, const GpuSceneOptions& options = {},
+                 const glm::vec3* stage_color = nullptr);
 // Why a light cannot be rendered (zero or negative radius, a degenerate projection, a non-finite or huge
 // origin, colour or axis, a volume that does not close), or nullopt when it can. WorldSync skips such
 // lights with a warning naming them.

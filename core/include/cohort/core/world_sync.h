@@ -6,8 +6,18 @@
 //
 // Index conventions: entity handle = KInstance::entity; instances are the static world then the entity
 // defs in handle order; lights are the live light defs in handle order; textures use texture_slot().
-// The default material sits right after the map's materials; materials defined later go after it, so
-// no triangle's material index ever moves (kmaterial_index()).
+// The default material sits right after the map's materials; materials defined later and entity
+// material instances (below) go after it in the order they appear, so no triangle's material index ever
+// moves (kmaterial_index()).
+//
+// Animated materials (docs/materials.md): every sync evaluates the materials whose registers read time or
+// globals at the view's time (RenderView::time_ms, or set_time()), with the world's parms (parm0-3 = 1);
+// diff_materials then sends only those whose KMaterial changed, so a constant material is never re-sent.
+// An entity whose parms differ from the world's and whose model (or customShader) uses a material that
+// reads parms gets its own evaluated copy of that material (a material instance, one KMaterial slot per
+// entity and material, reused when its parms change): through KInstance::material_override when the
+// model draws one material, else through its own BLAS with the instance slots in its triangles. Lights
+// whose shader's stage colour reads time (flicker tables) are converted again every frame.
 //
 // Replaying a recorded stream (`cohort render --replay FILE`), per frame:
 //   scene::Player player(file);                       // player.header().map_name names the map to load
@@ -24,6 +34,7 @@
 #include <cstdint>
 #include <map>
 #include <memory>
+#include <optional>
 #include <set>
 #include <string>
 #include <vector>
@@ -31,6 +42,7 @@
 #include "cohort/commit/commit_buffer.h"
 #include "cohort/core/frame_defaults.h"
 #include "cohort/core/gpu_scene.h"
+#include "cohort/scene/material_registers.h"
 #include "cohort/scene/render_world.h"
 
 namespace cohort::core {
@@ -49,6 +61,8 @@ struct WorldSyncStats {  // of the last sync()
   bool tlas_rebuilt = false;
   bool tlas_refit = false;      // only instance transforms changed: the TLAS was refit, not rebuilt
   uint32_t lights_skipped = 0;  // lights left out for a defect (light_defect), warned once each
+  uint32_t materials_evaluated = 0;  // animated materials and entity material instances evaluated
+  uint32_t lights_animated = 0;      // lights converted again for an animated shader
   double sync_ms = 0.0;
 };
 
@@ -71,13 +85,17 @@ class WorldSync {
   CompiledScene release() &&;
   // KMaterial index of scene material m (see above); the default material for -1.
   uint32_t kmaterial_index(int scene_material) const;
+  // Material registers' time in seconds from now on, instead of the view's time_ms (headless renders
+  // without a view). The next sync evaluates animated materials at it.
+  void set_time(double seconds) { time_override_ = seconds; }
+  double material_time() const;
 
  private:
   uint32_t ensure_blas(int mesh, commit::CommitBuffer& out);
   // The moved entities' instances updated in place and the TLAS refit; false (nothing changed) when
   // the refit tree has decayed past the rebuild threshold.
   bool refit_moved_instances(const std::vector<int>& moved, commit::CommitBuffer& out);
-  uint32_t build_mesh_blas(int mesh, commit::CommitBuffer& out);
+  uint32_t build_mesh_blas(int mesh, commit::CommitBuffer& out, const std::map<int, uint32_t>* instance_slots = nullptr);
   // A character drawn with a skinned mesh and joints: its own BLAS (its own vertices), posed by its
   // joints. Returns the BLAS, or K_NONE when the joints do not fit the skin (not drawn, as in the engine).
   uint32_t pose_skinned_entity(int handle, const scene::RenderEntity& def, commit::CommitBuffer& out);
@@ -91,8 +109,23 @@ class WorldSync {
   void rebuild_skinned_blas(SkinnedEntity& entity, commit::CommitBuffer& out);
   bool update_textures(const std::set<int>& changed, commit::CommitBuffer& out);
   void set_material(int scene_material);
+  scene::RegisterInputs world_registers() const;
+  // The entity's material instances brought to its parms and this frame's time; returns the material
+  // override and whether it needs a BLAS of its own (several instanced materials on one model).
+  struct EntityMaterials {
+    std::map<int, uint32_t> slots;   // scene material -> its KMaterial instance slot
+    int mesh = -1;
+    uint32_t own_blas = K_NONE;      // the model with the instance slots in its triangles
+  };
+  bool needs_material_instances(const scene::RenderEntity& def) const;
+  void update_entity_materials(int handle, const scene::RenderEntity& def, EntityMaterials& em);
+  uint32_t entity_blas(int handle, const scene::RenderEntity& def, uint32_t shared_blas, commit::CommitBuffer& out);
+  void release_entity_materials(int handle);
+  uint32_t new_material_slot();
+  bool evaluate_animated(commit::CommitBuffer& out);
   void build_static_world();
   KInstance entity_instance(int handle, const scene::RenderEntity& def, uint32_t blas) const;
+  KLight to_klight_at_time(int handle, const scene::Light& light);
   void warn_bad_light(int handle, const scene::Light& light, const std::string& defect);
 
   const scene::RenderWorld& world_;
@@ -111,6 +144,13 @@ class WorldSync {
   std::map<int, KLight> lights_by_handle_;
   std::set<std::string> warned_lights_;           // "handle defect" already warned about
   uint32_t base_material_count_ = 0;              // the map's materials; the default material's index
+  mutable std::map<int, uint32_t> late_material_slots_;  // scene materials defined after the map
+  mutable uint32_t next_material_slot_ = 0;
+  std::vector<uint32_t> free_material_slots_;     // instance slots of freed entities
+  std::vector<int> animated_materials_;           // scene materials whose registers read time or globals
+  std::map<int, EntityMaterials> entity_materials_;  // entities with material instances, by handle
+  std::set<int> animated_lights_;                 // light handles whose shader animates
+  std::optional<double> time_override_;
   std::vector<std::array<KTexture, kTextureUseCount>> image_textures_;  // per scene image and use
   std::shared_ptr<const commit::TracerScene> snapshot_;
   WorldSyncStats stats_;

@@ -8,6 +8,7 @@
 
 #include "cohort/scene/image_program.h"
 #include "cohort/scene/material_expression.h"
+#include "cohort/scene/material_registers.h"
 #include "cohort/scene/parse_error.h"
 #include "cohort/scene/scene.h"
 
@@ -23,11 +24,13 @@ struct MaterialStage {
   StageBlend blend = StageBlend::Replace;
   ImageProgram image;               // empty for stages without one (cube, video, render and shader maps)
   std::string special_map;          // "cubeMap", "videoMap", "program", ... when the stage has no plain image
+  // color, alpha_ref and tex_transform: the registers evaluated at time 0 with the world's parms.
   glm::vec4 color{1.0f};
   bool vertex_color = false;
   bool alpha_test = false;
   float alpha_ref = 0.5f;
   float tex_transform[6] = {1, 0, 0, 0, 1, 0};
+  StageRegisters registers;   // the expressions behind them
   int line = 0;
 };
 

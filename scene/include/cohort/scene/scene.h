@@ -24,6 +24,8 @@ struct Image {
 
 enum class BlendClass : uint8_t { Opaque, PassThrough, Additive, Modulate, Alpha };
 
+struct MaterialRegisters;
+
 struct Material {
   std::string name;
   std::string source_file; int source_line = 0;
@@ -40,6 +42,9 @@ struct Material {
   int light_image = -1, falloff_image = -1;
   glm::vec3 light_stage_color{1.0f};
   bool is_default = false;     // made up because the name was not found
+  // The expressions behind the colours, texture matrix, alphaTest and light stage colour when any reads
+  // time, parms or globals (material_registers.h); null: the fields above are the look at every frame.
+  std::shared_ptr<const MaterialRegisters> registers;
 };
 
 struct Vertex {
