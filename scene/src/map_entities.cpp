@@ -152,6 +152,13 @@ Entity entity_from_map(const MapEntity& e, const std::string& where, std::vector
     entity.axis = angle != 0.0f ? yaw_axis(angle) : glm::mat3(1.0f);
   }
   entity.no_shadows = parse_bool(e.get_or("noshadows", "0"));
+  const glm::vec3 color = vec3_key(e, "_color", glm::vec3(1.0f), where, warnings);
+  for (int c = 0; c < 3; ++c) entity.shader_parms[c] = color[c];
+  entity.shader_parms[3] = float_key(e, "shaderParm3", 1.0f, where, warnings);
+  for (int p = 4; p < 12; ++p) {
+    const std::string key = "shaderParm" + std::to_string(p);
+    entity.shader_parms[p] = float_key(e, key.c_str(), 0.0f, where, warnings);
+  }
   for (const auto& [key, value] : e.keys) entity.keys[key] = value;
   return entity;
 }

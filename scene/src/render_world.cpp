@@ -125,6 +125,7 @@ RenderEntity render_entity_from(const Entity& entity) {
   def.origin = entity.origin;
   def.axis = entity.axis;
   def.no_shadows = entity.no_shadows;
+  std::copy(std::begin(entity.shader_parms), std::end(entity.shader_parms), def.shader_parms);
   return def;
 }
 

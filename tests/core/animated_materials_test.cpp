@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include "cohort/core/world_sync.h"
+#include "cohort/scene/map_loader.h"
 #include "cohort/scene/material_build.h"
 #include "cohort/scene/material_file.h"
 #include "cohort/scene/render_world.h"
@@ -189,4 +190,40 @@ TEST(AnimatedMaterials, EntityParmsTintItsOwnMaterialInstance) {
   world.UpdateEntityDef(plain_handle, tinted);
   sync.sync(world.TakeChanges(), 3);
   EXPECT_EQ(instance_of(plain_handle).material_override, t.material_override);
+}
+
+// The generated test map: its animated materials re-send at a new time, and crate_2's _color tints its
+// own instance of the crate material while the other crates share the map's.
+TEST(AnimatedMaterials, TestMapAnimatesAndTintsCrate2) {
+  scene::Vfs vfs;
+  vfs.add_search_path(std::string(COHORT_SOURCE_DIR) + "/assets/testmap");
+  scene::RenderWorld world(scene::load_map(vfs, "testmap"));
+  WorldSync sync(world);
+  world.TakeChanges();
+  const scene::Scene& s = world.scene();
+  std::set<uint32_t> animated;
+  for (const char* name : {"textures/testmap/pillar", "textures/testmap/vent", "textures/testmap/lightpanel_pulse"}) {
+    const int m = s.find_material(name);
+    ASSERT_GE(m, 0) << name;
+    animated.insert(sync.kmaterial_index(m));
+  }
+  set_time(world, 700);
+  commit::CommitBuffer frame = sync.sync(world.TakeChanges(), 1);
+  std::set<uint32_t> sent;
+  for (const auto& [index, material] : frame.materials()) sent.insert(index);
+  EXPECT_EQ(sent, animated);
+  EXPECT_EQ(frame.lights().size(), 1u);   // light_flicker
+
+  const int crate2 = world.FindEntityDef("crate_2"), crate1 = world.FindEntityDef("crate_1");
+  ASSERT_GE(crate2, 0);
+  ASSERT_GE(crate1, 0);
+  for (const KInstance& i : sync.master().instances) {
+    if (i.entity == uint32_t(crate1)) EXPECT_EQ(i.material_override, K_NONE);
+    if (i.entity != uint32_t(crate2)) continue;
+    ASSERT_NE(i.material_override, K_NONE);
+    const KMaterial& tinted = sync.master().materials.at(i.material_override);
+    EXPECT_FLOAT_EQ(tinted.diffuse_color[0], 0.55f);
+    EXPECT_FLOAT_EQ(tinted.diffuse_color[1], 0.8f);
+    EXPECT_FLOAT_EQ(tinted.diffuse_color[2], 1.0f);
+  }
 }

@@ -106,8 +106,9 @@ def add_details(area_meshes):
     for x0, y0 in ((224, 32), (224, 320), (32, 176), (448, 176)):
         z = 159.75
         _quad(hall, panel, [(x0, y0, z), (x0 + 64, y0, z), (x0 + 64, y0 + 32, z), (x0, y0 + 32, z)], (0, 0, -1))
-    _quad(corridor, panel, [(576, 176, 127.75), (704, 176, 127.75), (704, 208, 127.75), (576, 208, 127.75)],
-          (0, 0, -1))
+    # The corridor's light strip pulses (an animated emitter).
+    _quad(corridor, M + "lightpanel_pulse",
+          [(576, 176, 127.75), (704, 176, 127.75), (704, 208, 127.75), (576, 208, 127.75)], (0, 0, -1))
     for y0 in (96, 256):
         z = 255.75
         _quad(gallery, M + "lightpanel_blue", [(1504, y0, z), (1568, y0, z), (1568, y0 + 32, z), (1504, y0 + 32, z)],
@@ -115,6 +116,9 @@ def add_details(area_meshes):
     # Wall panel in the atrium, facing +y, emissive strip.
     _quad(atrium, M + "lightpanel_blue", [(1024, 0.25, 96), (1088, 0.25, 96), (1088, 0.25, 128), (1024, 0.25, 128)],
           (0, 1, 0))
+
+    # A turning vent grille on the hall's west wall (animated texture rotation).
+    _quad(hall, M + "vent", [(0.25, 164, 64), (0.25, 100, 64), (0.25, 100, 128), (0.25, 164, 128)], (1, 0, 0))
 
     # Decals: slightly off the surface they sit on.
     _quad(hall, M + "decal_blood", [(0.25, 264, 24), (0.25, 200, 24), (0.25, 200, 88), (0.25, 264, 88)], (1, 0, 0))
@@ -185,8 +189,10 @@ def entities():
                                    ("speed", 90), ("rotation", yaw_rotation(0))]))
     for name, origin, yaw in (("crate_1", (424, 40, 0), 0), ("crate_2", (424, 40, 48), 30),
                               ("crate_3", (1720, 300, 96), 45), ("crate_4", (1100, 336, 24), 15)):
-        ents.append(("func_static", [("name", name), ("model", "testmap_crate"), ("origin", origin),
-                                     ("rotation", yaw_rotation(yaw))]))
+        keys = [("name", name), ("model", "testmap_crate"), ("origin", origin), ("rotation", yaw_rotation(yaw))]
+        if name == "crate_2":
+            keys.append(("_color", (0.55, 0.8, 1)))   # shaderParm tint through the crate's `colored` stage
+        ents.append(("func_static", keys))
     ents.append(("func_static", [("name", "table_1"), ("model", "testmap_table"), ("origin", (160, 192, 0)),
                                  ("rotation", yaw_rotation(90))]))
 
@@ -208,7 +214,7 @@ def entities():
         ("light_hall_fill", [("origin", (48, 336, 112)), ("light_radius", (256, 256, 160)),
                              ("_color", (0.35, 0.45, 0.7)), ("noshadows", 1)]),
         ("light_flicker", [("origin", (640, 192, 112)), ("light_radius", (160, 80, 128)),
-                           ("_color", (1, 0.6, 0.25)), ("texture", "lights/testmap_round")]),
+                           ("_color", (1, 0.6, 0.25)), ("texture", "lights/testmap_flicker"), ("shaderParm4", 0.3)]),
         ("light_beam", [("origin", (800, 192, 160)), ("light_target", (256, 0, -96)), ("light_right", (0, -64, 0)),
                         ("light_up", (24, 0, 64)), ("light_start", (32, 0, -12)), ("light_end", (320, 0, -120)),
                         ("_color", (0.9, 0.95, 1)), ("texture", "lights/testmap_round")]),

@@ -7,6 +7,11 @@ MTR = r"""/*
 	Image paths are relative to the base folder (assets/testmap).
 */
 
+// ---- tables for animated materials (docs/materials.md): one period over index 0..1 -------------
+
+table testmap_flicker { snap { 1, 0.85, 1, 0.3, 1, 1, 0.6, 1, 0.9, 0.15, 1, 1 } }
+table testmap_pulse { { 0.15, 1 } }
+
 // ---- world surfaces -------------------------------------------------------------------------
 
 textures/testmap/floor_tiles
@@ -60,7 +65,8 @@ textures/testmap/pillar
 	{
 		blend	diffusemap
 		map		textures/testmap/concrete_d.tga
-		scroll	0.25, 0
+		// animated: creeps sideways, one texture width every ten seconds
+		scroll	time * 0.1, 0
 	}
 	bumpmap		heightmap( textures/testmap/concrete_h.tga, 6 )
 	specularmap	textures/testmap/metal_s.tga
@@ -114,9 +120,14 @@ textures/testmap/fan
 	specularmap	textures/testmap/metal_s.tga
 }
 
+// `colored`: tinted by each crate entity's _color (shaderParm0-2)
 textures/testmap/crate
 {
-	diffusemap	textures/testmap/crate_d.tga
+	{
+		blend	diffusemap
+		map		textures/testmap/crate_d.tga
+		colored
+	}
 	bumpmap		textures/testmap/crate_local.tga
 	specularmap	textures/testmap/crate_s.tga
 }
@@ -195,6 +206,18 @@ textures/testmap/decal_sign
 	}
 }
 
+// animated: a fan grille turning about its centre, a quarter turn a second
+textures/testmap/vent
+{
+	noshadows
+	{
+		blend	diffusemap
+		map		textures/testmap/grate_d.tga
+		rotate	time * 0.25
+	}
+	specularmap	textures/testmap/metal_s.tga
+}
+
 // ---- emitters: stages without interaction, added to the frame ------------------------------
 
 textures/testmap/lightpanel
@@ -215,6 +238,17 @@ textures/testmap/lightpanel_blue
 		red		0.5
 		green	0.75
 		blue	1.0
+	}
+}
+
+// animated: glows up and down once every two seconds
+textures/testmap/lightpanel_pulse
+{
+	noshadows
+	{
+		blend	add
+		map		textures/testmap/lightpanel_d.tga
+		rgb		testmap_pulse[ time * 0.5 ]
 	}
 }
 
@@ -246,6 +280,17 @@ lights/testmap_round
 	{
 		map		lights/testmap_round.tga
 		colored
+		zeroClamp
+	}
+}
+
+// animated: the stage colour follows a snapped flicker table, phase-shifted by the light's shaderParm4
+lights/testmap_flicker
+{
+	lightFalloffImage	lights/testmap_falloff.tga
+	{
+		map		lights/testmap_round.tga
+		rgb		testmap_flicker[ time * 0.5 + parm4 ]
 		zeroClamp
 	}
 }

@@ -118,6 +118,9 @@ struct Entity {
   glm::vec3 origin{0.0f};
   glm::mat3 axis{1.0f};         // columns: the entity's x, y, z axes in world space
   bool no_shadows = false;
+  // parm0-2 = _color, parm3 = shaderParm3 (default 1), parm4-11 = shaderParmN (default 0); materials
+  // that read them (`colored`, parmN) are tinted per entity.
+  float shader_parms[12] = {1, 1, 1, 1, 0, 0, 0, 0, 0, 0, 0, 0};
   std::map<std::string, std::string> keys;   // the map's keys, then its entityDef's for keys it lacks
   // Where a model file's mesh came from (empty for inline .proc models), the skin applied to it, and
   // for MD5 models the animation the entity plays (empty: none); the mesh is the bind pose.
