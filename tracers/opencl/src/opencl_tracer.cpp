@@ -105,7 +105,7 @@ struct OpenCLTracer::Impl {
   DeviceBuffer vertices, triangles, blas_nodes, blases, instances, tlas_nodes, materials, textures, texels, lights, light_nodes,
       emissive;
   DeviceBuffer skins, skin_vertices, skin_weights, skin_adjacency, joints;
-  cl_kernel skin_positions = nullptr, skin_normals = nullptr, refit_blas = nullptr;
+  cl_kernel skin_positions = nullptr, skin_normals = nullptr, refit_leaves = nullptr, refit_blas = nullptr;
 
   // Poses the given skins on the device: positions, then normals, then the BLAS refit (in queue order).
   void run_skinning(const commit::TracerScene& s, const std::vector<uint32_t>& which) {
@@ -126,8 +126,15 @@ struct OpenCLTracer::Impl {
       check(clEnqueueNDRangeKernel(queue, skin_normals, 1, nullptr, &global, &local, 0, nullptr, nullptr),
             "launching the skinned-normals kernel");
       const cl_mem refit_args[] = {blas_nodes.mem(), triangles.mem(), vertices.mem(), blases.mem(), skins.mem()};
-      for (cl_uint a = 0; a < 5; ++a) check(clSetKernelArg(refit_blas, a, sizeof(cl_mem), &refit_args[a]), "clSetKernelArg");
-      check(clSetKernelArg(refit_blas, 5, sizeof skin_index, &skin_index), "clSetKernelArg");
+      for (cl_kernel k : {refit_leaves, refit_blas}) {
+        for (cl_uint a = 0; a < 5; ++a) check(clSetKernelArg(k, a, sizeof(cl_mem), &refit_args[a]), "clSetKernelArg");
+        check(clSetKernelArg(k, 5, sizeof skin_index, &skin_index), "clSetKernelArg");
+      }
+      const uint32_t node_count = skin.blas < s.blases.size() ? s.blases[skin.blas].node_count : 0u;
+      const size_t leaf_global = (size_t(node_count) + local - 1) / local * local;
+      if (leaf_global > 0)
+        check(clEnqueueNDRangeKernel(queue, refit_leaves, 1, nullptr, &leaf_global, &local, 0, nullptr, nullptr),
+              "launching the BLAS leaf refit kernel");
       const size_t one = 1;
       check(clEnqueueNDRangeKernel(queue, refit_blas, 1, nullptr, &one, &one, 0, nullptr, nullptr),
             "launching the BLAS refit kernel");
@@ -139,7 +146,7 @@ struct OpenCLTracer::Impl {
   ~Impl() {
     for (cl_mem m : {params, camera, output, row_rays})
       if (m) clReleaseMemObject(m);
-    for (cl_kernel k : {kernel, skin_positions, skin_normals, refit_blas})
+    for (cl_kernel k : {kernel, skin_positions, skin_normals, refit_leaves, refit_blas})
       if (k) clReleaseKernel(k);
     if (program) clReleaseProgram(program);
     if (queue) clReleaseCommandQueue(queue);
@@ -194,6 +201,8 @@ OpenCLTracer::OpenCLTracer(const Options& options) : impl_(std::make_unique<Impl
   check(err, "clCreateKernel(cohort_skin_positions)");
   impl_->skin_normals = clCreateKernel(impl_->program, "cohort_skin_normals", &err);
   check(err, "clCreateKernel(cohort_skin_normals)");
+  impl_->refit_leaves = clCreateKernel(impl_->program, "cohort_refit_blas_leaves", &err);
+  check(err, "clCreateKernel(cohort_refit_blas_leaves)");
   impl_->refit_blas = clCreateKernel(impl_->program, "cohort_refit_blas", &err);
   check(err, "clCreateKernel(cohort_refit_blas)");
   impl_->params = clCreateBuffer(impl_->context, CL_MEM_READ_ONLY, sizeof(KFrameParams), nullptr, &err);
