@@ -28,9 +28,11 @@ int run_info(const std::string& map, std::vector<std::string> bases, size_t max_
             << " nodes, " << report.shadow_models_skipped << " shadow models skipped)\n"
             << "triangles  " << report.world_triangles << " world, " << report.entity_triangles << " in entities ("
             << report.inline_models << " inline models)\n"
-            << "materials  " << report.materials_used << " used (" << report.materials_missing << " missing, "
-            << report.emitters << " emitters), " << report.materials_declared << " declared in "
-            << report.material_files << " .mtr files\n"
+            << "materials  " << report.materials_used << " used (" << report.materials_missing << " missing), "
+            << report.materials_declared << " declared in " << report.material_files << " .mtr files\n"
+            << "  glowing  " << report.emitters << ": " << report.emitting_surfaces
+            << " opaque (light sources for next-event estimation), " << report.emitters - report.emitting_surfaces
+            << " blended layers (seen, not sampled)\n"
             << "textures   " << report.images_loaded + report.images_placeholder << " (" << report.images_placeholder
             << " placeholders)\n"
             << "lights     " << loaded.lights.size() << ": " << report.lights_point << " point, "

@@ -3,8 +3,7 @@
 // world's bounding box, each sized so that about --overlap of them reach an average point, as in a map
 // where more lights light more rooms rather than the same spot; --radius R fixes their size instead.
 //
-//   bench_lights [scene.pack | map] [--counts 8,64,256,1024] [--modes tree,all,every] [--width W]
-//                [--height H] [--spp S] [--bounces B] [--overlap K | --radius R] [--repeats R] [--json FILE]
+//   bench_lights [scene.pack | map] [options]   (bench_lights --help lists them)
 // Default: the generated test map (assets/testmap) from the player start, Embree, 320x180, 1 spp, 1 bounce.
 #include <algorithm>
 #include <chrono>
@@ -19,6 +18,7 @@
 #include <string>
 #include <vector>
 
+#include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
 
 #include "cohort/core/frame_defaults.h"
@@ -43,42 +43,32 @@ struct Config {
   std::string json = "bench_lights.json";
 };
 
-template <class T>
-std::vector<T> split(const std::string& text, T (*convert)(const std::string&)) {
-  std::vector<T> out;
-  std::stringstream in(text);
-  for (std::string item; std::getline(in, item, ',');)
-    if (!item.empty()) out.push_back(convert(item));
-  return out;
-}
-
 Config parse(int argc, char** argv) {
   Config c;
-  for (int i = 1; i < argc; ++i) {
-    std::string a = argv[i];
-    auto next = [&]() -> std::string {
-      if (i + 1 >= argc) {
-        std::cerr << a << " needs a value\n";
-        std::exit(2);
-      }
-      return argv[++i];
-    };
-    if (a == "--counts") c.counts = split<int>(next(), [](const std::string& s) { return std::stoi(s); });
-    else if (a == "--modes") c.modes = split<std::string>(next(), [](const std::string& s) { return s; });
-    else if (a == "--tracer") c.tracer = next();
-    else if (a == "--width") c.width = std::stoi(next());
-    else if (a == "--height") c.height = std::stoi(next());
-    else if (a == "--spp") c.spp = std::stoi(next());
-    else if (a == "--bounces") c.bounces = std::stoi(next());
-    else if (a == "--overlap") c.overlap = std::stof(next());
-    else if (a == "--radius") c.radius = std::stof(next());
-    else if (a == "--repeats") c.repeats = std::stoi(next());
-    else if (a == "--json") c.json = next();
-    else if (!a.empty() && a[0] != '-') c.scene = a;
-    else {
-      std::cerr << "unknown option " << a << "\n";
-      std::exit(2);
-    }
+  CLI::App app{"Frame time against the light count on the same geometry, per light-sampling mode (tree, all, "
+               "every): N point lights scattered over the world's box, sized so that about --overlap reach an "
+               "average point. Prints a table and writes JSON."};
+  app.add_option("scene", c.scene, "scene pack or .map (default: the generated test map)");
+  app.add_option("--tracer", c.tracer, "tracer name (tracer registry: embree, opencl:N, cuda:N)")->capture_default_str();
+  app.add_option("--counts", c.counts, "light counts, comma-separated")->delimiter(',')->check(CLI::Range(1, 1 << 20))
+      ->capture_default_str();
+  app.add_option("--modes", c.modes, "light-sampling modes, comma-separated")->delimiter(',')
+      ->check(CLI::IsMember({"tree", "all", "every"}))->capture_default_str();
+  app.add_option("--width", c.width, "image width")->check(CLI::PositiveNumber)->capture_default_str();
+  app.add_option("--height", c.height, "image height")->check(CLI::PositiveNumber)->capture_default_str();
+  app.add_option("--spp", c.spp, "samples per pixel")->check(CLI::PositiveNumber)->capture_default_str();
+  app.add_option("--bounces", c.bounces, "indirect bounces")->check(CLI::NonNegativeNumber)->capture_default_str();
+  auto* overlap = app.add_option("--overlap", c.overlap, "lights reaching an average point (sets their radius)")
+                      ->check(CLI::PositiveNumber)->capture_default_str();
+  app.add_option("--radius", c.radius, "fixed light radius instead of --overlap")->check(CLI::PositiveNumber)
+      ->excludes(overlap);
+  app.add_option("--repeats", c.repeats, "timed renders per case (the best counts)")->check(CLI::PositiveNumber)
+      ->capture_default_str();
+  app.add_option("--json", c.json, "JSON output")->capture_default_str();
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    std::exit(app.exit(e));
   }
   return c;
 }

@@ -3,10 +3,7 @@
 // whose floor is a bumpy grid of the wanted triangle count, lit by a grid of point lights under the
 // ceiling. Prints a table, writes JSON and a PNG chart (ms per frame against lights, a line per
 // triangle count).
-//   bench_scaling [--tracer embree|cuda:0|opencl:0] [--width W] [--height H] [--spp S] [--bounces B]
-//                 [--light-samples N] [--frames F] [--lights 8,64,...] [--triangles 3000,...]
-//                 [--smoke] [--json FILE] [--plot FILE]
-// --smoke: tiny sizes, for the ctest that keeps the benchmark running.
+//   bench_scaling [--tracer embree|cuda:0|opencl:0] [options]   (bench_scaling --help lists them)
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -20,6 +17,7 @@
 #include <string>
 #include <vector>
 
+#include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
 
 #include "cohort/core/frame_defaults.h"
@@ -45,62 +43,35 @@ struct Config {
   std::string json = "out/bench_scaling.json", plot = "out/bench_scaling.png";
 };
 
-std::vector<int> parse_list(const std::string& option, const std::string& text) {
-  std::vector<int> out;
-  std::stringstream ss(text);
-  std::string item;
-  while (std::getline(ss, item, ',')) {
-    try {
-      size_t used = 0;
-      const int v = std::stoi(item, &used);
-      if (used != item.size() || v <= 0) throw std::invalid_argument(item);
-      out.push_back(v);
-    } catch (const std::exception&) {
-      std::cerr << option << ": '" << item << "' is not a positive integer\n";
-      std::exit(2);
-    }
-  }
-  if (out.empty()) {
-    std::cerr << option << " needs at least one value\n";
-    std::exit(2);
-  }
-  return out;
-}
-
 Config parse(int argc, char** argv) {
   Config c;
-  for (int i = 1; i < argc; ++i) {
-    const std::string a = argv[i];
-    auto next = [&]() -> std::string {
-      if (i + 1 >= argc) {
-        std::cerr << a << " needs a value\n";
-        std::exit(2);
-      }
-      return argv[++i];
-    };
-    if (a == "--tracer") c.tracer = next();
-    else if (a == "--width") c.width = std::stoi(next());
-    else if (a == "--height") c.height = std::stoi(next());
-    else if (a == "--spp") c.spp = std::stoi(next());
-    else if (a == "--bounces") c.bounces = std::stoi(next());
-    else if (a == "--light-samples") c.light_samples = std::stoi(next());
-    else if (a == "--frames") c.frames = std::stoi(next());
-    else if (a == "--lights") c.lights = parse_list(a, next());
-    else if (a == "--triangles") c.triangles = parse_list(a, next());
-    else if (a == "--json") c.json = next();
-    else if (a == "--plot") c.plot = next();
-    else if (a == "--smoke") {
-      c.width = 64, c.height = 36, c.frames = 1;
-      c.lights = {8, 64};
-      c.triangles = {3000, 30000};
-    } else {
-      std::cerr << "unknown option " << a << " (see the header of bench/bench_scaling.cpp)\n";
-      std::exit(2);
-    }
+  CLI::App app{"Scaling benchmark (issue 16): frame time and rays/s as the light count and the triangle count "
+               "grow, on one tracer, in generated rooms. Prints a table, writes JSON and a chart."};
+  app.add_option("--tracer", c.tracer, "tracer name (tracer registry: embree, opencl:N, cuda:N)")->capture_default_str();
+  app.add_option("--width", c.width, "image width")->check(CLI::PositiveNumber)->capture_default_str();
+  app.add_option("--height", c.height, "image height")->check(CLI::PositiveNumber)->capture_default_str();
+  app.add_option("--spp", c.spp, "samples per pixel")->check(CLI::PositiveNumber)->capture_default_str();
+  app.add_option("--bounces", c.bounces, "indirect bounces")->check(CLI::NonNegativeNumber)->capture_default_str();
+  app.add_option("--light-samples", c.light_samples, "lights sampled per hit (default: the renderer's)")
+      ->check(CLI::NonNegativeNumber);
+  app.add_option("--frames", c.frames, "timed frames per case")->check(CLI::PositiveNumber)->capture_default_str();
+  app.add_option("--lights", c.lights, "light counts, comma-separated")->delimiter(',')->check(CLI::Range(1, 1 << 20))
+      ->capture_default_str();
+  app.add_option("--triangles", c.triangles, "triangle counts, comma-separated")->delimiter(',')
+      ->check(CLI::Range(1, 1 << 28))->capture_default_str();
+  app.add_option("--json", c.json, "JSON output")->capture_default_str();
+  app.add_option("--plot", c.plot, "chart output (PNG, or PPM without OpenImageIO)")->capture_default_str();
+  bool smoke = false;
+  app.add_flag("--smoke", smoke, "tiny sizes, for the ctest that keeps the benchmark running");
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    std::exit(app.exit(e));
   }
-  if (c.width <= 0 || c.height <= 0 || c.spp <= 0 || c.bounces < 0 || c.frames <= 0) {
-    std::cerr << "--width, --height, --spp and --frames must be positive, --bounces >= 0\n";
-    std::exit(2);
+  if (smoke) {
+    c.width = 64, c.height = 36, c.frames = 1;
+    c.lights = {8, 64};
+    c.triangles = {3000, 30000};
   }
   return c;
 }

@@ -266,7 +266,10 @@ class SceneBuilder {
     report_.materials_used = static_cast<int>(scene_.materials.size());
     report_.images_loaded = images_.loaded_count();
     report_.images_placeholder = images_.placeholder_count();
-    for (const Material& m : scene_.materials) report_.emitters += m.emitter ? 1 : 0;
+    for (const Material& m : scene_.materials) {
+      report_.emitters += m.emitter ? 1 : 0;
+      report_.emitting_surfaces += m.emitter && m.blend == BlendClass::Opaque ? 1 : 0;
+    }
   }
 
  private:
