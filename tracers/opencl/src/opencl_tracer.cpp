@@ -104,8 +104,9 @@ struct OpenCLTracer::Impl {
   cl_kernel kernel = nullptr;
   DeviceBuffer vertices, triangles, blas_nodes, blases, instances, tlas_nodes, materials, textures, texels, lights, light_nodes,
       emissive;
-  DeviceBuffer skins, skin_vertices, skin_weights, skin_adjacency, joints;
-  cl_kernel skin_positions = nullptr, skin_normals = nullptr, refit_leaves = nullptr, refit_blas = nullptr;
+  DeviceBuffer skins, skin_vertices, skin_weights, skin_triangles, skin_adjacency, skin_faces, joints;
+  cl_kernel skin_positions = nullptr, skin_faces_kernel = nullptr, skin_normals = nullptr, refit_leaves = nullptr,
+            refit_blas = nullptr;
 
   // Poses the given skins on the device: positions, then normals, then the BLAS refit (in queue order).
   void run_skinning(const commit::TracerScene& s, const std::vector<uint32_t>& which) {
@@ -120,9 +121,17 @@ struct OpenCLTracer::Impl {
       check(clSetKernelArg(skin_positions, 5, sizeof skin_index, &skin_index), "clSetKernelArg");
       check(clEnqueueNDRangeKernel(queue, skin_positions, 1, nullptr, &global, &local, 0, nullptr, nullptr),
             "launching the skinning kernel");
-      const cl_mem normal_args[] = {vertices.mem(), skin_vertices.mem(), skin_adjacency.mem(), skins.mem()};
-      for (cl_uint a = 0; a < 4; ++a) check(clSetKernelArg(skin_normals, a, sizeof(cl_mem), &normal_args[a]), "clSetKernelArg");
-      check(clSetKernelArg(skin_normals, 4, sizeof skin_index, &skin_index), "clSetKernelArg");
+      const cl_mem face_args[] = {vertices.mem(), skin_triangles.mem(), skin_faces.mem(), skins.mem()};
+      for (cl_uint a = 0; a < 4; ++a) check(clSetKernelArg(skin_faces_kernel, a, sizeof(cl_mem), &face_args[a]), "clSetKernelArg");
+      check(clSetKernelArg(skin_faces_kernel, 4, sizeof skin_index, &skin_index), "clSetKernelArg");
+      const size_t face_global = (size_t(skin.triangle_count) + local - 1) / local * local;
+      if (face_global > 0)
+        check(clEnqueueNDRangeKernel(queue, skin_faces_kernel, 1, nullptr, &face_global, &local, 0, nullptr, nullptr),
+              "launching the skinned-faces kernel");
+      const cl_mem normal_args[] = {vertices.mem(), skin_vertices.mem(), skin_adjacency.mem(), skin_triangles.mem(),
+                                    skin_faces.mem(), skins.mem()};
+      for (cl_uint a = 0; a < 6; ++a) check(clSetKernelArg(skin_normals, a, sizeof(cl_mem), &normal_args[a]), "clSetKernelArg");
+      check(clSetKernelArg(skin_normals, 6, sizeof skin_index, &skin_index), "clSetKernelArg");
       check(clEnqueueNDRangeKernel(queue, skin_normals, 1, nullptr, &global, &local, 0, nullptr, nullptr),
             "launching the skinned-normals kernel");
       const cl_mem refit_args[] = {blas_nodes.mem(), triangles.mem(), vertices.mem(), blases.mem(), skins.mem()};
@@ -146,7 +155,7 @@ struct OpenCLTracer::Impl {
   ~Impl() {
     for (cl_mem m : {params, camera, output, row_rays})
       if (m) clReleaseMemObject(m);
-    for (cl_kernel k : {kernel, skin_positions, skin_normals, refit_leaves, refit_blas})
+    for (cl_kernel k : {kernel, skin_positions, skin_faces_kernel, skin_normals, refit_leaves, refit_blas})
       if (k) clReleaseKernel(k);
     if (program) clReleaseProgram(program);
     if (queue) clReleaseCommandQueue(queue);
@@ -199,6 +208,8 @@ OpenCLTracer::OpenCLTracer(const Options& options) : impl_(std::make_unique<Impl
   check(err, "clCreateKernel");
   impl_->skin_positions = clCreateKernel(impl_->program, "cohort_skin_positions", &err);
   check(err, "clCreateKernel(cohort_skin_positions)");
+  impl_->skin_faces_kernel = clCreateKernel(impl_->program, "cohort_skin_faces", &err);
+  check(err, "clCreateKernel(cohort_skin_faces)");
   impl_->skin_normals = clCreateKernel(impl_->program, "cohort_skin_normals", &err);
   check(err, "clCreateKernel(cohort_skin_normals)");
   impl_->refit_leaves = clCreateKernel(impl_->program, "cohort_refit_blas_leaves", &err);
@@ -243,7 +254,9 @@ void OpenCLTracer::upload(const commit::ChangeSet& changes) {
     m.skins.upload(c, q, s.skins, "uploading skins");
     m.skin_vertices.upload(c, q, s.skin_vertices, "uploading skin vertices");
     m.skin_weights.upload(c, q, s.skin_weights, "uploading skin weights");
+    m.skin_triangles.upload(c, q, s.skin_triangles, "uploading skin triangles");
     m.skin_adjacency.upload(c, q, s.skin_adjacency, "uploading skin adjacency");
+    m.skin_faces.upload(c, q, s.skin_faces, "sizing the skin faces");   // the kernels write them
   }
   if (all || !changes.posed_skins.empty()) m.joints.upload(c, q, s.joints, "uploading joints");
   // Vertices just uploaded from the host copy are not posed there (the host keeps only the joints), so
