@@ -80,8 +80,10 @@ bool same_tracer_scene(const TracerScene& a, const TracerScene& b, std::string* 
          same_array(a.skins, b.skins, "skins", where) &&
          same_array(a.skin_vertices, b.skin_vertices, "skin_vertices", where) &&
          same_array(a.skin_weights, b.skin_weights, "skin_weights", where) &&
+         same_array(a.skin_triangles, b.skin_triangles, "skin_triangles", where) &&
          same_array(a.skin_adjacency, b.skin_adjacency, "skin_adjacency", where) &&
          same_array(a.joints, b.joints, "joints", where) &&
+         same_array(a.skin_faces, b.skin_faces, "skin_faces", where) &&
          same_array(std::vector<KCamera>{a.camera}, std::vector<KCamera>{b.camera}, "camera", where);
 }
 

@@ -15,7 +15,8 @@ size_t BlasUpload::bytes() const {
 
 size_t SkinUpload::bytes() const {
   return kRecordHeaderBytes + sizeof(skin) + 2 * sizeof(uint32_t) + vertices.size() * sizeof(KSkinVertex) +
-         weights.size() * sizeof(KSkinWeight) + adjacency.size() * sizeof(KSkinTriangle);
+         weights.size() * sizeof(KSkinWeight) + triangles.size() * sizeof(KSkinTriangle) +
+         adjacency.size() * sizeof(uint32_t);
 }
 
 size_t TexelUpload::bytes() const { return kRecordHeaderBytes + texels.size() * sizeof(uint32_t); }
@@ -236,7 +237,10 @@ ChangeSet apply_commit(const CommitBuffer& commit, TracerScene& scene, Skinning 
   for (const SkinUpload& up : commit.skin_uploads()) {
     write_range(scene.skin_vertices, up.skin.skin_vertex_offset, up.vertices);
     write_range(scene.skin_weights, up.weight_offset, up.weights);
+    write_range(scene.skin_triangles, up.skin.triangle_offset, up.triangles);
     write_range(scene.skin_adjacency, up.adjacency_offset, up.adjacency);
+    const size_t faces_end = size_t(up.skin.face_offset) + up.skin.triangle_count;
+    if (scene.skin_faces.size() < faces_end) scene.skin_faces.resize(faces_end, KSkinFace{});
     write_range(scene.skins, up.skin_index, std::vector<KSkin>{up.skin});
     changes.skin_data = true;
   }

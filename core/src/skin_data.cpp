@@ -43,13 +43,15 @@ MeshSkinData mesh_skin_data(const scene::Mesh& mesh) {
     out.weights.push_back(k);
   }
   std::vector<int> group_of(count, -1);
-  std::vector<std::vector<KSkinTriangle>> groups;
+  std::vector<std::vector<uint32_t>> groups;
   for (const scene::Surface& surface : mesh.surfaces) {
     std::map<std::vector<uint32_t>, int> by_key;
     for (uint32_t i = 0; i + 2 < surface.index_count; i += 3) {
       const size_t first = size_t(surface.first_index) + i;
       if (first + 2 >= mesh.indices.size()) throw std::runtime_error("mesh '" + mesh.name + "' has a surface past its indices");
       KSkinTriangle t{mesh.indices[first], mesh.indices[first + 1], mesh.indices[first + 2], 0u};
+      const uint32_t triangle = uint32_t(out.triangles.size());
+      out.triangles.push_back(t);
       int seen[3] = {-1, -1, -1};
       for (int k = 0; k < 3; ++k) {
         const uint32_t v = k == 0 ? t.v0 : k == 1 ? t.v1 : t.v2;
@@ -65,7 +67,7 @@ MeshSkinData mesh_skin_data(const scene::Mesh& mesh) {
         const int g = group_of[v];
         if (g == seen[0] || g == seen[1]) continue;  // one entry per group, as the vertex sums it once
         seen[k] = g;
-        groups[size_t(g)].push_back(t);
+        groups[size_t(g)].push_back(triangle);
       }
     }
   }

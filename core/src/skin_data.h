@@ -10,11 +10,13 @@
 namespace cohort::core {
 
 // Per mesh, shared by every character drawn with it: indices relative to the vectors themselves
-// (first_weight into weights, first_adjacent into adjacency; adjacency vertices into the mesh).
+// (first_weight into weights, first_adjacent into adjacency, adjacency entries into triangles, triangle
+// corners into the mesh's vertices).
 struct MeshSkinData {
   std::vector<KSkinVertex> vertices;
   std::vector<KSkinWeight> weights;
-  std::vector<KSkinTriangle> adjacency;
+  std::vector<KSkinTriangle> triangles;
+  std::vector<uint32_t> adjacency;
 };
 
 // Adjacency for the normals skin_md5 regenerates: per surface, vertices at the same bind position share

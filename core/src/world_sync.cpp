@@ -350,12 +350,17 @@ WorldSync::SkinnedEntity WorldSync::add_skinned_blas(int mesh_index, commit::Com
       v.first_weight += skin_up.weight_offset;
       v.first_adjacent += skin_up.adjacency_offset;
     }
-    shared = skin_vertices_of_mesh_.emplace(mesh_index, uint32_t(master_.skin_vertices.size())).first;
+    shared = skin_vertices_of_mesh_
+                 .emplace(mesh_index, SharedSkin{uint32_t(master_.skin_vertices.size()),
+                                                 uint32_t(master_.skin_triangles.size()), uint32_t(data.triangles.size())})
+                 .first;
     skin_up.vertices = std::move(data.vertices);
     skin_up.weights = std::move(data.weights);
+    skin_up.triangles = std::move(data.triangles);
     skin_up.adjacency = std::move(data.adjacency);
     master_.skin_vertices.insert(master_.skin_vertices.end(), skin_up.vertices.begin(), skin_up.vertices.end());
     master_.skin_weights.insert(master_.skin_weights.end(), skin_up.weights.begin(), skin_up.weights.end());
+    master_.skin_triangles.insert(master_.skin_triangles.end(), skin_up.triangles.begin(), skin_up.triangles.end());
     master_.skin_adjacency.insert(master_.skin_adjacency.end(), skin_up.adjacency.begin(), skin_up.adjacency.end());
   }
 
@@ -385,9 +390,19 @@ WorldSync::SkinnedEntity WorldSync::add_skinned_blas(int mesh_index, commit::Com
   ++stats_.blas_builds;
 
   skin_up.skin_index = uint32_t(master_.skins.size());
-  skin_up.skin = KSkin{entity.blas, up.vertex_offset, uint32_t(up.vertices.size()), shared->second,
-                       uint32_t(master_.joints.size()), uint32_t(mesh.skin->joint_count), 0u, 0u};
+  const SharedSkin& shared_skin = shared->second;
+  skin_up.skin = KSkin{entity.blas,
+                       up.vertex_offset,
+                       uint32_t(up.vertices.size()),
+                       shared_skin.skin_vertex_offset,
+                       uint32_t(master_.joints.size()),
+                       uint32_t(mesh.skin->joint_count),
+                       shared_skin.triangle_offset,
+                       shared_skin.triangle_count,
+                       uint32_t(master_.skin_faces.size()),
+                       0u, 0u, 0u};
   master_.joints.resize(master_.joints.size() + size_t(mesh.skin->joint_count), KJoint{});
+  master_.skin_faces.resize(master_.skin_faces.size() + shared_skin.triangle_count, KSkinFace{});
   master_.skins.push_back(skin_up.skin);
   entity.skin = skin_up.skin_index;
   out.add_blas(std::move(up));

@@ -240,11 +240,12 @@ TEST(Skinning, BrokenSkinUploadIsRefused) {
   world.UpdateEntityDef(0, posed(world, scene::bind_pose(md5)));
   const commit::CommitBuffer records = sync.sync(world.TakeChanges(), 1);
   ASSERT_EQ(records.skin_uploads().size(), 1u);
-  for (int breakage = 0; breakage < 3; ++breakage) {
+  for (int breakage = 0; breakage < 4; ++breakage) {
     commit::CommitBuffer broken;
     for (const commit::BlasUpload& b : records.blas_uploads()) broken.add_blas(b);
     commit::SkinUpload up = records.skin_uploads()[0];
-    if (breakage == 0) up.adjacency[3].v1 = up.skin.vertex_count;       // a vertex past the skin's
+    if (breakage == 0) up.triangles[3].v1 = up.skin.vertex_count;       // a vertex past the skin's
+    if (breakage == 3) up.adjacency[3] = up.skin.triangle_count;        // a triangle past the skin's
     if (breakage == 1) up.vertices[5].first_weight = uint32_t(up.weights.size());  // weights past the pool
     if (breakage == 2) up.skin.blas = 99;                                // no such BLAS
     broken.add_skin(up);

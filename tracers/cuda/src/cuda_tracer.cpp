@@ -44,7 +44,9 @@ struct CudaTracer::Impl {
   DeviceArray<KSkin> skins;
   DeviceArray<KSkinVertex> skin_vertices;
   DeviceArray<KSkinWeight> skin_weights;
-  DeviceArray<KSkinTriangle> skin_adjacency;
+  DeviceArray<KSkinTriangle> skin_triangles;
+  DeviceArray<uint32_t> skin_adjacency;
+  DeviceArray<KSkinFace> skin_faces;
   DeviceArray<KJoint> joints;
   cudaTextureObject_t texel_texture = 0;
   DeviceArray<float> previous_transforms;
@@ -167,7 +169,9 @@ void CudaTracer::upload(const commit::ChangeSet& changes) {
     m.skins.upload(scene.skins, 0, s);
     m.skin_vertices.upload(scene.skin_vertices, 0, s);
     m.skin_weights.upload(scene.skin_weights, 0, s);
+    m.skin_triangles.upload(scene.skin_triangles, 0, s);
     m.skin_adjacency.upload(scene.skin_adjacency, 0, s);
+    m.skin_faces.upload(scene.skin_faces, 0, s);   // sized here, written by the kernels
   }
   if (all || !changes.posed_skins.empty()) m.joints.upload(scene.joints, 0, s);
   // The host copy keeps only the joints: after vertices came from it every skin runs again, otherwise
@@ -181,8 +185,9 @@ void CudaTracer::upload(const commit::ChangeSet& changes) {
     if (index >= scene.skins.size()) continue;
     const KSkin& skin = scene.skins[index];
     if (size_t(skin.joint_offset) + skin.joint_count > scene.joints.size() || skin.blas >= scene.blases.size()) continue;
-    launch_skinning(m.vertices.data(), m.skin_vertices.data(), m.skin_weights.data(), m.skin_adjacency.data(),
-                    m.joints.data(), skin, m.blas_nodes.data(), m.triangles.data(), scene.blases[skin.blas], s);
+    const SkinBuffers pools{m.skin_vertices.data(), m.skin_weights.data(), m.skin_triangles.data(),
+                            m.skin_adjacency.data(), m.skin_faces.data(), m.joints.data()};
+    launch_skinning(m.vertices.data(), pools, skin, m.blas_nodes.data(), m.triangles.data(), scene.blases[skin.blas], s);
   }
   COHORT_CUDA(cudaStreamSynchronize(s));
 }

@@ -105,8 +105,9 @@ struct OpenCLTracer::Impl {
   DeviceBuffer previous_transforms;
   DeviceBuffer vertices, triangles, blas_nodes, blases, instances, tlas_nodes, materials, textures, texels, lights, light_nodes,
       emissive;
-  DeviceBuffer skins, skin_vertices, skin_weights, skin_adjacency, joints;
-  cl_kernel skin_positions = nullptr, skin_normals = nullptr, refit_blas = nullptr;
+  DeviceBuffer skins, skin_vertices, skin_weights, skin_triangles, skin_adjacency, skin_faces, joints;
+  cl_kernel skin_positions = nullptr, skin_faces_kernel = nullptr, skin_normals = nullptr, refit_leaves = nullptr,
+            refit_blas = nullptr;
 
   // Poses the given skins on the device: positions, then normals, then the BLAS refit (in queue order).
   void run_skinning(const commit::TracerScene& s, const std::vector<uint32_t>& which) {
@@ -121,14 +122,29 @@ struct OpenCLTracer::Impl {
       check(clSetKernelArg(skin_positions, 5, sizeof skin_index, &skin_index), "clSetKernelArg");
       check(clEnqueueNDRangeKernel(queue, skin_positions, 1, nullptr, &global, &local, 0, nullptr, nullptr),
             "launching the skinning kernel");
-      const cl_mem normal_args[] = {vertices.mem(), skin_vertices.mem(), skin_adjacency.mem(), skins.mem()};
-      for (cl_uint a = 0; a < 4; ++a) check(clSetKernelArg(skin_normals, a, sizeof(cl_mem), &normal_args[a]), "clSetKernelArg");
-      check(clSetKernelArg(skin_normals, 4, sizeof skin_index, &skin_index), "clSetKernelArg");
+      const cl_mem face_args[] = {vertices.mem(), skin_triangles.mem(), skin_faces.mem(), skins.mem()};
+      for (cl_uint a = 0; a < 4; ++a) check(clSetKernelArg(skin_faces_kernel, a, sizeof(cl_mem), &face_args[a]), "clSetKernelArg");
+      check(clSetKernelArg(skin_faces_kernel, 4, sizeof skin_index, &skin_index), "clSetKernelArg");
+      const size_t face_global = (size_t(skin.triangle_count) + local - 1) / local * local;
+      if (face_global > 0)
+        check(clEnqueueNDRangeKernel(queue, skin_faces_kernel, 1, nullptr, &face_global, &local, 0, nullptr, nullptr),
+              "launching the skinned-faces kernel");
+      const cl_mem normal_args[] = {vertices.mem(), skin_vertices.mem(), skin_adjacency.mem(), skin_triangles.mem(),
+                                    skin_faces.mem(), skins.mem()};
+      for (cl_uint a = 0; a < 6; ++a) check(clSetKernelArg(skin_normals, a, sizeof(cl_mem), &normal_args[a]), "clSetKernelArg");
+      check(clSetKernelArg(skin_normals, 6, sizeof skin_index, &skin_index), "clSetKernelArg");
       check(clEnqueueNDRangeKernel(queue, skin_normals, 1, nullptr, &global, &local, 0, nullptr, nullptr),
             "launching the skinned-normals kernel");
       const cl_mem refit_args[] = {blas_nodes.mem(), triangles.mem(), vertices.mem(), blases.mem(), skins.mem()};
-      for (cl_uint a = 0; a < 5; ++a) check(clSetKernelArg(refit_blas, a, sizeof(cl_mem), &refit_args[a]), "clSetKernelArg");
-      check(clSetKernelArg(refit_blas, 5, sizeof skin_index, &skin_index), "clSetKernelArg");
+      for (cl_kernel k : {refit_leaves, refit_blas}) {
+        for (cl_uint a = 0; a < 5; ++a) check(clSetKernelArg(k, a, sizeof(cl_mem), &refit_args[a]), "clSetKernelArg");
+        check(clSetKernelArg(k, 5, sizeof skin_index, &skin_index), "clSetKernelArg");
+      }
+      const uint32_t node_count = skin.blas < s.blases.size() ? s.blases[skin.blas].node_count : 0u;
+      const size_t leaf_global = (size_t(node_count) + local - 1) / local * local;
+      if (leaf_global > 0)
+        check(clEnqueueNDRangeKernel(queue, refit_leaves, 1, nullptr, &leaf_global, &local, 0, nullptr, nullptr),
+              "launching the BLAS leaf refit kernel");
       const size_t one = 1;
       check(clEnqueueNDRangeKernel(queue, refit_blas, 1, nullptr, &one, &one, 0, nullptr, nullptr),
             "launching the BLAS refit kernel");
@@ -141,7 +157,7 @@ struct OpenCLTracer::Impl {
   ~Impl() {
     for (cl_mem m : {params, camera, previous_camera, output, row_rays, aux})
       if (m) clReleaseMemObject(m);
-    for (cl_kernel k : {kernel, aux_kernel, skin_positions, skin_normals, refit_blas})
+    for (cl_kernel k : {kernel, aux_kernel, skin_positions, skin_faces_kernel, skin_normals, refit_leaves, refit_blas})
       if (k) clReleaseKernel(k);
     if (program) clReleaseProgram(program);
     if (queue) clReleaseCommandQueue(queue);
@@ -194,8 +210,12 @@ OpenCLTracer::OpenCLTracer(const Options& options) : impl_(std::make_unique<Impl
   check(err, "clCreateKernel");
   impl_->skin_positions = clCreateKernel(impl_->program, "cohort_skin_positions", &err);
   check(err, "clCreateKernel(cohort_skin_positions)");
+  impl_->skin_faces_kernel = clCreateKernel(impl_->program, "cohort_skin_faces", &err);
+  check(err, "clCreateKernel(cohort_skin_faces)");
   impl_->skin_normals = clCreateKernel(impl_->program, "cohort_skin_normals", &err);
   check(err, "clCreateKernel(cohort_skin_normals)");
+  impl_->refit_leaves = clCreateKernel(impl_->program, "cohort_refit_blas_leaves", &err);
+  check(err, "clCreateKernel(cohort_refit_blas_leaves)");
   impl_->refit_blas = clCreateKernel(impl_->program, "cohort_refit_blas", &err);
   check(err, "clCreateKernel(cohort_refit_blas)");
   impl_->aux_kernel = clCreateKernel(impl_->program, "cohort_aux_band", &err);
@@ -240,7 +260,9 @@ void OpenCLTracer::upload(const commit::ChangeSet& changes) {
     m.skins.upload(c, q, s.skins, "uploading skins");
     m.skin_vertices.upload(c, q, s.skin_vertices, "uploading skin vertices");
     m.skin_weights.upload(c, q, s.skin_weights, "uploading skin weights");
+    m.skin_triangles.upload(c, q, s.skin_triangles, "uploading skin triangles");
     m.skin_adjacency.upload(c, q, s.skin_adjacency, "uploading skin adjacency");
+    m.skin_faces.upload(c, q, s.skin_faces, "sizing the skin faces");   // the kernels write them
   }
   if (all || !changes.posed_skins.empty()) m.joints.upload(c, q, s.joints, "uploading joints");
   // Vertices just uploaded from the host copy are not posed there (the host keeps only the joints), so

@@ -39,10 +39,13 @@ struct BlasUpload {
 struct SkinUpload {
   uint32_t skin_index = 0;
   KSkin skin{};
-  uint32_t weight_offset = 0, adjacency_offset = 0;   // skin.skin_vertex_offset places the vertices
+  // skin.skin_vertex_offset and skin.triangle_offset place the vertices and triangles; the skin's faces
+  // (skin.face_offset, one per triangle) are the tracer's to write.
+  uint32_t weight_offset = 0, adjacency_offset = 0;
   std::vector<KSkinVertex> vertices;
   std::vector<KSkinWeight> weights;
-  std::vector<KSkinTriangle> adjacency;
+  std::vector<KSkinTriangle> triangles;
+  std::vector<uint32_t> adjacency;
   size_t bytes() const;
 };
 

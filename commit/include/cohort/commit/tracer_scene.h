@@ -32,8 +32,10 @@ struct TracerScene {
   std::vector<KSkin> skins;
   std::vector<KSkinVertex> skin_vertices;
   std::vector<KSkinWeight> skin_weights;
-  std::vector<KSkinTriangle> skin_adjacency;
+  std::vector<KSkinTriangle> skin_triangles;
+  std::vector<uint32_t> skin_adjacency;    // triangle indices relative to a skin's triangle_offset
   std::vector<KJoint> joints;
+  std::vector<KSkinFace> skin_faces;       // per posed character, written with its vertices
   KCamera camera{};
   uint64_t version = 0;               // frame number of the last commit applied
 };
@@ -45,7 +47,7 @@ struct ChangeSet {
   size_t vertices_from = 0, triangles_from = 0, blas_nodes_from = 0, blases_from = 0;  // first changed element
   bool instances = false, tlas = false, materials = false, textures = false, lights = false, camera = false;
   bool light_tree = false, emissive = false;
-  bool skin_data = false;             // skins / skin vertices / weights / adjacency grew or changed
+  bool skin_data = false;             // skins / skin vertices / weights / triangles / adjacency / faces grew
   std::vector<uint32_t> posed_skins;  // skins whose joints changed: their vertices and BLAS follow them
   bool any() const {
     return full_resync || geometry || instances || tlas || materials || textures || lights || light_tree || emissive ||

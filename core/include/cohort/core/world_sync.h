@@ -139,7 +139,10 @@ class WorldSync {
   std::map<int, KInstance> entity_instances_;     // by entity handle
   std::map<int, int> mesh_of_entity_;
   std::map<int, SkinnedEntity> skinned_;          // by entity handle
-  std::map<int, uint32_t> skin_vertices_of_mesh_; // a skinned mesh's shared weights: its first KSkinVertex
+  struct SharedSkin {                             // a skinned mesh's data, shared by its characters
+    uint32_t skin_vertex_offset = 0, triangle_offset = 0, triangle_count = 0;
+  };
+  std::map<int, SharedSkin> skin_vertices_of_mesh_;
   std::set<int> warned_joint_counts_;             // entity handles
   std::map<int, KLight> lights_by_handle_;
   std::set<std::string> warned_lights_;           // "handle defect" already warned about

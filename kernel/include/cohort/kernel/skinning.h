@@ -6,7 +6,7 @@
  * The results equal scene::skin_md5 (md5_pose.cpp): position = sum of bias * (R offset + T) over the
  * vertex's weights; normal = the normalised sum of the unit face normals of every triangle touching a
  * vertex at the same position in this pose (R_DeriveTangents; candidates are the triangles at the
- * vertex's bind position); tangent from the texture derivatives of the vertex's own
+ * vertex's bind position, each triangle's face computed once per pose); tangent from the texture derivatives of the vertex's own
  * triangles (scene/tangents.cpp), orthogonalised against the normal. */
 #ifndef COHORT_KERNEL_SKINNING_H
 #define COHORT_KERNEL_SKINNING_H
@@ -14,7 +14,9 @@
 #include "vec.h"
 
 /* A skinned BLAS: its vertices [vertex_offset, vertex_offset + vertex_count) of the vertex pool are
- * written from skin vertices [skin_vertex_offset, ...) and joints [joint_offset, joint_offset + joint_count). */
+ * written from skin vertices [skin_vertex_offset, ...) and joints [joint_offset, joint_offset + joint_count).
+ * Its mesh's triangles are [triangle_offset, +triangle_count) of the skin triangle pool (shared by every
+ * character of the mesh); each pose writes one KSkinFace per triangle at [face_offset, +triangle_count). */
 typedef struct KSkin {
   kuint blas;
   kuint vertex_offset;
@@ -22,12 +24,16 @@ typedef struct KSkin {
   kuint skin_vertex_offset;
   kuint joint_offset;
   kuint joint_count;
-  kuint pad0, pad1;
+  kuint triangle_offset;
+  kuint triangle_count;
+  kuint face_offset;
+  kuint pad0, pad1, pad2;
 } KSkin;
 
 /* Per skinned vertex: its weights [first_weight, +weight_count) (absolute in the weight pool), and the
  * triangles touching a vertex at its bind position [first_adjacent, +adjacent_count) (absolute in the
- * adjacency pool). Shared by every skin of one mesh. */
+ * adjacency pool, whose entries are triangle indices relative to KSkin.triangle_offset). Shared by every
+ * skin of one mesh. */
 typedef struct KSkinVertex {
   kuint first_weight;
   kuint weight_count;
@@ -41,12 +47,19 @@ typedef struct KSkinWeight {
   kuint pad0, pad1, pad2;
 } KSkinWeight;
 
-/* A triangle of a skinned mesh by vertex indices relative to KSkin.vertex_offset (its winding as drawn),
- * so every character of one mesh shares the mesh's weights and adjacency. */
+/* A triangle of a skinned mesh by vertex indices relative to KSkin.vertex_offset (its winding as drawn). */
 typedef struct KSkinTriangle {
   kuint v0, v1, v2;
   kuint pad;
 } KSkinTriangle;
+
+/* What one posed triangle gives the vertices around it: its unit face normal and, when its texture
+ * coordinates are not degenerate (has_tangent), its texture-space directions. */
+typedef struct KSkinFace {
+  float normal[3]; kuint has_tangent;
+  float sdir[3]; float pad0;
+  float tdir[3]; float pad1;
+} KSkinFace;
 
 /* A joint in model space: rotation quaternion (x, y, z, w; column form, v' = q v q*) and position. */
 typedef struct KJoint {
@@ -55,7 +68,8 @@ typedef struct KJoint {
 } KJoint;
 
 #if defined(__cplusplus) && !defined(__CUDACC_RTC__)
-static_assert(sizeof(KSkin) == 32, "KSkin layout");
+static_assert(sizeof(KSkin) == 48, "KSkin layout");
+static_assert(sizeof(KSkinFace) == 48, "KSkinFace layout");
 static_assert(sizeof(KSkinVertex) == 16, "KSkinVertex layout");
 static_assert(sizeof(KSkinWeight) == 32, "KSkinWeight layout");
 static_assert(sizeof(KSkinTriangle) == 16, "KSkinTriangle layout");
@@ -100,37 +114,57 @@ KFN KVec3 k_skin_any_perpendicular(KVec3 n) {
 
 KFN int k_skin_same_point(KVec3 a, KVec3 b) { return a.x == b.x && a.y == b.y && a.z == b.z; }
 
-/* Pass 2, after every position of the skin is written: vertex i's normal and tangent. */
+/* Pass 2, after every position of the skin is written: triangle t's face (0 <= t < triangle_count). */
+KFN void k_skin_face(KGLOBAL const KVertex* vertices, KGLOBAL const KSkinTriangle* triangles, KGLOBAL KSkinFace* faces,
+                     KSkin skin, kuint t) {
+  KGLOBAL const KSkinTriangle* tri = triangles + skin.triangle_offset + t;
+  KGLOBAL const KVertex* base = vertices + skin.vertex_offset;
+  KGLOBAL const KVertex* va = base + tri->v0;
+  KGLOBAL const KVertex* vb = base + tri->v1;
+  KGLOBAL const KVertex* vc = base + tri->v2;
+  KVec3 p0 = v3_load_g(va->pos), p1 = v3_load_g(vb->pos), p2 = v3_load_g(vc->pos);
+  KVec3 face = v3_cross(v3_sub(p2, p0), v3_sub(p1, p0));
+  float length = v3_length(face);
+  if (length > 0.0f) face = v3(face.x / length, face.y / length, face.z / length);
+  KGLOBAL KSkinFace* out = faces + skin.face_offset + t;
+  out->normal[0] = face.x;
+  out->normal[1] = face.y;
+  out->normal[2] = face.z;
+  out->has_tangent = 0u;
+  KVec3 e1 = v3_sub(p1, p0), e2 = v3_sub(p2, p0);
+  float d1x = vb->u - va->u, d1y = vb->v - va->v, d2x = vc->u - va->u, d2y = vc->v - va->v;
+  float det = d1x * d2y - d2x * d1y;
+  if (!k_skin_finite(det) || k_fabs(det) < 1e-12f) return;
+  float r = 1.0f / det;
+  KVec3 sdir = v3_scale(v3_sub(v3_scale(e1, d2y), v3_scale(e2, d1y)), r);
+  KVec3 tdir = v3_scale(v3_sub(v3_scale(e2, d1x), v3_scale(e1, d2x)), r);
+  if (!k_skin_finite(sdir.x + sdir.y + sdir.z + tdir.x + tdir.y + tdir.z)) return;
+  out->has_tangent = 1u;
+  out->sdir[0] = sdir.x; out->sdir[1] = sdir.y; out->sdir[2] = sdir.z;
+  out->tdir[0] = tdir.x; out->tdir[1] = tdir.y; out->tdir[2] = tdir.z;
+}
+
+/* Pass 3, after every face: vertex i's normal and tangent. */
 KFN void k_skin_normal(KGLOBAL KVertex* vertices, KGLOBAL const KSkinVertex* skin_vertices,
-                       KGLOBAL const KSkinTriangle* adjacency, KSkin skin, kuint i) {
+                       KGLOBAL const kuint* adjacency, KGLOBAL const KSkinTriangle* triangles,
+                       KGLOBAL const KSkinFace* faces, KSkin skin, kuint i) {
   KGLOBAL const KSkinVertex* sv = skin_vertices + skin.skin_vertex_offset + i;
   KGLOBAL const KVertex* base = vertices + skin.vertex_offset;
   const KVec3 me = v3_load_g(base[i].pos);
   KVec3 normal = v3s(0.0f), tan_s = v3s(0.0f), tan_t = v3s(0.0f);
   for (kuint a = 0; a < sv->adjacent_count; ++a) {
-    KGLOBAL const KSkinTriangle* t = adjacency + sv->first_adjacent + a;
-    KGLOBAL const KVertex* va = base + t->v0;
-    KGLOBAL const KVertex* vb = base + t->v1;
-    KGLOBAL const KVertex* vc = base + t->v2;
-    KVec3 p0 = v3_load_g(va->pos), p1 = v3_load_g(vb->pos), p2 = v3_load_g(vc->pos);
+    const kuint t = adjacency[sv->first_adjacent + a];
+    KGLOBAL const KSkinTriangle* tri = triangles + skin.triangle_offset + t;
     /* Only a corner at exactly this position counts: vertices that met in the bind pose may part. */
-    if (!k_skin_same_point(p0, me) && !k_skin_same_point(p1, me) && !k_skin_same_point(p2, me)) continue;
-    KVec3 face = v3_cross(v3_sub(p2, p0), v3_sub(p1, p0));
-    float length = v3_length(face);
-    if (length > 0.0f) face = v3(face.x / length, face.y / length, face.z / length);
-    normal = v3_add(normal, face);
-    if (t->v0 != i && t->v1 != i && t->v2 != i) continue;
+    if (!k_skin_same_point(v3_load_g(base[tri->v0].pos), me) && !k_skin_same_point(v3_load_g(base[tri->v1].pos), me) &&
+        !k_skin_same_point(v3_load_g(base[tri->v2].pos), me))
+      continue;
+    KGLOBAL const KSkinFace* face = faces + skin.face_offset + t;
+    normal = v3_add(normal, v3_load_g(face->normal));
     /* The vertex's own triangle: its texture-space directions. */
-    KVec3 e1 = v3_sub(p1, p0), e2 = v3_sub(p2, p0);
-    float d1x = vb->u - va->u, d1y = vb->v - va->v, d2x = vc->u - va->u, d2y = vc->v - va->v;
-    float det = d1x * d2y - d2x * d1y;
-    if (!k_skin_finite(det) || k_fabs(det) < 1e-12f) continue;
-    float r = 1.0f / det;
-    KVec3 sdir = v3_scale(v3_sub(v3_scale(e1, d2y), v3_scale(e2, d1y)), r);
-    KVec3 tdir = v3_scale(v3_sub(v3_scale(e2, d1x), v3_scale(e1, d2x)), r);
-    if (!k_skin_finite(sdir.x + sdir.y + sdir.z + tdir.x + tdir.y + tdir.z)) continue;
-    tan_s = v3_add(tan_s, sdir);
-    tan_t = v3_add(tan_t, tdir);
+    if ((tri->v0 != i && tri->v1 != i && tri->v2 != i) || face->has_tangent == 0u) continue;
+    tan_s = v3_add(tan_s, v3_load_g(face->sdir));
+    tan_t = v3_add(tan_t, v3_load_g(face->tdir));
   }
   float nlen = v3_length(normal);
   normal = nlen > 0.0f ? v3(normal.x / nlen, normal.y / nlen, normal.z / nlen) : v3(0.0f, 0.0f, 1.0f);
