@@ -24,6 +24,9 @@ struct Image {
 
 enum class BlendClass : uint8_t { Opaque, PassThrough, Additive, Modulate, Alpha };
 
+// What a light material makes of its light (Material.h fogLight / blendLight / ambientLight).
+enum class LightKind : uint8_t { Normal, Fog, Blend, Ambient };
+
 struct Material {
   std::string name;
   std::string source_file; int source_line = 0;
@@ -39,6 +42,9 @@ struct Material {
   bool is_light_material = false;
   int light_image = -1, falloff_image = -1;
   glm::vec3 light_stage_color{1.0f};
+  LightKind light_kind = LightKind::Normal;
+  float light_stage_alpha = 1.0f;   // fog lights: a fog distance when > 1 (RB_FogPass)
+  bool light_blend_adds = false;    // blend lights: `blend add` adds, anything else multiplies
   bool is_default = false;     // made up because the name was not found
 };
 
