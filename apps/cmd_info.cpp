@@ -21,6 +21,14 @@ int run_info(const std::string& map, std::vector<std::string> bases, size_t max_
     spdlog::error("cohort info: {}", e.what());
     return kExitFailure;
   }
+  // Light kinds come from the light material (fogLight / blendLight / ambientLight); no material: normal.
+  int kinds[4] = {0, 0, 0, 0};
+  for (const scene::Light& light : loaded.lights) {
+    scene::LightKind kind = scene::LightKind::Normal;
+    if (light.material >= 0 && size_t(light.material) < loaded.materials.size())
+      kind = loaded.materials[size_t(light.material)].light_kind;
+    ++kinds[static_cast<int>(kind)];
+  }
   std::cout << "map        " << loaded.name << "\n"
             << "  .map     " << report.map_file << "\n"
             << "  .proc    " << report.proc_file << "\n"
@@ -37,6 +45,8 @@ int run_info(const std::string& map, std::vector<std::string> bases, size_t max_
             << " placeholders)\n"
             << "lights     " << loaded.lights.size() << ": " << report.lights_point << " point, "
             << report.lights_projected << " projected, " << report.lights_parallel << " parallel\n"
+            << "  kinds    " << kinds[0] << " normal, " << kinds[1] << " fog, " << kinds[2] << " blend, " << kinds[3]
+            << " ambient\n"
             << "entities   " << loaded.entities.size() << "\n";
   for (const auto& [classname, count] : report.entities_by_class)
     std::cout << "  " << classname << " " << count << "\n";

@@ -110,16 +110,41 @@ KLight to_klight(const scene::Light& light, const scene::Scene& scene, const Gpu
   glm::vec3 stage_color(1.0f);
   k.light_tex = K_NONE;
   k.falloff_tex = K_NONE;
+  scene::LightKind kind = scene::LightKind::Normal;
+  float stage_alpha = 1.0f;
+  bool blend_adds = false;
   if (material >= 0) {
     const scene::Material& m = scene.materials[static_cast<size_t>(material)];
     stage_color = evaluated_stage_color ? *evaluated_stage_color : m.light_stage_color;
+    kind = m.light_kind;
+    stage_alpha = m.light_stage_alpha;
+    blend_adds = m.light_blend_adds;
     k.light_tex = texture_slot(m.light_image, TextureUse::LightImage, scene);
     k.falloff_tex = texture_slot(m.falloff_image, TextureUse::Falloff, scene);
   }
   store(k.origin, light.origin);
-  store(k.color, options.light_scale * stage_color * light.color);
+  // Fog and blend lights use their stage colour without r_lightScale (RB_FogPass, RB_BlendLight).
+  const float scale = kind == scene::LightKind::Fog || kind == scene::LightKind::Blend ? 1.0f : options.light_scale;
+  store(k.color, scale * stage_color * light.color);
   store(k.radius, light.radius);
   k.flags = (light.no_shadows ? K_LIGHT_NO_SHADOWS : 0u) | (light.no_specular ? K_LIGHT_NO_SPECULAR : 0u);
+  switch (kind) {
+    case scene::LightKind::Normal: break;
+    case scene::LightKind::Fog:
+      k.flags |= K_LIGHT_FOG | K_LIGHT_NO_SHADOWS;
+      k.light_tex = K_NONE;   // the fog pass reads neither the light image nor the falloff image
+      k.falloff_tex = K_NONE;
+      // D = stage alpha when > 1, else 500. The stock fog materials are `colored`, whose alpha is the
+      // light's shaderParm3 (the editor's "fog distance"); the parser keeps constant colours only.
+      k.fog_distance = stage_alpha > 1.0f ? stage_alpha : light.shader_parms[3] > 1.0f ? light.shader_parms[3] : 500.0f;
+      break;
+    case scene::LightKind::Blend:
+      k.flags |= K_LIGHT_BLEND | K_LIGHT_NO_SHADOWS | (blend_adds ? K_LIGHT_BLEND_ADD : 0u);
+      break;
+    case scene::LightKind::Ambient:
+      k.flags |= K_LIGHT_AMBIENT | K_LIGHT_NO_SHADOWS | K_LIGHT_NO_SPECULAR;
+      break;
+  }
   for (int row = 0; row < 3; ++row) store(k.axis + 4 * row, glm::vec4(light.axis[row], 0.0f));
 
   glm::vec4 planes[4] = {glm::vec4(0.0f), glm::vec4(0.0f), glm::vec4(0.0f), glm::vec4(0.0f)};

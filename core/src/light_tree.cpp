@@ -171,7 +171,8 @@ std::vector<KLightNode> build_light_tree(const std::vector<KLight>& lights) {
   items.reserve(lights.size());
   for (size_t i = 0; i < lights.size(); ++i) {
     std::optional<LightBounds> box = light_bounds(lights[i]);
-    if (!box) continue;
+    // Fog and blend lights light nothing: the integrator applies them along rays, never by NEE.
+    if (!box || (lights[i].flags & K_LIGHT_VOLUME_EFFECT)) continue;
     Item item;
     item.light = uint32_t(i);
     item.box = *box;

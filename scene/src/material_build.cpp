@@ -30,11 +30,20 @@ struct RegisterSources {
 void build_light_material(const MaterialDecl& decl, ImageLibrary& images, Material& m, RegisterSources& sources) {
   m.is_light_material = true;
   const std::string context = "light material " + decl.name;
+  m.light_kind = decl.fog_light ? LightKind::Fog
+               : decl.blend_light ? LightKind::Blend
+               : decl.ambient_light ? LightKind::Ambient : LightKind::Normal;
+  if (decl.fog_light && !decl.stages.empty()) {
+    // The fog pass reads stage 0 only: its colour and, in alpha, the fog distance; not its image.
+    m.light_stage_color = glm::vec3(decl.stages.front().color);
+    m.light_stage_alpha = decl.stages.front().color.a;
+  }
   for (const MaterialStage& s : decl.stages) {
-    if (!draws_image(s)) continue;
+    if (decl.fog_light || !draws_image(s)) continue;
     m.light_image = images.get(s.image, ImageRole::LightProjection, context);
     m.light_stage_color = glm::vec3(s.color);
     sources.set(sources.r.light, s);
+    m.light_blend_adds = s.blend == StageBlend::Add;
     break;
   }
   if (!decl.falloff_image.empty()) m.falloff_image = images.get(decl.falloff_image, ImageRole::LightFalloff, context);

@@ -74,7 +74,8 @@ void material_layout(Codec& c, Mat& v) {
            v.tex_transform);
   c.flags("material", v.alpha_test, v.translucent, v.no_shadows, v.two_sided, v.nonsolid, v.emitter,
           v.vertex_color, v.is_light_material, v.is_default);
-  c.fields(v.alpha_ref, v.blend, v.light_stage_color);
+  c.fields(v.alpha_ref, v.blend, v.light_stage_color, v.light_kind, v.light_stage_alpha);
+  c.flags("light material", v.light_blend_adds);
 }
 
 template <class Codec, class Img>
@@ -167,6 +168,12 @@ void Decoder::field(BlendClass& v) {
   uint8_t blend = u8();
   if (blend > static_cast<uint8_t>(BlendClass::Alpha)) fail(fmt::format("blend class {} unknown", blend));
   v = static_cast<BlendClass>(blend);
+}
+
+void Decoder::field(LightKind& v) {
+  uint8_t kind = u8();
+  if (kind > static_cast<uint8_t>(LightKind::Ambient)) fail(fmt::format("light kind {} unknown", kind));
+  v = static_cast<LightKind>(kind);
 }
 
 void Decoder::field(RenderEntity& v) { entity_layout(*this, v); }

@@ -40,6 +40,7 @@ class Encoder {
   template <size_t N>
   void field(const float (&values)[N]) { for (float v : values) f32(v); }
   void field(BlendClass v) { u8(static_cast<uint8_t>(v)); }
+  void field(LightKind v) { u8(static_cast<uint8_t>(v)); }
   void field(const RenderEntity& v);
   void field(const RenderLight& v);
   void field(const Material& v);
@@ -102,6 +103,7 @@ class Decoder {
   template <size_t N>
   void field(float (&values)[N]) { for (float& v : values) v = f32(); }
   void field(BlendClass& v);
+  void field(LightKind& v);
   void field(RenderEntity& v);
   void field(RenderLight& v);
   void field(Material& v);

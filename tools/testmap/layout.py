@@ -226,6 +226,13 @@ def entities():
                            ("_color", (1, 0.85, 0.7)), ("texture", "lights/testmap_round")]),
         ("light_gel", [("origin", (1552, 256, 240)), ("light_target", (0, 0, -144)), ("light_right", (64, 0, 0)),
                        ("light_up", (0, 64, 0)), ("_color", (1, 1, 1)), ("texture", "lights/testmap_gel")]),
+        # Light kinds: fog over the stairs, a blend light tinting the flicker room, ambient fill in the gallery.
+        ("light_fog", [("origin", (1280, 192, 120)), ("light_radius", (120, 80, 100)), ("_color", (0.55, 0.6, 0.7)),
+                       ("shaderParm3", 600), ("texture", "lights/testmap_fog")]),
+        ("light_blend", [("origin", (640, 192, 48)), ("light_radius", (64, 64, 64)), ("_color", (1, 0.5, 0.3)),
+                         ("texture", "lights/testmap_blend")]),
+        ("light_ambient", [("origin", (1600, 96, 150)), ("light_radius", (320, 256, 180)),
+                           ("_color", (0.12, 0.12, 0.16)), ("texture", "lights/testmap_ambient")]),
     ]
     for name, keys in lights:
         ents.append(("light", [("name", name)] + keys))
@@ -238,5 +245,6 @@ def expected_area_of_entity(name):
         "info_player_start_1": 0, "door_main": 1, "fan_spin": 0, "crate_1": 0, "crate_2": 0, "crate_3": 5,
         "crate_4": 2, "table_1": 0, "light_hall": 0, "light_hall_fill": 0, "light_flicker": 1, "light_beam": 2,
         "light_sun": 3, "light_stairs": 4, "light_gallery": 5, "light_gel": 5,
+        "light_fog": 4, "light_blend": 1, "light_ambient": 5,
         "lamp_1": 0, "lamp_2": 0, "light_lamp": 0, "wedge_1": 2, "wedge_2": 5, "walker_1": 0, "walker_2": 5,
     }.get(name)

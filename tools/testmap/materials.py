@@ -304,6 +304,41 @@ lights/testmap_gel
 		zeroClamp
 	}
 }
+
+// Fog, blend and ambient lights (doom3-content.md section 9). The fog's colour and distance come from
+// the light entity (`colored`: parm0-2 and shaderParm3); the fog pass ignores its image.
+lights/testmap_fog
+{
+	fogLight
+	noShadows
+	lightFalloffImage	makeintensity( lights/testmap_falloff.tga )
+	{
+		map		_white
+		colored
+	}
+}
+
+lights/testmap_blend
+{
+	blendLight
+	lightFalloffImage	makeintensity( lights/testmap_falloff.tga )
+	{
+		blend	filter
+		map		lights/testmap_round.tga
+		colored
+		zeroClamp
+	}
+}
+
+lights/testmap_ambient
+{
+	ambientLight
+	lightFalloffImage	makeintensity( lights/testmap_falloff.tga )
+	{
+		map		_white
+		colored
+	}
+}
 """
 
 

@@ -15,6 +15,7 @@
 #define COHORT_KERNEL_INTEGRATOR_H
 #include "emissive_tree.h"
 #include "emitters.h"
+#include "fog.h"
 #include "light_tree.h"
 #include "rng.h"
 
@@ -210,12 +211,18 @@ KFN KVec3 k_trace_path(KTraceCtx* ctx, const KFrameParams* params, KVec3 org, KV
   for (;;) {
     KHit hit;
     hit.cost = 0u;
+    int lit_mode = params->mode == K_MODE_PATH || params->mode == K_MODE_DIRECT;
     if (!k_trace_closest(ctx, org, dir, tmax, K_RAY_PRIMARY, &hit)) {
       if (params->mode == K_MODE_BVH && bounce == 0u) radiance = k_heat_color((float)hit.cost / 200.0f);
+      if (lit_mode) k_apply_fog(scene, org, dir, tmax, &radiance, &throughput);
       break;
     }
     if (params->mode == K_MODE_BVH) { radiance = k_heat_color((float)hit.cost / 200.0f); break; }
     if (params->mode == K_MODE_TRIANGLES) { radiance = k_id_color(hit.triangle); break; }
+    if (lit_mode) {
+      k_apply_fog(scene, org, dir, hit.t, &radiance, &throughput);
+      if (v3_max_component(throughput) <= 0.0f) break;
+    }
     cone_width += spread * hit.t;
     KSurface sf = k_surface_eval(scene, hit, org, dir, cone_width);
     KVec3 wo = v3_neg(dir);
@@ -246,6 +253,7 @@ KFN KVec3 k_trace_path(KTraceCtx* ctx, const KFrameParams* params, KVec3 org, KV
       sf.roughness = k_fmax(sf.roughness, K_REGULARIZED_ROUGHNESS);
       vertex_params.spec_boost = 1.0f;
     }
+    k_apply_blend_lights(scene, sf.position, &radiance, &throughput);
     KVec3 contribution = sf.emission;
     if (bounce > 0u && emissive_nee && v3_max_component(sf.emission) > 0.0f) {
       KVec3 d = v3_sub(sf.position, vertex_position);

@@ -100,6 +100,14 @@ typedef struct KTexture {
 
 #define K_LIGHT_NO_SHADOWS  1u
 #define K_LIGHT_NO_SPECULAR 2u
+/* Light kinds of the light material (doom3-content.md section 9). Fog and blend lights light nothing:
+ * next-event estimation skips them and the integrator applies them along rays (fog.h). Ambient lights
+ * come with K_LIGHT_NO_SHADOWS | K_LIGHT_NO_SPECULAR and light from a constant tangent-space vector. */
+#define K_LIGHT_FOG         4u
+#define K_LIGHT_BLEND       8u
+#define K_LIGHT_AMBIENT     16u
+#define K_LIGHT_BLEND_ADD   32u   /* blend light whose stage is `blend add` (else it multiplies) */
+#define K_LIGHT_VOLUME_EFFECT (K_LIGHT_FOG | K_LIGHT_BLEND)
 
 typedef struct KLight {
   float origin[3];  kuint type;
@@ -108,7 +116,9 @@ typedef struct KLight {
   float center[3];  kuint falloff_tex;  /* falloff image at (F, 0.5); K_NONE: windowed (1-(d/r)^2)^2 */
   float axis[12];                       /* rows of the light axis, each padded to 4 floats */
   float plane_s[4]; float plane_t[4]; float plane_q[4]; float plane_f[4];  /* world space lightProject */
-  float extent;     float pad[3];       /* soft-shadow jitter radius in world units */
+  float extent;                         /* soft-shadow jitter radius in world units */
+  float fog_distance;                   /* fog lights: distance D of the engine's fog table */
+  float pad[2];
 } KLight;
 
 /* ---- Light trees: which light sources to sample at a point, at a cost that does not grow with their

@@ -26,6 +26,9 @@ enum class BlendClass : uint8_t { Opaque, PassThrough, Additive, Modulate, Alpha
 
 struct MaterialRegisters;
 
+// What a light material makes of its light (Material.h fogLight / blendLight / ambientLight).
+enum class LightKind : uint8_t { Normal, Fog, Blend, Ambient };
+
 struct Material {
   std::string name;
   std::string source_file; int source_line = 0;
@@ -41,6 +44,9 @@ struct Material {
   bool is_light_material = false;
   int light_image = -1, falloff_image = -1;
   glm::vec3 light_stage_color{1.0f};
+  LightKind light_kind = LightKind::Normal;
+  float light_stage_alpha = 1.0f;   // fog lights: a fog distance when > 1 (RB_FogPass)
+  bool light_blend_adds = false;    // blend lights: `blend add` adds, anything else multiplies
   bool is_default = false;     // made up because the name was not found
   // The expressions behind the colours, texture matrix, alphaTest and light stage colour when any reads
   // time, parms or globals (material_registers.h); null: the fields above are the look at every frame.
