@@ -8,7 +8,8 @@
 #                              registers NVIDIA's OpenCL, runs the GPU tests and benchmarks, writes
 #                              results (logs, JSON, PPM frames) to $OUT
 #   tools/gpu_run.sh frametimes  there: only the end-to-end frame times (large map 1080p generated there,
-#                              test map 720p; cuda:0, 1 spp, NEE + 1 bounce; with and without emissive NEE)
+#                              test map 720p; cuda:0, 1 spp, NEE + 1 bounce; with and without emissive NEE,
+#                              reprojection and Brigade's blend; per-stage medians)
 #
 # The binaries and libraries travel compressed (.gpu/payload.tar.xz, ~11 MB instead of ~60 MB): the device
 # tool carries at most 64 MiB with the working tree.
@@ -48,13 +49,18 @@ case "${1:-}" in
     nvidia-smi --query-gpu=index,name --format=csv,noheader
     [ -f /tmp/largemap.cpk ] || { python3 tools/gen_testmap.py --large --out /tmp/largemap >/dev/null &&
       "$stage/bin/cohort" pack /tmp/largemap/maps/largemap.map --out /tmp/largemap.cpk | tail -n 1; }
-    for emissive in 1 0; do
+    # Emissive NEE on and off with the default convergence, then the paper's blend for the host's share.
+    for variant in "1 reproject" "0 reproject" "1 brigade"; do
+      read -r emissive convergence <<<"$variant"
       for map in large test; do
         if [ $map = large ]; then args=(/tmp/largemap.cpk --width 1920 --height 1080 --camera 1690 300 80 5 -12)
         else args=("$stage/testmap.cpk" --width 1280 --height 720); fi
+        run=/tmp/ft_$map${emissive}_$convergence
         "$stage/bin/cohort" render "${args[@]}" --tracers "${COHORT_GPU_TRACERS:-cuda:0}" --spp 1 --bounces 1 \
-          --emissive-samples $emissive --frames 60 --camera-path spin-slow --write last --out /tmp/ft_$map$emissive >/dev/null
-        echo "$map map, emissive samples $emissive: $(python3 tools/frame_times.py /tmp/ft_$map$emissive/stats.json --skip 10 | head -n 1)"
+          --emissive-samples $emissive --convergence $convergence --frames 60 --camera-path spin-slow \
+          --write last --out $run >/dev/null
+        echo "== $map map, emissive samples $emissive, convergence $convergence"
+        python3 tools/frame_times.py $run/stats.json --skip 10
       done
     done
     ;;

@@ -2,6 +2,7 @@
 
 #include <cuda_runtime.h>
 
+#include <algorithm>
 #include <vector>
 
 #include "device_array.h"
@@ -48,6 +49,7 @@ struct CudaTracer::Impl {
   DeviceArray<uint32_t> skin_adjacency;
   DeviceArray<KSkinFace> skin_faces;
   DeviceArray<KJoint> joints;
+  DeviceArray<kuint> refit_scratch;
   cudaTextureObject_t texel_texture = 0;
   DeviceArray<float> previous_transforms;
   DeviceArray<KAux> aux;
@@ -181,13 +183,19 @@ void CudaTracer::upload(const commit::ChangeSet& changes) {
     to_pose.resize(scene.skins.size());
     for (size_t i = 0; i < to_pose.size(); ++i) to_pose[i] = uint32_t(i);
   }
+  size_t most_nodes = 0;
+  for (uint32_t index : to_pose)
+    if (index < scene.skins.size() && scene.skins[index].blas < scene.blases.size())
+      most_nodes = std::max<size_t>(most_nodes, scene.blases[scene.skins[index].blas].node_count);
+  kuint* scratch = most_nodes ? m.refit_scratch.scratch(2 * most_nodes) : nullptr;
+  const RefitScratch refit{scratch, scratch + most_nodes};
   for (uint32_t index : to_pose) {
     if (index >= scene.skins.size()) continue;
     const KSkin& skin = scene.skins[index];
     if (size_t(skin.joint_offset) + skin.joint_count > scene.joints.size() || skin.blas >= scene.blases.size()) continue;
     const SkinBuffers pools{m.skin_vertices.data(), m.skin_weights.data(), m.skin_triangles.data(),
                             m.skin_adjacency.data(), m.skin_faces.data(), m.joints.data()};
-    launch_skinning(m.vertices.data(), pools, skin, m.blas_nodes.data(), m.triangles.data(), scene.blases[skin.blas], s);
+    launch_skinning(m.vertices.data(), pools, skin, m.blas_nodes.data(), m.triangles.data(), scene.blases[skin.blas], refit, s);
   }
   COHORT_CUDA(cudaStreamSynchronize(s));
 }

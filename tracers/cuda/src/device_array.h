@@ -37,6 +37,19 @@ class DeviceArray {
                                   (size_ - first_changed) * sizeof(T), cudaMemcpyHostToDevice, stream));
     return moved;
   }
+  // Device-only storage of at least n elements (contents undefined), e.g. per-launch scratch.
+  T* scratch(size_t n) {
+    if (n > capacity_) {
+      size_t capacity = capacity_ ? capacity_ : 64;
+      while (capacity < n) capacity *= 2;
+      if (ptr_) COHORT_CUDA(cudaFree(ptr_));
+      ptr_ = nullptr;
+      COHORT_CUDA(cudaMalloc(&ptr_, capacity * sizeof(T)));
+      capacity_ = capacity;
+    }
+    size_ = n;
+    return ptr_;
+  }
   T* data() const { return ptr_; }
   size_t size() const { return size_; }
   size_t bytes() const { return capacity_ * sizeof(T); }

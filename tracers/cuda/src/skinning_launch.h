@@ -1,6 +1,9 @@
 // Skinned characters on the GPU (kernel/skinning.h compiled as CUDA): one thread per vertex for the
-// positions, one per triangle for its face, then one per vertex for the normals; the BLAS refit runs its leaves one thread each, then a single thread
-// sweeps the inner nodes bottom-up. Everything is queued on the tracer's stream, in order.
+// positions, one per triangle for its face, then one per vertex for the normals. The BLAS refit runs
+// bottom-up in parallel: a thread per leaf refits it and climbs; at each inner node the first child's
+// thread to arrive stops and the second refits the node and goes on (an arrival counter per node), so
+// every level is refit as soon as both its children are. Everything is queued on the tracer's stream, in
+// order.
 #pragma once
 
 #include <cuda_runtime.h>
@@ -18,7 +21,12 @@ struct SkinBuffers {   // device pointers to the scene's skin pools
   const KJoint* joints;
 };
 
+struct RefitScratch {  // two uints per node of the largest skinned BLAS: parent and arrival count
+  kuint* parent;
+  kuint* arrivals;
+};
+
 void launch_skinning(KVertex* vertices, const SkinBuffers& pools, const KSkin& skin, KBvhNode* blas_nodes,
-                     const KTriangle* triangles, const KBlas& blas, cudaStream_t stream);
+                     const KTriangle* triangles, const KBlas& blas, const RefitScratch& scratch, cudaStream_t stream);
 
 }  // namespace cohort::tracers
