@@ -51,27 +51,46 @@ void trace_camera_packets(embree_kernel::TraceCtx& ctx, KVec3 org, int n, Arena&
     for (int i = 0; i < n; ++i) ctx.log->rays.camera.push_back(embree_kernel::logged_ray(org, a.dirs[i], K_INF, K_RAY_PRIMARY));
 }
 
-void store_rows(const Frame& frame, const Tile& tile, Arena& a, embree_kernel::TraceCtx& ctx, uint64_t* row_rays,
-                float scale) {
-  const int w = tile.x1 - tile.x0;
+// The tile's aux planes (depth, normal, albedo, id, motion): one unjittered ray through each pixel's
+// centre, traced ahead in packets like the camera rays, then k_pixel_aux from those hits.
+void write_aux(const Frame& frame, const Tile& tile, Arena& a, embree_kernel::TraceCtx& ctx, uint64_t* row_rays) {
+  const int w = tile.x1 - tile.x0, n = w * (tile.y1 - tile.y0);
+  for (int i = 0; i < n; ++i)
+    a.dirs[i] = k_camera_direction(&frame.camera, static_cast<float>(tile.x0 + i % w) + 0.5f,
+                                   static_cast<float>(tile.y0 + i / w) + 0.5f);
+  trace_camera_packets(ctx, v3_load(frame.camera.origin), n, a);
   for (int y = tile.y0; y < tile.y1; ++y) {
-    const KVec3* sums = a.sums + (y - tile.y0) * w;
-    for (int x = 0; x < w; ++x) {
-      const KVec3 c = v3_scale(sums[x], scale);
-      a.rgba[4 * x + 0] = c.x;
-      a.rgba[4 * x + 1] = c.y;
-      a.rgba[4 * x + 2] = c.z;
-      a.rgba[4 * x + 3] = 1.0f;
-    }
-    if (frame.target) frame.target->store(y, tile.x0, a.rgba, static_cast<size_t>(w));
-    if (!frame.write_aux || !frame.target) continue;
     const uint64_t before = ctx.rays;
-    for (int x = 0; x < w; ++x)
+    for (int x = 0; x < w; ++x) {
+      const int i = (y - tile.y0) * w + x;
+      ctx.primed_hit = &a.hits[i];
+      ctx.primed_found = a.found[i];
+      ctx.primed_dir = a.dirs[i];
       k_pixel_aux(&ctx, &frame.camera, &frame.previous_camera, frame.object_history,
                   static_cast<kuint>(tile.x0 + x), static_cast<kuint>(y), &a.aux[x]);
+      ctx.primed_hit = nullptr;
+    }
     frame.target->store_aux(y, tile.x0, a.aux, static_cast<size_t>(w));
     row_rays[y - tile.y0] += ctx.rays - before;
   }
+}
+
+void store_rows(const Frame& frame, const Tile& tile, Arena& a, embree_kernel::TraceCtx& ctx, uint64_t* row_rays,
+                float scale) {
+  const int w = tile.x1 - tile.x0;
+  if (frame.target)
+    for (int y = tile.y0; y < tile.y1; ++y) {
+      const KVec3* sums = a.sums + (y - tile.y0) * w;
+      for (int x = 0; x < w; ++x) {
+        const KVec3 c = v3_scale(sums[x], scale);
+        a.rgba[4 * x + 0] = c.x;
+        a.rgba[4 * x + 1] = c.y;
+        a.rgba[4 * x + 2] = c.z;
+        a.rgba[4 * x + 3] = 1.0f;
+      }
+      frame.target->store(y, tile.x0, a.rgba, static_cast<size_t>(w));
+    }
+  if (frame.write_aux && frame.target) write_aux(frame, tile, a, ctx, row_rays);
 }
 
 }  // namespace
