@@ -20,6 +20,12 @@ struct RayLog {
   KVec3 camera_dir;  // the current sample's camera direction: closest rays along it are camera rays
 };
 
+enum RayClass { kCameraRay, kShadowRay, kBounceRay };
+
+// Appends a ray to the log. Out of line (embree_tracer.cpp): the tile renderer is also compiled for
+// x86-64-v3, and no code compiled that way may end up shared with the baseline build (std templates).
+void log_ray(RayLog* log, RayClass ray_class, KVec3 org, KVec3 dir, float tmax, kuint ray_mask);
+
 struct TraceCtx {
   KSceneView scene;
   RTCScene top;
@@ -44,7 +50,7 @@ void filter_hit(const RTCFilterFunctionNArguments* args);
 
 // coherent: rays of one batch start close together and point alike (camera packets), so Embree may
 // trace them together.
-inline FilterContext filter_context(const KSceneView* scene, kuint ray_mask, int shadow_ray, bool coherent = false) {
+static inline FilterContext filter_context(const KSceneView* scene, kuint ray_mask, int shadow_ray, bool coherent = false) {
   FilterContext fc;
   rtcInitIntersectContext(&fc.base);
   if (coherent) fc.base.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
@@ -55,7 +61,7 @@ inline FilterContext filter_context(const KSceneView* scene, kuint ray_mask, int
 }
 
 // A ray from org along dir up to tmax, visible to every geometry (masks are applied by filter_hit).
-inline RTCRay make_ray(KVec3 org, KVec3 dir, float tmax) {
+static inline RTCRay make_ray(KVec3 org, KVec3 dir, float tmax) {
   RTCRay ray;
   ray.org_x = org.x; ray.org_y = org.y; ray.org_z = org.z;
   ray.dir_x = dir.x; ray.dir_y = dir.y; ray.dir_z = dir.z;
@@ -68,12 +74,8 @@ inline RTCRay make_ray(KVec3 org, KVec3 dir, float tmax) {
   return ray;
 }
 
-inline EmbreeRay logged_ray(KVec3 org, KVec3 dir, float tmax, kuint ray_mask) {
-  return EmbreeRay{{org.x, org.y, org.z}, {dir.x, dir.y, dir.z}, tmax, ray_mask};
-}
-
 // The scene's triangle index of an Embree hit (primID counts within the instance's BLAS).
-inline kuint scene_triangle(const KSceneView& scene, kuint instance, kuint prim) {
+static inline kuint scene_triangle(const KSceneView& scene, kuint instance, kuint prim) {
   return scene.blases[scene.instances[instance].blas].tri_offset + prim;
 }
 
@@ -96,7 +98,7 @@ static inline int k_trace_closest(KTraceCtx* ctx, KVec3 org, KVec3 dir, float tm
   if (ctx->log) {
     const bool camera = dir.x == ctx->log->camera_dir.x && dir.y == ctx->log->camera_dir.y &&
                         dir.z == ctx->log->camera_dir.z;
-    (camera ? ctx->log->rays.camera : ctx->log->rays.bounce).push_back(ek::logged_ray(org, dir, tmax, ray_mask));
+    ek::log_ray(ctx->log, camera ? ek::kCameraRay : ek::kBounceRay, org, dir, tmax, ray_mask);
   }
   ek::FilterContext fc = ek::filter_context(&ctx->scene, ray_mask, 0);
   RTCRayHit rh;
@@ -116,7 +118,7 @@ static inline int k_trace_closest(KTraceCtx* ctx, KVec3 org, KVec3 dir, float tm
 static inline int k_trace_occluded(KTraceCtx* ctx, KVec3 org, KVec3 dir, float tmax, kuint ray_mask) {
   namespace ek = cohort::tracers::embree_kernel;
   ++ctx->rays;
-  if (ctx->log) ctx->log->rays.shadow.push_back(ek::logged_ray(org, dir, tmax, ray_mask));
+  if (ctx->log) ek::log_ray(ctx->log, ek::kShadowRay, org, dir, tmax, ray_mask);
   ek::FilterContext fc = ek::filter_context(&ctx->scene, ray_mask, 1);
   RTCRay ray = ek::make_ray(org, dir, tmax);
   rtcOccluded1(ctx->top, &fc.base, &ray);

@@ -3,10 +3,16 @@
 #include "cohort/kernel/integrator.h"
 #include "cohort/kernel/aux_outputs.h"
 
-#include <algorithm>
 
 #include "embree_bvh_view.h"
 #include "embree_tiles.h"
+
+// Built twice (CMakeLists.txt): as render_tile for any x86-64, and with -march=x86-64-v3 as
+// render_tile_x86_64_v3. Nothing here may instantiate a template or inline function with external
+// linkage: the linker could hand the baseline build the v3 copy.
+#ifndef COHORT_RENDER_TILE
+#define COHORT_RENDER_TILE render_tile
+#endif
 
 namespace cohort::tracers::embree_tiles {
 
@@ -19,7 +25,7 @@ void trace_camera_packets(embree_kernel::TraceCtx& ctx, KVec3 org, int n, Arena&
     RTCRayHit8& rh = a.packets[first / kPacketSize];
     int valid[kPacketSize];
     for (int k = 0; k < kPacketSize; ++k) {
-      const int i = std::min(first + k, n - 1);  // unused lanes repeat the last ray, masked off
+      const int i = first + k < n ? first + k : n - 1;  // unused lanes repeat the last ray, masked off
       valid[k] = first + k < n ? -1 : 0;
       rh.ray.org_x[k] = org.x; rh.ray.org_y[k] = org.y; rh.ray.org_z[k] = org.z;
       rh.ray.dir_x[k] = a.dirs[i].x; rh.ray.dir_y[k] = a.dirs[i].y; rh.ray.dir_z[k] = a.dirs[i].z;
@@ -48,7 +54,7 @@ void trace_camera_packets(embree_kernel::TraceCtx& ctx, KVec3 org, int n, Arena&
     }
   }
   if (ctx.log)
-    for (int i = 0; i < n; ++i) ctx.log->rays.camera.push_back(embree_kernel::logged_ray(org, a.dirs[i], K_INF, K_RAY_PRIMARY));
+    for (int i = 0; i < n; ++i) embree_kernel::log_ray(ctx.log, embree_kernel::kCameraRay, org, a.dirs[i], K_INF, K_RAY_PRIMARY);
 }
 
 // The tile's aux planes (depth, normal, albedo, id, motion): one unjittered ray through each pixel's
@@ -95,8 +101,8 @@ void store_rows(const Frame& frame, const Tile& tile, Arena& a, embree_kernel::T
 
 }  // namespace
 
-void render_tile(const Frame& frame, const Tile& tile, Arena& a, embree_kernel::RayLog* log,
-                 uint64_t row_rays[kTileHeight]) {
+void COHORT_RENDER_TILE(const Frame& frame, const Tile& tile, Arena& a, embree_kernel::RayLog* log,
+                        uint64_t row_rays[kTileHeight]) {
   embree_kernel::TraceCtx ctx = frame.base;
   ctx.log = log;
   ctx.primed_hit = nullptr;

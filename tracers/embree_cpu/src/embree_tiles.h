@@ -50,5 +50,10 @@ struct Arena {
 // log: null, or where every ray is recorded (the caller runs tiles one at a time then).
 void render_tile(const Frame& frame, const Tile& tile, Arena& arena, embree_kernel::RayLog* log,
                  uint64_t row_rays[kTileHeight]);
+// The same, compiled for x86-64-v3 (AVX2, FMA): faster shading where the CPU has it (has_x86_64_v3).
+void render_tile_x86_64_v3(const Frame& frame, const Tile& tile, Arena& arena, embree_kernel::RayLog* log,
+                           uint64_t row_rays[kTileHeight]);
+// Whether this build has render_tile_x86_64_v3 and this CPU can run it.
+bool has_x86_64_v3();
 
 }  // namespace cohort::tracers::embree_tiles

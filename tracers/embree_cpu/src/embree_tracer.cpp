@@ -21,6 +21,12 @@ namespace cohort::tracers {
 
 namespace embree_kernel {
 
+void log_ray(RayLog* log, RayClass ray_class, KVec3 org, KVec3 dir, float tmax, kuint ray_mask) {
+  const EmbreeRay ray{{org.x, org.y, org.z}, {dir.x, dir.y, dir.z}, tmax, ray_mask};
+  (ray_class == kCameraRay ? log->rays.camera : ray_class == kShadowRay ? log->rays.shadow : log->rays.bounce)
+      .push_back(ray);
+}
+
 void filter_hit(const RTCFilterFunctionNArguments* args) {
   const auto* fc = reinterpret_cast<const FilterContext*>(args->context);
   const KSceneView* scene = fc->scene;
@@ -40,6 +46,32 @@ void filter_hit(const RTCFilterFunctionNArguments* args) {
 
 }  // namespace embree_kernel
 
+namespace embree_tiles {
+
+bool has_x86_64_v3() {
+#if defined(COHORT_EMBREE_X86_64_V3)
+#if defined(__clang__) || (defined(__GNUC__) && __GNUC__ < 12)
+  static const bool has = __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma") &&
+                          __builtin_cpu_supports("bmi") && __builtin_cpu_supports("bmi2") &&
+                          __builtin_cpu_supports("f16c");
+#else
+  static const bool has = __builtin_cpu_supports("x86-64-v3");
+#endif
+  return has;
+#else
+  return false;
+#endif
+}
+
+#if !defined(COHORT_EMBREE_X86_64_V3)
+void render_tile_x86_64_v3(const Frame& frame, const Tile& tile, Arena& arena, embree_kernel::RayLog* log,
+                           uint64_t row_rays[kTileHeight]) {
+  render_tile(frame, tile, arena, log, row_rays);
+}
+#endif
+
+}  // namespace embree_tiles
+
 namespace {
 
 void check_device(RTCDevice device, const char* what) {
@@ -57,6 +89,15 @@ struct EmbreeTracer::Impl {
   std::vector<RTCScene> blas_scenes;
   std::unique_ptr<tbb::global_control> thread_limit;
   uint64_t rays_traced = 0;
+  bool x86_64_v3 = embree_tiles::has_x86_64_v3();
+
+  void render_tile(const embree_tiles::Frame& frame, const embree_tiles::Tile& tile, embree_tiles::Arena& arena,
+                   embree_kernel::RayLog* log, uint64_t* row_rays) const {
+    if (x86_64_v3)
+      embree_tiles::render_tile_x86_64_v3(frame, tile, arena, log, row_rays);
+    else
+      embree_tiles::render_tile(frame, tile, arena, log, row_rays);
+  }
   // Each thread's tile buffers, kept from band to band: rendering allocates nothing per tile or ray.
   tbb::enumerable_thread_specific<embree_tiles::Arena> arenas;
 
@@ -185,7 +226,7 @@ core::BandResult EmbreeTracer::render_band(const core::BandJob& job, core::BandB
       const embree_tiles::Tile tile{x0, y0, std::min(x0 + embree_tiles::kTileWidth, width),
                                     std::min(y0 + embree_tiles::kTileHeight, row_end)};
       uint64_t tile_rows[embree_tiles::kTileHeight] = {};
-      embree_tiles::render_tile(frame, tile, arena, nullptr, tile_rows);
+      impl_->render_tile(frame, tile, arena, nullptr, tile_rows);
       for (int y = tile.y0; y < tile.y1; ++y) {
         row_rays[static_cast<size_t>(y - row_begin)] += tile_rows[y - tile.y0];
         local += tile_rows[y - tile.y0];
@@ -201,6 +242,11 @@ core::BandResult EmbreeTracer::render_band(const core::BandJob& job, core::BandB
     for (size_t i = 0; i < row_rays.size(); ++i) result.row_work[i] = static_cast<float>(row_rays[i].load());
   }
   return result;
+}
+
+bool EmbreeTracer::prefer_x86_64_v3(bool prefer) {
+  impl_->x86_64_v3 = prefer && embree_tiles::has_x86_64_v3();
+  return impl_->x86_64_v3;
 }
 
 uint64_t EmbreeTracer::rays_traced() const { return impl_->rays_traced; }
@@ -219,7 +265,7 @@ EmbreeRaySet EmbreeTracer::record_rays(const core::BandJob& job) {
       const embree_tiles::Tile tile{x0, y0, std::min(x0 + embree_tiles::kTileWidth, width),
                                     std::min(y0 + embree_tiles::kTileHeight, static_cast<int>(params.row_end))};
       uint64_t tile_rows[embree_tiles::kTileHeight] = {};
-      embree_tiles::render_tile(frame, tile, *arena, &log, tile_rows);
+      impl_->render_tile(frame, tile, *arena, &log, tile_rows);
     }
   return std::move(log.rays);
 }

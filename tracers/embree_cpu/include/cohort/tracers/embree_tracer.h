@@ -48,6 +48,9 @@ class EmbreeTracer : public TracerBase {
   // else: closest hits (occlusion = false) or occlusion. coherent sets RTC_INTERSECT_CONTEXT_FLAG_COHERENT.
   // Returns how many hit (or were occluded).
   uint64_t trace_raw(const std::vector<EmbreeRay>& rays, bool occlusion, EmbreeRayApi api, bool coherent);
+  // Which build of the shading code runs: the one for x86-64-v3 (AVX2, FMA) where the CPU has it, the
+  // default, or the baseline x86-64 one. Returns whether the x86-64-v3 build is now in use.
+  bool prefer_x86_64_v3(bool prefer);
   // Camera, bounce and shadow rays traced by render_band since construction.
   uint64_t rays_traced() const;
 
