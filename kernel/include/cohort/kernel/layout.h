@@ -178,7 +178,10 @@ typedef struct KFrameParams {
   float firefly_clamp; float spec_boost;  kuint mode;          kuint light_count;
   kuint row_begin;    kuint row_end;      kuint instance_count; kuint tlas_node_count;
   float soft_shadow_scale; float rr_start; kuint light_sampling; kuint light_node_count;
-  kuint emissive_count; kuint emissive_samples; kuint aux_outputs; kuint pad1;
+  kuint emissive_count; kuint emissive_samples; kuint aux_outputs;
+  /* How many lights at the end of the light array are neither fog nor blend lights, so the per-ray
+   * fog and blend loops (fog.h) stop before them; 0 checks every light. Set with the counts. */
+  kuint plain_light_tail;
 } KFrameParams;
 
 /* One pixel's auxiliary outputs (aux_outputs.h says what each field means). */
