@@ -14,6 +14,7 @@
 #include "cohort/core/image_output.h"
 #include "commands.h"
 #include "default_map.h"
+#include "convergence_choice.h"
 #include "play_session.h"
 #include "viewer/hud.h"
 #include "viewer/viewer_actions.h"
@@ -31,7 +32,7 @@ struct PlayArgs {
   int spp = 1;
   int bounces = 1;
   std::string light_sampling = "tree";
-  std::string convergence = "reproject";  // measured better than brigade (docs/denoising.md)
+  std::string convergence = "auto";  // convergence_choice.h
   std::string mode = "path";
   std::string tone = "aces";
   int frames = 0;            // 0: until the window closes
@@ -118,7 +119,7 @@ int run_play(PlayArgs a) {
   settings.light_sampling = core::light_sampling_mode(a.light_sampling);
   settings.mode = debug_mode_from_name(a.mode).value_or(K_MODE_PATH);
   settings.tone_curve = a.tone;
-  settings.reproject = a.convergence == "reproject";
+  settings.reproject = resolve_convergence(a.convergence, session->any_gpu_tracer()) == "reproject";
   float scale = a.scale;
   bool show_hud = true;
   std::vector<Notice> notices;
@@ -307,10 +308,10 @@ void add_play_command(CLI::App& app, int& exit_code) {
       ->capture_default_str()
       ->check(CLI::IsMember(core::light_sampling_names()));
   cmd->add_option("--convergence", a->convergence,
-                  "how frames accumulate: reproject (per-pixel history through motion vectors) or brigade "
-                  "(whole-frame blend); see `cohort render --help`")
+                  "how frames accumulate: reproject (per-pixel history through motion vectors), brigade "
+                  "(whole-frame blend) or auto (reproject unless a tracer renders on a GPU); see `cohort render --help`")
       ->capture_default_str()
-      ->check(CLI::IsMember({"brigade", "reproject"}));
+      ->check(CLI::IsMember({"auto", "brigade", "reproject"}));
   cmd->add_option("--mode", a->mode, "debug mode at start")
       ->capture_default_str()
       ->check(CLI::IsMember(debug_mode_names()));

@@ -30,6 +30,7 @@
 #include "cohort/core/tonemap.h"
 #include "commands.h"
 #include "camera_path.h"
+#include "convergence_choice.h"
 #include "default_map.h"
 #include "progress_bar.h"
 #include "render_scene_source.h"
@@ -54,7 +55,7 @@ struct RenderArgs {
   std::vector<float> camera;  // x y z yaw pitch
   std::vector<std::string> bases;
   bool no_convergence = false;
-  std::string convergence = "reproject";  // measured better than brigade (docs/denoising.md)
+  std::string convergence = "auto";  // convergence_choice.h
   std::string replay;
   std::string trace;
   std::string denoise = "none";
@@ -85,6 +86,9 @@ int run_render(const RenderArgs& a) {
   if (a.map.empty() && a.replay.empty()) throw std::invalid_argument("name a map or scene pack (or --replay FILE)");
   RenderScene scene = a.replay.empty() ? load_render_scene(a.map, bases_or_test_map(a.bases)) : RenderScene{};
   std::vector<std::unique_ptr<core::Tracer>> tracers = tracers::make_tracers(a.tracers);
+  bool any_gpu_tracer = false;
+  for (const auto& tracer : tracers) any_gpu_tracer = any_gpu_tracer || tracer->renders_on_gpu();
+  const std::string convergence_mode = resolve_convergence(a.convergence, any_gpu_tracer);
   core::RendererOptions options;
   options.balancer = a.balancer;
   options.band_format = a.band_format == "rgba32f" ? core::BandFormat::rgba32f : core::BandFormat::rgb16f;
@@ -123,7 +127,7 @@ int run_render(const RenderArgs& a) {
   nlohmann::json stats_json = nlohmann::json::array();
   core::AdaptiveConvergence convergence;
   core::TemporalReprojection reprojection;
-  const bool reproject = a.convergence == "reproject" && !a.no_convergence;
+  const bool reproject = convergence_mode == "reproject" && !a.no_convergence;
   core::FrameBuffer albedo_guide, normal_guide;
   KCamera previous_camera{};  // none yet: the first frame is its own previous
   const std::optional<CameraPath> path =
@@ -247,7 +251,7 @@ int run_render(const RenderArgs& a) {
                            {"spp", a.spp},       {"bounces", a.bounces},
                            {"light_sampling", a.light_sampling}, {"light_samples", a.light_samples},    {"mode", a.mode},
                            {"camera_path", a.camera_path}, {"denoise", a.denoise},
-                           {"convergence", a.no_convergence ? "none" : a.convergence}, {"frames", stats_json}};
+                           {"convergence", a.no_convergence ? "none" : convergence_mode}, {"frames", stats_json}};
   std::ofstream(std::filesystem::path(a.out) / "stats.json") << report.dump(2) << "\n";
   std::cout << "wrote " << rendered << " frame(s) and stats.json to " << a.out << "\n";
   return kExitOk;
@@ -325,9 +329,11 @@ void add_render_command(CLI::App& app, int& exit_code) {
   cmd->add_option("--convergence", a->convergence,
                   "how frames accumulate: reproject (per-pixel history through motion vectors, with disocclusion "
                   "tests and neighbourhood clamping; the tracers also write depth, normal, albedo, id and motion) "
-                  "or brigade (whole-frame blend, f from camera motion; the paper's)")
+                  "or brigade (whole-frame blend, f from camera motion; the paper's); auto: reproject unless a "
+                  "tracer renders on a GPU, where the host's reprojection would set the frame rate "
+                  "(docs/denoising.md)")
       ->capture_default_str()
-      ->check(CLI::IsMember({"brigade", "reproject"}));
+      ->check(CLI::IsMember({"auto", "brigade", "reproject"}));
   cmd->add_flag("--no-convergence", a->no_convergence,
                  "write each frame as rendered instead of blending frames with adaptive convergence");
   cmd->add_option("--write", a->write, "images of every frame, or only the last (stats.json always has every frame)")

@@ -3,10 +3,18 @@
 #include <gtest/gtest.h>
 
 #include "camera_path.h"
+#include "convergence_choice.h"
 #include "progress_bar.h"
 
 namespace cohort::app {
 namespace {
+
+TEST(ConvergenceChoice, AutoReprojectsOnlyWhenNoTracerRendersOnAGpu) {
+  EXPECT_EQ(resolve_convergence("auto", false), "reproject");
+  EXPECT_EQ(resolve_convergence("auto", true), "brigade");
+  EXPECT_EQ(resolve_convergence("reproject", true), "reproject") << "an explicit choice stands";
+  EXPECT_EQ(resolve_convergence("brigade", false), "brigade");
+}
 
 TEST(CameraPath, ParsesNamesAndRejectsUnknownOnes) {
   EXPECT_EQ(parse_camera_path("spin").kind, CameraPath::Kind::spin);
