@@ -24,6 +24,7 @@ typedef struct KSceneView {
   kuint light_count;
   kuint light_node_count;
   kuint emissive_count;
+  kuint volume_light_begin, volume_light_end;  /* fog and blend lights lie in this range (layout.h) */
 } KSceneView;
 
 /* The view over a scene's arrays, wherever they live. The counts come from the frame parameters,
@@ -54,6 +55,8 @@ KFN KSceneView k_scene_view(KGLOBAL const KVertex* vertices, KGLOBAL const KTria
   v.light_count = params->light_count;
   v.light_node_count = params->light_node_count;
   v.emissive_count = params->emissive_count;
+  v.volume_light_begin = params->volume_light_begin;
+  v.volume_light_end = params->volume_light_end < params->light_count ? params->volume_light_end : params->light_count;
   return v;
 }
 
