@@ -192,8 +192,16 @@ typedef struct KAux {
   float normal[3]; float albedo[3];  kuint id;       kuint pad;
 } KAux;
 
+/* KAux as it travels to the host (core's BandBuffer): 32 bytes, the normal and albedo as IEEE half
+ * floats (their bits). GPU tracers pack it on the device so that only these bytes cross the bus. */
+typedef struct KAuxTexel {
+  float depth; float prev_depth; float motion[2];
+  unsigned short normal[3]; unsigned short albedo[3]; kuint id;
+} KAuxTexel;
+
 #if defined(__cplusplus) && !defined(__CUDACC_RTC__)
 static_assert(sizeof(KAux) == 48, "KAux layout");
+static_assert(sizeof(KAuxTexel) == 32, "KAuxTexel layout");
 static_assert(sizeof(KBvhNode) == 32, "KBvhNode layout");
 static_assert(sizeof(KBlas) == 16, "KBlas layout");
 static_assert(sizeof(KInstance) == 112, "KInstance layout");
