@@ -100,7 +100,9 @@ INSTANTIATE_TEST_SUITE_P(Modes, Agreement,
                                            Case{K_MODE_PATH, 1, "path_all_pick", 1, K_LIGHTS_ALL},
                                            Case{K_MODE_PATH, 1, "path_no_emissive_nee", 1, K_LIGHTS_TREE, 0},
                                            Case{K_MODE_DIRECT, 0, "direct"}, Case{K_MODE_ALBEDO, 0, "albedo"},
-                                           Case{K_MODE_NORMALS, 0, "normals"}),
+                                           Case{K_MODE_NORMALS, 0, "normals"},
+                                           // Embree draws its heat map on Cohort's own BVH, as OpenCL does.
+                                           Case{K_MODE_BVH, 0, "bvh"}),
                          [](const auto& info) { return std::string(info.param.name); });
 
 // The light tree's descent (more lights than K_LIGHT_TREE_GATHER overlap) and the emissive-triangle

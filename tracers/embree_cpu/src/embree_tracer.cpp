@@ -8,15 +8,24 @@
 #include <vector>
 
 #include <tbb/blocked_range.h>
+#include <tbb/enumerable_thread_specific.h>
 #include <tbb/global_control.h>
 #include <tbb/parallel_for.h>
 
 #include "embree_kernel.h"
+#include "embree_raw.h"
 #include "embree_skinned.h"
+#include "embree_tiles.h"
 
 namespace cohort::tracers {
 
 namespace embree_kernel {
+
+void log_ray(RayLog* log, RayClass ray_class, KVec3 org, KVec3 dir, float tmax, kuint ray_mask) {
+  const EmbreeRay ray{{org.x, org.y, org.z}, {dir.x, dir.y, dir.z}, tmax, ray_mask};
+  (ray_class == kCameraRay ? log->rays.camera : ray_class == kShadowRay ? log->rays.shadow : log->rays.bounce)
+      .push_back(ray);
+}
 
 void filter_hit(const RTCFilterFunctionNArguments* args) {
   const auto* fc = reinterpret_cast<const FilterContext*>(args->context);
@@ -37,6 +46,32 @@ void filter_hit(const RTCFilterFunctionNArguments* args) {
 
 }  // namespace embree_kernel
 
+namespace embree_tiles {
+
+bool has_x86_64_v3() {
+#if defined(COHORT_EMBREE_X86_64_V3)
+#if defined(__clang__) || (defined(__GNUC__) && __GNUC__ < 12)
+  static const bool has = __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma") &&
+                          __builtin_cpu_supports("bmi") && __builtin_cpu_supports("bmi2") &&
+                          __builtin_cpu_supports("f16c");
+#else
+  static const bool has = __builtin_cpu_supports("x86-64-v3");
+#endif
+  return has;
+#else
+  return false;
+#endif
+}
+
+#if !defined(COHORT_EMBREE_X86_64_V3)
+void render_tile_x86_64_v3(const Frame& frame, const Tile& tile, Arena& arena, embree_kernel::RayLog* log,
+                           uint64_t row_rays[kTileHeight]) {
+  render_tile(frame, tile, arena, log, row_rays);
+}
+#endif
+
+}  // namespace embree_tiles
+
 namespace {
 
 void check_device(RTCDevice device, const char* what) {
@@ -54,6 +89,17 @@ struct EmbreeTracer::Impl {
   std::vector<RTCScene> blas_scenes;
   std::unique_ptr<tbb::global_control> thread_limit;
   uint64_t rays_traced = 0;
+  bool x86_64_v3 = embree_tiles::has_x86_64_v3();
+
+  void render_tile(const embree_tiles::Frame& frame, const embree_tiles::Tile& tile, embree_tiles::Arena& arena,
+                   embree_kernel::RayLog* log, uint64_t* row_rays) const {
+    if (x86_64_v3)
+      embree_tiles::render_tile_x86_64_v3(frame, tile, arena, log, row_rays);
+    else
+      embree_tiles::render_tile(frame, tile, arena, log, row_rays);
+  }
+  // Each thread's tile buffers, kept from band to band: rendering allocates nothing per tile or ray.
+  tbb::enumerable_thread_specific<embree_tiles::Arena> arenas;
 
   ~Impl() {
     release_top();
@@ -137,78 +183,97 @@ void EmbreeTracer::upload(const commit::ChangeSet& changes) {
   check_device(impl_->device, "building the instance scene");
 }
 
+namespace {
+
+embree_tiles::Frame make_frame(const KFrameParams& params, const core::BandJob& job, const KSceneView& scene,
+                               RTCScene top, const float* object_history, core::BandBuffer* target) {
+  embree_tiles::Frame frame;
+  frame.params = params;
+  frame.camera = job.camera;
+  frame.previous_camera = job.previous_camera.width > 0 ? job.previous_camera : job.camera;
+  frame.object_history = object_history;
+  frame.write_aux = target && params.aux_outputs != 0u && target->has_aux();
+  frame.base = embree_kernel::TraceCtx{scene, top, 0, nullptr, 0, v3s(0.0f), nullptr};
+  frame.target = target;
+  return frame;
+}
+
+}  // namespace
+
 core::BandResult EmbreeTracer::render_band(const core::BandJob& job, core::BandBuffer& target) {
   if (!impl_->top) throw std::runtime_error("EmbreeTracer: render_band before any commit was applied");
   auto start = std::chrono::steady_clock::now();
   const KFrameParams params = frame_params(job);
-  const KCamera camera = job.camera;
   const int row_begin = static_cast<int>(params.row_begin);
   const int row_end = std::min(static_cast<int>(params.row_end), target.height());
-  const int width = std::min(static_cast<int>(camera.width), target.width());
-  const embree_kernel::TraceCtx base{host_scene_view(params), impl_->top, 0};
-  const bool write_aux = params.aux_outputs != 0u && target.has_aux();
-  const KCamera previous_camera = job.previous_camera.width > 0 ? job.previous_camera : camera;
-  const float* object_history = previous_transforms().empty() ? nullptr : previous_transforms().data();
-  std::atomic<uint64_t> rays{0};
+  const int width = std::min(static_cast<int>(job.camera.width), target.width());
+  const KSceneView scene = host_scene_view(params);
+  const embree_tiles::Frame frame =
+      make_frame(params, job, scene, impl_->top,
+                 previous_transforms().empty() ? nullptr : previous_transforms().data(), &target);
   // Rays traced per row: the balancer's per-row work proxy (BandResult::row_work), as the GPU tracers count it.
-  std::vector<float> row_rays(static_cast<size_t>(std::max(row_end - row_begin, 0)), 0.0f);
-  tbb::parallel_for(tbb::blocked_range<int>(row_begin, row_end, 1), [&](const tbb::blocked_range<int>& rows) {
-    embree_kernel::TraceCtx ctx = base;
-    std::vector<float> out(static_cast<size_t>(width) * 4);  // one row, stored in the target's format
-    std::vector<KAux> aux(write_aux ? static_cast<size_t>(width) : 0u);
-    for (int y = rows.begin(); y < rows.end(); ++y) {
-      const uint64_t rays_before = ctx.rays;
-      for (int x = 0; x < width; ++x) {
-        KVec3 c = k_render_pixel(&ctx, &params, &camera, static_cast<kuint>(x), static_cast<kuint>(y));
-        out[4 * x + 0] = c.x;
-        out[4 * x + 1] = c.y;
-        out[4 * x + 2] = c.z;
-        out[4 * x + 3] = 1.0f;
+  std::vector<std::atomic<uint64_t>> row_rays(static_cast<size_t>(std::max(row_end - row_begin, 0)));
+  std::atomic<uint64_t> rays{0};
+  // A grid of tiles, handed to the cores by TBB's work stealing (tiles differ widely in cost).
+  const int tiles_x = (std::max(width, 0) + embree_tiles::kTileWidth - 1) / embree_tiles::kTileWidth;
+  const int tiles_y = (std::max(row_end - row_begin, 0) + embree_tiles::kTileHeight - 1) / embree_tiles::kTileHeight;
+  tbb::parallel_for(tbb::blocked_range<int>(0, tiles_x * tiles_y), [&](const tbb::blocked_range<int>& r) {
+    embree_tiles::Arena& arena = impl_->arenas.local();
+    uint64_t local = 0;
+    for (int index = r.begin(); index < r.end(); ++index) {
+      const int x0 = (index % tiles_x) * embree_tiles::kTileWidth;
+      const int y0 = row_begin + (index / tiles_x) * embree_tiles::kTileHeight;
+      const embree_tiles::Tile tile{x0, y0, std::min(x0 + embree_tiles::kTileWidth, width),
+                                    std::min(y0 + embree_tiles::kTileHeight, row_end)};
+      uint64_t tile_rows[embree_tiles::kTileHeight] = {};
+      impl_->render_tile(frame, tile, arena, nullptr, tile_rows);
+      for (int y = tile.y0; y < tile.y1; ++y) {
+        row_rays[static_cast<size_t>(y - row_begin)] += tile_rows[y - tile.y0];
+        local += tile_rows[y - tile.y0];
       }
-      target.store(y, 0, out.data(), static_cast<size_t>(width));
-      if (write_aux) {
-        for (int x = 0; x < width; ++x)
-          k_pixel_aux(&ctx, &camera, &previous_camera, object_history, static_cast<kuint>(x),
-                      static_cast<kuint>(y), &aux[static_cast<size_t>(x)]);
-        target.store_aux(y, 0, aux.data(), static_cast<size_t>(width));
-      }
-      row_rays[static_cast<size_t>(y - row_begin)] = static_cast<float>(ctx.rays - rays_before);
     }
-    rays += ctx.rays;
+    rays += local;
   });
   impl_->rays_traced += rays.load();
   core::BandResult result;
   result.device_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
-  if (row_end == static_cast<int>(params.row_end)) result.row_work = std::move(row_rays);
+  if (row_end == static_cast<int>(params.row_end)) {
+    result.row_work.resize(row_rays.size());
+    for (size_t i = 0; i < row_rays.size(); ++i) result.row_work[i] = static_cast<float>(row_rays[i].load());
+  }
   return result;
+}
+
+bool EmbreeTracer::prefer_x86_64_v3(bool prefer) {
+  impl_->x86_64_v3 = prefer && embree_tiles::has_x86_64_v3();
+  return impl_->x86_64_v3;
 }
 
 uint64_t EmbreeTracer::rays_traced() const { return impl_->rays_traced; }
 
-uint64_t EmbreeTracer::trace_camera_rays_only(const core::BandJob& job) {
-  if (!impl_->top) throw std::runtime_error("EmbreeTracer: trace before any commit was applied");
+EmbreeRaySet EmbreeTracer::record_rays(const core::BandJob& job) {
+  if (!impl_->top) throw std::runtime_error("EmbreeTracer: record_rays before any commit was applied");
   const KFrameParams params = frame_params(job);
-  const KCamera camera = job.camera;
-  const kuint spp = params.spp > 0u ? params.spp : 1u;
-  const embree_kernel::TraceCtx base{host_scene_view(params), impl_->top, 0};
-  std::atomic<uint64_t> hits{0};
-  tbb::parallel_for(tbb::blocked_range<int>(static_cast<int>(params.row_begin), static_cast<int>(params.row_end), 1),
-                    [&](const tbb::blocked_range<int>& rows) {
-                      embree_kernel::TraceCtx ctx = base;
-                      uint64_t local = 0;
-                      KVec3 org = v3_load(camera.origin);
-                      for (int y = rows.begin(); y < rows.end(); ++y)
-                        for (kuint x = 0; x < camera.width; ++x)
-                          for (kuint s = 0; s < spp; ++s) {
-                            KRng rng = k_rng_seed(x, static_cast<kuint>(y), params.frame_index, s);
-                            float jx = k_rng_next(&rng), jy = k_rng_next(&rng);
-                            KVec3 dir = k_camera_direction(&camera, float(x) + jx, float(y) + jy);
-                            KHit hit;
-                            local += static_cast<uint64_t>(k_trace_closest(&ctx, org, dir, K_INF, K_RAY_PRIMARY, &hit));
-                          }
-                      hits += local;
-                    });
-  return hits.load();
+  const KSceneView scene = host_scene_view(params);
+  const embree_tiles::Frame frame = make_frame(params, job, scene, impl_->top, nullptr, nullptr);
+  auto arena = std::make_unique<embree_tiles::Arena>();
+  embree_kernel::RayLog log;
+  log.camera_dir = v3s(0.0f);
+  const int width = static_cast<int>(job.camera.width);
+  for (int y0 = static_cast<int>(params.row_begin); y0 < static_cast<int>(params.row_end); y0 += embree_tiles::kTileHeight)
+    for (int x0 = 0; x0 < width; x0 += embree_tiles::kTileWidth) {
+      const embree_tiles::Tile tile{x0, y0, std::min(x0 + embree_tiles::kTileWidth, width),
+                                    std::min(y0 + embree_tiles::kTileHeight, static_cast<int>(params.row_end))};
+      uint64_t tile_rows[embree_tiles::kTileHeight] = {};
+      impl_->render_tile(frame, tile, *arena, &log, tile_rows);
+    }
+  return std::move(log.rays);
+}
+
+uint64_t EmbreeTracer::trace_raw(const std::vector<EmbreeRay>& rays, bool occlusion, EmbreeRayApi api, bool coherent) {
+  if (!impl_->top) throw std::runtime_error("EmbreeTracer: trace_raw before any commit was applied");
+  const KFrameParams params = frame_params(core::BandJob{});
+  return embree_raw::trace(impl_->top, host_scene_view(params), rays, occlusion, api, coherent);
 }
 
 }  // namespace cohort::tracers

@@ -293,15 +293,26 @@ KFN KVec3 k_trace_path(KTraceCtx* ctx, const KFrameParams* params, KVec3 org, KV
   return radiance;
 }
 
+/* The angle one pixel subtends, for k_trace_path's mip selection. */
+KFN float k_pixel_spread(const KCamera* cam) { return 2.0f * cam->tan_half_fov_x / (float)cam->width; }
+
+/* Sample s of pixel (x, y): the camera ray's direction (from cam->origin) and, in *rng, the sample's
+ * random stream after the jitter, ready for k_trace_path. Tracers that trace camera rays ahead in
+ * batches (Embree's packets) start each path from here, so their rays are exactly these. */
+KFN KVec3 k_camera_sample(const KFrameParams* params, const KCamera* cam, kuint x, kuint y, kuint s, KRng* rng) {
+  *rng = k_rng_seed(x, y, params->frame_index, s);
+  float jx = k_rng_next(rng), jy = k_rng_next(rng);
+  return k_camera_direction(cam, (float)x + jx, (float)y + jy);
+}
+
 KFN KVec3 k_render_pixel(KTraceCtx* ctx, const KFrameParams* params, const KCamera* cam, kuint x, kuint y) {
   kuint spp = params->spp > 0u ? params->spp : 1u;
   KVec3 sum = v3s(0.0f);
   KVec3 org = v3_load(cam->origin);
-  float pixel_spread = 2.0f * cam->tan_half_fov_x / (float)cam->width;
+  float pixel_spread = k_pixel_spread(cam);
   for (kuint s = 0u; s < spp; ++s) {
-    KRng rng = k_rng_seed(x, y, params->frame_index, s);
-    float jx = k_rng_next(&rng), jy = k_rng_next(&rng);
-    KVec3 dir = k_camera_direction(cam, (float)x + jx, (float)y + jy);
+    KRng rng;
+    KVec3 dir = k_camera_sample(params, cam, x, y, s, &rng);
     sum = v3_add(sum, k_trace_path(ctx, params, org, dir, pixel_spread, &rng));
   }
   return v3_scale(sum, 1.0f / (float)spp);

@@ -64,8 +64,10 @@ KFN KVec4 k_texture_sample_level(const KSceneView* scene, kuint tex, float s, fl
   float fx0 = k_floor(x), fy0 = k_floor(y);
   float ax = x - fx0, ay = y - fy0;
   int x0 = (int)fx0, y0 = (int)fy0;
-  kuint xa = k_tex_coord(x0, w, clamp), xb = k_tex_coord(x0 + 1, w, clamp);
-  kuint ya = k_tex_coord(y0, h, clamp), yb = k_tex_coord(y0 + 1, h, clamp);
+  kuint xa = k_tex_coord(x0, w, clamp), ya = k_tex_coord(y0, h, clamp);
+  /* The next texel without a second integer division (wrapping: the one after the last is the first). */
+  kuint xb = clamp ? k_tex_coord(x0 + 1, w, clamp) : (xa + 1u == w ? 0u : xa + 1u);
+  kuint yb = clamp ? k_tex_coord(y0 + 1, h, clamp) : (ya + 1u == h ? 0u : ya + 1u);
   KVec4 c00 = k_texel_fetch(scene->texels, offset, w, xa, ya, flags);
   KVec4 c10 = k_texel_fetch(scene->texels, offset, w, xb, ya, flags);
   KVec4 c01 = k_texel_fetch(scene->texels, offset, w, xa, yb, flags);

@@ -1,14 +1,35 @@
 // The CPU tracer: Embree 3 two-level scene (one geometry per BLAS, one instance per KInstance) and the
-// shared integrator (kernel/include/cohort/kernel/integrator.h), multithreaded over the rows of its band.
+// shared integrator (kernel/include/cohort/kernel/integrator.h), over tiles of its band spread across
+// the cores by TBB. Each tile traces its camera rays ahead in coherent packets; the paths then go on
+// from those hits with single-ray shadow and bounce traces.
 #pragma once
 
 #include <cstdint>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "cohort/tracers/tracer_base.h"
 
 namespace cohort::tracers {
+
+// A ray as the integrator asked for it (origin, direction, tmax, K_RAY_* mask), for the benchmarks.
+struct EmbreeRay {
+  float org[3];
+  float dir[3];
+  float tmax;
+  uint32_t mask;
+};
+
+// The rays of one render_band by class. camera: camera rays and their continuations through
+// transparent layers; bounce: every other closest-hit ray; shadow: occlusion rays.
+struct EmbreeRaySet {
+  std::vector<EmbreeRay> camera, shadow, bounce;
+};
+
+// How trace_raw hands rays to Embree: rtcIntersect1/rtcOccluded1 one by one, rtcIntersect8/rtcOccluded8
+// on consecutive groups of 8, or rtcIntersect1M/rtcOccluded1M on consecutive streams of 256.
+enum class EmbreeRayApi { single, packet8, stream };
 
 class EmbreeTracer : public TracerBase {
  public:
@@ -21,9 +42,15 @@ class EmbreeTracer : public TracerBase {
   using core::Tracer::render_band;
   core::BandResult render_band(const core::BandJob& job, core::BandBuffer& target) override;
 
-  // Raw closest-hit throughput: traces exactly the band's camera rays (same jitter as the integrator,
-  // params.spp per pixel) with rtcIntersect1 and nothing else. Returns the number of rays that hit.
-  uint64_t trace_camera_rays_only(const core::BandJob& job);
+  // Renders the band once on the calling thread (no image) and returns every ray the integrator traced.
+  EmbreeRaySet record_rays(const core::BandJob& job);
+  // Traces the rays on the applied scene with the same filter functions as the integrator, nothing
+  // else: closest hits (occlusion = false) or occlusion. coherent sets RTC_INTERSECT_CONTEXT_FLAG_COHERENT.
+  // Returns how many hit (or were occluded).
+  uint64_t trace_raw(const std::vector<EmbreeRay>& rays, bool occlusion, EmbreeRayApi api, bool coherent);
+  // Which build of the shading code runs: the one for x86-64-v3 (AVX2, FMA) where the CPU has it, the
+  // default, or the baseline x86-64 one. Returns whether the x86-64-v3 build is now in use.
+  bool prefer_x86_64_v3(bool prefer);
   // Camera, bounce and shadow rays traced by render_band since construction.
   uint64_t rays_traced() const;
 

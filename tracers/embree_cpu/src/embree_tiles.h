@@ -1,0 +1,59 @@
+// The Embree tracer's unit of work: a tile of the band. Per sample the tile traces all its camera rays
+// ahead in coherent 8-ray packets, then runs the shared integrator (k_trace_path) per pixel from those
+// hits; shadow and bounce rays are traced one by one as the integrator asks for them. Everything a tile
+// needs lives in a per-thread Arena, so rendering allocates nothing per tile or ray.
+#pragma once
+
+#include <embree3/rtcore.h>
+
+#include <cstdint>
+
+#include "cohort/core/band_buffer.h"
+#include "cohort/kernel/rng.h"
+#include "embree_kernel.h"
+
+namespace cohort::tracers::embree_tiles {
+
+constexpr int kTileWidth = 32;
+constexpr int kTileHeight = 4;
+constexpr int kTilePixels = kTileWidth * kTileHeight;
+constexpr int kPacketSize = 8;  // rtcIntersect8: AVX2's native width
+constexpr int kTilePackets = kTilePixels / kPacketSize;
+
+// What every tile of one band shares.
+struct Frame {
+  KFrameParams params;
+  KCamera camera;
+  KCamera previous_camera;
+  const float* object_history;  // previous object-to-world transforms, or null
+  bool write_aux;
+  embree_kernel::TraceCtx base;
+  core::BandBuffer* target;  // null: render without storing (recording rays)
+};
+
+struct Tile {
+  int x0, y0, x1, y1;  // [x0, x1) x [y0, y1), at most kTileWidth x kTileHeight
+};
+
+struct Arena {
+  RTCRayHit8 packets[kTilePackets];
+  KHit hits[kTilePixels];
+  int found[kTilePixels];
+  KVec3 dirs[kTilePixels];
+  KRng rngs[kTilePixels];
+  KVec3 sums[kTilePixels];
+  float rgba[kTileWidth * 4];
+  KAux aux[kTileWidth];
+};
+
+// Renders the tile into frame.target and adds the rays traced per row to row_rays[y - tile.y0].
+// log: null, or where every ray is recorded (the caller runs tiles one at a time then).
+void render_tile(const Frame& frame, const Tile& tile, Arena& arena, embree_kernel::RayLog* log,
+                 uint64_t row_rays[kTileHeight]);
+// The same, compiled for x86-64-v3 (AVX2, FMA): faster shading where the CPU has it (has_x86_64_v3).
+void render_tile_x86_64_v3(const Frame& frame, const Tile& tile, Arena& arena, embree_kernel::RayLog* log,
+                           uint64_t row_rays[kTileHeight]);
+// Whether this build has render_tile_x86_64_v3 and this CPU can run it.
+bool has_x86_64_v3();
+
+}  // namespace cohort::tracers::embree_tiles
