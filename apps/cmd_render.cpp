@@ -50,6 +50,7 @@ struct RenderArgs {
   std::string light_sampling = "tree";
   float fov = core::kDefaultFovX, exposure = 1.0f, firefly_clamp = 5.0f, spec_boost = 2.0f, soft_shadow_scale = 0.2f;
   float yaw_step = 0.0f;
+  double time = 0.0, time_step_ms = 1000.0 / 60.0;  // material time of frame 0 and per frame (60 Hz game tics)
   std::string camera_path;    // spin/orbit[-slow|-fast]; empty: fixed camera (plus --yaw-step)
   std::string write = "all";  // images of every frame, or only the last
   std::vector<float> camera;  // x y z yaw pitch
@@ -112,7 +113,18 @@ int run_render(const RenderArgs& a) {
     sync = std::make_unique<core::WorldSync>(*world, sync_options);
     renderer.submit_commit(commit::CommitBuffer::full(sync->snapshot(), 0));
     frames = a.frames_given ? a.frames : std::numeric_limits<int>::max();
+  } else if (scene.world) {
+    // A map: its materials' registers (time, tables) are evaluated at each frame's time, and only the
+    // materials that changed travel (core/world_sync.h).
+    core::WorldSyncOptions sync_options;
+    sync_options.width = uint32_t(a.width);
+    sync_options.height = uint32_t(a.height);
+    sync = std::make_unique<core::WorldSync>(*scene.world, sync_options);
+    sync->set_time(a.time);
+    renderer.submit_commit(commit::CommitBuffer::full(sync->snapshot(), 0));
   } else {
+    if (a.time != 0.0 || a.frames > 1)
+      spdlog::info("{}: a scene pack's materials are fixed when it is packed; render the map to animate them", a.map);
     renderer.submit_commit(commit::CommitBuffer::full(scene.tracer_scene, 1));
   }
 
@@ -218,11 +230,18 @@ int run_render(const RenderArgs& a) {
       renderer.submit_commit(sync->sync(world->TakeChanges(), uint64_t(f) + 1), [&] { return sync->snapshot(); });
       syncing.finish();
       job.camera = sync->master().camera;
-    } else if (path) {
-      const CameraPose pose = camera_path_pose(*path, eye, angles.yaw, f);
-      job.camera = core::make_camera(pose.origin, {pose.yaw, angles.pitch}, a.fov, a.width, a.height);
     } else {
-      job.camera = core::make_camera(eye, {angles.yaw + a.yaw_step * float(f), angles.pitch}, a.fov, a.width, a.height);
+      if (sync && f > 0) {  // a map: its animated materials at this frame's time
+        sync->set_time(a.time + double(f) * a.time_step_ms * 0.001);
+        core::ScopedStage syncing(stages, core::kCoreTrack, "world sync");
+        renderer.submit_commit(sync->sync(scene.world->TakeChanges(), uint64_t(f)), [&] { return sync->snapshot(); });
+      }
+      if (path) {
+        const CameraPose pose = camera_path_pose(*path, eye, angles.yaw, f);
+        job.camera = core::make_camera(pose.origin, {pose.yaw, angles.pitch}, a.fov, a.width, a.height);
+      } else {
+        job.camera = core::make_camera(eye, {angles.yaw + a.yaw_step * float(f), angles.pitch}, a.fov, a.width, a.height);
+      }
     }
     KFrameParams& p = job.params;
     p = core::default_frame_params();
@@ -283,6 +302,12 @@ void add_render_command(CLI::App& app, int& exit_code) {
   cmd->add_option("--height", a->height, "image height")->capture_default_str()->check(CLI::PositiveNumber);
   cmd->add_option("--spp", a->spp, "samples per pixel per frame")->capture_default_str()->check(CLI::PositiveNumber);
   auto* frames_option =
+      cmd->add_option("--time", a->time, "game time of frame 0 in seconds, for the materials' registers (time, "
+                                         "tables: flicker, scrolling, pulsing); maps only, scene packs are fixed")
+          ->capture_default_str();
+      cmd->add_option("--time-step", a->time_step_ms, "game time between frames in ms (0 freezes the materials)")
+          ->capture_default_str()
+          ->check(CLI::NonNegativeNumber);
       cmd->add_option("--frames", a->frames, "frames to render (with --replay: at most this many; default all)")
           ->capture_default_str()
           ->check(CLI::PositiveNumber);
