@@ -5,6 +5,7 @@
 #include <cmath>
 #include <filesystem>
 #include <iostream>
+#include <optional>
 
 #include <spdlog/spdlog.h>
 
@@ -14,6 +15,8 @@
 #include "cohort/core/image_output.h"
 #include "commands.h"
 #include "default_map.h"
+#include "convergence_choice.h"
+#include "workload_choice.h"
 #include "play_session.h"
 #include "viewer/hud.h"
 #include "viewer/viewer_actions.h"
@@ -31,7 +34,9 @@ struct PlayArgs {
   int spp = 1;
   int bounces = 1;
   std::string light_sampling = "tree";
-  std::string convergence = "reproject";  // measured better than brigade (docs/denoising.md)
+  std::string convergence = "auto";  // convergence_choice.h
+  int target_fps = -1;       // -1: 30 when only CPU tracers render, else off (workload_choice.h)
+  bool workload_given = false;  // --scale or --spp on the command line: they stand unless --target-fps
   std::string mode = "path";
   std::string tone = "aces";
   int frames = 0;            // 0: until the window closes
@@ -118,8 +123,13 @@ int run_play(PlayArgs a) {
   settings.light_sampling = core::light_sampling_mode(a.light_sampling);
   settings.mode = debug_mode_from_name(a.mode).value_or(K_MODE_PATH);
   settings.tone_curve = a.tone;
-  settings.reproject = a.convergence == "reproject";
+  settings.reproject = resolve_convergence(a.convergence, session->any_gpu_tracer()) == "reproject";
   float scale = a.scale;
+  // A frame-rate target: spp and render scale follow the measured frame time (core/workload_scaler.h)
+  // until the user picks either by hand.
+  int target_fps = resolve_target_fps(a.target_fps, session->any_gpu_tracer(), a.workload_given);
+  std::optional<core::WorkloadScaler> workload;
+  if (target_fps > 0) workload.emplace(workload_options(target_fps), core::WorkloadSetting{settings.spp, scale});
   bool show_hud = true;
   std::vector<Notice> notices;
   auto notify = [&](std::string text) {
@@ -163,6 +173,16 @@ int run_play(PlayArgs a) {
         case Action::spp_down: settings.spp = std::max(settings.spp / 2, 1); break;
         case Action::scale_up: scale = step_scale(scale, 1); break;
         case Action::scale_down: scale = step_scale(scale, -1); break;
+        default: break;
+      }
+      const bool manual_workload = action == Action::spp_up || action == Action::spp_down ||
+                                   action == Action::scale_up || action == Action::scale_down;
+      if (manual_workload && workload) {
+        workload.reset();
+        target_fps = 0;
+        notify("frame-rate target off: spp and scale are yours");
+      }
+      switch (action) {
         case Action::next_tone_mapper: settings.tone_curve = cycle(tone_curve_names(), settings.tone_curve, 1); break;
         case Action::toggle_scenario_pause:
           if (session->scenario_running()) session->set_scenario_paused(!session->scenario_paused());
@@ -183,12 +203,19 @@ int run_play(PlayArgs a) {
         case Action::speed_up: camera.change_speed(1); break;
         case Action::speed_down: camera.change_speed(-1); break;
         case Action::reset_camera: camera = session->start_camera(); break;
+        default: break;
       }
     }
 
     const clock::time_point now = clock::now();
-    const double dt = std::min(std::chrono::duration<double>(now - previous).count(), 0.25);
+    const double frame_s = std::chrono::duration<double>(now - previous).count();
+    const double dt = std::min(frame_s, 0.25);
     previous = now;
+    if (workload && have_frame) {
+      const core::WorkloadSetting chosen = workload->update(1000.0 * frame_s);
+      settings.spp = chosen.spp;
+      scale = static_cast<float>(chosen.render_scale);
+    }
     camera.update(window->take_move_input(), static_cast<float>(dt));
 
     const int fb_w = std::max(window->framebuffer_width(), 1), fb_h = std::max(window->framebuffer_height(), 1);
@@ -224,6 +251,7 @@ int run_play(PlayArgs a) {
       hud.mode = debug_mode_names()[settings.mode];
       hud.spp = settings.spp;
       hud.render_scale = scale;
+      hud.target_fps = target_fps;
       hud.render_width = settings.width;
       hud.render_height = settings.height;
       hud.tone_mapper = settings.tone_curve;
@@ -296,10 +324,11 @@ void add_play_command(CLI::App& app, int& exit_code) {
       ->check(CLI::IsMember(balance::balancer_names()));
   cmd->add_option("--width", a->width, "window width")->capture_default_str()->check(CLI::Range(16, 16384));
   cmd->add_option("--height", a->height, "window height")->capture_default_str()->check(CLI::Range(16, 16384));
-  cmd->add_option("--scale", a->scale, "render resolution / window resolution")
+  CLI::Option* scale_option = cmd->add_option("--scale", a->scale, "render resolution / window resolution")
       ->capture_default_str()
       ->check(CLI::Range(0.05f, 1.0f));
-  cmd->add_option("--spp", a->spp, "samples per pixel per frame")->capture_default_str()->check(CLI::Range(1, 256));
+  CLI::Option* spp_option =
+      cmd->add_option("--spp", a->spp, "samples per pixel per frame")->capture_default_str()->check(CLI::Range(1, 256));
   cmd->add_option("--bounces", a->bounces, "indirect bounces")->capture_default_str()->check(CLI::Range(0, 16));
   cmd->add_option("--light-sampling", a->light_sampling,
                   "how each hit picks the map's lights: tree (the light tree), all or every (references; see "
@@ -307,10 +336,16 @@ void add_play_command(CLI::App& app, int& exit_code) {
       ->capture_default_str()
       ->check(CLI::IsMember(core::light_sampling_names()));
   cmd->add_option("--convergence", a->convergence,
-                  "how frames accumulate: reproject (per-pixel history through motion vectors) or brigade "
-                  "(whole-frame blend); see `cohort render --help`")
+                  "how frames accumulate: reproject (per-pixel history through motion vectors), brigade "
+                  "(whole-frame blend) or auto (reproject unless a tracer renders on a GPU); see `cohort render --help`")
       ->capture_default_str()
-      ->check(CLI::IsMember({"brigade", "reproject"}));
+      ->check(CLI::IsMember({"auto", "brigade", "reproject"}));
+  cmd->add_option("--target-fps", a->target_fps,
+                  "hold this frame rate by choosing spp and render scale from the measured frame time (0: off; "
+                  "default: 30 when only CPU tracers render and neither --spp nor --scale is given, off with a GPU); "
+                  "the spp and scale keys take over")
+      ->default_str("auto")
+      ->check(CLI::Range(0, 1000));
   cmd->add_option("--mode", a->mode, "debug mode at start")
       ->capture_default_str()
       ->check(CLI::IsMember(debug_mode_names()));
@@ -324,7 +359,8 @@ void add_play_command(CLI::App& app, int& exit_code) {
                                        "ui.perfetto.dev or chrome://tracing); the HUD draws the last frame's");
   cmd->add_option("--window-screenshot", a->window_shot, "with --frames: write what the window showed last (the "
                                                          "frame scaled to the window, HUD included)");
-  cmd->callback([a, &exit_code] {
+  cmd->callback([a, &exit_code, scale_option, spp_option] {
+    a->workload_given = scale_option->count() > 0 || spp_option->count() > 0;
 #ifdef COHORT_HAVE_VIEWER
     exit_code = run_play(*a);
 #else

@@ -30,6 +30,7 @@
 #include "cohort/core/tonemap.h"
 #include "commands.h"
 #include "camera_path.h"
+#include "convergence_choice.h"
 #include "default_map.h"
 #include "progress_bar.h"
 #include "render_scene_source.h"
@@ -49,12 +50,13 @@ struct RenderArgs {
   std::string light_sampling = "tree";
   float fov = core::kDefaultFovX, exposure = 1.0f, firefly_clamp = 5.0f, spec_boost = 2.0f, soft_shadow_scale = 0.2f;
   float yaw_step = 0.0f;
+  double time = 0.0, time_step_ms = 1000.0 / 60.0;  // material time of frame 0 and per frame (60 Hz game tics)
   std::string camera_path;    // spin/orbit[-slow|-fast]; empty: fixed camera (plus --yaw-step)
   std::string write = "all";  // images of every frame, or only the last
   std::vector<float> camera;  // x y z yaw pitch
   std::vector<std::string> bases;
   bool no_convergence = false;
-  std::string convergence = "reproject";  // measured better than brigade (docs/denoising.md)
+  std::string convergence = "auto";  // convergence_choice.h
   std::string replay;
   std::string trace;
   std::string denoise = "none";
@@ -85,6 +87,9 @@ int run_render(const RenderArgs& a) {
   if (a.map.empty() && a.replay.empty()) throw std::invalid_argument("name a map or scene pack (or --replay FILE)");
   RenderScene scene = a.replay.empty() ? load_render_scene(a.map, bases_or_test_map(a.bases)) : RenderScene{};
   std::vector<std::unique_ptr<core::Tracer>> tracers = tracers::make_tracers(a.tracers);
+  bool any_gpu_tracer = false;
+  for (const auto& tracer : tracers) any_gpu_tracer = any_gpu_tracer || tracer->renders_on_gpu();
+  const std::string convergence_mode = resolve_convergence(a.convergence, any_gpu_tracer);
   core::RendererOptions options;
   options.balancer = a.balancer;
   options.band_format = a.band_format == "rgba32f" ? core::BandFormat::rgba32f : core::BandFormat::rgb16f;
@@ -108,7 +113,18 @@ int run_render(const RenderArgs& a) {
     sync = std::make_unique<core::WorldSync>(*world, sync_options);
     renderer.submit_commit(commit::CommitBuffer::full(sync->snapshot(), 0));
     frames = a.frames_given ? a.frames : std::numeric_limits<int>::max();
+  } else if (scene.world) {
+    // A map: its materials' registers (time, tables) are evaluated at each frame's time, and only the
+    // materials that changed travel (core/world_sync.h).
+    core::WorldSyncOptions sync_options;
+    sync_options.width = uint32_t(a.width);
+    sync_options.height = uint32_t(a.height);
+    sync = std::make_unique<core::WorldSync>(*scene.world, sync_options);
+    sync->set_time(a.time);
+    renderer.submit_commit(commit::CommitBuffer::full(sync->snapshot(), 0));
   } else {
+    if (a.time != 0.0 || a.frames > 1)
+      spdlog::info("{}: a scene pack's materials are fixed when it is packed; render the map to animate them", a.map);
     renderer.submit_commit(commit::CommitBuffer::full(scene.tracer_scene, 1));
   }
 
@@ -123,7 +139,7 @@ int run_render(const RenderArgs& a) {
   nlohmann::json stats_json = nlohmann::json::array();
   core::AdaptiveConvergence convergence;
   core::TemporalReprojection reprojection;
-  const bool reproject = a.convergence == "reproject" && !a.no_convergence;
+  const bool reproject = convergence_mode == "reproject" && !a.no_convergence;
   core::FrameBuffer albedo_guide, normal_guide;
   KCamera previous_camera{};  // none yet: the first frame is its own previous
   const std::optional<CameraPath> path =
@@ -214,11 +230,18 @@ int run_render(const RenderArgs& a) {
       renderer.submit_commit(sync->sync(world->TakeChanges(), uint64_t(f) + 1), [&] { return sync->snapshot(); });
       syncing.finish();
       job.camera = sync->master().camera;
-    } else if (path) {
-      const CameraPose pose = camera_path_pose(*path, eye, angles.yaw, f);
-      job.camera = core::make_camera(pose.origin, {pose.yaw, angles.pitch}, a.fov, a.width, a.height);
     } else {
-      job.camera = core::make_camera(eye, {angles.yaw + a.yaw_step * float(f), angles.pitch}, a.fov, a.width, a.height);
+      if (sync && f > 0) {  // a map: its animated materials at this frame's time
+        sync->set_time(a.time + double(f) * a.time_step_ms * 0.001);
+        core::ScopedStage syncing(stages, core::kCoreTrack, "world sync");
+        renderer.submit_commit(sync->sync(scene.world->TakeChanges(), uint64_t(f)), [&] { return sync->snapshot(); });
+      }
+      if (path) {
+        const CameraPose pose = camera_path_pose(*path, eye, angles.yaw, f);
+        job.camera = core::make_camera(pose.origin, {pose.yaw, angles.pitch}, a.fov, a.width, a.height);
+      } else {
+        job.camera = core::make_camera(eye, {angles.yaw + a.yaw_step * float(f), angles.pitch}, a.fov, a.width, a.height);
+      }
     }
     KFrameParams& p = job.params;
     p = core::default_frame_params();
@@ -247,7 +270,7 @@ int run_render(const RenderArgs& a) {
                            {"spp", a.spp},       {"bounces", a.bounces},
                            {"light_sampling", a.light_sampling}, {"light_samples", a.light_samples},    {"mode", a.mode},
                            {"camera_path", a.camera_path}, {"denoise", a.denoise},
-                           {"convergence", a.no_convergence ? "none" : a.convergence}, {"frames", stats_json}};
+                           {"convergence", a.no_convergence ? "none" : convergence_mode}, {"frames", stats_json}};
   std::ofstream(std::filesystem::path(a.out) / "stats.json") << report.dump(2) << "\n";
   std::cout << "wrote " << rendered << " frame(s) and stats.json to " << a.out << "\n";
   return kExitOk;
@@ -279,6 +302,12 @@ void add_render_command(CLI::App& app, int& exit_code) {
   cmd->add_option("--height", a->height, "image height")->capture_default_str()->check(CLI::PositiveNumber);
   cmd->add_option("--spp", a->spp, "samples per pixel per frame")->capture_default_str()->check(CLI::PositiveNumber);
   auto* frames_option =
+      cmd->add_option("--time", a->time, "game time of frame 0 in seconds, for the materials' registers (time, "
+                                         "tables: flicker, scrolling, pulsing); maps only, scene packs are fixed")
+          ->capture_default_str();
+      cmd->add_option("--time-step", a->time_step_ms, "game time between frames in ms (0 freezes the materials)")
+          ->capture_default_str()
+          ->check(CLI::NonNegativeNumber);
       cmd->add_option("--frames", a->frames, "frames to render (with --replay: at most this many; default all)")
           ->capture_default_str()
           ->check(CLI::PositiveNumber);
@@ -325,9 +354,11 @@ void add_render_command(CLI::App& app, int& exit_code) {
   cmd->add_option("--convergence", a->convergence,
                   "how frames accumulate: reproject (per-pixel history through motion vectors, with disocclusion "
                   "tests and neighbourhood clamping; the tracers also write depth, normal, albedo, id and motion) "
-                  "or brigade (whole-frame blend, f from camera motion; the paper's)")
+                  "or brigade (whole-frame blend, f from camera motion; the paper's); auto: reproject unless a "
+                  "tracer renders on a GPU, where the host's reprojection would set the frame rate "
+                  "(docs/denoising.md)")
       ->capture_default_str()
-      ->check(CLI::IsMember({"brigade", "reproject"}));
+      ->check(CLI::IsMember({"auto", "brigade", "reproject"}));
   cmd->add_flag("--no-convergence", a->no_convergence,
                  "write each frame as rendered instead of blending frames with adaptive convergence");
   cmd->add_option("--write", a->write, "images of every frame, or only the last (stats.json always has every frame)")

@@ -78,6 +78,7 @@ struct PlaySession::State {
   uint64_t frame_index = 0;
   kuint last_mode = K_MODE_PATH;
   std::string map_name;
+  bool any_gpu_tracer = false;
 };
 
 PlaySession::PlaySession(const SessionOptions& options) {
@@ -102,6 +103,7 @@ PlaySession::PlaySession(const SessionOptions& options) {
   if (tracers.empty())
     throw std::runtime_error("no tracer could start (asked for: " + list + "); see the warnings above");
 
+  for (const auto& tracer : tracers) s.any_gpu_tracer = s.any_gpu_tracer || tracer->renders_on_gpu();
   core::RendererOptions renderer_options;
   renderer_options.balancer = options.balancer;
   renderer_options.band_format = core::BandFormat::rgb16f;  // half the bytes; the HUD image cannot tell
@@ -231,6 +233,8 @@ void PlaySession::set_balancer(const std::string& name) { state_->renderer->set_
 const std::string& PlaySession::balancer() const { return state_->renderer->balancer_name(); }
 bool PlaySession::scenario_running() const { return state_->scenario != nullptr; }
 const std::string& PlaySession::map_name() const { return state_->map_name; }
+
+bool PlaySession::any_gpu_tracer() const { return state_->any_gpu_tracer; }
 
 std::vector<std::string> PlaySession::tracer_names() const {
   std::vector<std::string> names;

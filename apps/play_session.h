@@ -63,6 +63,8 @@ class PlaySession {
   bool scenario_paused() const { return paused_; }
   void set_scenario_paused(bool paused) { paused_ = paused; }
   std::vector<std::string> tracer_names() const;
+  // Whether any of the session's tracers renders on a GPU (see convergence_choice.h).
+  bool any_gpu_tracer() const;
   // Tracers that did not start, a scenario that cannot run: things the HUD and log should say.
   const std::vector<std::string>& warnings() const { return warnings_; }
   const std::string& map_name() const;

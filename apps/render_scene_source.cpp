@@ -31,7 +31,7 @@ RenderScene load_render_scene(const std::string& path, const std::vector<std::st
   out.name = loaded.name;
   out.player_start = loaded.player_start;
   out.player_yaw = loaded.player_yaw;
-  out.tracer_scene = std::make_shared<const commit::TracerScene>(core::compile_scene(std::move(loaded)).tracer_scene);
+  out.world = std::make_shared<scene::RenderWorld>(std::move(loaded));
   return out;
 }
 

@@ -32,6 +32,8 @@ std::vector<std::string> hud_lines(const HudState& s) {
   }
   lines.push_back(format("MODE %s  SPP %d  SCALE %.2f (%dX%d)  TONE %s", s.mode.c_str(), s.spp, s.render_scale,
                          s.render_width, s.render_height, s.tone_mapper.c_str()));
+  if (s.target_fps > 0)
+    lines.back() += format("  AUTO %d FPS", s.target_fps);
   if (s.stats) {
     lines.push_back(format("BALANCER %s  IDLE %.1f%%  CONV F %.2f  COMMIT %s", s.balancer.c_str(),
                            s.stats->idle_percent, s.stats->convergence_f, format_bytes(s.commit_bytes).c_str()));

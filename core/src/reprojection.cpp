@@ -51,6 +51,9 @@ void TemporalReprojection::accumulate(const FrameBuffer& fresh, const GBuffer& g
   const bool have_history = image_.width == width && image_.height == height && length_.size() == pixels;
   if (next_image_.width != width || next_image_.height != height) next_image_.resize(width, height);
   next_length_.resize(pixels);
+  next_depth_.resize(pixels);
+  next_normal_.resize(3 * pixels);
+  next_id_.resize(pixels);
   const ReprojectionOptions& o = options_;
   const float max_history = static_cast<float>(std::max(o.max_history, 1));
 
@@ -71,6 +74,11 @@ void TemporalReprojection::accumulate(const FrameBuffer& fresh, const GBuffer& g
       for (int x = 0; x < width; ++x) {
         const size_t p = static_cast<size_t>(y) * width + x;
         const float* sample = fresh.rgba.data() + 4 * p;
+        // This frame's surfaces become the next frame's history tests (copied here, in parallel, while
+        // they are in cache, rather than in a serial pass at the end).
+        next_depth_[p] = gbuffer.depth[p];
+        next_id_[p] = gbuffer.id[p];
+        for (int k = 0; k < 3; ++k) next_normal_[3 * p + k] = gbuffer.normal[3 * p + k];
         // Neighbourhood moments of the fresh frame in YCoCg (finite samples only), when needed.
         float m1[3] = {0, 0, 0}, m2[3] = {0, 0, 0};
         int count = 0;
@@ -163,9 +171,9 @@ void TemporalReprojection::accumulate(const FrameBuffer& fresh, const GBuffer& g
   });
   std::swap(image_, next_image_);
   std::swap(length_, next_length_);
-  depth_ = gbuffer.depth;
-  normal_ = gbuffer.normal;
-  id_ = gbuffer.id;
+  std::swap(depth_, next_depth_);
+  std::swap(normal_, next_normal_);
+  std::swap(id_, next_id_);
 }
 
 }  // namespace cohort::core

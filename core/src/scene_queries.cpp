@@ -20,6 +20,8 @@ KTraceCtx context_for(const commit::TracerScene& s) {
   ctx.scene.instance_count = kuint(s.instances.size());
   ctx.scene.tlas_node_count = kuint(s.tlas_nodes.size());
   ctx.scene.light_count = kuint(s.lights.size());
+  ctx.scene.volume_light_begin = 0u;
+  ctx.scene.volume_light_end = kuint(s.lights.size());
   return ctx;
 }
 

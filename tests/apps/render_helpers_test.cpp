@@ -3,10 +3,34 @@
 #include <gtest/gtest.h>
 
 #include "camera_path.h"
+#include "convergence_choice.h"
+#include "workload_choice.h"
 #include "progress_bar.h"
 
 namespace cohort::app {
 namespace {
+
+TEST(WorkloadChoice, CpuOnlySessionsHoldThirtyFpsByDefault) {
+  EXPECT_EQ(resolve_target_fps(-1, false, false), kCpuTargetFps);
+  EXPECT_EQ(resolve_target_fps(-1, true, false), 0) << "a GPU session keeps the user's spp and scale";
+  EXPECT_EQ(resolve_target_fps(-1, false, true), 0) << "--spp or --scale given: they stand";
+  EXPECT_EQ(resolve_target_fps(0, false, false), 0) << "0 turns the target off";
+  EXPECT_EQ(resolve_target_fps(60, true, true), 60);
+  // A frame four times too slow at full scale and 1 spp: the scaler lowers the scale, not below 0.25.
+  core::WorkloadScaler scaler(workload_options(30), core::WorkloadSetting{1, 1.0});
+  core::WorkloadSetting s = scaler.current();
+  for (int frame = 0; frame < 40; ++frame) s = scaler.update(4.0 * 33.3 * s.render_scale * s.render_scale);
+  EXPECT_EQ(s.spp, 1);
+  EXPECT_NEAR(s.render_scale, 0.5, 0.06) << "frame time ~ scale^2: half the scale fits";
+  EXPECT_GE(s.render_scale, 0.25);
+}
+
+TEST(ConvergenceChoice, AutoReprojectsOnlyWhenNoTracerRendersOnAGpu) {
+  EXPECT_EQ(resolve_convergence("auto", false), "reproject");
+  EXPECT_EQ(resolve_convergence("auto", true), "brigade");
+  EXPECT_EQ(resolve_convergence("reproject", true), "reproject") << "an explicit choice stands";
+  EXPECT_EQ(resolve_convergence("brigade", false), "brigade");
+}
 
 TEST(CameraPath, ParsesNamesAndRejectsUnknownOnes) {
   EXPECT_EQ(parse_camera_path("spin").kind, CameraPath::Kind::spin);

@@ -1,11 +1,12 @@
-# A recorded scenario replays through `cohort render --replay`: every recorded frame is rendered.
+# A recorded scenario replays through `cohort render --replay`: every recorded frame is rendered, and
+# with only a CPU tracer the default convergence (auto) is reprojection.
 if(TARGET cohort)
   set(_dir ${CMAKE_BINARY_DIR}/test_output/render_replay)
   add_test(NAME apps.render_replay
            COMMAND bash -c "set -e; rm -rf '${_dir}'; mkdir -p '${_dir}'
              '$<TARGET_FILE:cohort>' record-scenario testmap --base '${CMAKE_SOURCE_DIR}/assets/testmap' --frames 5 --out '${_dir}/s.cdelta'
              '$<TARGET_FILE:cohort>' render --replay '${_dir}/s.cdelta' --base '${CMAKE_SOURCE_DIR}/assets/testmap' --tracers embree --width 64 --height 36 --spp 1 --write last --out '${_dir}/out'
-             python3 -c \"import json,sys; d=json.load(open('${_dir}/out/stats.json')); n=len(d['frames']); print(n, 'frames'); sys.exit(0 if n == 5 else 1)\"")
+             python3 -c \"import json,sys; d=json.load(open('${_dir}/out/stats.json')); n=len(d['frames']); print(n, 'frames', d['convergence']); sys.exit(0 if n == 5 and d['convergence'] == 'reproject' else 1)\"")
   set_tests_properties(apps.render_replay PROPERTIES LABELS apps TIMEOUT 300)
 endif()
 

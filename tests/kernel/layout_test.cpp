@@ -16,7 +16,7 @@ TEST(KernelLayout, FieldOffsetsArePacked) {
   EXPECT_EQ(offsetof(KFrameParams, light_node_count), 60u);
   EXPECT_EQ(offsetof(KFrameParams, emissive_count), 64u);
   EXPECT_EQ(offsetof(KFrameParams, emissive_samples), 68u);
-  EXPECT_EQ(sizeof(KFrameParams), 80u);
+  EXPECT_EQ(sizeof(KFrameParams), 96u);
   EXPECT_EQ(offsetof(KLightNode, left_first), 12u);
   EXPECT_EQ(offsetof(KLightNode, count), 28u);
   EXPECT_EQ(offsetof(KLightNode, power), 32u);

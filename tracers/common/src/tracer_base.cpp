@@ -37,12 +37,12 @@ KFrameParams TracerBase::frame_params(const core::BandJob& job) const {
   params.tlas_node_count = static_cast<kuint>(scene_.tlas_nodes.size());
   params.light_node_count = static_cast<kuint>(scene_.light_nodes.size());
   params.emissive_count = static_cast<kuint>(scene_.emissive_triangles.size());
-  // Maps with hundreds of lights and few fog or blend lights (often none) would otherwise check every
-  // light's flags along every ray segment.
-  kuint tail = 0;
-  for (auto light = scene_.lights.rbegin(); light != scene_.lights.rend(); ++light, ++tail)
-    if (light->flags & (K_LIGHT_FOG | K_LIGHT_BLEND)) break;
-  params.plain_light_tail = tail;
+  params.volume_light_begin = params.volume_light_end = 0u;
+  for (size_t i = 0; i < scene_.lights.size(); ++i) {
+    if (!(scene_.lights[i].flags & K_LIGHT_VOLUME_EFFECT)) continue;
+    if (params.volume_light_end == 0u) params.volume_light_begin = static_cast<kuint>(i);
+    params.volume_light_end = static_cast<kuint>(i + 1);
+  }
   return params;
 }
 

@@ -53,7 +53,7 @@ struct CudaTracer::Impl {
   cudaTextureObject_t texel_texture = 0;
   DeviceArray<float> previous_transforms;
   DeviceArray<KAux> aux;
-  std::vector<KAux> host_aux;
+  DeviceArray<KAuxTexel> aux_texels;
   float4* band = nullptr;
   unsigned short* band_rgb16f = nullptr;   // the band as RGB halves, for RGB16F targets
   bool count_rays = false;
@@ -66,21 +66,24 @@ struct CudaTracer::Impl {
   // The targets the band is copied into, page-locked (cudaHostRegister) so that the copy is a true
   // asynchronous DMA on the tracer's stream instead of going through the driver's pageable staging
   // (about 3 ms of a 1080p frame otherwise). The Renderer alternates two targets by frame parity (the
-  // pipeline), so the last two stay registered.
+  // pipeline), so the last two stay registered, with their auxiliary planes when they have them.
   struct Registered {
     void* ptr = nullptr;
     size_t bytes = 0;
   };
-  Registered registered[2];
+  Registered registered[4];
   int next_registration = 0;
 
   void register_target(core::BandBuffer& target) {
-    void* ptr = target.data();
-    const size_t bytes = target.bytes();
+    register_host(target.data(), target.bytes());
+    if (target.has_aux()) register_host(target.aux_data(), target.aux_bytes());
+  }
+
+  void register_host(void* ptr, size_t bytes) {
     for (const Registered& r : registered)
       if (r.ptr == ptr && r.bytes == bytes) return;
     Registered& slot = registered[next_registration];
-    next_registration ^= 1;
+    next_registration = (next_registration + 1) % 4;
     if (slot.ptr) cudaHostUnregister(slot.ptr);
     slot = {};
     if (cudaHostRegister(ptr, bytes, cudaHostRegisterPortable) == cudaSuccess) {
@@ -247,11 +250,13 @@ core::BandResult CudaTracer::render_band(const core::BandJob& job, core::BandBuf
     // Only frames that ask pay for it: a second kernel after the band's, on the same stream.
     const KCamera previous = job.previous_camera.width > 0 ? job.previous_camera : camera;
     m.previous_transforms.upload(previous_transforms(), 0, m.stream);
-    m.host_aux.resize(pixels);
-    m.aux.upload(m.host_aux, pixels, m.stream);   // sizes the device array; nothing to copy
+    KAux* aux = m.aux.scratch(pixels);
+    KAuxTexel* texels = m.aux_texels.scratch(pixels);
     launch_aux_band(m.view(params), params, camera, previous,
-                    previous_transforms().empty() ? nullptr : m.previous_transforms.data(), m.aux.data(), m.stream);
-    COHORT_CUDA(cudaMemcpyAsync(m.host_aux.data(), m.aux.data(), pixels * sizeof(KAux), cudaMemcpyDeviceToHost, m.stream));
+                    previous_transforms().empty() ? nullptr : m.previous_transforms.data(), aux, m.stream);
+    launch_aux_to_texels(aux, texels, pixels, m.stream);
+    COHORT_CUDA(cudaMemcpyAsync(target.aux_row(int(params.row_begin)), texels, pixels * sizeof(KAuxTexel),
+                                cudaMemcpyDeviceToHost, m.stream));
   }
   m.host_row_rays.resize(rows);
   COHORT_CUDA(cudaMemcpyAsync(m.host_row_rays.data(), m.row_rays, rows * sizeof(unsigned), cudaMemcpyDeviceToHost, m.stream));
@@ -260,9 +265,6 @@ core::BandResult CudaTracer::render_band(const core::BandJob& job, core::BandBuf
     COHORT_CUDA(cudaMemcpyAsync(counts, m.ray_counts, sizeof counts, cudaMemcpyDeviceToHost, m.stream));
   COHORT_CUDA(cudaStreamSynchronize(m.stream));
   m.last_counts = RayCounts{counts[0], counts[1]};
-  if (write_aux)
-    for (size_t r = 0; r < rows; ++r)
-      target.store_aux(int(params.row_begin + r), 0, m.host_aux.data() + r * camera.width, camera.width);
   float kernel_ms = 0.0f;
   COHORT_CUDA(cudaEventElapsedTime(&kernel_ms, m.start, m.stop));
   core::BandResult result;

@@ -19,5 +19,7 @@ void launch_aux_band(const KSceneView& scene, const KFrameParams& params, const 
                      cudaStream_t stream);
 // Converts a rendered band (float4 per pixel) to RGB halves (3 x 16 bits per pixel) on the stream.
 void launch_band_to_rgb16f(const float4* band, unsigned short* rgb, size_t pixels, cudaStream_t stream);
+// KAux -> the 32-byte KAuxTexel the host's BandBuffer keeps (halves for normal and albedo).
+void launch_aux_to_texels(const KAux* aux, KAuxTexel* texels, size_t pixels, cudaStream_t stream);
 
 }  // namespace cohort::tracers

@@ -98,6 +98,7 @@ class DeviceBuffer {
 
 struct OpenCLTracer::Impl {
   std::string label;
+  bool gpu = false;
   cl_context context = nullptr;
   cl_command_queue queue = nullptr;
   cl_program program = nullptr;
@@ -179,6 +180,9 @@ OpenCLTracer::OpenCLTracer(const Options& options) : impl_(std::make_unique<Impl
                              std::to_string(devices.size()) + " available");
   const DeviceEntry& dev = devices[static_cast<size_t>(options.device)];
   impl_->label = dev.label;
+  cl_device_type type = 0;
+  impl_->gpu = clGetDeviceInfo(dev.device, CL_DEVICE_TYPE, sizeof(type), &type, nullptr) == CL_SUCCESS &&
+               (type & CL_DEVICE_TYPE_GPU) != 0;
   cl_int err = CL_SUCCESS;
   cl_context_properties props[] = {CL_CONTEXT_PLATFORM, reinterpret_cast<cl_context_properties>(dev.platform), 0};
   impl_->context = clCreateContext(props, 1, &dev.device, nullptr, nullptr, &err);
@@ -231,6 +235,8 @@ OpenCLTracer::OpenCLTracer(const Options& options) : impl_(std::make_unique<Impl
 OpenCLTracer::~OpenCLTracer() = default;
 
 std::string OpenCLTracer::name() const { return "opencl (" + impl_->label + ")"; }
+
+bool OpenCLTracer::renders_on_gpu() const { return impl_->gpu; }
 
 void OpenCLTracer::upload(const commit::ChangeSet& changes) {
   Impl& m = *impl_;

@@ -43,11 +43,15 @@ class BandBuffer {
   void copy_rows_to(FrameBuffer& out, int row_begin, int row_end) const;
 
   // Auxiliary planes (kernel/aux_outputs.h), kept only for frames that ask for them: 32 bytes a pixel
-  // (depths, motion and id as 32-bit values, normal and albedo as half floats). Off frees them.
+  // (KAuxTexel: depths, motion and id as 32-bit values, normal and albedo as half floats). Off frees them.
   void enable_aux(bool on);
   bool has_aux() const { return !aux_.empty(); }
   // Writes `pixels` aux records at (x, y) onwards.
   void store_aux(int y, int x, const KAux* aux, size_t pixels);
+  // Row y's packed aux texels (a GPU tracer copies its band's straight into place), and the whole block.
+  KAuxTexel* aux_row(int y) { return aux_.data() + static_cast<size_t>(y) * static_cast<size_t>(width_); }
+  void* aux_data() { return aux_.data(); }
+  size_t aux_bytes() const { return aux_.size() * sizeof(KAuxTexel); }
   // Reads rows [row_begin, row_end) into the same rows of `out` (which must have this size).
   void copy_aux_rows_to(GBuffer& out, int row_begin, int row_end) const;
 
@@ -55,12 +59,7 @@ class BandBuffer {
   int width_ = 0, height_ = 0;
   BandFormat format_ = BandFormat::rgba32f;
   std::vector<unsigned char> storage_;
-  struct AuxTexel {
-    float depth, prev_depth, motion[2];
-    uint16_t normal[3], albedo[3];
-    uint32_t id;
-  };
-  static_assert(sizeof(AuxTexel) == 32, "AuxTexel layout");
+  using AuxTexel = KAuxTexel;
   std::vector<AuxTexel> aux_;
 };
 

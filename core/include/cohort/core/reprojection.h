@@ -47,8 +47,8 @@ class TemporalReprojection {
   FrameBuffer image_, next_image_;
   std::vector<float> length_, next_length_;
   // The previous frame's surfaces, to test history taps against.
-  std::vector<float> depth_, normal_;
-  std::vector<uint32_t> id_;
+  std::vector<float> depth_, normal_, next_depth_, next_normal_;
+  std::vector<uint32_t> id_, next_id_;
   // The fresh frame in YCoCg and which of its samples are finite (scratch).
   std::vector<float> ycocg_;
   std::vector<uint8_t> finite_;

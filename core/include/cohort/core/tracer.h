@@ -31,6 +31,9 @@ class Tracer {
  public:
   virtual ~Tracer() = default;
   virtual std::string name() const = 0;
+  // Whether the tracer's rays run on a GPU (its frames then come back faster than the host can
+  // post-process them; see apps' choice of convergence).
+  virtual bool renders_on_gpu() const { return false; }
   // Bring the tracer's scene copy (and device buffers) up to date. Called on the tracer's thread.
   virtual void apply(const commit::CommitBuffer& commit) = 0;
   // Render rows [row_begin, row_end) of the frame into target (full frame size, in the format it

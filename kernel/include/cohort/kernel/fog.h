@@ -58,8 +58,7 @@ KFN float k_light_volume_length(KGLOBAL const KLight* light, KVec3 org, KVec3 di
 /* Fog along the segment (0, tmax) of a ray: adds the fog colour seen through it to *radiance and
  * leaves in *throughput what reaches the segment's end. */
 KFN void k_apply_fog(const KSceneView* scene, KVec3 org, KVec3 dir, float tmax, KVec3* radiance, KVec3* throughput) {
-  kuint volume_light_end = scene->light_count - scene->plain_light_tail;
-  for (kuint i = 0u; i < volume_light_end; ++i) {
+  for (kuint i = scene->volume_light_begin; i < scene->volume_light_end; ++i) {
     KGLOBAL const KLight* light = &scene->lights[i];
     if (!(light->flags & K_LIGHT_FOG)) continue;
     float a = k_fog_opacity(k_light_volume_length(light, org, dir, tmax), light->fog_distance);
@@ -78,8 +77,7 @@ KFN int k_light_volume_contains(KGLOBAL const KLight* light, KVec3 p) {
 
 /* Blend lights at an opaque surface point: multiplies *throughput (filter) or adds to *radiance (add). */
 KFN void k_apply_blend_lights(const KSceneView* scene, KVec3 p, KVec3* radiance, KVec3* throughput) {
-  kuint volume_light_end = scene->light_count - scene->plain_light_tail;
-  for (kuint i = 0u; i < volume_light_end; ++i) {
+  for (kuint i = scene->volume_light_begin; i < scene->volume_light_end; ++i) {
     KGLOBAL const KLight* light = &scene->lights[i];
     if (!(light->flags & K_LIGHT_BLEND) || !k_light_volume_contains(light, p)) continue;
     KVec3 factor = k_light_radiance_at(scene, light, p);

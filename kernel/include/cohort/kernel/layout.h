@@ -172,16 +172,17 @@ typedef struct KCamera {
  * the scene's arrays, set by the host from the tracer's scene copy and read only by k_scene_view
  * (scene_view.h). emissive_samples: emissive triangles sampled per hit (0: emitters are found only by
  * bounce rays; 1: one sample, combined with the bounce by MIS). aux_outputs: 1 = the tracer also writes
- * the band's auxiliary planes (aux_outputs.h: depth, normal, albedo, id, motion), 0 = it does not (no cost). */
+ * the band's auxiliary planes (aux_outputs.h: depth, normal, albedo, id, motion), 0 = it does not (no cost).
+ * [volume_light_begin, volume_light_end): the index range holding every fog and blend light
+ * (K_LIGHT_VOLUME_EFFECT), empty when the map has none: rays and hits test only those lights' volumes,
+ * not every light of a map with thousands. */
 typedef struct KFrameParams {
   kuint frame_index;  kuint spp;          kuint max_bounces;   kuint light_samples;
   float firefly_clamp; float spec_boost;  kuint mode;          kuint light_count;
   kuint row_begin;    kuint row_end;      kuint instance_count; kuint tlas_node_count;
   float soft_shadow_scale; float rr_start; kuint light_sampling; kuint light_node_count;
-  kuint emissive_count; kuint emissive_samples; kuint aux_outputs;
-  /* How many lights at the end of the light array are neither fog nor blend lights, so the per-ray
-   * fog and blend loops (fog.h) stop before them; 0 checks every light. Set with the counts. */
-  kuint plain_light_tail;
+  kuint emissive_count; kuint emissive_samples; kuint aux_outputs; kuint volume_light_begin;
+  kuint volume_light_end; kuint pad1;       kuint pad2;        kuint pad3;
 } KFrameParams;
 
 /* One pixel's auxiliary outputs (aux_outputs.h says what each field means). */
@@ -191,8 +192,16 @@ typedef struct KAux {
   float normal[3]; float albedo[3];  kuint id;       kuint pad;
 } KAux;
 
+/* KAux as it travels to the host (core's BandBuffer): 32 bytes, the normal and albedo as IEEE half
+ * floats (their bits). GPU tracers pack it on the device so that only these bytes cross the bus. */
+typedef struct KAuxTexel {
+  float depth; float prev_depth; float motion[2];
+  unsigned short normal[3]; unsigned short albedo[3]; kuint id;
+} KAuxTexel;
+
 #if defined(__cplusplus) && !defined(__CUDACC_RTC__)
 static_assert(sizeof(KAux) == 48, "KAux layout");
+static_assert(sizeof(KAuxTexel) == 32, "KAuxTexel layout");
 static_assert(sizeof(KBvhNode) == 32, "KBvhNode layout");
 static_assert(sizeof(KBlas) == 16, "KBlas layout");
 static_assert(sizeof(KInstance) == 112, "KInstance layout");
@@ -204,7 +213,7 @@ static_assert(sizeof(KLight) == 192, "KLight layout");
 static_assert(sizeof(KCamera) == 64, "KCamera layout");
 static_assert(sizeof(KLightNode) == 48, "KLightNode layout");
 static_assert(sizeof(KEmissiveTriangle) == 48, "KEmissiveTriangle layout");
-static_assert(sizeof(KFrameParams) == 80, "KFrameParams layout");
+static_assert(sizeof(KFrameParams) == 96, "KFrameParams layout");
 #endif
 
 #endif

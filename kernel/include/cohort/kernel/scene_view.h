@@ -24,7 +24,7 @@ typedef struct KSceneView {
   kuint light_count;
   kuint light_node_count;
   kuint emissive_count;
-  kuint plain_light_tail;  /* KFrameParams.plain_light_tail, at most light_count; 0 (unknown) checks every light */
+  kuint volume_light_begin, volume_light_end;  /* fog and blend lights lie in this range (layout.h) */
 } KSceneView;
 
 /* The view over a scene's arrays, wherever they live. The counts come from the frame parameters,
@@ -55,7 +55,8 @@ KFN KSceneView k_scene_view(KGLOBAL const KVertex* vertices, KGLOBAL const KTria
   v.light_count = params->light_count;
   v.light_node_count = params->light_node_count;
   v.emissive_count = params->emissive_count;
-  v.plain_light_tail = params->plain_light_tail < params->light_count ? params->plain_light_tail : params->light_count;
+  v.volume_light_begin = params->volume_light_begin;
+  v.volume_light_end = params->volume_light_end < params->light_count ? params->volume_light_end : params->light_count;
   return v;
 }
 

@@ -19,6 +19,7 @@ class CudaTracer final : public TracerBase {
   explicit CudaTracer(int device);
   ~CudaTracer() override;
   std::string name() const override;
+  bool renders_on_gpu() const override { return true; }
   using core::Tracer::render_band;
   core::BandResult render_band(const core::BandJob& job, core::BandBuffer& target) override;
 

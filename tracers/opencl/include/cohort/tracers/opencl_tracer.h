@@ -24,6 +24,7 @@ class OpenCLTracer : public TracerBase {
   OpenCLTracer& operator=(const OpenCLTracer&) = delete;
 
   std::string name() const override;
+  bool renders_on_gpu() const override;
   using core::Tracer::render_band;
   core::BandResult render_band(const core::BandJob& job, core::BandBuffer& target) override;
 
