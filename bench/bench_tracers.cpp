@@ -258,8 +258,7 @@ nlohmann::json measure_others(const Config& cfg, const LoadedScene& s) {
 
 }  // namespace
 
-int main(int argc, char** argv) {
-  const Config cfg = parse(argc, argv);
+static int run(const Config& cfg) {
   std::vector<std::string> scenes = {cfg.scene};
   if (cfg.large != "none") {
     if (std::filesystem::exists(cfg.large))
@@ -287,4 +286,14 @@ int main(int argc, char** argv) {
     std::printf("wrote %s\n", cfg.json.c_str());
   }
   return 0;
+}
+
+int main(int argc, char** argv) {
+  const Config cfg = parse(argc, argv);
+  try {
+    return run(cfg);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "bench_tracers: %s\n", e.what());
+    return 1;
+  }
 }

@@ -76,6 +76,9 @@ TEST_P(LightKinds, FogOpacityFollowsTheFogTable) {
   scene::Light fog = point_light({0, 0, 0}, glm::vec3(half), fog_colour);
   fog.material = mat;
   s.lights.push_back(fog);
+  // Plain lights after the fog light, too far away to light anything here: the fog loop covers only the
+  // range holding fog and blend lights (KFrameParams.volume_light_begin/end), which must still hold it.
+  for (int i = 0; i < 2; ++i) s.lights.push_back(point_light({5000.0 + 100.0 * i, 5000, 0}, glm::vec3(10), glm::vec3(1)));
 
   const int n = 48;
   const glm::dvec3 eye(0, 0, 300);

@@ -60,14 +60,15 @@ static inline FilterContext filter_context(const KSceneView* scene, kuint ray_ma
   return fc;
 }
 
-// A ray from org along dir up to tmax, visible to every geometry (masks are applied by filter_hit).
-static inline RTCRay make_ray(KVec3 org, KVec3 dir, float tmax) {
+// A ray from org along dir up to tmax that sees the instances sharing a bit with ray_mask (Embree's ray
+// masks where the device has them, filter_hit otherwise).
+static inline RTCRay make_ray(KVec3 org, KVec3 dir, float tmax, kuint ray_mask) {
   RTCRay ray;
   ray.org_x = org.x; ray.org_y = org.y; ray.org_z = org.z;
   ray.dir_x = dir.x; ray.dir_y = dir.y; ray.dir_z = dir.z;
   ray.tnear = 0.0f;
   ray.tfar = tmax;
-  ray.mask = 0xFFFFFFFFu;
+  ray.mask = ray_mask;
   ray.time = 0.0f;
   ray.id = 0;
   ray.flags = 0;
@@ -102,7 +103,7 @@ static inline int k_trace_closest(KTraceCtx* ctx, KVec3 org, KVec3 dir, float tm
   }
   ek::FilterContext fc = ek::filter_context(&ctx->scene, ray_mask, 0);
   RTCRayHit rh;
-  rh.ray = ek::make_ray(org, dir, tmax);
+  rh.ray = ek::make_ray(org, dir, tmax, ray_mask);
   rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
   rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
   rtcIntersect1(ctx->top, &fc.base, &rh);
@@ -120,7 +121,7 @@ static inline int k_trace_occluded(KTraceCtx* ctx, KVec3 org, KVec3 dir, float t
   ++ctx->rays;
   if (ctx->log) ek::log_ray(ctx->log, ek::kShadowRay, org, dir, tmax, ray_mask);
   ek::FilterContext fc = ek::filter_context(&ctx->scene, ray_mask, 1);
-  RTCRay ray = ek::make_ray(org, dir, tmax);
+  RTCRay ray = ek::make_ray(org, dir, tmax, ray_mask);
   rtcOccluded1(ctx->top, &fc.base, &ray);
   return ray.tfar < 0.0f;  // Embree sets tfar to -inf on occlusion
 }

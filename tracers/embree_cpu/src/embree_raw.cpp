@@ -15,7 +15,7 @@ namespace {
 constexpr size_t kStream = 256;
 
 RTCRay to_rtc(const EmbreeRay& r) {
-  return embree_kernel::make_ray(v3(r.org[0], r.org[1], r.org[2]), v3(r.dir[0], r.dir[1], r.dir[2]), r.tmax);
+  return embree_kernel::make_ray(v3(r.org[0], r.org[1], r.org[2]), v3(r.dir[0], r.dir[1], r.dir[2]), r.tmax, r.mask);
 }
 
 uint64_t trace_single(RTCScene top, embree_kernel::FilterContext& fc, const EmbreeRay* rays, size_t n, bool occlusion) {
@@ -42,7 +42,7 @@ void fill_lane(RTCRay8& p, int k, const EmbreeRay& r) {
   p.dir_x[k] = r.dir[0]; p.dir_y[k] = r.dir[1]; p.dir_z[k] = r.dir[2];
   p.tnear[k] = 0.0f;
   p.tfar[k] = r.tmax;
-  p.mask[k] = 0xFFFFFFFFu;
+  p.mask[k] = r.mask;
   p.time[k] = 0.0f;
   p.id[k] = static_cast<unsigned>(k);
   p.flags[k] = 0u;

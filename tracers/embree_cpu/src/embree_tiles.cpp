@@ -31,7 +31,7 @@ void trace_camera_packets(embree_kernel::TraceCtx& ctx, KVec3 org, int n, Arena&
       rh.ray.dir_x[k] = a.dirs[i].x; rh.ray.dir_y[k] = a.dirs[i].y; rh.ray.dir_z[k] = a.dirs[i].z;
       rh.ray.tnear[k] = 0.0f;
       rh.ray.tfar[k] = K_INF;
-      rh.ray.mask[k] = 0xFFFFFFFFu;
+      rh.ray.mask[k] = K_RAY_PRIMARY;
       rh.ray.time[k] = 0.0f;
       rh.ray.id[k] = static_cast<unsigned>(k);
       rh.ray.flags[k] = 0u;

@@ -12,6 +12,7 @@
 #include <tbb/global_control.h>
 #include <tbb/parallel_for.h>
 
+#include "embree_filters.h"
 #include "embree_kernel.h"
 #include "embree_raw.h"
 #include "embree_skinned.h"
@@ -87,6 +88,9 @@ struct EmbreeTracer::Impl {
   RTCDevice device = nullptr;
   RTCScene top = nullptr;
   std::vector<RTCScene> blas_scenes;
+  bool ray_masks = false;            // the device applies instance masks itself (rtcSetGeometryMask)
+  std::vector<char> passing_materials;  // per BLAS: embree_filters::blases_with_passing_materials
+  std::vector<char> filtered;           // per BLAS: whether its geometry has filter_hit attached
   std::unique_ptr<tbb::global_control> thread_limit;
   uint64_t rays_traced = 0;
   bool x86_64_v3 = embree_tiles::has_x86_64_v3();
@@ -117,9 +121,32 @@ struct EmbreeTracer::Impl {
     blas_scenes.clear();
   }
 
+  static void set_filter(RTCGeometry g, bool on) {
+    rtcSetGeometryIntersectFilterFunction(g, on ? embree_kernel::filter_hit : nullptr);
+    rtcSetGeometryOccludedFilterFunction(g, on ? embree_kernel::filter_hit : nullptr);
+  }
+
+  // Attaches or detaches filter_hit where a BLAS's need changed (materials or overrides changed).
+  // Returns whether any BLAS changed: the instance scene must then be rebuilt.
+  bool update_filters(const std::vector<char>& needs) {
+    bool changed = false;
+    for (size_t b = 0; b < blas_scenes.size() && b < needs.size(); ++b) {
+      if (filtered[b] == needs[b]) continue;
+      filtered[b] = needs[b];
+      RTCGeometry g = rtcGetGeometry(blas_scenes[b], 0);
+      if (!g) continue;
+      set_filter(g, needs[b] != 0);
+      rtcCommitGeometry(g);
+      rtcCommitScene(blas_scenes[b]);
+      changed = true;
+    }
+    return changed;
+  }
+
   // One Embree scene per KBlas, sharing the TracerScene's vertex and triangle arrays (no copies).
-  void build_blases(const commit::TracerScene& scene) {
+  void build_blases(const commit::TracerScene& scene, const std::vector<char>& needs_filter) {
     release_blases();
+    filtered = needs_filter;
     for (size_t index = 0; index < scene.blases.size(); ++index) {
       const KBlas& b = scene.blases[index];
       RTCScene s = rtcNewScene(device);
@@ -129,8 +156,7 @@ struct EmbreeTracer::Impl {
                                    sizeof(KVertex), scene.vertices.size());
         rtcSetSharedGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, scene.triangles.data(),
                                    size_t(b.tri_offset) * sizeof(KTriangle), sizeof(KTriangle), b.tri_count);
-        rtcSetGeometryIntersectFilterFunction(g, embree_kernel::filter_hit);
-        rtcSetGeometryOccludedFilterFunction(g, embree_kernel::filter_hit);
+        set_filter(g, needs_filter[index] != 0);
         if (embree_skinned::is_skinned(scene, uint32_t(index))) embree_skinned::prepare(s, g);
         rtcCommitGeometry(g);
         rtcAttachGeometryByID(s, g, 0);
@@ -153,6 +179,7 @@ struct EmbreeTracer::Impl {
       RTCGeometry g = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_INSTANCE);
       rtcSetGeometryInstancedScene(g, blas_scenes[inst.blas]);
       rtcSetGeometryTransform(g, 0, RTC_FORMAT_FLOAT3X4_ROW_MAJOR, inst.object_to_world);
+      rtcSetGeometryMask(g, ray_masks ? inst.mask : 0xFFFFFFFFu);
       rtcCommitGeometry(g);
       rtcAttachGeometryByID(top, g, static_cast<unsigned>(i));
       rtcReleaseGeometry(g);
@@ -164,6 +191,7 @@ struct EmbreeTracer::Impl {
 EmbreeTracer::EmbreeTracer(int threads) : impl_(std::make_unique<Impl>()) {
   impl_->device = rtcNewDevice(nullptr);
   if (!impl_->device) throw std::runtime_error("EmbreeTracer: rtcNewDevice failed");
+  impl_->ray_masks = rtcGetDeviceProperty(impl_->device, RTC_DEVICE_PROPERTY_RAY_MASK_SUPPORTED) != 0;
   if (threads > 0)
     impl_->thread_limit =
         std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism, size_t(threads));
@@ -172,13 +200,23 @@ EmbreeTracer::EmbreeTracer(int threads) : impl_(std::make_unique<Impl>()) {
 EmbreeTracer::~EmbreeTracer() = default;
 
 void EmbreeTracer::upload(const commit::ChangeSet& changes) {
-  if (changes.full_resync || changes.geometry) {
-    impl_->build_blases(scene());
+  const bool rebuild = changes.full_resync || changes.geometry;
+  if (rebuild || changes.materials)
+    impl_->passing_materials = embree_filters::blases_with_passing_materials(scene());
+  if (rebuild) {
+    impl_->build_blases(scene(),
+                        embree_filters::blases_needing_filters(scene(), impl_->passing_materials, impl_->ray_masks));
     check_device(impl_->device, "building the BLAS scenes");
     impl_->build_top(scene());
-  } else if (changes.instances || changes.tlas || !changes.posed_skins.empty() || !impl_->top) {
-    embree_skinned::refit(scene(), changes.posed_skins, impl_->blas_scenes);
-    impl_->build_top(scene());
+  } else {
+    bool top_changed = changes.instances || changes.tlas || !changes.posed_skins.empty() || !impl_->top;
+    if (changes.materials || changes.instances)
+      top_changed |= impl_->update_filters(
+          embree_filters::blases_needing_filters(scene(), impl_->passing_materials, impl_->ray_masks));
+    if (top_changed) {
+      embree_skinned::refit(scene(), changes.posed_skins, impl_->blas_scenes);
+      impl_->build_top(scene());
+    }
   }
   check_device(impl_->device, "building the instance scene");
 }
