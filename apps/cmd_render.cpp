@@ -15,6 +15,7 @@
 #include "cohort/core/frame_timeline.h"
 #include "cohort/core/gpu_scene.h"
 #include "cohort/core/convergence.h"
+#include "cohort/core/atrous_filter.h"
 #include "cohort/core/reprojection.h"
 #include "cohort/core/oidn_denoiser.h"
 #include "cohort/core/frame_defaults.h"
@@ -61,6 +62,7 @@ struct RenderArgs {
   std::string trace;
   std::string denoise = "none";
   std::string denoise_quality = "high";
+  int atrous_passes = 0;  // 0: from the image height (core/atrous_filter.h)
   std::string band_format = "rgb16f";
   bool frames_given = false;
 };
@@ -150,7 +152,11 @@ int run_render(const RenderArgs& a) {
   // The denoiser filters what is shown and written, never the accumulated history.
   std::unique_ptr<core::OidnDenoiser> denoiser;
   core::FrameBuffer denoised;
-  if (a.denoise != "none") {
+  const bool atrous = a.denoise == "atrous";
+  core::AtrousOptions atrous_options;
+  atrous_options.passes = a.atrous_passes > 0 ? a.atrous_passes : core::atrous_passes_for_height(a.height);
+  core::AtrousFilter atrous_filter(atrous_options);
+  if (a.denoise != "none" && !atrous) {
     denoiser = core::OidnDenoiser::open(core::parse_oidn_device(a.denoise == "oidn-cuda" ? "cuda" : "cpu"),
                                          core::parse_oidn_quality(a.denoise_quality));
     spdlog::info("denoising with Open Image Denoise ({} device, {})", core::oidn_device_name(denoiser->device()),
@@ -180,7 +186,11 @@ int run_render(const RenderArgs& a) {
     const core::FrameBuffer* shown_image =
         a.no_convergence ? &frame : reproject ? &reprojection.image() : &convergence.image();
     const bool writes_frame = !(a.write == "last" && f + 1 < a.frames && !player);
-    if (denoiser && writes_frame) {
+    if (atrous && !gbuffer.empty()) {  // every frame: it is the real-time filter
+      core::ScopedStage denoising(stats.stages, core::kCoreTrack, "denoise");
+      atrous_filter.apply(*shown_image, gbuffer, denoised);
+      shown_image = &denoised;
+    } else if (denoiser && writes_frame) {
       core::ScopedStage denoising(stats.stages, core::kCoreTrack, "denoise");
       core::DenoiseGuides guides;
       if (!gbuffer.empty()) {  // the aux planes guide the filter where the frame has them
@@ -255,7 +265,7 @@ int run_render(const RenderArgs& a) {
     p.spec_boost = a.spec_boost;
     p.mode = modes().at(a.mode);
     p.soft_shadow_scale = a.soft_shadow_scale;
-    if (reproject) {
+    if (reproject || atrous) {
       p.aux_outputs = 1u;
       job.previous_camera = previous_camera;
       previous_camera = job.camera;
@@ -343,10 +353,16 @@ void add_render_command(CLI::App& app, int& exit_code) {
         }
       });
   cmd->add_option("--denoise", a->denoise,
-                  "denoise the shown frame: none, oidn (Intel Open Image Denoise on the CPU) or oidn-cuda (on an "
-                  "NVIDIA GPU); tools/fetch_oidn.sh installs the library")
+                  "denoise the shown frame: none, atrous (the real-time edge-aware a-trous filter of the portable "
+                  "kernel, every frame), oidn (Intel Open Image Denoise on the CPU) or oidn-cuda (on an NVIDIA GPU); "
+                  "tools/fetch_oidn.sh installs the library")
       ->capture_default_str()
-      ->check(CLI::IsMember({"none", "oidn", "oidn-cuda"}));
+      ->check(CLI::IsMember({"none", "atrous", "oidn", "oidn-cuda"}));
+  cmd->add_option("--atrous-passes", a->atrous_passes,
+                  "passes of --denoise atrous (steps 1, 2, 4, ...: 1 pass is a 5x5 filter, 3 a 29-pixel one); "
+                  "0 picks them from the image height (1 up to 360 rows, 3 at 1080)")
+      ->capture_default_str()
+      ->check(CLI::Range(0, 6));
   cmd->add_option("--denoise-quality", a->denoise_quality,
                   "Open Image Denoise's filter quality: high, balanced or fast (several times quicker)")
       ->capture_default_str()
