@@ -15,8 +15,7 @@
 #include "cohort/core/frame_timeline.h"
 #include "cohort/core/gpu_scene.h"
 #include "cohort/core/convergence.h"
-#include "cohort/core/atrous_filter.h"
-#include "cohort/core/reprojection.h"
+#include "cohort/core/frame_post.h"
 #include "cohort/core/oidn_denoiser.h"
 #include "cohort/core/frame_defaults.h"
 #include "cohort/core/frame_pipeline.h"
@@ -63,6 +62,7 @@ struct RenderArgs {
   std::string denoise = "none";
   std::string denoise_quality = "high";
   int atrous_passes = 0;  // 0: from the image height (core/atrous_filter.h)
+  std::string post_on = "auto";
   std::string band_format = "rgb16f";
   bool frames_given = false;
 };
@@ -140,7 +140,6 @@ int run_render(const RenderArgs& a) {
   const bool oiio = core::have_image_library();
   nlohmann::json stats_json = nlohmann::json::array();
   core::AdaptiveConvergence convergence;
-  core::TemporalReprojection reprojection;
   const bool reproject = convergence_mode == "reproject" && !a.no_convergence;
   core::FrameBuffer albedo_guide, normal_guide;
   KCamera previous_camera{};  // none yet: the first frame is its own previous
@@ -153,9 +152,20 @@ int run_render(const RenderArgs& a) {
   std::unique_ptr<core::OidnDenoiser> denoiser;
   core::FrameBuffer denoised;
   const bool atrous = a.denoise == "atrous";
-  core::AtrousOptions atrous_options;
-  atrous_options.passes = a.atrous_passes > 0 ? a.atrous_passes : core::atrous_passes_for_height(a.height);
-  core::AtrousFilter atrous_filter(atrous_options);
+  // Reprojection and the a-trous filter run together, on the host or on a GPU (core/frame_post.h).
+  std::unique_ptr<core::FramePost> post;
+  if (reproject || atrous) {
+    core::FramePostOptions post_options;
+    post_options.reproject = reproject;
+    post_options.atrous = atrous;
+    post_options.atrous_options.passes =
+        a.atrous_passes > 0 ? a.atrous_passes : core::atrous_passes_for_height(a.height);
+    const std::string place =
+        a.post_on == "auto" ? tracers::auto_frame_post_place(tracers::parse_tracer_list(a.tracers)) : a.post_on;
+    post = tracers::make_frame_post(place, post_options);
+    spdlog::info("{}{}{} on {}", reproject ? "reprojection" : "", reproject && atrous ? " and " : "",
+                 atrous ? "the a-trous filter" : "", post->where());
+  }
   if (a.denoise != "none" && !atrous) {
     denoiser = core::OidnDenoiser::open(core::parse_oidn_device(a.denoise == "oidn-cuda" ? "cuda" : "cpu"),
                                          core::parse_oidn_quality(a.denoise_quality));
@@ -175,21 +185,21 @@ int run_render(const RenderArgs& a) {
     // Adaptive convergence: a still camera accumulates every frame; motion raises f (see convergence.h).
     // Reprojection (--convergence reproject): per-pixel history through the frame's motion vectors.
     const core::GBuffer& gbuffer = pipeline.gbuffer();
-    if (reproject) {
-      core::ScopedStage blending(stats.stages, core::kCoreTrack, "convergence");
-      reprojection.accumulate(frame, gbuffer);
-      stats.convergence_f = 1.0 / std::max(reprojection.mean_history_length(), 1.0);
-    } else if (!a.no_convergence) {
+    if (!reproject && !a.no_convergence) {
       core::ScopedStage blending(stats.stages, core::kCoreTrack, "convergence");
       stats.convergence_f = convergence.accumulate(done.job.camera, frame);
     }
-    const core::FrameBuffer* shown_image =
-        a.no_convergence ? &frame : reproject ? &reprojection.image() : &convergence.image();
+    const core::FrameBuffer* shown_image = a.no_convergence ? &frame : &convergence.image();
+    if (post && !gbuffer.empty()) {
+      // One stage: on a GPU the two steps share one upload and one download.
+      core::ScopedStage posting(stats.stages, core::kCoreTrack,
+                                !atrous ? "convergence" : reproject ? "convergence+denoise" : "denoise");
+      post->process(reproject ? frame : *shown_image, gbuffer);
+      if (reproject) stats.convergence_f = 1.0 / std::max(post->mean_history_length(), 1.0);
+    }
     const bool writes_frame = !(a.write == "last" && f + 1 < a.frames && !player);
-    if (atrous && !gbuffer.empty()) {  // every frame: it is the real-time filter
-      core::ScopedStage denoising(stats.stages, core::kCoreTrack, "denoise");
-      atrous_filter.apply(*shown_image, gbuffer, denoised);
-      shown_image = &denoised;
+    if (post && !gbuffer.empty()) {
+      shown_image = &post->image();
     } else if (denoiser && writes_frame) {
       core::ScopedStage denoising(stats.stages, core::kCoreTrack, "denoise");
       core::DenoiseGuides guides;
@@ -363,6 +373,11 @@ void add_render_command(CLI::App& app, int& exit_code) {
                   "0 picks them from the image height (1 up to 360 rows, 3 at 1080)")
       ->capture_default_str()
       ->check(CLI::Range(0, 6));
+  cmd->add_option("--post-on", a->post_on,
+                  "where reprojection and the a-trous filter run: host (the CPU's threads), cuda:N (a GPU; the "
+                  "frame and its G-buffer cross the bus each frame) or auto (the first CUDA tracer's GPU, else the "
+                  "host)")
+      ->capture_default_str();
   cmd->add_option("--denoise-quality", a->denoise_quality,
                   "Open Image Denoise's filter quality: high, balanced or fast (several times quicker)")
       ->capture_default_str()

@@ -12,11 +12,9 @@ namespace cohort::core {
 namespace {
 
 constexpr size_t kRowsPerTask = 8;
-constexpr float kLeastAlbedo = 0.01f;  // black surfaces: divide by this, multiply back by the same
+}  // namespace
 
-float demodulator(float albedo) { return std::max(albedo, kLeastAlbedo); }
-
-int normal_squarings(int power) {
+int atrous_normal_squarings(int power) {
   int squarings = 0;
   while ((1 << squarings) < power && squarings < 30) ++squarings;
   if (power < 1 || (1 << squarings) != power)
@@ -25,7 +23,6 @@ int normal_squarings(int power) {
   return squarings;
 }
 
-}  // namespace
 
 int atrous_passes_for_height(int height) {
   int passes = 1;
@@ -43,12 +40,12 @@ void AtrousFilter::apply(const FrameBuffer& frame, const GBuffer& gbuffer, Frame
   HostThreads& threads = HostThreads::shared();
   threads.for_ranges(pixels, 16384, [&](size_t begin, size_t end) {
     for (size_t p = begin; p < end; ++p)
-      for (int k = 0; k < 3; ++k) ping_.rgba[4 * p + k] = frame.rgba[4 * p + k] / demodulator(gbuffer.albedo[3 * p + k]);
+      k_atrous_modulate(frame.rgba.data(), gbuffer.albedo.data(), ping_.rgba.data(), static_cast<kint>(p), 0);
   });
   KAtrousParams params{};
   params.width = width;
   params.height = height;
-  params.normal_squarings = normal_squarings(options_.normal_power);
+  params.normal_squarings = atrous_normal_squarings(options_.normal_power);
   params.depth_sigma = options_.depth_sigma;
   params.color_sigma = options_.color_sigma;
   FrameBuffer* from = &ping_;
@@ -63,10 +60,8 @@ void AtrousFilter::apply(const FrameBuffer& frame, const GBuffer& gbuffer, Frame
     std::swap(from, to);
   }
   threads.for_ranges(pixels, 16384, [&](size_t begin, size_t end) {
-    for (size_t p = begin; p < end; ++p) {
-      for (int k = 0; k < 3; ++k) out.rgba[4 * p + k] = from->rgba[4 * p + k] * demodulator(gbuffer.albedo[3 * p + k]);
-      out.rgba[4 * p + 3] = 1.0f;
-    }
+    for (size_t p = begin; p < end; ++p)
+      k_atrous_modulate(from->rgba.data(), gbuffer.albedo.data(), out.rgba.data(), static_cast<kint>(p), 1);
   });
 }
 

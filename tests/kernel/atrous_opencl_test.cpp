@@ -1,5 +1,6 @@
 // kernel/atrous.h compiled as OpenCL C 1.2 from its own text and run on the first OpenCL device: one
 // filter pass must equal the same header compiled as C++ (the host's AtrousFilter runs that one).
+// kernel/reproject.h is built into the same program, so a construct OpenCL C refuses fails here too.
 #include <cmath>
 #include <random>
 #include <string>
@@ -21,6 +22,22 @@ __kernel void atrous(__global const float* in_rgba, __global float* out_rgba, __
                      __global const float* normal, KAtrousParams params) {
   kint x = (kint)get_global_id(0), y = (kint)get_global_id(1);
   if (x < params.width && y < params.height) k_atrous_pixel(in_rgba, out_rgba, depth, normal, &params, x, y);
+}
+/* kernel/reproject.h goes through the same OpenCL C compiler here (its planes travel in private structs
+   of __global pointers, which OpenCL C 1.2 allows inside a kernel but not as arguments). */
+#include "cohort/kernel/reproject.h"
+__kernel void reproject(KReprojectParams params, __global const float* rgba, __global float* ycocgw,
+                        __global const float* depth, __global const float* prev_depth, __global const float* motion,
+                        __global const float* normal, __global const uint* id, __global const float* h_rgba,
+                        __global const float* h_length, __global const float* h_depth, __global const float* h_normal,
+                        __global const uint* h_id, __global float* n_rgba, __global float* n_length,
+                        __global float* n_depth, __global float* n_normal, __global uint* n_id) {
+  kint x = (kint)get_global_id(0), y = (kint)get_global_id(1);
+  if (x >= params.width || y >= params.height) return;
+  KReprojectFresh fresh = {rgba, ycocgw, depth, prev_depth, motion, normal, id};
+  KReprojectHistory history = {h_rgba, h_length, h_depth, h_normal, h_id};
+  KReprojectState next = {n_rgba, n_length, n_depth, n_normal, n_id};
+  k_reproject_pixel(&params, &fresh, &history, &next, x, y);
 }
 )CL";
 
@@ -54,7 +71,7 @@ TEST(AtrousOpenCL, APassMatchesTheCppBuildOfTheSameHeader) {
     clGetProgramBuildInfo(program, device, CL_PROGRAM_BUILD_LOG, 0, nullptr, &size);
     std::string log(size, '\0');
     clGetProgramBuildInfo(program, device, CL_PROGRAM_BUILD_LOG, size, log.data(), nullptr);
-    FAIL() << "atrous.h does not build as OpenCL C:\n" << log;
+    FAIL() << "atrous.h or reproject.h does not build as OpenCL C:\n" << log;
   }
   cl_kernel kernel = clCreateKernel(program, "atrous", &err);
   ASSERT_EQ(err, CL_SUCCESS);

@@ -22,6 +22,9 @@ struct AtrousOptions {
 // that blur lighting detail that FLIP sees, and reprojected frames need little spatial help.
 int atrous_passes_for_height(int height);
 
+// log2 of the normal stop's power, which must be a power of two (std::invalid_argument otherwise).
+int atrous_normal_squarings(int power);
+
 class AtrousFilter {
  public:
   explicit AtrousFilter(AtrousOptions options = {}) : options_(options) {}

@@ -20,8 +20,16 @@ typedef struct KAtrousParams {
   float depth_sigma; float color_sigma; float pad0; float pad1;
 } KAtrousParams;
 
-KFN int k_finite3(float r, float g, float b) {
-  return r == r && g == g && b == b && k_fabs(r) <= 3.0e38f && k_fabs(g) <= 3.0e38f && k_fabs(b) <= 3.0e38f;
+/* Illumination = colour / albedo before the passes, colour = illumination * albedo after (multiply = 1),
+ * so textures stay sharp; black surfaces divide by the least albedo and multiply back by the same. */
+#define K_ATROUS_LEAST_ALBEDO 0.01f
+KFN void k_atrous_modulate(KGLOBAL const float* in_rgba, KGLOBAL const float* albedo, KGLOBAL float* out_rgba, kint p,
+                           int multiply) {
+  for (int k = 0; k < 3; ++k) {
+    float a = k_fmax(albedo[3 * p + k], K_ATROUS_LEAST_ALBEDO);
+    out_rgba[4 * p + k] = multiply ? in_rgba[4 * p + k] * a : in_rgba[4 * p + k] / a;
+  }
+  out_rgba[4 * p + 3] = 1.0f;
 }
 
 KFN float k_atrous_luminance(KGLOBAL const float* c) { return 0.2126f * c[0] + 0.7152f * c[1] + 0.0722f * c[2]; }
