@@ -8,8 +8,9 @@
 #                              registers NVIDIA's OpenCL, runs the GPU tests and benchmarks, writes
 #                              results (logs, JSON, PPM frames) to $OUT
 #   tools/gpu_run.sh frametimes  there: only the end-to-end frame times (large map 1080p generated there,
-#                              test map 720p; cuda:0, 1 spp, NEE + 1 bounce; with and without emissive NEE,
-#                              reprojection and Brigade's blend; per-stage medians)
+#                              test map 720p; cuda:0, 1 spp, NEE + 1 bounce; reprojection on the GPU with and
+#                              without the a-trous filter, on the host, and Brigade's blend; per-stage medians;
+#                              the last frames go to $OUT/frames)
 #
 # The binaries and libraries travel compressed (.gpu/payload.tar.xz, ~11 MB instead of ~60 MB): the device
 # tool carries at most 64 MiB with the working tree.
@@ -49,18 +50,19 @@ case "${1:-}" in
     nvidia-smi --query-gpu=index,name --format=csv,noheader
     [ -f /tmp/largemap.cpk ] || { python3 tools/gen_testmap.py --large --out /tmp/largemap >/dev/null &&
       "$stage/bin/cohort" pack /tmp/largemap/maps/largemap.map --out /tmp/largemap.cpk | tail -n 1; }
-    # Emissive NEE on and off with the default convergence, then the paper's blend for the host's share.
-    for variant in "1 reproject" "0 reproject" "1 brigade"; do
-      read -r emissive convergence <<<"$variant"
+    # Reprojection on the GPU (alone, then with the a-trous filter) and on the host, then the paper's blend.
+    for variant in "reproject cuda:0 none" "reproject cuda:0 atrous" "reproject host none" "brigade host none"; do
+      read -r convergence post denoise <<<"$variant"
       for map in large test; do
         if [ $map = large ]; then args=(/tmp/largemap.cpk --width 1920 --height 1080 --camera 1690 300 80 5 -12)
         else args=("$stage/testmap.cpk" --width 1280 --height 720); fi
-        run=/tmp/ft_$map${emissive}_$convergence
+        run=/tmp/ft_${map}_${convergence}_${post}_$denoise
         "$stage/bin/cohort" render "${args[@]}" --tracers "${COHORT_GPU_TRACERS:-cuda:0}" --spp 1 --bounces 1 \
-          --emissive-samples $emissive --convergence $convergence --frames 60 --camera-path spin-slow \
+          --convergence $convergence --post-on $post --denoise $denoise --frames 60 --camera-path spin-slow \
           --write last --out $run >/dev/null
-        echo "== $map map, emissive samples $emissive, convergence $convergence"
+        echo "== $map map, convergence $convergence, post on $post, denoise $denoise"
         python3 tools/frame_times.py $run/stats.json --skip 10
+        [ -n "${OUT:-}" ] && [ $map = test ] && mkdir -p "$OUT/frames" && cp $run/frame_0059.* "$OUT/frames/${map}_${convergence}_${post}_$denoise.$(ls $run/frame_0059.* | head -n1 | sed 's/.*\.//')" 2>/dev/null || true
       done
     done
     ;;
