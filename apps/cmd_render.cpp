@@ -91,7 +91,9 @@ int run_render(const RenderArgs& a) {
   std::vector<std::unique_ptr<core::Tracer>> tracers = tracers::make_tracers(a.tracers);
   bool any_gpu_tracer = false;
   for (const auto& tracer : tracers) any_gpu_tracer = any_gpu_tracer || tracer->renders_on_gpu();
-  const std::string convergence_mode = resolve_convergence(a.convergence, any_gpu_tracer);
+  const std::string post_place =
+      a.post_on == "auto" ? tracers::auto_frame_post_place(tracers::parse_tracer_list(a.tracers)) : a.post_on;
+  const std::string convergence_mode = resolve_convergence(a.convergence, any_gpu_tracer, post_place);
   core::RendererOptions options;
   options.balancer = a.balancer;
   options.band_format = a.band_format == "rgba32f" ? core::BandFormat::rgba32f : core::BandFormat::rgb16f;
@@ -160,9 +162,7 @@ int run_render(const RenderArgs& a) {
     post_options.atrous = atrous;
     post_options.atrous_options.passes =
         a.atrous_passes > 0 ? a.atrous_passes : core::atrous_passes_for_height(a.height);
-    const std::string place =
-        a.post_on == "auto" ? tracers::auto_frame_post_place(tracers::parse_tracer_list(a.tracers)) : a.post_on;
-    post = tracers::make_frame_post(place, post_options);
+    post = tracers::make_frame_post(post_place, post_options);
     spdlog::info("{}{}{} on {}", reproject ? "reprojection" : "", reproject && atrous ? " and " : "",
                  atrous ? "the a-trous filter" : "", post->where());
   }
@@ -385,9 +385,9 @@ void add_render_command(CLI::App& app, int& exit_code) {
   cmd->add_option("--convergence", a->convergence,
                   "how frames accumulate: reproject (per-pixel history through motion vectors, with disocclusion "
                   "tests and neighbourhood clamping; the tracers also write depth, normal, albedo, id and motion) "
-                  "or brigade (whole-frame blend, f from camera motion; the paper's); auto: reproject unless a "
-                  "tracer renders on a GPU, where the host's reprojection would set the frame rate "
-                  "(docs/denoising.md)")
+                  "or brigade (whole-frame blend, f from camera motion; the paper's); auto: reproject, except when "
+                  "GPU tracers render and the reprojection would run on the host (no CUDA GPU for --post-on), "
+                  "where it would set the frame rate (docs/denoising.md)")
       ->capture_default_str()
       ->check(CLI::IsMember({"auto", "brigade", "reproject"}));
   cmd->add_flag("--no-convergence", a->no_convergence,

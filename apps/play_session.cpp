@@ -79,6 +79,7 @@ struct PlaySession::State {
   kuint last_mode = K_MODE_PATH;
   std::string map_name;
   bool any_gpu_tracer = false;
+  std::string post_place;
 };
 
 PlaySession::PlaySession(const SessionOptions& options) {
@@ -113,7 +114,8 @@ PlaySession::PlaySession(const SessionOptions& options) {
   s.renderer->submit_commit(commit::CommitBuffer::full(initial_scene, 0));
   s.pipeline = std::make_unique<core::FramePipeline>(*s.renderer);
   core::FramePostOptions post_options;  // reprojection alone: the HUD view is not filtered
-  s.reprojection = tracers::make_frame_post(tracers::auto_frame_post_place(started), post_options);
+  s.post_place = tracers::auto_frame_post_place(started);
+  s.reprojection = tracers::make_frame_post(s.post_place, post_options);
 
   if (options.scenario) {
     try {
@@ -239,6 +241,7 @@ bool PlaySession::scenario_running() const { return state_->scenario != nullptr;
 const std::string& PlaySession::map_name() const { return state_->map_name; }
 
 bool PlaySession::any_gpu_tracer() const { return state_->any_gpu_tracer; }
+const std::string& PlaySession::frame_post_place() const { return state_->post_place; }
 
 std::vector<std::string> PlaySession::tracer_names() const {
   std::vector<std::string> names;
