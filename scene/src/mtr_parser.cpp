@@ -218,7 +218,11 @@ class MaterialReader {
     } else if (k == "wobblesky") {
       stage.texgen = TexGen::WobbleSky;
       const RegisterInputs at_load;
-      for (float& value : stage.wobble_sky) value = parse_expression(lex, context).evaluate(at_load);
+      stage.registers.wobble_sky.clear();
+      for (float& value : stage.wobble_sky) {
+        stage.registers.wobble_sky.push_back(parse_expression(lex, context));
+        value = stage.registers.wobble_sky.back().evaluate(at_load);
+      }
     } else if (k == "normal") {
       stage.texgen = TexGen::Normal;
     } else if (k == "reflect") {

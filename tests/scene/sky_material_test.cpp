@@ -11,6 +11,7 @@
 #include "cohort/scene/image_library.h"
 #include "cohort/scene/material_build.h"
 #include "cohort/scene/material_file.h"
+#include "cohort/scene/material_registers.h"
 
 using namespace cohort::scene;
 namespace fs = std::filesystem;
@@ -236,6 +237,20 @@ TEST(SkyMaterials, SkyStagesMakeSkyMaterialsAndReflectionsDoNot) {
     EXPECT_NEAR(wobble.sky_axis[1][k], glm::vec3(0, 1, 0)[k], 1e-6f);
     EXPECT_NEAR(wobble.sky_axis[0][k], glm::vec3(c, 0, -s)[k], 1e-6f);
   }
+
+  // The wobble follows the frame's time: the registers are kept and evaluate to the engine's axes.
+  ASSERT_TRUE(wobble.registers);
+  EXPECT_NE(wobble.registers->depends & kDependsTime, 0u);
+  RegisterInputs at_ten;
+  at_ten.time = 10.0f;
+  Material wobble_at_ten;
+  evaluate_material(wobble, at_ten, wobble_at_ten);
+  const glm::mat3 want = wobble_sky_axes(30.0f, 1.0f, 2.0f, 10.0f);
+  for (int col = 0; col < 3; ++col)
+    for (int k = 0; k < 3; ++k) EXPECT_NEAR(wobble_at_ten.sky_axis[col][k], want[col][k], 1e-6f);
+  EXPECT_GT(glm::length(wobble_at_ten.sky_axis[2] - wobble.sky_axis[2]), 0.1f) << "Z' moved in 10 s at 1 turn/min";
+  EXPECT_FALSE(build_material(*find(f, "textures/sky/camera"), fx.library, false).registers)
+      << "a skybox with a constant colour does not animate";
 
   // A cube map with texgen reflect on a lit surface is an environment reflection, not a sky.
   Material glass = build_material(*find(f, "textures/glass/reflective"), fx.library, false);

@@ -31,7 +31,7 @@ struct MaterialStage {
   CubeMapKind cube_kind = CubeMapKind::None;   // cubeMap / cameraCubeMap (cube_map.h)
   std::string cube_map;             // the faces' common name (before _px / _forward ...)
   TexGen texgen = TexGen::Explicit;
-  float wobble_sky[3] = {0, 0, 0};  // texgen wobbleSky: degrees, speed, rotation speed, at time 0
+  float wobble_sky[3] = {0, 0, 0};  // texgen wobbleSky: degrees, speed, rotation speed, at time 0 (registers: the expressions)
   // color, alpha_ref and tex_transform: the registers evaluated at time 0 with the world's parms.
   glm::vec4 color{1.0f};
   bool vertex_color = false;
