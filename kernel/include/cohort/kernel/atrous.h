@@ -65,6 +65,7 @@ KFN void k_atrous_pixel(KGLOBAL const float* in_rgba, KGLOBAL float* out_rgba, K
           KVec3 nq = v3(normal[3 * q], normal[3 * q + 1], normal[3 * q + 2]);
           float cosine = k_fmax(v3_dot(np, nq), 0.0f);
           for (kint s = 0; s < p->normal_squarings; ++s) cosine *= cosine;
+          if (cosine < 1e-4f) continue; /* across an edge; and the squarings would reach subnormals */
           w *= cosine;
           exponent += k_fabs(zp - zq) * inv_depth_scale;
         }
@@ -72,7 +73,8 @@ KFN void k_atrous_pixel(KGLOBAL const float* in_rgba, KGLOBAL float* out_rgba, K
           float lq = k_atrous_luminance(cq);
           exponent += k_fabs(lp - lq) / (p->color_sigma * 0.5f * (k_fabs(lp) + k_fabs(lq)) + 1e-4f);
         }
-        if (!(w > 0.0f)) continue;
+        if (!(w > 0.0f) || exponent > 12.0f) continue; /* weight below 6e-6 of the stops' best: left out, and
+                                                          so are exp's subnormal results, slow on CPUs */
         w *= k_exp(-exponent);
       }
       if (!(w > 0.0f)) continue;
