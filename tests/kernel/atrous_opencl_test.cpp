@@ -12,6 +12,8 @@
 
 #ifdef COHORT_HAVE_OPENCL
 #include <CL/cl.h>
+
+#include "opencl_kernel_program.h"
 #endif
 
 namespace {
@@ -47,32 +49,13 @@ TEST(AtrousOpenCL, APassMatchesTheCppBuildOfTheSameHeader) {
 #ifndef COHORT_HAVE_OPENCL
   GTEST_SKIP() << "built without OpenCL (COHORT_WITH_OPENCL=OFF)";
 #else
-  cl_uint platform_count = 0;
-  if (clGetPlatformIDs(0, nullptr, &platform_count) != CL_SUCCESS || platform_count == 0)
-    GTEST_SKIP() << "no OpenCL platform on this machine (install pocl-opencl-icd for a CPU one)";
-  std::vector<cl_platform_id> platforms(platform_count);
-  clGetPlatformIDs(platform_count, platforms.data(), nullptr);
-  cl_device_id device = nullptr;
-  for (cl_platform_id p : platforms) {
-    if (clGetDeviceIDs(p, CL_DEVICE_TYPE_ALL, 1, &device, nullptr) == CL_SUCCESS) break;
-    device = nullptr;
-  }
-  if (!device) GTEST_SKIP() << "OpenCL platforms exist but none has a device";
+  OpenCLKernelProgram cl(kProgram);
+  if (!cl.skip.empty()) GTEST_SKIP() << cl.skip;
+  ASSERT_TRUE(cl.problem.empty()) << "atrous.h or reproject.h: " << cl.problem;
+  cl_context context = cl.context;
+  cl_command_queue queue = cl.queue;
+  cl_program program = cl.program;
   cl_int err = CL_SUCCESS;
-  cl_context context = clCreateContext(nullptr, 1, &device, nullptr, nullptr, &err);
-  ASSERT_EQ(err, CL_SUCCESS);
-  cl_command_queue queue = clCreateCommandQueue(context, device, 0, &err);
-  ASSERT_EQ(err, CL_SUCCESS);
-  cl_program program = clCreateProgramWithSource(context, 1, &kProgram, nullptr, &err);
-  ASSERT_EQ(err, CL_SUCCESS);
-  const std::string options = std::string("-cl-std=CL1.2 -I ") + COHORT_SOURCE_DIR + "/kernel/include";
-  if (clBuildProgram(program, 1, &device, options.c_str(), nullptr, nullptr) != CL_SUCCESS) {
-    size_t size = 0;
-    clGetProgramBuildInfo(program, device, CL_PROGRAM_BUILD_LOG, 0, nullptr, &size);
-    std::string log(size, '\0');
-    clGetProgramBuildInfo(program, device, CL_PROGRAM_BUILD_LOG, size, log.data(), nullptr);
-    FAIL() << "atrous.h or reproject.h does not build as OpenCL C:\n" << log;
-  }
   cl_kernel kernel = clCreateKernel(program, "atrous", &err);
   ASSERT_EQ(err, CL_SUCCESS);
 
@@ -111,8 +94,5 @@ TEST(AtrousOpenCL, APassMatchesTheCppBuildOfTheSameHeader) {
   for (size_t i = 0; i < out.size(); ++i) ASSERT_NEAR(out[i], expected[i], 1e-4f * (1.0f + std::fabs(expected[i]))) << i;
   for (cl_mem m : mems) clReleaseMemObject(m);
   clReleaseKernel(kernel);
-  clReleaseProgram(program);
-  clReleaseCommandQueue(queue);
-  clReleaseContext(context);
 #endif
 }
