@@ -213,3 +213,39 @@ TEST(AgreementAux, EveryTracerWritesEmbreesAuxPlanes) {
   }
   if (checked == 0) GTEST_SKIP() << "no tracer besides Embree runs here";
 }
+
+// A band in half floats (what `cohort render` and `play` use by default: GPU tracers convert it on the
+// device) equals the same tracer's band in floats within half precision.
+TEST(AgreementBandFormat, HalfFloatBandsEqualFloatBands) {
+  const int w = 48, h = 32;
+  const KCamera cam = test_room_camera(w, h);
+  auto room = std::make_shared<commit::TracerScene>(core::compile_scene(test_room()).tracer_scene);
+  int checked = 0;
+  for (const std::string& kind : built_tracers()) {
+    if (!tracer_runs_here(kind)) continue;
+    auto tracer = make_test_tracer(kind);
+    tracer->apply(commit::CommitBuffer::full(room, 1));
+    core::BandJob job;
+    job.params = frame_params(K_MODE_PATH, 2, 1, h);
+    job.params.row_begin = 8;  // a band that does not start at row 0
+    job.camera = cam;
+    core::FrameBuffer as_float, as_half;
+    for (auto [format, out] : {std::pair{core::BandFormat::rgba32f, &as_float}, std::pair{core::BandFormat::rgb16f, &as_half}}) {
+      core::BandBuffer band(w, h, format);
+      tracer->render_band(job, band);
+      out->resize(w, h);
+      band.copy_rows_to(*out, 0, h);
+    }
+    double lit = 0.0;
+    for (int y = 8; y < h; ++y)
+      for (int x = 0; x < w; ++x)
+        for (int k = 0; k < 3; ++k) {
+          const float f = as_float.row(y)[4 * x + k], v = as_half.row(y)[4 * x + k];
+          ASSERT_NEAR(v, f, 1e-3f * std::fabs(f) + 1e-6f) << kind << " pixel " << x << "," << y;
+          lit += f;
+        }
+    EXPECT_GT(lit, 0.0) << kind << " rendered a black band";
+    ++checked;
+  }
+  EXPECT_GT(checked, 0);
+}

@@ -70,5 +70,32 @@ __kernel void cohort_aux_band(__global const KVertex* vertices, __global const K
   band_aux[(size_t)row * camera.width + x] = a;
 }
 
+/* What crosses the bus: the band as RGB half floats (core's BandFormat::rgb16f, 6 bytes a pixel instead
+ * of 16) and the aux records packed to KAuxTexel (32 bytes instead of 48), converted here so the host
+ * reads them straight into its band buffer. vstore_half_rte rounds as the host's and CUDA's conversions. */
+__kernel void cohort_band_to_rgb16f(__global const float* band, __global half* rgb, kuint pixels) {
+  kuint p = (kuint)get_global_id(0);
+  if (p >= pixels) return;
+  vstore_half_rte(band[4 * p + 0], 3 * p + 0, rgb);
+  vstore_half_rte(band[4 * p + 1], 3 * p + 1, rgb);
+  vstore_half_rte(band[4 * p + 2], 3 * p + 2, rgb);
+}
+
+__kernel void cohort_aux_to_texels(__global const KAux* aux, __global KAuxTexel* texels, kuint pixels) {
+  kuint p = (kuint)get_global_id(0);
+  if (p >= pixels) return;
+  KAux a = aux[p];
+  __global KAuxTexel* t = texels + p;
+  t->depth = a.depth;
+  t->prev_depth = a.prev_depth;
+  t->motion[0] = a.motion[0];
+  t->motion[1] = a.motion[1];
+  for (int k = 0; k < 3; ++k) {
+    vstore_half_rte(a.normal[k], 0, (__global half*)&t->normal[k]);
+    vstore_half_rte(a.albedo[k], 0, (__global half*)&t->albedo[k]);
+  }
+  t->id = a.id;
+}
+
 /* Skinned characters: the skinning kernels share the program. */
 #include "skinning.cl"

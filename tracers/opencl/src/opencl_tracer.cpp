@@ -154,11 +154,37 @@ struct OpenCLTracer::Impl {
   cl_mem params = nullptr, camera = nullptr, previous_camera = nullptr, output = nullptr, row_rays = nullptr,
          aux = nullptr;
   size_t output_bytes = 0, row_rays_rows = 0, aux_bytes = 0;
+  // The band and aux records as they cross the bus (converted on the device, read into the band buffer).
+  cl_kernel to_rgb16f = nullptr, to_texels = nullptr;
+  cl_mem packed = nullptr, packed_aux = nullptr;
+  size_t packed_bytes = 0, packed_aux_bytes = 0;
+
+  // A device buffer of at least `bytes`, reallocated (contents lost) when it is smaller.
+  cl_mem& grow(cl_mem& mem, size_t& capacity, size_t bytes, const char* what) {
+    if (bytes > capacity) {
+      if (mem) clReleaseMemObject(mem);
+      cl_int err = CL_SUCCESS;
+      mem = clCreateBuffer(context, CL_MEM_READ_WRITE, bytes, nullptr, &err);
+      check(err, what);
+      capacity = bytes;
+    }
+    return mem;
+  }
+  // Runs a 1-D packing kernel (source, destination, pixel count) over `pixels`.
+  void pack(cl_kernel k, cl_mem from, cl_mem to, size_t pixels, const char* what) {
+    const cl_uint n = static_cast<cl_uint>(pixels);
+    check(clSetKernelArg(k, 0, sizeof(cl_mem), &from), what);
+    check(clSetKernelArg(k, 1, sizeof(cl_mem), &to), what);
+    check(clSetKernelArg(k, 2, sizeof n, &n), what);
+    const size_t local = 64, global = (pixels + local - 1) / local * local;
+    check(clEnqueueNDRangeKernel(queue, k, 1, nullptr, &global, &local, 0, nullptr, nullptr), what);
+  }
 
   ~Impl() {
-    for (cl_mem m : {params, camera, previous_camera, output, row_rays, aux})
+    for (cl_mem m : {params, camera, previous_camera, output, row_rays, aux, packed, packed_aux})
       if (m) clReleaseMemObject(m);
-    for (cl_kernel k : {kernel, aux_kernel, skin_positions, skin_faces_kernel, skin_normals, refit_leaves, refit_blas})
+    for (cl_kernel k : {kernel, aux_kernel, skin_positions, skin_faces_kernel, skin_normals, refit_leaves, refit_blas,
+                        to_rgb16f, to_texels})
       if (k) clReleaseKernel(k);
     if (program) clReleaseProgram(program);
     if (queue) clReleaseCommandQueue(queue);
@@ -224,6 +250,10 @@ OpenCLTracer::OpenCLTracer(const Options& options) : impl_(std::make_unique<Impl
   check(err, "clCreateKernel(cohort_refit_blas)");
   impl_->aux_kernel = clCreateKernel(impl_->program, "cohort_aux_band", &err);
   check(err, "clCreateKernel(aux)");
+  impl_->to_rgb16f = clCreateKernel(impl_->program, "cohort_band_to_rgb16f", &err);
+  check(err, "clCreateKernel(cohort_band_to_rgb16f)");
+  impl_->to_texels = clCreateKernel(impl_->program, "cohort_aux_to_texels", &err);
+  check(err, "clCreateKernel(cohort_aux_to_texels)");
   impl_->previous_camera = clCreateBuffer(impl_->context, CL_MEM_READ_ONLY, sizeof(KCamera), nullptr, &err);
   check(err, "clCreateBuffer(previous camera)");
   impl_->params = clCreateBuffer(impl_->context, CL_MEM_READ_ONLY, sizeof(KFrameParams), nullptr, &err);
@@ -322,8 +352,24 @@ core::BandResult OpenCLTracer::render_band(const core::BandJob& job, core::BandB
   const size_t global[2] = {(camera.width + 7) / 8 * 8, (rows + 7) / 8 * 8};
   cl_event done = nullptr;
   check(clEnqueueNDRangeKernel(m.queue, m.kernel, 2, nullptr, global, local, 0, nullptr, &done), "launching the kernel");
-  std::vector<float> band(rows * camera.width * 4);
-  check(clEnqueueReadBuffer(m.queue, m.output, CL_TRUE, 0, bytes, band.data(), 0, nullptr, nullptr), "reading the band");
+  // The band goes straight into its rows of the target, converted on the device to the target's format.
+  const size_t pixels = rows * camera.width;
+  const bool straight = target.width() == static_cast<int>(camera.width);
+  std::vector<float> band;
+  if (!straight) {
+    band.resize(pixels * 4);
+    check(clEnqueueReadBuffer(m.queue, m.output, CL_TRUE, 0, bytes, band.data(), 0, nullptr, nullptr), "reading the band");
+  } else if (target.format() == core::BandFormat::rgb16f) {
+    cl_mem packed = m.grow(m.packed, m.packed_bytes, pixels * 6, "clCreateBuffer(half band)");
+    m.pack(m.to_rgb16f, m.output, packed, pixels, "converting the band to half floats");
+    check(clEnqueueReadBuffer(m.queue, packed, CL_TRUE, 0, pixels * 6, target.row(int(params.row_begin)), 0, nullptr,
+                              nullptr),
+          "reading the band");
+  } else {
+    check(clEnqueueReadBuffer(m.queue, m.output, CL_TRUE, 0, bytes, target.row(int(params.row_begin)), 0, nullptr,
+                              nullptr),
+          "reading the band");
+  }
   std::vector<cl_uint> row_rays(rows);
   check(clEnqueueReadBuffer(m.queue, m.row_rays, CL_TRUE, 0, rows * sizeof(cl_uint), row_rays.data(), 0, nullptr, nullptr),
         "reading the row ray counts");
@@ -331,7 +377,7 @@ core::BandResult OpenCLTracer::render_band(const core::BandJob& job, core::BandB
   clGetEventProfilingInfo(done, CL_PROFILING_COMMAND_START, sizeof start, &start, nullptr);
   clGetEventProfilingInfo(done, CL_PROFILING_COMMAND_END, sizeof end, &end, nullptr);
   clReleaseEvent(done);
-  for (size_t r = 0; r < rows; ++r)
+  for (size_t r = 0; r < rows && !straight; ++r)
     target.store(static_cast<int>(params.row_begin + r), 0, band.data() + r * camera.width * 4, camera.width);
   if (params.aux_outputs != 0u && target.has_aux()) render_aux(job, params, camera, rows, target);
   core::BandResult result;
@@ -366,7 +412,16 @@ void OpenCLTracer::render_aux(const core::BandJob& job, const KFrameParams& para
   const size_t global[2] = {(camera.width + 7) / 8 * 8, (rows + 7) / 8 * 8};
   check(clEnqueueNDRangeKernel(m.queue, m.aux_kernel, 2, nullptr, global, local, 0, nullptr, nullptr),
         "launching the aux kernel");
-  std::vector<KAux> aux(rows * camera.width);
+  const size_t pixels = rows * camera.width;
+  if (target.width() == static_cast<int>(camera.width)) {
+    cl_mem packed = m.grow(m.packed_aux, m.packed_aux_bytes, pixels * sizeof(KAuxTexel), "clCreateBuffer(aux texels)");
+    m.pack(m.to_texels, m.aux, packed, pixels, "packing the aux records");
+    check(clEnqueueReadBuffer(m.queue, packed, CL_TRUE, 0, pixels * sizeof(KAuxTexel), target.aux_row(int(params.row_begin)),
+                              0, nullptr, nullptr),
+          "reading the aux band");
+    return;
+  }
+  std::vector<KAux> aux(pixels);
   check(clEnqueueReadBuffer(m.queue, m.aux, CL_TRUE, 0, bytes, aux.data(), 0, nullptr, nullptr), "reading the aux band");
   for (size_t r = 0; r < rows; ++r)
     target.store_aux(static_cast<int>(params.row_begin + r), 0, aux.data() + r * camera.width, camera.width);
