@@ -86,14 +86,15 @@ case "${1:-}" in
     for map in test large; do
       if [ $map = large ]; then args=(/tmp/largemap.cpk --width 1920 --height 1080 --camera 1690 300 80 5 -12)
       else args=("$stage/testmap.cpk" --width 1280 --height 720); fi
-      for convergence in auto brigade; do
+      for convergence in ${COHORT_GPU_CONVERGENCE:-auto brigade}; do
         for mix in ${COHORT_GPU_MIXES:-cuda:0 cuda:0,cuda:1 embree,cuda:0 embree,cuda:0,cuda:1 cuda:0,opencl:0 embree,cuda:0,opencl:0}; do
           run=/tmp/mg_${map}_${convergence}_$(echo "$mix" | tr ',:' '__')
           timeout 120 "$stage/bin/cohort" render "${args[@]}" --tracers "$mix" --spp 1 --light-samples 1 --bounces 1 \
-            --convergence $convergence --frames 100 --camera-path spin-slow --write last --out $run >/dev/null 2>&1 ||
+            ${COHORT_GPU_RENDER_ARGS:-} --convergence $convergence --frames 100 --camera-path spin-slow --write last --out $run >/dev/null 2>&1 ||
             { echo "== $map $convergence $mix: failed"; continue; }
           echo "== $map map, $convergence, $mix"
-          python3 tools/frame_times.py $run/stats.json --skip 20 --json $out/$(basename $run).json | head -n 1
+          python3 tools/frame_times.py $run/stats.json --skip 20 --json $out/$(basename $run).json > $run/summary.txt
+          head -n 1 $run/summary.txt
         done
       done
       [ "${COHORT_GPU_SKIP_DEVICES:-0}" = 1 ] || timeout 300 "$stage/bin/cohort" bench devices --scene "${args[0]}" --width "${args[2]}" --height "${args[4]}" \
