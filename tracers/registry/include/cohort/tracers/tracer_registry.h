@@ -1,5 +1,6 @@
 // Tracers by name, for the apps, the benchmarks and the tests alike: "embree", "opencl" / "opencl:N"
-// (N-th OpenCL device of all platforms), "cuda" / "cuda:N", and the "all" lists. A library of its own
+// (N-th OpenCL device of all platforms), "cuda" / "cuda:N", "mpi:RANK" (a remote tracer: the bands
+// render on that MPI rank's `cohort node`, docs/cluster.md), and the "all" lists. A library of its own
 // above the concrete tracers, so that neither the core nor tracers/common depends on them.
 #pragma once
 
@@ -12,8 +13,8 @@
 namespace cohort::tracers {
 
 struct TracerSpec {
-  std::string kind;  // embree, opencl, cuda
-  int device = 0;
+  std::string kind;  // embree, opencl, cuda, mpi
+  int device = 0;    // for mpi: the node's rank
   std::string text;  // as written
 };
 
@@ -21,7 +22,8 @@ struct TracerSpec {
 // throws std::invalid_argument naming a malformed entry.
 std::vector<TracerSpec> parse_tracer_list(const std::string& list);
 
-// Throws std::runtime_error when this build lacks the tracer or the device cannot be opened.
+// Throws std::runtime_error when this build lacks the tracer or the device cannot be opened. A remote
+// tracer whose node cannot serve is logged and left out of make_tracers' list (it throws when none is left).
 std::unique_ptr<core::Tracer> make_tracer(const TracerSpec& spec);
 std::vector<std::unique_ptr<core::Tracer>> make_tracers(const std::string& list);
 

@@ -1,0 +1,219 @@
+#include "cohort/tracers/mpi_tracer.h"
+
+#include <cstring>
+
+#include <fmt/format.h>
+#include <spdlog/spdlog.h>
+
+#include "cohort/tracers/mpi_link.h"
+#include "cohort/tracers/mpi_wire.h"
+
+namespace cohort::tracers {
+
+namespace {
+double ms_since(MpiClock::time_point start) {
+  return std::chrono::duration<double, std::milli>(MpiClock::now() - start).count();
+}
+}  // namespace
+
+MpiTracer::MpiTracer(MpiTracerOptions options) : options_(options) {
+  MpiSession& mpi = MpiSession::get();
+  mpi.set_farewell(wire::frame_message(wire::Kind::shutdown, 0, {}));
+  if (mpi.rank() != 0)
+    throw NodeUnavailable(fmt::format("mpi:{}: remote tracers are driven from rank 0; this process is rank {}",
+                                      options_.rank, mpi.rank()));
+  if (options_.rank < 1 || options_.rank >= mpi.size())
+    throw NodeUnavailable(fmt::format("mpi:{}: no such rank: the MPI world has {} rank(s) (launch under mpirun, "
+                                      "with `cohort node` on ranks 1 and up; docs/cluster.md)",
+                                      options_.rank, mpi.size()));
+  const auto deadline = MpiClock::now() + options_.hello_timeout;
+  for (;;) {
+    std::optional<std::vector<uint8_t>> bytes = mpi.receive(options_.rank, deadline);
+    if (!bytes)
+      throw NodeUnavailable(fmt::format("mpi:{}: the node sent no hello within {} ms (is `cohort node` running on "
+                                        "that rank?)", options_.rank, options_.hello_timeout.count()));
+    wire::Message m;
+    try {
+      m = wire::parse_message(bytes->data(), bytes->size());
+    } catch (const wire::WireError& e) {
+      spdlog::warn("mpi:{}: refused a message before the hello: {}", options_.rank, e.what());
+      continue;
+    }
+    if (m.kind == wire::Kind::load_failed) {
+      mpi.released(options_.rank);  // it has left
+      throw NodeUnavailable(fmt::format("mpi:{}: the node could not load its scene and leaves: {}", options_.rank,
+                                        wire::decode_text(m.payload)));
+    }
+    if (m.kind != wire::Kind::hello) {
+      spdlog::warn("mpi:{}: ignored a {} message before the hello", options_.rank, wire::to_string(m.kind));
+      continue;
+    }
+    const wire::Hello hello = wire::decode_hello(m.payload);
+    const std::string mine = wire::cohort_version();
+    if (hello.cohort_version != mine || hello.protocol != wire::kProtocolVersion) {
+      const std::string why = fmt::format(
+          "version mismatch: rank 0 runs Cohort {} (protocol {}), rank {} on {} runs Cohort {} (protocol {}); run the "
+          "same build on every rank", mine, wire::kProtocolVersion, options_.rank, hello.host, hello.cohort_version,
+          hello.protocol);
+      send(int(wire::Kind::refuse), 0, wire::encode_text(why));
+      mpi.released(options_.rank);
+      mpi.flush_sends(options_.rank, MpiClock::now() + std::chrono::seconds(1));
+      throw NodeUnavailable("mpi:" + std::to_string(options_.rank) + ": " + why);
+    }
+    node_fingerprint_ = hello.scene_fingerprint;
+    gpu_ = hello.tracers.find("cuda") != std::string::npos || hello.tracers.find("opencl") != std::string::npos;
+    description_ = fmt::format("rank {} on {}: {}{}", options_.rank, hello.host, hello.tracers,
+                               hello.scene_name.empty() ? "" : ", scene " + hello.scene_name);
+    send(int(wire::Kind::welcome), 0, {});
+    spdlog::info("mpi:{}: node joined ({})", options_.rank, description_);
+    return;
+  }
+}
+
+MpiTracer::~MpiTracer() {
+  try {
+    MpiSession& mpi = MpiSession::get();
+    if (mpi.finalized()) return;
+    send(int(wire::Kind::shutdown), 0, {});
+    mpi.released(options_.rank);
+    mpi.flush_sends(options_.rank, MpiClock::now() + std::chrono::seconds(1));
+  } catch (const std::exception& e) {
+    spdlog::warn("mpi:{}: shutdown: {}", options_.rank, e.what());
+  }
+}
+
+std::string MpiTracer::name() const { return "mpi:" + std::to_string(options_.rank); }
+
+void MpiTracer::send(int kind, uint64_t sequence, const std::vector<uint8_t>& payload) {
+  std::vector<uint8_t> message = wire::frame_message(wire::Kind(kind), sequence, payload);
+  {
+    std::lock_guard lock(stats_mutex_);
+    stats_.bytes_sent += message.size();
+    pending_sent_ += message.size();
+  }
+  MpiSession::get().send(options_.rank, std::move(message));
+}
+
+void MpiTracer::apply(const commit::CommitBuffer& commit) {
+  if (!commit.is_full_resync()) {
+    if (node_needs_resync_)
+      throw std::runtime_error(fmt::format("mpi:{}: the node's scene is behind ({}); it needs a full resync",
+                                           options_.rank, node_failure_));
+    send(int(wire::Kind::commit), commit.frame(), wire::encode_commit(commit));
+    return;
+  }
+  const commit::TracerScene& scene = *commit.full_scene();
+  if (hashed_scene_ != commit.shared_full_scene()) {
+    hashed_fingerprint_ = wire::scene_fingerprint(scene);
+    hashed_scene_ = commit.shared_full_scene();
+  }
+  if (node_fingerprint_ != 0 && hashed_fingerprint_ == node_fingerprint_) {
+    // The node loaded this very scene: only the frame and camera travel.
+    send(int(wire::Kind::full_local), commit.frame(), wire::encode_full_local({scene.version, scene.camera}));
+  } else {
+    spdlog::info("mpi:{}: sending the whole scene (the node's own load differs or is gone)", options_.rank);
+    send(int(wire::Kind::commit), commit.frame(), wire::encode_commit(commit));
+  }
+  node_needs_resync_ = false;
+}
+
+core::BandResult MpiTracer::render_band(const core::BandJob& job, core::BandBuffer& target) {
+  MpiSession& mpi = MpiSession::get();
+  const uint64_t id = next_job_++;
+  wire::BandRequest request;
+  request.job = job;
+  request.format = target.format();
+  request.aux = target.has_aux();
+  const auto start = MpiClock::now();
+  send(int(wire::Kind::band_job), id, wire::encode_band_request(request));
+  double expected_ms;
+  {
+    std::lock_guard lock(stats_mutex_);
+    expected_ms = stats_.last_round_trip_ms;
+  }
+  const auto deadline = start + options_.band_timeout + std::chrono::microseconds(int64_t(4000.0 * expected_ms));
+  for (;;) {
+    std::optional<std::vector<uint8_t>> bytes = mpi.receive(options_.rank, deadline);
+    if (!bytes)
+      throw std::runtime_error(fmt::format("mpi:{}: no answer for rows [{}, {}) within {:.0f} ms (node stalled?)",
+                                           options_.rank, job.params.row_begin, job.params.row_end, ms_since(start)));
+    {
+      std::lock_guard lock(stats_mutex_);
+      stats_.bytes_received += bytes->size();
+    }
+    wire::Message m;
+    try {
+      m = wire::parse_message(bytes->data(), bytes->size());
+    } catch (const wire::WireError& e) {
+      std::lock_guard lock(stats_mutex_);
+      ++stats_.refused_messages;
+      spdlog::warn("mpi:{}: refused a message: {}", options_.rank, e.what());
+      continue;
+    }
+    if (m.kind != wire::Kind::band_rows && m.kind != wire::Kind::band_failed) {
+      spdlog::warn("mpi:{}: ignored an unexpected {} message", options_.rank, wire::to_string(m.kind));
+      continue;
+    }
+    if (m.sequence != id) {  // the answer to a job that timed out before
+      std::lock_guard lock(stats_mutex_);
+      ++stats_.stale_answers;
+      spdlog::debug("mpi:{}: dropped the late answer to job {}", options_.rank, m.sequence);
+      continue;
+    }
+    if (m.kind == wire::Kind::band_failed) {
+      wire::BandFailure failure;
+      try {
+        failure = wire::decode_band_failure(m.payload);
+      } catch (const wire::WireError& e) {
+        failure.reason = std::string("(unreadable reason: ") + e.what() + ")";
+      }
+      if (failure.needs_full_resync) {
+        node_needs_resync_ = true;
+        node_failure_ = failure.reason;
+        node_fingerprint_ = 0;  // whatever it loaded, send the whole scene next time
+      }
+      throw std::runtime_error(fmt::format("mpi:{}: {}", options_.rank, failure.reason));
+    }
+    wire::BandRows rows;
+    try {
+      rows = wire::decode_band_rows(m.payload);
+    } catch (const wire::WireError& e) {
+      std::lock_guard lock(stats_mutex_);
+      ++stats_.refused_messages;
+      throw std::runtime_error(fmt::format("mpi:{}: refused the band's rows: {}", options_.rank, e.what()));
+    }
+    if (rows.row_begin != job.params.row_begin || rows.row_end != job.params.row_end ||
+        int(rows.width) != target.width() || rows.format != target.format() ||
+        job.params.row_end > uint32_t(target.height()) || (target.has_aux() && rows.aux.empty()))
+      throw std::runtime_error(fmt::format("mpi:{}: refused the band's rows: rows [{}, {}) of {} {} pixels, asked "
+                                           "for [{}, {}) of {} {}{}", options_.rank, rows.row_begin, rows.row_end,
+                                           rows.width, core::to_string(rows.format), job.params.row_begin,
+                                           job.params.row_end, target.width(), core::to_string(target.format()),
+                                           target.has_aux() ? " with aux planes" : ""));
+    if (!rows.pixels.empty()) std::memcpy(target.row(int(rows.row_begin)), rows.pixels.data(), rows.pixels.size());
+    if (target.has_aux() && !rows.aux.empty())
+      std::memcpy(target.aux_row(int(rows.row_begin)), rows.aux.data(), rows.aux.size());
+    const double round_trip = ms_since(start);
+    {
+      std::lock_guard lock(stats_mutex_);
+      ++stats_.bands;
+      stats_.last_round_trip_ms = round_trip;
+      stats_.total_round_trip_ms += round_trip;
+      stats_.last_node_ms = rows.device_ms;
+      stats_.last_band_bytes_sent = pending_sent_;
+      stats_.last_band_bytes_received = bytes->size();
+      pending_sent_ = 0;
+    }
+    core::BandResult result;
+    result.device_ms = rows.device_ms;
+    result.row_work = std::move(rows.row_work);
+    return result;
+  }
+}
+
+MpiLinkStats MpiTracer::link_stats() const {
+  std::lock_guard lock(stats_mutex_);
+  return stats_;
+}
+
+}  // namespace cohort::tracers
