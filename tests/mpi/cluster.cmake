@@ -1,0 +1,19 @@
+# Cluster runs under mpiexec on localhost (tests/mpi/run_cluster.py): rank 0 renders with Embree plus
+# mpi:1 and mpi:2, ranks 1 and 2 run `cohort node` with Embree, and every frame must match the
+# single-process render. Only where MPI was found. Open MPI refuses to start as root (CI runs as root)
+# unless told twice that it is meant.
+if(TARGET cohort AND TARGET cohort_tracer_mpi AND TARGET cohort_tracer_embree AND MPIEXEC_EXECUTABLE)
+  find_package(Python3 COMPONENTS Interpreter QUIET)
+  if(Python3_Interpreter_FOUND)
+    foreach(case match stall version load_error)
+      add_test(NAME mpi.cluster_${case}
+               COMMAND Python3::Interpreter ${CMAKE_CURRENT_LIST_DIR}/run_cluster.py ${case}
+                       --mpiexec ${MPIEXEC_EXECUTABLE} --cohort $<TARGET_FILE:cohort>
+                       --map ${CMAKE_SOURCE_DIR}/tests/scene/data/base/maps/two_rooms.map
+                       --broken-map ${CMAKE_SOURCE_DIR}/tests/scene/data/broken_base/maps/bad_proc.map
+                       --out ${CMAKE_BINARY_DIR}/test_output/mpi_cluster_${case})
+      set_tests_properties(mpi.cluster_${case} PROPERTIES LABELS mpi TIMEOUT 300 RUN_SERIAL TRUE
+                           ENVIRONMENT "OMPI_ALLOW_RUN_AS_ROOT=1;OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1")
+    endforeach()
+  endif()
+endif()
