@@ -1,6 +1,8 @@
 #include "cohort/tracers/mpi_tracer.h"
 
+#include <atomic>
 #include <cstring>
+#include <map>
 
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
@@ -14,6 +16,21 @@ namespace {
 double ms_since(MpiClock::time_point start) {
   return std::chrono::duration<double, std::milli>(MpiClock::now() - start).count();
 }
+
+// A node says hello once per run; tracers made for it later (`cohort bench devices` makes one per mix)
+// find it here and start with a full resync like any tracer.
+struct JoinedNode {
+  wire::Hello hello;
+};
+std::mutex joined_mutex;
+std::map<int, JoinedNode>& joined_nodes() {
+  static std::map<int, JoinedNode> nodes;
+  return nodes;
+}
+
+// Band job ids are unique over the run, so that a late answer to an earlier tracer's job is never
+// taken for the current one.
+std::atomic<uint64_t> next_band_job{1};
 }  // namespace
 
 MpiTracer::MpiTracer(MpiTracerOptions options) : options_(options) {
@@ -26,6 +43,14 @@ MpiTracer::MpiTracer(MpiTracerOptions options) : options_(options) {
     throw NodeUnavailable(fmt::format("mpi:{}: no such rank: the MPI world has {} rank(s) (launch under mpirun, "
                                       "with `cohort node` on ranks 1 and up; docs/cluster.md)",
                                       options_.rank, mpi.size()));
+  {
+    std::lock_guard lock(joined_mutex);
+    auto known = joined_nodes().find(options_.rank);
+    if (known != joined_nodes().end()) {
+      adopt(known->second.hello);
+      return;
+    }
+  }
   const auto deadline = MpiClock::now() + options_.hello_timeout;
   for (;;) {
     std::optional<std::vector<uint8_t>> bytes = mpi.receive(options_.rank, deadline);
@@ -60,25 +85,36 @@ MpiTracer::MpiTracer(MpiTracerOptions options) : options_(options) {
       mpi.flush_sends(options_.rank, MpiClock::now() + std::chrono::seconds(1));
       throw NodeUnavailable("mpi:" + std::to_string(options_.rank) + ": " + why);
     }
-    node_fingerprint_ = hello.scene_fingerprint;
-    gpu_ = hello.tracers.find("cuda") != std::string::npos || hello.tracers.find("opencl") != std::string::npos;
-    description_ = fmt::format("rank {} on {}: {}{}", options_.rank, hello.host, hello.tracers,
-                               hello.scene_name.empty() ? "" : ", scene " + hello.scene_name);
     send(int(wire::Kind::welcome), 0, {});
+    adopt(hello);
+    {
+      std::lock_guard lock(joined_mutex);
+      joined_nodes()[options_.rank] = {hello};
+    }
     spdlog::info("mpi:{}: node joined ({})", options_.rank, description_);
     return;
   }
 }
 
+void MpiTracer::adopt(const wire::Hello& hello) {
+  node_fingerprint_ = hello.scene_fingerprint;
+  gpu_ = hello.tracers.find("cuda") != std::string::npos || hello.tracers.find("opencl") != std::string::npos;
+  description_ = fmt::format("rank {} on {}: {}{}", options_.rank, hello.host, hello.tracers,
+                             hello.scene_name.empty() ? "" : ", scene " + hello.scene_name);
+}
+
 MpiTracer::~MpiTracer() {
+  const MpiLinkStats s = link_stats();
+  if (s.bands > 0)
+    spdlog::info("mpi:{}: {} band(s), {:.1f} KiB sent and {:.1f} KiB received a band, round trip {:.2f} ms a band",
+                 options_.rank, s.bands, double(s.bytes_sent) / double(s.bands) / 1024.0,
+                 double(s.bytes_received) / double(s.bands) / 1024.0, s.total_round_trip_ms / double(s.bands));
+  // The node stays for later tracers of this run; the session's end tells every node to leave.
   try {
     MpiSession& mpi = MpiSession::get();
-    if (mpi.finalized()) return;
-    send(int(wire::Kind::shutdown), 0, {});
-    mpi.released(options_.rank);
-    mpi.flush_sends(options_.rank, MpiClock::now() + std::chrono::seconds(1));
+    if (!mpi.finalized()) mpi.flush_sends(options_.rank, MpiClock::now() + std::chrono::seconds(1));
   } catch (const std::exception& e) {
-    spdlog::warn("mpi:{}: shutdown: {}", options_.rank, e.what());
+    spdlog::warn("mpi:{}: {}", options_.rank, e.what());
   }
 }
 
@@ -119,7 +155,7 @@ void MpiTracer::apply(const commit::CommitBuffer& commit) {
 
 core::BandResult MpiTracer::render_band(const core::BandJob& job, core::BandBuffer& target) {
   MpiSession& mpi = MpiSession::get();
-  const uint64_t id = next_job_++;
+  const uint64_t id = next_band_job++;
   wire::BandRequest request;
   request.job = job;
   request.format = target.format();
@@ -200,6 +236,7 @@ core::BandResult MpiTracer::render_band(const core::BandJob& job, core::BandBuff
       stats_.last_round_trip_ms = round_trip;
       stats_.total_round_trip_ms += round_trip;
       stats_.last_node_ms = rows.device_ms;
+      stats_.total_node_ms += rows.device_ms;
       stats_.last_band_bytes_sent = pending_sent_;
       stats_.last_band_bytes_received = bytes->size();
       pending_sent_ = 0;

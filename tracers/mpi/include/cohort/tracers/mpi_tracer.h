@@ -6,7 +6,8 @@
 // previous band is merged. render_band() sends the band job and waits for the rows, at most the band
 // timeout; a node that stalls, fails or sends a malformed answer makes it throw, so the Renderer's
 // recovery re-renders the rows on the other tracers and the frame is delivered. A late answer is
-// recognised by its job id and dropped. The destructor tells the node to leave.
+// recognised by its job id and dropped. A node joins once per run (its hello is remembered), so a later
+// tracer for the same rank starts at once; the MPI session's end (program exit) tells every node to leave.
 #pragma once
 
 #include <chrono>
@@ -16,6 +17,7 @@
 #include <string>
 
 #include "cohort/core/tracer.h"
+#include "cohort/tracers/mpi_wire.h"
 
 namespace cohort::tracers {
 
@@ -35,6 +37,7 @@ struct MpiLinkStats {
   double last_round_trip_ms = 0.0;  // job sent -> rows received
   double last_node_ms = 0.0;        // the node's own time for the band (apply + render)
   double total_round_trip_ms = 0.0;
+  double total_node_ms = 0.0;
   uint64_t stale_answers = 0;       // late answers to jobs that had timed out, dropped
   uint64_t refused_messages = 0;    // malformed answers, refused
 };
@@ -59,6 +62,7 @@ class MpiTracer : public core::Tracer {
 
  private:
   void send(int kind, uint64_t sequence, const std::vector<uint8_t>& payload);
+  void adopt(const wire::Hello& hello);
 
   MpiTracerOptions options_;
   std::string description_;
@@ -68,7 +72,6 @@ class MpiTracer : public core::Tracer {
   uint64_t hashed_fingerprint_ = 0;
   bool node_needs_resync_ = false;
   std::string node_failure_;
-  uint64_t next_job_ = 1;
   mutable std::mutex stats_mutex_;
   MpiLinkStats stats_;
   uint64_t pending_sent_ = 0;
