@@ -1,11 +1,16 @@
 # Cluster runs under mpiexec on localhost (tests/mpi/run_cluster.py): rank 0 renders with Embree plus
 # mpi:1 and mpi:2, ranks 1 and 2 run `cohort node` with Embree, and every frame must match the
-# single-process render. Only where MPI was found. Open MPI refuses to start as root (CI runs as root)
+# single-process render (with OpenCL on the nodes, PoCL where there is no GPU: within the tracers'
+# agreement). Only where MPI was found. Open MPI refuses to start as root (CI runs as root)
 # unless told twice that it is meant.
 if(TARGET cohort AND TARGET cohort_tracer_mpi AND TARGET cohort_tracer_embree AND MPIEXEC_EXECUTABLE)
   find_package(Python3 COMPONENTS Interpreter QUIET)
   if(Python3_Interpreter_FOUND)
-    foreach(case match stall version load_error)
+    set(_cases match stall version load_error bench)
+    if(TARGET cohort_tracer_opencl)
+      list(APPEND _cases mixed)
+    endif()
+    foreach(case ${_cases})
       add_test(NAME mpi.cluster_${case}
                COMMAND Python3::Interpreter ${CMAKE_CURRENT_LIST_DIR}/run_cluster.py ${case}
                        --mpiexec ${MPIEXEC_EXECUTABLE} --cohort $<TARGET_FILE:cohort>
