@@ -4,9 +4,12 @@
 # agreement). Only where MPI was found. Open MPI refuses to start as root (CI runs as root)
 # unless told twice that it is meant.
 if(TARGET cohort AND TARGET cohort_tracer_mpi AND TARGET cohort_tracer_embree AND MPIEXEC_EXECUTABLE)
+  # The remote tracer against a node over MPI with malformed messages (protocol_check.cpp).
+  add_executable(mpi_protocol_check ${CMAKE_CURRENT_LIST_DIR}/protocol_check.cpp)
+  target_link_libraries(mpi_protocol_check PRIVATE cohort_tracer_registry cohort_core cohort_test_support cohort_warnings)
   find_package(Python3 COMPONENTS Interpreter QUIET)
   if(Python3_Interpreter_FOUND)
-    set(_cases match stall version load_error bench)
+    set(_cases match stall version load_error bench protocol)
     if(TARGET cohort_tracer_opencl)
       list(APPEND _cases mixed)
     endif()
@@ -14,6 +17,7 @@ if(TARGET cohort AND TARGET cohort_tracer_mpi AND TARGET cohort_tracer_embree AN
       add_test(NAME mpi.cluster_${case}
                COMMAND Python3::Interpreter ${CMAKE_CURRENT_LIST_DIR}/run_cluster.py ${case}
                        --mpiexec ${MPIEXEC_EXECUTABLE} --cohort $<TARGET_FILE:cohort>
+                       --protocol-check $<TARGET_FILE:mpi_protocol_check>
                        --map ${CMAKE_SOURCE_DIR}/tests/scene/data/base/maps/two_rooms.map
                        --broken-map ${CMAKE_SOURCE_DIR}/tests/scene/data/broken_base/maps/bad_proc.map
                        --out ${CMAKE_BINARY_DIR}/test_output/mpi_cluster_${case})

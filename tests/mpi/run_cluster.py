@@ -10,7 +10,8 @@ renders on OpenCL: PoCL on a machine without GPUs; images agree within the trace
 the others and every frame is still delivered), version (rank 1 announces another version: rank 0
 names both and renders without it), load_error (rank 1 cannot load its map: rank 0 logs its file:line
 reason and renders without it), bench (`cohort bench devices` with remote tracers reports their bytes
-per frame and round trip).
+per frame and round trip), protocol (protocol_check.cpp on 2 ranks: malformed messages against a
+real node).
 """
 import argparse
 import json
@@ -96,17 +97,24 @@ def bench(a):
 
 def main():
     parser = argparse.ArgumentParser()
-    parser.add_argument("case", choices=["match", "mixed", "stall", "version", "load_error", "bench"])
+    parser.add_argument("case", choices=["match", "mixed", "stall", "version", "load_error", "bench", "protocol"])
     parser.add_argument("--mpiexec", required=True)
     parser.add_argument("--cohort", required=True)
     parser.add_argument("--map", required=True)
     parser.add_argument("--broken-map")
+    parser.add_argument("--protocol-check")
     parser.add_argument("--out", required=True)
     a = parser.parse_args()
 
     shutil.rmtree(a.out, ignore_errors=True)
     if a.case == "bench":
         bench(a)
+        return
+    if a.case == "protocol":
+        _, output = run([a.mpiexec] + mpiexec_flags(a.mpiexec) + ["-np", "2", a.protocol_check])
+        if "FAILED" in output or output.count("ok: ") < 6:
+            sys.exit("protocol check failed")
+        print("protocol: ok")
         return
     single, cluster = os.path.join(a.out, "single"), os.path.join(a.out, "cluster")
     run([a.cohort, "render", a.map, "--tracers", "embree", "--out", single] + RENDER_ARGS)

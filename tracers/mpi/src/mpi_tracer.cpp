@@ -133,8 +133,7 @@ void MpiTracer::send(int kind, uint64_t sequence, const std::vector<uint8_t>& pa
 void MpiTracer::apply(const commit::CommitBuffer& commit) {
   if (!commit.is_full_resync()) {
     if (node_needs_resync_)
-      throw std::runtime_error(fmt::format("mpi:{}: the node's scene is behind ({}); it needs a full resync",
-                                           options_.rank, node_failure_));
+      throw std::runtime_error(fmt::format("mpi:{}: {}; it needs a full resync", options_.rank, node_failure_));
     send(int(wire::Kind::commit), commit.frame(), wire::encode_commit(commit));
     return;
   }
