@@ -29,7 +29,7 @@ struct NodeArgs {
   double time = 0.0;
   std::string announced_version;
   int stall_frame = -1, stall_ms = 0;
-  int idle_timeout_s = 3600;
+  int idle_timeout_s = 600;
 };
 
 #ifdef COHORT_HAVE_MPI

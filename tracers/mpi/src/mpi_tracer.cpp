@@ -1,5 +1,6 @@
 #include "cohort/tracers/mpi_tracer.h"
 
+#include <algorithm>
 #include <atomic>
 #include <cstring>
 #include <map>
@@ -150,6 +151,7 @@ void MpiTracer::apply(const commit::CommitBuffer& commit) {
     send(int(wire::Kind::commit), commit.frame(), wire::encode_commit(commit));
   }
   node_needs_resync_ = false;
+  after_full_resync_ = true;
 }
 
 core::BandResult MpiTracer::render_band(const core::BandJob& job, core::BandBuffer& target) {
@@ -166,12 +168,17 @@ core::BandResult MpiTracer::render_band(const core::BandJob& job, core::BandBuff
     std::lock_guard lock(stats_mutex_);
     expected_ms = stats_.last_round_trip_ms;
   }
-  const auto deadline = start + options_.band_timeout + std::chrono::microseconds(int64_t(4000.0 * expected_ms));
+  // The first band after a full resync also waits for the node to build its acceleration structures.
+  const auto allowance = options_.band_timeout * (after_full_resync_ ? 10 : 1);
+  const auto deadline = start + allowance + std::chrono::microseconds(int64_t(4000.0 * expected_ms));
   for (;;) {
     std::optional<std::vector<uint8_t>> bytes = mpi.receive(options_.rank, deadline);
-    if (!bytes)
+    if (!bytes) {
+      timed_out_job_ = id;
+      timed_out_start_ = start;
       throw std::runtime_error(fmt::format("mpi:{}: no answer for rows [{}, {}) within {:.0f} ms (node stalled?)",
                                            options_.rank, job.params.row_begin, job.params.row_end, ms_since(start)));
+    }
     {
       std::lock_guard lock(stats_mutex_);
       stats_.bytes_received += bytes->size();
@@ -192,6 +199,9 @@ core::BandResult MpiTracer::render_band(const core::BandJob& job, core::BandBuff
     if (m.sequence != id) {  // the answer to a job that timed out before
       std::lock_guard lock(stats_mutex_);
       ++stats_.stale_answers;
+      // A band that merely took longer than the timeout teaches the next deadline how long bands take.
+      if (m.sequence == timed_out_job_)
+        stats_.last_round_trip_ms = std::max(stats_.last_round_trip_ms, ms_since(timed_out_start_));
       spdlog::debug("mpi:{}: dropped the late answer to job {}", options_.rank, m.sequence);
       continue;
     }
@@ -229,6 +239,7 @@ core::BandResult MpiTracer::render_band(const core::BandJob& job, core::BandBuff
     if (target.has_aux() && !rows.aux.empty())
       std::memcpy(target.aux_row(int(rows.row_begin)), rows.aux.data(), rows.aux.size());
     const double round_trip = ms_since(start);
+    after_full_resync_ = false;
     {
       std::lock_guard lock(stats_mutex_);
       ++stats_.bands;

@@ -28,7 +28,7 @@ struct NodeOptions {
   int stall_frame = -1;
   int stall_ms = 0;
   // Rank 0 silent this long: the node leaves.
-  std::chrono::seconds idle_timeout{3600};
+  std::chrono::seconds idle_timeout{600};
 };
 
 // Serves rank 0 until it says shutdown; returns the process's exit code (0 after a clean shutdown).

@@ -23,7 +23,9 @@ namespace cohort::tracers {
 
 struct MpiTracerOptions {
   int rank = 1;
-  // A band that has not come back after this long (plus four times the last round trip) fails.
+  // A band that has not come back after this long (plus four times the last round trip; ten times as long
+  // for the first band after a full resync, which the node spends building its BVHs) fails. A late
+  // answer still teaches the next deadline how long the node's bands take.
   std::chrono::milliseconds band_timeout{2000};
   // How long the constructor waits for the node's hello (it loads its scene first).
   std::chrono::milliseconds hello_timeout{120000};
@@ -71,6 +73,9 @@ class MpiTracer : public core::Tracer {
   std::shared_ptr<const commit::TracerScene> hashed_scene_;  // kept alive, so the pointer means this scene
   uint64_t hashed_fingerprint_ = 0;
   bool node_needs_resync_ = false;
+  bool after_full_resync_ = false;
+  uint64_t timed_out_job_ = 0;
+  std::chrono::steady_clock::time_point timed_out_start_{};
   std::string node_failure_;
   mutable std::mutex stats_mutex_;
   MpiLinkStats stats_;
