@@ -70,6 +70,28 @@ TEST(WireCodec, FullResyncCarriesTheWholeScene) {
   EXPECT_EQ(std::memcmp(&decoded.full_scene()->camera, &scene->camera, sizeof(KCamera)), 0);
 }
 
+// A channel that took a full resync and then more frames' records before its tracer's job holds a full
+// buffer with records on top: both must travel.
+TEST(WireCodec, FullResyncWithRecordsOnTopKeepsTheRecords) {
+  test::SceneChurn churn(13);
+  for (uint64_t frame = 1; frame <= 3; ++frame) churn.step(frame, true);
+  auto base = std::make_shared<commit::TracerScene>(churn.master());
+  commit::CommitBuffer pending = commit::CommitBuffer::full(base, 3);
+  for (uint64_t frame = 4; frame <= 6; ++frame) pending.merge(churn.step(frame, frame == 5));
+  ASSERT_TRUE(pending.is_full_resync());
+  ASSERT_GT(pending.record_count(), 0u);
+  std::string where;
+  const commit::CommitBuffer decoded = wire::decode_commit(wire::encode_commit(pending));
+  EXPECT_EQ(decoded.record_count(), pending.record_count());
+  EXPECT_TRUE(commit::same_tracer_scene(applied(decoded, {}), churn.master(), &where)) << where;
+  // The same as a full resync to the node's own copy of `base`: only camera, version and records travel.
+  const std::vector<uint8_t> local = wire::encode_full_local(pending);
+  EXPECT_LT(local.size(), wire::encode_commit(pending).size());
+  const commit::CommitBuffer rebuilt = wire::decode_full_local(local, base);
+  EXPECT_TRUE(commit::same_tracer_scene(applied(rebuilt, {}), churn.master(), &where)) << where;
+  expect_every_prefix_refused(local, [&](const auto& p) { return wire::decode_full_local(p, base); });
+}
+
 TEST(WireCodec, TruncatedCommitsAreRefused) {
   test::SceneChurn churn(5);
   const commit::CommitBuffer records = churn.step(1, true);

@@ -76,21 +76,18 @@ class Node {
   }
 
   void apply_full_local(const wire::Message& m) {
-    wire::FullLocal full;
-    try {
-      full = wire::decode_full_local(m.payload);
-    } catch (const wire::WireError& e) {
-      diverge(fmt::format("refused full resync of frame {}: {}", m.sequence, e.what()));
-      return;
-    }
     if (!options_.scene) {
       diverge("rank 0 sent a full resync to the node's own scene, but it loaded none");
       return;
     }
-    auto scene = std::make_shared<commit::TracerScene>(*options_.scene);
-    scene->camera = full.camera;
-    scene->version = full.frame;
-    apply(commit::CommitBuffer::full(std::move(scene), m.sequence));
+    commit::CommitBuffer full;
+    try {
+      full = wire::decode_full_local(m.payload, options_.scene);
+    } catch (const wire::WireError& e) {
+      diverge(fmt::format("refused full resync of frame {}: {}", m.sequence, e.what()));
+      return;
+    }
+    apply(full);
   }
 
   void apply(const commit::CommitBuffer& commit) {

@@ -145,7 +145,7 @@ void MpiTracer::apply(const commit::CommitBuffer& commit) {
   }
   if (node_fingerprint_ != 0 && hashed_fingerprint_ == node_fingerprint_) {
     // The node loaded this very scene: only the frame and camera travel.
-    send(int(wire::Kind::full_local), commit.frame(), wire::encode_full_local({scene.version, scene.camera}));
+    send(int(wire::Kind::full_local), commit.frame(), wire::encode_full_local(commit));
   } else {
     spdlog::info("mpi:{}: sending the whole scene (the node's own load differs or is gone)", options_.rank);
     send(int(wire::Kind::commit), commit.frame(), wire::encode_commit(commit));

@@ -211,17 +211,11 @@ std::string decode_text(const std::vector<uint8_t>& payload) {
   return text;
 }
 
-std::vector<uint8_t> encode_commit(const commit::CommitBuffer& c) {
-  Writer w;
-  w.scalar(uint8_t(c.is_full_resync() ? 1 : 0));
-  w.scalar(uint64_t(c.frame()));
-  if (c.is_full_resync()) {
-    const commit::TracerScene& s = *c.full_scene();
-    visit_scene_arrays(s, [&](const auto& v) { w.array(v); });
-    w.scalar(s.camera);
-    w.scalar(s.version);
-    return std::move(w.out);
-  }
+namespace {
+
+// The incremental records of a buffer (a full resync may carry some on top of its scene: records
+// folded in after it, applied after it).
+void write_records(Writer& w, const commit::CommitBuffer& c) {
   auto count = [&](Record tag, const std::optional<uint32_t>& n) {
     if (!n) return;
     w.tag(tag);
@@ -268,29 +262,15 @@ std::vector<uint8_t> encode_commit(const commit::CommitBuffer& c) {
   }
   if (c.camera()) { w.tag(Record::camera); w.scalar(*c.camera()); }
   w.tag(Record::end);
-  return std::move(w.out);
 }
 
-commit::CommitBuffer decode_commit(const std::vector<uint8_t>& payload) {
-  Reader r(payload, "commit");
-  const uint8_t full = r.scalar<uint8_t>();
-  const uint64_t frame = r.scalar<uint64_t>();
-  if (full > 1) r.fail(fmt::format("full-resync flag {} is neither 0 nor 1", full));
-  if (full) {
-    auto scene = std::make_shared<commit::TracerScene>();
-    read_scene_arrays(r, *scene);
-    scene->camera = r.scalar<KCamera>();
-    scene->version = r.scalar<uint64_t>();
-    r.expect_end();
-    check_scene(*scene, r);
-    return commit::CommitBuffer::full(std::move(scene), frame);
-  }
-  commit::CommitBuffer c;
-  c.set_frame(frame);
+// Reads records up to the end tag into `c` (which may be a full resync already) and expects the
+// message to end there.
+void read_records(Reader& r, commit::CommitBuffer& c) {
   for (;;) {
     const uint32_t tag = r.scalar<uint32_t>();
     switch (Record(tag)) {
-      case Record::end: r.expect_end(); return c;
+      case Record::end: r.expect_end(); return;
       case Record::instance_count: c.set_instance_count(r.scalar<uint32_t>()); break;
       case Record::light_count: c.set_light_count(r.scalar<uint32_t>()); break;
       case Record::material_count: c.set_material_count(r.scalar<uint32_t>()); break;
@@ -308,9 +288,6 @@ commit::CommitBuffer decode_commit(const std::vector<uint8_t>& payload) {
         b.vertex_offset = r.scalar<uint32_t>(); b.vertices = r.array<KVertex>("BLAS vertices");
         b.triangle_offset = r.scalar<uint32_t>(); b.triangles = r.array<KTriangle>("BLAS triangles");
         b.node_offset = r.scalar<uint32_t>(); b.nodes = r.array<KBvhNode>("BLAS nodes");
-        if (b.blas.node_count != b.nodes.size() || b.blas.tri_count != b.triangles.size())
-          r.fail(fmt::format("BLAS {} announces {} nodes and {} triangles but carries {} and {}", b.blas_index,
-                             b.blas.node_count, b.blas.tri_count, b.nodes.size(), b.triangles.size()));
         c.add_blas(std::move(b));
         break;
       }
@@ -336,20 +313,60 @@ commit::CommitBuffer decode_commit(const std::vector<uint8_t>& payload) {
   }
 }
 
-std::vector<uint8_t> encode_full_local(const FullLocal& full) {
+}  // namespace
+
+std::vector<uint8_t> encode_commit(const commit::CommitBuffer& c) {
   Writer w;
-  w.scalar(full.frame);
-  w.scalar(full.camera);
+  w.scalar(uint8_t(c.is_full_resync() ? 1 : 0));
+  w.scalar(uint64_t(c.frame()));
+  if (c.is_full_resync()) {
+    const commit::TracerScene& s = *c.full_scene();
+    visit_scene_arrays(s, [&](const auto& v) { w.array(v); });
+    w.scalar(s.camera);
+    w.scalar(s.version);
+  }
+  write_records(w, c);
   return std::move(w.out);
 }
 
-FullLocal decode_full_local(const std::vector<uint8_t>& payload) {
+commit::CommitBuffer decode_commit(const std::vector<uint8_t>& payload) {
+  Reader r(payload, "commit");
+  const uint8_t full = r.scalar<uint8_t>();
+  const uint64_t frame = r.scalar<uint64_t>();
+  if (full > 1) r.fail(fmt::format("full-resync flag {} is neither 0 nor 1", full));
+  commit::CommitBuffer c;
+  if (full) {
+    auto scene = std::make_shared<commit::TracerScene>();
+    read_scene_arrays(r, *scene);
+    scene->camera = r.scalar<KCamera>();
+    scene->version = r.scalar<uint64_t>();
+    check_scene(*scene, r);
+    c = commit::CommitBuffer::full(std::move(scene), frame);
+  }
+  c.set_frame(frame);
+  read_records(r, c);
+  return c;
+}
+
+std::vector<uint8_t> encode_full_local(const commit::CommitBuffer& full) {
+  Writer w;
+  w.scalar(uint64_t(full.frame()));
+  w.scalar(full.full_scene()->camera);
+  w.scalar(full.full_scene()->version);
+  write_records(w, full);
+  return std::move(w.out);
+}
+
+commit::CommitBuffer decode_full_local(const std::vector<uint8_t>& payload,
+                                       std::shared_ptr<const commit::TracerScene> own_scene) {
   Reader r(payload, "full_local");
-  FullLocal f;
-  f.frame = r.scalar<uint64_t>();
-  f.camera = r.scalar<KCamera>();
-  r.expect_end();
-  return f;
+  const uint64_t frame = r.scalar<uint64_t>();
+  auto scene = std::make_shared<commit::TracerScene>(*own_scene);
+  scene->camera = r.scalar<KCamera>();
+  scene->version = r.scalar<uint64_t>();
+  commit::CommitBuffer c = commit::CommitBuffer::full(std::move(scene), frame);
+  read_records(r, c);
+  return c;
 }
 
 std::vector<uint8_t> encode_band_request(const BandRequest& request) {

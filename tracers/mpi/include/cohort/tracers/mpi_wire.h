@@ -76,17 +76,16 @@ Hello decode_hello(const std::vector<uint8_t>& payload);
 std::vector<uint8_t> encode_text(const std::string& text);
 std::string decode_text(const std::vector<uint8_t>& payload);
 
-// A commit buffer, every record; a full resync carries the whole scene.
+// A commit buffer, every record; a full resync carries the whole scene, then the records folded in
+// after it (a channel that took a full resync and then more frames' records before its tracer's job).
 std::vector<uint8_t> encode_commit(const commit::CommitBuffer& commit);
 commit::CommitBuffer decode_commit(const std::vector<uint8_t>& payload);
 
-// A full resync to the node's own scene: the frame and camera it is at.
-struct FullLocal {
-  uint64_t frame = 0;
-  KCamera camera{};
-};
-std::vector<uint8_t> encode_full_local(const FullLocal& full);
-FullLocal decode_full_local(const std::vector<uint8_t>& payload);
+// A full resync to the scene the node loaded itself (same fingerprint): the scene's camera and
+// version, and the records on top; the node's own scene fills in the rest.
+std::vector<uint8_t> encode_full_local(const commit::CommitBuffer& full);
+commit::CommitBuffer decode_full_local(const std::vector<uint8_t>& payload,
+                                       std::shared_ptr<const commit::TracerScene> own_scene);
 
 struct BandRequest {
   core::BandJob job;
