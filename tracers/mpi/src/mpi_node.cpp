@@ -8,6 +8,7 @@
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
 
+#include "cohort/balance/bands.h"
 #include "cohort/core/band_buffer.h"
 #include "cohort/tracers/mpi_link.h"
 #include "cohort/tracers/mpi_wire.h"
@@ -148,14 +149,12 @@ class Node {
   std::vector<float> render_split(const core::BandJob& job) {
     const uint32_t begin = job.params.row_begin, end = job.params.row_end, rows = end - begin;
     const size_t n = tracers_.size();
+    // Shares in proportion to speed (the balancer module's Perfect division, in its 4-row units): the
+    // band's size changes every frame with rank 0's balancing, so speeds, not bands, are what carry over.
     std::vector<uint32_t> cuts(n + 1, begin);
-    double total = 0.0;
-    for (double r : rows_per_ms_) total += r;
-    double acc = 0.0;
-    for (size_t i = 0; i < n; ++i) {
-      acc += rows_per_ms_[i];
-      cuts[i + 1] = i + 1 == n ? end : begin + uint32_t(std::lround(rows * acc / total));
-    }
+    const std::vector<balance::Band> parts = balance::bands_from_shares(int(rows), rows_per_ms_);
+    for (size_t i = 0; i < n; ++i) cuts[i + 1] = begin + uint32_t(parts[i].end);
+    cuts[n] = end;
     std::vector<core::BandResult> results(n);
     std::vector<std::string> errors(n);
     std::vector<double> ms(n, 0.0);
@@ -182,7 +181,8 @@ class Node {
     }
     for (size_t i = 0; i < n; ++i) {
       if (!errors[i].empty() || cuts[i] >= cuts[i + 1]) continue;
-      rows_per_ms_[i] = std::max(double(cuts[i + 1] - cuts[i]) / std::max(ms[i], 1e-3), 1e-3);
+      const double speed = std::max(double(cuts[i + 1] - cuts[i]) / std::max(ms[i], 1e-3), 1e-3);
+      rows_per_ms_[i] = 0.5 * rows_per_ms_[i] + 0.5 * speed;  // smoothed like Perfect Smooth's alpha 0.5
     }
     bool complete_work = true;
     for (size_t i = 0; i < n; ++i) {

@@ -1,8 +1,9 @@
 // The node side of a remote tracer (`cohort node`, docs/cluster.md): a rank above 0 that holds its own
 // tracers, each with its own TracerScene, applies the commits rank 0 forwards and renders the bands it
 // is sent. A node with several tracers splits its band among them in proportion to the speed each
-// showed on its last band. Every message is checked before use: a malformed one is refused with a
-// logged reason and, for a commit, the node asks for a full resync instead of rendering a stale scene.
+// showed (smoothed over bands), in the balancer module's 4-row units (balance::bands_from_shares).
+// Every message is checked before use: a malformed one is refused with a logged reason and, for a
+// commit, the node asks for a full resync instead of rendering a stale scene.
 #pragma once
 
 #include <chrono>
