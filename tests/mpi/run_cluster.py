@@ -12,7 +12,9 @@ names both and renders without it), load_error (rank 1 cannot load its map: rank
 reason and renders without it), bench (`cohort bench devices` with remote tracers reports their bytes
 per frame and round trip), protocol (protocol_check.cpp on 2 ranks: malformed messages against a
 real node), replay (the test map's recorded scenario: door, fan, flicker, a skinned walker; instance,
-TLAS, light and joint records cross the wire every frame, and every frame matches).
+TLAS, light and joint records cross the wire every frame, and every frame matches), play (`cohort play`
+under a virtual display with remote tracers: the scenario runs, the screenshot is written and not
+uniform; skipped with status 77 without xvfb-run or the viewer).
 """
 import argparse
 import json
@@ -93,6 +95,29 @@ def replay(a):
     print("replay: ok")
 
 
+def play(a):
+    if not shutil.which("xvfb-run"):
+        print("SKIP: xvfb-run is not installed")
+        sys.exit(77)
+    if a.viewer_built.upper() not in ("ON", "1", "TRUE", "YES"):
+        print("SKIP: cohort was built without the viewer (COHORT_WITH_VIEWER=OFF)")
+        sys.exit(77)
+    os.makedirs(a.out)
+    shot = os.path.join(a.out, "play.png")
+    testmap = os.path.join(a.testmap_base, "maps", "testmap.map")
+    flags = mpiexec_flags(a.mpiexec)
+    _, output = run([a.mpiexec] + flags + ["-np", "1", "xvfb-run", "-a", "-s", "-screen 0 1024x768x24", a.cohort, "play",
+                                           testmap, "--tracers", "embree,mpi:1,mpi:2", "--frames", "20", "--width",
+                                           "160", "--height", "120", "--scale", "1", "--screenshot", shot] +
+                    [":"] + flags + ["-np", "2", a.cohort, "node", testmap, "--tracers", "embree"])
+    for rank in (1, 2):
+        if not re.search(rf"mpi:{rank}: \d+ band\(s\)", output):
+            sys.exit(f"mpi:{rank} rendered no band in cohort play")
+    run([sys.executable, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "apps", "image_not_uniform.py"),
+         shot])
+    print("play: ok")
+
+
 def bench(a):
     os.makedirs(a.out)
     pack = os.path.join(a.out, "scene.cpk")
@@ -120,13 +145,14 @@ def bench(a):
 
 def main():
     parser = argparse.ArgumentParser()
-    parser.add_argument("case", choices=["match", "mixed", "stall", "version", "load_error", "bench", "protocol", "replay"])
+    parser.add_argument("case", choices=["match", "mixed", "stall", "version", "load_error", "bench", "protocol", "replay", "play"])
     parser.add_argument("--mpiexec", required=True)
     parser.add_argument("--cohort", required=True)
     parser.add_argument("--map", required=True)
     parser.add_argument("--broken-map")
     parser.add_argument("--protocol-check")
     parser.add_argument("--testmap-base")
+    parser.add_argument("--viewer-built", default="OFF")
     parser.add_argument("--out", required=True)
     a = parser.parse_args()
 
@@ -136,6 +162,9 @@ def main():
         return
     if a.case == "replay":
         replay(a)
+        return
+    if a.case == "play":
+        play(a)
         return
     if a.case == "protocol":
         _, output = run([a.mpiexec] + mpiexec_flags(a.mpiexec) + ["-np", "2", a.protocol_check])
