@@ -6,7 +6,8 @@ pixel, so the images must match byte for byte).
     run_cluster.py CASE --mpiexec PATH --cohort PATH --map MAP --out DIR [--broken-map MAP]
 
 CASE: match (Embree on every rank), mixed (rank 1 splits its band between Embree and OpenCL, rank 2
-renders on OpenCL: PoCL on a machine without GPUs; images agree within the tracers' tolerance), stall (rank 2 sleeps through frame 1: its rows are re-rendered by
+renders on OpenCL: PoCL on a machine without GPUs; images agree within the tracers' tolerance),
+stall (rank 2 sleeps through frame 1: its rows are re-rendered by
 the others and every frame is still delivered), version (rank 1 announces another version: rank 0
 names both and renders without it), load_error (rank 1 cannot load its map: rank 0 logs its file:line
 reason and renders without it), bench (`cohort bench devices` with remote tracers reports their bytes
@@ -216,7 +217,7 @@ def main():
         if any("mpi:1" in o for o in outcomes):
             sys.exit("the refused node still took part")
     elif a.case == "load_error":
-        if not re.search(r"mpi:1: the node could not load its scene and leaves: .*:\d+", output):
+        if not re.search(r"mpi:1: the node could not start \(its scene or its tracers\) and leaves: .*:\d+", output):
             sys.exit("rank 0 did not log the node's file:line reason")
         if any("mpi:1" in o for o in outcomes):
             sys.exit("the node that could not load its map still took part")

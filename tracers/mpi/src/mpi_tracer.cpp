@@ -67,8 +67,8 @@ MpiTracer::MpiTracer(MpiTracerOptions options) : options_(options) {
     }
     if (m.kind == wire::Kind::load_failed) {
       mpi.released(options_.rank);  // it has left
-      throw NodeUnavailable(fmt::format("mpi:{}: the node could not load its scene and leaves: {}", options_.rank,
-                                        wire::decode_text(m.payload)));
+      throw NodeUnavailable(fmt::format("mpi:{}: the node could not start (its scene or its tracers) and leaves: {}",
+                                        options_.rank, wire::decode_text(m.payload)));
     }
     if (m.kind != wire::Kind::hello) {
       spdlog::warn("mpi:{}: ignored a {} message before the hello", options_.rank, wire::to_string(m.kind));

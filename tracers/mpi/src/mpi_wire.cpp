@@ -157,7 +157,8 @@ std::vector<uint8_t> frame_message(Kind kind, uint64_t sequence, const std::vect
 
 Message parse_message(const uint8_t* bytes, size_t size) {
   Header h;
-  if (size < sizeof h) throw WireError(fmt::format("message of {} bytes is shorter than the {}-byte header", size, sizeof h));
+  if (size < sizeof h)
+    throw WireError(fmt::format("message of {} bytes is shorter than the {}-byte header", size, sizeof h));
   std::memcpy(&h, bytes, sizeof h);
   if (h.magic != kMagic) throw WireError(fmt::format("bad magic 0x{:08x} (not a Cohort message)", h.magic));
   if (h.protocol != kProtocolVersion)
@@ -306,7 +307,11 @@ void read_records(Reader& r, commit::CommitBuffer& c) {
         c.add_skin(std::move(s));
         break;
       }
-      case Record::skin_joints: { auto skin = r.scalar<uint32_t>(); c.set_skin_joints(skin, r.array<KJoint>("joints")); break; }
+      case Record::skin_joints: {
+        auto skin = r.scalar<uint32_t>();
+        c.set_skin_joints(skin, r.array<KJoint>("joints"));
+        break;
+      }
       case Record::camera: c.set_camera(r.scalar<KCamera>()); break;
       default: r.fail(fmt::format("unknown record tag {}", tag));
     }

@@ -21,7 +21,8 @@ struct NodeOptions {
   // The scene this node loaded itself (a full resync to it costs rank 0 only the camera), or null.
   std::shared_ptr<const commit::TracerScene> scene;
   std::string scene_name;
-  // Non-empty: the node could not load its scene; it reports this (file:line: problem) and leaves.
+  // Non-empty: the node could not load its scene (file:line: problem) or open its tracers; it reports
+  // this to rank 0 and leaves.
   std::string load_error;
   // Tests: the version announced in the hello instead of this build's.
   std::string announced_version;

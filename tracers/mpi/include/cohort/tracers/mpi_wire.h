@@ -22,7 +22,7 @@ constexpr uint16_t kProtocolVersion = 1;
 
 enum class Kind : uint16_t {
   hello = 1,        // node -> 0: versions, what scene it loaded, its tracers
-  load_failed = 2,  // node -> 0: it could not load its scene (the reason, file:line), and leaves
+  load_failed = 2,  // node -> 0: it could not load its scene (file:line) or open its tracers, and leaves
   welcome = 3,      // 0 -> node: versions agree, serve bands
   refuse = 4,       // 0 -> node: versions disagree (the reason), leave
   commit = 5,       // 0 -> node: a commit buffer (records, or a whole scene)
