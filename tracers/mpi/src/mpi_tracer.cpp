@@ -154,8 +154,40 @@ void MpiTracer::apply(const commit::CommitBuffer& commit) {
   after_full_resync_ = true;
 }
 
+void MpiTracer::take_late_answers() {
+  MpiSession& mpi = MpiSession::get();
+  while (timed_out_job_ != 0) {
+    std::optional<std::vector<uint8_t>> bytes = mpi.receive(options_.rank, MpiClock::now());
+    if (!bytes) return;
+    std::lock_guard lock(stats_mutex_);
+    stats_.bytes_received += bytes->size();
+    try {
+      const wire::Message m = wire::parse_message(bytes->data(), bytes->size());
+      ++stats_.stale_answers;
+      if ((m.kind == wire::Kind::band_rows || m.kind == wire::Kind::band_failed) && m.sequence == timed_out_job_) {
+        stats_.last_round_trip_ms = std::max(stats_.last_round_trip_ms, ms_since(timed_out_start_));
+        timed_out_job_ = 0;
+        spdlog::info("mpi:{}: the node answered again, {:.0f} ms after its band was sent", options_.rank,
+                     ms_since(timed_out_start_));
+      }
+    } catch (const wire::WireError& e) {
+      ++stats_.refused_messages;
+      spdlog::warn("mpi:{}: refused a message: {}", options_.rank, e.what());
+    }
+  }
+}
+
 core::BandResult MpiTracer::render_band(const core::BandJob& job, core::BandBuffer& target) {
   MpiSession& mpi = MpiSession::get();
+  if (timed_out_job_ != 0) {
+    // A node that has not answered its last band yet (stalled, or gone) is not sent another: its band
+    // fails at once, so it costs one late frame, not one per frame, and it is back when it answers.
+    take_late_answers();
+    if (timed_out_job_ != 0)
+      throw std::runtime_error(fmt::format("mpi:{}: the node has not answered the band it was sent {:.0f} ms ago "
+                                           "(stalled or gone); its rows go to the others", options_.rank,
+                                           ms_since(timed_out_start_)));
+  }
   const uint64_t id = next_band_job++;
   wire::BandRequest request;
   request.job = job;
@@ -200,8 +232,10 @@ core::BandResult MpiTracer::render_band(const core::BandJob& job, core::BandBuff
       std::lock_guard lock(stats_mutex_);
       ++stats_.stale_answers;
       // A band that merely took longer than the timeout teaches the next deadline how long bands take.
-      if (m.sequence == timed_out_job_)
+      if (m.sequence == timed_out_job_) {
         stats_.last_round_trip_ms = std::max(stats_.last_round_trip_ms, ms_since(timed_out_start_));
+        timed_out_job_ = 0;
+      }
       spdlog::debug("mpi:{}: dropped the late answer to job {}", options_.rank, m.sequence);
       continue;
     }

@@ -6,8 +6,10 @@
 // previous band is merged. render_band() sends the band job and waits for the rows, at most the band
 // timeout; a node that stalls, fails or sends a malformed answer makes it throw, so the Renderer's
 // recovery re-renders the rows on the other tracers and the frame is delivered. A late answer is
-// recognised by its job id and dropped. A node joins once per run (its hello is remembered), so a later
-// tracer for the same rank starts at once; the MPI session's end (program exit) tells every node to leave.
+// recognised by its job id and dropped; until it has come, the node is sent no band (its bands fail at
+// once), so a stalled or lost node costs one late frame. A node joins once per run (its hello is
+// remembered), so a later tracer for the same rank starts at once; the MPI session's end (program
+// exit) tells every node to leave.
 #pragma once
 
 #include <chrono>
@@ -65,6 +67,9 @@ class MpiTracer : public core::Tracer {
  private:
   void send(int kind, uint64_t sequence, const std::vector<uint8_t>& payload);
   void adopt(const wire::Hello& hello);
+  // Reads, without waiting, what the node sent since a band timed out; clears timed_out_job_ once the
+  // answer to that band is among it.
+  void take_late_answers();
 
   MpiTracerOptions options_;
   std::string description_;
