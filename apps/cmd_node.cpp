@@ -28,7 +28,7 @@ struct NodeArgs {
   int width = 0, height = 0;
   double time = 0.0;
   std::string announced_version;
-  int stall_frame = -1, stall_ms = 0;
+  int stall_frame = -1, stall_ms = 0, die_frame = -1;
   int idle_timeout_s = 600;
 };
 
@@ -39,6 +39,7 @@ int run_node_command(const NodeArgs& a) {
   options.announced_version = a.announced_version;
   options.stall_frame = a.stall_frame;
   options.stall_ms = a.stall_ms;
+  options.die_frame = a.die_frame;
   options.idle_timeout = std::chrono::seconds(a.idle_timeout_s);
   std::vector<std::unique_ptr<core::Tracer>> tracers;
   try {
@@ -89,6 +90,7 @@ void add_node_command(CLI::App& app, int& exit_code) {
   cmd->add_option("--announce-version", a->announced_version, "")->group("");
   cmd->add_option("--stall-frame", a->stall_frame, "")->group("");
   cmd->add_option("--stall-ms", a->stall_ms, "")->group("");
+  cmd->add_option("--die-frame", a->die_frame, "")->group("");
   cmd->callback([a, &exit_code] {
 #ifdef COHORT_HAVE_MPI
     exit_code = run_node_command(*a);

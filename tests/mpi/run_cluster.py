@@ -8,7 +8,8 @@ pixel, so the images must match byte for byte).
 CASE: match (Embree on every rank), mixed (rank 1 splits its band between Embree and OpenCL, rank 2
 renders on OpenCL: PoCL on a machine without GPUs; images agree within the tracers' tolerance),
 stall (rank 2 sleeps through frame 1: its rows are re-rendered by
-the others, only that frame is late, and rank 2 renders again once it answers), version (rank 1 announces another version: rank 0
+the others, only that frame is late, and rank 2 renders again once it answers), killed (the same with
+rank 2 killed: Open MPI only, with orte_enable_recovery), version (rank 1 announces another version: rank 0
 names both and renders without it), load_error (rank 1 cannot load its map: rank 0 logs its file:line
 reason and renders without it), bench (`cohort bench devices` with remote tracers reports their bytes
 per frame and round trip), protocol (protocol_check.cpp on 2 ranks: malformed messages against a
@@ -74,10 +75,18 @@ def tracer_outcomes(out_dir):
     return [{t["name"]: t["outcome"] for t in frame["tracers"]} for frame in stats["frames"]]
 
 
-def stall(a):
-    """Rank 2 sleeps 1.2 s before its band of frame 1; bands time out after 1 s. Frame 1 is the one late
-    frame (its rows are re-rendered by the others); while rank 2 has not answered, its bands fail at
-    once; once it answers it renders again. The last frame matches the single-process render."""
+def stall(a, killed=False):
+    """Rank 2 sleeps 1.2 s before its band of frame 1 (killed: kills itself there); bands time out after
+    1 s. Frame 1 is the one late frame (its rows are re-rendered by the others); while rank 2 has not
+    answered, its bands fail at once; a stalled rank 2 renders again once it answers. The last frame
+    matches the single-process render. A killed rank needs a launcher that lets the job outlive it:
+    Open MPI with orte_enable_recovery (others: skipped)."""
+    flags = mpiexec_flags(a.mpiexec)
+    if killed:
+        if "--oversubscribe" not in flags:
+            print("SKIP: only Open MPI's mpirun is known here to let a job outlive a killed rank")
+            sys.exit(77)
+        flags = flags + ["--mca", "orte_enable_recovery", "1"]
     frames = 400
     args = ["--width", "192", "--height", "128", "--spp", "2", "--frames", str(frames), "--write", "last",
             "--balancer", "perfect-smooth"]
@@ -85,13 +94,15 @@ def stall(a):
     run([a.cohort, "render", a.map, "--tracers", "embree", "--out", single] + args)
     env = dict(os.environ)
     env["COHORT_MPI_BAND_TIMEOUT_MS"] = "1000"
-    flags = mpiexec_flags(a.mpiexec)
+    fault = ["--die-frame", "1"] if killed else ["--stall-frame", "1", "--stall-ms", "1200"]
     _, output = run([a.mpiexec] + flags + ["-np", "1", a.cohort, "render", a.map, "--tracers", "embree,mpi:1,mpi:2",
                                            "--out", cluster] + args +
                     [":"] + flags + ["-np", "1", a.cohort, "node", a.map, "--tracers", "embree"] +
-                    [":"] + flags + ["-np", "1", a.cohort, "node", a.map, "--tracers", "embree", "--stall-frame", "1",
-                                     "--stall-ms", "1200"], env=env)
+                    [":"] + flags + ["-np", "1", a.cohort, "node", a.map, "--tracers", "embree"] + fault,
+                    env=env, expect_ok=not killed)
     name = f"frame_{frames - 1:04d}.png"
+    if not os.path.exists(os.path.join(cluster, "stats.json")):
+        sys.exit("rank 0 did not finish the run")
     (w, h, ca, pa), (_, _, cb, pb) = read_image(os.path.join(single, name)), read_image(os.path.join(cluster, name))
     differing = sum(1 for p in range(w * h) if pa[p * ca:p * ca + 3] != pb[p * cb:p * cb + 3])
     print(f"{name}: {differing} of {w * h} pixels differ")
@@ -106,14 +117,19 @@ def stall(a):
     if differing:
         sys.exit("the last frame differs from the single-process render")
     if late != [1]:
-        sys.exit(f"the stall should make frame 1, and only it, late: {late}")
+        sys.exit(f"the fault should make frame 1, and only it, late: {late}")
     if "no answer for rows" not in outcome[1]["mpi:2"][1]:
-        sys.exit(f"frame 1: the stalled node's band should have timed out: {outcome[1]['mpi:2']}")
+        sys.exit(f"frame 1: the node's band should have timed out: {outcome[1]['mpi:2']}")
     if outcome[2]["mpi:2"][0] != "threw" or "has not answered" not in outcome[2]["mpi:2"][1]:
-        sys.exit(f"frame 2: the still-stalled node should have been skipped at once: {outcome[2]['mpi:2']}")
-    if outcome[-1]["mpi:2"][0] != "rendered":
+        sys.exit(f"frame 2: the silent node should have been skipped at once: {outcome[2]['mpi:2']}")
+    if killed:
+        if any(o["mpi:2"][0] == "rendered" for o in outcome[1:]):
+            sys.exit("a killed node cannot have rendered")
+        if any(o["mpi:1"][0] != "rendered" for o in outcome):
+            sys.exit("the surviving node should have rendered every frame")
+    elif outcome[-1]["mpi:2"][0] != "rendered":
         sys.exit("the node did not come back after answering")
-    print("stall: ok")
+    print(f"{a.case}: ok")
 
 
 def replay(a):
@@ -188,7 +204,8 @@ def bench(a):
 
 def main():
     parser = argparse.ArgumentParser()
-    parser.add_argument("case", choices=["match", "mixed", "stall", "version", "load_error", "bench", "protocol", "replay", "play"])
+    parser.add_argument("case", choices=["match", "mixed", "stall", "killed", "version", "load_error", "bench", "protocol", "replay",
+                                           "play"])
     parser.add_argument("--mpiexec", required=True)
     parser.add_argument("--cohort", required=True)
     parser.add_argument("--map", required=True)
@@ -200,8 +217,8 @@ def main():
     a = parser.parse_args()
 
     shutil.rmtree(a.out, ignore_errors=True)
-    if a.case == "stall":
-        stall(a)
+    if a.case in ("stall", "killed"):
+        stall(a, killed=a.case == "killed")
         return
     if a.case == "bench":
         bench(a)

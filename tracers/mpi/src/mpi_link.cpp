@@ -50,6 +50,9 @@ MpiSession::MpiSession() : impl_(new Impl) {
   }
   // A communicator of our own, so that Cohort's messages never meet another library's.
   MPI_Comm_dup(MPI_COMM_WORLD, &impl_->comm);
+  // Failures come back as error codes (a lost peer fails that peer's tracer, not the process), where
+  // the library and launcher let the job outlive a rank at all.
+  MPI_Comm_set_errhandler(impl_->comm, MPI_ERRORS_RETURN);
   MPI_Comm_rank(impl_->comm, &rank_);
   MPI_Comm_size(impl_->comm, &size_);
 }

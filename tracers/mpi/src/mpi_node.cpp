@@ -3,6 +3,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <csignal>
 #include <thread>
 
 #include <fmt/format.h>
@@ -122,6 +123,10 @@ class Node {
       return;
     }
     const KFrameParams& p = request.job.params;
+    if (int(p.frame_index) == options_.die_frame) {
+      spdlog::warn("node {}: killing itself before frame {} (--die-frame)", mpi.rank(), p.frame_index);
+      std::raise(SIGKILL);
+    }
     if (int(p.frame_index) == options_.stall_frame && !stalled_) {
       stalled_ = true;
       spdlog::warn("node {}: stalling {} ms before frame {} (--stall-frame)", mpi.rank(), options_.stall_ms,

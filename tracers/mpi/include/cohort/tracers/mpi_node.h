@@ -29,6 +29,8 @@ struct NodeOptions {
   // Tests: before rendering the band of this frame index, sleep stall_ms once (a stalled node).
   int stall_frame = -1;
   int stall_ms = 0;
+  // Tests: before rendering the band of this frame index, the process kills itself (a lost node).
+  int die_frame = -1;
   // Rank 0 silent this long: the node leaves.
   std::chrono::seconds idle_timeout{600};
 };
