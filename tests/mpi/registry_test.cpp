@@ -18,6 +18,15 @@ TEST(MpiRegistry, RemoteTracersAreNamedByRank) {
   EXPECT_NE(std::find(kinds.begin(), kinds.end(), "mpi"), kinds.end());
 }
 
+TEST(MpiRegistry, ANodeServesOneRemoteTracer) {
+  try {
+    tracers::parse_tracer_list("mpi:1,embree,mpi:1");
+    ADD_FAILURE() << "mpi:1 twice was accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("named twice"), std::string::npos) << e.what();
+  }
+}
+
 TEST(MpiRegistry, ARemoteTracerNeedsARankAboveZero) {
   for (const char* bad : {"mpi", "mpi:0", "mpi:x", "mpi:"}) {
     try {

@@ -100,6 +100,11 @@ std::vector<TracerSpec> parse_tracer_list(const std::string& list) {
       throw std::invalid_argument("unknown tracer '" + item + "' (known: embree, opencl[:N], cuda[:N], mpi:RANK)");
     if (spec.kind == "mpi" && (colon == std::string::npos || spec.device < 1))
       throw std::invalid_argument("tracer '" + item + "': a remote tracer names its node's MPI rank, 1 or more (mpi:1)");
+    // Two tracers on one node would take each other's answers: a node serves one remote tracer.
+    for (const TracerSpec& earlier : specs)
+      if (spec.kind == "mpi" && earlier.kind == "mpi" && earlier.device == spec.device)
+        throw std::invalid_argument("tracer '" + item + "' is named twice: a node serves one remote tracer (give it "
+                                    "several local tracers with `cohort node --tracers`)");
     if (spec.kind == "embree" && colon != std::string::npos)
       throw std::invalid_argument("tracer '" + item + "': the Embree tracer takes no device index");
     specs.push_back(spec);
