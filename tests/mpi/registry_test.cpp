@@ -14,8 +14,10 @@ TEST(MpiRegistry, RemoteTracersAreNamedByRank) {
   EXPECT_EQ(specs[1].device, 1);
   EXPECT_EQ(specs[2].device, 12);
   EXPECT_EQ(specs[2].text, "mpi:12");
+  EXPECT_TRUE(tracers::remote_tracers_built());
+  // The in-process kinds, which the tracer tests iterate, leave it out: it needs a node to render.
   const auto kinds = tracers::built_tracer_kinds();
-  EXPECT_NE(std::find(kinds.begin(), kinds.end(), "mpi"), kinds.end());
+  EXPECT_EQ(std::find(kinds.begin(), kinds.end(), "mpi"), kinds.end());
 }
 
 TEST(MpiRegistry, ANodeServesOneRemoteTracer) {

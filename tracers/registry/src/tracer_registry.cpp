@@ -172,10 +172,15 @@ std::vector<std::string> built_tracer_kinds() {
 #ifdef COHORT_HAVE_CUDA
   kinds.push_back("cuda");
 #endif
-#ifdef COHORT_HAVE_MPI
-  kinds.push_back("mpi");
-#endif
   return kinds;
+}
+
+bool remote_tracers_built() {
+#ifdef COHORT_HAVE_MPI
+  return true;
+#else
+  return false;
+#endif
 }
 
 int device_count(const std::string& kind) {

@@ -27,8 +27,11 @@ std::vector<TracerSpec> parse_tracer_list(const std::string& list);
 std::unique_ptr<core::Tracer> make_tracer(const TracerSpec& spec);
 std::vector<std::unique_ptr<core::Tracer>> make_tracers(const std::string& list);
 
-// The tracer kinds this binary was built with.
+// The tracer kinds this binary was built with that render in this process (the remote `mpi` kind is
+// not among them: it needs a node on another MPI rank).
 std::vector<std::string> built_tracer_kinds();
+// Whether this binary has remote tracers (`mpi:RANK`, COHORT_WITH_MPI).
+bool remote_tracers_built();
 
 // How many devices of that kind this machine offers the tracer: 1 for Embree (the CPU), 0 for a kind
 // this build lacks. Never throws.
