@@ -123,7 +123,7 @@ int run_play(PlayArgs a) {
   settings.light_sampling = core::light_sampling_mode(a.light_sampling);
   settings.mode = debug_mode_from_name(a.mode).value_or(K_MODE_PATH);
   settings.tone_curve = a.tone;
-  settings.reproject = resolve_convergence(a.convergence, session->any_gpu_tracer()) == "reproject";
+  settings.reproject = resolve_convergence(a.convergence, session->any_gpu_tracer(), session->frame_post_place()) == "reproject";
   float scale = a.scale;
   // A frame-rate target: spp and render scale follow the measured frame time (core/workload_scaler.h)
   // until the user picks either by hand.
@@ -337,7 +337,8 @@ void add_play_command(CLI::App& app, int& exit_code) {
       ->check(CLI::IsMember(core::light_sampling_names()));
   cmd->add_option("--convergence", a->convergence,
                   "how frames accumulate: reproject (per-pixel history through motion vectors), brigade "
-                  "(whole-frame blend) or auto (reproject unless a tracer renders on a GPU); see `cohort render --help`")
+                  "(whole-frame blend) or auto (reproject, on the first CUDA tracer's GPU if any; Brigade's blend when only OpenCL GPUs would wait "
+                  "for the host's reprojection); see `cohort render --help`")
       ->capture_default_str()
       ->check(CLI::IsMember({"auto", "brigade", "reproject"}));
   cmd->add_option("--target-fps", a->target_fps,

@@ -15,7 +15,7 @@
 #include "cohort/core/frame_timeline.h"
 #include "cohort/core/gpu_scene.h"
 #include "cohort/core/convergence.h"
-#include "cohort/core/reprojection.h"
+#include "cohort/core/frame_post.h"
 #include "cohort/core/oidn_denoiser.h"
 #include "cohort/core/frame_defaults.h"
 #include "cohort/core/frame_pipeline.h"
@@ -61,6 +61,8 @@ struct RenderArgs {
   std::string trace;
   std::string denoise = "none";
   std::string denoise_quality = "high";
+  int atrous_passes = 0;  // 0: from the image height (core/atrous_filter.h)
+  std::string post_on = "auto";
   std::string band_format = "rgb16f";
   bool frames_given = false;
 };
@@ -89,7 +91,9 @@ int run_render(const RenderArgs& a) {
   std::vector<std::unique_ptr<core::Tracer>> tracers = tracers::make_tracers(a.tracers);
   bool any_gpu_tracer = false;
   for (const auto& tracer : tracers) any_gpu_tracer = any_gpu_tracer || tracer->renders_on_gpu();
-  const std::string convergence_mode = resolve_convergence(a.convergence, any_gpu_tracer);
+  const std::string post_place =
+      a.post_on == "auto" ? tracers::auto_frame_post_place(tracers::parse_tracer_list(a.tracers)) : a.post_on;
+  const std::string convergence_mode = resolve_convergence(a.convergence, any_gpu_tracer, post_place);
   core::RendererOptions options;
   options.balancer = a.balancer;
   options.band_format = a.band_format == "rgba32f" ? core::BandFormat::rgba32f : core::BandFormat::rgb16f;
@@ -138,7 +142,6 @@ int run_render(const RenderArgs& a) {
   const bool oiio = core::have_image_library();
   nlohmann::json stats_json = nlohmann::json::array();
   core::AdaptiveConvergence convergence;
-  core::TemporalReprojection reprojection;
   const bool reproject = convergence_mode == "reproject" && !a.no_convergence;
   core::FrameBuffer albedo_guide, normal_guide;
   KCamera previous_camera{};  // none yet: the first frame is its own previous
@@ -150,7 +153,20 @@ int run_render(const RenderArgs& a) {
   // The denoiser filters what is shown and written, never the accumulated history.
   std::unique_ptr<core::OidnDenoiser> denoiser;
   core::FrameBuffer denoised;
-  if (a.denoise != "none") {
+  const bool atrous = a.denoise == "atrous";
+  // Reprojection and the a-trous filter run together, on the host or on a GPU (core/frame_post.h).
+  std::unique_ptr<core::FramePost> post;
+  if (reproject || atrous) {
+    core::FramePostOptions post_options;
+    post_options.reproject = reproject;
+    post_options.atrous = atrous;
+    post_options.atrous_options.passes =
+        a.atrous_passes > 0 ? a.atrous_passes : core::atrous_passes_for_height(a.height);
+    post = tracers::make_frame_post(post_place, post_options);
+    spdlog::info("{}{}{} on {}", reproject ? "reprojection" : "", reproject && atrous ? " and " : "",
+                 atrous ? "the a-trous filter" : "", post->where());
+  }
+  if (a.denoise != "none" && !atrous) {
     denoiser = core::OidnDenoiser::open(core::parse_oidn_device(a.denoise == "oidn-cuda" ? "cuda" : "cpu"),
                                          core::parse_oidn_quality(a.denoise_quality));
     spdlog::info("denoising with Open Image Denoise ({} device, {})", core::oidn_device_name(denoiser->device()),
@@ -169,18 +185,22 @@ int run_render(const RenderArgs& a) {
     // Adaptive convergence: a still camera accumulates every frame; motion raises f (see convergence.h).
     // Reprojection (--convergence reproject): per-pixel history through the frame's motion vectors.
     const core::GBuffer& gbuffer = pipeline.gbuffer();
-    if (reproject) {
-      core::ScopedStage blending(stats.stages, core::kCoreTrack, "convergence");
-      reprojection.accumulate(frame, gbuffer);
-      stats.convergence_f = 1.0 / std::max(reprojection.mean_history_length(), 1.0);
-    } else if (!a.no_convergence) {
+    if (!reproject && !a.no_convergence) {
       core::ScopedStage blending(stats.stages, core::kCoreTrack, "convergence");
       stats.convergence_f = convergence.accumulate(done.job.camera, frame);
     }
-    const core::FrameBuffer* shown_image =
-        a.no_convergence ? &frame : reproject ? &reprojection.image() : &convergence.image();
+    const core::FrameBuffer* shown_image = a.no_convergence ? &frame : &convergence.image();
+    if (post && !gbuffer.empty()) {
+      // One stage: on a GPU the two steps share one upload and one download.
+      core::ScopedStage posting(stats.stages, core::kCoreTrack,
+                                !atrous ? "convergence" : reproject ? "convergence+denoise" : "denoise");
+      post->process(reproject ? frame : *shown_image, gbuffer);
+      if (reproject) stats.convergence_f = 1.0 / std::max(post->mean_history_length(), 1.0);
+    }
     const bool writes_frame = !(a.write == "last" && f + 1 < a.frames && !player);
-    if (denoiser && writes_frame) {
+    if (post && !gbuffer.empty()) {
+      shown_image = &post->image();
+    } else if (denoiser && writes_frame) {
       core::ScopedStage denoising(stats.stages, core::kCoreTrack, "denoise");
       core::DenoiseGuides guides;
       if (!gbuffer.empty()) {  // the aux planes guide the filter where the frame has them
@@ -255,7 +275,7 @@ int run_render(const RenderArgs& a) {
     p.spec_boost = a.spec_boost;
     p.mode = modes().at(a.mode);
     p.soft_shadow_scale = a.soft_shadow_scale;
-    if (reproject) {
+    if (reproject || atrous) {
       p.aux_outputs = 1u;
       job.previous_camera = previous_camera;
       previous_camera = job.camera;
@@ -343,10 +363,21 @@ void add_render_command(CLI::App& app, int& exit_code) {
         }
       });
   cmd->add_option("--denoise", a->denoise,
-                  "denoise the shown frame: none, oidn (Intel Open Image Denoise on the CPU) or oidn-cuda (on an "
-                  "NVIDIA GPU); tools/fetch_oidn.sh installs the library")
+                  "denoise the shown frame: none, atrous (the real-time edge-aware a-trous filter of the portable "
+                  "kernel, every frame), oidn (Intel Open Image Denoise on the CPU) or oidn-cuda (on an NVIDIA GPU); "
+                  "tools/fetch_oidn.sh installs the library")
       ->capture_default_str()
-      ->check(CLI::IsMember({"none", "oidn", "oidn-cuda"}));
+      ->check(CLI::IsMember({"none", "atrous", "oidn", "oidn-cuda"}));
+  cmd->add_option("--atrous-passes", a->atrous_passes,
+                  "passes of --denoise atrous (steps 1, 2, 4, ...: 1 pass is a 5x5 filter, 3 a 29-pixel one); "
+                  "0 picks them from the image height (1 up to 360 rows, 3 at 1080)")
+      ->capture_default_str()
+      ->check(CLI::Range(0, 6));
+  cmd->add_option("--post-on", a->post_on,
+                  "where reprojection and the a-trous filter run: host (the CPU's threads), cuda:N (a GPU; the "
+                  "frame and its G-buffer cross the bus each frame) or auto (the first CUDA tracer's GPU, else the "
+                  "host)")
+      ->capture_default_str();
   cmd->add_option("--denoise-quality", a->denoise_quality,
                   "Open Image Denoise's filter quality: high, balanced or fast (several times quicker)")
       ->capture_default_str()
@@ -354,9 +385,9 @@ void add_render_command(CLI::App& app, int& exit_code) {
   cmd->add_option("--convergence", a->convergence,
                   "how frames accumulate: reproject (per-pixel history through motion vectors, with disocclusion "
                   "tests and neighbourhood clamping; the tracers also write depth, normal, albedo, id and motion) "
-                  "or brigade (whole-frame blend, f from camera motion; the paper's); auto: reproject unless a "
-                  "tracer renders on a GPU, where the host's reprojection would set the frame rate "
-                  "(docs/denoising.md)")
+                  "or brigade (whole-frame blend, f from camera motion; the paper's); auto: reproject, except when "
+                  "GPU tracers render and the reprojection would run on the host (no CUDA GPU for --post-on), "
+                  "where it would set the frame rate (docs/denoising.md)")
       ->capture_default_str()
       ->check(CLI::IsMember({"auto", "brigade", "reproject"}));
   cmd->add_flag("--no-convergence", a->no_convergence,

@@ -1,21 +1,23 @@
 // `--convergence auto`: which accumulation a run uses when the user did not say.
 //
-// Reprojection looks far better in motion (docs/denoising.md) but runs on the host: on nvidia-h100-x1
-// (16 cores) it costs 31 ms a frame at 1920x1080 and 12 ms at 1280x720, plus the tracers' auxiliary
-// planes, against a GPU frame of 5-17 ms, so with a GPU tracer it would set the frame rate (measured:
-// 49.9 against 16.7 ms per frame on the large map, 22.0 against 4.8 ms on the test map;
-// docs/denoising.md, "Cost on the GPU machine"). CPU tracers take far longer per frame than the
-// reprojection, so there it is nearly free.
+// Reprojection looks far better in motion (docs/denoising.md). Its per-pixel work runs where the frame's
+// post-processing runs (core/frame_post.h): on the host it costs 18-31 ms a frame at 1920x1080 on
+// nvidia-h100-x1's 16 cores, longer than a GPU's frame (22.5 against 13.7 ms per frame with Brigade's
+// blend on the large map); on the GPU it is hidden behind the next frame's render (16.4 ms per frame,
+// the tracer's auxiliary planes being the difference; docs/denoising.md, "Cost on the GPU machine").
+// So: reproject when only CPU tracers render (their frame is far longer than the host's reprojection)
+// or when the post-processing runs on a GPU; Brigade's blend when GPU tracers would wait for the host.
 #pragma once
 
 #include <string>
 
 namespace cohort::app {
 
-// "reproject" or "brigade" for a requested mode of auto, reproject or brigade.
-inline std::string resolve_convergence(const std::string& requested, bool any_gpu_tracer) {
+// "reproject" or "brigade" for a requested mode of auto, reproject or brigade; `post_place` is where the
+// frame's post-processing runs ("host", "cuda:N").
+inline std::string resolve_convergence(const std::string& requested, bool any_gpu_tracer, const std::string& post_place) {
   if (requested != "auto") return requested;
-  return any_gpu_tracer ? "brigade" : "reproject";
+  return !any_gpu_tracer || post_place != "host" ? "reproject" : "brigade";
 }
 
 }  // namespace cohort::app

@@ -8,7 +8,7 @@
 
 #include "cohort/commit/commit_buffer.h"
 #include "cohort/core/convergence.h"
-#include "cohort/core/reprojection.h"
+#include "cohort/core/frame_post.h"
 #include "cohort/core/frame_defaults.h"
 #include "cohort/core/frame_pipeline.h"
 #include "cohort/core/frame_timeline.h"
@@ -71,7 +71,7 @@ struct PlaySession::State {
     bool animating = false;
   } in_flight;
   core::AdaptiveConvergence convergence;
-  core::TemporalReprojection reprojection;
+  std::unique_ptr<core::FramePost> reprojection;  // on the first CUDA tracer's GPU, else the host
   KCamera previous_camera{};   // of the frame handed out last, for motion vectors
   std::vector<float> moving_mask;
   double scenario_seconds = 0.0;
@@ -79,6 +79,7 @@ struct PlaySession::State {
   kuint last_mode = K_MODE_PATH;
   std::string map_name;
   bool any_gpu_tracer = false;
+  std::string post_place;
 };
 
 PlaySession::PlaySession(const SessionOptions& options) {
@@ -92,9 +93,11 @@ PlaySession::PlaySession(const SessionOptions& options) {
   std::vector<std::unique_ptr<core::Tracer>> tracers;
   // parse_tracer_list expands "all" and ":all" by probing devices; a device that then fails to open
   // is dropped with a warning and the others carry on.
+  std::vector<tracers::TracerSpec> started;
   for (const tracers::TracerSpec& spec : tracers::parse_tracer_list(list)) {
     try {
       tracers.push_back(tracers::make_tracer(spec));
+      started.push_back(spec);
     } catch (const std::exception& e) {
       warnings_.push_back("tracer " + spec.text + " did not start: " + e.what());
       spdlog::warn("{}; carrying on with the others", warnings_.back());
@@ -110,6 +113,9 @@ PlaySession::PlaySession(const SessionOptions& options) {
   s.renderer = std::make_unique<core::Renderer>(std::move(tracers), renderer_options);
   s.renderer->submit_commit(commit::CommitBuffer::full(initial_scene, 0));
   s.pipeline = std::make_unique<core::FramePipeline>(*s.renderer);
+  core::FramePostOptions post_options;  // reprojection alone: the HUD view is not filtered
+  s.post_place = tracers::auto_frame_post_place(started);
+  s.reprojection = tracers::make_frame_post(s.post_place, post_options);
 
   if (options.scenario) {
     try {
@@ -189,23 +195,23 @@ SessionFrame PlaySession::frame(const viewer::FlyCamera& camera, double seconds,
 
   if (mode != s.last_mode) {  // another view of the scene entirely
     s.convergence.reset();
-    s.reprojection.reset();
+    s.reprojection->reset();
   }
   s.last_mode = mode;
   const core::GBuffer& gbuffer = s.pipeline->gbuffer();
   if (done->job.params.aux_outputs != 0u && !gbuffer.empty()) {
     // Per-pixel history: moving objects carry their own motion, so no mask is needed.
     core::ScopedStage blending(out.stats.stages, core::kCoreTrack, "convergence");
-    s.reprojection.accumulate(hdr, gbuffer);
-    out.stats.convergence_f = 1.0 / std::max(s.reprojection.mean_history_length(), 1.0);
+    s.reprojection->process(hdr, gbuffer);
+    out.stats.convergence_f = 1.0 / std::max(s.reprojection->mean_history_length(), 1.0);
     blending.finish();
     core::ToneMapOptions tm;
     tm.curve = core::parse_tone_curve(settings.tone_curve);
     core::ScopedStage tone_mapping(out.stats.stages, core::kCoreTrack, "tone map");
-    out.display = core::tone_map(s.reprojection.image(), tm);
+    out.display = core::tone_map(s.reprojection->image(), tm);
     tone_mapping.finish();
-    out.width = s.reprojection.image().width;
-    out.height = s.reprojection.image().height;
+    out.width = s.reprojection->image().width;
+    out.height = s.reprojection->image().height;
     return out;
   }
   // Without per-pixel object ids every pixel counts as possibly moving while the door, fan and
@@ -235,6 +241,7 @@ bool PlaySession::scenario_running() const { return state_->scenario != nullptr;
 const std::string& PlaySession::map_name() const { return state_->map_name; }
 
 bool PlaySession::any_gpu_tracer() const { return state_->any_gpu_tracer; }
+const std::string& PlaySession::frame_post_place() const { return state_->post_place; }
 
 std::vector<std::string> PlaySession::tracer_names() const {
   std::vector<std::string> names;

@@ -65,6 +65,8 @@ class PlaySession {
   std::vector<std::string> tracer_names() const;
   // Whether any of the session's tracers renders on a GPU (see convergence_choice.h).
   bool any_gpu_tracer() const;
+  // Where the reprojection runs: "host" or "cuda:N" (the first CUDA tracer's GPU).
+  const std::string& frame_post_place() const;
   // Tracers that did not start, a scenario that cannot run: things the HUD and log should say.
   const std::vector<std::string>& warnings() const { return warnings_; }
   const std::string& map_name() const;

@@ -3,7 +3,8 @@
 // host besides the tracers. Two simulated tracers (virtual clock) split the rows; the camera stays
 // still, so every frame blends into the accumulated image. The reprojection (core/reprojection.h) is
 // timed beside the blend on a synthetic G-buffer in which every pixel moves (0.3 pixels a frame, the
-// costly case: bilinear history and neighbourhood clamp everywhere).
+// costly case: bilinear history and neighbourhood clamp everywhere), then the a-trous filter over its
+// result with the passes `--denoise atrous` picks for the height.
 //
 //   bench_host_frame [--width 1920] [--height 1080] [--frames 40] [--json FILE]   (out/bench_host_frame.json)
 #include <algorithm>
@@ -19,6 +20,7 @@
 #include "cohort/core/frame_pipeline.h"
 #include "cohort/core/host_threads.h"
 #include "cohort/core/renderer.h"
+#include "cohort/core/atrous_filter.h"
 #include "cohort/core/reprojection.h"
 #include "cohort/core/simulated_tracer.h"
 #include "cohort/core/tonemap.h"
@@ -57,6 +59,8 @@ nlohmann::json run(BandFormat format, int width, int height, int frames) {
   AdaptiveConvergence convergence;
   ToneMapOptions tone_options;
   TemporalReprojection reprojection;
+  AtrousFilter atrous(AtrousOptions{atrous_passes_for_height(height)});
+  FrameBuffer filtered;
   GBuffer moving;
   moving.resize(width, height);
   for (size_t p = 0; p < moving.pixels(); ++p) {
@@ -64,8 +68,9 @@ nlohmann::json run(BandFormat format, int width, int height, int frames) {
     moving.normal[3 * p + 2] = 1.0f;
     moving.id[p] = 0;
     moving.motion[2 * p] = 0.3f;
+    for (int k = 0; k < 3; ++k) moving.albedo[3 * p + k] = 0.5f;
   }
-  std::vector<double> merge, blend, tone, reproject;
+  std::vector<double> merge, blend, tone, reproject, denoise;
   auto finish = [&](FramePipeline::Delivered done) {
     ScopedStage blending(done.stats.stages, kCoreTrack, "convergence");
     convergence.accumulate(done.job.camera, pipeline.image());
@@ -73,6 +78,9 @@ nlohmann::json run(BandFormat format, int width, int height, int frames) {
     ScopedStage reprojecting(done.stats.stages, kCoreTrack, "reproject");
     reprojection.accumulate(pipeline.image(), moving);
     reprojecting.finish();
+    ScopedStage filtering(done.stats.stages, kCoreTrack, "atrous");
+    atrous.apply(reprojection.image(), moving, filtered);
+    filtering.finish();
     ScopedStage mapping(done.stats.stages, kCoreTrack, "tone map");
     const std::vector<uint8_t> display = tone_map(convergence.image(), tone_options);
     mapping.finish();
@@ -81,6 +89,7 @@ nlohmann::json run(BandFormat format, int width, int height, int frames) {
     blend.push_back(stage_ms(done.stats, "convergence"));
     tone.push_back(stage_ms(done.stats, "tone map"));
     reproject.push_back(stage_ms(done.stats, "reproject"));
+    denoise.push_back(stage_ms(done.stats, "atrous"));
   };
   for (int f = 0; f < frames; ++f) {
     BandJob job;
@@ -92,7 +101,8 @@ nlohmann::json run(BandFormat format, int width, int height, int frames) {
   const double m = median(merge), c = median(blend), t = median(tone);
   return {{"band_format", to_string(format)}, {"band_bytes_per_pixel", bytes_per_pixel(format)},
           {"merge_ms", m}, {"convergence_ms", c}, {"tone_map_ms", t}, {"host_ms", m + c + t},
-          {"reproject_ms", median(reproject)}};
+          {"reproject_ms", median(reproject)}, {"atrous_passes", atrous_passes_for_height(height)},
+          {"atrous_ms", median(denoise)}};
 }
 
 }  // namespace
@@ -113,14 +123,14 @@ int main(int argc, char** argv) {
   }
   std::printf("host work per frame at %dx%d, %u host threads, median of %d frames\n", width, height,
               HostThreads::shared().threads(), frames - 5);
-  std::printf("%-8s %10s %10s %14s %12s %10s %13s\n", "band", "bytes/px", "merge ms", "convergence ms", "tone map ms",
-              "host ms", "reproject ms");
+  std::printf("%-8s %10s %10s %14s %12s %10s %13s %10s\n", "band", "bytes/px", "merge ms", "convergence ms",
+              "tone map ms", "host ms", "reproject ms", "atrous ms");
   nlohmann::json results = nlohmann::json::array();
   for (BandFormat format : {BandFormat::rgba32f, BandFormat::rgb16f}) {
     const nlohmann::json r = run(format, width, height, frames);
-    std::printf("%-8s %10zu %10.2f %14.2f %12.2f %10.2f %13.2f\n", to_string(format), bytes_per_pixel(format),
+    std::printf("%-8s %10zu %10.2f %14.2f %12.2f %10.2f %13.2f %10.2f\n", to_string(format), bytes_per_pixel(format),
                 r["merge_ms"].get<double>(), r["convergence_ms"].get<double>(), r["tone_map_ms"].get<double>(),
-                r["host_ms"].get<double>(), r["reproject_ms"].get<double>());
+                r["host_ms"].get<double>(), r["reproject_ms"].get<double>(), r["atrous_ms"].get<double>());
     results.push_back(r);
   }
   const std::filesystem::path path(json_path);

@@ -7,9 +7,12 @@
 #   tools/gpu_run.sh remote    there (device tool: run command "bash tools/gpu_run.sh remote", carry [".gpu"]):
 #                              registers NVIDIA's OpenCL, runs the GPU tests and benchmarks, writes
 #                              results (logs, JSON, PPM frames) to $OUT
+#   tools/gpu_run.sh multigpu  there, on a several-GPU kind: issue 14's end-to-end mixes (two GPUs, each with
+#                              Embree and OpenCL), bench devices on both maps, Table 1 with two real GPUs
 #   tools/gpu_run.sh frametimes  there: only the end-to-end frame times (large map 1080p generated there,
-#                              test map 720p; cuda:0, 1 spp, NEE + 1 bounce; with and without emissive NEE,
-#                              reprojection and Brigade's blend; per-stage medians)
+#                              test map 720p; cuda:0, 1 spp, NEE + 1 bounce; reprojection on the GPU with and
+#                              without the a-trous filter, on the host, and Brigade's blend; per-stage medians;
+#                              the last frames go to $OUT/frames)
 #
 # The binaries and libraries travel compressed (.gpu/payload.tar.xz, ~11 MB instead of ~60 MB): the device
 # tool carries at most 64 MiB with the working tree.
@@ -49,20 +52,55 @@ case "${1:-}" in
     nvidia-smi --query-gpu=index,name --format=csv,noheader
     [ -f /tmp/largemap.cpk ] || { python3 tools/gen_testmap.py --large --out /tmp/largemap >/dev/null &&
       "$stage/bin/cohort" pack /tmp/largemap/maps/largemap.map --out /tmp/largemap.cpk | tail -n 1; }
-    # Emissive NEE on and off with the default convergence, then the paper's blend for the host's share.
-    for variant in "1 reproject" "0 reproject" "1 brigade"; do
-      read -r emissive convergence <<<"$variant"
+    # Reprojection on the GPU (alone, then with the a-trous filter) and on the host, then the paper's blend.
+    for variant in "reproject cuda:0 none" "reproject cuda:0 atrous" "reproject host none" "brigade host none"; do
+      read -r convergence post denoise <<<"$variant"
       for map in large test; do
         if [ $map = large ]; then args=(/tmp/largemap.cpk --width 1920 --height 1080 --camera 1690 300 80 5 -12)
         else args=("$stage/testmap.cpk" --width 1280 --height 720); fi
-        run=/tmp/ft_$map${emissive}_$convergence
+        run=/tmp/ft_${map}_${convergence}_${post}_$denoise
         "$stage/bin/cohort" render "${args[@]}" --tracers "${COHORT_GPU_TRACERS:-cuda:0}" --spp 1 --bounces 1 \
-          --emissive-samples $emissive --convergence $convergence --frames 60 --camera-path spin-slow \
+          --convergence $convergence --post-on $post --denoise $denoise --frames 60 --camera-path spin-slow \
           --write last --out $run >/dev/null
-        echo "== $map map, emissive samples $emissive, convergence $convergence"
+        echo "== $map map, convergence $convergence, post on $post, denoise $denoise"
         python3 tools/frame_times.py $run/stats.json --skip 10
+        [ -n "${OUT:-}" ] && [ $map = test ] && mkdir -p "$OUT/frames" && cp $run/frame_0059.* "$OUT/frames/${map}_${convergence}_${post}_$denoise.$(ls $run/frame_0059.* | head -n1 | sed 's/.*\.//')" 2>/dev/null || true
       done
     done
+    ;;
+  multigpu)
+    # Issue 14 on a machine with several GPUs: end-to-end frame times of each mix (the test map at
+    # 1280x720 and the large map at 1920x1080, 1 spp, NEE + 1 bounce, spin-slow, 100 frames, medians of
+    # frames 20-99; default convergence, then Brigade's blend), bench devices, and Table 1 with real GPUs.
+    [ -d "$stage/bin" ] || tar -C "$stage" -xJf "$stage/payload.tar.xz"
+    export LD_LIBRARY_PATH="$PWD/$stage/lib${LD_LIBRARY_PATH:+:$LD_LIBRARY_PATH}"
+    mkdir -p /tmp/icd && echo libnvidia-opencl.so.1 > /tmp/icd/nvidia.icd
+    export OCL_ICD_VENDORS=/tmp/icd
+    out="${OUT:-/tmp/cohort-out}"; mkdir -p "$out"
+    nvidia-smi --query-gpu=index,name --format=csv,noheader; nproc
+    (clinfo -l 2>&1 || true) | head -n 6
+    [ -f /tmp/largemap.cpk ] || { python3 tools/gen_testmap.py --large --out /tmp/largemap >/dev/null &&
+      "$stage/bin/cohort" pack /tmp/largemap/maps/largemap.map --out /tmp/largemap.cpk | tail -n 1; }
+    COHORT_PACK="$stage/testmap.cpk" "$stage/bin/cohort_tracers_tests" --gtest_filter='CudaMultiGpu*:FramePost*' 2>&1 |
+      grep -E "^\[  (PASSED|FAILED|SKIPPED) |^\[       OK" || true
+    for map in test large; do
+      if [ $map = large ]; then args=(/tmp/largemap.cpk --width 1920 --height 1080 --camera 1690 300 80 5 -12)
+      else args=("$stage/testmap.cpk" --width 1280 --height 720); fi
+      for convergence in auto brigade; do
+        for mix in ${COHORT_GPU_MIXES:-cuda:0 cuda:0,cuda:1 embree,cuda:0 embree,cuda:0,cuda:1 cuda:0,opencl:0 embree,cuda:0,opencl:0}; do
+          run=/tmp/mg_${map}_${convergence}_$(echo "$mix" | tr ',:' '__')
+          timeout 120 "$stage/bin/cohort" render "${args[@]}" --tracers "$mix" --spp 1 --light-samples 1 --bounces 1 \
+            --convergence $convergence --frames 100 --camera-path spin-slow --write last --out $run >/dev/null 2>&1 ||
+            { echo "== $map $convergence $mix: failed"; continue; }
+          echo "== $map map, $convergence, $mix"
+          python3 tools/frame_times.py $run/stats.json --skip 20 --json $out/$(basename $run).json | head -n 1
+        done
+      done
+      timeout 300 "$stage/bin/cohort" bench devices --scene "${args[0]}" --width "${args[2]}" --height "${args[4]}" \
+        --frames 60 --json "$out/bench_devices_$map.json" 2>&1 | tail -n 14 || true
+    done
+    timeout 200 "$stage/bin/cohort" bench balance --real cuda:0,cuda:1 --scene "$stage/testmap.cpk" --rows 720 \
+      --frames 200 --json "$out/bench_balance_2gpu.json" 2>&1 | grep -v "loads" | tail -n 16 || true
     ;;
   remote)
     [ -d "$stage/bin" ] || tar -C "$stage" -xJf "$stage/payload.tar.xz"

@@ -7,7 +7,8 @@ reference frame: NVIDIA's FLIP (flip-evaluator, LDR, on the tone-mapped PNGs a v
 Methods: none (each frame as rendered), brigade (adaptive convergence, Brigade's blend), oidn (each frame
 denoised by Open Image Denoise), brigade+oidn (the blended frame denoised), reproject (per-pixel history
 through motion vectors, core/reprojection.h), reproject+oidn (the reprojected frame denoised, with the
-albedo and normal planes as the denoiser's guides). Reports a table, JSON, a
+albedo and normal planes as the denoiser's guides), atrous and reproject+atrous (the real-time edge-aware
+a-trous filter of the portable kernel, core/atrous_filter.h, on each frame or on the reprojected one). Reports a table, JSON, a
 per-frame FLIP plot and the milliseconds each method's extra stages took (from stats.json).
 
 Setup once: bench/quality/setup_env.sh, then
@@ -34,6 +35,8 @@ METHODS = {
     "brigade+oidn": ["--convergence", "brigade", "--denoise", "oidn"],
     "reproject": ["--convergence", "reproject"],
     "reproject+oidn": ["--convergence", "reproject", "--denoise", "oidn"],
+    "atrous": ["--no-convergence", "--denoise", "atrous"],
+    "reproject+atrous": ["--convergence", "reproject", "--denoise", "atrous"],
 }
 EXTRA_STAGES = ("convergence", "denoise")
 

@@ -25,11 +25,12 @@ TEST(WorkloadChoice, CpuOnlySessionsHoldThirtyFpsByDefault) {
   EXPECT_GE(s.render_scale, 0.25);
 }
 
-TEST(ConvergenceChoice, AutoReprojectsOnlyWhenNoTracerRendersOnAGpu) {
-  EXPECT_EQ(resolve_convergence("auto", false), "reproject");
-  EXPECT_EQ(resolve_convergence("auto", true), "brigade");
-  EXPECT_EQ(resolve_convergence("reproject", true), "reproject") << "an explicit choice stands";
-  EXPECT_EQ(resolve_convergence("brigade", false), "brigade");
+TEST(ConvergenceChoice, AutoReprojectsUnlessGpuTracersWouldWaitForTheHost) {
+  EXPECT_EQ(resolve_convergence("auto", false, "host"), "reproject");
+  EXPECT_EQ(resolve_convergence("auto", true, "host"), "brigade") << "an OpenCL GPU with the host's reprojection";
+  EXPECT_EQ(resolve_convergence("auto", true, "cuda:0"), "reproject") << "the post-processing on the GPU";
+  EXPECT_EQ(resolve_convergence("reproject", true, "host"), "reproject") << "an explicit choice stands";
+  EXPECT_EQ(resolve_convergence("brigade", false, "cuda:1"), "brigade");
 }
 
 TEST(CameraPath, ParsesNamesAndRejectsUnknownOnes) {

@@ -23,7 +23,7 @@ void trace_camera_packets(embree_kernel::TraceCtx& ctx, KVec3 org, int n, Arena&
   embree_kernel::FilterContext fc = embree_kernel::filter_context(&ctx.scene, K_RAY_PRIMARY, 0, true);
   for (int first = 0; first < n; first += kPacketSize) {
     RTCRayHit8& rh = a.packets[first / kPacketSize];
-    alignas(32) int valid[kPacketSize];  // Embree reads the mask with aligned AVX loads
+    alignas(32) int valid[kPacketSize];  // Embree loads the mask as one vector: unaligned, it faults on AVX-512 CPUs
     for (int k = 0; k < kPacketSize; ++k) {
       const int i = first + k < n ? first + k : n - 1;  // unused lanes repeat the last ray, masked off
       valid[k] = first + k < n ? -1 : 0;

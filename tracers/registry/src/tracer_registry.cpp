@@ -11,6 +11,7 @@
 #endif
 #ifdef COHORT_HAVE_CUDA
 #include "cohort/tracers/cuda_tracer.h"
+#include "cohort/tracers/cuda_frame_post.h"
 #endif
 #ifdef COHORT_HAVE_MPI
 #include <cstdlib>
@@ -194,6 +195,27 @@ int device_count(const std::string& kind) {
   if (kind == "cuda") return cuda_device_count();
 #endif
   return 0;
+}
+
+std::unique_ptr<core::FramePost> make_frame_post(const std::string& where, const core::FramePostOptions& options) {
+  if (where == "host") return std::make_unique<core::HostFramePost>(options);
+  if (where.rfind("cuda", 0) == 0) {
+    const std::vector<TracerSpec> specs = parse_tracer_list(where);
+    if (specs.size() != 1 || specs[0].kind != "cuda")
+      throw std::invalid_argument("frame post: '" + where + "' names no single CUDA device (cuda:N)");
+#ifdef COHORT_HAVE_CUDA
+    return make_cuda_frame_post(specs[0].device, options);
+#else
+    throw std::runtime_error("frame post on " + where + ": this build has no CUDA (configure with COHORT_WITH_CUDA=ON)");
+#endif
+  }
+  throw std::invalid_argument("frame post: unknown place '" + where + "' (host or cuda:N)");
+}
+
+std::string auto_frame_post_place(const std::vector<TracerSpec>& tracers) {
+  for (const TracerSpec& t : tracers)
+    if (t.kind == "cuda") return "cuda:" + std::to_string(t.device);
+  return "host";
 }
 
 }  // namespace cohort::tracers

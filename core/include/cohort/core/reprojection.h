@@ -10,6 +10,8 @@
 // is exactly the running average of its frames (up to max_history). Blend: C = H + (S - H) / n, n the
 // history length (capped at max_history). Samples that are not finite (NaN, Inf) never enter the
 // history: the pixel keeps its history (or shows its neighbourhood's mean when it has none).
+// The per-pixel arithmetic is the portable kernel's (kernel/reproject.h); this class runs it on the host's
+// threads and keeps the history.
 #pragma once
 
 #include <cstdint>
@@ -49,9 +51,8 @@ class TemporalReprojection {
   // The previous frame's surfaces, to test history taps against.
   std::vector<float> depth_, normal_, next_depth_, next_normal_;
   std::vector<uint32_t> id_, next_id_;
-  // The fresh frame in YCoCg and which of its samples are finite (scratch).
-  std::vector<float> ycocg_;
-  std::vector<uint8_t> finite_;
+  // The fresh frame in YCoCg, w = 1 where its sample is finite (scratch; kernel/reproject.h).
+  std::vector<float> ycocgw_;
 };
 
 }  // namespace cohort::core

@@ -20,6 +20,10 @@ KFN float v3_dot(KVec3 a, KVec3 b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
 KFN KVec3 v3_cross(KVec3 a, KVec3 b) {
   return v3(a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x);
 }
+/* Whether three floats are all finite (no NaN, no infinity), without isfinite: fast-math builds may fold it. */
+KFN int k_finite3(float r, float g, float b) {
+  return r == r && g == g && b == b && k_fabs(r) <= 3.0e38f && k_fabs(g) <= 3.0e38f && k_fabs(b) <= 3.0e38f;
+}
 KFN float v3_length(KVec3 a) { return k_sqrt(v3_dot(a, a)); }
 KFN KVec3 v3_normalize(KVec3 a) {
   float l = v3_length(a);

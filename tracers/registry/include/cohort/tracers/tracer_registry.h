@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "cohort/core/frame_post.h"
 #include "cohort/core/tracer.h"
 
 namespace cohort::tracers {
@@ -36,5 +37,13 @@ bool remote_tracers_built();
 // How many devices of that kind this machine offers the tracer: 1 for Embree (the CPU), 0 for a kind
 // this build lacks. Never throws.
 int device_count(const std::string& kind);
+
+// The frame's post-processing (core/frame_post.h) at a place: "host" or "cuda:N". Throws
+// std::invalid_argument for a malformed place, std::runtime_error when this build or machine lacks it.
+std::unique_ptr<core::FramePost> make_frame_post(const std::string& where, const core::FramePostOptions& options);
+
+// Where `--post-on auto` runs it: the GPU of the first CUDA tracer (it holds the frame's device memory
+// and the bus to it), else the host.
+std::string auto_frame_post_place(const std::vector<TracerSpec>& tracers);
 
 }  // namespace cohort::tracers

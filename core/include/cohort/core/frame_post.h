@@ -1,0 +1,55 @@
+// What happens to a merged frame before it is shown: temporal reprojection (core/reprojection.h) and the
+// a-trous spatial filter (core/atrous_filter.h), on the host's threads or on a GPU (tracers/cuda's
+// CudaFramePost, made by name in tracers/registry). Both run the portable kernel's per-pixel code
+// (kernel/reproject.h, kernel/atrous.h), so where they run changes the cost, not the picture.
+#pragma once
+
+#include <memory>
+#include <string>
+
+#include "cohort/core/atrous_filter.h"
+#include "cohort/core/frame_buffer.h"
+#include "cohort/core/gbuffer.h"
+#include "cohort/core/reprojection.h"
+
+namespace cohort::core {
+
+struct FramePostOptions {
+  bool reproject = true;  // false: the fresh frame goes straight to the filter (or is shown as it is)
+  ReprojectionOptions reprojection;
+  bool atrous = false;
+  AtrousOptions atrous_options;
+};
+
+class FramePost {
+ public:
+  virtual ~FramePost() = default;
+  // Takes the merged frame and its G-buffer (same size); a size change restarts the history.
+  virtual void process(const FrameBuffer& fresh, const GBuffer& gbuffer) = 0;
+  // The frame to show: reprojected, then filtered, as the options ask.
+  virtual const FrameBuffer& image() const = 0;
+  // Mean history length over the frame (1 = nothing reused; 1 when not reprojecting).
+  virtual double mean_history_length() const = 0;
+  virtual void reset() = 0;
+  // Where it runs, for logs and stats: "host", "cuda:0".
+  virtual std::string where() const = 0;
+};
+
+class HostFramePost final : public FramePost {
+ public:
+  explicit HostFramePost(FramePostOptions options);
+  void process(const FrameBuffer& fresh, const GBuffer& gbuffer) override;
+  const FrameBuffer& image() const override { return *shown_; }
+  double mean_history_length() const override;
+  void reset() override;
+  std::string where() const override { return "host"; }
+
+ private:
+  FramePostOptions options_;
+  TemporalReprojection reprojection_;
+  AtrousFilter atrous_;
+  FrameBuffer filtered_, copy_;
+  const FrameBuffer* shown_ = &copy_;
+};
+
+}  // namespace cohort::core

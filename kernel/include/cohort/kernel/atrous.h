@@ -1,0 +1,92 @@
+/* The edge-aware a-trous wavelet filter (Dammertz et al., "Edge-Avoiding A-Trous Wavelet Transform for
+ * fast Global Illumination Filtering", HPG 2010; the spatial filter of SVGF without its variance
+ * estimate), one pass at one pixel. Passes run with step 1, 2, 4, ...: each is a 5x5 B3-spline kernel
+ * whose taps lie `step` pixels apart, so four passes cover a 61-pixel footprint for 100 taps a pixel.
+ * A tap's weight is the spline's times three edge stops, so that light does not leak across geometry:
+ *   normal      max(0, n_p . n_q) ^ (2 ^ normal_squarings)   (squarings, not pow: 64 is 6 multiplies)
+ *   depth       exp(-|z_p - z_q| / (depth_sigma * z_p * step))     (relative: any scale of map)
+ *   luminance   exp(-|l_p - l_q| / (color_sigma * (l_p + l_q) / 2 + 1e-4))   (relative: HDR)
+ * Camera misses (depth 0) only mix with misses. Taps whose colour is not finite are left out; the centre
+ * always counts, so a pixel keeps its colour where every neighbour is across an edge. The two exponential
+ * stops are one exp of their summed arguments: transcendental calls set this filter's cost on the CPU.
+ * Planes are the host's G-buffer layout (core/gbuffer.h): depth one float a pixel, normal three, colour
+ * RGBA floats. */
+#ifndef COHORT_KERNEL_ATROUS_H
+#define COHORT_KERNEL_ATROUS_H
+#include "vec.h"
+
+typedef struct KAtrousParams {
+  kint width; kint height; kint step; kint normal_squarings;
+  float depth_sigma; float color_sigma; float pad0; float pad1;
+} KAtrousParams;
+
+/* Illumination = colour / albedo before the passes, colour = illumination * albedo after (multiply = 1),
+ * so textures stay sharp; black surfaces divide by the least albedo and multiply back by the same. */
+#define K_ATROUS_LEAST_ALBEDO 0.01f
+KFN void k_atrous_modulate(KGLOBAL const float* in_rgba, KGLOBAL const float* albedo, KGLOBAL float* out_rgba, kint p,
+                           int multiply) {
+  for (int k = 0; k < 3; ++k) {
+    float a = k_fmax(albedo[3 * p + k], K_ATROUS_LEAST_ALBEDO);
+    out_rgba[4 * p + k] = multiply ? in_rgba[4 * p + k] * a : in_rgba[4 * p + k] / a;
+  }
+  out_rgba[4 * p + 3] = 1.0f;
+}
+
+KFN float k_atrous_luminance(KGLOBAL const float* c) { return 0.2126f * c[0] + 0.7152f * c[1] + 0.0722f * c[2]; }
+
+KFN void k_atrous_pixel(KGLOBAL const float* in_rgba, KGLOBAL float* out_rgba, KGLOBAL const float* depth,
+                        KGLOBAL const float* normal, const KAtrousParams* p, kint x, kint y) {
+  const float spline[3] = {0.375f, 0.25f, 0.0625f};
+  kint centre = y * p->width + x;
+  KGLOBAL const float* c = in_rgba + 4 * centre;
+  KGLOBAL float* out = out_rgba + 4 * centre;
+  float zp = depth[centre];
+  KVec3 np = v3(normal[3 * centre], normal[3 * centre + 1], normal[3 * centre + 2]);
+  int centre_ok = k_finite3(c[0], c[1], c[2]);
+  float lp = centre_ok ? k_atrous_luminance(c) : 0.0f;
+  float inv_depth_scale = zp > 0.0f ? 1.0f / (p->depth_sigma * zp * (float)p->step + 1e-6f) : 0.0f;
+  float sum[3] = {0.0f, 0.0f, 0.0f};
+  float weight_sum = 0.0f;
+  for (kint dy = -2; dy <= 2; ++dy) {
+    kint qy = y + dy * p->step;
+    if (qy < 0 || qy >= p->height) continue;
+    for (kint dx = -2; dx <= 2; ++dx) {
+      kint qx = x + dx * p->step;
+      if (qx < 0 || qx >= p->width) continue;
+      kint q = qy * p->width + qx;
+      KGLOBAL const float* cq = in_rgba + 4 * q;
+      if (!k_finite3(cq[0], cq[1], cq[2])) continue;
+      float w = spline[dx < 0 ? -dx : dx] * spline[dy < 0 ? -dy : dy];
+      if (q != centre) {
+        float zq = depth[q];
+        float exponent = 0.0f;
+        if ((zp > 0.0f) != (zq > 0.0f)) continue;  /* a surface and a miss */
+        if (zp > 0.0f) {
+          KVec3 nq = v3(normal[3 * q], normal[3 * q + 1], normal[3 * q + 2]);
+          float cosine = k_fmax(v3_dot(np, nq), 0.0f);
+          for (kint s = 0; s < p->normal_squarings; ++s) cosine *= cosine;
+          w *= cosine;
+          exponent += k_fabs(zp - zq) * inv_depth_scale;
+        }
+        if (centre_ok) {
+          float lq = k_atrous_luminance(cq);
+          exponent += k_fabs(lp - lq) / (p->color_sigma * 0.5f * (k_fabs(lp) + k_fabs(lq)) + 1e-4f);
+        }
+        if (!(w > 0.0f)) continue;
+        w *= k_exp(-exponent);
+      }
+      if (!(w > 0.0f)) continue;
+      sum[0] += w * cq[0];
+      sum[1] += w * cq[1];
+      sum[2] += w * cq[2];
+      weight_sum += w;
+    }
+  }
+  float inv = weight_sum > 0.0f ? 1.0f / weight_sum : 0.0f;
+  out[0] = sum[0] * inv;
+  out[1] = sum[1] * inv;
+  out[2] = sum[2] * inv;
+  out[3] = 1.0f;
+}
+
+#endif

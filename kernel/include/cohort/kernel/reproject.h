@@ -1,0 +1,178 @@
+/* Temporal accumulation with reprojection, one pixel at a time (core/reprojection.h explains the method:
+ * history fetched through the motion vectors, taps tested for the same surface, neighbourhood clamp in
+ * YCoCg where the pixel moved, blend by history length). Written once here so the host's threads and a
+ * GPU run the same arithmetic (C++, CUDA and OpenCL C).
+ *
+ * Two passes a frame:
+ *   k_reproject_prepare  the fresh frame in YCoCg, w = 1 where the sample is finite, 0 where it is not;
+ *   k_reproject_pixel    reads the previous frame's state and writes the next state (ping-pong).
+ * Planes follow the host's G-buffer layout (core/gbuffer.h): one float a pixel for depths, two for
+ * motion, three for normals, one kuint for ids; colours are RGBA floats. */
+#ifndef COHORT_KERNEL_REPROJECT_H
+#define COHORT_KERNEL_REPROJECT_H
+#include "vec.h"
+
+typedef struct KReprojectParams {
+  kint width; kint height; kint have_history; kint pad0;
+  float max_history;      /* frames: 1 / max_history is the least weight of a new sample */
+  float depth_tolerance;  /* relative depth difference above which a history tap is another surface */
+  float normal_cos;       /* least cosine between the normals of a pixel and its history tap */
+  float clamp_sigma;      /* neighbourhood box half-width in standard deviations (moving pixels) */
+  float still_motion;     /* pixels: motion below this counts as no motion (no clamp) */
+  float pad1; float pad2; float pad3;
+} KReprojectParams;
+
+/* The fresh planes of one frame. */
+typedef struct KReprojectFresh {
+  KGLOBAL const float* rgba;
+  KGLOBAL const float* ycocgw;  /* from k_reproject_prepare */
+  KGLOBAL const float* depth;
+  KGLOBAL const float* prev_depth;
+  KGLOBAL const float* motion;
+  KGLOBAL const float* normal;
+  KGLOBAL const kuint* id;
+} KReprojectFresh;
+
+/* The history a pixel reads (the previous frame's state). */
+typedef struct KReprojectHistory {
+  KGLOBAL const float* rgba;
+  KGLOBAL const float* length;
+  KGLOBAL const float* depth;
+  KGLOBAL const float* normal;
+  KGLOBAL const kuint* id;
+} KReprojectHistory;
+
+/* The state a pixel writes (the next frame's history). */
+typedef struct KReprojectState {
+  KGLOBAL float* rgba;
+  KGLOBAL float* length;
+  KGLOBAL float* depth;
+  KGLOBAL float* normal;
+  KGLOBAL kuint* id;
+} KReprojectState;
+
+KFN void k_reproject_prepare(KGLOBAL const float* rgba, KGLOBAL float* ycocgw, kint p) {
+  KGLOBAL const float* c = rgba + 4 * p;
+  KGLOBAL float* out = ycocgw + 4 * p;
+  if (k_finite3(c[0], c[1], c[2])) {
+    out[0] = 0.25f * c[0] + 0.5f * c[1] + 0.25f * c[2];
+    out[1] = 0.5f * c[0] - 0.5f * c[2];
+    out[2] = -0.25f * c[0] + 0.5f * c[1] - 0.25f * c[2];
+    out[3] = 1.0f;
+  } else {
+    out[0] = 0.0f; out[1] = 0.0f; out[2] = 0.0f; out[3] = 0.0f;
+  }
+}
+
+KFN KVec3 k_reproject_to_ycocg(KVec3 c) {
+  return v3(0.25f * c.x + 0.5f * c.y + 0.25f * c.z, 0.5f * c.x - 0.5f * c.z, -0.25f * c.x + 0.5f * c.y - 0.25f * c.z);
+}
+KFN KVec3 k_reproject_from_ycocg(KVec3 v) {
+  float t = v.x - v.z;
+  return v3(t + v.y, v.x + v.z, t - v.y);
+}
+
+/* Mean and variance of the finite fresh samples of the 3x3 neighbourhood, in YCoCg; returns the count. */
+KFN int k_reproject_moments(const KReprojectParams* p, KGLOBAL const float* ycocgw, kint x, kint y, KVec3* m1,
+                            KVec3* m2) {
+  int count = 0;
+  *m1 = v3s(0.0f);
+  *m2 = v3s(0.0f);
+  for (kint dy = -1; dy <= 1; ++dy) {
+    kint ny = y + dy;
+    if (ny < 0 || ny >= p->height) continue;
+    for (kint dx = -1; dx <= 1; ++dx) {
+      kint nx = x + dx;
+      if (nx < 0 || nx >= p->width) continue;
+      KGLOBAL const float* v = ycocgw + 4 * (ny * p->width + nx);
+      if (v[3] == 0.0f) continue;
+      KVec3 s = v3(v[0], v[1], v[2]);
+      *m1 = v3_add(*m1, s);
+      *m2 = v3_add(*m2, v3_mul(s, s));
+      ++count;
+    }
+  }
+  return count;
+}
+
+KFN void k_reproject_pixel(const KReprojectParams* p, const KReprojectFresh* fresh, const KReprojectHistory* history,
+                           const KReprojectState* next, kint x, kint y) {
+  kint pix = y * p->width + x;
+  next->depth[pix] = fresh->depth[pix];
+  next->id[pix] = fresh->id[pix];
+  next->normal[3 * pix] = fresh->normal[3 * pix];
+  next->normal[3 * pix + 1] = fresh->normal[3 * pix + 1];
+  next->normal[3 * pix + 2] = fresh->normal[3 * pix + 2];
+
+  /* The history, reprojected: bilinear over the taps that saw the same surface. */
+  KVec3 h = v3s(0.0f);
+  float history_length = 0.0f;
+  float mx = fresh->motion[2 * pix], my = fresh->motion[2 * pix + 1];
+  int moved = k_fabs(mx) > p->still_motion || k_fabs(my) > p->still_motion;
+  if (p->have_history && k_fabs(mx) < 1e8f) {
+    float hx = (float)x + mx, hy = (float)y + my; /* pixel-centre space */
+    float fx = k_floor(hx), fy = k_floor(hy);
+    float wx = hx - fx, wy = hy - fy;
+    kint x0 = (kint)fx, y0 = (kint)fy;
+    kuint id = fresh->id[pix];
+    float expected_depth = fresh->prev_depth[pix];
+    KVec3 n = v3_load_g(fresh->normal + 3 * pix);
+    float weight_sum = 0.0f, length_sum = 0.0f;
+    for (int t = 0; t < 4; ++t) {
+      kint tx = x0 + (t & 1), ty = y0 + (t >> 1);
+      float w = ((t & 1) ? wx : 1.0f - wx) * ((t >> 1) ? wy : 1.0f - wy);
+      if (w <= 0.0f || tx < 0 || ty < 0 || tx >= p->width || ty >= p->height) continue;
+      kint q = ty * p->width + tx;
+      if (history->id[q] != id || !(history->length[q] > 0.0f)) continue;
+      if (id != 0xFFFFFFFFu) { /* a surface: same depth and orientation as the history's */
+        if (k_fabs(history->depth[q] - expected_depth) > p->depth_tolerance * k_fmax(expected_depth, 1e-3f)) continue;
+        if (v3_dot(n, v3_load_g(history->normal + 3 * q)) < p->normal_cos) continue;
+      }
+      h = v3_madd(h, v3_load_g(history->rgba + 4 * q), w);
+      length_sum += w * history->length[q];
+      weight_sum += w;
+    }
+    if (weight_sum > 1e-3f) {
+      float inv = 1.0f / weight_sum;
+      h = v3_scale(h, inv);
+      history_length = length_sum * inv;
+    }
+  }
+  KVec3 m1, m2;
+  if (history_length > 0.0f && moved) {
+    int count = k_reproject_moments(p, fresh->ycocgw, x, y, &m1, &m2);
+    if (count > 0) {
+      float inv = 1.0f / (float)count;
+      KVec3 mean = v3_scale(m1, inv);
+      KVec3 var = v3_sub(v3_scale(m2, inv), v3_mul(mean, mean));
+      KVec3 sigma = v3(k_sqrt(k_fmax(var.x, 0.0f)), k_sqrt(k_fmax(var.y, 0.0f)), k_sqrt(k_fmax(var.z, 0.0f)));
+      KVec3 lo = v3_madd(mean, sigma, -p->clamp_sigma), hi = v3_madd(mean, sigma, p->clamp_sigma);
+      KVec3 v = k_reproject_to_ycocg(h);
+      v = v3_min(v3_max(v, lo), hi);
+      h = k_reproject_from_ycocg(v);
+    }
+  }
+  KGLOBAL const float* sample = fresh->rgba + 4 * pix;
+  KGLOBAL float* out = next->rgba + 4 * pix;
+  out[3] = 1.0f;
+  if (fresh->ycocgw[4 * pix + 3] != 0.0f) {
+    float count = k_fmin(history_length + 1.0f, p->max_history);
+    float f = history_length > 0.0f ? 1.0f / count : 1.0f;
+    out[0] = h.x + f * (sample[0] - h.x);
+    out[1] = h.y + f * (sample[1] - h.y);
+    out[2] = h.z + f * (sample[2] - h.z);
+    next->length[pix] = history_length > 0.0f ? count : 1.0f;
+  } else if (history_length > 0.0f) {
+    out[0] = h.x; out[1] = h.y; out[2] = h.z;
+    next->length[pix] = history_length;
+  } else {
+    /* No usable sample and no history: show the neighbourhood's mean, keep no history. */
+    int count = k_reproject_moments(p, fresh->ycocgw, x, y, &m1, &m2);
+    KVec3 mean = v3_scale(m1, count > 0 ? 1.0f / (float)count : 0.0f);
+    KVec3 c = k_reproject_from_ycocg(mean);
+    out[0] = c.x; out[1] = c.y; out[2] = c.z;
+    next->length[pix] = 0.0f;
+  }
+}
+
+#endif

@@ -1,0 +1,135 @@
+// The frame's post-processing (core/frame_post.h) by place: the host composition equals its parts, a
+// GPU runs the same portable kernel and must give the host's picture over a moving sequence (history,
+// disocclusion, the a-trous passes), and places are named clearly or refused.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+#include <stdexcept>
+
+#include "cohort/core/atrous_filter.h"
+#include "cohort/core/frame_post.h"
+#include "cohort/core/reprojection.h"
+#include "cohort/tracers/tracer_registry.h"
+
+using namespace cohort;
+
+namespace {
+
+constexpr int kW = 96, kH = 64;
+
+// Frame `f` of a scene sliding right by 0.7 pixels a frame: a floor (id 0, depth ramp), a box (id 5) that
+// uncovers the floor as it moves, and sky (misses) on the top rows; noisy colours, and one NaN sample.
+void make_frame(int f, core::FrameBuffer& frame, core::GBuffer& g) {
+  frame.resize(kW, kH);
+  g.resize(kW, kH);
+  std::mt19937 rng(100 + f);
+  std::uniform_real_distribution<float> noise(0.5f, 1.5f);
+  const float shift = 0.7f * f;
+  for (int y = 0; y < kH; ++y)
+    for (int x = 0; x < kW; ++x) {
+      const size_t p = size_t(y) * kW + x;
+      const bool sky = y < 8;
+      const bool box = !sky && x - shift > 30 && x - shift < 50 && y > 20 && y < 44;
+      g.depth[p] = sky ? 0.0f : box ? 6.0f : 10.0f + 0.05f * y;
+      g.prev_depth[p] = g.depth[p];
+      g.motion[2 * p] = f == 0 ? 0.0f : -0.7f;
+      g.normal[3 * p + (box ? 0 : 2)] = sky ? 0.0f : 1.0f;
+      for (int k = 0; k < 3; ++k) g.albedo[3 * p + k] = box ? 0.8f : 0.3f + 0.2f * ((x / 4 + y / 4) % 2);
+      g.id[p] = sky ? 0xFFFFFFFFu : box ? 5u : 0u;
+      const float light = sky ? 0.2f : box ? 2.0f : 1.0f;
+      float* c = frame.rgba.data() + 4 * p;
+      for (int k = 0; k < 3; ++k) c[k] = light * g.albedo[3 * p + k] * noise(rng) * (sky ? 5.0f : 1.0f);
+      c[3] = 1.0f;
+    }
+  frame.rgba[4 * (30 * kW + 10)] = std::nanf("");
+}
+
+core::FramePostOptions both() {
+  core::FramePostOptions o;
+  o.reproject = true;
+  o.atrous = true;
+  o.atrous_options.passes = 2;
+  return o;
+}
+
+double max_relative_difference(const core::FrameBuffer& a, const core::FrameBuffer& b) {
+  double worst = 0.0;
+  for (size_t i = 0; i < a.rgba.size(); ++i)
+    worst = std::max(worst, std::fabs(double(a.rgba[i]) - b.rgba[i]) / (std::fabs(double(b.rgba[i])) + 1e-3));
+  return worst;
+}
+
+}  // namespace
+
+TEST(FramePost, HostRunsReprojectionThenTheFilter) {
+  core::HostFramePost post(both());
+  core::TemporalReprojection reprojection;
+  core::AtrousFilter filter(both().atrous_options);
+  core::FrameBuffer frame, filtered;
+  core::GBuffer g;
+  for (int f = 0; f < 4; ++f) {
+    make_frame(f, frame, g);
+    post.process(frame, g);
+    reprojection.accumulate(frame, g);
+    filter.apply(reprojection.image(), g, filtered);
+    ASSERT_EQ(post.image().rgba, filtered.rgba) << "frame " << f;
+    EXPECT_DOUBLE_EQ(post.mean_history_length(), reprojection.mean_history_length());
+  }
+  EXPECT_GT(post.mean_history_length(), 2.0) << "the sliding floor keeps its history";
+}
+
+TEST(FramePost, HostWithNeitherStepShowsTheFrame) {
+  core::FramePostOptions none;
+  none.reproject = false;
+  core::HostFramePost post(none);
+  core::FrameBuffer frame;
+  core::GBuffer g;
+  make_frame(1, frame, g);
+  post.process(frame, g);
+  EXPECT_EQ(post.image().rgba.size(), frame.rgba.size());
+  EXPECT_DOUBLE_EQ(post.mean_history_length(), 1.0);
+  EXPECT_EQ(post.where(), "host");
+}
+
+TEST(FramePost, PlacesAreNamedOrRefused) {
+  EXPECT_EQ(tracers::make_frame_post("host", both())->where(), "host");
+  EXPECT_THROW(tracers::make_frame_post("gpu", both()), std::invalid_argument);
+  EXPECT_THROW(tracers::make_frame_post("cuda:x", both()), std::invalid_argument);
+  EXPECT_ANY_THROW(tracers::make_frame_post("cuda:99", both()));  // no such device, or no CUDA in this build
+  EXPECT_EQ(tracers::auto_frame_post_place(tracers::parse_tracer_list("embree")), "host");
+  core::FramePostOptions odd = both();
+  odd.atrous_options.normal_power = 48;
+  EXPECT_THROW(tracers::make_frame_post("host", odd)->process(core::FrameBuffer{}, core::GBuffer{}),
+               std::invalid_argument);
+}
+
+TEST(FramePost, CudaMatchesTheHostOverAMovingSequence) {
+  if (tracers::device_count("cuda") == 0) GTEST_SKIP() << "no CUDA device (or a build without CUDA)";
+  EXPECT_EQ(tracers::auto_frame_post_place(tracers::parse_tracer_list("embree,cuda:0")), "cuda:0");
+  for (bool atrous : {false, true}) {
+    core::FramePostOptions options = both();
+    options.atrous = atrous;
+    core::HostFramePost host(options);
+    std::unique_ptr<core::FramePost> gpu = tracers::make_frame_post("cuda:0", options);
+    EXPECT_EQ(gpu->where(), "cuda:0");
+    core::FrameBuffer frame;
+    core::GBuffer g;
+    for (int f = 0; f < 6; ++f) {
+      make_frame(f, frame, g);
+      host.process(frame, g);
+      gpu->process(frame, g);
+      ASSERT_EQ(gpu->image().width, kW);
+      // Same arithmetic; only the device's exp/sqrt/FMA contraction differ.
+      EXPECT_LT(max_relative_difference(gpu->image(), host.image()), 2e-3) << "frame " << f << " atrous " << atrous;
+      EXPECT_NEAR(gpu->mean_history_length(), host.mean_history_length(), 1e-3) << "frame " << f;
+    }
+    gpu->reset();
+    host.reset();
+    make_frame(7, frame, g);
+    host.process(frame, g);
+    gpu->process(frame, g);
+    EXPECT_NEAR(gpu->mean_history_length(), 1.0, 1e-3) << "reset drops the history";
+    EXPECT_NEAR(host.mean_history_length(), 1.0, 1e-3);
+  }
+}

@@ -1,0 +1,233 @@
+#include "cohort/tracers/cuda_frame_post.h"
+
+#include <algorithm>
+#include <string>
+#include <vector>
+
+#include <cuda_runtime.h>
+
+#include "cohort/kernel/atrous.h"
+#include "cohort/kernel/reproject.h"
+#include "cuda_check.h"
+#include "device_array.h"
+
+namespace cohort::tracers {
+
+namespace {
+
+constexpr unsigned kThreads = 256;
+
+unsigned blocks_for(size_t n) { return static_cast<unsigned>((n + kThreads - 1) / kThreads); }
+
+__global__ void prepare_kernel(const float* rgba, float* ycocgw, int pixels) {
+  const int p = blockIdx.x * blockDim.x + threadIdx.x;
+  if (p < pixels) k_reproject_prepare(rgba, ycocgw, p);
+}
+
+__global__ void reproject_kernel(KReprojectParams params, KReprojectFresh fresh, KReprojectHistory history,
+                                 KReprojectState next, double* length_sum) {
+  const int p = blockIdx.x * blockDim.x + threadIdx.x;
+  float length = 0.0f;
+  if (p < params.width * params.height) {
+    k_reproject_pixel(&params, &fresh, &history, &next, p % params.width, p / params.width);
+    length = next.length[p];
+  }
+  // The mean history length for stats, summed per warp then once per warp into one double.
+  for (int offset = 16; offset > 0; offset /= 2) length += __shfl_down_sync(0xffffffffu, length, offset);
+  if ((threadIdx.x & 31) == 0) atomicAdd(length_sum, static_cast<double>(length));
+}
+
+__global__ void modulate_kernel(const float* rgba, const float* albedo, float* out, int pixels, int multiply) {
+  const int p = blockIdx.x * blockDim.x + threadIdx.x;
+  if (p < pixels) k_atrous_modulate(rgba, albedo, out, p, multiply);
+}
+
+__global__ void atrous_kernel(const float* in, float* out, const float* depth, const float* normal, KAtrousParams params) {
+  const int p = blockIdx.x * blockDim.x + threadIdx.x;
+  if (p < params.width * params.height)
+    k_atrous_pixel(in, out, depth, normal, &params, p % params.width, p / params.width);
+}
+
+class CudaFramePost final : public core::FramePost {
+ public:
+  CudaFramePost(int device, const core::FramePostOptions& options) : device_(device), options_(options) {
+    int count = 0;
+    if (cudaGetDeviceCount(&count) != cudaSuccess || device < 0 || device >= count) {
+      cudaGetLastError();
+      throw std::runtime_error("frame post on cuda:" + std::to_string(device) + ": no such CUDA device (" +
+                               std::to_string(count) + " found)");
+    }
+    COHORT_CUDA(cudaSetDevice(device_));
+    COHORT_CUDA(cudaStreamCreateWithFlags(&stream_, cudaStreamNonBlocking));
+    COHORT_CUDA(cudaMallocHost(&length_sum_host_, sizeof(double)));
+    if (options_.atrous) normal_squarings_ = core::atrous_normal_squarings(options_.atrous_options.normal_power);
+  }
+  ~CudaFramePost() override {
+    cudaSetDevice(device_);
+    cudaStreamSynchronize(stream_);
+    for (const Registered& r : registered_)
+      if (r.ptr) cudaHostUnregister(const_cast<void*>(r.ptr));
+    if (shown_registered_) cudaHostUnregister(shown_registered_);
+    cudaFreeHost(length_sum_host_);
+    cudaStreamDestroy(stream_);
+  }
+
+  void process(const core::FrameBuffer& fresh, const core::GBuffer& g) override {
+    if (g.width != fresh.width || g.height != fresh.height)
+      throw std::invalid_argument("CudaFramePost: the G-buffer's size differs from the frame's");
+    COHORT_CUDA(cudaSetDevice(device_));
+    const int width = fresh.width, height = fresh.height;
+    const size_t pixels = static_cast<size_t>(width) * static_cast<size_t>(height);
+    if (width != width_ || height != height_) {
+      width_ = width, height_ = height;
+      have_history_ = false;
+    }
+    if (pixels == 0) return;
+    upload(fresh.rgba, frame_);
+    upload(g.depth, depth_);
+    upload(g.normal, normal_);
+    if (options_.reproject) {
+      upload(g.prev_depth, prev_depth_);
+      upload(g.motion, motion_);
+      upload(g.id, id_);
+    }
+    if (options_.atrous) upload(g.albedo, albedo_);
+
+    float* current = frame_.data();
+    mean_length_ = 1.0;
+    if (options_.reproject) {
+      State& from = state_[parity_];
+      State& to = state_[parity_ ^ 1];
+      for (State* s : {&from, &to}) s->resize(pixels);
+      KReprojectParams params{};
+      params.width = width, params.height = height, params.have_history = have_history_ ? 1 : 0;
+      const core::ReprojectionOptions& o = options_.reprojection;
+      params.max_history = static_cast<float>(std::max(o.max_history, 1));
+      params.depth_tolerance = o.depth_tolerance;
+      params.normal_cos = o.normal_cos;
+      params.clamp_sigma = o.clamp_sigma;
+      params.still_motion = o.still_motion;
+      float* ycocgw = ycocgw_.scratch(4 * pixels);
+      prepare_kernel<<<blocks_for(pixels), kThreads, 0, stream_>>>(frame_.data(), ycocgw, static_cast<int>(pixels));
+      const KReprojectFresh planes{frame_.data(), ycocgw,      depth_.data(), prev_depth_.data(),
+                                   motion_.data(), normal_.data(), id_.data()};
+      const KReprojectHistory history{from.rgba.data(), from.length.data(), from.depth.data(), from.normal.data(),
+                                      from.id.data()};
+      const KReprojectState next{to.rgba.data(), to.length.data(), to.depth.data(), to.normal.data(), to.id.data()};
+      double* sum = length_sum_.scratch(1);
+      COHORT_CUDA(cudaMemsetAsync(sum, 0, sizeof(double), stream_));
+      reproject_kernel<<<blocks_for(pixels), kThreads, 0, stream_>>>(params, planes, history, next, sum);
+      COHORT_CUDA(cudaGetLastError());
+      COHORT_CUDA(cudaMemcpyAsync(length_sum_host_, sum, sizeof(double), cudaMemcpyDeviceToHost, stream_));
+      parity_ ^= 1;
+      have_history_ = true;
+      current = to.rgba.data();
+    }
+    if (options_.atrous) {
+      float* ping = ping_.scratch(4 * pixels);
+      float* pong = pong_.scratch(4 * pixels);
+      modulate_kernel<<<blocks_for(pixels), kThreads, 0, stream_>>>(current, albedo_.data(), ping,
+                                                                       static_cast<int>(pixels), 0);
+      KAtrousParams params{};
+      params.width = width, params.height = height;
+      params.normal_squarings = normal_squarings_;
+      params.depth_sigma = options_.atrous_options.depth_sigma;
+      params.color_sigma = options_.atrous_options.color_sigma;
+      for (int pass = 0; pass < std::max(options_.atrous_options.passes, 0); ++pass) {
+        params.step = 1 << pass;
+        atrous_kernel<<<blocks_for(pixels), kThreads, 0, stream_>>>(ping, pong, depth_.data(), normal_.data(), params);
+        std::swap(ping, pong);
+      }
+      float* shown = shown_device_.scratch(4 * pixels);
+      modulate_kernel<<<blocks_for(pixels), kThreads, 0, stream_>>>(ping, albedo_.data(), shown,
+                                                                       static_cast<int>(pixels), 1);
+      COHORT_CUDA(cudaGetLastError());
+      current = shown;
+    }
+    if (shown_.width != width || shown_.height != height) {
+      if (shown_registered_) cudaHostUnregister(shown_registered_);
+      shown_registered_ = nullptr;
+      shown_.resize(width, height);
+      if (cudaHostRegister(shown_.rgba.data(), shown_.rgba.size() * sizeof(float), cudaHostRegisterPortable) ==
+          cudaSuccess)
+        shown_registered_ = shown_.rgba.data();
+      else
+        cudaGetLastError();
+    }
+    COHORT_CUDA(cudaMemcpyAsync(shown_.rgba.data(), current, 4 * pixels * sizeof(float), cudaMemcpyDeviceToHost,
+                                stream_));
+    COHORT_CUDA(cudaStreamSynchronize(stream_));
+    if (options_.reproject) mean_length_ = *length_sum_host_ / static_cast<double>(pixels);
+  }
+
+  const core::FrameBuffer& image() const override { return shown_; }
+  double mean_history_length() const override { return mean_length_; }
+  void reset() override { have_history_ = false; }
+  std::string where() const override { return "cuda:" + std::to_string(device_); }
+
+ private:
+  // One frame's history on the device (kernel/reproject.h's state).
+  struct State {
+    DeviceArray<float> rgba, length, depth, normal;
+    DeviceArray<kuint> id;
+    void resize(size_t pixels) {
+      rgba.scratch(4 * pixels);
+      length.scratch(pixels);
+      depth.scratch(pixels);
+      normal.scratch(3 * pixels);
+      id.scratch(pixels);
+    }
+  };
+  struct Registered {
+    const void* ptr = nullptr;
+    size_t bytes = 0;
+  };
+
+  // Host planes are page-locked where the driver lets us (a true asynchronous DMA at full bus speed);
+  // the callers keep their planes between frames, so the registrations are cached.
+  template <class T>
+  void upload(const std::vector<T>& host, DeviceArray<T>& device) {
+    register_host(host.data(), host.size() * sizeof(T));
+    T* d = device.scratch(host.size());
+    COHORT_CUDA(cudaMemcpyAsync(d, host.data(), host.size() * sizeof(T), cudaMemcpyHostToDevice, stream_));
+  }
+  void register_host(const void* ptr, size_t bytes) {
+    for (const Registered& r : registered_)
+      if (r.ptr == ptr && r.bytes == bytes) return;
+    Registered& slot = registered_[next_registration_];
+    next_registration_ = (next_registration_ + 1) % kRegistrations;
+    if (slot.ptr) cudaHostUnregister(const_cast<void*>(slot.ptr));
+    slot = {};
+    if (cudaHostRegister(const_cast<void*>(ptr), bytes, cudaHostRegisterPortable) == cudaSuccess)
+      slot = {ptr, bytes};
+    else
+      cudaGetLastError();  // not fatal: pageable memory copies too, only slower
+  }
+
+  static constexpr int kRegistrations = 24;  // two frames' worth of planes (the pipeline alternates)
+  int device_;
+  core::FramePostOptions options_;
+  cudaStream_t stream_ = nullptr;
+  int width_ = 0, height_ = 0;
+  bool have_history_ = false;
+  int parity_ = 0;
+  int normal_squarings_ = 0;
+  State state_[2];
+  DeviceArray<float> frame_, depth_, prev_depth_, motion_, normal_, albedo_, ycocgw_, ping_, pong_, shown_device_;
+  DeviceArray<kuint> id_;
+  DeviceArray<double> length_sum_;
+  double* length_sum_host_ = nullptr;
+  double mean_length_ = 1.0;
+  core::FrameBuffer shown_;
+  void* shown_registered_ = nullptr;
+  Registered registered_[kRegistrations];
+  int next_registration_ = 0;
+};
+
+}  // namespace
+
+std::unique_ptr<core::FramePost> make_cuda_frame_post(int device, const core::FramePostOptions& options) {
+  return std::make_unique<CudaFramePost>(device, options);
+}
+
+}  // namespace cohort::tracers
