@@ -67,14 +67,27 @@ MpiTracer::MpiTracer(MpiTracerOptions options) : options_(options) {
     }
     if (m.kind == wire::Kind::load_failed) {
       mpi.released(options_.rank);  // it has left
+      std::string reason;
+      try {
+        reason = wire::decode_text(m.payload);
+      } catch (const wire::WireError& e) {
+        reason = std::string("(unreadable reason: ") + e.what() + ")";
+      }
       throw NodeUnavailable(fmt::format("mpi:{}: the node could not start (its scene or its tracers) and leaves: {}",
-                                        options_.rank, wire::decode_text(m.payload)));
+                                        options_.rank, reason));
     }
     if (m.kind != wire::Kind::hello) {
       spdlog::warn("mpi:{}: ignored a {} message before the hello", options_.rank, wire::to_string(m.kind));
       continue;
     }
-    const wire::Hello hello = wire::decode_hello(m.payload);
+    wire::Hello hello;
+    try {
+      hello = wire::decode_hello(m.payload);
+    } catch (const wire::WireError& e) {
+      mpi.released(options_.rank);
+      send(int(wire::Kind::refuse), 0, wire::encode_text(std::string("malformed hello: ") + e.what()));
+      throw NodeUnavailable(fmt::format("mpi:{}: refused the node's malformed hello: {}", options_.rank, e.what()));
+    }
     const std::string mine = wire::cohort_version();
     if (hello.cohort_version != mine || hello.protocol != wire::kProtocolVersion) {
       const std::string why = fmt::format(

@@ -2,10 +2,10 @@
 // Renderer and its balancer it is one device whose cost includes the network round trip.
 //
 // apply() forwards the commit (records, or a whole scene; a full resync to the scene the node loaded
-// itself sends only the camera) with a non-blocking send and returns: the commit travels while the
-// previous band is merged. render_band() sends the band job and waits for the rows, at most the band
-// timeout; a node that stalls, fails or sends a malformed answer makes it throw, so the Renderer's
-// recovery re-renders the rows on the other tracers and the frame is delivered. A late answer is
+// itself sends only the camera and the records on top) with a non-blocking send and returns at once.
+// render_band() sends the band job and waits for the rows, at most the band timeout; a node that
+// stalls, fails or sends a malformed answer makes it throw, so the Renderer's recovery re-renders the
+// rows on the other tracers and the frame is delivered. A late answer is
 // recognised by its job id and dropped; until it has come, the node is sent no band (its bands fail at
 // once), so a stalled or lost node costs one late frame. A node joins once per run (its hello is
 // remembered), so a later tracer for the same rank starts at once; the MPI session's end (program
