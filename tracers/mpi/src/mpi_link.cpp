@@ -1,6 +1,10 @@
 #include "cohort/tracers/mpi_link.h"
 
+#include <atomic>
+#include <cstdio>
+#include <cstdlib>
 #include <limits>
+#include <memory>
 #include <map>
 #include <stdexcept>
 #include <string>
@@ -12,7 +16,13 @@ namespace cohort::tracers {
 
 namespace {
 constexpr int kTag = 0x434f;  // every Cohort message; the header says what it is
+
+int finalize_timeout_seconds() {
+  const char* text = std::getenv("COHORT_MPI_FINALIZE_TIMEOUT_S");
+  const int seconds = text && *text ? std::atoi(text) : 10;
+  return seconds > 0 ? seconds : 10;
 }
+}  // namespace
 
 struct MpiSession::Impl {
   MPI_Comm comm = MPI_COMM_NULL;
@@ -92,7 +102,23 @@ void MpiSession::finalize() {
   MPI_Comm_free(&impl_->comm);
   int mpi_finalized = 0;
   MPI_Finalized(&mpi_finalized);
-  if (impl_->we_initialized && !mpi_finalized) MPI_Finalize();
+  if (!impl_->we_initialized || mpi_finalized) return;
+  // MPI_Finalize synchronizes with every rank, so a rank that was lost (killed, under a launcher that let
+  // the job go on) can keep it from returning. Everything is written by now: past the deadline the
+  // process leaves without it rather than hang.
+  auto done = std::make_shared<std::atomic<bool>>(false);
+  const int seconds = finalize_timeout_seconds();
+  std::thread([done, seconds] {
+    const auto deadline = MpiClock::now() + std::chrono::seconds(seconds);
+    while (!done->load() && MpiClock::now() < deadline) std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    if (done->load()) return;
+    std::fprintf(stderr, "cohort: MPI_Finalize did not return within %d s (a rank was lost?); leaving without it\n",
+                 seconds);
+    std::fflush(nullptr);
+    std::_Exit(0);
+  }).detach();
+  MPI_Finalize();
+  done->store(true);
 }
 
 void MpiSession::send(int destination, std::vector<uint8_t> bytes) {
