@@ -96,11 +96,14 @@ case "${1:-}" in
           python3 tools/frame_times.py $run/stats.json --skip 20 --json $out/$(basename $run).json | head -n 1
         done
       done
-      timeout 300 "$stage/bin/cohort" bench devices --scene "${args[0]}" --width "${args[2]}" --height "${args[4]}" \
+      [ "${COHORT_GPU_SKIP_DEVICES:-0}" = 1 ] || timeout 300 "$stage/bin/cohort" bench devices --scene "${args[0]}" --width "${args[2]}" --height "${args[4]}" \
         --frames 60 --json "$out/bench_devices_$map.json" 2>&1 | tail -n 14 || true
     done
-    timeout 200 "$stage/bin/cohort" bench balance --real cuda:0,cuda:1 --scene "$stage/testmap.cpk" --rows 720 \
-      --frames 200 --json "$out/bench_balance_2gpu.json" 2>&1 | grep -v "loads" | tail -n 16 || true
+    for real in ${COHORT_GPU_BALANCE_MIXES:-cuda:0,cuda:1}; do
+    echo "== Table 1, real tracers $real"
+    timeout 200 "$stage/bin/cohort" bench balance --real $real --scene "$stage/testmap.cpk" --rows 720 \
+      --frames 200 --json "$out/bench_balance_$(echo $real | tr ',:' '__').json" 2>&1 | grep -v "loads" | tail -n 16 || true
+    done
     ;;
   remote)
     [ -d "$stage/bin" ] || tar -C "$stage" -xJf "$stage/payload.tar.xz"

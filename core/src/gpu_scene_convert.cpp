@@ -14,6 +14,7 @@ uint32_t to_kblend(scene::BlendClass blend) {
     case scene::BlendClass::Additive: return K_BLEND_ADDITIVE;
     case scene::BlendClass::Modulate: return K_BLEND_MODULATE;
     case scene::BlendClass::Alpha: return K_BLEND_ALPHA;
+    case scene::BlendClass::Sky: return K_BLEND_SKY;
   }
   return K_BLEND_OPAQUE;
 }
@@ -64,6 +65,22 @@ void box_light_planes(const scene::Light& light, glm::vec4 planes[4]) {
   planes[3] = glm::vec4(0.0f, 0.0f, 0.5f / r.z, 0.5f);
 }
 
+// The sky's cube faces are consecutive images, so their clamped (light-image) slots are consecutive
+// too: the kernel reads face f at emissive_tex + f (sky.h). A cube without six usable faces is its
+// colour alone.
+void to_ksky(const scene::Material& material, const scene::Scene& scene, KMaterial& k) {
+  k.diffuse_tex = k.normal_tex = k.specular_tex = K_NONE;
+  store(k.diffuse_color, glm::vec4(0.0f, 0.0f, 0.0f, 1.0f));
+  store(k.specular_color, glm::vec4(0.0f));
+  k.emissive_tex = texture_slot(material.sky_cube_image, TextureUse::LightImage, scene);
+  for (int face = 1; face < 6 && k.emissive_tex != K_NONE; ++face)
+    if (texture_slot(material.sky_cube_image + face, TextureUse::LightImage, scene) != k.emissive_tex + uint32_t(face))
+      k.emissive_tex = K_NONE;
+  store(k.tex_transform, material.sky_axis[0]);
+  store(k.tex_transform + 3, material.sky_axis[1]);
+  k.tex_transform[6] = k.tex_transform[7] = 0.0f;
+}
+
 }  // namespace
 
 KMaterial to_kmaterial(const scene::Material& material, const scene::Scene& scene) {
@@ -87,6 +104,12 @@ KMaterial to_kmaterial(const scene::Material& material, const scene::Scene& scen
   if (material.nonsolid) flags |= K_MAT_NONSOLID;
   if (material.emitter) flags |= K_MAT_EMISSIVE;
   if (material.vertex_color) flags |= K_MAT_VERTEX_COLOR;
+  if (material.no_self_shadow) flags |= K_MAT_NO_SELF_SHADOW;
+  if (k.blend == K_BLEND_SKY) {
+    to_ksky(material, scene, k);
+    k.flags = flags & ~K_MAT_EMISSIVE;
+    return k;
+  }
   if (k.blend != K_BLEND_OPAQUE) {
     // A blended layer is its stage image: the kernel reads it as the layer colour, unlit.
     if (k.diffuse_tex == K_NONE && k.emissive_tex != K_NONE) {

@@ -155,4 +155,42 @@ int ImageLibrary::get(const ImageProgram& program, ImageRole role, const std::st
   return index;
 }
 
+int ImageLibrary::get_cube(const std::string& name, CubeMapKind kind, const std::string& context) {
+  const std::string base = strip_extension(name);
+  const std::string key = lowercase(base) + (kind == CubeMapKind::Camera ? "#cameracube" : "#cube");
+  auto cached = by_key_.find(key);
+  if (cached != by_key_.end()) return cached->second;
+  std::vector<Image> faces;
+  std::string error;
+  for (int face = 0; face < 6 && error.empty(); ++face) {
+    const std::string face_name = base + cube_face_suffix(kind, face);
+    std::optional<Image> image = load_file(face_name, error);
+    if (!image || image->rgba.empty()) {
+      error = "face '" + face_name + "': " + (error.empty() ? "empty image" : error);
+    } else if (image->width != image->height) {
+      error = "face '" + face_name + "' is " + std::to_string(image->width) + "x" + std::to_string(image->height) +
+              ", not square";
+    } else if (!faces.empty() && image->width != faces.front().width) {
+      error = "face '" + face_name + "' is " + std::to_string(image->width) + " wide, face '" + base +
+              cube_face_suffix(kind, 0) + "' " + std::to_string(faces.front().width);
+    } else {
+      image->name = face_name;
+      faces.push_back(kind == CubeMapKind::Camera ? camera_image_to_cube_face(*image, face) : std::move(*image));
+    }
+  }
+  if (!error.empty()) {
+    warnings_.push_back(context + ": cube map '" + base + "': " + error + "; using placeholder faces");
+    faces.clear();
+    for (int face = 0; face < 6; ++face)
+      faces.push_back(placeholder_for(ImageRole::Color, base + cube_face_suffix(kind, face)));
+    placeholders_ += 6;
+  } else {
+    loaded_ += 6;
+  }
+  const int first = static_cast<int>(images_.size());
+  for (Image& face : faces) images_.push_back(std::move(face));
+  by_key_[key] = first;
+  return first;
+}
+
 }  // namespace cohort::scene

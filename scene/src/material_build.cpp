@@ -14,7 +14,7 @@ struct RegisterSources {
   MaterialRegisters r;
   void set(std::optional<StageRegisters>& slot, const MaterialStage& s) { slot = s.registers; }
   void attach(Material& m) {
-    for (auto* slot : {&r.diffuse, &r.specular, &r.emissive, &r.look, &r.light}) {
+    for (auto* slot : {&r.diffuse, &r.specular, &r.emissive, &r.look, &r.light, &r.sky}) {
       if (!*slot) continue;
       if ((*slot)->depends() == 0) {
         slot->reset();
@@ -60,6 +60,26 @@ void copy_stage_look(const MaterialStage& s, Material& m, RegisterSources& sourc
   m.vertex_color = m.vertex_color || s.vertex_color;
 }
 
+bool is_sky_stage(const MaterialStage& s) {
+  return s.cube_kind != CubeMapKind::None && (s.texgen == TexGen::Skybox || s.texgen == TexGen::WobbleSky) &&
+         s.blend != StageBlend::None;
+}
+
+// An unlit surface whose stage looks a cube map up by the view direction: what every ray reaching it sees.
+void build_sky(const MaterialDecl& decl, const MaterialStage& s, ImageLibrary& images, Material& m,
+               RegisterSources& sources) {
+  const std::string context = decl.file + ":" + std::to_string(s.line) + ": material " + decl.name;
+  m.blend = BlendClass::Sky;
+  m.sky_cube_image = images.get_cube(s.cube_map, s.cube_kind, context);
+  m.emissive_color = s.color;
+  m.diffuse_color = glm::vec4(0.0f, 0.0f, 0.0f, 1.0f);
+  sources.set(sources.r.emissive, s);   // an animated stage colour
+  if (s.texgen == TexGen::WobbleSky) {
+    m.sky_axis = wobble_sky_axes(s.wobble_sky[0], s.wobble_sky[1], s.wobble_sky[2], 0.0f);
+    sources.set(sources.r.sky, s);
+  }
+}
+
 void glow_with(Material& m, int image, const MaterialStage& s, RegisterSources& sources) {
   m.emitter = true;
   m.emissive_image = image;
@@ -89,6 +109,7 @@ static Material build_material_look(const MaterialDecl& decl, ImageLibrary& imag
   m.no_shadows = decl.no_shadows;
   m.two_sided = decl.two_sided;
   m.nonsolid = decl.nonsolid;
+  m.no_self_shadow = decl.no_self_shadow;
   const bool light_like = as_light || !decl.falloff_image.empty() || decl.fog_light || decl.blend_light ||
                           decl.ambient_light || starts_with_ignoring_case(decl.name, "lights/");
   if (light_like) {
@@ -138,6 +159,11 @@ static Material build_material_look(const MaterialDecl& decl, ImageLibrary& imag
         break;
       }
     }
+    return m;
+  }
+  for (const MaterialStage& s : decl.stages) {
+    if (!is_sky_stage(s)) continue;
+    build_sky(decl, s, images, m, sources);
     return m;
   }
   if (!first_ambient) {

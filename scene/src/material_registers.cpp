@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "cohort/scene/cube_map.h"
 #include "cohort/scene/scene.h"
 
 namespace cohort::scene {
@@ -57,6 +58,7 @@ uint32_t StageRegisters::depends() const {
   uint32_t d = alpha_test ? alpha_ref.depends() : 0u;
   for (const Expression& e : color) d |= e.depends();
   for (const TextureOp& op : tex_ops) d |= op.a.depends() | op.b.depends();
+  for (const Expression& e : wobble_sky) d |= e.depends() | kDependsTime;
   return d;
 }
 
@@ -64,6 +66,7 @@ uint32_t StageRegisters::parms_read() const {
   uint32_t p = alpha_test ? alpha_ref.parms_read() : 0u;
   for (const Expression& e : color) p |= e.parms_read();
   for (const TextureOp& op : tex_ops) p |= op.a.parms_read() | op.b.parms_read();
+  for (const Expression& e : wobble_sky) p |= e.parms_read();
   return p;
 }
 
@@ -79,6 +82,9 @@ void evaluate_material(const Material& base, const RegisterInputs& r, Material& 
     compose_texture_matrix(g.look->tex_ops, r, out.tex_transform);
     if (g.look->alpha_test) out.alpha_ref = g.look->alpha_ref.evaluate(r);
   }
+  if (g.sky && g.sky->wobble_sky.size() == 3)
+    out.sky_axis = wobble_sky_axes(g.sky->wobble_sky[0].evaluate(r), g.sky->wobble_sky[1].evaluate(r),
+                                   g.sky->wobble_sky[2].evaluate(r), r.time);
   if (g.light) {
     glm::vec3 c = glm::vec3(evaluate_color(*g.light, r));
     for (int i = 0; i < 3; ++i) c[i] = c[i] < 0.001f ? 0.0f : c[i];

@@ -33,7 +33,7 @@ const std::set<std::string>& ignored_stage_words() {
 
 const std::set<std::string>& ignored_material_words() {
   static const std::set<std::string> words = {
-      "mirror", "forceoverlays", "forceopaque", "forceshadows", "noselfshadow", "noportalfog",
+      "mirror", "forceoverlays", "forceopaque", "forceshadows", "noportalfog",
       "unsmoothedtangents", "discrete", "nofragment", "noimpact", "nooverlays", "playerclip", "monsterclip",
       "moveableclip", "ikclip", "blood", "trigger", "aassolid", "aasobstacle", "flashlight_trigger",
       "nullnormal", "areaportal", "qer_nocarve", "collision", "nodamage", "solid", "water", "clamp", "zeroclamp",
@@ -57,6 +57,7 @@ const std::map<std::string, bool MaterialDecl::*>& material_flag_words() {
       {"noshadows", &MaterialDecl::no_shadows},
       {"twosided", &MaterialDecl::two_sided},
       {"nonsolid", &MaterialDecl::nonsolid},
+      {"noselfshadow", &MaterialDecl::no_self_shadow},
       {"decal_macro", &MaterialDecl::no_shadows},  // the macro: polygonOffset, discrete, sort decal, noShadows
       {"foglight", &MaterialDecl::fog_light},
       {"blendlight", &MaterialDecl::blend_light},
@@ -144,12 +145,23 @@ class MaterialReader {
       else lex.fail(mode, "unknown blend mode '" + mode.text + "'");
     } else if (word == "map") {
       stage.image = parse_image_program(lex);
-    } else if (word == "cubemap" || word == "cameracubemap" || word == "videomap" || word == "soundmap" ||
+    } else if (word == "cubemap" || word == "cameracubemap") {
+      stage.special_map = t.text;
+      stage.cube_kind = word == "cubemap" ? CubeMapKind::Axis : CubeMapKind::Camera;
+      ImageProgram program = parse_image_program(lex);
+      if (!program.function.empty())
+        warnings_.push_back(at(file_, t.line) + "material " + m.name + ": " + t.text +
+                            " of an image program: only its first image's faces are loaded");
+      while (!program.function.empty() && !program.inputs.empty()) program = program.inputs.front();
+      stage.cube_map = program.path;
+    } else if (word == "texgen") {
+      read_texgen(lex, stage, m, context);
+    } else if (word == "videomap" || word == "soundmap" ||
                word == "mirrorrendermap" || word == "remoterendermap" || word == "xrayrendermap" ||
                word == "fragmentprogram" || word == "vertexprogram" || word == "program" || word == "megatexture") {
       stage.special_map = t.text;
       lex.skip_rest_of_line();
-    } else if (word == "vertexparm" || word == "fragmentmap" || word == "texgen" || word == "privatepolygonoffset") {
+    } else if (word == "vertexparm" || word == "fragmentmap" || word == "privatepolygonoffset") {
       lex.skip_rest_of_line();
     } else if (word == "alphatest") {
       stage.registers.alpha_test = true;
@@ -194,6 +206,31 @@ class MaterialReader {
     } else {
       warnings_.push_back(at(file_, t.line) + "material " + m.name + ": unknown stage keyword '" + t.text + "' skipped");
       lex.skip_rest_of_line();
+    }
+  }
+
+  // texgen skybox | wobbleSky a b c | normal | reflect | screen | screen2 | glassWarp (Material.cpp ParseStage).
+  void read_texgen(Lexer& lex, MaterialStage& stage, const MaterialDecl& m, ExpressionContext& context) {
+    Token kind = lex.expect_any("a texgen kind");
+    std::string k = lowercase(kind.text);
+    if (k == "skybox") {
+      stage.texgen = TexGen::Skybox;
+    } else if (k == "wobblesky") {
+      stage.texgen = TexGen::WobbleSky;
+      const RegisterInputs at_load;
+      stage.registers.wobble_sky.clear();
+      for (float& value : stage.wobble_sky) {
+        stage.registers.wobble_sky.push_back(parse_expression(lex, context));
+        value = stage.registers.wobble_sky.back().evaluate(at_load);
+      }
+    } else if (k == "normal") {
+      stage.texgen = TexGen::Normal;
+    } else if (k == "reflect") {
+      stage.texgen = TexGen::Reflect;
+    } else if (k == "screen" || k == "screen2" || k == "glasswarp") {
+      stage.texgen = TexGen::Screen;
+    } else {
+      warnings_.push_back(at(file_, kind.line) + "material " + m.name + ": unknown texgen '" + kind.text + "' skipped");
     }
   }
 

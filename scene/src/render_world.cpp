@@ -210,6 +210,9 @@ int RenderWorld::DefineMaterial(const Material& material) {
     if (!image_ok(i))
       throw RenderWorldError(fmt::format("DefineMaterial '{}': image {} out of range ({} images)", material.name, i,
                                          scene_.images.size()));
+  if (material.sky_cube_image != -1 && !(material.sky_cube_image >= 0 && material.sky_cube_image + 5 < int(scene_.images.size())))
+    throw RenderWorldError(fmt::format("DefineMaterial '{}': sky cube faces {}..{} out of range ({} images)", material.name,
+                                       material.sky_cube_image, material.sky_cube_image + 5, scene_.images.size()));
   return define_by_name(scene_.materials, scene_.find_material(material.name), material, changes_.materials,
                         "DefineMaterial: too many materials");
 }

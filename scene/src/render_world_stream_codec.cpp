@@ -73,9 +73,10 @@ void material_layout(Codec& c, Mat& v) {
            v.emissive_image, v.light_image, v.falloff_image, v.diffuse_color, v.specular_color, v.emissive_color,
            v.tex_transform);
   c.flags("material", v.alpha_test, v.translucent, v.no_shadows, v.two_sided, v.nonsolid, v.emitter,
-          v.vertex_color, v.is_light_material, v.is_default);
+          v.vertex_color, v.is_light_material, v.is_default, v.no_self_shadow);
   c.fields(v.alpha_ref, v.blend, v.light_stage_color, v.light_kind, v.light_stage_alpha);
   c.flags("light material", v.light_blend_adds);
+  c.fields(v.sky_cube_image, v.sky_axis);
 }
 
 template <class Codec, class Img>
@@ -166,7 +167,7 @@ void Decoder::check_flags(uint32_t bits, size_t flag_count, const char* what) co
 
 void Decoder::field(BlendClass& v) {
   uint8_t blend = u8();
-  if (blend > static_cast<uint8_t>(BlendClass::Alpha)) fail(fmt::format("blend class {} unknown", blend));
+  if (blend > static_cast<uint8_t>(BlendClass::Sky)) fail(fmt::format("blend class {} unknown", blend));
   v = static_cast<BlendClass>(blend);
 }
 

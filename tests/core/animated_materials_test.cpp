@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include "cohort/core/world_sync.h"
+#include "cohort/scene/cube_map.h"
 #include "cohort/scene/map_loader.h"
 #include "cohort/scene/material_build.h"
 #include "cohort/scene/material_file.h"
@@ -225,5 +226,40 @@ TEST(AnimatedMaterials, TestMapAnimatesAndTintsCrate2) {
     EXPECT_FLOAT_EQ(tinted.diffuse_color[0], 0.55f);
     EXPECT_FLOAT_EQ(tinted.diffuse_color[1], 0.8f);
     EXPECT_FLOAT_EQ(tinted.diffuse_color[2], 1.0f);
+  }
+}
+
+// texgen wobbleSky reads time: the sky's KMaterial carries the engine's axes for the frame's time
+// (X' and Y' in tex_transform, kernel/sky.h) and is re-sent as they turn.
+TEST(AnimatedMaterials, WobblingSkyTurnsWithTime) {
+  scene::Scene s;
+  scene::MaterialTables tables;
+  scene::MaterialFile f =
+      scene::parse_materials("textures/sky/wobble { { cameraCubeMap env/none texgen wobbleSky 20 2 0.5 } }", "sky.mtr",
+                             tables);
+  scene::Vfs vfs;
+  std::vector<std::string> warnings;
+  scene::ImageLibrary images(vfs, s.images, warnings);
+  s.materials.push_back(scene::build_material(f.materials.at(0), images, false));
+  ASSERT_EQ(s.materials[0].blend, scene::BlendClass::Sky);
+  scene::Mesh ceiling;
+  ceiling.name = "_area0";
+  test::add_quad(ceiling, 0, {-64, -64, 64}, {64, -64, 64}, {64, 64, 64}, {-64, 64, 64}, {0, 0, -1});
+  test::add_world_mesh(s, std::move(ceiling));
+  scene::RenderWorld world(s);
+  WorldSync sync(world);
+  world.TakeChanges();
+  const uint32_t sky = sync.kmaterial_index(0);
+  for (int ms : {4000, 15000}) {
+    set_time(world, ms);
+    commit::CommitBuffer frame = sync.sync(world.TakeChanges(), uint64_t(ms));
+    EXPECT_EQ(frame.materials().count(sky), 1u) << "at " << ms;
+    const glm::mat3 want = scene::wobble_sky_axes(20.0f, 2.0f, 0.5f, ms * 0.001f);
+    const KMaterial& k = sync.master().materials[sky];
+    EXPECT_EQ(k.blend, K_BLEND_SKY);
+    for (int i = 0; i < 3; ++i) {
+      EXPECT_NEAR(k.tex_transform[i], want[0][i], 1e-5f) << "X' at " << ms;
+      EXPECT_NEAR(k.tex_transform[3 + i], want[1][i], 1e-5f) << "Y' at " << ms;
+    }
   }
 }

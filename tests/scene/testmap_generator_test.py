@@ -161,8 +161,8 @@ class ProcFile(unittest.TestCase):
 
     def test_world_shell_closed_across_areas(self):
         """Edges of all opaque world surfaces (floor/wall/ceiling materials) pair up exactly."""
-        shell = ("floor_tiles", "wall_bricks", "ceiling", "concrete", "metalfloor", "wood_floor", "sky", "pillar",
-                 "metal")
+        shell = ("floor_tiles", "wall_bricks", "ceiling", "concrete", "metalfloor", "wood_floor", "sky", "skybox",
+                 "pillar", "metal")
         edges = {}
         for n in range(self.num_areas):
             for material, verts, idx in self.models["_area%d" % n]:

@@ -183,6 +183,14 @@ TEST_F(TestMap, MaterialClasses) {
   EXPECT_EQ(m("textures/testmap/lightpanel_blue").emissive_color, glm::vec4(0.5f, 0.75f, 1.0f, 1.0f));
   EXPECT_TRUE(m("textures/testmap/sky").emitter);
   EXPECT_EQ(m("textures/testmap/sky").blend, BlendClass::Opaque);
+  // The sky court's ceiling: a camera cube map with texgen skybox, its six faces found (docs/sky.md).
+  const Material& skybox = m("textures/testmap/skybox");
+  EXPECT_EQ(skybox.blend, BlendClass::Sky);
+  ASSERT_GE(skybox.sky_cube_image, 0);
+  for (int face = 0; face < 6; ++face)
+    EXPECT_FALSE(scene.images.at(static_cast<size_t>(skybox.sky_cube_image + face)).is_placeholder) << face;
+  EXPECT_EQ(scene.images.at(static_cast<size_t>(skybox.sky_cube_image + 4)).name, "env/testmap_sky_up");
+  EXPECT_TRUE(m("textures/testmap/leaves").no_self_shadow);
   EXPECT_EQ(m("textures/testmap/floor_tiles").blend, BlendClass::Opaque);
   EXPECT_GE(m("textures/testmap/floor_tiles").normal_image, 0);
   EXPECT_TRUE(scene.images[static_cast<size_t>(m("textures/testmap/floor_tiles").normal_image)].is_normal_map);

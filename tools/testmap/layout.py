@@ -22,6 +22,9 @@ AREAS = [
         ceiling=M + "concrete"),
     Box("gallery", (1408, 32, 96), (1792, 352, 256), floor=M + "wood_floor", wall=M + "wall_bricks",
         ceiling=M + "ceiling"),
+    # Off the gallery's north wall, behind the gallery view: its opening stays out of every older view.
+    Box("sky_court", (1408, 352, 96), (1536, 512, 256), floor=M + "concrete", wall=M + "wall_bricks",
+        ceiling=M + "skybox"),
 ]
 
 AREA_NOTES = {
@@ -32,6 +35,8 @@ AREA_NOTES = {
     "skylight_shaft": "sky cap (emitter, noshadows), holds `light_sun`",
     "stairwell": "eight steps (rise 12, run 28) up to the gallery floor at z 96",
     "gallery": "raised room: pedestal with a glass case, gel projector `light_gel`, blue panels, crate",
+    "sky_court": "ceiling is sky (`textures/testmap/skybox`: a cameraCubeMap with texgen skybox), a shrub "
+                 "whose leaves are `noSelfShadow`, lit by `light_court`",
 }
 
 # Suggested cameras (origin, yaw degrees, pitch degrees down) for renders and benchmarks.
@@ -40,6 +45,7 @@ VIEWS = [
     ("atrium_skylight", (790, 30, 110), 40, 20),
     ("stairs_up", (1168, 192, 68), 0, -10),
     ("gallery", (1440, 300, 164), -30, 15),
+    ("sky_court", (1420, 364, 120), 60, -35),
 ]
 
 STAIR_STEPS = 8
@@ -100,7 +106,7 @@ def _quad(mesh, material, points, normal, texel_scale=None):
 
 
 def add_details(area_meshes):
-    hall, corridor, atrium, shaft, stairwell, gallery = area_meshes
+    hall, corridor, atrium, shaft, stairwell, gallery, sky_court = area_meshes
     panel = M + "lightpanel"
     # Ceiling light panels hang a quarter unit below the ceiling, facing down.
     for x0, y0 in ((224, 32), (224, 320), (32, 176), (448, 176)):
@@ -158,6 +164,14 @@ def inline_models():
     add_box(crate, M + "crate", (-24, -24, 0), (24, 24, 48), texel_scale=48.0)
     models.append(crate)
 
+    # Crossed leaf slabs on a stem: the leaves are noSelfShadow (they do not shadow each other, but do
+    # shadow the floor and the stem).
+    shrub = Mesh("testmap_shrub")
+    add_box(shrub, M + "wood", (-3, -3, 0), (3, 3, 40), texel_scale=32.0)
+    for lo, hi in (((-28, -4, 30), (28, 4, 70)), ((-4, -28, 30), (4, 28, 70)), ((-20, -20, 50), (20, 20, 56))):
+        add_box(shrub, M + "leaves", lo, hi, texel_scale=32.0)
+    models.append(shrub)
+
     table = Mesh("testmap_table")
     add_box(table, M + "wood", (-48, -32, 30), (48, 32, 34), texel_scale=64.0)
     for sx in (-1, 1):
@@ -193,6 +207,8 @@ def entities():
         if name == "crate_2":
             keys.append(("_color", (0.55, 0.8, 1)))   # shaderParm tint through the crate's `colored` stage
         ents.append(("func_static", keys))
+    ents.append(("func_static", [("name", "shrub_1"), ("model", "testmap_shrub"), ("origin", (1472, 448, 96)),
+                                 ("rotation", yaw_rotation(20))]))
     ents.append(("func_static", [("name", "table_1"), ("model", "testmap_table"), ("origin", (160, 192, 0)),
                                  ("rotation", yaw_rotation(90))]))
 
@@ -233,6 +249,8 @@ def entities():
                          ("texture", "lights/testmap_blend")]),
         ("light_ambient", [("origin", (1600, 96, 150)), ("light_radius", (320, 256, 180)),
                            ("_color", (0.12, 0.12, 0.16)), ("texture", "lights/testmap_ambient")]),
+        ("light_court", [("origin", (1500, 420, 230)), ("light_radius", (160, 160, 200)),
+                         ("_color", (1, 0.95, 0.85))]),
     ]
     for name, keys in lights:
         ents.append(("light", [("name", name)] + keys))
@@ -246,5 +264,6 @@ def expected_area_of_entity(name):
         "crate_4": 2, "table_1": 0, "light_hall": 0, "light_hall_fill": 0, "light_flicker": 1, "light_beam": 2,
         "light_sun": 3, "light_stairs": 4, "light_gallery": 5, "light_gel": 5,
         "light_fog": 4, "light_blend": 1, "light_ambient": 5,
+        "shrub_1": 6, "light_court": 6,
         "lamp_1": 0, "lamp_2": 0, "light_lamp": 0, "wedge_1": 2, "wedge_2": 5, "walker_1": 0, "walker_2": 5,
     }.get(name)

@@ -263,6 +263,25 @@ textures/testmap/sky
 	}
 }
 
+// the sky court's ceiling: an unlit stage of a camera cube map looked up by the view direction
+// (env/testmap_sky_forward.tga ... _down.tga), as Doom 3 skies are made; it blocks light (no noshadows)
+textures/testmap/skybox
+{
+	{
+		blend			GL_ONE, GL_ZERO
+		cameraCubeMap	env/testmap_sky
+		texgen			skybox
+	}
+}
+
+// the shrub's leaves (inline model testmap_shrub): noSelfShadow, so they do not shadow each other
+textures/testmap/leaves
+{
+	noSelfShadow
+	twoSided
+	diffusemap	textures/testmap/leaves_d.tga
+}
+
 // ---- model surfaces (tools/testmap/models.py) ------------------------------------------------
 
 models/testmap/walker

@@ -181,10 +181,50 @@ def build_images():
     add(tex + "sky_d.tga", make_image(size, size, lambda x, y: _tint(0.55, 0.72, 1.0,
                                                                      0.8 + 0.4 * fbm(x, y, size, 4, 4, 101))))
 
+    add(tex + "leaves_d.tga", make_image(64, 64, lambda x, y: _tint(0.22, 0.5, 0.16,
+                                                                    0.6 + 0.6 * fbm(x, y, 64, 8, 3, 131))))
+    for suffix, view in SKY_CAMERA_VIEWS:
+        add("env/testmap_sky" + suffix + ".tga", make_image(SKY_FACE, SKY_FACE, lambda x, y, v=view: _sky_view(x, y, v)))
+
     add("lights/testmap_gel.tga", make_image(size, size, lambda x, y: _gel(x, y, size)))
     add("lights/testmap_round.tga", make_image(size, size, lambda x, y: _round_spot(x, y, size)))
     add("lights/testmap_falloff.tga", make_image(64, 8, lambda x, y: _falloff(x, 64)), rle=True)
     return images
+
+
+# The six images of a cameraCubeMap (doom3-content.md section 8), each an ordinary 90-degree view:
+# (suffix, (forward, right, up)). forward, back, left, right look along +X, -X, +Y, -Y with image-up +Z;
+# up and down are the forward view pitched up and down.
+SKY_CAMERA_VIEWS = (
+    ("_forward", ((1, 0, 0), (0, -1, 0), (0, 0, 1))),
+    ("_back", ((-1, 0, 0), (0, 1, 0), (0, 0, 1))),
+    ("_left", ((0, 1, 0), (1, 0, 0), (0, 0, 1))),
+    ("_right", ((0, -1, 0), (-1, 0, 0), (0, 0, 1))),
+    ("_up", ((0, 0, 1), (0, -1, 0), (-1, 0, 0))),
+    ("_down", ((0, 0, -1), (0, -1, 0), (1, 0, 0))),
+)
+SKY_FACE = 64
+SKY_SUN = (0.48, 0.6, 0.64)   # unit direction toward the painted sun
+
+
+def _sky_view(x, y, view):
+    """Pixel (x, y) of a camera image of the sky: the world direction through it, then the sky's colour
+    there. If the loader turns the faces right, the cube shows one seamless sky."""
+    forward, right, up = view
+    sx = (2.0 * (x + 0.5) / SKY_FACE) - 1.0
+    sy = 1.0 - (2.0 * (y + 0.5) / SKY_FACE)
+    d = [forward[i] + sx * right[i] + sy * up[i] for i in range(3)]
+    length = math.sqrt(sum(c * c for c in d))
+    d = [c / length for c in d]
+    if d[2] < 0.0:   # ground below the horizon, darker with depth
+        k = 0.55 + 0.45 * (1.0 + d[2])
+        return rgb(0.32 * k, 0.28 * k, 0.22 * k)
+    zenith, horizon = (0.16, 0.34, 0.78), (0.78, 0.85, 0.95)
+    t = math.sqrt(d[2])
+    sky = [horizon[i] + (zenith[i] - horizon[i]) * t for i in range(3)]
+    sun = sum(d[i] * SKY_SUN[i] for i in range(3))
+    glow = max(0.0, sun) ** 64 * 0.6 + (1.0 if sun > 0.995 else 0.0)
+    return rgb(*[min(1.0, c + glow) for c in sky])
 
 
 def _tint(r, g, b, k):

@@ -8,7 +8,8 @@ namespace {
 bool material_may_pass(const commit::TracerScene& scene, kuint material) {
   if (material >= scene.materials.size()) return true;  // let the filter see what this is
   const KMaterial& m = scene.materials[material];
-  return m.blend != K_BLEND_OPAQUE || (m.flags & (K_MAT_ALPHA_TEST | K_MAT_NO_SHADOWS | K_MAT_TRANSLUCENT)) != 0u;
+  return (m.blend != K_BLEND_OPAQUE && m.blend != K_BLEND_SKY) ||
+         (m.flags & (K_MAT_ALPHA_TEST | K_MAT_NO_SHADOWS | K_MAT_TRANSLUCENT | K_MAT_NO_SELF_SHADOW)) != 0u;
 }
 
 }  // namespace

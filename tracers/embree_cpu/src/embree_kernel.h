@@ -43,7 +43,7 @@ struct FilterContext {
   RTCIntersectContext base;
   const KSceneView* scene;
   kuint ray_mask;
-  int shadow_ray;
+  int shadow_ray;   // material.h's ray kind: 0 camera or bounce, 1 shadow, 2 shadow from a noSelfShadow surface
 };
 
 void filter_hit(const RTCFilterFunctionNArguments* args);
@@ -120,7 +120,7 @@ static inline int k_trace_occluded(KTraceCtx* ctx, KVec3 org, KVec3 dir, float t
   namespace ek = cohort::tracers::embree_kernel;
   ++ctx->rays;
   if (ctx->log) ek::log_ray(ctx->log, ek::kShadowRay, org, dir, tmax, ray_mask);
-  ek::FilterContext fc = ek::filter_context(&ctx->scene, ray_mask, 1);
+  ek::FilterContext fc = ek::filter_context(&ctx->scene, ray_mask, k_shadow_ray_kind(ray_mask));
   RTCRay ray = ek::make_ray(org, dir, tmax, ray_mask);
   rtcOccluded1(ctx->top, &fc.base, &ray);
   return ray.tfar < 0.0f;  // Embree sets tfar to -inf on occlusion

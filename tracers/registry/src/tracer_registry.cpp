@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <stdexcept>
+#include <thread>
 
 #ifdef COHORT_HAVE_EMBREE
 #include "cohort/tracers/embree_tracer.h"
@@ -111,12 +112,22 @@ std::vector<TracerSpec> parse_tracer_list(const std::string& list) {
     specs.push_back(spec);
   }
   if (specs.empty()) throw std::invalid_argument("no tracers named in '" + list + "'");
+  bool any_cuda = false;
+  for (const TracerSpec& s : specs) any_cuda = any_cuda || s.kind == "cuda";
+  if (any_cuda)
+    for (TracerSpec& s : specs)
+      if (s.kind == "embree") s.threads = embree_threads_beside_gpus(std::thread::hardware_concurrency());
   return specs;
+}
+
+int embree_threads_beside_gpus(unsigned hardware_threads) {
+  const int all = static_cast<int>(std::max(hardware_threads, 1u));
+  return std::max(1, all - std::max(2, all / 4));
 }
 
 std::unique_ptr<core::Tracer> make_tracer(const TracerSpec& spec) {
 #ifdef COHORT_HAVE_EMBREE
-  if (spec.kind == "embree") return std::make_unique<EmbreeTracer>();
+  if (spec.kind == "embree") return std::make_unique<EmbreeTracer>(spec.threads);
 #endif
 #ifdef COHORT_HAVE_OPENCL
   if (spec.kind == "opencl") {

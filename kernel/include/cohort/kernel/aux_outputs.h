@@ -12,7 +12,8 @@
  *               rotation only (a point at infinity). K_AUX_NO_MOTION when the point was behind the
  *               previous camera.
  *   normal      world-space shading normal (unit); 0 on a miss
- *   albedo      linear diffuse reflectance plus emission, clamped to [0, 1] (what OIDN wants)
+ *   albedo      linear diffuse reflectance plus emission, clamped to [0, 1] (what OIDN wants); on a sky
+ *               surface (treated as a miss otherwise) the sky's colour
  *   id          the instance's entity + 1 (0 for the world), K_NONE on a miss: stable across frames,
  *               unlike instance indices, which follow the TLAS leaf order
  * Object motion: prev_object_to_world holds, per instance (the KInstance array's order), the 3x4
@@ -69,6 +70,14 @@ KFN void k_pixel_aux(KTraceCtx* ctx, const KCamera* cam, const KCamera* prev_cam
     hit.cost = 0u;
     if (!k_trace_closest(ctx, ray_org, dir, K_INF, K_RAY_PRIMARY, &hit)) break;
     KSurface sf = k_surface_eval(scene, hit, ray_org, dir, pixel_spread * hit.t);
+    if (sf.blend == K_BLEND_SKY) {
+      /* Infinitely far, as a miss (depth 0, motion by the camera's rotation), but with its colour. */
+      KVec3 sky = k_sky_radiance(scene, hit.instance, sf.material, dir);
+      out->albedo[0] = k_saturate(sky.x);
+      out->albedo[1] = k_saturate(sky.y);
+      out->albedo[2] = k_saturate(sky.z);
+      break;
+    }
     if (sf.blend != K_BLEND_OPAQUE) {
       ray_org = v3_madd(sf.position, dir, k_ray_epsilon(sf.position));
       continue;

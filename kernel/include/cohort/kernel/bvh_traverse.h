@@ -19,7 +19,8 @@
  *   K_BVH_CONTEXT                    type handed to the hooks (pointer or scalar); default int
  *   K_BVH_HIT_PASSES(ctx, instance, triangle, u, v, shadow_ray)
  *        float: 1 when the ray goes through this surface (pass-through, alpha-test miss), 0 when the
- *        hit counts. Used by k_bvh_closest (shadow_ray 0) and k_bvh_any (shadow_ray 1).
+ *        hit counts. Used by k_bvh_closest (shadow_ray 0) and k_bvh_any (shadow_ray 1, or 2 when the
+ *        mask carries K_RAY_FLAG_FROM_NO_SELF_SHADOW: material.h's k_shadow_ray_kind).
  *        Default 0: every surface counts. Same meaning as material.h's k_hit_transmittance.
  *   K_BVH_SHADOW_TRANSMITTANCE(ctx, instance, triangle, u, v)
  *        KVec3: the fraction of light the surface lets through (0 opaque; tinted glass in between).
@@ -150,14 +151,14 @@ KFN int k_bvh_hit_triangle(KSceneRef scene, kuint triangle, KVec3 o, KVec3 d, fl
 
 /* One candidate hit. CLOSEST records it and shrinks *tmax; ANY reports it; SHADOW multiplies it
  * into *transmittance. Returns 1 when the whole query is decided. */
-KFN int k_bvh_accept(K_BVH_CONTEXT ctx, int query, kuint instance, kuint triangle, float t, float u, float v,
-                     float* tmax, KHit* hit, KVec3* transmittance) {
+KFN int k_bvh_accept(K_BVH_CONTEXT ctx, int query, int shadow_ray, kuint instance, kuint triangle, float t, float u,
+                     float v, float* tmax, KHit* hit, KVec3* transmittance) {
   if (query == K_BVH_QUERY_SHADOW) {
     KVec3 through = K_BVH_SHADOW_TRANSMITTANCE(ctx, instance, triangle, u, v);
     *transmittance = v3_mul(*transmittance, through);
     return v3_max_component(*transmittance) <= 0.0f;
   }
-  if (K_BVH_HIT_PASSES(ctx, instance, triangle, u, v, query == K_BVH_QUERY_ANY) > 0.0f) return 0;
+  if (K_BVH_HIT_PASSES(ctx, instance, triangle, u, v, shadow_ray) > 0.0f) return 0;
   if (query == K_BVH_QUERY_ANY) return 1;
   *tmax = t;
   hit->t = t;
@@ -169,7 +170,7 @@ KFN int k_bvh_accept(K_BVH_CONTEXT ctx, int query, kuint instance, kuint triangl
 }
 
 /* Walks one instance's BLAS with the object-space ray. */
-KFN int k_bvh_traverse_blas(KSceneRef scene, K_BVH_CONTEXT ctx, int query, kuint instance, KBvhRay r,
+KFN int k_bvh_traverse_blas(KSceneRef scene, K_BVH_CONTEXT ctx, int query, int shadow_ray, kuint instance, KBvhRay r,
                             float tmin, float* tmax, KHit* hit, KVec3* transmittance) {
   KGLOBAL const KBlas* blas = scene.blases + scene.instances[instance].blas;
   if (blas->node_count == 0u) return 0;
@@ -187,7 +188,7 @@ KFN int k_bvh_traverse_blas(KSceneRef scene, K_BVH_CONTEXT ctx, int query, kuint
         kuint triangle = blas->tri_offset + i;
         float t, u, v;
         if (!k_bvh_hit_triangle(scene, triangle, r.o, r.d, tmin, *tmax, &t, &u, &v)) continue;
-        if (k_bvh_accept(ctx, query, instance, triangle, t, u, v, tmax, hit, transmittance)) return 1;
+        if (k_bvh_accept(ctx, query, shadow_ray, instance, triangle, t, u, v, tmax, hit, transmittance)) return 1;
       }
     } else if (k_bvh_descend(r, nodes, n, tmin, *tmax, stack, &sp, &node)) {
       continue;
@@ -206,6 +207,8 @@ KFN_OUTLINED int k_bvh_traverse(KSceneRef scene, K_BVH_CONTEXT ctx, int query, K
   hit->triangle = K_NONE;
   hit->cost = 0u;
   if (scene.tlas_node_count == 0u || scene.instance_count == 0u) return 0;
+  /* The hooks' ray kind: 0 closest (camera, bounce), 1 occlusion, 2 occlusion from a noSelfShadow surface. */
+  int shadow_ray = query == K_BVH_QUERY_CLOSEST ? 0 : ((mask & K_RAY_FLAG_FROM_NO_SELF_SHADOW) ? 2 : 1);
   KBvhRay world = k_bvh_make_ray(o, d);
   kuint stack[K_BVH_MAX_DEPTH];
   int sp = 0;
@@ -221,7 +224,7 @@ KFN_OUTLINED int k_bvh_traverse(KSceneRef scene, K_BVH_CONTEXT ctx, int query, K
         if ((inst->mask & mask) == 0u) continue;
         KBvhRay object_ray = k_bvh_make_ray(xform_point_g(inst->world_to_object, o),
                                        xform_vector_g(inst->world_to_object, d));
-        if (k_bvh_traverse_blas(scene, ctx, query, i, object_ray, tmin, &tmax, hit, transmittance)) return 1;
+        if (k_bvh_traverse_blas(scene, ctx, query, shadow_ray, i, object_ray, tmin, &tmax, hit, transmittance)) return 1;
       }
     } else if (k_bvh_descend(world, scene.tlas_nodes, n, tmin, tmax, stack, &sp, &node)) {
       continue;

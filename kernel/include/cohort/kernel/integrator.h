@@ -18,6 +18,7 @@
 #include "fog.h"
 #include "light_tree.h"
 #include "rng.h"
+#include "sky.h"
 
 #ifndef K_CTX_SCENE
 #define K_CTX_SCENE(ctx) (&(ctx)->scene)
@@ -49,7 +50,7 @@ KFN int k_light_visible(KTraceCtx* ctx, const KFrameParams* params, const KSurfa
   float eps = k_ray_epsilon(sf->position);
   KVec3 org = v3_madd(sf->position, sf->geo_normal, eps);
   float tmax = dist < K_INF ? dist - 2.0f * eps : K_INF;
-  return tmax <= 0.0f || !k_trace_occluded(ctx, org, dir, tmax, K_RAY_SHADOW);
+  return tmax <= 0.0f || !k_trace_occluded(ctx, org, dir, tmax, k_shadow_ray_mask(sf->flags));
 }
 
 /* Next-event estimation toward the Doom 3 lights, three ways (KFrameParams.light_sampling):
@@ -171,7 +172,8 @@ KFN KVec3 k_emissive_lighting(KTraceCtx* ctx, const KSurface* sf, KVec3 wo, int 
   KVec3 seg = v3_sub(x, org);
   float seg_len = v3_length(seg);
   float tmax = seg_len - 2.0f * k_ray_epsilon(x);
-  if (tmax > 0.0f && k_trace_occluded(ctx, org, v3_scale(seg, 1.0f / seg_len), tmax, K_RAY_SHADOW)) return v3s(0.0f);
+  if (tmax > 0.0f && k_trace_occluded(ctx, org, v3_scale(seg, 1.0f / seg_len), tmax, k_shadow_ray_mask(sf->flags)))
+    return v3s(0.0f);
 
   float pdf = pick * 2.0f / double_area * dist2 / cos_light;
   float weight = 1.0f;
@@ -222,6 +224,15 @@ KFN KVec3 k_trace_path(KTraceCtx* ctx, const KFrameParams* params, KVec3 org, KV
     if (lit_mode) {
       k_apply_fog(scene, org, dir, hit.t, &radiance, &throughput);
       if (v3_max_component(throughput) <= 0.0f) break;
+    }
+    kuint hit_material = k_hit_material(scene, hit.instance, hit.triangle);
+    if (scene->materials[hit_material].blend == K_BLEND_SKY) {
+      /* The sky: what its cube shows along the ray, and nothing behind it. */
+      if (lit_mode || params->mode == K_MODE_ALBEDO) {
+        KVec3 sky = v3_mul(throughput, k_sky_radiance(scene, hit.instance, hit_material, dir));
+        radiance = v3_add(radiance, bounce > 0u ? k_clamp_radiance(sky, params->firefly_clamp) : sky);
+      }
+      break;
     }
     cone_width += spread * hit.t;
     KSurface sf = k_surface_eval(scene, hit, org, dir, cone_width);

@@ -30,6 +30,9 @@ typedef struct KBlas {
 /* Instance mask bits: a ray carries a mask and skips instances that share no bit with it. */
 #define K_MASK_PRIMARY 1u   /* visible to camera and bounce rays */
 #define K_MASK_SHADOW  2u   /* casts shadows (cleared for noShadows entities) */
+/* Not an instance bit (no instance carries it): a shadow ray carries it when it leaves a noSelfShadow
+ * surface, so that the material hooks let other noSelfShadow surfaces through (k_shadow_ray_kind). */
+#define K_RAY_FLAG_FROM_NO_SELF_SHADOW 4u
 
 typedef struct KInstance {
   float object_to_world[12];  /* 3x4 row-major */
@@ -60,6 +63,11 @@ typedef struct KTriangle {
 #define K_BLEND_ADDITIVE    2u  /* adds its colour and lets the ray continue (glows, decals that add) */
 #define K_BLEND_MODULATE    3u  /* multiplies throughput and continues (filter decals, tinted glass) */
 #define K_BLEND_ALPHA       4u  /* mixes by alpha and continues (blend stages) */
+#define K_BLEND_SKY         5u  /* a cube map read by the ray's direction (sky.h); the path ends there. It
+                                 * blocks shadow rays unless K_MAT_NO_SHADOWS. emissive_tex: face +X, the
+                                 * other faces follow in the texture table (-X, +Y, -Y, +Z, -Z);
+                                 * emissive_color: the stage colour; tex_transform[0..2] and [3..5]: the
+                                 * axes X' and Y' (Z' = X' x Y') the model-space direction is read against */
 
 #define K_MAT_ALPHA_TEST   1u
 #define K_MAT_TRANSLUCENT  2u
@@ -69,6 +77,7 @@ typedef struct KTriangle {
 #define K_MAT_EMISSIVE     32u  /* ambient-only stages: an emitter */
 #define K_MAT_VERTEX_COLOR 64u
 #define K_MAT_NO_SPECULAR  128u
+#define K_MAT_NO_SELF_SHADOW 256u  /* noSelfShadow: does not shadow other noSelfShadow surfaces */
 
 typedef struct KMaterial {
   float diffuse_color[4];   /* multiplies the diffuse map; rgba */

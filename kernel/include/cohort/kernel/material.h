@@ -48,17 +48,39 @@ KFN float k_hit_alpha(const KSceneView* scene, kuint triangle, float u, float v,
   return alpha;
 }
 
+/* What kind of ray the material hooks see (their shadow_ray argument). */
+#define K_CAMERA_OR_BOUNCE_RAY 0
+#define K_SHADOW_RAY 1
+#define K_SHADOW_RAY_FROM_NO_SELF_SHADOW 2   /* leaves a noSelfShadow surface */
+
+/* The kind of an occlusion ray with this ray mask. */
+KFN int k_shadow_ray_kind(kuint ray_mask) {
+  return (ray_mask & K_RAY_FLAG_FROM_NO_SELF_SHADOW) ? K_SHADOW_RAY_FROM_NO_SELF_SHADOW : K_SHADOW_RAY;
+}
+
+/* The mask of a shadow ray leaving a surface with these material flags. Per light the engine draws
+ * the shadows of ordinary casters, lights the noSelfShadow receivers, then adds the noSelfShadow
+ * casters' shadows for everything else (RB_ARB2_DrawInteractions): noSelfShadow surfaces, of any
+ * entity, never shadow each other but do shadow ordinary surfaces. */
+KFN kuint k_shadow_ray_mask(kuint surface_flags) {
+  return K_RAY_SHADOW | ((surface_flags & K_MAT_NO_SELF_SHADOW) ? K_RAY_FLAG_FROM_NO_SELF_SHADOW : 0u);
+}
+
 /* The hook both ways of tracing call for every candidate hit (Embree's filter functions and
  * bvh_traverse.h's K_SURFACE_TRANSMITTANCE): 1 when the ray passes through this surface, 0 when the
  * hit counts. Camera and bounce rays skip pass-through surfaces and alpha-test misses; shadow rays
- * also skip everything that is not an opaque shadow caster (translucent layers, noShadows decals). */
+ * also skip everything that is not an opaque shadow caster (translucent layers, noShadows decals) and,
+ * leaving a noSelfShadow surface, other noSelfShadow surfaces. Sky surfaces block shadow rays (a sky
+ * is not a light in Doom 3) unless their material is noShadows. shadow_ray: K_CAMERA_OR_BOUNCE_RAY,
+ * K_SHADOW_RAY or K_SHADOW_RAY_FROM_NO_SELF_SHADOW. */
 KFN float k_hit_transmittance(const KSceneView* scene, kuint instance, kuint triangle, float u, float v,
                               int shadow_ray) {
   KGLOBAL const KMaterial* m = &scene->materials[k_hit_material(scene, instance, triangle)];
   if (m->blend == K_BLEND_PASSTHROUGH) return 1.0f;
   if (shadow_ray) {
-    if (m->blend != K_BLEND_OPAQUE) return 1.0f;
+    if (m->blend != K_BLEND_OPAQUE && m->blend != K_BLEND_SKY) return 1.0f;
     if (m->flags & (K_MAT_NO_SHADOWS | K_MAT_TRANSLUCENT)) return 1.0f;
+    if (shadow_ray == K_SHADOW_RAY_FROM_NO_SELF_SHADOW && (m->flags & K_MAT_NO_SELF_SHADOW)) return 1.0f;
   }
   if ((m->flags & K_MAT_ALPHA_TEST) && k_hit_alpha(scene, triangle, u, v, m) < m->alpha_ref) return 1.0f;
   return 0.0f;

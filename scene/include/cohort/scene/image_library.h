@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "cohort/scene/cube_map.h"
 #include "cohort/scene/image_program.h"
 #include "cohort/scene/scene.h"
 #include "cohort/scene/vfs.h"
@@ -23,6 +24,10 @@ class ImageLibrary {
 
   // Index into the images vector; always a valid image. `context` prefixes warnings ("material x").
   int get(const ImageProgram& program, ImageRole role, const std::string& context);
+  // A cube map's six faces as six consecutive images (GL order +X, -X, +Y, -Y, +Z, -Z); returns the
+  // first one's index. A face that is missing, unreadable, not square or not the size of the others
+  // fails the whole cube, as in the engine: a warning naming the face, and six placeholder faces.
+  int get_cube(const std::string& name, CubeMapKind kind, const std::string& context);
   // Whether a plain image of that name can be found (for materials named after an image).
   bool can_find(const std::string& name) const;
 

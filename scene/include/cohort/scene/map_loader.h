@@ -24,6 +24,8 @@ struct LoadReport {
   std::map<std::string, int> entities_by_class;
   int emitters = 0;                          // materials that glow (ambient-only stages)
   int emitting_surfaces = 0;                 // of those, opaque ones: light sources for NEE (the rest are layers)
+  int skies = 0;                             // sky materials (cube map + texgen skybox/wobbleSky; docs/sky.md)
+  int no_self_shadow = 0;                    // materials marked noSelfShadow
   int def_files = 0, entity_defs = 0, model_defs = 0, skins = 0;
   int model_files_loaded = 0;                // distinct model files (and skins of them) read
   std::map<std::string, int> unresolved_classes;   // classnames no entityDef defines, with their counts

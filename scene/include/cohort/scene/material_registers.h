@@ -31,6 +31,9 @@ struct StageRegisters {
   bool alpha_test = false;
   Expression alpha_ref{0.5f};
   std::vector<TextureOp> tex_ops;
+  // texgen wobbleSky: degrees, speed and rotate speed (empty otherwise). The texgen reads time itself,
+  // so a wobbling sky depends on time even when the three are constants.
+  std::vector<Expression> wobble_sky;
   uint32_t depends() const;
   uint32_t parms_read() const;
 };
@@ -39,6 +42,7 @@ struct MaterialRegisters {
   std::optional<StageRegisters> diffuse, specular, emissive;  // the stages whose colours the Material holds
   std::optional<StageRegisters> look;    // the stage whose texture matrix and alphaTest the Material holds
   std::optional<StageRegisters> light;   // a light shader's projected stage
+  std::optional<StageRegisters> sky;     // a sky's stage: its wobbleSky axes (Material::sky_axis)
   uint32_t depends = 0;                  // kDepends* of all of them
   uint32_t parms_read = 0;               // bit i: parmi is read
 };

@@ -22,7 +22,9 @@ struct Image {
   bool is_placeholder = false; // generated because the file was missing or unreadable
 };
 
-enum class BlendClass : uint8_t { Opaque, PassThrough, Additive, Modulate, Alpha };
+// Sky: an unlit surface whose stage is a cube map looked up by the ray direction (`texgen skybox` or
+// `wobbleSky`, doom3-content.md section 8); rays that reach it see the cube and end there.
+enum class BlendClass : uint8_t { Opaque, PassThrough, Additive, Modulate, Alpha, Sky };
 
 struct MaterialRegisters;
 
@@ -39,7 +41,12 @@ struct Material {
   bool translucent = false, no_shadows = false, two_sided = false, nonsolid = false;
   bool emitter = false;        // ambient-only stages: emits its stage image
   bool vertex_color = false;
+  bool no_self_shadow = false; // noSelfShadow: never shadows, nor is shadowed by, other noSelfShadow surfaces
   BlendClass blend = BlendClass::Opaque;
+  // Sky: six consecutive Scene::images, the cube faces +X, -X, +Y, -Y, +Z, -Z (GL order), and the
+  // axes the model-space ray direction is read against (identity for skybox, wobbleSky's rotation).
+  int sky_cube_image = -1;
+  glm::mat3 sky_axis{1.0f};
   // Light materials (lights/...): the projected image and the falloff image.
   bool is_light_material = false;
   int light_image = -1, falloff_image = -1;

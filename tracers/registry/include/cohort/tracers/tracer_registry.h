@@ -17,10 +17,18 @@ struct TracerSpec {
   std::string kind;  // embree, opencl, cuda, mpi
   int device = 0;    // for mpi: the node's rank
   std::string text;  // as written
+  int threads = 0;   // Embree: CPU threads it may use (0: all); parse_tracer_list sets it beside CUDA tracers
 };
 
+// The threads an Embree tracer takes when it renders beside CUDA tracers: all but a quarter of the
+// hardware threads (at least 2 left), which stay free for the host's share of the frame (merge, the
+// post-processing's uploads, tone map) and the GPU tracers' own threads. Measured on nvidia-h100-x2 with
+// every thread, Embree slowed the two GPUs' frame by 70% at 1080p with reprojection (docs/balancing.md).
+int embree_threads_beside_gpus(unsigned hardware_threads);
+
 // Splits "embree,opencl:1" and expands "all", "cuda:all" and "opencl:all" by probing the devices;
-// throws std::invalid_argument naming a malformed entry.
+// throws std::invalid_argument naming a malformed entry. An Embree entry in a list with a CUDA tracer gets
+// embree_threads_beside_gpus threads.
 std::vector<TracerSpec> parse_tracer_list(const std::string& list);
 
 // Throws std::runtime_error when this build lacks the tracer or the device cannot be opened. A remote
