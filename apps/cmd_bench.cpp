@@ -171,7 +171,9 @@ void add_bench_devices_command(CLI::App& bench, int& exit_code) {
       "devices",
       "Does every device add speed? The same camera path on each tracer alone and on mixes of them: median and\n"
       "p95 wall ms per frame, fps, idle % and scaling efficiency = (1/T_mix) / sum of (1/T_alone) over the mix.\n"
-      "Default mixes: Embree and every GPU alone, each GPU with Embree, all GPUs without and with Embree.");
+      "Default mixes: Embree and every GPU alone, each GPU with Embree, all GPUs without and with Embree.\n"
+      "Remote tracers (mpi:RANK, under mpirun with `cohort node` on that rank) also report bytes per frame and\n"
+      "the band round trip (docs/cluster.md).");
   struct Args {
     std::vector<std::string> mixes;
     std::string json, plot;

@@ -15,6 +15,8 @@ void add_bench_command(CLI::App& app, int& exit_code);
 void add_bench_devices_command(CLI::App& bench, int& exit_code);
 void add_pack_command(CLI::App& app, int& exit_code);
 void add_scenario_command(CLI::App& app, int& exit_code);
+// `cohort node`: serve a remote tracer on an MPI rank above 0 (docs/cluster.md).
+void add_node_command(CLI::App& app, int& exit_code);
 
 // Exit codes shared by every subcommand.
 constexpr int kExitOk = 0;

@@ -27,6 +27,7 @@ int main(int argc, char** argv) {
   cohort::app::add_bench_command(app, exit_code);
   cohort::app::add_pack_command(app, exit_code);
   cohort::app::add_scenario_command(app, exit_code);
+  cohort::app::add_node_command(app, exit_code);
 
   app.parse_complete_callback([&] { spdlog::set_level(spdlog::level::from_str(log_level)); });
   try {

@@ -64,6 +64,18 @@ if(COHORT_WITH_CUDA)
   find_package(CUDAToolkit REQUIRED)
 endif()
 
+# MPI: remote tracers on other processes or machines (tracers/mpi, `cohort node`, docs/cluster.md). Any
+# MPI-3 library (Open MPI, MPICH) through the standard interface only.
+find_package(MPI QUIET COMPONENTS CXX)
+set(_mpi_default OFF)
+if(MPI_CXX_FOUND)
+  set(_mpi_default ON)
+endif()
+option(COHORT_WITH_MPI "Build the remote tracers over MPI (cohort node, mpi:RANK)" ${_mpi_default})
+if(COHORT_WITH_MPI AND NOT MPI_CXX_FOUND)
+  message(FATAL_ERROR "COHORT_WITH_MPI=ON but no MPI for C++ was found (install libopenmpi-dev openmpi-bin)")
+endif()
+
 find_package(glfw3 3.3 QUIET)
 find_package(OpenGL QUIET)
 set(_viewer_default OFF)

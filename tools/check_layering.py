@@ -23,14 +23,16 @@ MODULES = {
     "tracers/embree": ("tracers/embree_cpu", "cohort_tracer_embree",  ["kernel", "commit", "core", "tracers/common"]),
     "tracers/opencl": ("tracers/opencl",     "cohort_tracer_opencl",  ["kernel", "commit", "core", "tracers/common"]),
     "tracers/cuda":   ("tracers/cuda",       "cohort_tracer_cuda",    ["kernel", "commit", "core", "tracers/common"]),
+    "tracers/mpi":    ("tracers/mpi",        "cohort_tracer_mpi",     ["kernel", "commit", "core", "tracers/common", "balance"]),
     "tracers/registry": ("tracers/registry", "cohort_tracer_registry", ["kernel", "commit", "core", "tracers/common",
-                                                                        "tracers/embree", "tracers/opencl", "tracers/cuda"]),
+                                                                        "tracers/embree", "tracers/opencl", "tracers/cuda",
+                                                                        "tracers/mpi"]),
 }
 
 # Public header folders: cohort/<name>/ -> module. Tracer headers all live under cohort/tracers/.
 HEADER_OWNER = {"kernel": "kernel", "scene": "scene", "balance": "balance", "commit": "commit", "core": "core"}
 TRACER_HEADERS = {  # header file stem prefix under cohort/tracers/ -> module
-    "embree": "tracers/embree", "opencl": "tracers/opencl", "cuda": "tracers/cuda", "tracer_registry": "tracers/registry",
+    "embree": "tracers/embree", "opencl": "tracers/opencl", "cuda": "tracers/cuda", "mpi": "tracers/mpi", "tracer_registry": "tracers/registry",
 }
 INCLUDE = re.compile(r'^\s*#\s*include\s*[<"]cohort/([a-z_]+)/([^">]+)[">]')
 TARGET = re.compile(r"\b(cohort_(?:kernel|scene|balance|commit|core|tracer_[a-z_]+))\b")

@@ -15,6 +15,7 @@ PACKAGES=(
   libcli11-dev nlohmann-json3-dev libzip-dev libspdlog-dev libfmt-dev   # CLI, JSON, .pk4, logging
   python3 python3-pip xvfb xauth    # viewer test under a virtual display; pip fetches OIDN
   ccache                              # compile cache (used when present; speeds rebuilds and worktrees)
+  libopenmpi-dev openmpi-bin          # remote tracers over MPI (cohort node, mpi:N); optional at build time
 )
 
 if [ -r /etc/os-release ]; then . /etc/os-release; else ID=unknown; VERSION_ID=; fi

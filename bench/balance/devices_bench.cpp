@@ -13,6 +13,9 @@
 #include "cohort/core/view.h"
 #include "cohort/tracers/tracer_registry.h"
 #include "real_tracers.h"
+#ifdef COHORT_HAVE_MPI
+#include "cohort/tracers/mpi_tracer.h"
+#endif
 
 namespace cohort::app {
 
@@ -39,6 +42,13 @@ DevicesBenchRun run_mix(const DevicesBenchConfig& config, const std::vector<std:
   RealTracers real = make_real_tracers(names, config.scene);
   core::RendererOptions options;
   options.balancer = config.balancer;
+#ifdef COHORT_HAVE_MPI
+  // The remote tracers' link counters, read before and after the counted frames.
+  std::vector<const tracers::MpiTracer*> remote;
+  for (const auto& t : real.tracers)
+    if (const auto* m = dynamic_cast<const tracers::MpiTracer*>(t.get())) remote.push_back(m);
+  std::vector<tracers::MpiLinkStats> before(remote.size());
+#endif
   core::Renderer renderer(std::move(real.tracers), options);
   const CameraPath path = parse_camera_path(config.camera_path);
 
@@ -52,6 +62,10 @@ DevicesBenchRun run_mix(const DevicesBenchConfig& config, const std::vector<std:
     job.camera = core::make_camera(pose.origin, {pose.yaw, 0.0f}, core::kDefaultFovX, config.width, config.height);
     job.params = core::default_frame_params();
     job.params.frame_index = static_cast<kuint>(f);
+#ifdef COHORT_HAVE_MPI
+    if (f == config.warmup)
+      for (size_t i = 0; i < remote.size(); ++i) before[i] = remote[i]->link_stats();
+#endif
     const core::FrameStats stats = renderer.render(job, frame);
     if (f < config.warmup) continue;
     run.wall_ms.push_back(stats.wall_ms);
@@ -61,6 +75,21 @@ DevicesBenchRun run_mix(const DevicesBenchConfig& config, const std::vector<std:
     ++counted;
   }
   if (counted == 0) throw std::invalid_argument("bench devices: --frames must exceed --warmup");
+#ifdef COHORT_HAVE_MPI
+  for (size_t i = 0; i < remote.size(); ++i) {
+    const tracers::MpiLinkStats after = remote[i]->link_stats();
+    RemoteLinkRun link;
+    link.tracer = remote[i]->name();
+    link.sent_bytes_per_frame = double(after.bytes_sent - before[i].bytes_sent) / counted;
+    link.received_bytes_per_frame = double(after.bytes_received - before[i].bytes_received) / counted;
+    const uint64_t bands = after.bands - before[i].bands;
+    if (bands > 0) {
+      link.mean_round_trip_ms = (after.total_round_trip_ms - before[i].total_round_trip_ms) / double(bands);
+      link.mean_node_ms = (after.total_node_ms - before[i].total_node_ms) / double(bands);
+    }
+    run.remote.push_back(link);
+  }
+#endif
   run.mean_idle_percent /= counted;
   run.mean_rendering_tracers /= counted;
   run.median_ms = percentile(run.wall_ms, 0.5);
@@ -134,8 +163,34 @@ std::string devices_bench_table(const std::vector<DevicesBenchRun>& runs) {
                   100.0 * r.efficiency);
     out += line;
   }
+  bool any_remote = false;
+  for (const DevicesBenchRun& r : runs) any_remote = any_remote || !r.remote.empty();
+  if (!any_remote) return out;
+  std::snprintf(line, sizeof line, "\n%-36s %-10s %14s %14s %15s %12s\n", "remote tracers (per counted frame)", "tracer",
+                "sent bytes", "received bytes", "round trip ms", "node ms");
+  out += line;
+  for (const DevicesBenchRun& r : runs)
+    for (const RemoteLinkRun& l : r.remote) {
+      std::snprintf(line, sizeof line, "%-36s %-10s %14.0f %14.0f %15.3f %12.3f\n", join(r.tracers).c_str(),
+                    l.tracer.c_str(), l.sent_bytes_per_frame, l.received_bytes_per_frame, l.mean_round_trip_ms,
+                    l.mean_node_ms);
+      out += line;
+    }
   return out;
 }
+
+namespace {
+nlohmann::json remote_json(const std::vector<RemoteLinkRun>& links) {
+  nlohmann::json out = nlohmann::json::array();
+  for (const RemoteLinkRun& l : links)
+    out.push_back({{"tracer", l.tracer},
+                   {"sent_bytes_per_frame", l.sent_bytes_per_frame},
+                   {"received_bytes_per_frame", l.received_bytes_per_frame},
+                   {"mean_round_trip_ms", l.mean_round_trip_ms},
+                   {"mean_node_ms", l.mean_node_ms}});
+  return out;
+}
+}  // namespace
 
 nlohmann::json devices_bench_json(const DevicesBenchConfig& config, const std::vector<DevicesBenchRun>& runs) {
   nlohmann::json j;
@@ -153,7 +208,8 @@ nlohmann::json devices_bench_json(const DevicesBenchConfig& config, const std::v
                          {"worst_idle_percent", r.worst_idle_percent},
                          {"mean_rendering_tracers", r.mean_rendering_tracers},
                          {"efficiency", r.efficiency},
-                         {"wall_ms", r.wall_ms}});
+                         {"wall_ms", r.wall_ms},
+                         {"remote", remote_json(r.remote)}});
   }
   return j;
 }

@@ -22,6 +22,15 @@ struct DevicesBenchConfig {
   std::string balancer = "whole-cost";
 };
 
+// A remote tracer's traffic over the counted frames (tracers/mpi): what crossed the wire per frame
+// (commits and band jobs out, band rows back, headers included) and the band round trip.
+struct RemoteLinkRun {
+  std::string tracer;
+  double sent_bytes_per_frame = 0.0, received_bytes_per_frame = 0.0;
+  double mean_round_trip_ms = 0.0;  // band job sent -> rows received
+  double mean_node_ms = 0.0;        // the node's own time for its band
+};
+
 struct DevicesBenchRun {
   std::vector<std::string> tracers;
   double median_ms = 0.0, p95_ms = 0.0, fps = 0.0;
@@ -29,6 +38,7 @@ struct DevicesBenchRun {
   double mean_rendering_tracers = 0.0;  // tracers given rows per frame (a balancer may bench one)
   double efficiency = 0.0;              // scaling efficiency; 1 for a tracer alone
   std::vector<double> wall_ms;          // per counted frame
+  std::vector<RemoteLinkRun> remote;    // one per remote tracer of the mix
 };
 
 // Every GPU alone (CUDA devices, else OpenCL accelerators, else every OpenCL device), Embree alone,

@@ -14,6 +14,13 @@
 #include "cohort/tracers/cuda_tracer.h"
 #include "cohort/tracers/cuda_frame_post.h"
 #endif
+#ifdef COHORT_HAVE_MPI
+#include <cstdlib>
+
+#include <spdlog/spdlog.h>
+
+#include "cohort/tracers/mpi_tracer.h"
+#endif
 
 namespace cohort::tracers {
 
@@ -91,8 +98,15 @@ std::vector<TracerSpec> parse_tracer_list(const std::string& list) {
         throw std::invalid_argument("tracer '" + item + "': the device after ':' must be a number");
       spec.device = std::stoi(index);
     }
-    if (spec.kind != "embree" && spec.kind != "opencl" && spec.kind != "cuda")
-      throw std::invalid_argument("unknown tracer '" + item + "' (known: embree, opencl[:N], cuda[:N])");
+    if (spec.kind != "embree" && spec.kind != "opencl" && spec.kind != "cuda" && spec.kind != "mpi")
+      throw std::invalid_argument("unknown tracer '" + item + "' (known: embree, opencl[:N], cuda[:N], mpi:RANK)");
+    if (spec.kind == "mpi" && (colon == std::string::npos || spec.device < 1))
+      throw std::invalid_argument("tracer '" + item + "': a remote tracer names its node's MPI rank, 1 or more (mpi:1)");
+    // Two tracers on one node would take each other's answers: a node serves one remote tracer.
+    for (const TracerSpec& earlier : specs)
+      if (spec.kind == "mpi" && earlier.kind == "mpi" && earlier.device == spec.device)
+        throw std::invalid_argument("tracer '" + item + "' is named twice: a node serves one remote tracer (give it "
+                                    "several local tracers with `cohort node --tracers`)");
     if (spec.kind == "embree" && colon != std::string::npos)
       throw std::invalid_argument("tracer '" + item + "': the Embree tracer takes no device index");
     specs.push_back(spec);
@@ -128,12 +142,37 @@ std::unique_ptr<core::Tracer> make_tracer(const TracerSpec& spec) {
 #ifdef COHORT_HAVE_CUDA
   if (spec.kind == "cuda") return std::make_unique<CudaTracer>(spec.device);
 #endif
-  throw std::runtime_error("tracer '" + spec.text + "' is not built into this binary");
+#ifdef COHORT_HAVE_MPI
+  if (spec.kind == "mpi") {
+    MpiTracerOptions options;
+    options.rank = spec.device;
+    if (const char* ms = std::getenv("COHORT_MPI_BAND_TIMEOUT_MS"); ms && *ms)
+      options.band_timeout = std::chrono::milliseconds(std::max(1L, std::atol(ms)));
+    return std::make_unique<MpiTracer>(options);
+  }
+#endif
+  throw std::runtime_error("tracer '" + spec.text + "' is not built into this binary" +
+                           (spec.kind == "mpi" ? " (configure with MPI found: COHORT_WITH_MPI)" : ""));
 }
 
 std::vector<std::unique_ptr<core::Tracer>> make_tracers(const std::string& list) {
   std::vector<std::unique_ptr<core::Tracer>> out;
-  for (const TracerSpec& spec : parse_tracer_list(list)) out.push_back(make_tracer(spec));
+  std::vector<std::string> left;
+  for (const TracerSpec& spec : parse_tracer_list(list)) {
+#ifdef COHORT_HAVE_MPI
+    // A node that cannot serve (its scene failed to load, another version) leaves the set; the
+    // others render without it.
+    try {
+      out.push_back(make_tracer(spec));
+    } catch (const NodeUnavailable& e) {
+      spdlog::error("{}", e.what());
+      left.push_back(e.what());
+    }
+#else
+    out.push_back(make_tracer(spec));
+#endif
+  }
+  if (out.empty()) throw std::runtime_error("no tracer could start: " + (left.empty() ? list : left.front()));
   return out;
 }
 
@@ -149,6 +188,14 @@ std::vector<std::string> built_tracer_kinds() {
   kinds.push_back("cuda");
 #endif
   return kinds;
+}
+
+bool remote_tracers_built() {
+#ifdef COHORT_HAVE_MPI
+  return true;
+#else
+  return false;
+#endif
 }
 
 int device_count(const std::string& kind) {

@@ -1,5 +1,6 @@
 // Tracers by name, for the apps, the benchmarks and the tests alike: "embree", "opencl" / "opencl:N"
-// (N-th OpenCL device of all platforms), "cuda" / "cuda:N", and the "all" lists. A library of its own
+// (N-th OpenCL device of all platforms), "cuda" / "cuda:N", "mpi:RANK" (a remote tracer: the bands
+// render on that MPI rank's `cohort node`, docs/cluster.md), and the "all" lists. A library of its own
 // above the concrete tracers, so that neither the core nor tracers/common depends on them.
 #pragma once
 
@@ -13,8 +14,8 @@
 namespace cohort::tracers {
 
 struct TracerSpec {
-  std::string kind;  // embree, opencl, cuda
-  int device = 0;
+  std::string kind;  // embree, opencl, cuda, mpi
+  int device = 0;    // for mpi: the node's rank
   std::string text;  // as written
   int threads = 0;   // Embree: CPU threads it may use (0: all); parse_tracer_list sets it beside CUDA tracers
   bool yield_to_host = false;  // Embree: its threads at a lower OS priority (beside CUDA tracers)
@@ -31,12 +32,16 @@ int embree_threads_beside_gpus(unsigned hardware_threads);
 // embree_threads_beside_gpus threads, which yield to the host's threads (EmbreeTracer's yield_to_host).
 std::vector<TracerSpec> parse_tracer_list(const std::string& list);
 
-// Throws std::runtime_error when this build lacks the tracer or the device cannot be opened.
+// Throws std::runtime_error when this build lacks the tracer or the device cannot be opened. A remote
+// tracer whose node cannot serve is logged and left out of make_tracers' list (it throws when none is left).
 std::unique_ptr<core::Tracer> make_tracer(const TracerSpec& spec);
 std::vector<std::unique_ptr<core::Tracer>> make_tracers(const std::string& list);
 
-// The tracer kinds this binary was built with.
+// The tracer kinds this binary was built with that render in this process (the remote `mpi` kind is
+// not among them: it needs a node on another MPI rank).
 std::vector<std::string> built_tracer_kinds();
+// Whether this binary has remote tracers (`mpi:RANK`, COHORT_WITH_MPI).
+bool remote_tracers_built();
 
 // How many devices of that kind this machine offers the tracer: 1 for Embree (the CPU), 0 for a kind
 // this build lacks. Never throws.

@@ -1,0 +1,280 @@
+#!/usr/bin/env python3
+"""Cluster runs of `cohort render` on rank 0 with `cohort node` on ranks 1 and 2, all on localhost,
+checked against a single-process render of the same frames (the integrator is deterministic per
+pixel, so the images must match byte for byte).
+
+    run_cluster.py CASE --mpiexec PATH --cohort PATH --map MAP --out DIR [--broken-map MAP]
+
+CASE: match (Embree on every rank), mixed (rank 1 splits its band between Embree and OpenCL, rank 2
+renders on OpenCL: PoCL on a machine without GPUs; images agree within the tracers' tolerance),
+stall (rank 2 sleeps through frame 1: its rows are re-rendered by
+the others, only that frame is late, and rank 2 renders again once it answers), killed (the same with
+rank 2 killed: Open MPI only, with orte_enable_recovery), version (rank 1 announces another version: rank 0
+names both and renders without it), load_error (rank 1 cannot load its map: rank 0 logs its file:line
+reason and renders without it), bench (`cohort bench devices` with remote tracers reports their bytes
+per frame and round trip), protocol (protocol_check.cpp on 2 ranks: malformed messages against a
+real node), replay (the test map's recorded scenario: door, fan, flicker, a skinned walker; instance,
+TLAS, light and joint records cross the wire every frame, and every frame matches), play (`cohort play`
+under a virtual display with remote tracers: the scenario runs, the screenshot is written and not
+uniform; skipped with status 77 without xvfb-run or the viewer).
+"""
+import argparse
+import json
+import os
+import re
+import shutil
+import subprocess
+import sys
+
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "apps"))
+from compare_images import read_image  # noqa: E402
+
+FRAMES = 4
+RENDER_ARGS = ["--width", "96", "--height", "64", "--spp", "2", "--frames", str(FRAMES), "--balancer", "perfect-smooth"]
+
+
+def mpiexec_flags(mpiexec):
+    """Open MPI needs --oversubscribe to start 3 ranks on fewer cores; MPICH's mpiexec has no such flag."""
+    version = subprocess.run([mpiexec, "--version"], capture_output=True, text=True).stdout
+    return ["--oversubscribe"] if "Open MPI" in version or "OpenRTE" in version else []
+
+
+def run(command, env=None, expect_ok=True):
+    print("$ " + " ".join(command), flush=True)
+    result = subprocess.run(command, capture_output=True, text=True, timeout=180, env=env)
+    output = result.stdout + result.stderr
+    print(output[-6000:])
+    if expect_ok and result.returncode != 0:
+        sys.exit(f"exit status {result.returncode}")
+    return result.returncode, output
+
+
+def compare_frames(a_dir, b_dir, tolerant=False):
+    """Byte for byte; tolerant (other tracer kinds): at most 0.5% of pixels differ, by at most 3 levels."""
+    for f in range(FRAMES):
+        name = f"frame_{f:04d}.png"
+        a, b = os.path.join(a_dir, name), os.path.join(b_dir, name)
+        if not os.path.exists(b):
+            sys.exit(f"{b} was not written: the cluster lost frame {f}")
+        (wa, ha, ca, pa), (wb, hb, cb, pb) = read_image(a), read_image(b)
+        if (wa, ha) != (wb, hb):
+            sys.exit(f"{name}: sizes differ")
+        differing, worst = 0, 0
+        for p in range(wa * ha):
+            d = max(abs(pa[p * ca + c] - pb[p * cb + c]) for c in range(3))
+            differing += d > 0
+            worst = max(worst, d)
+        print(f"{name}: {differing} of {wa * ha} pixels differ, by at most {worst} levels")
+        if (differing > 0.005 * wa * ha or worst > 3) if tolerant else differing:
+            sys.exit(f"{name}: the cluster's image differs from the single-process render")
+
+
+def tracer_outcomes(out_dir):
+    with open(os.path.join(out_dir, "stats.json")) as f:
+        stats = json.load(f)
+    return [{t["name"]: t["outcome"] for t in frame["tracers"]} for frame in stats["frames"]]
+
+
+def stall(a, killed=False):
+    """Rank 2 sleeps 1.2 s before its band of frame 1 (killed: kills itself there); bands time out after
+    1 s. Frame 1 is the one late frame (its rows are re-rendered by the others); while rank 2 has not
+    answered, its bands fail at once; a stalled rank 2 renders again once it answers. The last frame
+    matches the single-process render. A killed rank needs a launcher that lets the job outlive it:
+    Open MPI with orte_enable_recovery (others: skipped)."""
+    flags = mpiexec_flags(a.mpiexec)
+    if killed:
+        if "--oversubscribe" not in flags:
+            print("SKIP: only Open MPI's mpirun is known here to let a job outlive a killed rank")
+            sys.exit(77)
+        flags = flags + ["--mca", "orte_enable_recovery", "1"]
+    frames = 400
+    args = ["--width", "192", "--height", "128", "--spp", "2", "--frames", str(frames), "--write", "last",
+            "--balancer", "perfect-smooth"]
+    single, cluster = os.path.join(a.out, "single"), os.path.join(a.out, "cluster")
+    run([a.cohort, "render", a.map, "--tracers", "embree", "--out", single] + args)
+    env = dict(os.environ)
+    env["COHORT_MPI_BAND_TIMEOUT_MS"] = "1000"
+    fault = ["--die-frame", "1"] if killed else ["--stall-frame", "1", "--stall-ms", "1200"]
+    _, output = run([a.mpiexec] + flags + ["-np", "1", a.cohort, "render", a.map, "--tracers", "embree,mpi:1,mpi:2",
+                                           "--out", cluster] + args +
+                    [":"] + flags + ["-np", "1", a.cohort, "node", a.map, "--tracers", "embree"] +
+                    [":"] + flags + ["-np", "1", a.cohort, "node", a.map, "--tracers", "embree"] + fault,
+                    env=env, expect_ok=not killed)
+    name = f"frame_{frames - 1:04d}.png"
+    if not os.path.exists(os.path.join(cluster, "stats.json")):
+        sys.exit("rank 0 did not finish the run")
+    (w, h, ca, pa), (_, _, cb, pb) = read_image(os.path.join(single, name)), read_image(os.path.join(cluster, name))
+    differing = sum(1 for p in range(w * h) if pa[p * ca:p * ca + 3] != pb[p * cb:p * cb + 3])
+    print(f"{name}: {differing} of {w * h} pixels differ")
+    with open(os.path.join(cluster, "stats.json")) as f:
+        stats = json.load(f)["frames"]
+    late = [f["frame"] for f in stats if f["wall_ms"] > 500]
+    outcome = [{t["name"]: (t["outcome"], t.get("error", "")) for t in f["tracers"]} for f in stats]
+    print("late frames:", late)
+    print("mpi:2 per frame:", [o["mpi:2"][0] for o in outcome])
+    if len(stats) != frames:
+        sys.exit(f"{len(stats)} of {frames} frames delivered")
+    if differing:
+        sys.exit("the last frame differs from the single-process render")
+    if late != [1]:
+        sys.exit(f"the fault should make frame 1, and only it, late: {late}")
+    if "no answer for rows" not in outcome[1]["mpi:2"][1]:
+        sys.exit(f"frame 1: the node's band should have timed out: {outcome[1]['mpi:2']}")
+    if outcome[2]["mpi:2"][0] != "threw" or "has not answered" not in outcome[2]["mpi:2"][1]:
+        sys.exit(f"frame 2: the silent node should have been skipped at once: {outcome[2]['mpi:2']}")
+    if killed:
+        if any(o["mpi:2"][0] == "rendered" for o in outcome[1:]):
+            sys.exit("a killed node cannot have rendered")
+        if any(o["mpi:1"][0] != "rendered" for o in outcome):
+            sys.exit("the surviving node should have rendered every frame")
+    elif outcome[-1]["mpi:2"][0] != "rendered":
+        sys.exit("the node did not come back after answering")
+    print(f"{a.case}: ok")
+
+
+def replay(a):
+    os.makedirs(a.out)
+    stream = os.path.join(a.out, "scenario.cdelta")
+    run([a.cohort, "record-scenario", "testmap", "--base", a.testmap_base, "--frames", str(FRAMES), "--out", stream])
+    args = ["--replay", stream, "--base", a.testmap_base, "--width", "96", "--height", "54", "--spp", "1"]
+    single, cluster = os.path.join(a.out, "single"), os.path.join(a.out, "cluster")
+    run([a.cohort, "render", "--tracers", "embree", "--out", single] + args)
+    flags = mpiexec_flags(a.mpiexec)
+    _, output = run([a.mpiexec] + flags + ["-np", "1", a.cohort, "render", "--tracers", "embree,mpi:1,mpi:2",
+                                           "--out", cluster] + args +
+                    [":"] + flags + ["-np", "2", a.cohort, "node", "testmap", "--base", a.testmap_base,
+                                     "--tracers", "embree"])
+    compare_frames(single, cluster)
+    outcomes = tracer_outcomes(cluster)
+    print("outcomes per frame:", outcomes)
+    if any(o.get("mpi:1") != "rendered" or o.get("mpi:2") != "rendered" for o in outcomes):
+        sys.exit("a remote tracer failed a band of the scenario")
+    if "sending the whole scene" in output:
+        sys.exit("the nodes loaded the same map: the first resync should not have sent the whole scene")
+    print("replay: ok")
+
+
+def play(a):
+    if not shutil.which("xvfb-run"):
+        print("SKIP: xvfb-run is not installed")
+        sys.exit(77)
+    if a.viewer_built.upper() not in ("ON", "1", "TRUE", "YES"):
+        print("SKIP: cohort was built without the viewer (COHORT_WITH_VIEWER=OFF)")
+        sys.exit(77)
+    os.makedirs(a.out)
+    shot = os.path.join(a.out, "play.png")
+    testmap = os.path.join(a.testmap_base, "maps", "testmap.map")
+    flags = mpiexec_flags(a.mpiexec)
+    _, output = run([a.mpiexec] + flags + ["-np", "1", "xvfb-run", "-a", "-s", "-screen 0 1024x768x24", a.cohort, "play",
+                                           testmap, "--tracers", "embree,mpi:1,mpi:2", "--frames", "20", "--width",
+                                           "160", "--height", "120", "--scale", "1", "--screenshot", shot] +
+                    [":"] + flags + ["-np", "2", a.cohort, "node", testmap, "--tracers", "embree"])
+    for rank in (1, 2):
+        if not re.search(rf"mpi:{rank}: \d+ band\(s\)", output):
+            sys.exit(f"mpi:{rank} rendered no band in cohort play")
+    run([sys.executable, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "apps", "image_not_uniform.py"),
+         shot])
+    print("play: ok")
+
+
+def bench(a):
+    os.makedirs(a.out)
+    pack = os.path.join(a.out, "scene.cpk")
+    run([a.cohort, "pack", a.map, "--out", pack])
+    flags = mpiexec_flags(a.mpiexec)
+    report = os.path.join(a.out, "bench.json")
+    run([a.mpiexec] + flags + ["-np", "1", a.cohort, "bench", "devices", "--scene", pack, "--width", "64", "--height",
+                               "48", "--frames", "6", "--warmup", "2", "--mix", "embree,mpi:1,mpi:2", "--json", report,
+                               ":"] + flags + ["-np", "2", a.cohort, "node", pack, "--tracers", "embree"])
+    with open(report) as f:
+        runs = json.load(f)["runs"]
+    mix = [r for r in runs if r["tracers"] == ["embree", "mpi:1", "mpi:2"]]
+    alone = [r for r in runs if r["tracers"] == ["mpi:1"]]
+    if not mix or not alone:
+        sys.exit("the remote tracers' runs are missing from the report")
+    links = alone[0]["remote"]
+    print("mpi:1 alone:", links)
+    # Alone, mpi:1 renders every row: at least the whole frame's pixels (16 bytes each as RGBA32F) come back.
+    if len(links) != 1 or links[0]["received_bytes_per_frame"] < 64 * 48 * 16 or links[0]["mean_round_trip_ms"] <= 0:
+        sys.exit("mpi:1 alone: bytes per frame or round trip not reported")
+    if len(mix[0]["remote"]) != 2:
+        sys.exit("the mix should report both remote tracers")
+    print("bench: ok")
+
+
+def main():
+    parser = argparse.ArgumentParser()
+    parser.add_argument("case", choices=["match", "mixed", "stall", "killed", "version", "load_error", "bench", "protocol", "replay",
+                                           "play"])
+    parser.add_argument("--mpiexec", required=True)
+    parser.add_argument("--cohort", required=True)
+    parser.add_argument("--map", required=True)
+    parser.add_argument("--broken-map")
+    parser.add_argument("--protocol-check")
+    parser.add_argument("--testmap-base")
+    parser.add_argument("--viewer-built", default="OFF")
+    parser.add_argument("--out", required=True)
+    a = parser.parse_args()
+
+    shutil.rmtree(a.out, ignore_errors=True)
+    if a.case in ("stall", "killed"):
+        stall(a, killed=a.case == "killed")
+        return
+    if a.case == "bench":
+        bench(a)
+        return
+    if a.case == "replay":
+        replay(a)
+        return
+    if a.case == "play":
+        play(a)
+        return
+    if a.case == "protocol":
+        _, output = run([a.mpiexec] + mpiexec_flags(a.mpiexec) + ["-np", "2", a.protocol_check])
+        if "FAILED" in output or output.count("ok: ") < 6:
+            sys.exit("protocol check failed")
+        print("protocol: ok")
+        return
+    single, cluster = os.path.join(a.out, "single"), os.path.join(a.out, "cluster")
+    run([a.cohort, "render", a.map, "--tracers", "embree", "--out", single] + RENDER_ARGS)
+
+    env = dict(os.environ)
+    node1 = [a.cohort, "node", a.map, "--tracers", "embree"]
+    node2 = [a.cohort, "node", a.map, "--tracers", "embree"]
+    if a.case == "mixed":
+        node1 = [a.cohort, "node", a.map, "--tracers", "embree,opencl:0"]
+        node2 = [a.cohort, "node", a.map, "--tracers", "opencl:0"]
+    if a.case == "version":
+        node1 += ["--announce-version", "0.0.0-test"]
+    if a.case == "load_error":
+        node1 = [a.cohort, "node", a.broken_map, "--tracers", "embree"]
+    flags = mpiexec_flags(a.mpiexec)
+    command = ([a.mpiexec] + flags + ["-np", "1", a.cohort, "render", a.map, "--tracers", "embree,mpi:1,mpi:2",
+                                      "--out", cluster] + RENDER_ARGS +
+               [":"] + flags + ["-np", "1"] + node1 + [":"] + flags + ["-np", "1"] + node2)
+    code, output = run(command, env=env, expect_ok=a.case in ("match", "mixed"))
+    compare_frames(single, cluster, tolerant=a.case == "mixed")
+    outcomes = tracer_outcomes(cluster)
+    print("outcomes per frame:", outcomes)
+
+    if a.case in ("match", "mixed"):
+        for f, o in enumerate(outcomes):
+            if o.get("mpi:1") != "rendered" or o.get("mpi:2") != "rendered":
+                sys.exit(f"frame {f}: a remote tracer did not render its band: {o}")
+    elif a.case == "version":
+        if not re.search(r"rank 0 runs Cohort \S+ .*rank 1 .* runs Cohort 0\.0\.0-test", output):
+            sys.exit("rank 0 did not name both versions")
+        if "refused this node" not in output:
+            sys.exit("rank 1 did not report the refusal")
+        if any("mpi:1" in o for o in outcomes):
+            sys.exit("the refused node still took part")
+    elif a.case == "load_error":
+        if not re.search(r"mpi:1: the node could not start \(its scene or its tracers\) and leaves: .*:\d+", output):
+            sys.exit("rank 0 did not log the node's file:line reason")
+        if any("mpi:1" in o for o in outcomes):
+            sys.exit("the node that could not load its map still took part")
+    print(f"{a.case}: ok")
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,95 @@
+// A tracer on rank 0 whose bands render on another MPI rank, a `cohort node` (docs/cluster.md). To the
+// Renderer and its balancer it is one device whose cost includes the network round trip.
+//
+// apply() forwards the commit (records, or a whole scene; a full resync to the scene the node loaded
+// itself sends only the camera and the records on top) with a non-blocking send and returns at once.
+// render_band() sends the band job and waits for the rows, at most the band timeout; a node that
+// stalls, fails or sends a malformed answer makes it throw, so the Renderer's recovery re-renders the
+// rows on the other tracers and the frame is delivered. A late answer is
+// recognised by its job id and dropped; until it has come, the node is sent no band (its bands fail at
+// once), so a stalled or lost node costs one late frame. A node joins once per run (its hello is
+// remembered), so a later tracer for the same rank starts at once; the MPI session's end (program
+// exit) tells every node to leave.
+#pragma once
+
+#include <chrono>
+#include <cstdint>
+#include <memory>
+#include <mutex>
+#include <string>
+
+#include "cohort/core/tracer.h"
+#include "cohort/tracers/mpi_wire.h"
+
+namespace cohort::tracers {
+
+struct MpiTracerOptions {
+  int rank = 1;
+  // A band that has not come back after this long (plus four times the last round trip; ten times as long
+  // for the first band after a full resync, which the node spends building its BVHs) fails. A late
+  // answer still teaches the next deadline how long the node's bands take.
+  std::chrono::milliseconds band_timeout{2000};
+  // How long the constructor waits for the node's hello (it loads its scene first).
+  std::chrono::milliseconds hello_timeout{120000};
+};
+
+// What crossed the wire for this tracer, for `cohort bench devices` and the logs.
+struct MpiLinkStats {
+  uint64_t bands = 0;
+  uint64_t bytes_sent = 0, bytes_received = 0;  // whole messages, headers included
+  uint64_t last_band_bytes_sent = 0, last_band_bytes_received = 0;  // commit(s) and job since the last band, and its rows
+  double last_round_trip_ms = 0.0;  // job sent -> rows received
+  double last_node_ms = 0.0;        // the node's own time for the band (apply + render)
+  double total_round_trip_ms = 0.0;
+  double total_node_ms = 0.0;
+  uint64_t stale_answers = 0;       // late answers to jobs that had timed out, dropped
+  uint64_t refused_messages = 0;    // malformed answers, refused
+};
+
+class MpiTracer : public core::Tracer {
+ public:
+  // Joins the MPI session, waits for the node's hello and checks its version against this build's.
+  // Throws NodeUnavailable when the rank does not exist, the node could not load its scene (its
+  // file:line reason), or runs another Cohort version (both named).
+  explicit MpiTracer(MpiTracerOptions options);
+  ~MpiTracer() override;
+
+  std::string name() const override;
+  bool renders_on_gpu() const override { return gpu_; }
+  void apply(const commit::CommitBuffer& commit) override;
+  using core::Tracer::render_band;
+  core::BandResult render_band(const core::BandJob& job, core::BandBuffer& target) override;
+
+  MpiLinkStats link_stats() const;
+  // What the node said it runs: its host and tracers.
+  const std::string& node_description() const { return description_; }
+
+ private:
+  void send(int kind, uint64_t sequence, const std::vector<uint8_t>& payload);
+  void adopt(const wire::Hello& hello);
+  // Reads, without waiting, what the node sent since a band timed out; clears timed_out_job_ once the
+  // answer to that band is among it.
+  void take_late_answers();
+
+  MpiTracerOptions options_;
+  std::string description_;
+  bool gpu_ = false;
+  uint64_t node_fingerprint_ = 0;  // of the scene the node holds from its own load; 0: none usable
+  std::shared_ptr<const commit::TracerScene> hashed_scene_;  // kept alive, so the pointer means this scene
+  uint64_t hashed_fingerprint_ = 0;
+  bool node_needs_resync_ = false;
+  bool after_full_resync_ = false;
+  uint64_t timed_out_job_ = 0;
+  std::chrono::steady_clock::time_point timed_out_start_{};
+  std::string node_failure_;
+  mutable std::mutex stats_mutex_;
+  MpiLinkStats stats_;
+  uint64_t pending_sent_ = 0;
+};
+
+class NodeUnavailable : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+}  // namespace cohort::tracers

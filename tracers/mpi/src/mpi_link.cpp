@@ -1,0 +1,224 @@
+#include "cohort/tracers/mpi_link.h"
+
+#include <atomic>
+#include <cstdio>
+#include <cstdlib>
+#include <limits>
+#include <memory>
+#include <map>
+#include <stdexcept>
+#include <string>
+#include <thread>
+
+#include <mpi.h>
+
+namespace cohort::tracers {
+
+namespace {
+constexpr int kTag = 0x434f;  // every Cohort message; the header says what it is
+
+int finalize_timeout_seconds() {
+  const char* text = std::getenv("COHORT_MPI_FINALIZE_TIMEOUT_S");
+  const int seconds = text && *text ? std::atoi(text) : 10;
+  return seconds > 0 ? seconds : 10;
+}
+}  // namespace
+
+struct MpiSession::Impl {
+  MPI_Comm comm = MPI_COMM_NULL;
+  bool we_initialized = false;
+  struct Outgoing {
+    int destination;
+    std::vector<uint8_t> bytes;
+    MPI_Request request;
+  };
+  std::list<Outgoing> sends;
+  struct Incoming {
+    std::vector<uint8_t> bytes;
+    MPI_Request request;
+  };
+  std::map<int, Incoming> receives;  // per source: a matched message still arriving
+  std::vector<uint8_t> farewell;
+  std::vector<bool> released;
+};
+
+MpiSession& MpiSession::get() {
+  static MpiSession session;
+  return session;
+}
+
+MpiSession::MpiSession() : impl_(new Impl) {
+  int initialized = 0;
+  MPI_Initialized(&initialized);
+  if (!initialized) {
+    int provided = 0;
+    if (MPI_Init_thread(nullptr, nullptr, MPI_THREAD_SERIALIZED, &provided) != MPI_SUCCESS)
+      throw std::runtime_error("MPI_Init_thread failed");
+    impl_->we_initialized = true;
+    if (provided < MPI_THREAD_SERIALIZED)
+      throw std::runtime_error("this MPI library offers no MPI_THREAD_SERIALIZED; remote tracers need it");
+  }
+  // A communicator of our own, so that Cohort's messages never meet another library's.
+  MPI_Comm_dup(MPI_COMM_WORLD, &impl_->comm);
+  // Failures come back as error codes (a lost peer fails that peer's tracer, not the process), where
+  // the library and launcher let the job outlive a rank at all.
+  MPI_Comm_set_errhandler(impl_->comm, MPI_ERRORS_RETURN);
+  MPI_Comm_rank(impl_->comm, &rank_);
+  MPI_Comm_size(impl_->comm, &size_);
+}
+
+MpiSession::~MpiSession() {
+  finalize();
+  delete impl_;
+}
+
+void MpiSession::finalize() {
+  std::lock_guard lock(mutex_);
+  if (finalized_) return;
+  finalized_ = true;
+  if (rank_ == 0 && !impl_->farewell.empty()) {
+    impl_->released.resize(size_t(size_), false);
+    for (int r = 1; r < size_; ++r) {
+      if (impl_->released[size_t(r)]) continue;
+      impl_->sends.push_back({r, impl_->farewell, MPI_REQUEST_NULL});
+      Impl::Outgoing& out = impl_->sends.back();
+      MPI_Isend(out.bytes.data(), int(out.bytes.size()), MPI_BYTE, r, kTag, impl_->comm, &out.request);
+    }
+  }
+  // Sends still queued get a second; then they are freed (the library completes or drops them).
+  const auto deadline = MpiClock::now() + std::chrono::seconds(1);
+  while (!impl_->sends.empty() && MpiClock::now() < deadline) {
+    for (auto it = impl_->sends.begin(); it != impl_->sends.end();) {
+      int done = 0;
+      MPI_Test(&it->request, &done, MPI_STATUS_IGNORE);
+      it = done ? impl_->sends.erase(it) : std::next(it);
+    }
+    std::this_thread::sleep_for(std::chrono::microseconds(100));
+  }
+  for (auto& s : impl_->sends) MPI_Request_free(&s.request);
+  impl_->sends.clear();
+  for (auto& [source, r] : impl_->receives) MPI_Request_free(&r.request);
+  impl_->receives.clear();
+  MPI_Comm_free(&impl_->comm);
+  int mpi_finalized = 0;
+  MPI_Finalized(&mpi_finalized);
+  if (!impl_->we_initialized || mpi_finalized) return;
+  // MPI_Finalize synchronizes with every rank, so a rank that was lost (killed, under a launcher that let
+  // the job go on) can keep it from returning. Everything is written by now: past the deadline the
+  // process leaves without it rather than hang.
+  auto done = std::make_shared<std::atomic<bool>>(false);
+  const int seconds = finalize_timeout_seconds();
+  std::thread([done, seconds] {
+    const auto deadline = MpiClock::now() + std::chrono::seconds(seconds);
+    while (!done->load() && MpiClock::now() < deadline) std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    if (done->load()) return;
+    std::fprintf(stderr, "cohort: MPI_Finalize did not return within %d s (a rank was lost?); leaving without it\n",
+                 seconds);
+    std::fflush(nullptr);
+    std::_Exit(0);
+  }).detach();
+  MPI_Finalize();
+  done->store(true);
+}
+
+void MpiSession::send(int destination, std::vector<uint8_t> bytes) {
+  if (bytes.size() > size_t(std::numeric_limits<int>::max()))
+    throw std::runtime_error("MPI message of " + std::to_string(bytes.size()) + " bytes is over the 2 GiB a send takes");
+  std::lock_guard lock(mutex_);
+  if (finalized_) throw std::runtime_error("MPI send after the session was finalized");
+  impl_->sends.push_back({destination, std::move(bytes), MPI_REQUEST_NULL});
+  Impl::Outgoing& out = impl_->sends.back();
+  if (MPI_Isend(out.bytes.data(), int(out.bytes.size()), MPI_BYTE, destination, kTag, impl_->comm, &out.request) !=
+      MPI_SUCCESS) {
+    impl_->sends.pop_back();
+    throw std::runtime_error("MPI_Isend to rank " + std::to_string(destination) + " failed");
+  }
+}
+
+void MpiSession::set_farewell(std::vector<uint8_t> bytes) {
+  std::lock_guard lock(mutex_);
+  impl_->farewell = std::move(bytes);
+}
+
+void MpiSession::released(int rank) {
+  std::lock_guard lock(mutex_);
+  impl_->released.resize(size_t(size_), false);
+  if (rank >= 0 && rank < size_) impl_->released[size_t(rank)] = true;
+}
+
+size_t MpiSession::progress_sends() {
+  std::lock_guard lock(mutex_);
+  for (auto it = impl_->sends.begin(); it != impl_->sends.end();) {
+    int done = 0;
+    MPI_Test(&it->request, &done, MPI_STATUS_IGNORE);
+    it = done ? impl_->sends.erase(it) : std::next(it);
+  }
+  return impl_->sends.size();
+}
+
+bool MpiSession::flush_sends(int destination, MpiClock::time_point deadline) {
+  for (;;) {
+    bool pending = false;
+    {
+      std::lock_guard lock(mutex_);
+      if (finalized_) return impl_->sends.empty();
+      for (auto it = impl_->sends.begin(); it != impl_->sends.end();) {
+        int done = 0;
+        MPI_Test(&it->request, &done, MPI_STATUS_IGNORE);
+        if (!done && (destination < 0 || it->destination == destination)) pending = true;
+        it = done ? impl_->sends.erase(it) : std::next(it);
+      }
+    }
+    if (!pending) return true;
+    if (MpiClock::now() >= deadline) return false;
+    std::this_thread::sleep_for(std::chrono::microseconds(50));
+  }
+}
+
+std::optional<std::vector<uint8_t>> MpiSession::receive(int source, MpiClock::time_point deadline) {
+  // Polls: yields at first (a band's answer is often close), then sleeps briefly so that a waiting
+  // tracer thread does not take a core from the ones rendering.
+  for (int polls = 0;; ++polls) {
+    {
+      std::lock_guard lock(mutex_);
+      if (finalized_) throw std::runtime_error("MPI receive after the session was finalized");
+      auto pending = impl_->receives.find(source);
+      if (pending == impl_->receives.end()) {
+        int found = 0;
+        MPI_Message message;
+        MPI_Status status;
+        MPI_Improbe(source, kTag, impl_->comm, &found, &message, &status);
+        if (found) {
+          int count = 0;
+          MPI_Get_count(&status, MPI_BYTE, &count);
+          Impl::Incoming& in = impl_->receives[source];
+          in.bytes.resize(size_t(count));
+          MPI_Imrecv(in.bytes.data(), count, MPI_BYTE, &message, &in.request);
+          pending = impl_->receives.find(source);
+        }
+      }
+      if (pending != impl_->receives.end()) {
+        int done = 0;
+        MPI_Test(&pending->second.request, &done, MPI_STATUS_IGNORE);
+        if (done) {
+          std::vector<uint8_t> bytes = std::move(pending->second.bytes);
+          impl_->receives.erase(pending);
+          return bytes;
+        }
+      }
+      // Sends progress too while we wait (a library may move data only inside MPI calls).
+      for (auto it = impl_->sends.begin(); it != impl_->sends.end();) {
+        int done = 0;
+        MPI_Test(&it->request, &done, MPI_STATUS_IGNORE);
+        it = done ? impl_->sends.erase(it) : std::next(it);
+      }
+    }
+    if (MpiClock::now() >= deadline) return std::nullopt;
+    if (polls < 200)
+      std::this_thread::yield();
+    else
+      std::this_thread::sleep_for(std::chrono::microseconds(polls < 2000 ? 20 : 200));
+  }
+}
+
+}  // namespace cohort::tracers

@@ -1,0 +1,274 @@
+#include "cohort/tracers/mpi_node.h"
+
+#include <unistd.h>
+
+#include <algorithm>
+#include <csignal>
+#include <thread>
+
+#include <fmt/format.h>
+#include <spdlog/spdlog.h>
+
+#include "cohort/balance/bands.h"
+#include "cohort/core/band_buffer.h"
+#include "cohort/tracers/mpi_link.h"
+#include "cohort/tracers/mpi_wire.h"
+
+namespace cohort::tracers {
+
+namespace {
+
+constexpr int kRank0 = 0;
+
+std::string host_name() {
+  char name[256] = {};
+  if (gethostname(name, sizeof name - 1) != 0) return "unknown host";
+  return name;
+}
+
+void send(MpiSession& mpi, wire::Kind kind, uint64_t sequence, const std::vector<uint8_t>& payload) {
+  mpi.send(kRank0, wire::frame_message(kind, sequence, payload));
+}
+
+class Node {
+ public:
+  Node(std::vector<std::unique_ptr<core::Tracer>> tracers, const NodeOptions& options)
+      : tracers_(std::move(tracers)), options_(options), rows_per_ms_(tracers_.size(), 1.0) {}
+
+  int serve(MpiSession& mpi) {
+    for (;;) {
+      std::optional<std::vector<uint8_t>> bytes = mpi.receive(kRank0, MpiClock::now() + options_.idle_timeout);
+      if (!bytes) {
+        spdlog::error("node {}: rank 0 was silent for {} s; leaving", mpi.rank(), options_.idle_timeout.count());
+        return 1;
+      }
+      wire::Message m;
+      try {
+        m = wire::parse_message(bytes->data(), bytes->size());
+      } catch (const wire::WireError& e) {
+        spdlog::warn("node {}: refused a message: {}", mpi.rank(), e.what());
+        continue;
+      }
+      switch (m.kind) {
+        case wire::Kind::commit: apply_commit(m); break;
+        case wire::Kind::full_local: apply_full_local(m); break;
+        case wire::Kind::band_job: render(mpi, m); break;
+        case wire::Kind::shutdown:
+          spdlog::info("node {}: shutdown from rank 0 after {} band(s)", mpi.rank(), bands_);
+          mpi.flush_sends(kRank0, MpiClock::now() + std::chrono::seconds(2));
+          return 0;
+        default:
+          spdlog::warn("node {}: ignored an unexpected {} message", mpi.rank(), wire::to_string(m.kind));
+      }
+    }
+  }
+
+ private:
+  // A refused or failed commit leaves the scene behind rank 0's: every band fails, asking for a full
+  // resync, until one arrives.
+  void apply_commit(const wire::Message& m) {
+    commit::CommitBuffer commit;
+    try {
+      commit = wire::decode_commit(m.payload);
+    } catch (const wire::WireError& e) {
+      diverge(fmt::format("refused commit of frame {}: {}", m.sequence, e.what()));
+      return;
+    }
+    apply(commit);
+  }
+
+  void apply_full_local(const wire::Message& m) {
+    if (!options_.scene) {
+      diverge("rank 0 sent a full resync to the node's own scene, but it loaded none");
+      return;
+    }
+    commit::CommitBuffer full;
+    try {
+      full = wire::decode_full_local(m.payload, options_.scene);
+    } catch (const wire::WireError& e) {
+      diverge(fmt::format("refused full resync of frame {}: {}", m.sequence, e.what()));
+      return;
+    }
+    apply(full);
+  }
+
+  void apply(const commit::CommitBuffer& commit) {
+    if (diverged_ && !commit.is_full_resync()) return;  // records on top of a stale scene would be garbage
+    try {
+      for (auto& tracer : tracers_) tracer->apply(commit);
+      diverged_ = false;
+    } catch (const std::exception& e) {
+      diverge(fmt::format("applying the commit of frame {} failed: {}", commit.frame(), e.what()));
+    }
+  }
+
+  void diverge(std::string why) {
+    spdlog::warn("node: {}; waiting for a full resync", why);
+    if (!diverged_) divergence_ = std::move(why);
+    diverged_ = true;
+  }
+
+  void render(MpiSession& mpi, const wire::Message& m) {
+    wire::BandRequest request;
+    try {
+      request = wire::decode_band_request(m.payload);
+    } catch (const wire::WireError& e) {
+      spdlog::warn("node {}: refused a band job: {}", mpi.rank(), e.what());
+      send(mpi, wire::Kind::band_failed, m.sequence, wire::encode_band_failure({false, e.what()}));
+      return;
+    }
+    if (diverged_) {
+      send(mpi, wire::Kind::band_failed, m.sequence,
+           wire::encode_band_failure({true, "the node's scene is behind: " + divergence_}));
+      return;
+    }
+    const KFrameParams& p = request.job.params;
+    if (int(p.frame_index) == options_.die_frame) {
+      spdlog::warn("node {}: killing itself before frame {} (--die-frame)", mpi.rank(), p.frame_index);
+      std::raise(SIGKILL);
+    }
+    if (int(p.frame_index) == options_.stall_frame && !stalled_) {
+      stalled_ = true;
+      spdlog::warn("node {}: stalling {} ms before frame {} (--stall-frame)", mpi.rank(), options_.stall_ms,
+                   p.frame_index);
+      std::this_thread::sleep_for(std::chrono::milliseconds(options_.stall_ms));
+    }
+    const auto start = MpiClock::now();
+    target_.resize(int(request.job.camera.width), int(request.job.camera.height), request.format);
+    target_.enable_aux(request.aux);
+    std::vector<float> row_work;
+    try {
+      row_work = render_split(request.job);
+    } catch (const std::exception& e) {
+      send(mpi, wire::Kind::band_failed, m.sequence, wire::encode_band_failure({false, e.what()}));
+      return;
+    }
+    const double ms = std::chrono::duration<double, std::milli>(MpiClock::now() - start).count();
+    send(mpi, wire::Kind::band_rows, m.sequence, wire::encode_band_rows(target_, p.row_begin, p.row_end, ms, row_work));
+    ++bands_;
+  }
+
+  // The band split among the node's tracers by their last speed, rendered in parallel; a tracer that
+  // fails has its rows re-rendered by one that did not. Returns the per-row work when every part
+  // reported it.
+  std::vector<float> render_split(const core::BandJob& job) {
+    const uint32_t begin = job.params.row_begin, end = job.params.row_end, rows = end - begin;
+    const size_t n = tracers_.size();
+    // Shares in proportion to speed (the balancer module's Perfect division, in its 4-row units): the
+    // band's size changes every frame with rank 0's balancing, so speeds, not bands, are what carry over.
+    std::vector<uint32_t> cuts(n + 1, begin);
+    const std::vector<balance::Band> parts = balance::bands_from_shares(int(rows), rows_per_ms_);
+    for (size_t i = 0; i < n; ++i) cuts[i + 1] = begin + uint32_t(parts[i].end);
+    cuts[n] = end;
+    std::vector<core::BandResult> results(n);
+    std::vector<std::string> errors(n);
+    std::vector<double> ms(n, 0.0);
+    auto render_part = [&](size_t i, uint32_t from, uint32_t to) {
+      if (from >= to) return;
+      core::BandJob part = job;
+      part.params.row_begin = from;
+      part.params.row_end = to;
+      const auto start = MpiClock::now();
+      try {
+        results[i] = tracers_[i]->render_band(part, target_);
+        errors[i].clear();
+      } catch (const std::exception& e) {
+        errors[i] = tracers_[i]->name() + ": " + e.what();
+      }
+      ms[i] = std::chrono::duration<double, std::milli>(MpiClock::now() - start).count();
+    };
+    if (n == 1) {
+      render_part(0, begin, end);
+    } else {
+      std::vector<std::thread> threads;
+      for (size_t i = 0; i < n; ++i) threads.emplace_back(render_part, i, cuts[i], cuts[i + 1]);
+      for (auto& t : threads) t.join();
+    }
+    for (size_t i = 0; i < n; ++i) {
+      if (!errors[i].empty() || cuts[i] >= cuts[i + 1]) continue;
+      const double speed = std::max(double(cuts[i + 1] - cuts[i]) / std::max(ms[i], 1e-3), 1e-3);
+      rows_per_ms_[i] = 0.5 * rows_per_ms_[i] + 0.5 * speed;  // smoothed like Perfect Smooth's alpha 0.5
+    }
+    bool complete_work = true;
+    for (size_t i = 0; i < n; ++i) {
+      if (errors[i].empty()) {
+        complete_work = complete_work && results[i].row_work.size() == cuts[i + 1] - cuts[i];
+        continue;
+      }
+      spdlog::warn("node: {}; re-rendering its rows on the node's other tracers", errors[i]);
+      rows_per_ms_[i] = 1e-3;  // next band: (almost) none for it
+      size_t helper = n;
+      for (size_t j = 0; j < n && helper == n; ++j)
+        if (errors[j].empty()) helper = j;
+      if (helper == n) throw std::runtime_error(errors[i]);
+      const std::string first_error = errors[i];
+      render_part(helper, cuts[i], cuts[i + 1]);
+      if (!errors[helper].empty()) throw std::runtime_error(first_error + "; then " + errors[helper]);
+      complete_work = false;
+    }
+    std::vector<float> work;
+    if (!complete_work) return work;
+    for (size_t i = 0; i < n; ++i) work.insert(work.end(), results[i].row_work.begin(), results[i].row_work.end());
+    return work;
+  }
+
+  std::vector<std::unique_ptr<core::Tracer>> tracers_;
+  NodeOptions options_;
+  std::vector<double> rows_per_ms_;
+  core::BandBuffer target_;
+  bool diverged_ = false;
+  std::string divergence_;
+  bool stalled_ = false;
+  uint64_t bands_ = 0;
+};
+
+}  // namespace
+
+int run_node(std::vector<std::unique_ptr<core::Tracer>> tracers, const NodeOptions& options) {
+  MpiSession& mpi = MpiSession::get();
+  if (mpi.rank() == 0)
+    throw std::runtime_error("cohort node runs on ranks 1 and up; rank 0 runs `cohort render` or `cohort play` "
+                             "(docs/cluster.md)");
+  if (!options.load_error.empty()) {
+    spdlog::error("node {}: {}; leaving", mpi.rank(), options.load_error);
+    send(mpi, wire::Kind::load_failed, 0, wire::encode_text(options.load_error));
+    mpi.flush_sends(kRank0, MpiClock::now() + std::chrono::seconds(10));
+    return 1;
+  }
+  if (tracers.empty()) throw std::runtime_error("cohort node: no tracers");
+  wire::Hello hello;
+  hello.cohort_version = options.announced_version.empty() ? wire::cohort_version() : options.announced_version;
+  hello.host = host_name();
+  hello.tracers = options.tracers_text;
+  hello.scene_fingerprint = options.scene ? wire::scene_fingerprint(*options.scene) : 0;
+  hello.scene_name = options.scene_name;
+  send(mpi, wire::Kind::hello, 0, wire::encode_hello(hello));
+  // The answer: welcome, or refuse with the reason (versions disagree).
+  for (;;) {
+    std::optional<std::vector<uint8_t>> bytes = mpi.receive(kRank0, MpiClock::now() + options.idle_timeout);
+    if (!bytes) {
+      spdlog::error("node {}: rank 0 did not answer the hello within {} s; leaving", mpi.rank(),
+                    options.idle_timeout.count());
+      return 1;
+    }
+    wire::Message m;
+    try {
+      m = wire::parse_message(bytes->data(), bytes->size());
+    } catch (const wire::WireError& e) {
+      spdlog::warn("node {}: refused a message: {}", mpi.rank(), e.what());
+      continue;
+    }
+    if (m.kind == wire::Kind::refuse) {
+      spdlog::error("node {}: rank 0 refused this node: {}", mpi.rank(), wire::decode_text(m.payload));
+      return 1;
+    }
+    if (m.kind == wire::Kind::shutdown) return 0;  // rank 0 ended before it needed this node
+    if (m.kind == wire::Kind::welcome) break;
+    spdlog::warn("node {}: ignored a {} message before the welcome", mpi.rank(), wire::to_string(m.kind));
+  }
+  spdlog::info("node {}: serving rank 0 with {}", mpi.rank(), options.tracers_text);
+  Node node(std::move(tracers), options);
+  return node.serve(mpi);
+}
+
+}  // namespace cohort::tracers

@@ -1,0 +1,313 @@
+#include "cohort/tracers/mpi_tracer.h"
+
+#include <algorithm>
+#include <atomic>
+#include <cstring>
+#include <map>
+
+#include <fmt/format.h>
+#include <spdlog/spdlog.h>
+
+#include "cohort/tracers/mpi_link.h"
+#include "cohort/tracers/mpi_wire.h"
+
+namespace cohort::tracers {
+
+namespace {
+double ms_since(MpiClock::time_point start) {
+  return std::chrono::duration<double, std::milli>(MpiClock::now() - start).count();
+}
+
+// A node says hello once per run; tracers made for it later (`cohort bench devices` makes one per mix)
+// find it here and start with a full resync like any tracer.
+struct JoinedNode {
+  wire::Hello hello;
+};
+std::mutex joined_mutex;
+std::map<int, JoinedNode>& joined_nodes() {
+  static std::map<int, JoinedNode> nodes;
+  return nodes;
+}
+
+// Band job ids are unique over the run, so that a late answer to an earlier tracer's job is never
+// taken for the current one.
+std::atomic<uint64_t> next_band_job{1};
+}  // namespace
+
+MpiTracer::MpiTracer(MpiTracerOptions options) : options_(options) {
+  MpiSession& mpi = MpiSession::get();
+  mpi.set_farewell(wire::frame_message(wire::Kind::shutdown, 0, {}));
+  if (mpi.rank() != 0)
+    throw NodeUnavailable(fmt::format("mpi:{}: remote tracers are driven from rank 0; this process is rank {}",
+                                      options_.rank, mpi.rank()));
+  if (options_.rank < 1 || options_.rank >= mpi.size())
+    throw NodeUnavailable(fmt::format("mpi:{}: no such rank: the MPI world has {} rank(s) (launch under mpirun, "
+                                      "with `cohort node` on ranks 1 and up; docs/cluster.md)",
+                                      options_.rank, mpi.size()));
+  {
+    std::lock_guard lock(joined_mutex);
+    auto known = joined_nodes().find(options_.rank);
+    if (known != joined_nodes().end()) {
+      adopt(known->second.hello);
+      return;
+    }
+  }
+  const auto deadline = MpiClock::now() + options_.hello_timeout;
+  for (;;) {
+    std::optional<std::vector<uint8_t>> bytes = mpi.receive(options_.rank, deadline);
+    if (!bytes)
+      throw NodeUnavailable(fmt::format("mpi:{}: the node sent no hello within {} ms (is `cohort node` running on "
+                                        "that rank?)", options_.rank, options_.hello_timeout.count()));
+    wire::Message m;
+    try {
+      m = wire::parse_message(bytes->data(), bytes->size());
+    } catch (const wire::WireError& e) {
+      spdlog::warn("mpi:{}: refused a message before the hello: {}", options_.rank, e.what());
+      continue;
+    }
+    if (m.kind == wire::Kind::load_failed) {
+      mpi.released(options_.rank);  // it has left
+      std::string reason;
+      try {
+        reason = wire::decode_text(m.payload);
+      } catch (const wire::WireError& e) {
+        reason = std::string("(unreadable reason: ") + e.what() + ")";
+      }
+      throw NodeUnavailable(fmt::format("mpi:{}: the node could not start (its scene or its tracers) and leaves: {}",
+                                        options_.rank, reason));
+    }
+    if (m.kind != wire::Kind::hello) {
+      spdlog::warn("mpi:{}: ignored a {} message before the hello", options_.rank, wire::to_string(m.kind));
+      continue;
+    }
+    wire::Hello hello;
+    try {
+      hello = wire::decode_hello(m.payload);
+    } catch (const wire::WireError& e) {
+      mpi.released(options_.rank);
+      send(int(wire::Kind::refuse), 0, wire::encode_text(std::string("malformed hello: ") + e.what()));
+      throw NodeUnavailable(fmt::format("mpi:{}: refused the node's malformed hello: {}", options_.rank, e.what()));
+    }
+    const std::string mine = wire::cohort_version();
+    if (hello.cohort_version != mine || hello.protocol != wire::kProtocolVersion) {
+      const std::string why = fmt::format(
+          "version mismatch: rank 0 runs Cohort {} (protocol {}), rank {} on {} runs Cohort {} (protocol {}); run the "
+          "same build on every rank", mine, wire::kProtocolVersion, options_.rank, hello.host, hello.cohort_version,
+          hello.protocol);
+      send(int(wire::Kind::refuse), 0, wire::encode_text(why));
+      mpi.released(options_.rank);
+      mpi.flush_sends(options_.rank, MpiClock::now() + std::chrono::seconds(1));
+      throw NodeUnavailable("mpi:" + std::to_string(options_.rank) + ": " + why);
+    }
+    send(int(wire::Kind::welcome), 0, {});
+    adopt(hello);
+    {
+      std::lock_guard lock(joined_mutex);
+      joined_nodes()[options_.rank] = {hello};
+    }
+    spdlog::info("mpi:{}: node joined ({})", options_.rank, description_);
+    return;
+  }
+}
+
+void MpiTracer::adopt(const wire::Hello& hello) {
+  node_fingerprint_ = hello.scene_fingerprint;
+  gpu_ = hello.tracers.find("cuda") != std::string::npos || hello.tracers.find("opencl") != std::string::npos;
+  description_ = fmt::format("rank {} on {}: {}{}", options_.rank, hello.host, hello.tracers,
+                             hello.scene_name.empty() ? "" : ", scene " + hello.scene_name);
+}
+
+MpiTracer::~MpiTracer() {
+  const MpiLinkStats s = link_stats();
+  if (s.bands > 0)
+    spdlog::info("mpi:{}: {} band(s), {:.1f} KiB sent and {:.1f} KiB received a band, round trip {:.2f} ms a band",
+                 options_.rank, s.bands, double(s.bytes_sent) / double(s.bands) / 1024.0,
+                 double(s.bytes_received) / double(s.bands) / 1024.0, s.total_round_trip_ms / double(s.bands));
+  // The node stays for later tracers of this run; the session's end tells every node to leave.
+  try {
+    MpiSession& mpi = MpiSession::get();
+    if (!mpi.finalized()) mpi.flush_sends(options_.rank, MpiClock::now() + std::chrono::seconds(1));
+  } catch (const std::exception& e) {
+    spdlog::warn("mpi:{}: {}", options_.rank, e.what());
+  }
+}
+
+std::string MpiTracer::name() const { return "mpi:" + std::to_string(options_.rank); }
+
+void MpiTracer::send(int kind, uint64_t sequence, const std::vector<uint8_t>& payload) {
+  std::vector<uint8_t> message = wire::frame_message(wire::Kind(kind), sequence, payload);
+  {
+    std::lock_guard lock(stats_mutex_);
+    stats_.bytes_sent += message.size();
+    pending_sent_ += message.size();
+  }
+  MpiSession::get().send(options_.rank, std::move(message));
+}
+
+void MpiTracer::apply(const commit::CommitBuffer& commit) {
+  if (!commit.is_full_resync()) {
+    if (node_needs_resync_)
+      throw std::runtime_error(fmt::format("mpi:{}: {}; it needs a full resync", options_.rank, node_failure_));
+    send(int(wire::Kind::commit), commit.frame(), wire::encode_commit(commit));
+    return;
+  }
+  const commit::TracerScene& scene = *commit.full_scene();
+  if (hashed_scene_ != commit.shared_full_scene()) {
+    hashed_fingerprint_ = wire::scene_fingerprint(scene);
+    hashed_scene_ = commit.shared_full_scene();
+  }
+  if (node_fingerprint_ != 0 && hashed_fingerprint_ == node_fingerprint_) {
+    // The node loaded this very scene: only the frame and camera travel.
+    send(int(wire::Kind::full_local), commit.frame(), wire::encode_full_local(commit));
+  } else {
+    spdlog::info("mpi:{}: sending the whole scene (the node's own load differs or is gone)", options_.rank);
+    send(int(wire::Kind::commit), commit.frame(), wire::encode_commit(commit));
+  }
+  node_needs_resync_ = false;
+  after_full_resync_ = true;
+}
+
+void MpiTracer::take_late_answers() {
+  MpiSession& mpi = MpiSession::get();
+  while (timed_out_job_ != 0) {
+    std::optional<std::vector<uint8_t>> bytes = mpi.receive(options_.rank, MpiClock::now());
+    if (!bytes) return;
+    std::lock_guard lock(stats_mutex_);
+    stats_.bytes_received += bytes->size();
+    try {
+      const wire::Message m = wire::parse_message(bytes->data(), bytes->size());
+      ++stats_.stale_answers;
+      if ((m.kind == wire::Kind::band_rows || m.kind == wire::Kind::band_failed) && m.sequence == timed_out_job_) {
+        stats_.last_round_trip_ms = std::max(stats_.last_round_trip_ms, ms_since(timed_out_start_));
+        timed_out_job_ = 0;
+        spdlog::info("mpi:{}: the node answered again, {:.0f} ms after its band was sent", options_.rank,
+                     ms_since(timed_out_start_));
+      }
+    } catch (const wire::WireError& e) {
+      ++stats_.refused_messages;
+      spdlog::warn("mpi:{}: refused a message: {}", options_.rank, e.what());
+    }
+  }
+}
+
+core::BandResult MpiTracer::render_band(const core::BandJob& job, core::BandBuffer& target) {
+  MpiSession& mpi = MpiSession::get();
+  if (timed_out_job_ != 0) {
+    // A node that has not answered its last band yet (stalled, or gone) is not sent another: its band
+    // fails at once, so it costs one late frame, not one per frame, and it is back when it answers.
+    take_late_answers();
+    if (timed_out_job_ != 0)
+      throw std::runtime_error(fmt::format("mpi:{}: the node has not answered the band it was sent {:.0f} ms ago "
+                                           "(stalled or gone); its rows go to the others", options_.rank,
+                                           ms_since(timed_out_start_)));
+  }
+  const uint64_t id = next_band_job++;
+  wire::BandRequest request;
+  request.job = job;
+  request.format = target.format();
+  request.aux = target.has_aux();
+  const auto start = MpiClock::now();
+  send(int(wire::Kind::band_job), id, wire::encode_band_request(request));
+  double expected_ms;
+  {
+    std::lock_guard lock(stats_mutex_);
+    expected_ms = stats_.last_round_trip_ms;
+  }
+  // The first band after a full resync also waits for the node to build its acceleration structures.
+  const auto allowance = options_.band_timeout * (after_full_resync_ ? 10 : 1);
+  const auto deadline = start + allowance + std::chrono::microseconds(int64_t(4000.0 * expected_ms));
+  for (;;) {
+    std::optional<std::vector<uint8_t>> bytes = mpi.receive(options_.rank, deadline);
+    if (!bytes) {
+      timed_out_job_ = id;
+      timed_out_start_ = start;
+      throw std::runtime_error(fmt::format("mpi:{}: no answer for rows [{}, {}) within {:.0f} ms (node stalled?)",
+                                           options_.rank, job.params.row_begin, job.params.row_end, ms_since(start)));
+    }
+    {
+      std::lock_guard lock(stats_mutex_);
+      stats_.bytes_received += bytes->size();
+    }
+    wire::Message m;
+    try {
+      m = wire::parse_message(bytes->data(), bytes->size());
+    } catch (const wire::WireError& e) {
+      std::lock_guard lock(stats_mutex_);
+      ++stats_.refused_messages;
+      spdlog::warn("mpi:{}: refused a message: {}", options_.rank, e.what());
+      continue;
+    }
+    if (m.kind != wire::Kind::band_rows && m.kind != wire::Kind::band_failed) {
+      spdlog::warn("mpi:{}: ignored an unexpected {} message", options_.rank, wire::to_string(m.kind));
+      continue;
+    }
+    if (m.sequence != id) {  // the answer to a job that timed out before
+      std::lock_guard lock(stats_mutex_);
+      ++stats_.stale_answers;
+      // A band that merely took longer than the timeout teaches the next deadline how long bands take.
+      if (m.sequence == timed_out_job_) {
+        stats_.last_round_trip_ms = std::max(stats_.last_round_trip_ms, ms_since(timed_out_start_));
+        timed_out_job_ = 0;
+      }
+      spdlog::debug("mpi:{}: dropped the late answer to job {}", options_.rank, m.sequence);
+      continue;
+    }
+    if (m.kind == wire::Kind::band_failed) {
+      wire::BandFailure failure;
+      try {
+        failure = wire::decode_band_failure(m.payload);
+      } catch (const wire::WireError& e) {
+        failure.reason = std::string("(unreadable reason: ") + e.what() + ")";
+      }
+      if (failure.needs_full_resync) {
+        node_needs_resync_ = true;
+        node_failure_ = failure.reason;
+        node_fingerprint_ = 0;  // whatever it loaded, send the whole scene next time
+      }
+      throw std::runtime_error(fmt::format("mpi:{}: {}", options_.rank, failure.reason));
+    }
+    wire::BandRows rows;
+    try {
+      rows = wire::decode_band_rows(m.payload);
+    } catch (const wire::WireError& e) {
+      std::lock_guard lock(stats_mutex_);
+      ++stats_.refused_messages;
+      throw std::runtime_error(fmt::format("mpi:{}: refused the band's rows: {}", options_.rank, e.what()));
+    }
+    if (rows.row_begin != job.params.row_begin || rows.row_end != job.params.row_end ||
+        int(rows.width) != target.width() || rows.format != target.format() ||
+        job.params.row_end > uint32_t(target.height()) || (target.has_aux() && rows.aux.empty()))
+      throw std::runtime_error(fmt::format("mpi:{}: refused the band's rows: rows [{}, {}) of {} {} pixels, asked "
+                                           "for [{}, {}) of {} {}{}", options_.rank, rows.row_begin, rows.row_end,
+                                           rows.width, core::to_string(rows.format), job.params.row_begin,
+                                           job.params.row_end, target.width(), core::to_string(target.format()),
+                                           target.has_aux() ? " with aux planes" : ""));
+    if (!rows.pixels.empty()) std::memcpy(target.row(int(rows.row_begin)), rows.pixels.data(), rows.pixels.size());
+    if (target.has_aux() && !rows.aux.empty())
+      std::memcpy(target.aux_row(int(rows.row_begin)), rows.aux.data(), rows.aux.size());
+    const double round_trip = ms_since(start);
+    after_full_resync_ = false;
+    {
+      std::lock_guard lock(stats_mutex_);
+      ++stats_.bands;
+      stats_.last_round_trip_ms = round_trip;
+      stats_.total_round_trip_ms += round_trip;
+      stats_.last_node_ms = rows.device_ms;
+      stats_.total_node_ms += rows.device_ms;
+      stats_.last_band_bytes_sent = pending_sent_;
+      stats_.last_band_bytes_received = bytes->size();
+      pending_sent_ = 0;
+    }
+    core::BandResult result;
+    result.device_ms = rows.device_ms;
+    result.row_work = std::move(rows.row_work);
+    return result;
+  }
+}
+
+MpiLinkStats MpiTracer::link_stats() const {
+  std::lock_guard lock(stats_mutex_);
+  return stats_;
+}
+
+}  // namespace cohort::tracers
