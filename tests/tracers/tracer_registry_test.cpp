@@ -27,22 +27,4 @@ TEST(TracerRegistry, OnlyAListWithCudaLimitsEmbree) {
   EXPECT_EQ(mixed[1].kind, "embree");
   EXPECT_EQ(mixed[1].threads, embree_threads_beside_gpus(std::thread::hardware_concurrency()));
   EXPECT_EQ(mixed[0].threads, 0);
-  EXPECT_TRUE(mixed[1].yield_to_host);
-  EXPECT_FALSE(alone[0].yield_to_host);
 }
-
-#ifdef COHORT_HAVE_EMBREE
-#include <future>
-
-#include "cohort/tracers/embree_tracer.h"
-
-TEST(TracerRegistry, AYieldingThreadRunsAtALowerPriority) {
-  // On a thread of its own, so the test process keeps its priority.
-  const int nice = std::async(std::launch::async, [] { return EmbreeTracer::yield_this_thread_to_host(); }).get();
-#if defined(__linux__)
-  EXPECT_GE(nice, 10);
-#else
-  EXPECT_EQ(nice, 0);
-#endif
-}
-#endif

@@ -11,13 +11,6 @@
 #include <tbb/enumerable_thread_specific.h>
 #include <tbb/global_control.h>
 #include <tbb/parallel_for.h>
-#include <tbb/task_scheduler_observer.h>
-
-#if defined(__linux__)
-#include <sys/resource.h>
-#include <sys/syscall.h>
-#include <unistd.h>
-#endif
 
 #include "embree_filters.h"
 #include "embree_kernel.h"
@@ -91,32 +84,6 @@ void check_device(RTCDevice device, const char* what) {
 
 }  // namespace
 
-namespace {
-
-constexpr int kYieldingNice = 10;
-
-// Every TBB thread that joins the scheduler while it observes lowers its own priority.
-class YieldingThreads final : public tbb::task_scheduler_observer {
- public:
-  YieldingThreads() { observe(true); }
-  ~YieldingThreads() override { observe(false); }
-  void on_scheduler_entry(bool) override { EmbreeTracer::yield_this_thread_to_host(); }
-};
-
-}  // namespace
-
-int EmbreeTracer::yield_this_thread_to_host() {
-#if defined(__linux__)
-  // On Linux a thread's nice value is its own (setpriority on its tid); raising it needs no privilege.
-  const pid_t tid = static_cast<pid_t>(syscall(SYS_gettid));
-  if (getpriority(PRIO_PROCESS, static_cast<id_t>(tid)) < kYieldingNice)
-    setpriority(PRIO_PROCESS, static_cast<id_t>(tid), kYieldingNice);
-  return getpriority(PRIO_PROCESS, static_cast<id_t>(tid));
-#else
-  return 0;
-#endif
-}
-
 struct EmbreeTracer::Impl {
   RTCDevice device = nullptr;
   RTCScene top = nullptr;
@@ -125,7 +92,6 @@ struct EmbreeTracer::Impl {
   std::vector<char> passing_materials;  // per BLAS: embree_filters::blases_with_passing_materials
   std::vector<char> filtered;           // per BLAS: whether its geometry has filter_hit attached
   std::unique_ptr<tbb::global_control> thread_limit;
-  std::unique_ptr<YieldingThreads> yielding;  // set when it yields to the host
   uint64_t rays_traced = 0;
   bool x86_64_v3 = embree_tiles::has_x86_64_v3();
 
@@ -222,8 +188,7 @@ struct EmbreeTracer::Impl {
   }
 };
 
-EmbreeTracer::EmbreeTracer(int threads, bool yield_to_host) : impl_(std::make_unique<Impl>()) {
-  if (yield_to_host) impl_->yielding = std::make_unique<YieldingThreads>();
+EmbreeTracer::EmbreeTracer(int threads) : impl_(std::make_unique<Impl>()) {
   impl_->device = rtcNewDevice(nullptr);
   if (!impl_->device) throw std::runtime_error("EmbreeTracer: rtcNewDevice failed");
   impl_->ray_masks = rtcGetDeviceProperty(impl_->device, RTC_DEVICE_PROPERTY_RAY_MASK_SUPPORTED) != 0;
@@ -275,7 +240,6 @@ embree_tiles::Frame make_frame(const KFrameParams& params, const core::BandJob& 
 
 core::BandResult EmbreeTracer::render_band(const core::BandJob& job, core::BandBuffer& target) {
   if (!impl_->top) throw std::runtime_error("EmbreeTracer: render_band before any commit was applied");
-  if (impl_->yielding) yield_this_thread_to_host();  // the Renderer's worker thread renders tiles too
   auto start = std::chrono::steady_clock::now();
   const KFrameParams params = frame_params(job);
   const int row_begin = static_cast<int>(params.row_begin);

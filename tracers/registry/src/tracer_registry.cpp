@@ -116,10 +116,7 @@ std::vector<TracerSpec> parse_tracer_list(const std::string& list) {
   for (const TracerSpec& s : specs) any_cuda = any_cuda || s.kind == "cuda";
   if (any_cuda)
     for (TracerSpec& s : specs)
-      if (s.kind == "embree") {
-        s.threads = embree_threads_beside_gpus(std::thread::hardware_concurrency());
-        s.yield_to_host = true;
-      }
+      if (s.kind == "embree") s.threads = embree_threads_beside_gpus(std::thread::hardware_concurrency());
   return specs;
 }
 
@@ -130,7 +127,7 @@ int embree_threads_beside_gpus(unsigned hardware_threads) {
 
 std::unique_ptr<core::Tracer> make_tracer(const TracerSpec& spec) {
 #ifdef COHORT_HAVE_EMBREE
-  if (spec.kind == "embree") return std::make_unique<EmbreeTracer>(spec.threads, spec.yield_to_host);
+  if (spec.kind == "embree") return std::make_unique<EmbreeTracer>(spec.threads);
 #endif
 #ifdef COHORT_HAVE_OPENCL
   if (spec.kind == "opencl") {

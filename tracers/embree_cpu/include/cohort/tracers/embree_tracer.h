@@ -33,10 +33,7 @@ enum class EmbreeRayApi { single, packet8, stream };
 
 class EmbreeTracer : public TracerBase {
  public:
-  // threads: 0 for all hardware threads. yield_to_host: the threads that render its bands run at a lower
-  // OS priority (nice +10), so the host's share of the frame and GPU tracers' threads take a core first
-  // and Embree renders on what is left (for Embree beside GPUs: docs/balancing.md).
-  explicit EmbreeTracer(int threads = 0, bool yield_to_host = false);
+  explicit EmbreeTracer(int threads = 0);  // 0: all hardware threads
   ~EmbreeTracer() override;
   EmbreeTracer(const EmbreeTracer&) = delete;
   EmbreeTracer& operator=(const EmbreeTracer&) = delete;
@@ -54,9 +51,6 @@ class EmbreeTracer : public TracerBase {
   // Which build of the shading code runs: the one for x86-64-v3 (AVX2, FMA) where the CPU has it, the
   // default, or the baseline x86-64 one. Returns whether the x86-64-v3 build is now in use.
   bool prefer_x86_64_v3(bool prefer);
-  // Lowers the calling thread's OS priority to nice +10 (Linux; elsewhere nothing) and returns its nice
-  // value after, for the tests.
-  static int yield_this_thread_to_host();
   // Camera, bounce and shadow rays traced by render_band since construction.
   uint64_t rays_traced() const;
 

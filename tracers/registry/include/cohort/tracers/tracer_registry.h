@@ -18,7 +18,6 @@ struct TracerSpec {
   int device = 0;    // for mpi: the node's rank
   std::string text;  // as written
   int threads = 0;   // Embree: CPU threads it may use (0: all); parse_tracer_list sets it beside CUDA tracers
-  bool yield_to_host = false;  // Embree: its threads at a lower OS priority (beside CUDA tracers)
 };
 
 // The threads an Embree tracer takes when it renders beside CUDA tracers: all but a quarter of the
@@ -29,7 +28,7 @@ int embree_threads_beside_gpus(unsigned hardware_threads);
 
 // Splits "embree,opencl:1" and expands "all", "cuda:all" and "opencl:all" by probing the devices;
 // throws std::invalid_argument naming a malformed entry. An Embree entry in a list with a CUDA tracer gets
-// embree_threads_beside_gpus threads, which yield to the host's threads (EmbreeTracer's yield_to_host).
+// embree_threads_beside_gpus threads.
 std::vector<TracerSpec> parse_tracer_list(const std::string& list);
 
 // Throws std::runtime_error when this build lacks the tracer or the device cannot be opened. A remote
