@@ -166,6 +166,10 @@ int run_render(const RenderArgs& a) {
     spdlog::info("{}{}{} on {}", reproject ? "reprojection" : "", reproject && atrous ? " and " : "",
                  atrous ? "the a-trous filter" : "", post->where());
   }
+  // A GPU post-processing reprojection takes the bands as the tracers packed them: half the bytes cross
+  // the bus and the host skips its conversions (the float frame and G-buffer are not made).
+  const bool packed = post && reproject && post->where() != "host" && a.denoise != "oidn" && a.denoise != "oidn-cuda";
+  renderer.set_packed_merge(packed);
   if (a.denoise != "none" && !atrous) {
     denoiser = core::OidnDenoiser::open(core::parse_oidn_device(a.denoise == "oidn-cuda" ? "cuda" : "cpu"),
                                          core::parse_oidn_quality(a.denoise_quality));
@@ -190,15 +194,17 @@ int run_render(const RenderArgs& a) {
       stats.convergence_f = convergence.accumulate(done.job.camera, frame);
     }
     const core::FrameBuffer* shown_image = a.no_convergence ? &frame : &convergence.image();
-    if (post && !gbuffer.empty()) {
+    const bool post_runs = post && (packed || !gbuffer.empty());
+    if (post_runs) {
       // One stage: on a GPU the two steps share one upload and one download.
       core::ScopedStage posting(stats.stages, core::kCoreTrack,
                                 !atrous ? "convergence" : reproject ? "convergence+denoise" : "denoise");
-      post->process(reproject ? frame : *shown_image, gbuffer);
+      if (packed) post->process_packed(renderer.packed_frame());
+      else post->process(reproject ? frame : *shown_image, gbuffer);
       if (reproject) stats.convergence_f = 1.0 / std::max(post->mean_history_length(), 1.0);
     }
     const bool writes_frame = !(a.write == "last" && f + 1 < a.frames && !player);
-    if (post && !gbuffer.empty()) {
+    if (post_runs) {
       shown_image = &post->image();
     } else if (denoiser && writes_frame) {
       core::ScopedStage denoising(stats.stages, core::kCoreTrack, "denoise");

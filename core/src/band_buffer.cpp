@@ -160,4 +160,15 @@ void BandBuffer::copy_rows_to(FrameBuffer& out, int row_begin, int row_end) cons
   else rgb16f_to_rgba32f(static_cast<const uint16_t*>(row(row_begin)), to, pixels);
 }
 
+void BandBuffer::copy_rows_from(const BandBuffer& from, int row_begin, int row_end) {
+  if (from.width_ != width_ || from.height_ != height_ || from.format_ != format_)
+    throw std::invalid_argument("BandBuffer::copy_rows_from: size or format mismatch");
+  if (row_begin < 0 || row_end > height_ || row_begin > row_end) throw std::out_of_range("BandBuffer::copy_rows_from: rows");
+  const size_t rows = static_cast<size_t>(row_end - row_begin);
+  std::memcpy(row(row_begin), from.row(row_begin), rows * row_bytes());
+  if (!aux_.empty() && !from.aux_.empty())
+    std::memcpy(aux_row(row_begin), from.aux_.data() + static_cast<size_t>(row_begin) * static_cast<size_t>(width_),
+                rows * static_cast<size_t>(width_) * sizeof(AuxTexel));
+}
+
 }  // namespace cohort::core

@@ -457,6 +457,21 @@ void Renderer::merge_frame(FrameStats& stats) {
   FrameBuffer& out = *frame->out;
   const int width = static_cast<int>(frame->job.camera.width), height = static_cast<int>(frame->job.camera.height);
   ScopedStage merging(stats.stages, kCoreTrack, "merge");
+  if (packed_merge_) {
+    const bool aux = frame->job.params.aux_outputs != 0u;
+    if (packed_.width() != width || packed_.height() != height || packed_.format() != options_.band_format)
+      packed_.resize(width, height, options_.band_format);
+    packed_.enable_aux(aux);
+    for (const Assignment& a : frame->delivered) {
+      const BandBuffer& target = workers_[static_cast<size_t>(a.worker)]->targets[frame->slot];
+      HostThreads::shared().for_ranges(static_cast<size_t>(a.band.rows()), kRowsPerCopy, [&](size_t begin, size_t end) {
+        packed_.copy_rows_from(target, a.band.begin + static_cast<int>(begin), a.band.begin + static_cast<int>(end));
+      });
+    }
+    merging.finish();
+    stats.wall_ms = std::chrono::duration<double, std::milli>(Clock::now() - frame->start).count();
+    return;
+  }
   if (out.width != width || out.height != height) out.resize(width, height);
   merge(frame->delivered, frame->slot, out);
   if (frame->job.params.aux_outputs != 0u) {

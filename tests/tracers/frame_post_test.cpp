@@ -10,7 +10,11 @@
 #include "cohort/core/atrous_filter.h"
 #include "cohort/core/frame_post.h"
 #include "cohort/core/reprojection.h"
+#include "cohort/core/renderer.h"
+#include "cohort/core/gpu_scene.h"
 #include "cohort/tracers/tracer_registry.h"
+#include "test_scenes.h"
+#include "test_tracers.h"
 
 using namespace cohort;
 
@@ -131,5 +135,57 @@ TEST(FramePost, CudaMatchesTheHostOverAMovingSequence) {
     gpu->process(frame, g);
     EXPECT_NEAR(gpu->mean_history_length(), 1.0, 1e-3) << "reset drops the history";
     EXPECT_NEAR(host.mean_history_length(), 1.0, 1e-3);
+  }
+}
+
+// The Renderer's packed merge (bands copied as the tracers wrote them) holds exactly what the float merge
+// makes, and every place's post-processing gives the same picture from it.
+TEST(FramePost, PackedMergeUnpacksToTheFloatMergeEverywhere) {
+  using namespace cohort::test;
+  auto room = std::make_shared<commit::TracerScene>(core::compile_scene(test_room()).tracer_scene);
+  std::vector<std::unique_ptr<core::Tracer>> list;
+  list.push_back(make_test_tracer("embree"));
+  list.push_back(make_test_tracer("embree"));
+  core::RendererOptions options;
+  options.balancer = "none";
+  options.band_format = core::BandFormat::rgb16f;
+  core::Renderer renderer(std::move(list), options);
+  renderer.submit_commit(commit::CommitBuffer::full(room, 1));
+  const int w = 48, h = 32;
+  core::BandJob job;
+  job.camera = test_room_camera(w, h);
+  job.previous_camera = job.camera;
+  job.params = frame_params(K_MODE_PATH, 1, 1, h);
+  job.params.aux_outputs = 1u;
+  core::FrameBuffer floats;
+  renderer.render(job, floats);
+  const core::GBuffer g = renderer.gbuffer();
+  ASSERT_FALSE(g.empty());
+  renderer.set_packed_merge(true);
+  core::FrameBuffer untouched;
+  renderer.render(job, untouched);
+  const core::BandBuffer& packed = renderer.packed_frame();
+  ASSERT_TRUE(packed.has_aux());
+  core::FrameBuffer unpacked;
+  unpacked.resize(w, h);
+  packed.copy_rows_to(unpacked, 0, h);
+  EXPECT_EQ(unpacked.rgba, floats.rgba);
+  core::GBuffer unpacked_g;
+  unpacked_g.resize(w, h);
+  packed.copy_aux_rows_to(unpacked_g, 0, h);
+  EXPECT_EQ(unpacked_g.depth, g.depth);
+  EXPECT_EQ(unpacked_g.normal, g.normal);
+  EXPECT_EQ(unpacked_g.albedo, g.albedo);
+  EXPECT_EQ(unpacked_g.id, g.id);
+  EXPECT_EQ(unpacked_g.motion, g.motion);
+
+  core::HostFramePost from_floats(both()), from_packed(both());
+  from_floats.process(floats, g);
+  from_packed.process_packed(packed);
+  EXPECT_EQ(from_packed.image().rgba, from_floats.image().rgba);
+  if (tracers::device_count("cuda") > 0) {
+    std::unique_ptr<core::FramePost> gpu = tracers::make_frame_post("cuda:0", both());
+    gpu->process_packed(packed);
+    EXPECT_LT(max_relative_difference(gpu->image(), from_floats.image()), 2e-3) << "packed frame on cuda:0";
   }
 }

@@ -41,6 +41,9 @@ class BandBuffer {
   void store(int y, int x, const float* rgba, size_t pixels);
   // Reads rows [row_begin, row_end) into the same rows of `out` (which must have this size) as RGBA floats.
   void copy_rows_to(FrameBuffer& out, int row_begin, int row_end) const;
+  // Copies rows [row_begin, row_end) of `from` (same size and format) into the same rows here as they are,
+  // aux texels too where both have them: a packed merge, no conversion.
+  void copy_rows_from(const BandBuffer& from, int row_begin, int row_end);
 
   // Auxiliary planes (kernel/aux_outputs.h), kept only for frames that ask for them: 32 bytes a pixel
   // (KAuxTexel: depths, motion and id as 32-bit values, normal and albedo as half floats). Off frees them.

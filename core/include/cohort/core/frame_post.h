@@ -8,6 +8,7 @@
 #include <string>
 
 #include "cohort/core/atrous_filter.h"
+#include "cohort/core/band_buffer.h"
 #include "cohort/core/frame_buffer.h"
 #include "cohort/core/gbuffer.h"
 #include "cohort/core/reprojection.h"
@@ -26,6 +27,9 @@ class FramePost {
   virtual ~FramePost() = default;
   // Takes the merged frame and its G-buffer (same size); a size change restarts the history.
   virtual void process(const FrameBuffer& fresh, const GBuffer& gbuffer) = 0;
+  // The same from the Renderer's packed merge (Renderer::set_packed_merge): the frame in its band format
+  // with its aux texels. Here: unpacked on the host, then process(); a GPU place unpacks on the device.
+  virtual void process_packed(const BandBuffer& packed);
   // The frame to show: reprojected, then filtered, as the options ask.
   virtual const FrameBuffer& image() const = 0;
   // Mean history length over the frame (1 = nothing reused; 1 when not reprojecting).
@@ -33,6 +37,10 @@ class FramePost {
   virtual void reset() = 0;
   // Where it runs, for logs and stats: "host", "cuda:0".
   virtual std::string where() const = 0;
+
+ private:
+  FrameBuffer unpacked_frame_;
+  GBuffer unpacked_gbuffer_;
 };
 
 class HostFramePost final : public FramePost {

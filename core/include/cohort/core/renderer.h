@@ -94,6 +94,13 @@ class Renderer {
   FrameStats finish_frame();
   // The auxiliary planes of the last merged frame, when its job set params.aux_outputs (else empty).
   const GBuffer& gbuffer() const { return gbuffer_; }
+  // Packed merging: the frame's bands are copied as the tracers wrote them (band format, aux texels) into
+  // packed_frame() instead of being converted into the float frame and gbuffer(), which then stay as they
+  // were. For a consumer that unpacks elsewhere (CudaFramePost: half the bytes cross the bus, and the
+  // host's conversions are skipped). Call between frames.
+  void set_packed_merge(bool on) { packed_merge_ = on; }
+  bool packed_merge() const { return packed_merge_; }
+  const BandBuffer& packed_frame() const { return packed_; }
 
   int tracer_count() const;
   std::string tracer_name(int tracer) const;
@@ -158,6 +165,8 @@ class Renderer {
   std::unique_ptr<PendingFrame> unmerged_;   // waited for, bands not yet merged
   int next_slot_ = 0;
   GBuffer gbuffer_;
+  bool packed_merge_ = false;
+  BandBuffer packed_;
 };
 
 }  // namespace cohort::core
