@@ -201,6 +201,15 @@ int run_render(const RenderArgs& a) {
                                 !atrous ? "convergence" : reproject ? "convergence+denoise" : "denoise");
       if (packed) post->process_packed(renderer.packed_frame());
       else post->process(reproject ? frame : *shown_image, gbuffer);
+      // On a GPU its own clock tells the bus from the passes (a track of its own in the timeline).
+      if (const core::FramePostDeviceTimes t = post->device_times(); t.measured) {
+        const std::string track = "post on " + post->where();
+        const double download_at = core::timeline_now_ms() - t.download_ms;  // back to back, ending now
+        const double passes_at = download_at - t.passes_ms;
+        stats.stages.push_back({track, "upload", passes_at - t.upload_ms, t.upload_ms});
+        stats.stages.push_back({track, "passes", passes_at, t.passes_ms});
+        stats.stages.push_back({track, "download", download_at, t.download_ms});
+      }
       if (reproject) stats.convergence_f = 1.0 / std::max(post->mean_history_length(), 1.0);
     }
     const bool writes_frame = !(a.write == "last" && f + 1 < a.frames && !player);

@@ -127,6 +127,9 @@ TEST(FramePost, CudaMatchesTheHostOverAMovingSequence) {
       // Same arithmetic; only the device's exp/sqrt/FMA contraction differ.
       EXPECT_LT(max_relative_difference(gpu->image(), host.image()), 2e-3) << "frame " << f << " atrous " << atrous;
       EXPECT_NEAR(gpu->mean_history_length(), host.mean_history_length(), 1e-3) << "frame " << f;
+      EXPECT_TRUE(gpu->device_times().measured);
+      EXPECT_GT(gpu->device_times().passes_ms, 0.0);
+      EXPECT_FALSE(host.device_times().measured);
     }
     gpu->reset();
     host.reset();

@@ -87,6 +87,7 @@ class CudaFramePost final : public core::FramePost {
     COHORT_CUDA(cudaSetDevice(device_));
     COHORT_CUDA(cudaStreamCreateWithFlags(&stream_, cudaStreamNonBlocking));
     COHORT_CUDA(cudaMallocHost(&length_sum_host_, sizeof(double)));
+    for (cudaEvent_t& e : events_) COHORT_CUDA(cudaEventCreate(&e));
     if (options_.atrous) normal_squarings_ = core::atrous_normal_squarings(options_.atrous_options.normal_power);
   }
   ~CudaFramePost() override {
@@ -96,6 +97,7 @@ class CudaFramePost final : public core::FramePost {
       if (r.ptr) cudaHostUnregister(const_cast<void*>(r.ptr));
     if (shown_registered_) cudaHostUnregister(shown_registered_);
     cudaFreeHost(length_sum_host_);
+    for (cudaEvent_t e : events_) cudaEventDestroy(e);
     cudaStreamDestroy(stream_);
   }
 
@@ -103,6 +105,7 @@ class CudaFramePost final : public core::FramePost {
     if (g.width != fresh.width || g.height != fresh.height)
       throw std::invalid_argument("CudaFramePost: the G-buffer's size differs from the frame's");
     if (!begin(fresh.width, fresh.height)) return;
+    COHORT_CUDA(cudaEventRecord(events_[0], stream_));
     upload(fresh.rgba, frame_);
     upload(g.depth, depth_);
     upload(g.normal, normal_);
@@ -112,6 +115,7 @@ class CudaFramePost final : public core::FramePost {
       upload(g.id, id_);
     }
     if (options_.atrous) upload(g.albedo, albedo_);
+    COHORT_CUDA(cudaEventRecord(events_[1], stream_));
     run(fresh.width, fresh.height);
   }
 
@@ -122,6 +126,7 @@ class CudaFramePost final : public core::FramePost {
     const int width = packed.width(), height = packed.height();
     if (!begin(width, height)) return;
     const size_t pixels = size_t(width) * size_t(height);
+    COHORT_CUDA(cudaEventRecord(events_[0], stream_));
     register_host(packed.row(0), packed.bytes());
     unsigned char* colour = packed_colour_.scratch(packed.bytes());
     COHORT_CUDA(cudaMemcpyAsync(colour, packed.row(0), packed.bytes(), cudaMemcpyHostToDevice, stream_));
@@ -129,6 +134,7 @@ class CudaFramePost final : public core::FramePost {
     register_host(host_texels, packed.aux_bytes());
     KAuxTexel* texels = packed_aux_.scratch(pixels);
     COHORT_CUDA(cudaMemcpyAsync(texels, host_texels, packed.aux_bytes(), cudaMemcpyHostToDevice, stream_));
+    COHORT_CUDA(cudaEventRecord(events_[1], stream_));
     unpack_kernel<<<blocks_for(pixels), kThreads, 0, stream_>>>(
         colour, packed.format() == core::BandFormat::rgb16f ? 1 : 0, texels, frame_.scratch(4 * pixels),
         depth_.scratch(pixels), prev_depth_.scratch(pixels), motion_.scratch(2 * pixels), normal_.scratch(3 * pixels),
@@ -212,9 +218,14 @@ class CudaFramePost final : public core::FramePost {
       else
         cudaGetLastError();
     }
+    COHORT_CUDA(cudaEventRecord(events_[2], stream_));
     COHORT_CUDA(cudaMemcpyAsync(shown_.rgba.data(), current, 4 * pixels * sizeof(float), cudaMemcpyDeviceToHost,
                                 stream_));
+    COHORT_CUDA(cudaEventRecord(events_[3], stream_));
     COHORT_CUDA(cudaStreamSynchronize(stream_));
+    float ms[3] = {0, 0, 0};
+    for (int i = 0; i < 3; ++i) COHORT_CUDA(cudaEventElapsedTime(&ms[i], events_[i], events_[i + 1]));
+    times_ = {true, ms[0], ms[1], ms[2]};
     if (options_.reproject) mean_length_ = *length_sum_host_ / static_cast<double>(pixels);
   }
 
@@ -223,6 +234,7 @@ class CudaFramePost final : public core::FramePost {
   double mean_history_length() const override { return mean_length_; }
   void reset() override { have_history_ = false; }
   std::string where() const override { return "cuda:" + std::to_string(device_); }
+  core::FramePostDeviceTimes device_times() const override { return times_; }
 
  private:
   // One frame's history on the device (kernel/reproject.h's state).
@@ -279,6 +291,8 @@ class CudaFramePost final : public core::FramePost {
   DeviceArray<double> length_sum_;
   double* length_sum_host_ = nullptr;
   double mean_length_ = 1.0;
+  cudaEvent_t events_[4] = {};  // before the uploads, the passes, the download; after it
+  core::FramePostDeviceTimes times_;
   core::FrameBuffer shown_;
   void* shown_registered_ = nullptr;
   Registered registered_[kRegistrations];

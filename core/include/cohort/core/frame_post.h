@@ -22,6 +22,12 @@ struct FramePostOptions {
   AtrousOptions atrous_options;
 };
 
+// A GPU place's own clock for the last frame (CUDA events), to tell the bus from the passes.
+struct FramePostDeviceTimes {
+  bool measured = false;  // false on the host
+  double upload_ms = 0.0, passes_ms = 0.0, download_ms = 0.0;
+};
+
 class FramePost {
  public:
   virtual ~FramePost() = default;
@@ -37,6 +43,7 @@ class FramePost {
   virtual void reset() = 0;
   // Where it runs, for logs and stats: "host", "cuda:0".
   virtual std::string where() const = 0;
+  virtual FramePostDeviceTimes device_times() const { return {}; }
 
  private:
   FrameBuffer unpacked_frame_;
