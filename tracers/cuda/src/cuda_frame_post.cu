@@ -85,7 +85,11 @@ class CudaFramePost final : public core::FramePost {
                                std::to_string(count) + " found)");
     }
     COHORT_CUDA(cudaSetDevice(device_));
-    COHORT_CUDA(cudaStreamCreateWithFlags(&stream_, cudaStreamNonBlocking));
+    // The highest stream priority: the passes run while the same GPU renders the next frame, and would
+    // otherwise wait behind the render kernel's blocks (measured: 9.6 ms of passes at 1080p on an H100).
+    int least = 0, greatest = 0;
+    COHORT_CUDA(cudaDeviceGetStreamPriorityRange(&least, &greatest));
+    COHORT_CUDA(cudaStreamCreateWithPriority(&stream_, cudaStreamNonBlocking, greatest));
     COHORT_CUDA(cudaMallocHost(&length_sum_host_, sizeof(double)));
     for (cudaEvent_t& e : events_) COHORT_CUDA(cudaEventCreate(&e));
     if (options_.atrous) normal_squarings_ = core::atrous_normal_squarings(options_.atrous_options.normal_power);
