@@ -88,11 +88,12 @@ const std::map<std::string, uint32_t>& modes() {
 int run_render(const RenderArgs& a) {
   if (a.map.empty() && a.replay.empty()) throw std::invalid_argument("name a map or scene pack (or --replay FILE)");
   RenderScene scene = a.replay.empty() ? load_render_scene(a.map, bases_or_test_map(a.bases)) : RenderScene{};
-  std::vector<std::unique_ptr<core::Tracer>> tracers = tracers::make_tracers(a.tracers);
+  // Parsed once: "all" probes the devices.
+  const std::vector<tracers::TracerSpec> specs = tracers::parse_tracer_list(a.tracers);
+  std::vector<std::unique_ptr<core::Tracer>> tracers = tracers::make_tracers(specs);
   bool any_gpu_tracer = false;
   for (const auto& tracer : tracers) any_gpu_tracer = any_gpu_tracer || tracer->renders_on_gpu();
-  const std::string post_place =
-      a.post_on == "auto" ? tracers::auto_frame_post_place(tracers::parse_tracer_list(a.tracers)) : a.post_on;
+  const std::string post_place = a.post_on == "auto" ? tracers::auto_frame_post_place(specs) : a.post_on;
   const std::string convergence_mode = resolve_convergence(a.convergence, any_gpu_tracer, post_place);
   core::RendererOptions options;
   options.balancer = a.balancer;

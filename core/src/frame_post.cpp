@@ -5,11 +5,11 @@
 namespace cohort::core {
 
 void FramePost::process_packed(const BandBuffer& packed) {
+  if (!packed.has_aux())
+    throw std::invalid_argument("FramePost::process_packed: the packed frame has no aux planes (render with aux outputs)");
   const int width = packed.width(), height = packed.height();
   if (unpacked_frame_.width != width || unpacked_frame_.height != height) unpacked_frame_.resize(width, height);
   packed.copy_rows_to(unpacked_frame_, 0, height);
-  if (!packed.has_aux())
-    throw std::invalid_argument("FramePost::process_packed: the packed frame has no aux planes (render with aux outputs)");
   if (unpacked_gbuffer_.width != width || unpacked_gbuffer_.height != height) unpacked_gbuffer_.resize(width, height);
   packed.copy_aux_rows_to(unpacked_gbuffer_, 0, height);
   process(unpacked_frame_, unpacked_gbuffer_);

@@ -1,6 +1,7 @@
 #include "cohort/core/renderer.h"
 
 #include <algorithm>
+#include <functional>
 #include <condition_variable>
 #include <cstring>
 #include <mutex>
@@ -354,13 +355,18 @@ Renderer::RoundResult Renderer::collect(const std::vector<Assignment>& assignmen
   return result;
 }
 
-void Renderer::merge(const std::vector<Assignment>& bands, int slot, FrameBuffer& out) const {
+void Renderer::for_band_rows(const std::vector<Assignment>& bands, int slot,
+                             const std::function<void(const BandBuffer&, int, int)>& copy) const {
   for (const Assignment& a : bands) {
     const BandBuffer& target = workers_[static_cast<size_t>(a.worker)]->targets[slot];
     HostThreads::shared().for_ranges(static_cast<size_t>(a.band.rows()), kRowsPerCopy, [&](size_t begin, size_t end) {
-      target.copy_rows_to(out, a.band.begin + static_cast<int>(begin), a.band.begin + static_cast<int>(end));
+      copy(target, a.band.begin + static_cast<int>(begin), a.band.begin + static_cast<int>(end));
     });
   }
+}
+
+void Renderer::merge(const std::vector<Assignment>& bands, int slot, FrameBuffer& out) const {
+  for_band_rows(bands, slot, [&](const BandBuffer& target, int begin, int end) { target.copy_rows_to(out, begin, end); });
 }
 
 FrameStats Renderer::render(const BandJob& job, FrameBuffer& out, const std::vector<float>& row_cost_proxy) {
@@ -457,33 +463,23 @@ void Renderer::merge_frame(FrameStats& stats) {
   FrameBuffer& out = *frame->out;
   const int width = static_cast<int>(frame->job.camera.width), height = static_cast<int>(frame->job.camera.height);
   ScopedStage merging(stats.stages, kCoreTrack, "merge");
+  const bool aux = frame->job.params.aux_outputs != 0u;
   if (packed_merge_) {
-    const bool aux = frame->job.params.aux_outputs != 0u;
-    if (packed_.width() != width || packed_.height() != height || packed_.format() != options_.band_format)
-      packed_.resize(width, height, options_.band_format);
+    packed_.resize(width, height, options_.band_format);  // keeps its storage (and registration) when unchanged
     packed_.enable_aux(aux);
-    for (const Assignment& a : frame->delivered) {
-      const BandBuffer& target = workers_[static_cast<size_t>(a.worker)]->targets[frame->slot];
-      HostThreads::shared().for_ranges(static_cast<size_t>(a.band.rows()), kRowsPerCopy, [&](size_t begin, size_t end) {
-        packed_.copy_rows_from(target, a.band.begin + static_cast<int>(begin), a.band.begin + static_cast<int>(end));
+    for_band_rows(frame->delivered, frame->slot,
+                  [&](const BandBuffer& target, int begin, int end) { packed_.copy_rows_from(target, begin, end); });
+  } else {
+    if (out.width != width || out.height != height) out.resize(width, height);
+    merge(frame->delivered, frame->slot, out);
+    if (aux) {
+      if (gbuffer_.width != width || gbuffer_.height != height) gbuffer_.resize(width, height);
+      for_band_rows(frame->delivered, frame->slot, [&](const BandBuffer& target, int begin, int end) {
+        target.copy_aux_rows_to(gbuffer_, begin, end);
       });
+    } else if (!gbuffer_.empty()) {
+      gbuffer_.clear();
     }
-    merging.finish();
-    stats.wall_ms = std::chrono::duration<double, std::milli>(Clock::now() - frame->start).count();
-    return;
-  }
-  if (out.width != width || out.height != height) out.resize(width, height);
-  merge(frame->delivered, frame->slot, out);
-  if (frame->job.params.aux_outputs != 0u) {
-    if (gbuffer_.width != width || gbuffer_.height != height) gbuffer_.resize(width, height);
-    for (const Assignment& a : frame->delivered) {
-      const BandBuffer& target = workers_[static_cast<size_t>(a.worker)]->targets[frame->slot];
-      HostThreads::shared().for_ranges(static_cast<size_t>(a.band.rows()), kRowsPerCopy, [&](size_t begin, size_t end) {
-        target.copy_aux_rows_to(gbuffer_, a.band.begin + static_cast<int>(begin), a.band.begin + static_cast<int>(end));
-      });
-    }
-  } else if (!gbuffer_.empty()) {
-    gbuffer_.clear();
   }
   merging.finish();
   stats.wall_ms = std::chrono::duration<double, std::milli>(Clock::now() - frame->start).count();

@@ -153,9 +153,13 @@ std::unique_ptr<core::Tracer> make_tracer(const TracerSpec& spec) {
 }
 
 std::vector<std::unique_ptr<core::Tracer>> make_tracers(const std::string& list) {
+  return make_tracers(parse_tracer_list(list));
+}
+
+std::vector<std::unique_ptr<core::Tracer>> make_tracers(const std::vector<TracerSpec>& specs) {
   std::vector<std::unique_ptr<core::Tracer>> out;
   std::vector<std::string> left;
-  for (const TracerSpec& spec : parse_tracer_list(list)) {
+  for (const TracerSpec& spec : specs) {
 #ifdef COHORT_HAVE_MPI
     // A node that cannot serve (its scene failed to load, another version) leaves the set; the
     // others render without it.
@@ -169,7 +173,11 @@ std::vector<std::unique_ptr<core::Tracer>> make_tracers(const std::string& list)
     out.push_back(make_tracer(spec));
 #endif
   }
-  if (out.empty()) throw std::runtime_error("no tracer could start: " + (left.empty() ? list : left.front()));
+  if (out.empty()) {
+    std::string named;
+    for (const TracerSpec& spec : specs) named += (named.empty() ? "" : ",") + spec.text;
+    throw std::runtime_error("no tracer could start: " + (left.empty() ? named : left.front()));
+  }
   return out;
 }
 

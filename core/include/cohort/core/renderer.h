@@ -21,6 +21,7 @@
 
 #include <chrono>
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <string>
 #include <vector>
@@ -144,6 +145,10 @@ class Renderer {
                       std::chrono::steady_clock::time_point deadline, std::vector<StageSpan>& stages);
   // Copies delivered bands from the workers' targets `slot` into out.
   void merge(const std::vector<Assignment>& bands, int slot, FrameBuffer& out) const;
+  // Calls copy(band buffer, row_begin, row_end) over every band's rows of that slot, in ranges on the
+  // host's threads: the one loop of every merge (floats, aux planes, packed).
+  void for_band_rows(const std::vector<Assignment>& bands, int slot,
+                     const std::function<void(const BandBuffer&, int, int)>& copy) const;
   double measured_ms(const Worker& w) const;
   // A benched tracer's unwaited job (commits, maybe a probe) that has ended: its measurement joins
   // last_measurements_ and its stages the frame's. Call with the completion mutex held.

@@ -35,6 +35,8 @@ std::vector<TracerSpec> parse_tracer_list(const std::string& list);
 // tracer whose node cannot serve is logged and left out of make_tracers' list (it throws when none is left).
 std::unique_ptr<core::Tracer> make_tracer(const TracerSpec& spec);
 std::vector<std::unique_ptr<core::Tracer>> make_tracers(const std::string& list);
+// The same for a list already parsed (parse_tracer_list probes devices for "all": parse once).
+std::vector<std::unique_ptr<core::Tracer>> make_tracers(const std::vector<TracerSpec>& specs);
 
 // The tracer kinds this binary was built with that render in this process (the remote `mpi` kind is
 // not among them: it needs a node on another MPI rank).
