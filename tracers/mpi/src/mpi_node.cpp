@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <csignal>
+#include <optional>
 #include <thread>
 
 #include <fmt/format.h>
@@ -30,6 +31,20 @@ void send(MpiSession& mpi, wire::Kind kind, uint64_t sequence, const std::vector
   mpi.send(kRank0, wire::frame_message(kind, sequence, payload));
 }
 
+// The next well-formed message from rank 0 (a malformed one is logged, skipped, and the wait starts
+// again); nothing when rank 0 stays silent for `timeout`.
+std::optional<wire::Message> receive_from_rank0(MpiSession& mpi, std::chrono::seconds timeout) {
+  for (;;) {
+    std::optional<std::vector<uint8_t>> bytes = mpi.receive(kRank0, MpiClock::now() + timeout);
+    if (!bytes) return std::nullopt;
+    try {
+      return wire::parse_message(bytes->data(), bytes->size());
+    } catch (const wire::WireError& e) {
+      spdlog::warn("node {}: refused a message: {}", mpi.rank(), e.what());
+    }
+  }
+}
+
 class Node {
  public:
   Node(std::vector<std::unique_ptr<core::Tracer>> tracers, const NodeOptions& options)
@@ -37,18 +52,12 @@ class Node {
 
   int serve(MpiSession& mpi) {
     for (;;) {
-      std::optional<std::vector<uint8_t>> bytes = mpi.receive(kRank0, MpiClock::now() + options_.idle_timeout);
-      if (!bytes) {
+      std::optional<wire::Message> received = receive_from_rank0(mpi, options_.idle_timeout);
+      if (!received) {
         spdlog::error("node {}: rank 0 was silent for {} s; leaving", mpi.rank(), options_.idle_timeout.count());
         return 1;
       }
-      wire::Message m;
-      try {
-        m = wire::parse_message(bytes->data(), bytes->size());
-      } catch (const wire::WireError& e) {
-        spdlog::warn("node {}: refused a message: {}", mpi.rank(), e.what());
-        continue;
-      }
+      wire::Message& m = *received;
       switch (m.kind) {
         case wire::Kind::commit: apply_commit(m); break;
         case wire::Kind::full_local: apply_full_local(m); break;
@@ -245,19 +254,13 @@ int run_node(std::vector<std::unique_ptr<core::Tracer>> tracers, const NodeOptio
   send(mpi, wire::Kind::hello, 0, wire::encode_hello(hello));
   // The answer: welcome, or refuse with the reason (versions disagree).
   for (;;) {
-    std::optional<std::vector<uint8_t>> bytes = mpi.receive(kRank0, MpiClock::now() + options.idle_timeout);
-    if (!bytes) {
+    std::optional<wire::Message> received = receive_from_rank0(mpi, options.idle_timeout);
+    if (!received) {
       spdlog::error("node {}: rank 0 did not answer the hello within {} s; leaving", mpi.rank(),
                     options.idle_timeout.count());
       return 1;
     }
-    wire::Message m;
-    try {
-      m = wire::parse_message(bytes->data(), bytes->size());
-    } catch (const wire::WireError& e) {
-      spdlog::warn("node {}: refused a message: {}", mpi.rank(), e.what());
-      continue;
-    }
+    const wire::Message& m = *received;
     if (m.kind == wire::Kind::refuse) {
       spdlog::error("node {}: rank 0 refused this node: {}", mpi.rank(), wire::decode_text(m.payload));
       return 1;
