@@ -11,6 +11,7 @@
 #include "cohort/kernel/reproject.h"
 #include "cuda_check.h"
 #include "device_array.h"
+#include "host_registrations.h"
 
 namespace cohort::tracers {
 
@@ -97,8 +98,6 @@ class CudaFramePost final : public core::FramePost {
   ~CudaFramePost() override {
     cudaSetDevice(device_);
     cudaStreamSynchronize(stream_);
-    for (const Registered& r : registered_)
-      if (r.ptr) cudaHostUnregister(const_cast<void*>(r.ptr));
     if (shown_registered_) cudaHostUnregister(shown_registered_);
     cudaFreeHost(length_sum_host_);
     for (cudaEvent_t e : events_) cudaEventDestroy(e);
@@ -131,11 +130,11 @@ class CudaFramePost final : public core::FramePost {
     if (!begin(width, height)) return;
     const size_t pixels = size_t(width) * size_t(height);
     COHORT_CUDA(cudaEventRecord(events_[0], stream_));
-    register_host(packed.row(0), packed.bytes());
+    registered_.ensure(packed.row(0), packed.bytes());
     unsigned char* colour = packed_colour_.scratch(packed.bytes());
     COHORT_CUDA(cudaMemcpyAsync(colour, packed.row(0), packed.bytes(), cudaMemcpyHostToDevice, stream_));
     const KAuxTexel* host_texels = const_cast<core::BandBuffer&>(packed).aux_row(0);
-    register_host(host_texels, packed.aux_bytes());
+    registered_.ensure(host_texels, packed.aux_bytes());
     KAuxTexel* texels = packed_aux_.scratch(pixels);
     COHORT_CUDA(cudaMemcpyAsync(texels, host_texels, packed.aux_bytes(), cudaMemcpyHostToDevice, stream_));
     COHORT_CUDA(cudaEventRecord(events_[1], stream_));
@@ -253,33 +252,15 @@ class CudaFramePost final : public core::FramePost {
       id.scratch(pixels);
     }
   };
-  struct Registered {
-    const void* ptr = nullptr;
-    size_t bytes = 0;
-  };
-
   // Host planes are page-locked where the driver lets us (a true asynchronous DMA at full bus speed);
   // the callers keep their planes between frames, so the registrations are cached.
   template <class T>
   void upload(const std::vector<T>& host, DeviceArray<T>& device) {
-    register_host(host.data(), host.size() * sizeof(T));
+    registered_.ensure(host.data(), host.size() * sizeof(T));
     T* d = device.scratch(host.size());
     COHORT_CUDA(cudaMemcpyAsync(d, host.data(), host.size() * sizeof(T), cudaMemcpyHostToDevice, stream_));
   }
-  void register_host(const void* ptr, size_t bytes) {
-    for (const Registered& r : registered_)
-      if (r.ptr == ptr && r.bytes == bytes) return;
-    Registered& slot = registered_[next_registration_];
-    next_registration_ = (next_registration_ + 1) % kRegistrations;
-    if (slot.ptr) cudaHostUnregister(const_cast<void*>(slot.ptr));
-    slot = {};
-    if (cudaHostRegister(const_cast<void*>(ptr), bytes, cudaHostRegisterPortable) == cudaSuccess)
-      slot = {ptr, bytes};
-    else
-      cudaGetLastError();  // not fatal: pageable memory copies too, only slower
-  }
-
-  static constexpr int kRegistrations = 24;  // two frames' worth of planes (the pipeline alternates)
+  static constexpr size_t kRegistrations = 24;  // two frames' worth of planes (the pipeline alternates)
   int device_;
   core::FramePostOptions options_;
   cudaStream_t stream_ = nullptr;
@@ -299,8 +280,7 @@ class CudaFramePost final : public core::FramePost {
   core::FramePostDeviceTimes times_;
   core::FrameBuffer shown_;
   void* shown_registered_ = nullptr;
-  Registered registered_[kRegistrations];
-  int next_registration_ = 0;
+  HostRegistrations registered_{kRegistrations};
 };
 
 }  // namespace

@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "device_array.h"
+#include "host_registrations.h"
 #include "render_band_launch.h"
 #include "skinning_launch.h"
 
@@ -67,30 +68,11 @@ struct CudaTracer::Impl {
   // asynchronous DMA on the tracer's stream instead of going through the driver's pageable staging
   // (about 3 ms of a 1080p frame otherwise). The Renderer alternates two targets by frame parity (the
   // pipeline), so the last two stay registered, with their auxiliary planes when they have them.
-  struct Registered {
-    void* ptr = nullptr;
-    size_t bytes = 0;
-  };
-  Registered registered[4];
-  int next_registration = 0;
+  HostRegistrations registered{4};
 
   void register_target(core::BandBuffer& target) {
-    register_host(target.data(), target.bytes());
-    if (target.has_aux()) register_host(target.aux_data(), target.aux_bytes());
-  }
-
-  void register_host(void* ptr, size_t bytes) {
-    for (const Registered& r : registered)
-      if (r.ptr == ptr && r.bytes == bytes) return;
-    Registered& slot = registered[next_registration];
-    next_registration = (next_registration + 1) % 4;
-    if (slot.ptr) cudaHostUnregister(slot.ptr);
-    slot = {};
-    if (cudaHostRegister(ptr, bytes, cudaHostRegisterPortable) == cudaSuccess) {
-      slot = {ptr, bytes};
-    } else {
-      cudaGetLastError();   // not fatal: the copy still works from pageable memory, only slower
-    }
+    registered.ensure(target.data(), target.bytes());
+    if (target.has_aux()) registered.ensure(target.aux_data(), target.aux_bytes());
   }
 
   void rebind_texel_texture() {
@@ -129,8 +111,6 @@ CudaTracer::CudaTracer(int device) : impl_(std::make_unique<Impl>()) {
 CudaTracer::~CudaTracer() {
   cudaSetDevice(impl_->device);
   if (impl_->texel_texture) cudaDestroyTextureObject(impl_->texel_texture);
-  for (const Impl::Registered& r : impl_->registered)
-    if (r.ptr) cudaHostUnregister(r.ptr);
   if (impl_->band) cudaFree(impl_->band);
   if (impl_->band_rgb16f) cudaFree(impl_->band_rgb16f);
   if (impl_->ray_counts) cudaFree(impl_->ray_counts);
