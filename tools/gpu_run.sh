@@ -9,6 +9,11 @@
 #                              results (logs, JSON, PPM frames) to $OUT
 #   tools/gpu_run.sh multigpu  there, on a several-GPU kind: issue 14's end-to-end mixes (two GPUs, each with
 #                              Embree and OpenCL), bench devices on both maps, Table 1 with two real GPUs
+#   tools/gpu_run.sh compare BASE.tar.xz [MORE.tar.xz ...]  there: A/B of payloads on one machine (the staged
+#                              one against earlier stages' payload.tar.xz, renamed and carried in .gpu/): the CUDA
+#                              tracer tests of the staged one, then end-to-end ms per frame, cuda:0, both maps,
+#                              Brigade's blend, each payload in turn, three rounds (COHORT_GPU_COMPARE_ARGS adds
+#                              render options)
 #   tools/gpu_run.sh frametimes  there: only the end-to-end frame times (large map 1080p generated there,
 #                              test map 720p; cuda:0, 1 spp, NEE + 1 bounce; reprojection on the GPU with and
 #                              without the a-trous filter, on the host, and Brigade's blend; per-stage medians;
@@ -26,8 +31,9 @@ stage=.gpu
 case "${1:-}" in
   stage)
     cmake --preset gpu-travel
-    cmake --build --preset gpu-travel -j2 --target cohort cohort_tracers_tests bench_cuda bench_bvh \
-      bench_scaling bench_host_frame bench_skinning
+    # COHORT_GPU_TARGETS narrows the build while iterating on one part (e.g. "cohort cohort_tracers_tests").
+    cmake --build --preset gpu-travel -j2 --target ${COHORT_GPU_TARGETS:-cohort cohort_tracers_tests bench_cuda bench_bvh \
+      bench_scaling bench_host_frame bench_skinning}
     rm -rf "$stage" && mkdir -p "$stage/bin" "$stage/lib"
     for exe in build/gpu/bin/cohort build/gpu/bin/cohort_tracers_tests build/gpu/bin/bench_cuda \
                build/gpu/bin/bench_bvh build/gpu/bin/bench_scaling build/gpu/bin/bench_host_frame \
@@ -45,6 +51,34 @@ case "${1:-}" in
     fi
     tar -C "$stage" -cJf "$stage/payload.tar.xz" bin lib && rm -rf "$stage/bin" "$stage/lib"
     du -sh "$stage"
+    ;;
+  compare)
+    # Each payload unpacks into .gpu/cmp/NAME (NAME: its file name without .tar.xz; the staged one is "new").
+    [ $# -ge 2 ] || { echo "usage: gpu_run.sh compare BASE_PAYLOAD.tar.xz [MORE.tar.xz ...]"; exit 2; }
+    shift
+    names=()
+    for payload in "$@" "$stage/payload.tar.xz"; do
+      name=$(basename "$payload" .tar.xz); [ "$payload" = "$stage/payload.tar.xz" ] && name=new
+      mkdir -p "$stage/cmp/$name" && tar -C "$stage/cmp/$name" -xJf "$payload" && names+=("$name")
+    done
+    export LD_LIBRARY_PATH="$PWD/$stage/cmp/new/lib${LD_LIBRARY_PATH:+:$LD_LIBRARY_PATH}"
+    nvidia-smi --query-gpu=index,name --format=csv,noheader
+    [ -f /tmp/largemap.cpk ] || { python3 tools/gen_testmap.py --large --out /tmp/largemap >/dev/null &&
+      "$stage/cmp/new/bin/cohort" pack /tmp/largemap/maps/largemap.map --out /tmp/largemap.cpk | tail -n 1; }
+    COHORT_PACK="$stage/testmap.cpk" "$stage/cmp/new/bin/cohort_tracers_tests" --gtest_filter="${COHORT_GPU_TEST_FILTER:-*Cuda*}" 2>&1 |
+      grep -E "^\[  (PASSED|FAILED) |^\[  FAILED|tests? ran" || true
+    for round in 1 2 3; do
+      for name in "${names[@]}"; do
+        for map in large test; do
+          if [ $map = large ]; then args=(/tmp/largemap.cpk --width 1920 --height 1080 --camera 1690 300 80 5 -12)
+          else args=("$stage/testmap.cpk" --width 1280 --height 720); fi
+          run=/tmp/cmp_${name}_${map}_$round
+          "$stage/cmp/$name/bin/cohort" render "${args[@]}" --tracers cuda:0 --spp 1 --bounces 1 --convergence brigade \
+            --frames 60 --camera-path spin-slow ${COHORT_GPU_COMPARE_ARGS:-} --write last --out $run >/dev/null 2>&1
+          echo "== round $round, $name, $map map: $(python3 tools/frame_times.py $run/stats.json --skip 10 | head -n 1)"
+        done
+      done
+    done
     ;;
   frametimes)
     [ -d "$stage/bin" ] || tar -C "$stage" -xJf "$stage/payload.tar.xz"

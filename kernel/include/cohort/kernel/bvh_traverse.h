@@ -62,9 +62,10 @@ typedef struct KSceneRef {
 #define K_BVH_QUERY_ANY 1
 #define K_BVH_QUERY_SHADOW 2
 
-/* A ray in one space with the reciprocal direction for slab tests. */
+/* A ray in one space with the reciprocal direction for slab tests; o_inv_d = o * inv_d turns each
+ * slab distance into one multiply-add. */
 typedef struct KBvhRay {
-  KVec3 o, d, inv_d;
+  KVec3 o, d, inv_d, o_inv_d;
 } KBvhRay;
 
 KFN float k_bvh_safe_inverse(float x) {
@@ -78,43 +79,65 @@ KFN KBvhRay k_bvh_make_ray(KVec3 o, KVec3 d) {
   r.o = o;
   r.d = d;
   r.inv_d = v3(k_bvh_safe_inverse(d.x), k_bvh_safe_inverse(d.y), k_bvh_safe_inverse(d.z));
+  r.o_inv_d = v3_mul(o, r.inv_d);
   return r;
 }
 
-/* Entry distance into the node's box clipped to [tmin, tmax], or K_INF when the ray misses it. */
-KFN float k_bvh_ray_box(KBvhRay r, KGLOBAL const KBvhNode* n, float tmin, float tmax) {
-  float tx1 = (n->bmin[0] - r.o.x) * r.inv_d.x, tx2 = (n->bmax[0] - r.o.x) * r.inv_d.x;
-  float ty1 = (n->bmin[1] - r.o.y) * r.inv_d.y, ty2 = (n->bmax[1] - r.o.y) * r.inv_d.y;
-  float tz1 = (n->bmin[2] - r.o.z) * r.inv_d.z, tz2 = (n->bmax[2] - r.o.z) * r.inv_d.z;
+/* A node as two 16-byte loads: its box, and where its children or primitives start (count 0: an
+ * interior node whose two children sit at left_first and left_first + 1). */
+typedef struct KBvhNodeData {
+  KVec3 bmin, bmax;
+  kuint left_first, count;
+} KBvhNodeData;
+
+KFN KBvhNodeData k_bvh_load_node(KGLOBAL const KBvhNode* n) {
+  KFloat4 lo = k_load4((KGLOBAL const float*)n);
+  KFloat4 hi = k_load4((KGLOBAL const float*)n + 4);
+  KBvhNodeData d;
+  d.bmin = v3(lo.x, lo.y, lo.z);
+  d.bmax = v3(hi.x, hi.y, hi.z);
+  d.left_first = k_as_uint(lo.w);
+  d.count = k_as_uint(hi.w);
+  return d;
+}
+
+/* Entry distance into the box clipped to [tmin, tmax], or K_INF when the ray misses it. */
+KFN float k_bvh_ray_box(KBvhRay r, KVec3 bmin, KVec3 bmax, float tmin, float tmax) {
+  float tx1 = bmin.x * r.inv_d.x - r.o_inv_d.x, tx2 = bmax.x * r.inv_d.x - r.o_inv_d.x;
+  float ty1 = bmin.y * r.inv_d.y - r.o_inv_d.y, ty2 = bmax.y * r.inv_d.y - r.o_inv_d.y;
+  float tz1 = bmin.z * r.inv_d.z - r.o_inv_d.z, tz2 = bmax.z * r.inv_d.z - r.o_inv_d.z;
   float tnear = k_fmax(k_fmax(k_fmin(tx1, tx2), k_fmin(ty1, ty2)), k_fmax(k_fmin(tz1, tz2), tmin));
   float tfar = k_fmin(k_fmin(k_fmax(tx1, tx2), k_fmax(ty1, ty2)), k_fmin(k_fmax(tz1, tz2), tmax));
   return tnear <= tfar ? tnear : K_INF;
 }
 
-/* An interior node: pushes the far child when the ray enters both (the stack holds one entry per
- * level, so it cannot overflow) and moves to the nearer one. 0 when the ray misses both: pop. */
-KFN int k_bvh_descend(KBvhRay r, KGLOBAL const KBvhNode* nodes, KGLOBAL const KBvhNode* n, float tmin, float tmax,
-                      kuint* stack, int* sp, kuint* node) {
-  kuint near_child = n->left_first, far_child = n->left_first + 1u;
-  float t_near = k_bvh_ray_box(r, nodes + near_child, tmin, tmax);
-  float t_far = k_bvh_ray_box(r, nodes + far_child, tmin, tmax);
-  if (t_far < t_near) {
-    float tt = t_near; t_near = t_far; t_far = tt;
-    kuint tn = near_child; near_child = far_child; far_child = tn;
-  }
+/* An interior node whose children start at `left`: pushes the far child when the ray enters both (the
+ * stack holds one entry per level, so it cannot overflow) and makes the nearer one current, already
+ * loaded. 0 when the ray misses both: pop. */
+KFN int k_bvh_descend(KBvhRay r, KGLOBAL const KBvhNode* nodes, kuint left, float tmin, float tmax, kuint* stack,
+                      int* sp, KBvhNodeData* current) {
+  KBvhNodeData a = k_bvh_load_node(nodes + left);
+  KBvhNodeData b = k_bvh_load_node(nodes + left + 1u);
+  float ta = k_bvh_ray_box(r, a.bmin, a.bmax, tmin, tmax);
+  float tb = k_bvh_ray_box(r, b.bmin, b.bmax, tmin, tmax);
+  int b_first = tb < ta;
+  float t_near = b_first ? tb : ta, t_far = b_first ? ta : tb;
   if (t_near == K_INF) return 0;
-  if (t_far != K_INF && *sp < K_BVH_MAX_DEPTH) stack[(*sp)++] = far_child;
-  *node = near_child;
+  if (t_far != K_INF && *sp < K_BVH_MAX_DEPTH) stack[(*sp)++] = b_first ? left : left + 1u;
+  *current = b_first ? b : a;
   return 1;
 }
 
 /* The next pushed node the ray still enters (a closer hit found since the push can rule nodes out);
  * 0 when the stack is empty. */
 KFN int k_bvh_pop(KBvhRay r, KGLOBAL const KBvhNode* nodes, float tmin, float tmax, const kuint* stack, int* sp,
-                  kuint* node) {
+                  KBvhNodeData* current) {
   while (*sp > 0) {
-    *node = stack[--(*sp)];
-    if (k_bvh_ray_box(r, nodes + *node, tmin, tmax) != K_INF) return 1;
+    KBvhNodeData n = k_bvh_load_node(nodes + stack[--(*sp)]);
+    if (k_bvh_ray_box(r, n.bmin, n.bmax, tmin, tmax) != K_INF) {
+      *current = n;
+      return 1;
+    }
   }
   return 0;
 }
@@ -142,11 +165,18 @@ KFN int k_bvh_ray_triangle(KVec3 o, KVec3 d, KVec3 p0, KVec3 p1, KVec3 p2, float
   return 1;
 }
 
+/* A vertex position: the first three floats of its 16-byte-aligned KVertex. */
+KFN KVec3 k_bvh_vertex_position(KSceneRef scene, kuint vertex) {
+  KFloat4 p = k_load4((KGLOBAL const float*)(scene.vertices + vertex));
+  return v3(p.x, p.y, p.z);
+}
+
 KFN int k_bvh_hit_triangle(KSceneRef scene, kuint triangle, KVec3 o, KVec3 d, float tmin, float tmax,
                            float* t, float* u, float* v) {
-  KGLOBAL const KTriangle* tri = scene.triangles + triangle;
-  return k_bvh_ray_triangle(o, d, v3_load_g(scene.vertices[tri->v0].pos), v3_load_g(scene.vertices[tri->v1].pos),
-                            v3_load_g(scene.vertices[tri->v2].pos), tmin, tmax, t, u, v);
+  KFloat4 tri = k_load4((KGLOBAL const float*)(scene.triangles + triangle));
+  return k_bvh_ray_triangle(o, d, k_bvh_vertex_position(scene, k_as_uint(tri.x)),
+                            k_bvh_vertex_position(scene, k_as_uint(tri.y)),
+                            k_bvh_vertex_position(scene, k_as_uint(tri.z)), tmin, tmax, t, u, v);
 }
 
 /* One candidate hit. CLOSEST records it and shrinks *tmax; ANY reports it; SHADOW multiplies it
@@ -171,66 +201,89 @@ KFN int k_bvh_accept(K_BVH_CONTEXT ctx, int query, int shadow_ray, kuint instanc
 
 /* Walks one instance's BLAS with the object-space ray. */
 KFN int k_bvh_traverse_blas(KSceneRef scene, K_BVH_CONTEXT ctx, int query, int shadow_ray, kuint instance, KBvhRay r,
-                            float tmin, float* tmax, KHit* hit, KVec3* transmittance) {
+                            float tmin, float* tmax, KHit* hit, kuint* cost, KVec3* transmittance) {
   KGLOBAL const KBlas* blas = scene.blases + scene.instances[instance].blas;
   if (blas->node_count == 0u) return 0;
   KGLOBAL const KBvhNode* nodes = scene.blas_nodes + blas->node_offset;
+  kuint tri_offset = blas->tri_offset;
   kuint stack[K_BVH_MAX_DEPTH];
   int sp = 0;
-  kuint node = 0u;
-  if (k_bvh_ray_box(r, nodes, tmin, *tmax) == K_INF) return 0;
+  KBvhNodeData n = k_bvh_load_node(nodes);
+  if (k_bvh_ray_box(r, n.bmin, n.bmax, tmin, *tmax) == K_INF) return 0;
   for (;;) {
-    KGLOBAL const KBvhNode* n = nodes + node;
-    hit->cost += 1u;
-    if (n->count > 0u) {
-      kuint end = n->left_first + n->count;
-      for (kuint i = n->left_first; i < end; ++i) {
-        kuint triangle = blas->tri_offset + i;
+    *cost += 1u;
+    if (n.count > 0u) {
+      kuint end = n.left_first + n.count;
+      for (kuint i = n.left_first; i < end; ++i) {
+        kuint triangle = tri_offset + i;
         float t, u, v;
         if (!k_bvh_hit_triangle(scene, triangle, r.o, r.d, tmin, *tmax, &t, &u, &v)) continue;
         if (k_bvh_accept(ctx, query, shadow_ray, instance, triangle, t, u, v, tmax, hit, transmittance)) return 1;
       }
-    } else if (k_bvh_descend(r, nodes, n, tmin, *tmax, stack, &sp, &node)) {
+    } else if (k_bvh_descend(r, nodes, n.left_first, tmin, *tmax, stack, &sp, &n)) {
       continue;
     }
-    if (!k_bvh_pop(r, nodes, tmin, *tmax, stack, &sp, &node)) return 0;
+    if (!k_bvh_pop(r, nodes, tmin, *tmax, stack, &sp, &n)) return 0;
   }
 }
 
-/* Walks the TLAS; per instance leaf whose mask matches, the instance's BLAS in object space. */
+/* The instance's world-to-object rows, three 16-byte loads (KInstance keeps them 16-byte aligned). */
+KFN KBvhRay k_bvh_object_ray(KGLOBAL const KInstance* inst, KVec3 o, KVec3 d) {
+  KFloat4 r0 = k_load4(inst->world_to_object), r1 = k_load4(inst->world_to_object + 4);
+  KFloat4 r2 = k_load4(inst->world_to_object + 8);
+  KVec3 oo = v3(r0.x * o.x + r0.y * o.y + r0.z * o.z + r0.w, r1.x * o.x + r1.y * o.y + r1.z * o.z + r1.w,
+                r2.x * o.x + r2.y * o.y + r2.z * o.z + r2.w);
+  KVec3 od = v3(r0.x * d.x + r0.y * d.y + r0.z * d.z, r1.x * d.x + r1.y * d.y + r1.z * d.z,
+                r2.x * d.x + r2.y * d.y + r2.z * d.z);
+  return k_bvh_make_ray(oo, od);
+}
+
+/* Walks the TLAS; per instance leaf whose mask matches, the instance's BLAS in object space. The hit,
+ * step count and transmittance live in locals until the end: the caller's copies are behind pointers
+ * into a called function, which on the GPU would mean a local-memory store per step. */
 KFN_OUTLINED int k_bvh_traverse(KSceneRef scene, K_BVH_CONTEXT ctx, int query, KVec3 o, KVec3 d, float tmin, float tmax,
-                       kuint mask, KHit* hit, KVec3* transmittance) {
-  hit->t = tmax;
-  hit->u = 0.0f;
-  hit->v = 0.0f;
-  hit->instance = K_NONE;
-  hit->triangle = K_NONE;
-  hit->cost = 0u;
-  if (scene.tlas_node_count == 0u || scene.instance_count == 0u) return 0;
-  /* The hooks' ray kind: 0 closest (camera, bounce), 1 occlusion, 2 occlusion from a noSelfShadow surface. */
-  int shadow_ray = query == K_BVH_QUERY_CLOSEST ? 0 : ((mask & K_RAY_FLAG_FROM_NO_SELF_SHADOW) ? 2 : 1);
-  KBvhRay world = k_bvh_make_ray(o, d);
-  kuint stack[K_BVH_MAX_DEPTH];
-  int sp = 0;
-  kuint node = 0u;
-  if (k_bvh_ray_box(world, scene.tlas_nodes, tmin, tmax) == K_INF) return 0;
-  for (;;) {
-    KGLOBAL const KBvhNode* n = scene.tlas_nodes + node;
-    hit->cost += 1u;
-    if (n->count > 0u) {
-      kuint end = n->left_first + n->count;
-      for (kuint i = n->left_first; i < end; ++i) {
-        KGLOBAL const KInstance* inst = scene.instances + i;
-        if ((inst->mask & mask) == 0u) continue;
-        KBvhRay object_ray = k_bvh_make_ray(xform_point_g(inst->world_to_object, o),
-                                       xform_vector_g(inst->world_to_object, d));
-        if (k_bvh_traverse_blas(scene, ctx, query, shadow_ray, i, object_ray, tmin, &tmax, hit, transmittance)) return 1;
+                       kuint mask, KHit* hit_out, KVec3* transmittance_out) {
+  KHit hit;
+  hit.t = tmax;
+  hit.u = 0.0f;
+  hit.v = 0.0f;
+  hit.instance = K_NONE;
+  hit.triangle = K_NONE;
+  hit.cost = 0u;
+  hit.pad0 = 0u;
+  hit.pad1 = 0u;
+  kuint cost = 0u;
+  KVec3 transmittance = *transmittance_out;
+  int decided = 0;
+  if (scene.tlas_node_count > 0u && scene.instance_count > 0u) {
+    /* The hooks' ray kind: 0 closest (camera, bounce), 1 occlusion, 2 occlusion from a noSelfShadow surface. */
+    int shadow_ray = query == K_BVH_QUERY_CLOSEST ? 0 : ((mask & K_RAY_FLAG_FROM_NO_SELF_SHADOW) ? 2 : 1);
+    KBvhRay world = k_bvh_make_ray(o, d);
+    kuint stack[K_BVH_MAX_DEPTH];
+    int sp = 0;
+    KBvhNodeData n = k_bvh_load_node(scene.tlas_nodes);
+    int alive = k_bvh_ray_box(world, n.bmin, n.bmax, tmin, tmax) != K_INF;
+    while (alive) {
+      cost += 1u;
+      if (n.count > 0u) {
+        kuint end = n.left_first + n.count;
+        for (kuint i = n.left_first; i < end && !decided; ++i) {
+          KGLOBAL const KInstance* inst = scene.instances + i;
+          if ((inst->mask & mask) == 0u) continue;
+          decided = k_bvh_traverse_blas(scene, ctx, query, shadow_ray, i, k_bvh_object_ray(inst, o, d), tmin, &tmax,
+                                        &hit, &cost, &transmittance);
+        }
+        if (decided) break;
+      } else if (k_bvh_descend(world, scene.tlas_nodes, n.left_first, tmin, tmax, stack, &sp, &n)) {
+        continue;
       }
-    } else if (k_bvh_descend(world, scene.tlas_nodes, n, tmin, tmax, stack, &sp, &node)) {
-      continue;
+      alive = k_bvh_pop(world, scene.tlas_nodes, tmin, tmax, stack, &sp, &n);
     }
-    if (!k_bvh_pop(world, scene.tlas_nodes, tmin, tmax, stack, &sp, &node)) return 0;
   }
+  hit.cost = cost;
+  *hit_out = hit;
+  *transmittance_out = transmittance;
+  return decided;
 }
 
 KFN int k_bvh_closest(KSceneRef scene, K_BVH_CONTEXT ctx, KVec3 o, KVec3 d, float tmin, float tmax, kuint mask,

@@ -47,6 +47,7 @@
   #define KGLOBAL
   #define KCONSTANT static const
   #include <stdint.h>
+  #include <string.h>
   #include <math.h>
   typedef uint32_t kuint;
   typedef int32_t kint;
@@ -75,5 +76,44 @@
 #endif
 
 #define K_PI 3.14159265358979323846f
+
+/* k_load4(p): four consecutive floats from a global array whose element size keeps them 16-byte
+ * aligned (BVH nodes, vertex positions, triangles, instance matrices). On the GPU this is one 128-bit
+ * load through the read-only cache where scalar loads of a struct's fields cost four instructions and,
+ * in the BVH walk, most of its latency. k_as_uint reads an integer stored in a float lane. */
+#if defined(__OPENCL_VERSION__)
+  typedef float4 KFloat4;
+  #define k_load4(p) vload4(0, (p))
+  #define k_as_uint(f) as_uint(f)
+#elif defined(__CUDACC__)
+  typedef float4 KFloat4;
+  KFN KFloat4 k_load4(const float* p) {
+  #if defined(__CUDA_ARCH__)
+    return __ldg((const float4*)p);
+  #else
+    return make_float4(p[0], p[1], p[2], p[3]);
+  #endif
+  }
+  KFN kuint k_as_uint(float f) {
+  #if defined(__CUDA_ARCH__)
+    return __float_as_uint(f);
+  #else
+    kuint u;
+    memcpy(&u, &f, sizeof u);
+    return u;
+  #endif
+  }
+#else
+  typedef struct KFloat4 { float x, y, z, w; } KFloat4;
+  static inline KFloat4 k_load4(const float* p) {
+    KFloat4 v = {p[0], p[1], p[2], p[3]};
+    return v;
+  }
+  static inline kuint k_as_uint(float f) {
+    kuint u;
+    memcpy(&u, &f, sizeof u);
+    return u;
+  }
+#endif
 
 #endif
