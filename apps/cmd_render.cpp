@@ -48,7 +48,8 @@ struct RenderArgs {
   int width = core::kDefaultWidth, height = core::kDefaultHeight, spp = 4, frames = 1, bounces = 1, light_samples = 1,
       emissive_samples = 1;
   std::string light_sampling = "tree";
-  float fov = core::kDefaultFovX, exposure = 1.0f, firefly_clamp = 5.0f, spec_boost = 2.0f, soft_shadow_scale = 0.2f;
+  float fov = core::kDefaultFovX, exposure = 1.0f, firefly_clamp = 5.0f, spec_boost = 2.0f, soft_shadow_scale = 0.2f,
+        shadow_rr = core::default_frame_params().shadow_rr;
   float yaw_step = 0.0f;
   double time = 0.0, time_step_ms = 1000.0 / 60.0;  // material time of frame 0 and per frame (60 Hz game tics)
   std::string camera_path;    // spin/orbit[-slow|-fast]; empty: fixed camera (plus --yaw-step)
@@ -291,6 +292,7 @@ int run_render(const RenderArgs& a) {
     p.spec_boost = a.spec_boost;
     p.mode = modes().at(a.mode);
     p.soft_shadow_scale = a.soft_shadow_scale;
+    p.shadow_rr = a.shadow_rr;
     if (reproject || atrous) {
       p.aux_outputs = 1u;
       job.previous_camera = previous_camera;
@@ -415,6 +417,11 @@ void add_render_command(CLI::App& app, int& exit_code) {
   cmd->add_option("--exposure", a->exposure, "exposure before the tone curve")->capture_default_str();
   cmd->add_option("--firefly-clamp", a->firefly_clamp, "max indirect contribution (0: off)")->capture_default_str();
   cmd->add_option("--spec-boost", a->spec_boost, "specular boost of light interactions")->capture_default_str();
+  cmd->add_option("--shadow-rr", a->shadow_rr,
+                  "Russian roulette on shadow rays: a light sample adding less than this to the pixel traces its "
+                  "ray with probability contribution / this (unbiased; 0: every sample's ray is traced)")
+      ->capture_default_str()
+      ->check(CLI::NonNegativeNumber);
   cmd->add_option("--soft-shadows", a->soft_shadow_scale, "scale of the lights' soft-shadow extent")
       ->capture_default_str();
   cmd->add_option("--out", a->out, "output folder")->capture_default_str();

@@ -180,3 +180,37 @@ TEST(LightSampling, LightsWithDefectsAreSkippedAndNoPixelIsNaN) {
     }
   }
 }
+
+// Russian roulette on shadow rays (KFrameParams.shadow_rr): samples below the threshold trace their ray
+// with probability value / threshold and count threshold / value times. On the 96-light floor with a
+// threshold near the mean pixel value, most samples play the roulette; the image must keep its mean and
+// block means (unbiased) while differing from the image without it (the roulette really ran).
+TEST(LightSampling, ShadowRayRouletteKeepsTheImageUnbiased) {
+  if (!tracer_runs_here("embree")) GTEST_SKIP();
+  scene::Scene s = many_lights_floor(88, 8);
+  const int w = 64, h = 48;
+  const KCamera cam = camera_looking_down({0, 0, 1400}, 0.7f, w, h);
+  auto tracer = make_test_tracer("embree");
+  auto render_with = [&](float threshold, kuint frame) {
+    KFrameParams p = frame_params(K_MODE_DIRECT, 64, 0, h);
+    p.shadow_rr = threshold;
+    p.frame_index = frame;
+    return render(*tracer, s, cam, p);
+  };
+  const core::FrameBuffer off_a = render_with(0.0f, 1), off_b = render_with(0.0f, 2);
+  const double mean = mean_luminance(off_a);
+  ASSERT_GT(mean, 0.05) << "the floor should be lit";
+  const float threshold = float(mean);
+  const core::FrameBuffer on_a = render_with(threshold, 1), on_b = render_with(threshold, 2);
+  expect_finite(on_a, "shadow roulette");
+  const double noise_off = rms_difference(block_means(off_a, 8), block_means(off_b, 8));
+  const double noise_on = rms_difference(block_means(on_a, 8), block_means(on_b, 8));
+  const double bias = rms_difference(block_means(on_a, 8), block_means(off_b, 8));
+  const double mean_error = std::fabs(mean_luminance(on_a) - mean) / mean;
+  std::cout << "shadow roulette at " << threshold << ": block RMS vs without " << bias << ", seeds without "
+            << noise_off << ", with " << noise_on << ", mean error " << 100.0 * mean_error << "%\n";
+  EXPECT_GT(pixel_rmse(on_a, off_a), 0.0) << "the same seed with the roulette on must differ";
+  // Independent renders of one expectation: their block difference is about sqrt(noise_on^2 + noise_off^2)/sqrt(2).
+  EXPECT_LT(bias, 1.2 * std::sqrt(0.5 * (noise_on * noise_on + noise_off * noise_off)) + 1e-4 * mean);
+  EXPECT_LT(mean_error, 0.01);
+}

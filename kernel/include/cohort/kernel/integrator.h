@@ -40,6 +40,19 @@ KFN KVec3 k_camera_direction(const KCamera* cam, float px, float py) {
   return v3_normalize(d);
 }
 
+/* Russian roulette on a shadow ray (KFrameParams.shadow_rr, 0: off). A light sample whose unshadowed
+ * contribution to the pixel (its value times the path's throughput) is below the threshold traces its
+ * shadow ray with probability value / threshold and counts threshold / value times when it does: the
+ * estimate stays unbiased, the added variance is at most threshold x value, and most rays toward far or
+ * faint lights (a sky shaft's cap seen from rooms away, the tail of a light's falloff) are never traced.
+ * Returns the factor to scale the sample by, 0 when its ray is skipped. */
+KFN float k_shadow_roulette(float threshold, float pixel_value, KRng* rng) {
+  if (!(threshold > 0.0f) || pixel_value >= threshold) return 1.0f;
+  if (!(pixel_value > 0.0f)) return 0.0f;
+  float keep = pixel_value / threshold;
+  return k_rng_next(rng) < keep ? 1.0f / keep : 0.0f;
+}
+
 /* One shadow ray toward a point jittered over the light's extent: 1 when the light is visible. */
 KFN int k_light_visible(KTraceCtx* ctx, const KFrameParams* params, const KSurface* sf, KGLOBAL const KLight* light,
                         float u1, float u2) {
@@ -60,7 +73,8 @@ KFN int k_light_visible(KTraceCtx* ctx, const KFrameParams* params, const KSurfa
  *   whose volume holds the point (light_tree.h has the pdf), one shadow ray toward it.
  * - K_LIGHTS_ALL: per light sample, one light picked over every light of the map in proportion to its
  *   unshadowed contribution (the reference for the tree: same pick, cost grows with the map). */
-KFN KVec3 k_direct_lighting(KTraceCtx* ctx, const KFrameParams* params, const KSurface* sf, KVec3 wo, KRng* rng) {
+KFN KVec3 k_direct_lighting(KTraceCtx* ctx, const KFrameParams* params, const KSurface* sf, KVec3 wo, float path_weight,
+                            KRng* rng) {
   const KSceneView* scene = K_CTX_SCENE(ctx);
   KVec3 sum = v3s(0.0f);
   if (params->light_samples == 0u || params->light_sampling == K_LIGHTS_EVERY) {
@@ -69,7 +83,8 @@ KFN KVec3 k_direct_lighting(KTraceCtx* ctx, const KFrameParams* params, const KS
       KVec3 c = k_light_unshadowed(scene, light, sf, wo, params->spec_boost);
       if (v3_max_component(c) <= 0.0f) continue;
       float u1 = k_rng_next(rng), u2 = k_rng_next(rng);
-      if (k_light_visible(ctx, params, sf, light, u1, u2)) sum = v3_add(sum, c);
+      float kept = k_shadow_roulette(params->shadow_rr, v3_max_component(c) * path_weight, rng);
+      if (kept > 0.0f && k_light_visible(ctx, params, sf, light, u1, u2)) sum = v3_add(sum, v3_scale(c, kept));
     }
     return sum;
   }
@@ -103,8 +118,10 @@ KFN KVec3 k_direct_lighting(KTraceCtx* ctx, const KFrameParams* params, const KS
     }
     float u1 = k_rng_next(rng), u2 = k_rng_next(rng);
     if (chosen == K_NONE || !(pdf > 0.0f)) continue;
-    if (!k_light_visible(ctx, params, sf, &scene->lights[chosen], u1, u2)) continue;
-    sum = v3_add(sum, v3_scale(chosen_contrib, 1.0f / pdf));
+    KVec3 value = v3_scale(chosen_contrib, 1.0f / pdf);
+    float kept = k_shadow_roulette(params->shadow_rr, v3_max_component(value) * path_weight / (float)samples, rng);
+    if (kept <= 0.0f || !k_light_visible(ctx, params, sf, &scene->lights[chosen], u1, u2)) continue;
+    sum = v3_add(sum, v3_scale(value, kept));
   }
   return v3_scale(sum, 1.0f / (float)samples);
 }
@@ -133,7 +150,8 @@ KFN float k_emissive_pdf(const KSceneView* scene, KVec3 p, kuint instance, kuint
  * (near and bright ones first), a uniform point on it, its emission there, one shadow ray. With a bounce
  * to follow from this vertex the result is weighted by the power heuristic against BRDF sampling, which
  * weighs the emission it finds the same way (k_trace_path); without one it stands alone (weight 1). */
-KFN KVec3 k_emissive_lighting(KTraceCtx* ctx, const KSurface* sf, KVec3 wo, int bounce_follows, KRng* rng) {
+KFN KVec3 k_emissive_lighting(KTraceCtx* ctx, const KSurface* sf, KVec3 wo, int bounce_follows, float shadow_rr,
+                              float path_weight, KRng* rng) {
   const KSceneView* scene = K_CTX_SCENE(ctx);
   float u_pick = k_rng_next(rng), u1 = k_rng_next(rng), u2 = k_rng_next(rng);
   float pick = 0.0f;
@@ -167,6 +185,14 @@ KFN KVec3 k_emissive_lighting(KTraceCtx* ctx, const KSurface* sf, KVec3 wo, int 
   }
   if (v3_max_component(le) <= 0.0f) return v3s(0.0f);
 
+  float pdf = pick * 2.0f / double_area * dist2 / cos_light;
+  float weight = 1.0f;
+  if (bounce_follows)
+    weight = k_power_heuristic(pdf, k_brdf_pdf(sf, wo, wi));
+  KVec3 value = v3_scale(v3_mul(le, f), weight / pdf);
+  float kept = k_shadow_roulette(shadow_rr, v3_max_component(value) * path_weight, rng);
+  if (kept <= 0.0f) return v3s(0.0f);
+
   float eps = k_ray_epsilon(sf->position);
   KVec3 org = v3_madd(sf->position, sf->geo_normal, eps);
   KVec3 seg = v3_sub(x, org);
@@ -174,12 +200,7 @@ KFN KVec3 k_emissive_lighting(KTraceCtx* ctx, const KSurface* sf, KVec3 wo, int 
   float tmax = seg_len - 2.0f * k_ray_epsilon(x);
   if (tmax > 0.0f && k_trace_occluded(ctx, org, v3_scale(seg, 1.0f / seg_len), tmax, k_shadow_ray_mask(sf->flags)))
     return v3s(0.0f);
-
-  float pdf = pick * 2.0f / double_area * dist2 / cos_light;
-  float weight = 1.0f;
-  if (bounce_follows)
-    weight = k_power_heuristic(pdf, k_brdf_pdf(sf, wo, wi));
-  return v3_scale(v3_mul(le, f), weight / pdf);
+  return v3_scale(value, kept);
 }
 
 KFN KVec3 k_clamp_radiance(KVec3 c, float limit) {
@@ -272,10 +293,12 @@ KFN KVec3 k_trace_path(KTraceCtx* ctx, const KFrameParams* params, KVec3 org, KV
                                        k_fabs(v3_dot(sf.geo_normal, dir)));
       contribution = v3_scale(contribution, k_power_heuristic(vertex_brdf_pdf, light_pdf));
     }
-    contribution = v3_add(contribution, k_direct_lighting(ctx, &vertex_params, &sf, wo, rng));
+    float path_weight = v3_max_component(throughput);
+    contribution = v3_add(contribution, k_direct_lighting(ctx, &vertex_params, &sf, wo, path_weight, rng));
     if (emissive_nee) {
       int bounce_follows = params->mode != K_MODE_DIRECT && bounce < params->max_bounces;
-      contribution = v3_add(contribution, k_emissive_lighting(ctx, &sf, wo, bounce_follows, rng));
+      contribution = v3_add(contribution,
+                            k_emissive_lighting(ctx, &sf, wo, bounce_follows, params->shadow_rr, path_weight, rng));
     }
     contribution = v3_mul(throughput, contribution);
     if (bounce > 0u) contribution = k_clamp_radiance(contribution, params->firefly_clamp);

@@ -191,7 +191,7 @@ typedef struct KFrameParams {
   kuint row_begin;    kuint row_end;      kuint instance_count; kuint tlas_node_count;
   float soft_shadow_scale; float rr_start; kuint light_sampling; kuint light_node_count;
   kuint emissive_count; kuint emissive_samples; kuint aux_outputs; kuint volume_light_begin;
-  kuint volume_light_end; kuint pad1;       kuint pad2;        kuint pad3;
+  kuint volume_light_end; float shadow_rr;  kuint pad2;        kuint pad3;
 } KFrameParams;
 
 /* One pixel's auxiliary outputs (aux_outputs.h says what each field means). */
