@@ -2,6 +2,7 @@
 // counts taken from the files by plain text scanning, independent of the parsers.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <map>
 #include <set>
 #include <sstream>
@@ -219,7 +220,11 @@ TEST_F(TestMap, ModelPropsResolveThroughClassesAndShareMeshes) {
   for (const auto& [key, value] : lamp1.keys) EXPECT_NE(key.rfind("editor_", 0), 0u) << key;
   const Mesh& lamp = scene.meshes.at(static_cast<size_t>(lamp1.mesh));
   ASSERT_EQ(lamp.surfaces.size(), 2u);
-  EXPECT_EQ(material_of(scene, lamp1, 0), "textures/testmap/metal");
+  EXPECT_EQ(material_of(scene, lamp1, 0), "textures/testmap/lamppost");
+  // The post's vertex colours reach the mesh, and its material multiplies by them.
+  ASSERT_EQ(lamp.colors.size(), lamp.vertices.size());
+  EXPECT_NE(std::count(lamp.colors.begin(), lamp.colors.end(), 0xFFFFFFFFu), std::ptrdiff_t(lamp.colors.size()));
+  EXPECT_TRUE(scene.materials.at(static_cast<size_t>(lamp.surfaces[0].material)).vertex_color);
   EXPECT_EQ(material_of(scene, lamp1, 1), "textures/testmap/wood");   // the last sub-material's bitmap
   EXPECT_EQ(entity_named(scene, "wedge_1").mesh, entity_named(scene, "wedge_2").mesh);
   const Entity &walker1 = entity_named(scene, "walker_1"), &walker2 = entity_named(scene, "walker_2");
