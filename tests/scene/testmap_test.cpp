@@ -227,6 +227,16 @@ TEST_F(TestMap, ModelPropsResolveThroughClassesAndShareMeshes) {
   EXPECT_TRUE(scene.materials.at(static_cast<size_t>(lamp.surfaces[0].material)).vertex_color);
   EXPECT_EQ(material_of(scene, lamp1, 1), "textures/testmap/wood");   // the last sub-material's bitmap
   EXPECT_EQ(entity_named(scene, "wedge_1").mesh, entity_named(scene, "wedge_2").mesh);
+  // The wedge's RGBA map: 0.5 grey-yellow at the foot (idTech z = 0), white-ish at the ridge (z = 24).
+  const Mesh& wedge = scene.meshes.at(static_cast<size_t>(entity_named(scene, "wedge_1").mesh));
+  ASSERT_EQ(wedge.colors.size(), wedge.vertices.size());
+  for (size_t v = 0; v < wedge.vertices.size(); ++v) {
+    const float shade = 0.5f + 0.5f * wedge.vertices[v].position.z / 24.0f;
+    const glm::vec4 c = unpack_rgba8(wedge.colors[v]);
+    EXPECT_NEAR(c.r, shade, 0.6f / 255.0f) << "vertex " << v;
+    EXPECT_NEAR(c.b, shade * 0.9f, 0.6f / 255.0f) << "vertex " << v;
+    EXPECT_EQ(c.a, 1.0f);
+  }
   const Entity &walker1 = entity_named(scene, "walker_1"), &walker2 = entity_named(scene, "walker_2");
   EXPECT_NE(walker1.mesh, walker2.mesh);   // another skin, another mesh
   EXPECT_EQ(material_of(scene, walker1), "models/testmap/walker");

@@ -1,5 +1,5 @@
 """The test map's model files, generated: an ASE prop (two objects, a sub-material list, normals, vertex
-colours), an LWO2 prop (two surfaces, a TXUV map with a per-polygon VMAD override, smoothing angle) and an
+colours), an LWO2 prop (two surfaces, a TXUV map with a per-polygon VMAD override, an RGBA colour map, smoothing angle) and an
 MD5 character (a boxy walker: md5mesh plus a looping walk md5anim). Everything is exact small numbers,
 so the bytes are the same on every run. Formats as the engine reads them (doom3-content.md section 4-5).
 """
@@ -163,6 +163,12 @@ def lwo_bytes():
     uv = b"TXUV" + struct.pack(">H", 2) + _s0("txuv01")
     for index, (x, y, z) in enumerate(points):
         uv += struct.pack(">Hff", index, (x + 16) / 32.0, y / 24.0)
+    # Vertex colours (an RGBA map): darker at the foot, as a baked ambient occlusion would be. The wedge's
+    # materials do not say vertexColor, so they do not show; the map exercises the reader on a real file.
+    rgba = b"RGBA" + struct.pack(">H", 4) + _s0("shade")
+    for index, (x, y, z) in enumerate(points):
+        shade = 0.5 + 0.5 * y / 24.0
+        rgba += struct.pack(">Hffff", index, shade, shade, shade * 0.9, 1.0)
     vmad = b"TXUV" + struct.pack(">H", 2) + _s0("txuv01")
     # The end caps get their own mapping on the polygon corners (VMAD overrides VMAP).
     for poly_index in (6, 7):
@@ -181,6 +187,7 @@ def lwo_bytes():
     body += _chunk("PNTS", b"".join(struct.pack(">fff", *p) for p in points))
     body += _chunk("BBOX", struct.pack(">ffffff", -16, 0, -12, 16, 24, 12))
     body += _chunk("VMAP", uv)
+    body += _chunk("VMAP", rgba)
     body += _chunk("POLS", pols)
     body += _chunk("PTAG", ptag)
     body += _chunk("VMAD", vmad)
