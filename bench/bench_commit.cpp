@@ -77,7 +77,8 @@ struct Row {
 };
 
 size_t scene_bytes(const commit::TracerScene& s) {
-  return s.vertices.size() * sizeof(KVertex) + s.triangles.size() * sizeof(KTriangle) +
+  return s.vertices.size() * sizeof(KVertex) + s.vertex_colors.size() * sizeof(KVertexColor) +
+         s.triangles.size() * sizeof(KTriangle) +
          s.blas_nodes.size() * sizeof(KBvhNode) + s.blases.size() * sizeof(KBlas) +
          s.instances.size() * sizeof(KInstance) + s.tlas_nodes.size() * sizeof(KBvhNode) +
          s.materials.size() * sizeof(KMaterial) + s.textures.size() * sizeof(KTexture) +

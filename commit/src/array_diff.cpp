@@ -66,6 +66,7 @@ void diff_emissive_triangles(const std::vector<KEmissiveTriangle>& before, const
 
 bool same_tracer_scene(const TracerScene& a, const TracerScene& b, std::string* where) {
   return same_array(a.vertices, b.vertices, "vertices", where) &&
+         same_array(a.vertex_colors, b.vertex_colors, "vertex_colors", where) &&
          same_array(a.triangles, b.triangles, "triangles", where) &&
          same_array(a.blas_nodes, b.blas_nodes, "blas_nodes", where) &&
          same_array(a.blases, b.blases, "blases", where) &&

@@ -10,6 +10,7 @@ namespace cohort::commit {
 
 size_t BlasUpload::bytes() const {
   return kRecordHeaderBytes + sizeof(blas) + 3 * sizeof(uint32_t) + vertices.size() * sizeof(KVertex) +
+         vertex_colors.size() * sizeof(KVertexColor) +
          triangles.size() * sizeof(KTriangle) + nodes.size() * sizeof(KBvhNode);
 }
 
@@ -209,11 +210,21 @@ ChangeSet apply_commit(const CommitBuffer& commit, TracerScene& scene, Skinning 
       changes.blas_nodes_from = std::min<size_t>(changes.blas_nodes_from, up.node_offset);
       changes.blases_from = std::min<size_t>(changes.blases_from, up.blas_index);
       write_range(scene.vertices, up.vertex_offset, up.vertices);
+      if (!up.vertex_colors.empty() && up.vertex_colors.size() != up.vertices.size())
+        throw std::invalid_argument("commit uploads BLAS " + std::to_string(up.blas_index) + " with " +
+                                    std::to_string(up.vertices.size()) + " vertices but " +
+                                    std::to_string(up.vertex_colors.size()) + " vertex colours");
+      write_range(scene.vertex_colors, up.vertex_offset,
+                  up.vertex_colors.empty() ? std::vector<KVertexColor>(up.vertices.size(), K_VERTEX_COLOR_WHITE)
+                                           : up.vertex_colors);
       write_range(scene.triangles, up.triangle_offset, up.triangles);
       write_range(scene.blas_nodes, up.node_offset, up.nodes);
       write_range(scene.blases, up.blas_index, std::vector<KBlas>{up.blas});
     }
   }
+  // The colour pool follows the vertex pool: a scene written without colours (a full resync of an older
+  // scene) is white.
+  if (scene.vertex_colors.size() != scene.vertices.size()) scene.vertex_colors.resize(scene.vertices.size(), K_VERTEX_COLOR_WHITE);
   changes.instances = apply_elements(scene.instances, commit.instance_count(), commit.instances(), "instance");
   if (commit.tlas()) {
     scene.tlas_nodes = *commit.tlas();

@@ -15,6 +15,17 @@ KVertex to_kvertex(const scene::Vertex& v) {
   return k;
 }
 
+void append_vertex_colors(std::vector<KVertexColor>& pool, const scene::Mesh& mesh) {
+  if (mesh.colors.empty()) {
+    pool.insert(pool.end(), mesh.vertices.size(), K_VERTEX_COLOR_WHITE);
+    return;
+  }
+  if (mesh.colors.size() != mesh.vertices.size())
+    throw std::runtime_error("mesh '" + mesh.name + "' has " + std::to_string(mesh.colors.size()) +
+                             " vertex colours for " + std::to_string(mesh.vertices.size()) + " vertices");
+  pool.insert(pool.end(), mesh.colors.begin(), mesh.colors.end());
+}
+
 namespace {
 
 std::vector<KBvhNode> blas_roots(const commit::TracerScene& ts) {

@@ -104,6 +104,7 @@ KMaterial to_kmaterial(const scene::Material& material, const scene::Scene& scen
   if (material.nonsolid) flags |= K_MAT_NONSOLID;
   if (material.emitter) flags |= K_MAT_EMISSIVE;
   if (material.vertex_color) flags |= K_MAT_VERTEX_COLOR;
+  if (material.inverse_vertex_color) flags |= K_MAT_INVERSE_VERTEX_COLOR;
   if (material.no_self_shadow) flags |= K_MAT_NO_SELF_SHADOW;
   if (k.blend == K_BLEND_SKY) {
     to_ksky(material, scene, k);

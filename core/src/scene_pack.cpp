@@ -122,6 +122,7 @@ void write_scene_pack(const std::filesystem::path& file, const PackedScene& pack
   w.scalar(kScenePackVersion);
   w.section(fourcc("NAME"), pack.map_name.data(), pack.map_name.size());
   w.section(fourcc("VERT"), s.vertices);
+  w.section(fourcc("VCOL"), s.vertex_colors);
   w.section(fourcc("TRIS"), s.triangles);
   w.section(fourcc("BNOD"), s.blas_nodes);
   w.section(fourcc("BLAS"), s.blases);
@@ -168,6 +169,9 @@ PackedScene read_scene_pack(const std::filesystem::path& file) {
   pack.map_name.assign(name.begin(), name.end());
   auto& s = pack.tracer_scene;
   s.vertices = r.section<KVertex>(fourcc("VERT"), "vertices");
+  s.vertex_colors = r.section<KVertexColor>(fourcc("VCOL"), "vertex colours");
+  if (s.vertex_colors.size() != s.vertices.size())
+    r.fail(fmt::format("{} vertex colours for {} vertices", s.vertex_colors.size(), s.vertices.size()));
   s.triangles = r.section<KTriangle>(fourcc("TRIS"), "triangles");
   s.blas_nodes = r.section<KBvhNode>(fourcc("BNOD"), "BLAS nodes");
   s.blases = r.section<KBlas>(fourcc("BLAS"), "BLASes");

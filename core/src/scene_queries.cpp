@@ -8,6 +8,7 @@ namespace {
 KTraceCtx context_for(const commit::TracerScene& s) {
   KTraceCtx ctx{};
   ctx.scene.vertices = s.vertices.data();
+  ctx.scene.vertex_colors = s.vertex_colors.data();
   ctx.scene.triangles = s.triangles.data();
   ctx.scene.blas_nodes = s.blas_nodes.data();
   ctx.scene.blases = s.blases.data();

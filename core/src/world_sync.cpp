@@ -75,6 +75,7 @@ void WorldSync::build_static_world() {
   for (int mesh_index : scene.area_meshes) {
     const scene::Mesh& mesh = scene.meshes.at(size_t(mesh_index));
     const uint32_t base = uint32_t(master_.vertices.size());
+    append_vertex_colors(master_.vertex_colors, mesh);
     for (const scene::Vertex& v : mesh.vertices) master_.vertices.push_back(to_kvertex(v));
     std::vector<KTriangle> own = mesh_triangles(mesh, base, [this](int m) { return kmaterial_index(m); });
     triangles.insert(triangles.end(), own.begin(), own.end());
@@ -160,6 +161,7 @@ uint32_t WorldSync::build_mesh_blas(int mesh_index, commit::CommitBuffer& out, c
   up.triangle_offset = uint32_t(master_.triangles.size());
   up.node_offset = uint32_t(master_.blas_nodes.size());
   up.vertices = std::move(vertices);
+  up.vertex_colors = mesh.colors;
   up.triangles = std::move(build.triangles);
   for (KTriangle& t : up.triangles) {  // built on the mesh's own vertices; the pool is shared
     t.v0 += up.vertex_offset;
@@ -168,6 +170,7 @@ uint32_t WorldSync::build_mesh_blas(int mesh_index, commit::CommitBuffer& out, c
   }
   up.nodes = std::move(build.nodes);
   up.blas = {up.node_offset, uint32_t(up.nodes.size()), up.triangle_offset, uint32_t(up.triangles.size())};
+  append_vertex_colors(master_.vertex_colors, mesh);   // first: it throws for a mesh with colours missing
   master_.vertices.insert(master_.vertices.end(), up.vertices.begin(), up.vertices.end());
   master_.triangles.insert(master_.triangles.end(), up.triangles.begin(), up.triangles.end());
   master_.blas_nodes.insert(master_.blas_nodes.end(), up.nodes.begin(), up.nodes.end());
@@ -372,6 +375,7 @@ WorldSync::SkinnedEntity WorldSync::add_skinned_blas(int mesh_index, commit::Com
   up.triangle_offset = uint32_t(master_.triangles.size());
   up.node_offset = uint32_t(master_.blas_nodes.size());
   up.vertices = std::move(vertices);
+  up.vertex_colors = mesh.colors;
   up.triangles = std::move(build.triangles);
   for (KTriangle& t : up.triangles) {
     t.v0 += up.vertex_offset;
@@ -382,6 +386,7 @@ WorldSync::SkinnedEntity WorldSync::add_skinned_blas(int mesh_index, commit::Com
   // Room for any binary tree over these triangles, so a rebuild after the refit decays stays in place.
   up.nodes = std::move(build.nodes);
   up.nodes.resize(std::max<size_t>(up.nodes.size(), 2 * up.triangles.size() - 1), KBvhNode{});
+  append_vertex_colors(master_.vertex_colors, mesh);   // first: it throws for a mesh with colours missing
   master_.vertices.insert(master_.vertices.end(), up.vertices.begin(), up.vertices.end());
   master_.triangles.insert(master_.triangles.end(), up.triangles.begin(), up.triangles.end());
   master_.blas_nodes.insert(master_.blas_nodes.end(), up.nodes.begin(), up.nodes.end());

@@ -84,7 +84,7 @@ inline void fuzz_image(const uint8_t* data, size_t size) {
 inline void check_model(const ModelFile& model) {
   const Mesh& mesh = model.mesh;
   if (mesh.indices.size() % 3 != 0 || model.surface_materials.size() != mesh.surfaces.size()) __builtin_trap();
-  if (!model.colors.empty() && model.colors.size() != mesh.vertices.size()) __builtin_trap();
+  if (!mesh.colors.empty() && mesh.colors.size() != mesh.vertices.size()) __builtin_trap();
   for (uint32_t index : mesh.indices)
     if (index >= mesh.vertices.size()) __builtin_trap();
   for (const Surface& s : mesh.surfaces)

@@ -305,6 +305,15 @@ class AseParser {
     if (object.tface_count != 0 && object.tface_count != face_count)
       lex_.fail_here("*MESH_NUMTVFACES " + std::to_string(object.tface_count) + " differs from *MESH_NUMFACES " +
                      std::to_string(face_count) + " in object " + object.name);
+    if (object.cface_count != 0 && object.cface_count != face_count)
+      lex_.fail_here("*MESH_NUMCVFACES " + std::to_string(object.cface_count) + " differs from *MESH_NUMFACES " +
+                     std::to_string(face_count) + " in object " + object.name);
+    // A count given again after the faces that index it: those indices must still be in range.
+    for (const AseFace& f : object.faces)
+      for (int k = 0; k < 3; ++k)
+        if (object.cface_count != 0 && f.cv[k] >= object.cverts.size())
+          lex_.fail_here("*MESH_CFACE colour vertex " + std::to_string(f.cv[k]) + " out of range (" +
+                         std::to_string(object.cverts.size()) + ") in object " + object.name);
   }
 
   void read_corner_face(AseObject& object, size_t listed, size_t limit, const std::string& what,

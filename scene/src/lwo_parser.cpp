@@ -256,13 +256,16 @@ class LwoReader {
     uint32_t type = in_.u4("VMAP type");
     uint16_t dimension = in_.u2("VMAP dimension");
     in_.s0("VMAP name");
-    bool uv = type == id4("TXUV") && dimension == 2, rgba = type == id4("RGBA") && dimension == 4;
+    // Colour maps: RGBA (the engine's), and RGB read as opaque RGBA (LightWave writes either).
+    bool uv = type == id4("TXUV") && dimension == 2;
+    bool rgba = (type == id4("RGBA") && dimension == 4) || (type == id4("RGB ") && dimension == 3);
     if (!uv && !rgba) return;
     if (uv) layer_.has_uv_map = true;
     while (!in_.done()) {
       LwVmapValue value;
       value.point = point_index(per_polygon ? "VMAD" : "VMAP");
       if (per_polygon) value.polygon = static_cast<int>(polygon_index("VMAD"));
+      value.v[3] = 1.0f;
       for (int k = 0; k < dimension; ++k) value.v[k] = in_.f4("VMAP value");
       (uv ? layer_.uvs : layer_.rgbas).push_back(value);
     }

@@ -57,7 +57,9 @@ void copy_stage_look(const MaterialStage& s, Material& m, RegisterSources& sourc
     m.alpha_test = true;
     m.alpha_ref = s.alpha_ref;
   }
-  m.vertex_color = m.vertex_color || s.vertex_color;
+  // The stage that gives the surface its look decides (one colour mode per material here).
+  m.vertex_color = s.vertex_color;
+  m.inverse_vertex_color = s.inverse_vertex_color;
 }
 
 bool is_sky_stage(const MaterialStage& s) {

@@ -63,7 +63,7 @@ ModelFile ModelBuilder::finish(bool keep_colors) {
     glm::vec3 normal = c.has_normal ? c.normal : sums[{vertex_material_[v], c.position.x, c.position.y, c.position.z}];
     vertex.normal = unit_or(normal, glm::vec3(0.0f, 0.0f, 1.0f));
     out.mesh.vertices.push_back(vertex);
-    if (keep_colors) out.colors.push_back(c.color);
+    if (keep_colors) out.mesh.colors.push_back(pack_rgba8(c.color));
   }
   for (size_t b = 0; b < buckets_.size(); ++b) {
     Surface surface;

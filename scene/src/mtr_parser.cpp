@@ -167,7 +167,9 @@ class MaterialReader {
       stage.registers.alpha_test = true;
       stage.registers.alpha_ref = parse_expression(lex, context);
     } else if (word == "vertexcolor" || word == "inversevertexcolor") {
-      stage.vertex_color = true;
+      // The engine keeps one vertex-colour mode per stage: the keyword written last wins.
+      stage.inverse_vertex_color = word == "inversevertexcolor";
+      stage.vertex_color = !stage.inverse_vertex_color;
     } else if (word == "red" || word == "green" || word == "blue" || word == "alpha") {
       int c = word == "red" ? 0 : word == "green" ? 1 : word == "blue" ? 2 : 3;
       stage.registers.color[c] = parse_expression(lex, context);

@@ -237,6 +237,9 @@ int RenderWorld::DefineModel(const Mesh& mesh) {
     if (i >= mesh.vertices.size())
       throw RenderWorldError(fmt::format("DefineModel '{}': index {} past its {} vertices", mesh.name, i,
                                          mesh.vertices.size()));
+  if (!mesh.colors.empty() && mesh.colors.size() != mesh.vertices.size())
+    throw RenderWorldError(fmt::format("DefineModel '{}': {} vertex colours for {} vertices", mesh.name,
+                                       mesh.colors.size(), mesh.vertices.size()));
   for (const Surface& s : mesh.surfaces) {
     if (s.material < -1 || s.material >= int(scene_.materials.size()))
       throw RenderWorldError(fmt::format("DefineModel '{}': surface material {} out of range", mesh.name, s.material));

@@ -73,7 +73,7 @@ void material_layout(Codec& c, Mat& v) {
            v.emissive_image, v.light_image, v.falloff_image, v.diffuse_color, v.specular_color, v.emissive_color,
            v.tex_transform);
   c.flags("material", v.alpha_test, v.translucent, v.no_shadows, v.two_sided, v.nonsolid, v.emitter,
-          v.vertex_color, v.is_light_material, v.is_default, v.no_self_shadow);
+          v.vertex_color, v.is_light_material, v.is_default, v.no_self_shadow, v.inverse_vertex_color);
   c.fields(v.alpha_ref, v.blend, v.light_stage_color, v.light_kind, v.light_stage_alpha);
   c.flags("light material", v.light_blend_adds);
   c.fields(v.sky_cube_image, v.sky_axis);
@@ -91,6 +91,7 @@ void mesh_layout(Codec& c, M& v) {
   c.field(v.name);
   c.sequence(v.vertices, kVertexBytes, "vertex",
              [&](auto& x) { c.fields(x.position, x.st, x.normal, x.tangent); });
+  c.sequence(v.colors, 4, "vertex colour", [&](auto& rgba) { c.field(rgba); });
   c.sequence(v.indices, 4, "index", [&](auto& i) { c.field(i); });
   c.sequence(v.surfaces, kSurfaceBytes, "surface",
              [&](auto& s) { c.fields(s.material, s.first_index, s.index_count); });

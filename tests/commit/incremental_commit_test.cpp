@@ -135,3 +135,53 @@ TEST(CommitBuffer, FullResyncFollowedByRecordsAppliesBoth) {
   EXPECT_EQ(tracer.instances[0].object_to_world[3], 9.0f);
   EXPECT_EQ(tracer.version, 4u);
 }
+
+TEST(CommitBuffer, VertexColoursFollowTheVertexPool) {
+  TracerScene scene;
+  BlasUpload coloured;
+  coloured.blas_index = 0;
+  coloured.vertices.resize(3);
+  coloured.vertex_colors = {0xFF0000FFu, 0xFF00FF00u, 0xFFFF0000u};
+  coloured.triangles = {{0, 1, 2, 0}};
+  coloured.nodes.resize(1);
+  coloured.blas = {0, 1, 0, 1};
+  BlasUpload white = coloured;   // a mesh without colours sends none
+  white.blas_index = 1;
+  white.vertex_offset = 3;
+  white.vertex_colors.clear();
+  white.triangles = {{3, 4, 5, 0}};
+  white.triangle_offset = 1;
+  white.node_offset = 1;
+  white.blas = {1, 1, 1, 1};
+  EXPECT_EQ(coloured.bytes(), white.bytes() + 3 * sizeof(KVertexColor));
+  CommitBuffer c;
+  c.add_blas(coloured);
+  c.add_blas(white);
+  apply_commit(c, scene);
+  EXPECT_EQ(scene.vertex_colors,
+            (std::vector<KVertexColor>{0xFF0000FFu, 0xFF00FF00u, 0xFFFF0000u, K_VERTEX_COLOR_WHITE,
+                                       K_VERTEX_COLOR_WHITE, K_VERTEX_COLOR_WHITE}));
+
+  // A full resync of a scene written without colours (an older producer) comes out white.
+  auto bare = std::make_shared<TracerScene>();
+  bare->vertices.resize(4);
+  apply_commit(CommitBuffer::full(bare, 2), scene);
+  EXPECT_EQ(scene.vertex_colors, std::vector<KVertexColor>(4, K_VERTEX_COLOR_WHITE));
+}
+
+TEST(CommitBuffer, BlasUploadWithColoursForSomeVerticesIsRejected) {
+  TracerScene scene;
+  BlasUpload up;
+  up.blas_index = 0;
+  up.vertices.resize(3);
+  up.vertex_colors = {0xFFFFFFFFu, 0xFFFFFFFFu};
+  up.blas = {0, 0, 0, 0};
+  CommitBuffer c;
+  c.add_blas(up);
+  try {
+    apply_commit(c, scene);
+    FAIL() << "applied 2 colours for 3 vertices";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("BLAS 0 with 3 vertices but 2 vertex colours"), std::string::npos) << e.what();
+  }
+}

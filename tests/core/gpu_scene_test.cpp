@@ -207,4 +207,45 @@ TEST(GpuScene, MaterialsMapBlendFlagsAndMissingSpecular) {
   EXPECT_FLOAT_EQ(k.alpha_ref, 0.3f);
   EXPECT_FLOAT_EQ(k.specular_color[0], 0.0f) << "no specular map: no specular, as in Doom 3";
   EXPECT_EQ(k.diffuse_tex, K_NONE);
+  EXPECT_EQ(k.flags & (K_MAT_VERTEX_COLOR | K_MAT_INVERSE_VERTEX_COLOR), 0u);
+  m.vertex_color = true;
+  EXPECT_EQ(core::to_kmaterial(m, s).flags & (K_MAT_VERTEX_COLOR | K_MAT_INVERSE_VERTEX_COLOR), K_MAT_VERTEX_COLOR);
+  m.vertex_color = false;
+  m.inverse_vertex_color = true;
+  EXPECT_EQ(core::to_kmaterial(m, s).flags & (K_MAT_VERTEX_COLOR | K_MAT_INVERSE_VERTEX_COLOR),
+            K_MAT_INVERSE_VERTEX_COLOR);
+}
+
+TEST(GpuScene, VertexColoursSitBesideTheirVerticesWhiteWhereAMeshHasNone) {
+  scene::Scene s;
+  s.materials.emplace_back();
+  scene::Mesh world = quad_mesh("_area0", 0, 0.0f);
+  world.colors = {0xFF0000FFu, 0xFF00FF00u, 0xFFFF0000u, 0x80808080u};
+  s.meshes.push_back(world);
+  s.area_meshes.push_back(0);
+  s.meshes.push_back(quad_mesh("models/plain", 0, 1.0f));   // no colours
+  scene::Mesh coloured = quad_mesh("models/coloured", 0, 2.0f);
+  coloured.colors.assign(4, 0xFF123456u);
+  s.meshes.push_back(coloured);
+  for (int mesh : {1, 2}) {
+    scene::Entity e;
+    e.mesh = mesh;
+    s.entities.push_back(e);
+  }
+  core::CompiledScene compiled = core::compile_scene(s);
+  const commit::TracerScene& t = compiled.tracer_scene;
+  ASSERT_EQ(t.vertex_colors.size(), t.vertices.size());
+  // Each mesh's vertices are a run of the pool; find them by height.
+  for (size_t v = 0; v < t.vertices.size(); ++v) {
+    const float z = t.vertices[v].pos[2];
+    if (z == 1.0f) EXPECT_EQ(t.vertex_colors[v], K_VERTEX_COLOR_WHITE) << "vertex " << v;
+    if (z == 2.0f) EXPECT_EQ(t.vertex_colors[v], 0xFF123456u) << "vertex " << v;
+  }
+  std::vector<KVertexColor> world_colours;
+  for (size_t v = 0; v < t.vertices.size(); ++v)
+    if (t.vertices[v].pos[2] == 0.0f) world_colours.push_back(t.vertex_colors[v]);
+  EXPECT_EQ(world_colours, world.colors);
+
+  s.meshes[2].colors.pop_back();   // colours for some vertices only
+  EXPECT_THROW(core::compile_scene(s), std::runtime_error);
 }

@@ -18,6 +18,7 @@ PackedScene small_pack() {
   s.vertices.resize(3);
   s.vertices[1].pos[0] = 1.0f;
   s.vertices[2].pos[1] = 1.0f;
+  s.vertex_colors.assign(3, K_VERTEX_COLOR_WHITE);
   s.triangles.push_back({0, 1, 2, 0});
   s.blas_nodes.push_back({{0, 0, 0}, 0, {1, 1, 0}, 1});
   s.blases.push_back({0, 1, 0, 1});
@@ -113,6 +114,24 @@ TEST(ScenePack, ErrorNamesFileAndOffset) {
   } catch (const PackError& e) {
     EXPECT_NE(std::string(e.what()).find("bad_magic.cpk: byte 8: not a Cohort scene pack"), std::string::npos)
         << e.what();
+  }
+  fs::remove(file);
+}
+
+TEST(ScenePack, VertexColoursRoundTripAndMustMatchTheVertices) {
+  auto file = temp_file("colours.cpk");
+  PackedScene in = small_pack();
+  in.tracer_scene.vertex_colors = {0xFF0000FFu, 0x80FF00FFu, K_VERTEX_COLOR_WHITE};
+  write_scene_pack(file, in);
+  EXPECT_EQ(read_scene_pack(file).tracer_scene.vertex_colors, in.tracer_scene.vertex_colors);
+  in.tracer_scene.vertex_colors.pop_back();
+  write_scene_pack(file, in);
+  try {
+    read_scene_pack(file);
+    FAIL() << "read a pack with 2 vertex colours for 3 vertices";
+  } catch (const PackError& e) {
+    EXPECT_NE(std::string(e.what()).find("2 vertex colours for 3 vertices"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find(file.string()), std::string::npos) << e.what();
   }
   fs::remove(file);
 }

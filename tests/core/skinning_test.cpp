@@ -256,3 +256,40 @@ TEST(Skinning, BrokenSkinUploadIsRefused) {
   commit::TracerScene target = copy;
   EXPECT_NO_THROW(commit::apply_commit(records, target));
 }
+
+// Skinning moves positions only: a character whose mesh carries vertex colours keeps them, in the
+// master and in a tracer's copy, through every pose, while its vertices move.
+TEST(Skinning, VertexColoursStayWithTheirVerticesThroughPoses) {
+  const scene::Md5Mesh md5 = walker_mesh();
+  scene::Scene s = character_scene(md5);
+  const size_t count = s.meshes[0].vertices.size();
+  for (size_t v = 0; v < count; ++v) s.meshes[0].colors.push_back(0xFF000000u | uint32_t(v * 2654435761u & 0xFFFFFFu));
+  const std::vector<uint32_t> colours = s.meshes[0].colors;
+  scene::RenderWorld world(s);
+  core::WorldSync sync(world);
+  world.TakeChanges();
+  commit::TracerScene copy;
+  commit::apply_commit(commit::CommitBuffer::full(sync.snapshot(), 0), copy);
+  const scene::Md5Anim anim = walker_anim();
+  world.UpdateEntityDef(0, posed(world, scene::anim_pose(anim, 0)));   // the first pose makes the skin
+  commit::apply_commit(sync.sync(world.TakeChanges(), 1), copy);
+  ASSERT_EQ(sync.master().skins.size(), 1u);
+  const KSkin skin = sync.master().skins[0];
+  ASSERT_EQ(skin.vertex_count, count);
+  const std::vector<KVertex> first_pose(sync.master().vertices.begin() + skin.vertex_offset,
+                                  sync.master().vertices.begin() + skin.vertex_offset + count);
+  for (int time_ms : {130, 777}) {
+    world.UpdateEntityDef(0, posed(world, scene::anim_pose(anim, time_ms)));
+    commit::apply_commit(sync.sync(world.TakeChanges(), uint64_t(time_ms + 1)), copy);
+    for (const commit::TracerScene* t : {&sync.master(), static_cast<const commit::TracerScene*>(&copy)}) {
+      ASSERT_EQ(t->vertex_colors.size(), t->vertices.size());
+      EXPECT_TRUE(std::equal(colours.begin(), colours.end(), t->vertex_colors.begin() + skin.vertex_offset))
+          << "at " << time_ms << " ms";
+    }
+    float moved = 0.0f;
+    for (size_t v = 0; v < count; ++v)
+      moved = std::max(moved, max_abs(copy.vertices[skin.vertex_offset + v].pos,
+                                      glm::vec3(first_pose[v].pos[0], first_pose[v].pos[1], first_pose[v].pos[2])));
+    EXPECT_GT(moved, 1.0f) << "the pose at " << time_ms << " ms moved nothing";
+  }
+}

@@ -69,8 +69,11 @@ void define_and_free(scene::RenderWorldApi& world, int frame) {
     scene::Material m;
     m.name = "textures/test/crate";
     m.diffuse_image = tex;
+    m.vertex_color = true;
     int mat = world.DefineMaterial(m);
-    world.DefineModel(test::box_mesh("crate", {8, 8, 8}, mat));
+    scene::Mesh crate_mesh = test::box_mesh("crate", {8, 8, 8}, mat);   // vertex colours: a ramp of reds
+    for (uint32_t v = 0; v < crate_mesh.vertices.size(); ++v) crate_mesh.colors.push_back(0xFF000000u | (v * 30u + 10u));
+    world.DefineModel(crate_mesh);
     scene::RenderEntity crate;
     crate.model_name = "crate";
     crate.origin = {40, 40, 8};
@@ -284,6 +287,14 @@ TEST(WorldSync, RuntimeModelMaterialAndTextureReachTheTracerScene) {
   uint32_t first_texel = uint32_t(image.rgba[0]) | uint32_t(image.rgba[1]) << 8 | uint32_t(image.rgba[2]) << 16 |
                          uint32_t(image.rgba[3]) << 24;
   EXPECT_EQ(sync.master().texels.at(tex.offset), first_texel);
+  // Its vertex colours travel with the upload and sit beside its vertices in the master; the map's own
+  // geometry, which has none, is white there.
+  ASSERT_EQ(up.vertex_colors.size(), up.vertices.size());
+  EXPECT_EQ(up.vertex_colors[2], 0xFF000000u | 70u);
+  ASSERT_EQ(sync.master().vertex_colors.size(), sync.master().vertices.size());
+  EXPECT_EQ(sync.master().vertex_colors.at(up.vertex_offset + 2), 0xFF000000u | 70u);
+  EXPECT_EQ(sync.master().vertex_colors.front(), K_VERTEX_COLOR_WHITE);
+  EXPECT_NE(m.flags & K_MAT_VERTEX_COLOR, 0u);
   // The crate is instanced with its handle.
   bool found = false;
   for (const KInstance& inst : sync.master().instances) found |= inst.entity == 3 && inst.blas == up.blas_index;

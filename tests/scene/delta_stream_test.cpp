@@ -60,8 +60,11 @@ void drive(RenderWorldApi& world, int frames) {
       Material m;
       m.name = "textures/test/late";
       m.diffuse_image = tex;
+      m.inverse_vertex_color = true;
       int mat = world.DefineMaterial(m);
-      world.DefineModel(cohort::test::box_mesh("crate", {8, 8, 8}, mat));
+      Mesh crate_mesh = cohort::test::box_mesh("crate", {8, 8, 8}, mat);
+      for (size_t v = 0; v < crate_mesh.vertices.size(); ++v) crate_mesh.colors.push_back(0xFF000000u | uint32_t(v * 0x010203u));
+      world.DefineModel(crate_mesh);
       RenderEntity c;
       c.model_name = "crate";
       c.origin = {10, 20, 30};
@@ -95,12 +98,15 @@ void expect_same_world(const RenderWorld& a, const RenderWorld& b) {
   for (size_t i = 0; i < a.scene().materials.size(); ++i) {
     EXPECT_EQ(a.scene().materials[i].name, b.scene().materials[i].name);
     EXPECT_EQ(a.scene().materials[i].diffuse_image, b.scene().materials[i].diffuse_image);
+    EXPECT_EQ(a.scene().materials[i].vertex_color, b.scene().materials[i].vertex_color);
+    EXPECT_EQ(a.scene().materials[i].inverse_vertex_color, b.scene().materials[i].inverse_vertex_color);
   }
   ASSERT_EQ(a.scene().images.size(), b.scene().images.size());
   for (size_t i = 0; i < a.scene().images.size(); ++i) EXPECT_EQ(a.scene().images[i].rgba, b.scene().images[i].rgba);
   ASSERT_EQ(a.scene().meshes.size(), b.scene().meshes.size());
   for (size_t i = 0; i < a.scene().meshes.size(); ++i) {
     EXPECT_EQ(a.scene().meshes[i].indices, b.scene().meshes[i].indices);
+    EXPECT_EQ(a.scene().meshes[i].colors, b.scene().meshes[i].colors);
     ASSERT_EQ(a.scene().meshes[i].vertices.size(), b.scene().meshes[i].vertices.size());
     for (size_t v = 0; v < a.scene().meshes[i].vertices.size(); ++v)
       EXPECT_EQ(a.scene().meshes[i].vertices[v].position, b.scene().meshes[i].vertices[v].position);
@@ -149,6 +155,26 @@ TEST(DeltaStream, ReplayGivesTheSameStateAsTheDirectCalls) {
   EXPECT_EQ(played, frames);
   EXPECT_FALSE(player.play_frame(replayed));
   expect_same_world(direct, replayed);
+  // The late crate's vertex colours and its material's inverseVertexColor came through the stream.
+  const int crate = replayed.scene().find_mesh("crate");
+  ASSERT_GE(crate, 0);
+  ASSERT_EQ(replayed.scene().meshes[size_t(crate)].colors.size(), replayed.scene().meshes[size_t(crate)].vertices.size());
+  EXPECT_EQ(replayed.scene().meshes[size_t(crate)].colors[2], 0xFF000000u | (2u * 0x010203u));
+  const int late = replayed.scene().find_material("textures/test/late");
+  ASSERT_GE(late, 0);
+  EXPECT_TRUE(replayed.scene().materials[size_t(late)].inverse_vertex_color);
+}
+
+TEST(DeltaStream, ModelWithColoursForSomeVerticesIsRefused) {
+  RenderWorld world(cohort::test::small_test_map());
+  Mesh mesh = cohort::test::box_mesh("half_coloured", {1, 1, 1}, 0);
+  mesh.colors.assign(mesh.vertices.size() - 1, 0xFFFFFFFFu);
+  try {
+    world.DefineModel(mesh);
+    FAIL() << "accepted " << mesh.colors.size() << " colours for " << mesh.vertices.size() << " vertices";
+  } catch (const RenderWorldError& e) {
+    EXPECT_NE(std::string(e.what()).find("'half_coloured': 7 vertex colours for 8 vertices"), std::string::npos) << e.what();
+  }
 }
 
 TEST(DeltaStream, ReplayKeepsThePerFrameChangeLog) {

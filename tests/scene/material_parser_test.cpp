@@ -147,3 +147,25 @@ TEST(MaterialParser, MalformedExpressionsAndProgramsAreWarningsNotCrashes) {
   EXPECT_GE(f.warnings.size(), 5u);
   for (const auto& m : f.materials) EXPECT_TRUE(m.stages.empty()) << m.name;
 }
+
+TEST(MaterialParser, VertexColourModesLastKeywordWins) {
+  MaterialTables tables;
+  MaterialFile f = parse_materials(R"(textures/vc
+{
+  { blend diffusemap  map textures/a  vertexColor }
+  { blend diffusemap  map textures/b  inverseVertexColor }
+  { blend diffusemap  map textures/c  inverseVertexColor vertexColor }
+  { blend diffusemap  map textures/d }
+})", "vc.mtr", tables);
+  const MaterialDecl* vc = find(f, "textures/vc");
+  ASSERT_NE(vc, nullptr);
+  ASSERT_EQ(vc->stages.size(), 4u);
+  EXPECT_TRUE(vc->stages[0].vertex_color);
+  EXPECT_FALSE(vc->stages[0].inverse_vertex_color);
+  EXPECT_FALSE(vc->stages[1].vertex_color);
+  EXPECT_TRUE(vc->stages[1].inverse_vertex_color);
+  EXPECT_TRUE(vc->stages[2].vertex_color);
+  EXPECT_FALSE(vc->stages[2].inverse_vertex_color);
+  EXPECT_FALSE(vc->stages[3].vertex_color || vc->stages[3].inverse_vertex_color);
+  EXPECT_TRUE(f.warnings.empty()) << ::testing::PrintToString(f.warnings);
+}

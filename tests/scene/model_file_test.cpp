@@ -149,8 +149,8 @@ TEST(AseParser, FacesTurnedMaterialFromBitmapStTransformedNormalsRotatedColours)
   expect_vec(corner(m, 0, 0).normal, {0, 1, 0});
   expect_vec(corner(m, 0, 1).normal, {0, 0, 1});
   // Colours: 1 0.5 0 as bytes (0.5 * 255 rounds to 128), alpha 1.
-  ASSERT_EQ(m.colors.size(), m.mesh.vertices.size());
-  glm::vec4 c = m.colors[m.mesh.indices[0]];
+  ASSERT_EQ(m.mesh.colors.size(), m.mesh.vertices.size());
+  glm::vec4 c = unpack_rgba8(m.mesh.colors[m.mesh.indices[0]]);
   EXPECT_NEAR(c.r, 1.0f, 1e-6f);
   EXPECT_NEAR(c.g, 128.0f / 255.0f, 1e-6f);
   EXPECT_NEAR(c.b, 0.0f, 1e-6f);
@@ -276,8 +276,8 @@ TEST(LwoParser, AxesSwappedVFlippedSurfacesByTagColoursFromSurf) {
   glm::vec3 p0 = corner(m, 0, 0).position, p1 = corner(m, 0, 1).position, p2 = corner(m, 0, 2).position;
   expect_vec(glm::normalize(glm::cross(p2 - p0, p1 - p0)), {0, 0, -1});
   // Colour: SURF COLR for the defined surface, 200/255 grey for the tag without a SURF.
-  glm::vec4 defined = m.colors[m.mesh.indices[m.mesh.surfaces[0].first_index]];
-  glm::vec4 fallback = m.colors[m.mesh.indices[m.mesh.surfaces[1].first_index]];
+  glm::vec4 defined = unpack_rgba8(m.mesh.colors[m.mesh.indices[m.mesh.surfaces[0].first_index]]);
+  glm::vec4 fallback = unpack_rgba8(m.mesh.colors[m.mesh.indices[m.mesh.surfaces[1].first_index]]);
   EXPECT_NEAR(defined.g, 128.0f / 255.0f, 1e-6f);
   EXPECT_NEAR(fallback.r, 200.0f / 255.0f, 1e-6f);
   ASSERT_EQ(m.warnings.size(), 1u);   // the quad
@@ -477,7 +477,7 @@ TEST(LwoParser, LwobSurfacesFromSrfsDetailPolygonsAndByteColours) {
   ModelFile m = parse_lwo(bytes, "square.lwo");
   EXPECT_EQ(m.surface_materials, std::vector<std::string>{"textures/lwob"});
   EXPECT_EQ(m.mesh.triangle_count(), 3u);   // the detail polygon is read as an ordinary one
-  glm::vec4 c = m.colors.at(0);
+  glm::vec4 c = unpack_rgba8(m.mesh.colors.at(0));
   EXPECT_NEAR(c.r, 1.0f, 1e-6f);
   EXPECT_NEAR(c.g, 128.0f / 255.0f, 1e-6f);
   EXPECT_NEAR(c.b, 0.0f, 1e-6f);
@@ -489,3 +489,190 @@ TEST(LwoParser, LwobSurfacesFromSrfsDetailPolygonsAndByteColours) {
 }
 
 }  // namespace
+
+// --- Vertex colours ------------------------------------------------------------------------------
+
+namespace {
+
+glm::vec4 corner_color(const ModelFile& m, size_t surface, size_t k) {
+  return unpack_rgba8(m.mesh.colors.at(m.mesh.indices[m.mesh.surfaces[surface].first_index + k]));
+}
+
+void expect_rgba(glm::vec4 got, glm::vec4 want) {
+  EXPECT_NEAR(got.r, want.r, 1e-6f);
+  EXPECT_NEAR(got.g, want.g, 1e-6f);
+  EXPECT_NEAR(got.b, want.b, 1e-6f);
+  EXPECT_NEAR(got.a, want.a, 1e-6f);
+}
+
+// One triangle whose three corners have their own colour (red, green, blue) through a CFACE that names
+// them out of order, and a second object without colours.
+const char* kAseColoured = R"(*3DSMAX_ASCIIEXPORT	200
+*GEOMOBJECT {
+	*NODE_NAME "coloured"
+	*MESH {
+		*MESH_NUMVERTEX 3
+		*MESH_NUMFACES 1
+		*MESH_VERTEX_LIST {
+			*MESH_VERTEX 0 0 0 0
+			*MESH_VERTEX 1 10 0 0
+			*MESH_VERTEX 2 0 10 0
+		}
+		*MESH_FACE_LIST {
+			*MESH_FACE 0: A: 0 B: 1 C: 2
+		}
+		*MESH_NUMCVERTEX 3
+		*MESH_CVERTLIST {
+			*MESH_VERTCOL 0 1 0 0
+			*MESH_VERTCOL 1 0 1 0
+			*MESH_VERTCOL 2 0 0 1.5
+		}
+		*MESH_NUMCVFACES 1
+		*MESH_CFACELIST {
+			*MESH_CFACE 0 2 0 1
+		}
+	}
+}
+*GEOMOBJECT {
+	*NODE_NAME "plain"
+	*MESH {
+		*MESH_NUMVERTEX 3
+		*MESH_NUMFACES 1
+		*MESH_VERTEX_LIST {
+			*MESH_VERTEX 0 0 0 5
+			*MESH_VERTEX 1 0 10 5
+			*MESH_VERTEX 2 10 0 5
+		}
+		*MESH_FACE_LIST {
+			*MESH_FACE 0: A: 0 B: 1 C: 2
+		}
+	}
+}
+)";
+
+}  // namespace
+
+TEST(AseParser, CornerColoursFollowTheTurnedCFaceAndObjectsWithoutColoursAreWhite) {
+  ModelFile m = parse_ase(kAseColoured, "colours.ase");
+  ASSERT_EQ(m.mesh.surfaces.size(), 1u);   // both objects use the default material
+  ASSERT_EQ(m.mesh.colors.size(), m.mesh.vertices.size());
+  // CFACE (a, b, c) = (2, 0, 1) is stored (a, c, b) like the face: corner 0 blue, 1 green, 2 red.
+  expect_vec(corner(m, 0, 0).position, {0, 0, 0});
+  expect_rgba(corner_color(m, 0, 0), {0, 0, 1, 1});   // 1.5 clamps to 1
+  expect_rgba(corner_color(m, 0, 1), {0, 1, 0, 1});
+  expect_rgba(corner_color(m, 0, 2), {1, 0, 0, 1});
+  // The second object's triangle: no CVERTLIST, white like the engine's ASE default.
+  for (size_t k = 3; k < 6; ++k) expect_rgba(corner_color(m, 0, k), {1, 1, 1, 1});
+}
+
+TEST(AseParser, BrokenColourDataNamesFileAndLine) {
+  const std::string text = kAseColoured;
+  auto error_of = [](const std::string& bad) { return parse_error_of([&] { parse_ase(bad, "c.ase"); }); };
+  std::string cface_index = text;
+  cface_index.replace(cface_index.find("*MESH_CFACE 0 2 0 1"), 19, "*MESH_CFACE 0 2 0 3");
+  std::string e = error_of(cface_index);
+  EXPECT_NE(e.find(at_line_of("c.ase", cface_index, "*MESH_CFACE 0 2 0 3")), std::string::npos) << e;
+  EXPECT_NE(e.find("*MESH_CFACE index 3 out of range (3)"), std::string::npos) << e;
+
+  std::string cface_number = text;
+  cface_number.replace(cface_number.find("*MESH_CFACE 0 2 0 1"), 19, "*MESH_CFACE 4 2 0 1");
+  e = error_of(cface_number);
+  EXPECT_NE(e.find(at_line_of("c.ase", cface_number, "*MESH_CFACE 4")), std::string::npos) << e;
+  EXPECT_NE(e.find("*MESH_CFACE number 4 out of range"), std::string::npos) << e;
+
+  std::string vertcol = text;
+  vertcol.replace(vertcol.find("*MESH_VERTCOL 2 0 0 1.5"), 23, "*MESH_VERTCOL 7 0 0 1.5");
+  e = error_of(vertcol);
+  EXPECT_NE(e.find(at_line_of("c.ase", vertcol, "*MESH_VERTCOL 7")), std::string::npos) << e;
+  EXPECT_NE(e.find("*MESH_VERTCOL number 7 out of range (3)"), std::string::npos) << e;
+
+  std::string component = text;
+  component.replace(component.find("*MESH_VERTCOL 1 0 1 0"), 21, "*MESH_VERTCOL 1 0 one 0");
+  e = error_of(component);
+  EXPECT_NE(e.find(at_line_of("c.ase", component, "*MESH_VERTCOL 1 0 one")), std::string::npos) << e;
+
+  std::string face_count = text;
+  face_count.replace(face_count.find("*MESH_NUMCVFACES 1"), 18, "*MESH_NUMCVFACES 2");
+  e = error_of(face_count);
+  EXPECT_NE(e.find("c.ase:"), std::string::npos) << e;
+  EXPECT_NE(e.find("*MESH_NUMCVFACES 2 differs from *MESH_NUMFACES 1 in object coloured"), std::string::npos) << e;
+
+  // A colour vertex count given again, smaller, after the CFACE that indexed past it.
+  std::string shrunk = text;
+  shrunk.replace(shrunk.find("\t}\n}\n*GEOMOBJECT"), 0, "\t\t*MESH_NUMCVERTEX 1\n");
+  e = error_of(shrunk);
+  EXPECT_NE(e.find("c.ase:"), std::string::npos) << e;
+  EXPECT_NE(e.find("*MESH_CFACE colour vertex 2 out of range (1) in object coloured"), std::string::npos) << e;
+}
+
+namespace {
+
+// lwo_square's two triangles (points 0 1 2 and 0 2 3) with a colour vertex map of the given type and
+// dimension on points 0-3 (point p: (p/3, 1 - p/3, 0.5, alpha 0.25) or RGB without alpha), and a
+// VMAD that gives point 2 its own colour on polygon 1 only.
+std::string lwo_coloured(const char* type, int dimension, uint32_t bad_point = 0) {
+  IffWriter tags, pnts, pols, ptag, vmap, vmad;
+  tags.s0("textures/vc");
+  const float points[4][3] = {{0, 0, 0}, {4, 0, 0}, {4, 0, 4}, {0, 0, 4}};
+  for (auto& p : points) for (float f : p) pnts.f4(f);
+  pols.id("FACE");
+  for (auto tri : {std::array<int, 3>{0, 1, 2}, std::array<int, 3>{0, 2, 3}}) {
+    pols.u2(3);
+    for (int i : tri) pols.u2(unsigned(i));
+  }
+  ptag.id("SURF");
+  for (int p = 0; p < 2; ++p) { ptag.u2(unsigned(p)); ptag.u2(0); }
+  vmap.id(type); vmap.u2(unsigned(dimension)); vmap.s0("colours");
+  for (uint32_t p = 0; p < 4; ++p) {
+    vmap.u2(p == 3 && bad_point ? bad_point : p);
+    const float rgba[4] = {float(p) / 3.0f, 1.0f - float(p) / 3.0f, 0.5f, 0.25f};
+    for (int k = 0; k < dimension; ++k) vmap.f4(rgba[k]);
+  }
+  vmad.id(type); vmad.u2(unsigned(dimension)); vmad.s0("colours");
+  vmad.u2(2); vmad.u2(1);
+  const float override_rgba[4] = {0.0f, 0.0f, 1.0f, 1.0f};
+  for (int k = 0; k < dimension; ++k) vmad.f4(override_rgba[k]);
+  std::string body = chunk("TAGS", tags.bytes) + chunk("LAYR", std::string(16, '\0')) + chunk("PNTS", pnts.bytes) +
+                     chunk("POLS", pols.bytes) + chunk("PTAG", ptag.bytes) + chunk("VMAP", vmap.bytes) +
+                     chunk("VMAD", vmad.bytes);
+  return form(body);
+}
+
+}  // namespace
+
+TEST(LwoParser, RgbaAndRgbVertexMapsColourTheCornersAndVmadOverridesPerPolygon) {
+  for (int dimension : {4, 3}) {
+    SCOPED_TRACE(dimension == 4 ? "RGBA" : "RGB");
+    ModelFile m = parse_lwo(lwo_coloured(dimension == 4 ? "RGBA" : "RGB ", dimension), "vc.lwo");
+    ASSERT_EQ(m.mesh.colors.size(), m.mesh.vertices.size());
+    const float alpha = dimension == 4 ? 64.0f / 255.0f : 1.0f;   // 0.25 as a byte; RGB is opaque
+    // Polygon 0 = points 0 1 2 from the VMAP, bytes rounded (1/3 -> 85).
+    expect_rgba(corner_color(m, 0, 0), {0, 1, 128.0f / 255.0f, alpha});
+    expect_rgba(corner_color(m, 0, 1), {85.0f / 255.0f, 170.0f / 255.0f, 128.0f / 255.0f, alpha});
+    expect_rgba(corner_color(m, 0, 2), {170.0f / 255.0f, 85.0f / 255.0f, 128.0f / 255.0f, alpha});
+    // Polygon 1 = points 0 2 3: point 2 takes the VMAD's blue on this polygon only.
+    expect_rgba(corner_color(m, 0, 3), {0, 1, 128.0f / 255.0f, alpha});
+    expect_rgba(corner_color(m, 0, 4), {0, 0, 1, 1});
+    expect_rgba(corner_color(m, 0, 5), {1, 0, 128.0f / 255.0f, alpha});
+  }
+}
+
+TEST(LwoParser, ColourMapsOfOtherDimensionsAreIgnoredAndBadPointsNamed) {
+  // An RGBA map written with dimension 3 is not one the engine reads: the surface colour stays.
+  ModelFile m = parse_lwo(lwo_coloured("RGBA", 3), "odd.lwo");
+  expect_rgba(corner_color(m, 0, 0), {200.0f / 255.0f, 200.0f / 255.0f, 200.0f / 255.0f, 1});
+  std::string e = parse_error_of([] { parse_lwo(lwo_coloured("RGBA", 4, 9), "bad.lwo"); });
+  EXPECT_NE(e.find("bad.lwo: byte"), std::string::npos) << e;
+  EXPECT_NE(e.find("point 9 out of range"), std::string::npos) << e;
+  std::string cut = lwo_coloured("RGB ", 3);
+  cut.resize(cut.find("VMAD") + 8 + 6);   // the VMAD chunk header says more than the file holds
+  e = parse_error_of([&] { parse_lwo(cut, "cut.lwo"); });
+  EXPECT_NE(e.find("cut.lwo: byte"), std::string::npos) << e;
+}
+
+TEST(PackRgba8, RoundsClampsAndPutsRedInTheLowByte) {
+  EXPECT_EQ(pack_rgba8({1, 0, 0, 1}), 0xFF0000FFu);
+  EXPECT_EQ(pack_rgba8({0.5f, -1, 2, 0}), 0x00FF0080u);
+  EXPECT_EQ(pack_rgba8({std::nanf(""), 0, 0, 0}), 0u);
+  EXPECT_EQ(unpack_rgba8(0x80FF0040u), glm::vec4(64, 0, 255, 128) / 255.0f);
+}

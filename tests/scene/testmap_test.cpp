@@ -2,6 +2,7 @@
 // counts taken from the files by plain text scanning, independent of the parsers.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <map>
 #include <set>
 #include <sstream>
@@ -219,9 +220,23 @@ TEST_F(TestMap, ModelPropsResolveThroughClassesAndShareMeshes) {
   for (const auto& [key, value] : lamp1.keys) EXPECT_NE(key.rfind("editor_", 0), 0u) << key;
   const Mesh& lamp = scene.meshes.at(static_cast<size_t>(lamp1.mesh));
   ASSERT_EQ(lamp.surfaces.size(), 2u);
-  EXPECT_EQ(material_of(scene, lamp1, 0), "textures/testmap/metal");
+  EXPECT_EQ(material_of(scene, lamp1, 0), "textures/testmap/lamppost");
+  // The post's vertex colours reach the mesh, and its material multiplies by them.
+  ASSERT_EQ(lamp.colors.size(), lamp.vertices.size());
+  EXPECT_NE(std::count(lamp.colors.begin(), lamp.colors.end(), 0xFFFFFFFFu), std::ptrdiff_t(lamp.colors.size()));
+  EXPECT_TRUE(scene.materials.at(static_cast<size_t>(lamp.surfaces[0].material)).vertex_color);
   EXPECT_EQ(material_of(scene, lamp1, 1), "textures/testmap/wood");   // the last sub-material's bitmap
   EXPECT_EQ(entity_named(scene, "wedge_1").mesh, entity_named(scene, "wedge_2").mesh);
+  // The wedge's RGBA map: 0.5 grey-yellow at the foot (idTech z = 0), white-ish at the ridge (z = 24).
+  const Mesh& wedge = scene.meshes.at(static_cast<size_t>(entity_named(scene, "wedge_1").mesh));
+  ASSERT_EQ(wedge.colors.size(), wedge.vertices.size());
+  for (size_t v = 0; v < wedge.vertices.size(); ++v) {
+    const float shade = 0.5f + 0.5f * wedge.vertices[v].position.z / 24.0f;
+    const glm::vec4 c = unpack_rgba8(wedge.colors[v]);
+    EXPECT_NEAR(c.r, shade, 0.6f / 255.0f) << "vertex " << v;
+    EXPECT_NEAR(c.b, shade * 0.9f, 0.6f / 255.0f) << "vertex " << v;
+    EXPECT_EQ(c.a, 1.0f);
+  }
   const Entity &walker1 = entity_named(scene, "walker_1"), &walker2 = entity_named(scene, "walker_2");
   EXPECT_NE(walker1.mesh, walker2.mesh);   // another skin, another mesh
   EXPECT_EQ(material_of(scene, walker1), "models/testmap/walker");

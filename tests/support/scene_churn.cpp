@@ -95,12 +95,18 @@ void SceneChurn::add_blas(TracerScene& s, CommitBuffer* out) {
   up.node_offset = uint32_t(s.blas_nodes.size());
   up.vertices.resize(pick(3, 30));
   for (auto& v : up.vertices) fill_floats(v);
+  // Every other BLAS carries vertex colours, the rest leave them white (an empty array); derived from the
+  // index so that the random sequence, and with it every other record, stays as it was.
+  if (up.blas_index % 2 == 1)
+    for (uint32_t v = 0; v < up.vertices.size(); ++v) up.vertex_colors.push_back(0x9E3779B9u * (up.blas_index * 64u + v + 1u));
   up.triangles.resize(pick(1, 10));
   for (auto& t : up.triangles) t = {up.vertex_offset, up.vertex_offset + 1, up.vertex_offset + 2, 0};
   up.nodes.resize(up.triangles.size() * 2 - 1);
   for (auto& n : up.nodes) randomize(n);
   up.blas = {up.node_offset, uint32_t(up.nodes.size()), up.triangle_offset, uint32_t(up.triangles.size())};
   s.vertices.insert(s.vertices.end(), up.vertices.begin(), up.vertices.end());
+  if (up.vertex_colors.empty()) s.vertex_colors.insert(s.vertex_colors.end(), up.vertices.size(), K_VERTEX_COLOR_WHITE);
+  else s.vertex_colors.insert(s.vertex_colors.end(), up.vertex_colors.begin(), up.vertex_colors.end());
   s.triangles.insert(s.triangles.end(), up.triangles.begin(), up.triangles.end());
   s.blas_nodes.insert(s.blas_nodes.end(), up.nodes.begin(), up.nodes.end());
   s.blases.push_back(up.blas);

@@ -105,6 +105,18 @@ textures/testmap/metal
 	specularmap	textures/testmap/metal_s.tga
 }
 
+// the lamp post (lamp.ase): its diffuse stage takes the ASE's vertex colours, dark at the foot, warm at the top
+textures/testmap/lamppost
+{
+	{
+		blend	diffusemap
+		map		textures/testmap/metal_d.tga
+		vertexColor
+	}
+	bumpmap		textures/testmap/metal_local.tga
+	specularmap	textures/testmap/metal_s.tga
+}
+
 textures/testmap/door
 {
 	diffusemap	textures/testmap/metal_d.tga

@@ -47,7 +47,7 @@ KFrameParams TracerBase::frame_params(const core::BandJob& job) const {
 }
 
 KSceneView TracerBase::host_scene_view(const KFrameParams& params) const {
-  return k_scene_view(scene_.vertices.data(), scene_.triangles.data(), scene_.blas_nodes.data(), scene_.blases.data(),
+  return k_scene_view(scene_.vertices.data(), scene_.vertex_colors.data(), scene_.triangles.data(), scene_.blas_nodes.data(), scene_.blases.data(),
                       scene_.instances.data(), scene_.tlas_nodes.data(), scene_.materials.data(),
                       scene_.textures.data(), scene_.texels.data(), scene_.lights.data(), scene_.light_nodes.data(),
                       scene_.emissive_triangles.data(), &params);

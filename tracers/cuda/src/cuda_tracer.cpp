@@ -33,6 +33,7 @@ struct CudaTracer::Impl {
   cudaStream_t stream = nullptr;
   cudaEvent_t start = nullptr, stop = nullptr;
   DeviceArray<KVertex> vertices;
+  DeviceArray<KVertexColor> vertex_colors;
   DeviceArray<KTriangle> triangles;
   DeviceArray<KBvhNode> blas_nodes, tlas_nodes;
   DeviceArray<KBlas> blases;
@@ -89,7 +90,7 @@ struct CudaTracer::Impl {
   }
 
   KSceneView view(const KFrameParams& params) const {
-    return k_scene_view(vertices.data(), triangles.data(), blas_nodes.data(), blases.data(), instances.data(),
+    return k_scene_view(vertices.data(), vertex_colors.data(), triangles.data(), blas_nodes.data(), blases.data(), instances.data(),
                         tlas_nodes.data(), materials.data(), textures.data(), texels.data(), lights.data(), light_nodes.data(),
                         emissive.data(), &params);
   }
@@ -131,6 +132,7 @@ void CudaTracer::upload(const commit::ChangeSet& changes) {
   if (all || changes.geometry) {
     // Appended BLASes upload only their new tail; anything else re-sends the array.
     m.vertices.upload(scene.vertices, all ? 0 : changes.vertices_from, s);
+    m.vertex_colors.upload(scene.vertex_colors, all ? 0 : changes.vertices_from, s);
     m.triangles.upload(scene.triangles, all ? 0 : changes.triangles_from, s);
     m.blas_nodes.upload(scene.blas_nodes, all ? 0 : changes.blas_nodes_from, s);
     m.blases.upload(scene.blases, all ? 0 : changes.blases_from, s);

@@ -87,7 +87,7 @@ core::BandFormat band_format_of(uint32_t value, Reader& r) {
 
 // Every array of the scene, in one order for the encoder, the decoder and the fingerprint.
 template <class Visit> void visit_scene_arrays(const commit::TracerScene& s, Visit&& visit) {
-  visit(s.vertices); visit(s.triangles); visit(s.blas_nodes); visit(s.blases); visit(s.instances);
+  visit(s.vertices); visit(s.vertex_colors); visit(s.triangles); visit(s.blas_nodes); visit(s.blases); visit(s.instances);
   visit(s.tlas_nodes); visit(s.materials); visit(s.textures); visit(s.texels); visit(s.lights);
   visit(s.light_nodes); visit(s.emissive_triangles); visit(s.skins); visit(s.skin_vertices);
   visit(s.skin_weights); visit(s.skin_triangles); visit(s.skin_adjacency); visit(s.joints); visit(s.skin_faces);
@@ -95,6 +95,7 @@ template <class Visit> void visit_scene_arrays(const commit::TracerScene& s, Vis
 
 void read_scene_arrays(Reader& r, commit::TracerScene& s) {
   s.vertices = r.array<KVertex>("vertices");
+  s.vertex_colors = r.array<KVertexColor>("vertex colours");
   s.triangles = r.array<KTriangle>("triangles");
   s.blas_nodes = r.array<KBvhNode>("BLAS nodes");
   s.blases = r.array<KBlas>("BLASes");
@@ -243,7 +244,7 @@ void write_records(Writer& w, const commit::CommitBuffer& c) {
   for (const commit::BlasUpload& b : c.blas_uploads()) {
     w.tag(Record::blas);
     w.scalar(b.blas_index); w.scalar(b.blas);
-    w.scalar(b.vertex_offset); w.array(b.vertices);
+    w.scalar(b.vertex_offset); w.array(b.vertices); w.array(b.vertex_colors);
     w.scalar(b.triangle_offset); w.array(b.triangles);
     w.scalar(b.node_offset); w.array(b.nodes);
   }
@@ -287,6 +288,7 @@ void read_records(Reader& r, commit::CommitBuffer& c) {
         commit::BlasUpload b;
         b.blas_index = r.scalar<uint32_t>(); b.blas = r.scalar<KBlas>();
         b.vertex_offset = r.scalar<uint32_t>(); b.vertices = r.array<KVertex>("BLAS vertices");
+        b.vertex_colors = r.array<KVertexColor>("BLAS vertex colours");
         b.triangle_offset = r.scalar<uint32_t>(); b.triangles = r.array<KTriangle>("BLAS triangles");
         b.node_offset = r.scalar<uint32_t>(); b.nodes = r.array<KBvhNode>("BLAS nodes");
         c.add_blas(std::move(b));

@@ -4,7 +4,8 @@
 #include "cohort/kernel/integrator.h"
 #include "cohort/kernel/aux_outputs.h"
 
-__kernel void cohort_render_band(__global const KVertex* vertices, __global const KTriangle* triangles,
+__kernel void cohort_render_band(__global const KVertex* vertices, __global const KVertexColor* vertex_colors,
+                                 __global const KTriangle* triangles,
                                  __global const KBvhNode* blas_nodes, __global const KBlas* blases,
                                  __global const KInstance* instances, __global const KBvhNode* tlas_nodes,
                                  __global const KMaterial* materials, __global const KTexture* textures,
@@ -25,7 +26,7 @@ __kernel void cohort_render_band(__global const KVertex* vertices, __global cons
   barrier(CLK_LOCAL_MEM_FENCE);
   if (x < camera.width && y < params.row_end) {
     KTraceCtx ctx;
-    ctx.scene = k_scene_view(vertices, triangles, blas_nodes, blases, instances, tlas_nodes, materials, textures, texels,
+    ctx.scene = k_scene_view(vertices, vertex_colors, triangles, blas_nodes, blases, instances, tlas_nodes, materials, textures, texels,
                              lights, light_nodes, emissive, &params);
     ctx.closest_rays = 0u;
     ctx.occlusion_rays = 0u;
@@ -44,7 +45,8 @@ __kernel void cohort_render_band(__global const KVertex* vertices, __global cons
 /* Auxiliary outputs (aux_outputs.h), launched only for frames that ask for them: one work item per
  * pixel of the band, writing a KAux each. prev_transforms: 12 floats per instance (the host always
  * passes one; with no instance moved it equals the current transforms). */
-__kernel void cohort_aux_band(__global const KVertex* vertices, __global const KTriangle* triangles,
+__kernel void cohort_aux_band(__global const KVertex* vertices, __global const KVertexColor* vertex_colors,
+                                 __global const KTriangle* triangles,
                               __global const KBvhNode* blas_nodes, __global const KBlas* blases,
                               __global const KInstance* instances, __global const KBvhNode* tlas_nodes,
                               __global const KMaterial* materials, __global const KTexture* textures,
@@ -61,7 +63,7 @@ __kernel void cohort_aux_band(__global const KVertex* vertices, __global const K
   kuint y = params.row_begin + row;
   if (x >= camera.width || y >= params.row_end) return;
   KTraceCtx ctx;
-  ctx.scene = k_scene_view(vertices, triangles, blas_nodes, blases, instances, tlas_nodes, materials, textures, texels,
+  ctx.scene = k_scene_view(vertices, vertex_colors, triangles, blas_nodes, blases, instances, tlas_nodes, materials, textures, texels,
                            lights, light_nodes, emissive, &params);
   ctx.closest_rays = 0u;
   ctx.occlusion_rays = 0u;

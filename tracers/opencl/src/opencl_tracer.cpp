@@ -104,7 +104,7 @@ struct OpenCLTracer::Impl {
   cl_program program = nullptr;
   cl_kernel kernel = nullptr, aux_kernel = nullptr;
   DeviceBuffer previous_transforms;
-  DeviceBuffer vertices, triangles, blas_nodes, blases, instances, tlas_nodes, materials, textures, texels, lights, light_nodes,
+  DeviceBuffer vertices, vertex_colors, triangles, blas_nodes, blases, instances, tlas_nodes, materials, textures, texels, lights, light_nodes,
       emissive;
   DeviceBuffer skins, skin_vertices, skin_weights, skin_triangles, skin_adjacency, skin_faces, joints;
   cl_kernel skin_positions = nullptr, skin_faces_kernel = nullptr, skin_normals = nullptr, refit_leaves = nullptr,
@@ -276,6 +276,7 @@ void OpenCLTracer::upload(const commit::ChangeSet& changes) {
   cl_command_queue q = m.queue;
   if (all || changes.geometry) {
     m.vertices.upload(c, q, s.vertices, "uploading vertices");
+    m.vertex_colors.upload(c, q, s.vertex_colors, "uploading vertex colours");
     m.triangles.upload(c, q, s.triangles, "uploading triangles");
     m.blas_nodes.upload(c, q, s.blas_nodes, "uploading BLAS nodes");
     m.blases.upload(c, q, s.blases, "uploading BLASes");
@@ -342,7 +343,7 @@ core::BandResult OpenCLTracer::render_band(const core::BandJob& job, core::BandB
         "writing frame parameters");
   check(clEnqueueWriteBuffer(m.queue, m.camera, CL_FALSE, 0, sizeof camera, &camera, 0, nullptr, nullptr),
         "writing the camera");
-  cl_mem args[] = {m.vertices.mem(),  m.triangles.mem(), m.blas_nodes.mem(), m.blases.mem(),
+  cl_mem args[] = {m.vertices.mem(),  m.vertex_colors.mem(), m.triangles.mem(), m.blas_nodes.mem(), m.blases.mem(),
                    m.instances.mem(), m.tlas_nodes.mem(), m.materials.mem(), m.textures.mem(),
                    m.texels.mem(),    m.lights.mem(),     m.light_nodes.mem(), m.emissive.mem(),
                    m.params,          m.camera,           m.output,           m.row_rays};
@@ -401,7 +402,7 @@ void OpenCLTracer::render_aux(const core::BandJob& job, const KFrameParams& para
   check(clEnqueueWriteBuffer(m.queue, m.previous_camera, CL_FALSE, 0, sizeof previous, &previous, 0, nullptr, nullptr),
         "writing the previous camera");
   m.previous_transforms.upload(m.context, m.queue, previous_transforms(), "uploading previous transforms");
-  cl_mem args[] = {m.vertices.mem(),  m.triangles.mem(),  m.blas_nodes.mem(),  m.blases.mem(),
+  cl_mem args[] = {m.vertices.mem(),  m.vertex_colors.mem(), m.triangles.mem(),  m.blas_nodes.mem(),  m.blases.mem(),
                    m.instances.mem(), m.tlas_nodes.mem(), m.materials.mem(),   m.textures.mem(),
                    m.texels.mem(),    m.lights.mem(),     m.light_nodes.mem(), m.emissive.mem(),
                    m.params,          m.camera,           m.previous_camera,   m.previous_transforms.mem(),

@@ -22,11 +22,14 @@ namespace cohort::commit {
 
 // A new BLAS: its nodes, its triangles (leaf order, absolute vertex indices) and the vertices they
 // use, written at the given offsets of the tracer's geometry pools (appended at the end normally).
+// vertex_colors: one per vertex, or empty when every vertex is white (what most meshes are, so that
+// they send no colour bytes); the tracer's colour pool follows the vertex pool either way.
 struct BlasUpload {
   uint32_t blas_index = 0;
   KBlas blas{};
   uint32_t vertex_offset = 0;
   std::vector<KVertex> vertices;
+  std::vector<KVertexColor> vertex_colors;
   uint32_t triangle_offset = 0;
   std::vector<KTriangle> triangles;
   uint32_t node_offset = 0;

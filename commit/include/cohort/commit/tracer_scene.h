@@ -14,6 +14,7 @@ namespace cohort::commit {
 struct TracerScene {
   // Geometry pools: BLASes are appended; a rebuilt BLAS gets a new slot (old one freed on resync).
   std::vector<KVertex> vertices;
+  std::vector<KVertexColor> vertex_colors;  // one per vertex (RGBA8), white where a mesh has none
   std::vector<KTriangle> triangles;   // in BLAS leaf order
   std::vector<KBvhNode> blas_nodes;
   std::vector<KBlas> blases;

@@ -49,6 +49,9 @@ inline uint32_t default_material_index(const scene::Scene& scene) { return stati
 
 // The scene model's vertex in the kernels' layout.
 KVertex to_kvertex(const scene::Vertex& vertex);
+// Appends the mesh's vertex colours to a colour pool, white for a mesh without them (Mesh::colors).
+// Throws std::runtime_error naming the mesh when it has colours for some vertices but not all.
+void append_vertex_colors(std::vector<KVertexColor>& pool, const scene::Mesh& mesh);
 
 // The triangles of a mesh's surfaces with vertex indices offset by vertex_base, each with its
 // surface's KMaterial index (material_index(surface.material)). Throws std::runtime_error naming the

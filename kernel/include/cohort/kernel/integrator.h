@@ -183,6 +183,7 @@ KFN KVec3 k_emissive_lighting(KTraceCtx* ctx, const KSurface* sf, KVec3 wo, int 
     k_hit_st(scene, e->triangle, bu, bv, m, &s, &t);
     le = v3_mul(le, v4_rgb(k_texture_sample(scene, m->emissive_tex, s, t)));
   }
+  le = v3_mul(le, v4_rgb(k_hit_vertex_color(scene, e->triangle, bu, bv, m->flags)));
   if (v3_max_component(le) <= 0.0f) return v3s(0.0f);
 
   float pdf = pick * 2.0f / double_area * dist2 / cos_light;

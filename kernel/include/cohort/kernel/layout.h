@@ -50,6 +50,12 @@ typedef struct KVertex {
   float tangent[3]; float bitangent_sign;  /* bitangent = sign * cross(normal, tangent) */
 } KVertex;
 
+/* Vertex colours: one kuint per vertex, parallel to the vertex array (same index), RGBA8 with R in the
+ * low byte, as the engine's idDrawVert::color bytes. A separate array keeps KVertex at 48 bytes; meshes
+ * whose format has no colours carry white (0xFFFFFFFF). */
+typedef kuint KVertexColor;
+#define K_VERTEX_COLOR_WHITE 0xFFFFFFFFu
+
 /* Vertex indices are absolute into the vertex array; winding as stored in the .proc. */
 typedef struct KTriangle {
   kuint v0, v1, v2;
@@ -75,9 +81,10 @@ typedef struct KTriangle {
 #define K_MAT_TWO_SIDED    8u
 #define K_MAT_NONSOLID     16u
 #define K_MAT_EMISSIVE     32u  /* ambient-only stages: an emitter */
-#define K_MAT_VERTEX_COLOR 64u
+#define K_MAT_VERTEX_COLOR 64u  /* vertexColor: the surface's colours x the vertex colour (RGBA) */
 #define K_MAT_NO_SPECULAR  128u
 #define K_MAT_NO_SELF_SHADOW 256u  /* noSelfShadow: does not shadow other noSelfShadow surfaces */
+#define K_MAT_INVERSE_VERTEX_COLOR 512u  /* inverseVertexColor: colours x (1 - vertex RGB), alpha kept */
 
 typedef struct KMaterial {
   float diffuse_color[4];   /* multiplies the diffuse map; rgba */
@@ -215,6 +222,7 @@ static_assert(sizeof(KBvhNode) == 32, "KBvhNode layout");
 static_assert(sizeof(KBlas) == 16, "KBlas layout");
 static_assert(sizeof(KInstance) == 112, "KInstance layout");
 static_assert(sizeof(KVertex) == 48, "KVertex layout");
+static_assert(sizeof(KVertexColor) == 4, "KVertexColor layout");
 static_assert(sizeof(KTriangle) == 16, "KTriangle layout");
 static_assert(sizeof(KMaterial) == 112, "KMaterial layout");
 static_assert(sizeof(KTexture) == 16, "KTexture layout");

@@ -37,6 +37,28 @@ KFN void k_hit_st(const KSceneView* scene, kuint triangle, float u, float v, KGL
   *t = m->tex_transform[3] * s0 + m->tex_transform[4] * t0 + m->tex_transform[5];
 }
 
+/* What a vertexColor / inverseVertexColor material multiplies its colours by at barycentrics (u, v):
+ * the interpolated vertex RGBA, or (1 - RGB, 1) for inverseVertexColor (draw_arb2.cpp: colour =
+ * vc * modulate + add); white for every other material. The vertex bytes multiply like a stage colour
+ * (linear, not sRGB-decoded), as the stage colours in KMaterial do. */
+KFN KVec4 k_vertex_color_unpack(kuint c) {
+  return v4((float)(c & 0xFFu) / 255.0f, (float)((c >> 8) & 0xFFu) / 255.0f, (float)((c >> 16) & 0xFFu) / 255.0f,
+            (float)((c >> 24) & 0xFFu) / 255.0f);
+}
+
+KFN KVec4 k_hit_vertex_color(const KSceneView* scene, kuint triangle, float u, float v, kuint material_flags) {
+  if (!(material_flags & (K_MAT_VERTEX_COLOR | K_MAT_INVERSE_VERTEX_COLOR))) return v4(1.0f, 1.0f, 1.0f, 1.0f);
+  KTriangle tri = scene->triangles[triangle];
+  KVec4 a = k_vertex_color_unpack(scene->vertex_colors[tri.v0]);
+  KVec4 b = k_vertex_color_unpack(scene->vertex_colors[tri.v1]);
+  KVec4 c = k_vertex_color_unpack(scene->vertex_colors[tri.v2]);
+  float w = 1.0f - u - v;
+  KVec4 vc = v4(w * a.x + u * b.x + v * c.x, w * a.y + u * b.y + v * c.y, w * a.z + u * b.z + v * c.z,
+                w * a.w + u * b.w + v * c.w);
+  if (material_flags & K_MAT_INVERSE_VERTEX_COLOR) return v4(1.0f - vc.x, 1.0f - vc.y, 1.0f - vc.z, 1.0f);
+  return vc;
+}
+
 /* Coverage of an alpha-tested surface at the hit: the diffuse map's alpha times the colour's. */
 KFN float k_hit_alpha(const KSceneView* scene, kuint triangle, float u, float v, KGLOBAL const KMaterial* m) {
   float alpha = m->diffuse_color[3];
@@ -171,6 +193,10 @@ KFN KSurface k_surface_eval(const KSceneView* scene, KHit hit, KVec3 ray_org, KV
     KVec4 d = k_texture_sample_footprint(scene, m->diffuse_tex, s, t, footprint);
     diffuse = v4(diffuse.x * d.x, diffuse.y * d.y, diffuse.z * d.z, diffuse.w * d.w);
   }
+  /* The engine multiplies the whole interaction (diffuse and specular) and the ambient stages by it. */
+  KVec4 vertex_color = k_hit_vertex_color(scene, hit.triangle, u, v, m->flags);
+  diffuse = v4(diffuse.x * vertex_color.x, diffuse.y * vertex_color.y, diffuse.z * vertex_color.z,
+               diffuse.w * vertex_color.w);
   sf.albedo = v4_rgb(diffuse);
   sf.alpha = diffuse.w;
 
@@ -178,14 +204,14 @@ KFN KSurface k_surface_eval(const KSceneView* scene, KHit hit, KVec3 ray_org, KV
   if (m->specular_tex != K_NONE) spec = v3_mul(spec, v4_rgb(k_texture_sample_footprint(scene, m->specular_tex, s, t, footprint)));
   if (m->flags & K_MAT_NO_SPECULAR) spec = v3s(0.0f);
   k_gloss_to_roughness_metallic(v3_luminance(spec), &sf.roughness, &sf.metallic);
-  sf.specular = spec;
+  sf.specular = v3_mul(spec, v4_rgb(vertex_color));   /* after the gloss: the tint darkens, not roughens */
   sf.albedo = v3_scale(sf.albedo, 1.0f - sf.metallic);
 
   sf.emission = v3s(0.0f);
   if (m->flags & K_MAT_EMISSIVE) {
     KVec3 e = v3(m->emissive_color[0], m->emissive_color[1], m->emissive_color[2]);
     if (m->emissive_tex != K_NONE) e = v3_mul(e, v4_rgb(k_texture_sample_footprint(scene, m->emissive_tex, s, t, footprint)));
-    sf.emission = e;
+    sf.emission = v3_mul(e, v4_rgb(vertex_color));
   }
   sf.blend = m->blend;
   sf.flags = m->flags;

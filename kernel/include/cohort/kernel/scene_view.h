@@ -8,6 +8,7 @@
 
 typedef struct KSceneView {
   KGLOBAL const KVertex* vertices;
+  KGLOBAL const KVertexColor* vertex_colors;  /* one per vertex (layout.h); read only for vertexColor materials */
   KGLOBAL const KTriangle* triangles;
   KGLOBAL const KBvhNode* blas_nodes;
   KGLOBAL const KBlas* blases;
@@ -30,7 +31,8 @@ typedef struct KSceneView {
 /* The view over a scene's arrays, wherever they live. The counts come from the frame parameters,
  * which the host sets from the tracer's scene copy (tracers/common's TracerBase::frame_params): a
  * kernel that receives the arrays as separate buffers (OpenCL) learns their lengths that way. */
-KFN KSceneView k_scene_view(KGLOBAL const KVertex* vertices, KGLOBAL const KTriangle* triangles,
+KFN KSceneView k_scene_view(KGLOBAL const KVertex* vertices, KGLOBAL const KVertexColor* vertex_colors,
+                            KGLOBAL const KTriangle* triangles,
                             KGLOBAL const KBvhNode* blas_nodes, KGLOBAL const KBlas* blases,
                             KGLOBAL const KInstance* instances, KGLOBAL const KBvhNode* tlas_nodes,
                             KGLOBAL const KMaterial* materials, KGLOBAL const KTexture* textures,
@@ -39,6 +41,7 @@ KFN KSceneView k_scene_view(KGLOBAL const KVertex* vertices, KGLOBAL const KTria
                             const KFrameParams* params) {
   KSceneView v;
   v.vertices = vertices;
+  v.vertex_colors = vertex_colors;
   v.triangles = triangles;
   v.blas_nodes = blas_nodes;
   v.blases = blases;

@@ -34,7 +34,8 @@ struct MaterialStage {
   float wobble_sky[3] = {0, 0, 0};  // texgen wobbleSky: degrees, speed, rotation speed, at time 0 (registers: the expressions)
   // color, alpha_ref and tex_transform: the registers evaluated at time 0 with the world's parms.
   glm::vec4 color{1.0f};
-  bool vertex_color = false;
+  bool vertex_color = false;           // vertexColor
+  bool inverse_vertex_color = false;   // inverseVertexColor
   bool alpha_test = false;
   float alpha_ref = 0.5f;
   float tex_transform[6] = {1, 0, 0, 0, 1, 0};

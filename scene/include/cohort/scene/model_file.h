@@ -17,11 +17,11 @@
 namespace cohort::scene {
 
 struct ModelFile {
-  Mesh mesh;                                   // Surface::material left at -1; see surface_materials
+  // Surface::material left at -1 (see surface_materials); mesh.colors holds the vertex colours where the
+  // format has them (ASE CVERTLIST, else white; LWO RGB/RGBA vertex maps, else the surface COLR) and is
+  // empty for MD5, whose vertices are white here.
+  Mesh mesh;
   std::vector<std::string> surface_materials;  // material name per mesh surface (canonical: no extension)
-  // Per-vertex RGBA in [0, 1] as the engine's vertex colour bytes / 255; empty when the format has none
-  // (MD5). Not carried into the scene yet: no material path reads vertex colours.
-  std::vector<glm::vec4> colors;
   std::vector<std::string> warnings;           // things the engine would only warn about
 };
 

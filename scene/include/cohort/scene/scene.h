@@ -40,7 +40,8 @@ struct Material {
   bool alpha_test = false; float alpha_ref = 0.5f;
   bool translucent = false, no_shadows = false, two_sided = false, nonsolid = false;
   bool emitter = false;        // ambient-only stages: emits its stage image
-  bool vertex_color = false;
+  bool vertex_color = false;         // a stage is `vertexColor`: colours x the vertex colour
+  bool inverse_vertex_color = false; // a stage is `inverseVertexColor`: colours x (1 - vertex RGB)
   bool no_self_shadow = false; // noSelfShadow: never shadows, nor is shadowed by, other noSelfShadow surfaces
   BlendClass blend = BlendClass::Opaque;
   // Sky: six consecutive Scene::images, the cube faces +X, -X, +Y, -Y, +Z, -Z (GL order), and the
@@ -100,11 +101,18 @@ struct Surface {
 struct Mesh {
   std::string name;            // "_area0", an inline model's name, or a model file path
   std::vector<Vertex> vertices;
+  // Per-vertex colour as the engine's idDrawVert::color bytes, RGBA8 with R in the low byte
+  // (pack_rgba8); empty: every vertex white (.proc geometry, MD5). Only vertexColor materials read it.
+  std::vector<uint32_t> colors;
   std::vector<uint32_t> indices;  // three per triangle, winding as in the .proc
   std::vector<Surface> surfaces;
   std::shared_ptr<const MeshSkin> skin;   // MD5 meshes: an entity with joints is skinned by it
   size_t triangle_count() const { return indices.size() / 3; }
 };
+
+// A colour in [0, 1] as the engine's four colour bytes (rounded, clamped), R in the low byte; and back.
+uint32_t pack_rgba8(const glm::vec4& color);
+glm::vec4 unpack_rgba8(uint32_t rgba);
 
 enum class LightType : uint8_t { Point, Parallel, Projected };
 
