@@ -90,7 +90,7 @@ KFN void k_svgf_variance_pixel(KGLOBAL const float* illumination, KGLOBAL const 
 /* The pixel's variance seen through a 3x3 Gaussian (1/4 centre, 1/8 sides, 1/16 corners; SVGF), which
  * steadies the luminance stop against the estimate's own noise. */
 KFN float k_svgf_blurred_variance(KGLOBAL const float* variance, const KAtrousParams* p, kint x, kint y) {
-  const float kernel[2] = {0.25f, 0.125f};
+  const float gauss[2] = {0.25f, 0.125f};
   float sum = 0.0f, weight_sum = 0.0f;
   for (kint dy = -1; dy <= 1; ++dy) {
     kint qy = y + dy;
@@ -98,7 +98,7 @@ KFN float k_svgf_blurred_variance(KGLOBAL const float* variance, const KAtrousPa
     for (kint dx = -1; dx <= 1; ++dx) {
       kint qx = x + dx;
       if (qx < 0 || qx >= p->width) continue;
-      float w = kernel[dx != 0] * kernel[dy != 0] * 4.0f;
+      float w = gauss[dx != 0] * gauss[dy != 0] * 4.0f;
       sum += w * variance[qy * p->width + qx];
       weight_sum += w;
     }
