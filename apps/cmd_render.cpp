@@ -404,7 +404,7 @@ void add_render_command(CLI::App& app, int& exit_code) {
       ->check(CLI::IsMember({"variance", "fixed"}));
   cmd->add_option("--atrous-sigma", a->atrous_sigma,
                   "luminance stop's scale of --denoise atrous: standard deviations with the variance guide "
-                  "(default 4), relative difference with the fixed one (default 2); 0 keeps the default")
+                  "(default 2), relative difference with the fixed one (default 2); 0 keeps the default")
       ->capture_default_str()
       ->check(CLI::Range(0.0f, 1000.0f));
   cmd->add_option("--post-on", a->post_on,

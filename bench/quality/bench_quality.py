@@ -8,7 +8,8 @@ Methods: none (each frame as rendered), brigade (adaptive convergence, Brigade's
 denoised by Open Image Denoise), brigade+oidn (the blended frame denoised), reproject (per-pixel history
 through motion vectors, core/reprojection.h), reproject+oidn (the reprojected frame denoised, with the
 albedo and normal planes as the denoiser's guides), atrous and reproject+atrous (the real-time edge-aware
-a-trous filter of the portable kernel, core/atrous_filter.h, on each frame or on the reprojected one). Reports a table, JSON, a
+a-trous filter of the portable kernel, core/atrous_filter.h, on each frame or on the reprojected one, with
+its default luminance stop; the -fixed and -variance methods name the stop: --atrous-guide). Reports a table, JSON, a
 per-frame FLIP plot and the milliseconds each method's extra stages took (from stats.json).
 
 Setup once: bench/quality/setup_env.sh, then
@@ -36,6 +37,7 @@ METHODS = {
     "reproject": ["--convergence", "reproject"],
     "reproject+oidn": ["--convergence", "reproject", "--denoise", "oidn"],
     "atrous": ["--no-convergence", "--denoise", "atrous"],
+    "atrous-fixed": ["--no-convergence", "--denoise", "atrous", "--atrous-guide", "fixed"],
     "reproject+atrous": ["--convergence", "reproject", "--denoise", "atrous"],
     "reproject+atrous-fixed": ["--convergence", "reproject", "--denoise", "atrous", "--atrous-guide", "fixed"],
     "reproject+atrous-variance": ["--convergence", "reproject", "--denoise", "atrous", "--atrous-guide", "variance"],

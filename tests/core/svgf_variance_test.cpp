@@ -186,9 +186,8 @@ TEST(SvgfVariance, NonFiniteSamplesNeverEnterTheMoments) {
 
 // A lighting edge on one flat wall (a shadow's border: same normal and depth both sides), light 1 on the
 // left and 3 on the right with +-50% noise, after 8 still frames of reprojection. The guided filter (3
-// passes, sigma 4 standard deviations of the per-frame noise, as SVGF) must take most of the noise out of
-// the flat region and keep most of the edge; the fixed luminance stop, at its default scale, pulls the two
-// sides together four times as much.
+// passes, sigma 2 standard deviations of the per-frame noise) must take most of the noise out of the flat
+// region and keep the edge; the fixed luminance stop, at its default scale, pulls the two sides together.
 TEST(SvgfVariance, SmoothsAFlatNoisyRegionMoreThanItBlursASharpEdge) {
   const GBuffer g = still_wall();
   std::mt19937 rng(21);
@@ -199,6 +198,8 @@ TEST(SvgfVariance, SmoothsAFlatNoisyRegionMoreThanItBlursASharpEdge) {
     AtrousOptions options;
     options.guide = guide;
     options.passes = 3;
+    options.variance_sigma = 2.0f;
+    options.color_sigma = 2.0f;
     FrameBuffer out;
     AtrousFilter(options).apply(r.image(), g, out, history);
     const Stats before = region(r.image(), 2, kW / 2 - 8, 2, kH - 2), after = region(out, 2, kW / 2 - 8, 2, kH - 2);
@@ -217,9 +218,10 @@ TEST(SvgfVariance, SmoothsAFlatNoisyRegionMoreThanItBlursASharpEdge) {
   RecordProperty("fixed_edge_blur", std::to_string(fixed_blur));
   std::printf("noise left (after / before): variance %.3f, fixed %.3f; edge pulled in: variance %.3f, fixed %.3f\n",
               variance_noise, fixed_noise, variance_blur, fixed_blur);
-  // Measured: noise 0.058 of what reprojection left, edge pulled in by 0.117 of the step (fixed: 0.099, 0.402).
-  EXPECT_LT(variance_noise, 0.12) << "the flat region keeps less than an eighth of its noise";
-  EXPECT_LT(variance_blur, 0.16) << "the edge's two sides move by less than 16% of the step";
-  EXPECT_LT(variance_blur, 0.5 * fixed_blur) << "the fixed stop blurs the lighting edge more";
+  // Measured: noise 0.072 of what reprojection left, edge pulled in by 0.043 of the step (fixed: 0.099, 0.402;
+  // the variance guide at SVGF's sigma 4: 0.058, 0.117).
+  EXPECT_LT(variance_noise, 0.15) << "the flat region keeps less than a sixth of its noise";
+  EXPECT_LT(variance_blur, 0.08) << "the edge's two sides move by less than 8% of the step";
+  EXPECT_LT(variance_blur, 0.25 * fixed_blur) << "the fixed stop blurs the lighting edge far more";
   EXPECT_LT(variance_noise, 2.0 * fixed_noise) << "and does not denoise much better";
 }
