@@ -182,6 +182,15 @@ TEST(SvgfVariance, NonFiniteSamplesNeverEnterTheMoments) {
     EXPECT_NEAR(m1, mean, 1e-5 * sum2[p] / good[p]) << p;
     EXPECT_NEAR(m2 - m1 * m1, variance, 1e-5 * sum2[p] / good[p]) << p;
   }
+  // A finite sample whose luminance's square overflows a float (a firefly over a black albedo) enters the
+  // colour history but not the moments.
+  FrameBuffer f = lit_frame(g, rng, 0.5f, 1.0f, 2.0f);
+  f.rgba[4 * 5] = 1e36f;
+  const float m1_before = r.luminance_moments()[2 * 5], m2_before = r.luminance_moments()[2 * 5 + 1];
+  r.accumulate(f, g);
+  for (float v : r.luminance_moments()) ASSERT_TRUE(std::isfinite(v));
+  EXPECT_FLOAT_EQ(r.luminance_moments()[2 * 5], m1_before);
+  EXPECT_FLOAT_EQ(r.luminance_moments()[2 * 5 + 1], m2_before);
 }
 
 // A lighting edge on one flat wall (a shadow's border: same normal and depth both sides), light 1 on the
