@@ -167,7 +167,8 @@ int run_render(const RenderArgs& a) {
         a.atrous_passes > 0 ? a.atrous_passes : core::atrous_passes_for_height(a.height);
     core::AtrousOptions& ao = post_options.atrous_options;
     ao.guide = core::parse_atrous_guide(a.atrous_guide);
-    if (a.atrous_sigma > 0.0f) (ao.guide == core::AtrousGuide::variance ? ao.variance_sigma : ao.color_sigma) = a.atrous_sigma;
+    if (a.atrous_sigma > 0.0f)
+      (core::atrous_guide_uses_variance(ao.guide) ? ao.variance_sigma : ao.color_sigma) = a.atrous_sigma;
     post = tracers::make_frame_post(post_place, post_options);
     spdlog::info("{}{}{} on {}", reproject ? "reprojection" : "", reproject && atrous ? " and " : "",
                  atrous ? "the a-trous filter (" + std::to_string(ao.passes) + " passes, " + a.atrous_guide + " guide)"
@@ -399,9 +400,9 @@ void add_render_command(CLI::App& app, int& exit_code) {
   cmd->add_option("--atrous-guide", a->atrous_guide,
                   "luminance stop of --denoise atrous: variance (SVGF: each pixel's luminance variance from the "
                   "reprojected history's moments, or its neighbourhood while the history is short) or fixed (one "
-                  "relative scale everywhere)")
+                  "relative scale everywhere); variance-of-mean divides the variance by the history length")
       ->capture_default_str()
-      ->check(CLI::IsMember({"variance", "fixed"}));
+      ->check(CLI::IsMember({"variance", "variance-of-mean", "fixed"}));
   cmd->add_option("--atrous-sigma", a->atrous_sigma,
                   "luminance stop's scale of --denoise atrous: standard deviations with the variance guide "
                   "(default 2), relative difference with the fixed one (default 2); 0 keeps the default")

@@ -41,6 +41,8 @@ METHODS = {
     "reproject+atrous": ["--convergence", "reproject", "--denoise", "atrous"],
     "reproject+atrous-fixed": ["--convergence", "reproject", "--denoise", "atrous", "--atrous-guide", "fixed"],
     "reproject+atrous-variance": ["--convergence", "reproject", "--denoise", "atrous", "--atrous-guide", "variance"],
+    "reproject+atrous-variance-of-mean": ["--convergence", "reproject", "--denoise", "atrous", "--atrous-guide",
+                                          "variance-of-mean"],
 }
 EXTRA_STAGES = ("convergence", "denoise", "convergence+denoise")
 

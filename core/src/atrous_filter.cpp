@@ -27,11 +27,16 @@ int atrous_normal_squarings(int power) {
 
 AtrousGuide parse_atrous_guide(const std::string& name) {
   if (name == "variance") return AtrousGuide::variance;
+  if (name == "variance-of-mean") return AtrousGuide::variance_of_mean;
   if (name == "fixed") return AtrousGuide::fixed;
-  throw std::invalid_argument("a-trous guide: expected variance or fixed, got '" + name + "'");
+  throw std::invalid_argument("a-trous guide: expected variance, variance-of-mean or fixed, got '" + name + "'");
 }
 
-const char* atrous_guide_name(AtrousGuide guide) { return guide == AtrousGuide::variance ? "variance" : "fixed"; }
+const char* atrous_guide_name(AtrousGuide guide) {
+  return guide == AtrousGuide::variance ? "variance" : guide == AtrousGuide::variance_of_mean ? "variance-of-mean" : "fixed";
+}
+
+bool atrous_guide_uses_variance(AtrousGuide guide) { return guide != AtrousGuide::fixed; }
 
 int atrous_passes_for_height(int height) {
   int passes = 1;
@@ -52,7 +57,7 @@ void AtrousFilter::apply(const FrameBuffer& frame, const GBuffer& gbuffer, Frame
     for (size_t p = begin; p < end; ++p)
       k_atrous_modulate(frame.rgba.data(), gbuffer.albedo.data(), ping_.rgba.data(), static_cast<kint>(p), 0);
   });
-  const bool variance = options_.guide == AtrousGuide::variance;
+  const bool variance = atrous_guide_uses_variance(options_.guide);
   KAtrousParams params{};
   params.width = width;
   params.height = height;
@@ -78,6 +83,7 @@ void AtrousFilter::apply(const FrameBuffer& frame, const GBuffer& gbuffer, Frame
     v.have_history = history.moments && history.length ? 1 : 0;
     v.depth_sigma = options_.depth_sigma;
     v.short_history = options_.short_history;
+    v.of_mean = options_.guide == AtrousGuide::variance_of_mean ? 1 : 0;
     rows([&](int x, int y) {
       k_svgf_variance_pixel(ping_.rgba.data(), history.moments, history.length, gbuffer.depth.data(),
                             gbuffer.normal.data(), estimated_variance_.data(), &v, x, y);

@@ -17,7 +17,7 @@ void FramePost::process_packed(const BandBuffer& packed) {
 
 FramePostOptions with_history_moments(FramePostOptions options) {
   options.reprojection.luminance_moments =
-      options.reproject && options.atrous && options.atrous_options.guide == AtrousGuide::variance;
+      options.reproject && options.atrous && atrous_guide_uses_variance(options.atrous_options.guide);
   return options;
 }
 

@@ -69,7 +69,7 @@ AtrousOptions with(int passes, AtrousGuide guide) {
   return o;
 }
 
-const AtrousGuide kGuides[] = {AtrousGuide::variance, AtrousGuide::fixed};
+const AtrousGuide kGuides[] = {AtrousGuide::variance, AtrousGuide::variance_of_mean, AtrousGuide::fixed};
 
 }  // namespace
 
@@ -145,6 +145,8 @@ TEST(AtrousFilter, LeavesOutSamplesThatAreNotFinite) {
 TEST(AtrousFilter, GuidesAreNamedOrRefused) {
   EXPECT_EQ(parse_atrous_guide("variance"), AtrousGuide::variance);
   EXPECT_EQ(parse_atrous_guide("fixed"), AtrousGuide::fixed);
+  EXPECT_EQ(parse_atrous_guide("variance-of-mean"), AtrousGuide::variance_of_mean);
+  EXPECT_STREQ(atrous_guide_name(AtrousGuide::variance_of_mean), "variance-of-mean");
   EXPECT_STREQ(atrous_guide_name(AtrousGuide::fixed), "fixed");
   EXPECT_THROW(parse_atrous_guide("svgf"), std::invalid_argument);
 }

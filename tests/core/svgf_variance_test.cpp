@@ -87,6 +87,8 @@ TEST(SvgfVariance, TemporalMomentsMatchABruteForceVariance) {
   AtrousOptions options;
   options.guide = AtrousGuide::variance;
   AtrousFilter filter(options);
+  options.guide = AtrousGuide::variance_of_mean;
+  AtrousFilter of_mean(options);
   FrameBuffer filtered;
   std::mt19937 rng(3);
   const size_t pixels = size_t(kW) * kH;
@@ -99,15 +101,17 @@ TEST(SvgfVariance, TemporalMomentsMatchABruteForceVariance) {
     }
     r.accumulate(f, g);
     filter.apply(r.image(), g, filtered, AtrousHistory{r.luminance_moments().data(), r.history_length().data()});
+    of_mean.apply(r.image(), g, filtered, AtrousHistory{r.luminance_moments().data(), r.history_length().data()});
     ASSERT_EQ(r.luminance_moments().size(), 2 * pixels);
     for (size_t p = 0; p < pixels; ++p) {
       const double mean = sum[p] / n, variance = sum2[p] / n - mean * mean;
       const double m1 = r.luminance_moments()[2 * p], m2 = r.luminance_moments()[2 * p + 1];
       ASSERT_NEAR(m1, mean, 1e-5 * sum2[p] / n + 1e-6) << "frame " << n << " pixel " << p;
       ASSERT_NEAR(m2 - m1 * m1, variance, 1e-5 * sum2[p] / n + 1e-6) << "frame " << n << " pixel " << p;
-      // From 4 frames on, the filter's variance is the temporal one.
+      // From 4 frames on, the filter's variance is the temporal one (over n: the variance of the mean).
       if (n >= 4) {
         ASSERT_NEAR(filter.estimated_variance()[p], variance, 1e-5 * sum2[p] / n + 1e-6) << "frame " << n;
+        ASSERT_NEAR(of_mean.estimated_variance()[p], variance / n, 1e-5 * sum2[p] / n + 1e-6) << "frame " << n;
       }
     }
   }

@@ -144,9 +144,11 @@ TEST(AtrousOpenCL, TheVarianceGuideMatchesTheCppBuildOfTheSameHeader) {
       moments[2 * p] = m1, moments[2 * p + 1] = m1 * m1 + u(rng);
       length[p] = float((x + y) % 8);
     }
+  for (int of_mean : {0, 1}) {
+  SCOPED_TRACE(of_mean ? "variance of the mean" : "variance of a sample");
   KSvgfVarianceParams vp{};
   vp.width = w, vp.height = h, vp.normal_squarings = 6, vp.have_history = 1;
-  vp.depth_sigma = 0.1f, vp.short_history = 4.0f;
+  vp.depth_sigma = 0.1f, vp.short_history = 4.0f, vp.of_mean = of_mean;
   KAtrousParams params{};
   params.width = w, params.height = h, params.step = 2;
   params.normal_squarings = 6, params.depth_sigma = 0.1f, params.color_sigma = 4.0f;
@@ -193,6 +195,7 @@ TEST(AtrousOpenCL, TheVarianceGuideMatchesTheCppBuildOfTheSameHeader) {
         << "filtered variance " << i;
   for (cl_mem m : {m_rgba, m_moments, m_length, m_depth, m_normal, m_variance, m_out, m_out_variance})
     clReleaseMemObject(m);
+  }
   clReleaseKernel(variance_kernel);
   clReleaseKernel(pass_kernel);
 #endif

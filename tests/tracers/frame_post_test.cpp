@@ -67,13 +67,14 @@ double max_relative_difference(const core::FrameBuffer& a, const core::FrameBuff
 }  // namespace
 
 TEST(FramePost, HostRunsReprojectionThenTheFilter) {
-  for (core::AtrousGuide guide : {core::AtrousGuide::variance, core::AtrousGuide::fixed}) {
+  for (core::AtrousGuide guide :
+       {core::AtrousGuide::variance, core::AtrousGuide::variance_of_mean, core::AtrousGuide::fixed}) {
     core::FramePostOptions options = both();
     options.atrous_options.guide = guide;
     core::HostFramePost post(options);
     // The variance guide reads the history's luminance moments, which only it switches on.
     core::ReprojectionOptions reprojection_options;
-    reprojection_options.luminance_moments = guide == core::AtrousGuide::variance;
+    reprojection_options.luminance_moments = guide != core::AtrousGuide::fixed;
     EXPECT_EQ(core::with_history_moments(options).reprojection.luminance_moments, reprojection_options.luminance_moments);
     core::TemporalReprojection reprojection(reprojection_options);
     core::AtrousFilter filter(options.atrous_options);
@@ -122,14 +123,16 @@ TEST(FramePost, PlacesAreNamedOrRefused) {
 TEST(FramePost, CudaMatchesTheHostOverAMovingSequence) {
   if (tracers::device_count("cuda") == 0) GTEST_SKIP() << "no CUDA device (or a build without CUDA)";
   EXPECT_EQ(tracers::auto_frame_post_place(tracers::parse_tracer_list("embree,cuda:0")), "cuda:0");
-  // No filter, the fixed guide, the variance guide over the history's moments, and the variance guide
-  // alone (spatial estimate only).
-  for (int variant = 0; variant < 4; ++variant) {
+  // No filter, the fixed guide, the variance guide over the history's moments, the variance guide alone
+  // (spatial estimate only), and the variance of the mean.
+  for (int variant = 0; variant < 5; ++variant) {
     const bool atrous = variant > 0;
     core::FramePostOptions options = both();
     options.atrous = atrous;
     options.reproject = variant != 3;
-    options.atrous_options.guide = variant == 1 ? core::AtrousGuide::fixed : core::AtrousGuide::variance;
+    options.atrous_options.guide = variant == 1   ? core::AtrousGuide::fixed
+                                   : variant == 4 ? core::AtrousGuide::variance_of_mean
+                                                  : core::AtrousGuide::variance;
     core::HostFramePost host(options);
     std::unique_ptr<core::FramePost> gpu = tracers::make_frame_post("cuda:0", options);
     EXPECT_EQ(gpu->where(), "cuda:0");

@@ -216,7 +216,7 @@ class CudaFramePost final : public core::FramePost {
       modulate_kernel<<<blocks_for(pixels), kThreads, 0, stream_>>>(current, albedo_.data(), ping,
                                                                        static_cast<int>(pixels), 0);
       const core::AtrousOptions& ao = options_.atrous_options;
-      const bool variance = ao.guide == core::AtrousGuide::variance;
+      const bool variance = core::atrous_guide_uses_variance(ao.guide);
       KAtrousParams params{};
       params.width = width, params.height = height;
       params.normal_squarings = normal_squarings_;
@@ -232,6 +232,7 @@ class CudaFramePost final : public core::FramePost {
         v.have_history = options_.reproject ? 1 : 0;
         v.depth_sigma = ao.depth_sigma;
         v.short_history = ao.short_history;
+        v.of_mean = ao.guide == core::AtrousGuide::variance_of_mean ? 1 : 0;
         const State& history = state_[parity_];  // the state the reprojection just wrote
         svgf_variance_kernel<<<blocks_for(pixels), kThreads, 0, stream_>>>(
             ping, options_.reproject ? history.moments.data() : nullptr,

@@ -17,7 +17,9 @@
 
 namespace cohort::core {
 
-enum class AtrousGuide { variance, fixed };
+// variance: SVGF's, the luminance variance of one frame's sample; variance_of_mean: that over the history
+// length, the variance of the accumulated mean the filter sees (converged pixels are left alone).
+enum class AtrousGuide { variance, variance_of_mean, fixed };
 
 struct AtrousOptions {
   int passes = 1;             // steps 1, 2, 4, ...: 1 pass is a 5x5 filter, 4 a 61-pixel one
@@ -30,9 +32,11 @@ struct AtrousOptions {
   float short_history = 4.0f;   // variance guide: frames of history below which variance is estimated spatially
 };
 
-// "variance" or "fixed" (std::invalid_argument otherwise, naming the word).
+// "variance", "variance-of-mean" or "fixed" (std::invalid_argument otherwise, naming the word).
 AtrousGuide parse_atrous_guide(const std::string& name);
 const char* atrous_guide_name(AtrousGuide guide);
+// Whether the guide reads a variance (and the history's luminance moments when reprojecting).
+bool atrous_guide_uses_variance(AtrousGuide guide);
 
 // The reprojected history the variance guide reads (TemporalReprojection with luminance moments, two
 // floats a pixel, and its history lengths); null: no history, the variance is estimated spatially.

@@ -6,6 +6,8 @@
  *                          shorter than `short_history` frames (or there is none), from the moments of the
  *                          7x7 neighbourhood on the same surface (normal and depth stops), boosted by
  *                          short_history / length as SVGF does, since few frames underestimate it;
+ *                          with of_mean, either is divided by the history length: the variance of the
+ *                          accumulated mean the filter sees rather than of one frame's sample;
  *   k_svgf_atrous_pixel    one a-trous pass (kernel/atrous.h's taps, spline and geometric stops) whose
  *                          luminance stop is |l_p - l_q| / (sigma * sqrt(g3x3(var_p)) + eps): the
  *                          difference in standard deviations of the pixel's own noise, so converged pixels
@@ -24,7 +26,9 @@ typedef struct KSvgfVarianceParams {
   kint have_history;    /* 0: no temporal moments (no reprojection): always the spatial estimate */
   float depth_sigma;    /* relative depth difference per pixel of tap distance (the a-trous filter's) */
   float short_history;  /* frames: a history shorter than this gets the spatial estimate (SVGF: 4) */
-  float pad0; float pad1;
+  kint of_mean;         /* 1: the variance of the accumulated mean (the samples' over the history length),
+                           not SVGF's variance of one frame's sample */
+  float pad1;
 } KSvgfVarianceParams;
 
 /* Added to the luminance stop's scale: pixels with no measured noise still mix with equal neighbours. */
@@ -38,8 +42,9 @@ KFN void k_svgf_variance_pixel(KGLOBAL const float* illumination, KGLOBAL const 
                                KGLOBAL float* variance, const KSvgfVarianceParams* p, kint x, kint y) {
   kint centre = y * p->width + x;
   float history = p->have_history ? length[centre] : 0.0f;
+  float of_mean = p->of_mean ? 1.0f / k_fmax(history, 1.0f) : 1.0f;
   if (history >= p->short_history) {
-    variance[centre] = k_fmax(moments[2 * centre + 1] - moments[2 * centre] * moments[2 * centre], 0.0f);
+    variance[centre] = k_fmax(moments[2 * centre + 1] - moments[2 * centre] * moments[2 * centre], 0.0f) * of_mean;
     return;
   }
   float zp = depth[centre];
@@ -84,7 +89,7 @@ KFN void k_svgf_variance_pixel(KGLOBAL const float* illumination, KGLOBAL const 
     float mean = s1 / weight_sum;
     v = k_fmax(s2 / weight_sum - mean * mean, 0.0f);
   }
-  variance[centre] = v * (p->short_history / k_fmax(history, 1.0f));
+  variance[centre] = v * (p->short_history / k_fmax(history, 1.0f)) * of_mean;
 }
 
 /* The pixel's variance seen through a 3x3 Gaussian (1/4 centre, 1/8 sides, 1/16 corners; SVGF), which
