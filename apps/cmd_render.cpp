@@ -399,8 +399,9 @@ void add_render_command(CLI::App& app, int& exit_code) {
       ->check(CLI::Range(0, 6));
   cmd->add_option("--atrous-guide", a->atrous_guide,
                   "luminance stop of --denoise atrous: variance (SVGF: each pixel's luminance variance from the "
-                  "reprojected history's moments, or its neighbourhood while the history is short) or fixed (one "
-                  "relative scale everywhere); variance-of-mean divides the variance by the history length")
+                  "reprojected history's moments, or its neighbourhood while the history is short), "
+                  "variance-of-mean (that over the history length: the noise the accumulated frame still has) or "
+                  "fixed (one relative scale everywhere)")
       ->capture_default_str()
       ->check(CLI::IsMember({"variance", "variance-of-mean", "fixed"}));
   cmd->add_option("--atrous-sigma", a->atrous_sigma,

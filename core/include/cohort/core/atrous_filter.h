@@ -3,10 +3,12 @@
 // not colour: the frame is divided by the G-buffer's albedo before the passes and multiplied back
 // after, so textures stay sharp while the lighting's noise is smoothed (as SVGF does). Runs after the
 // merge (and after temporal accumulation), so band boundaries cannot show.
-// Two luminance stops (AtrousGuide): `variance`, SVGF's (kernel/svgf.h): each pixel's luminance variance,
+// Luminance stops (AtrousGuide): `variance`, SVGF's (kernel/svgf.h): each pixel's luminance variance,
 // from the reprojected history's temporal moments where it is at least `short_history` frames long and
 // from its neighbourhood elsewhere, sets how far luminance may differ, and is filtered along with the
-// colour; `fixed`, the relative difference of luminance with one scale everywhere (kernel/atrous.h).
+// colour; `variance_of_mean` (the default), the same over the history length: the noise the accumulated
+// frame still has, so converged pixels are left alone; `fixed`, the relative difference of luminance with
+// one scale everywhere (kernel/atrous.h).
 #pragma once
 
 #include <string>
@@ -26,7 +28,7 @@ struct AtrousOptions {
   int normal_power = 64;      // cosine exponent of the normal stop; a power of two (squared, not pow)
   float depth_sigma = 0.1f;   // relative depth difference per step of tap distance
   float color_sigma = 2.0f;   // fixed guide: relative luminance difference of the illumination
-  AtrousGuide guide = AtrousGuide::variance;
+  AtrousGuide guide = AtrousGuide::variance_of_mean;  // measured best on the test map (docs/denoising.md)
   float variance_sigma = 2.0f;  // variance guide: luminance difference in standard deviations (SVGF: 4; 2
                                 // measured better on the test map, docs/denoising.md)
   float short_history = 4.0f;   // variance guide: frames of history below which variance is estimated spatially
