@@ -63,6 +63,8 @@ struct RenderArgs {
   std::string denoise = "none";
   std::string denoise_quality = "high";
   int atrous_passes = 0;  // 0: from the image height (core/atrous_filter.h)
+  std::string atrous_guide = core::atrous_guide_name(core::AtrousOptions{}.guide);
+  float atrous_sigma = 0.0f;  // 0: the guide's default
   std::string post_on = "auto";
   std::string band_format = "rgb16f";
   bool frames_given = false;
@@ -164,9 +166,15 @@ int run_render(const RenderArgs& a) {
     post_options.atrous = atrous;
     post_options.atrous_options.passes =
         a.atrous_passes > 0 ? a.atrous_passes : core::atrous_passes_for_height(a.height);
+    core::AtrousOptions& ao = post_options.atrous_options;
+    ao.guide = core::parse_atrous_guide(a.atrous_guide);
+    if (a.atrous_sigma > 0.0f)
+      (core::atrous_guide_uses_variance(ao.guide) ? ao.variance_sigma : ao.color_sigma) = a.atrous_sigma;
     post = tracers::make_frame_post(post_place, post_options);
     spdlog::info("{}{}{} on {}", reproject ? "reprojection" : "", reproject && atrous ? " and " : "",
-                 atrous ? "the a-trous filter" : "", post->where());
+                 atrous ? "the a-trous filter (" + std::to_string(ao.passes) + " passes, " + a.atrous_guide + " guide)"
+                        : std::string(),
+                 post->where());
   }
   // A GPU post-processing reprojection takes the bands as the tracers packed them: half the bytes cross
   // the bus and the host skips its conversions (the float frame and G-buffer are not made).
@@ -391,6 +399,18 @@ void add_render_command(CLI::App& app, int& exit_code) {
                   "0 picks them from the image height (1 up to 360 rows, 3 at 1080)")
       ->capture_default_str()
       ->check(CLI::Range(0, 6));
+  cmd->add_option("--atrous-guide", a->atrous_guide,
+                  "luminance stop of --denoise atrous: variance (SVGF: each pixel's luminance variance from the "
+                  "reprojected history's moments, or its neighbourhood while the history is short), "
+                  "variance-of-mean (that over the history length: the noise the accumulated frame still has) or "
+                  "fixed (one relative scale everywhere)")
+      ->capture_default_str()
+      ->check(CLI::IsMember({"variance", "variance-of-mean", "fixed"}));
+  cmd->add_option("--atrous-sigma", a->atrous_sigma,
+                  "luminance stop's scale of --denoise atrous: standard deviations with the variance guide "
+                  "(default 2), relative difference with the fixed one (default 2); 0 keeps the default")
+      ->capture_default_str()
+      ->check(CLI::Range(0.0f, 1000.0f));
   cmd->add_option("--post-on", a->post_on,
                   "where reprojection and the a-trous filter run: host (the CPU's threads), cuda:N (a GPU; the "
                   "frame and its G-buffer cross the bus each frame) or auto (the first CUDA tracer's GPU, else the "

@@ -4,7 +4,10 @@
 // still, so every frame blends into the accumulated image. The reprojection (core/reprojection.h) is
 // timed beside the blend on a synthetic G-buffer in which every pixel moves (0.3 pixels a frame, the
 // costly case: bilinear history and neighbourhood clamp everywhere), then the a-trous filter over its
-// result with the passes `--denoise atrous` picks for the height.
+// result with the passes `--denoise atrous` picks for the height: with the fixed luminance stop, and
+// with the variance guide (core/atrous_filter.h) over a reprojection that keeps the luminance moments
+// (its own "reproject+moments" column): from the history's temporal variance (every pixel's history is
+// long after 4 frames) and, the worst case of a frame with no history, from the 7x7 spatial estimate.
 //
 //   bench_host_frame [--width 1920] [--height 1080] [--frames 40] [--json FILE]   (out/bench_host_frame.json)
 #include <algorithm>
@@ -59,7 +62,14 @@ nlohmann::json run(BandFormat format, int width, int height, int frames) {
   AdaptiveConvergence convergence;
   ToneMapOptions tone_options;
   TemporalReprojection reprojection;
-  AtrousFilter atrous(AtrousOptions{atrous_passes_for_height(height)});
+  ReprojectionOptions moment_options;
+  moment_options.luminance_moments = true;
+  TemporalReprojection reprojection_with_moments(moment_options);
+  AtrousOptions fixed_options, variance_options;
+  fixed_options.passes = variance_options.passes = atrous_passes_for_height(height);
+  fixed_options.guide = AtrousGuide::fixed;
+  variance_options.guide = AtrousGuide::variance_of_mean;  // the default; SVGF's "variance" costs the same
+  AtrousFilter atrous(fixed_options), guided(variance_options);
   FrameBuffer filtered;
   GBuffer moving;
   moving.resize(width, height);
@@ -70,7 +80,7 @@ nlohmann::json run(BandFormat format, int width, int height, int frames) {
     moving.motion[2 * p] = 0.3f;
     for (int k = 0; k < 3; ++k) moving.albedo[3 * p + k] = 0.5f;
   }
-  std::vector<double> merge, blend, tone, reproject, denoise;
+  std::vector<double> merge, blend, tone, reproject, denoise, reproject_moments, guided_ms, spatial_ms;
   auto finish = [&](FramePipeline::Delivered done) {
     ScopedStage blending(done.stats.stages, kCoreTrack, "convergence");
     convergence.accumulate(done.job.camera, pipeline.image());
@@ -81,6 +91,17 @@ nlohmann::json run(BandFormat format, int width, int height, int frames) {
     ScopedStage filtering(done.stats.stages, kCoreTrack, "atrous");
     atrous.apply(reprojection.image(), moving, filtered);
     filtering.finish();
+    ScopedStage with_moments(done.stats.stages, kCoreTrack, "reproject+moments");
+    reprojection_with_moments.accumulate(pipeline.image(), moving);
+    with_moments.finish();
+    ScopedStage guiding(done.stats.stages, kCoreTrack, "atrous variance");
+    guided.apply(reprojection_with_moments.image(), moving, filtered,
+                 AtrousHistory{reprojection_with_moments.luminance_moments().data(),
+                               reprojection_with_moments.history_length().data()});
+    guiding.finish();
+    ScopedStage spatial(done.stats.stages, kCoreTrack, "atrous variance spatial");
+    guided.apply(reprojection_with_moments.image(), moving, filtered);
+    spatial.finish();
     ScopedStage mapping(done.stats.stages, kCoreTrack, "tone map");
     const std::vector<uint8_t> display = tone_map(convergence.image(), tone_options);
     mapping.finish();
@@ -90,6 +111,9 @@ nlohmann::json run(BandFormat format, int width, int height, int frames) {
     tone.push_back(stage_ms(done.stats, "tone map"));
     reproject.push_back(stage_ms(done.stats, "reproject"));
     denoise.push_back(stage_ms(done.stats, "atrous"));
+    reproject_moments.push_back(stage_ms(done.stats, "reproject+moments"));
+    guided_ms.push_back(stage_ms(done.stats, "atrous variance"));
+    spatial_ms.push_back(stage_ms(done.stats, "atrous variance spatial"));
   };
   for (int f = 0; f < frames; ++f) {
     BandJob job;
@@ -102,7 +126,8 @@ nlohmann::json run(BandFormat format, int width, int height, int frames) {
   return {{"band_format", to_string(format)}, {"band_bytes_per_pixel", bytes_per_pixel(format)},
           {"merge_ms", m}, {"convergence_ms", c}, {"tone_map_ms", t}, {"host_ms", m + c + t},
           {"reproject_ms", median(reproject)}, {"atrous_passes", atrous_passes_for_height(height)},
-          {"atrous_ms", median(denoise)}};
+          {"atrous_ms", median(denoise)}, {"reproject_moments_ms", median(reproject_moments)},
+          {"atrous_variance_ms", median(guided_ms)}, {"atrous_variance_spatial_ms", median(spatial_ms)}};
 }
 
 }  // namespace
@@ -123,14 +148,17 @@ int main(int argc, char** argv) {
   }
   std::printf("host work per frame at %dx%d, %u host threads, median of %d frames\n", width, height,
               HostThreads::shared().threads(), frames - 5);
-  std::printf("%-8s %10s %10s %14s %12s %10s %13s %10s\n", "band", "bytes/px", "merge ms", "convergence ms",
-              "tone map ms", "host ms", "reproject ms", "atrous ms");
+  std::printf("%-8s %10s %10s %14s %12s %10s %13s %10s %15s %13s %13s\n", "band", "bytes/px", "merge ms",
+              "convergence ms", "tone map ms", "host ms", "reproject ms", "atrous ms", "+moments ms", "variance ms",
+              "spatial ms");
   nlohmann::json results = nlohmann::json::array();
   for (BandFormat format : {BandFormat::rgba32f, BandFormat::rgb16f}) {
     const nlohmann::json r = run(format, width, height, frames);
-    std::printf("%-8s %10zu %10.2f %14.2f %12.2f %10.2f %13.2f %10.2f\n", to_string(format), bytes_per_pixel(format),
-                r["merge_ms"].get<double>(), r["convergence_ms"].get<double>(), r["tone_map_ms"].get<double>(),
-                r["host_ms"].get<double>(), r["reproject_ms"].get<double>(), r["atrous_ms"].get<double>());
+    std::printf("%-8s %10zu %10.2f %14.2f %12.2f %10.2f %13.2f %10.2f %15.2f %13.2f %13.2f\n", to_string(format),
+                bytes_per_pixel(format), r["merge_ms"].get<double>(), r["convergence_ms"].get<double>(),
+                r["tone_map_ms"].get<double>(), r["host_ms"].get<double>(), r["reproject_ms"].get<double>(),
+                r["atrous_ms"].get<double>(), r["reproject_moments_ms"].get<double>(),
+                r["atrous_variance_ms"].get<double>(), r["atrous_variance_spatial_ms"].get<double>());
     results.push_back(r);
   }
   const std::filesystem::path path(json_path);

@@ -86,15 +86,19 @@ case "${1:-}" in
     nvidia-smi --query-gpu=index,name --format=csv,noheader
     [ -f /tmp/largemap.cpk ] || { python3 tools/gen_testmap.py --large --out /tmp/largemap >/dev/null &&
       "$stage/bin/cohort" pack /tmp/largemap/maps/largemap.map --out /tmp/largemap.cpk | tail -n 1; }
-    # Reprojection on the GPU (alone, then with the a-trous filter) and on the host, then the paper's blend.
-    for variant in "reproject cuda:0 none" "reproject cuda:0 atrous" "reproject host none" "brigade host none"; do
+    # Reprojection on the GPU (alone, then with the a-trous filter: variance guide, then the fixed stop) and
+    # on the host, then the paper's blend.
+    for variant in "reproject cuda:0 none" "reproject cuda:0 atrous" "reproject cuda:0 atrous-fixed" \
+                   "reproject host none" "brigade host none"; do
       read -r convergence post denoise <<<"$variant"
+      denoise_args=(--denoise "${denoise%-fixed}")
+      [ "$denoise" = atrous-fixed ] && denoise_args+=(--atrous-guide fixed)
       for map in large test; do
         if [ $map = large ]; then args=(/tmp/largemap.cpk --width 1920 --height 1080 --camera 1690 300 80 5 -12)
         else args=("$stage/testmap.cpk" --width 1280 --height 720); fi
         run=/tmp/ft_${map}_${convergence}_${post}_$denoise
         "$stage/bin/cohort" render "${args[@]}" --tracers "${COHORT_GPU_TRACERS:-cuda:0}" --spp 1 --bounces 1 \
-          --convergence $convergence --post-on $post --denoise $denoise --frames 60 --camera-path spin-slow \
+          --convergence $convergence --post-on $post "${denoise_args[@]}" --frames 60 --camera-path spin-slow \
           --write last --out $run >/dev/null
         echo "== $map map, convergence $convergence, post on $post, denoise $denoise"
         python3 tools/frame_times.py $run/stats.json --skip 10

@@ -8,7 +8,8 @@ Methods: none (each frame as rendered), brigade (adaptive convergence, Brigade's
 denoised by Open Image Denoise), brigade+oidn (the blended frame denoised), reproject (per-pixel history
 through motion vectors, core/reprojection.h), reproject+oidn (the reprojected frame denoised, with the
 albedo and normal planes as the denoiser's guides), atrous and reproject+atrous (the real-time edge-aware
-a-trous filter of the portable kernel, core/atrous_filter.h, on each frame or on the reprojected one). Reports a table, JSON, a
+a-trous filter of the portable kernel, core/atrous_filter.h, on each frame or on the reprojected one, with
+its default luminance stop; the -fixed and -variance methods name the stop: --atrous-guide). Reports a table, JSON, a
 per-frame FLIP plot and the milliseconds each method's extra stages took (from stats.json).
 
 Setup once: bench/quality/setup_env.sh, then
@@ -36,9 +37,14 @@ METHODS = {
     "reproject": ["--convergence", "reproject"],
     "reproject+oidn": ["--convergence", "reproject", "--denoise", "oidn"],
     "atrous": ["--no-convergence", "--denoise", "atrous"],
+    "atrous-fixed": ["--no-convergence", "--denoise", "atrous", "--atrous-guide", "fixed"],
     "reproject+atrous": ["--convergence", "reproject", "--denoise", "atrous"],
+    "reproject+atrous-fixed": ["--convergence", "reproject", "--denoise", "atrous", "--atrous-guide", "fixed"],
+    "reproject+atrous-variance": ["--convergence", "reproject", "--denoise", "atrous", "--atrous-guide", "variance"],
+    "reproject+atrous-variance-of-mean": ["--convergence", "reproject", "--denoise", "atrous", "--atrous-guide",
+                                          "variance-of-mean"],
 }
-EXTRA_STAGES = ("convergence", "denoise")
+EXTRA_STAGES = ("convergence", "denoise", "convergence+denoise")
 
 
 def render(args, out_dir, spp, extra):
@@ -96,7 +102,11 @@ def main():
     p.add_argument("--spp", type=int, default=1, help="samples per pixel per frame of the methods")
     p.add_argument("--ref-spp", type=int, default=256, help="samples per pixel of each reference frame")
     p.add_argument("--methods", default=",".join(METHODS), help="comma-separated: " + ", ".join(METHODS))
+    p.add_argument("--extra-args", default="", help="more `cohort render` arguments for every method (not the "
+                   "reference), e.g. \"--atrous-passes 2 --atrous-sigma 4\"")
     p.add_argument("--out", default="out/bench_quality")
+    p.add_argument("--reuse-reference", action="store_true",
+                   help="keep the reference frames already in --out when all are there (same path, size and spp)")
     args = p.parse_args()
     methods = args.methods.split(",")
     for m in methods:
@@ -107,7 +117,13 @@ def main():
 
     ref_dir = os.path.join(args.out, f"reference_{args.ref_spp}spp")
     print(f"reference: {args.frames} frames at {args.ref_spp} spp ...", flush=True)
-    ref_seconds = render(args, ref_dir, args.ref_spp, ["--no-convergence"])
+    have_reference = all(any(os.path.exists(os.path.join(ref_dir, f"frame_{f:04d}{ext}")) for ext in (".png", ".ppm"))
+                         for f in range(args.frames))
+    if args.reuse_reference and have_reference:
+        ref_seconds = 0.0
+        print("  (reused)", flush=True)
+    else:
+        ref_seconds = render(args, ref_dir, args.ref_spp, ["--no-convergence"])
     references = [load_ldr(frame_path(ref_dir, f)) for f in range(args.frames)]
 
     report = {"map": args.map, "tracers": args.tracers, "width": args.width, "height": args.height,
@@ -116,7 +132,7 @@ def main():
     for m in methods:
         out_dir = os.path.join(args.out, m.replace("+", "_"))
         print(f"{m} ...", flush=True)
-        render(args, out_dir, args.spp, METHODS[m])
+        render(args, out_dir, args.spp, METHODS[m] + args.extra_args.split())
         flips, psnrs = [], []
         for f in range(args.frames):
             test = load_ldr(frame_path(out_dir, f))
@@ -127,12 +143,13 @@ def main():
 
     print(f"\n{args.map}, {args.tracers}, {args.width}x{args.height}, {args.camera_path}, {args.frames} frames, "
           f"{args.spp} spp against {args.ref_spp} spp")
-    print(f"{'method':<14}{'mean FLIP':>10}{'last FLIP':>10}{'mean PSNR':>10}{'frame ms':>10}"
-          f"{'blend ms':>10}{'denoise ms':>11}")
+    print(f"{'method':<26}{'mean FLIP':>10}{'last FLIP':>10}{'mean PSNR':>10}{'frame ms':>10}"
+          f"{'blend ms':>10}{'denoise ms':>11}{'both ms':>9}")
     for m, r in report["methods"].items():
         ms = r["ms"]
-        print(f"{m:<14}{statistics.mean(r['flip']):>10.4f}{r['flip'][-1]:>10.4f}{statistics.mean(r['psnr']):>10.2f}"
-              f"{ms['frame']:>10.1f}{ms.get('convergence', 0.0):>10.2f}{ms.get('denoise', 0.0):>11.1f}")
+        print(f"{m:<26}{statistics.mean(r['flip']):>10.4f}{r['flip'][-1]:>10.4f}{statistics.mean(r['psnr']):>10.2f}"
+              f"{ms['frame']:>10.1f}{ms.get('convergence', 0.0):>10.2f}{ms.get('denoise', 0.0):>11.1f}"
+              f"{ms.get('convergence+denoise', 0.0):>9.1f}")
     os.makedirs(args.out, exist_ok=True)
     json_path = os.path.join(args.out, "bench_quality.json")
     with open(json_path, "w") as f:

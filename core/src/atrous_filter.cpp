@@ -6,6 +6,7 @@
 
 #include "cohort/core/host_threads.h"
 #include "cohort/kernel/atrous.h"
+#include "cohort/kernel/svgf.h"
 
 namespace cohort::core {
 
@@ -24,13 +25,27 @@ int atrous_normal_squarings(int power) {
 }
 
 
+AtrousGuide parse_atrous_guide(const std::string& name) {
+  if (name == "variance") return AtrousGuide::variance;
+  if (name == "variance-of-mean") return AtrousGuide::variance_of_mean;
+  if (name == "fixed") return AtrousGuide::fixed;
+  throw std::invalid_argument("a-trous guide: expected variance, variance-of-mean or fixed, got '" + name + "'");
+}
+
+const char* atrous_guide_name(AtrousGuide guide) {
+  return guide == AtrousGuide::variance ? "variance" : guide == AtrousGuide::variance_of_mean ? "variance-of-mean" : "fixed";
+}
+
+bool atrous_guide_uses_variance(AtrousGuide guide) { return guide != AtrousGuide::fixed; }
+
 int atrous_passes_for_height(int height) {
   int passes = 1;
   for (int rows = 360; rows < height && passes < 5; rows *= 2) ++passes;
   return passes;
 }
 
-void AtrousFilter::apply(const FrameBuffer& frame, const GBuffer& gbuffer, FrameBuffer& out) {
+void AtrousFilter::apply(const FrameBuffer& frame, const GBuffer& gbuffer, FrameBuffer& out,
+                         const AtrousHistory& history) {
   if (gbuffer.width != frame.width || gbuffer.height != frame.height)
     throw std::invalid_argument("AtrousFilter: the G-buffer's size differs from the frame's");
   const int width = frame.width, height = frame.height;
@@ -42,22 +57,56 @@ void AtrousFilter::apply(const FrameBuffer& frame, const GBuffer& gbuffer, Frame
     for (size_t p = begin; p < end; ++p)
       k_atrous_modulate(frame.rgba.data(), gbuffer.albedo.data(), ping_.rgba.data(), static_cast<kint>(p), 0);
   });
+  const bool variance = atrous_guide_uses_variance(options_.guide);
   KAtrousParams params{};
   params.width = width;
   params.height = height;
   params.normal_squarings = atrous_normal_squarings(options_.normal_power);
   params.depth_sigma = options_.depth_sigma;
-  params.color_sigma = options_.color_sigma;
+  params.color_sigma = variance ? options_.variance_sigma : options_.color_sigma;
+  const auto rows = [&](auto&& pixel) {
+    threads.for_ranges(static_cast<size_t>(height), kRowsPerTask, [&](size_t row_begin, size_t row_end) {
+      for (int y = static_cast<int>(row_begin); y < static_cast<int>(row_end); ++y)
+        for (int x = 0; x < width; ++x) pixel(x, y);
+    });
+  };
+  float* variance_from = nullptr;
+  float* variance_to = nullptr;
+  if (variance) {
+    estimated_variance_.resize(pixels);
+    variance_ping_.resize(pixels);
+    variance_pong_.resize(pixels);
+    KSvgfVarianceParams v{};
+    v.width = width;
+    v.height = height;
+    v.normal_squarings = params.normal_squarings;
+    v.have_history = history.moments && history.length ? 1 : 0;
+    v.depth_sigma = options_.depth_sigma;
+    v.short_history = options_.short_history;
+    v.of_mean = options_.guide == AtrousGuide::variance_of_mean ? 1 : 0;
+    rows([&](int x, int y) {
+      k_svgf_variance_pixel(ping_.rgba.data(), history.moments, history.length, gbuffer.depth.data(),
+                            gbuffer.normal.data(), estimated_variance_.data(), &v, x, y);
+    });
+    std::copy(estimated_variance_.begin(), estimated_variance_.end(), variance_ping_.begin());
+    variance_from = variance_ping_.data();
+    variance_to = variance_pong_.data();
+  }
   FrameBuffer* from = &ping_;
   FrameBuffer* to = &pong_;
   for (int pass = 0; pass < std::max(options_.passes, 0); ++pass) {
     params.step = 1 << pass;
-    threads.for_ranges(static_cast<size_t>(height), kRowsPerTask, [&](size_t row_begin, size_t row_end) {
-      for (int y = static_cast<int>(row_begin); y < static_cast<int>(row_end); ++y)
-        for (int x = 0; x < width; ++x)
-          k_atrous_pixel(from->rgba.data(), to->rgba.data(), gbuffer.depth.data(), gbuffer.normal.data(), &params, x, y);
-    });
+    if (variance)
+      rows([&](int x, int y) {
+        k_svgf_atrous_pixel(from->rgba.data(), variance_from, to->rgba.data(), variance_to, gbuffer.depth.data(),
+                            gbuffer.normal.data(), &params, x, y);
+      });
+    else
+      rows([&](int x, int y) {
+        k_atrous_pixel(from->rgba.data(), to->rgba.data(), gbuffer.depth.data(), gbuffer.normal.data(), &params, x, y);
+      });
     std::swap(from, to);
+    std::swap(variance_from, variance_to);
   }
   threads.for_ranges(pixels, 16384, [&](size_t begin, size_t end) {
     for (size_t p = begin; p < end; ++p)

@@ -15,8 +15,14 @@ void FramePost::process_packed(const BandBuffer& packed) {
   process(unpacked_frame_, unpacked_gbuffer_);
 }
 
+FramePostOptions with_history_moments(FramePostOptions options) {
+  options.reprojection.luminance_moments =
+      options.reproject && options.atrous && atrous_guide_uses_variance(options.atrous_options.guide);
+  return options;
+}
+
 HostFramePost::HostFramePost(FramePostOptions options)
-    : options_(options), reprojection_(options.reprojection), atrous_(options.atrous_options) {}
+    : options_(with_history_moments(options)), reprojection_(options_.reprojection), atrous_(options_.atrous_options) {}
 
 void HostFramePost::process(const FrameBuffer& fresh, const GBuffer& gbuffer) {
   const FrameBuffer* current = &fresh;
@@ -25,7 +31,12 @@ void HostFramePost::process(const FrameBuffer& fresh, const GBuffer& gbuffer) {
     current = &reprojection_.image();
   }
   if (options_.atrous) {
-    atrous_.apply(*current, gbuffer, filtered_);
+    AtrousHistory history;
+    if (options_.reprojection.luminance_moments) {
+      history.moments = reprojection_.luminance_moments().data();
+      history.length = reprojection_.history_length().data();
+    }
+    atrous_.apply(*current, gbuffer, filtered_, history);
     current = &filtered_;
   }
   if (current == &fresh) {  // neither step: keep a copy, the caller's frame may change under us

@@ -17,6 +17,7 @@ constexpr size_t kRowsPerTask = 8;
 void TemporalReprojection::reset() {
   image_ = FrameBuffer{};
   length_.clear();
+  moments_.clear();
   depth_.clear();
   normal_.clear();
   id_.clear();
@@ -40,11 +41,17 @@ void TemporalReprojection::accumulate(const FrameBuffer& fresh, const GBuffer& g
   next_depth_.resize(pixels);
   next_normal_.resize(3 * pixels);
   next_id_.resize(pixels);
+  const bool moments = options_.luminance_moments;
+  if (moments) {
+    next_moments_.resize(2 * pixels);
+    if (moments_.size() != 2 * pixels) moments_.assign(2 * pixels, 0.0f);
+  }
   const ReprojectionOptions& o = options_;
   KReprojectParams params{};
   params.width = width;
   params.height = height;
   params.have_history = have_history ? 1 : 0;
+  params.moments = moments ? 1 : 0;
   params.max_history = static_cast<float>(std::max(o.max_history, 1));
   params.depth_tolerance = o.depth_tolerance;
   params.normal_cos = o.normal_cos;
@@ -53,10 +60,12 @@ void TemporalReprojection::accumulate(const FrameBuffer& fresh, const GBuffer& g
 
   ycocgw_.resize(4 * pixels);
   const KReprojectFresh fresh_planes{fresh.rgba.data(), ycocgw_.data(),     gbuffer.depth.data(), gbuffer.prev_depth.data(),
-                                     gbuffer.motion.data(), gbuffer.normal.data(), gbuffer.id.data()};
-  const KReprojectHistory history{image_.rgba.data(), length_.data(), depth_.data(), normal_.data(), id_.data()};
+                                     gbuffer.motion.data(), gbuffer.normal.data(), gbuffer.id.data(),
+                                     gbuffer.albedo.data()};
+  const KReprojectHistory history{image_.rgba.data(), length_.data(), depth_.data(), normal_.data(), id_.data(),
+                                  moments ? moments_.data() : nullptr};
   const KReprojectState next{next_image_.rgba.data(), next_length_.data(), next_depth_.data(), next_normal_.data(),
-                             next_id_.data()};
+                             next_id_.data(), moments ? next_moments_.data() : nullptr};
   HostThreads::shared().for_ranges(pixels, 4096, [&](size_t begin, size_t end) {
     for (size_t p = begin; p < end; ++p) k_reproject_prepare(fresh.rgba.data(), ycocgw_.data(), static_cast<kint>(p));
   });
@@ -66,6 +75,7 @@ void TemporalReprojection::accumulate(const FrameBuffer& fresh, const GBuffer& g
   });
   std::swap(image_, next_image_);
   std::swap(length_, next_length_);
+  if (moments) std::swap(moments_, next_moments_);
   std::swap(depth_, next_depth_);
   std::swap(normal_, next_normal_);
   std::swap(id_, next_id_);

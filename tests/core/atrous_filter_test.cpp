@@ -62,27 +62,42 @@ Stats column_stats(const FrameBuffer& f, int x0, int x1) {
   return {mean, std::sqrt(std::max(sum2 / n - mean * mean, 0.0))};
 }
 
+AtrousOptions with(int passes, AtrousGuide guide) {
+  AtrousOptions o;
+  o.passes = passes;
+  o.guide = guide;
+  return o;
+}
+
+const AtrousGuide kGuides[] = {AtrousGuide::variance, AtrousGuide::variance_of_mean, AtrousGuide::fixed};
+
 }  // namespace
 
 TEST(AtrousFilter, SmoothsNoiseWithinASurfaceAndKeepsItsMean) {
+  for (AtrousGuide guide : kGuides) {
+  SCOPED_TRACE(atrous_guide_name(guide));
   const GBuffer g = two_walls();
   const FrameBuffer in = noisy(1.0f, 1.0f, 0.5f, 1);
   FrameBuffer out;
-  AtrousFilter(AtrousOptions{3}).apply(in, g, out);
+  AtrousFilter(with(3, guide)).apply(in, g, out);
   const Stats before = column_stats(in, 4, kW / 2 - 4), after = column_stats(out, 4, kW / 2 - 4);
   EXPECT_LT(after.stddev, 0.3 * before.stddev) << "before " << before.stddev << ", after " << after.stddev;
   EXPECT_NEAR(after.mean, before.mean, 0.03 * before.mean);
+  }
 }
 
 TEST(AtrousFilter, DoesNotLeakAcrossAGeometricEdge) {
+  for (AtrousGuide guide : kGuides) {
+  SCOPED_TRACE(atrous_guide_name(guide));
   const GBuffer g = two_walls();
   const FrameBuffer in = noisy(1.0f, 0.05f, 0.3f, 2);
   FrameBuffer out;
-  AtrousFilter(AtrousOptions{3}).apply(in, g, out);
+  AtrousFilter(with(3, guide)).apply(in, g, out);
   // The columns right next to the edge keep their own wall's level.
   const Stats left = column_stats(out, kW / 2 - 1, kW / 2), right = column_stats(out, kW / 2, kW / 2 + 1);
   EXPECT_NEAR(left.mean, 1.0, 0.08);
   EXPECT_NEAR(right.mean, 0.05, 0.01);
+  }
 }
 
 TEST(AtrousFilter, KeepsTexturesSharpThroughTheAlbedo) {
@@ -98,9 +113,12 @@ TEST(AtrousFilter, KeepsTexturesSharpThroughTheAlbedo) {
       for (int k = 0; k < 3; ++k) g.albedo[3 * p + k] = a, in.rgba[4 * p + k] = a;
       in.rgba[4 * p + 3] = 1.0f;
     }
-  FrameBuffer out;
-  AtrousFilter().apply(in, g, out);
-  for (size_t i = 0; i < in.rgba.size(); ++i) ASSERT_NEAR(out.rgba[i], in.rgba[i], 1e-4f) << "value " << i;
+  for (AtrousGuide guide : kGuides) {
+    FrameBuffer out;
+    AtrousFilter(with(1, guide)).apply(in, g, out);
+    for (size_t i = 0; i < in.rgba.size(); ++i)
+      ASSERT_NEAR(out.rgba[i], in.rgba[i], 1e-4f) << "value " << i << " " << atrous_guide_name(guide);
+  }
 }
 
 TEST(AtrousFilter, PassesGrowWithTheImageHeight) {
@@ -116,10 +134,21 @@ TEST(AtrousFilter, LeavesOutSamplesThatAreNotFinite) {
   FrameBuffer in = noisy(1.0f, 1.0f, 0.2f, 3);
   in.rgba[4 * (10 * kW + 10)] = std::numeric_limits<float>::quiet_NaN();
   in.rgba[4 * (20 * kW + 12) + 1] = std::numeric_limits<float>::infinity();
-  FrameBuffer out;
-  AtrousFilter().apply(in, g, out);
-  for (float v : out.rgba) ASSERT_TRUE(std::isfinite(v));
-  EXPECT_NEAR(out.rgba[4 * (10 * kW + 10)], 1.0f, 0.15f) << "a NaN pixel shows its neighbourhood";
+  for (AtrousGuide guide : kGuides) {
+    FrameBuffer out;
+    AtrousFilter(with(1, guide)).apply(in, g, out);
+    for (float v : out.rgba) ASSERT_TRUE(std::isfinite(v)) << atrous_guide_name(guide);
+    EXPECT_NEAR(out.rgba[4 * (10 * kW + 10)], 1.0f, 0.15f) << "a NaN pixel shows its neighbourhood";
+  }
+}
+
+TEST(AtrousFilter, GuidesAreNamedOrRefused) {
+  EXPECT_EQ(parse_atrous_guide("variance"), AtrousGuide::variance);
+  EXPECT_EQ(parse_atrous_guide("fixed"), AtrousGuide::fixed);
+  EXPECT_EQ(parse_atrous_guide("variance-of-mean"), AtrousGuide::variance_of_mean);
+  EXPECT_STREQ(atrous_guide_name(AtrousGuide::variance_of_mean), "variance-of-mean");
+  EXPECT_STREQ(atrous_guide_name(AtrousGuide::fixed), "fixed");
+  EXPECT_THROW(parse_atrous_guide("svgf"), std::invalid_argument);
 }
 
 TEST(AtrousFilter, RefusesANormalPowerThatIsNotAPowerOfTwo) {

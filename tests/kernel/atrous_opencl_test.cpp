@@ -1,6 +1,7 @@
 // kernel/atrous.h compiled as OpenCL C 1.2 from its own text and run on the first OpenCL device: one
 // filter pass must equal the same header compiled as C++ (the host's AtrousFilter runs that one).
-// kernel/reproject.h is built into the same program, so a construct OpenCL C refuses fails here too.
+// kernel/reproject.h is built into the same program, so a construct OpenCL C refuses fails here too;
+// kernel/svgf.h's variance estimate and variance-guided pass must equal their C++ build as well.
 #include <cmath>
 #include <random>
 #include <string>
@@ -9,6 +10,7 @@
 #include <gtest/gtest.h>
 
 #include "cohort/kernel/atrous.h"
+#include "cohort/kernel/svgf.h"
 
 #ifdef COHORT_HAVE_OPENCL
 #include <CL/cl.h>
@@ -30,16 +32,32 @@ __kernel void atrous(__global const float* in_rgba, __global float* out_rgba, __
 #include "cohort/kernel/reproject.h"
 __kernel void reproject(KReprojectParams params, __global const float* rgba, __global float* ycocgw,
                         __global const float* depth, __global const float* prev_depth, __global const float* motion,
-                        __global const float* normal, __global const uint* id, __global const float* h_rgba,
-                        __global const float* h_length, __global const float* h_depth, __global const float* h_normal,
-                        __global const uint* h_id, __global float* n_rgba, __global float* n_length,
-                        __global float* n_depth, __global float* n_normal, __global uint* n_id) {
+                        __global const float* normal, __global const uint* id, __global const float* albedo,
+                        __global const float* h_rgba, __global const float* h_length, __global const float* h_depth,
+                        __global const float* h_normal, __global const uint* h_id, __global const float* h_moments,
+                        __global float* n_rgba, __global float* n_length, __global float* n_depth,
+                        __global float* n_normal, __global uint* n_id, __global float* n_moments) {
   kint x = (kint)get_global_id(0), y = (kint)get_global_id(1);
   if (x >= params.width || y >= params.height) return;
-  KReprojectFresh fresh = {rgba, ycocgw, depth, prev_depth, motion, normal, id};
-  KReprojectHistory history = {h_rgba, h_length, h_depth, h_normal, h_id};
-  KReprojectState next = {n_rgba, n_length, n_depth, n_normal, n_id};
+  KReprojectFresh fresh = {rgba, ycocgw, depth, prev_depth, motion, normal, id, albedo};
+  KReprojectHistory history = {h_rgba, h_length, h_depth, h_normal, h_id, h_moments};
+  KReprojectState next = {n_rgba, n_length, n_depth, n_normal, n_id, n_moments};
   k_reproject_pixel(&params, &fresh, &history, &next, x, y);
+}
+#include "cohort/kernel/svgf.h"
+__kernel void svgf_variance(__global const float* illumination, __global const float* moments,
+                            __global const float* length, __global const float* depth, __global const float* normal,
+                            __global float* variance, KSvgfVarianceParams params) {
+  kint x = (kint)get_global_id(0), y = (kint)get_global_id(1);
+  if (x < params.width && y < params.height)
+    k_svgf_variance_pixel(illumination, moments, length, depth, normal, variance, &params, x, y);
+}
+__kernel void svgf_atrous(__global const float* in_rgba, __global const float* in_variance, __global float* out_rgba,
+                          __global float* out_variance, __global const float* depth, __global const float* normal,
+                          KAtrousParams params) {
+  kint x = (kint)get_global_id(0), y = (kint)get_global_id(1);
+  if (x < params.width && y < params.height)
+    k_svgf_atrous_pixel(in_rgba, in_variance, out_rgba, out_variance, depth, normal, &params, x, y);
 }
 )CL";
 
@@ -94,5 +112,91 @@ TEST(AtrousOpenCL, APassMatchesTheCppBuildOfTheSameHeader) {
   for (size_t i = 0; i < out.size(); ++i) ASSERT_NEAR(out[i], expected[i], 1e-4f * (1.0f + std::fabs(expected[i]))) << i;
   for (cl_mem m : mems) clReleaseMemObject(m);
   clReleaseKernel(kernel);
+#endif
+}
+
+TEST(AtrousOpenCL, TheVarianceGuideMatchesTheCppBuildOfTheSameHeader) {
+#ifndef COHORT_HAVE_OPENCL
+  GTEST_SKIP() << "built without OpenCL (COHORT_WITH_OPENCL=OFF)";
+#else
+  OpenCLKernelProgram cl(kProgram);
+  if (!cl.skip.empty()) GTEST_SKIP() << cl.skip;
+  ASSERT_TRUE(cl.problem.empty()) << "svgf.h: " << cl.problem;
+  cl_int err = CL_SUCCESS;
+  cl_kernel variance_kernel = clCreateKernel(cl.program, "svgf_variance", &err);
+  ASSERT_EQ(err, CL_SUCCESS);
+  cl_kernel pass_kernel = clCreateKernel(cl.program, "svgf_atrous", &err);
+  ASSERT_EQ(err, CL_SUCCESS);
+
+  // Noisy illumination over two walls and a miss; history lengths 0..7, so both estimates run.
+  const int w = 40, h = 30;
+  std::mt19937 rng(9);
+  std::uniform_real_distribution<float> u(0.0f, 2.0f);
+  std::vector<float> rgba(4 * w * h), depth(w * h), normal(3 * w * h, 0.0f), moments(2 * w * h), length(w * h);
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) {
+      const int p = y * w + x;
+      for (int k = 0; k < 3; ++k) rgba[4 * p + k] = u(rng);
+      rgba[4 * p + 3] = 1.0f;
+      depth[p] = x < 4 ? 0.0f : 5.0f + 0.1f * float(x);
+      normal[3 * p + (y < h / 2 ? 0 : 2)] = 1.0f;
+      const float m1 = u(rng);
+      moments[2 * p] = m1, moments[2 * p + 1] = m1 * m1 + u(rng);
+      length[p] = float((x + y) % 8);
+    }
+  for (int of_mean : {0, 1}) {
+  SCOPED_TRACE(of_mean ? "variance of the mean" : "variance of a sample");
+  KSvgfVarianceParams vp{};
+  vp.width = w, vp.height = h, vp.normal_squarings = 6, vp.have_history = 1;
+  vp.depth_sigma = 0.1f, vp.short_history = 4.0f, vp.of_mean = of_mean;
+  KAtrousParams params{};
+  params.width = w, params.height = h, params.step = 2;
+  params.normal_squarings = 6, params.depth_sigma = 0.1f, params.color_sigma = 4.0f;
+  std::vector<float> variance(w * h), out(4 * w * h), out_variance(w * h);
+  std::vector<float> expected_variance(w * h), expected(4 * w * h), expected_out_variance(w * h);
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x)
+      k_svgf_variance_pixel(rgba.data(), moments.data(), length.data(), depth.data(), normal.data(),
+                            expected_variance.data(), &vp, x, y);
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x)
+      k_svgf_atrous_pixel(rgba.data(), expected_variance.data(), expected.data(), expected_out_variance.data(),
+                          depth.data(), normal.data(), &params, x, y);
+
+  auto buffer = [&](std::vector<float>& v) {
+    cl_mem m = clCreateBuffer(cl.context, CL_MEM_READ_WRITE | CL_MEM_COPY_HOST_PTR, v.size() * sizeof(float), v.data(),
+                              &err);
+    EXPECT_EQ(err, CL_SUCCESS);
+    return m;
+  };
+  cl_mem m_rgba = buffer(rgba), m_moments = buffer(moments), m_length = buffer(length), m_depth = buffer(depth),
+         m_normal = buffer(normal), m_variance = buffer(variance), m_out = buffer(out),
+         m_out_variance = buffer(out_variance);
+  cl_mem variance_args[6] = {m_rgba, m_moments, m_length, m_depth, m_normal, m_variance};
+  for (cl_uint i = 0; i < 6; ++i) ASSERT_EQ(clSetKernelArg(variance_kernel, i, sizeof(cl_mem), &variance_args[i]), CL_SUCCESS);
+  ASSERT_EQ(clSetKernelArg(variance_kernel, 6, sizeof(KSvgfVarianceParams), &vp), CL_SUCCESS);
+  cl_mem pass_args[6] = {m_rgba, m_variance, m_out, m_out_variance, m_depth, m_normal};
+  for (cl_uint i = 0; i < 6; ++i) ASSERT_EQ(clSetKernelArg(pass_kernel, i, sizeof(cl_mem), &pass_args[i]), CL_SUCCESS);
+  ASSERT_EQ(clSetKernelArg(pass_kernel, 6, sizeof(KAtrousParams), &params), CL_SUCCESS);
+  const size_t global[2] = {size_t(w), size_t(h)};
+  ASSERT_EQ(clEnqueueNDRangeKernel(cl.queue, variance_kernel, 2, nullptr, global, nullptr, 0, nullptr, nullptr), CL_SUCCESS);
+  ASSERT_EQ(clEnqueueNDRangeKernel(cl.queue, pass_kernel, 2, nullptr, global, nullptr, 0, nullptr, nullptr), CL_SUCCESS);
+  ASSERT_EQ(clEnqueueReadBuffer(cl.queue, m_variance, CL_TRUE, 0, variance.size() * sizeof(float), variance.data(), 0,
+                                nullptr, nullptr), CL_SUCCESS);
+  ASSERT_EQ(clEnqueueReadBuffer(cl.queue, m_out, CL_TRUE, 0, out.size() * sizeof(float), out.data(), 0, nullptr, nullptr),
+            CL_SUCCESS);
+  ASSERT_EQ(clEnqueueReadBuffer(cl.queue, m_out_variance, CL_TRUE, 0, out_variance.size() * sizeof(float),
+                                out_variance.data(), 0, nullptr, nullptr), CL_SUCCESS);
+  for (size_t i = 0; i < variance.size(); ++i)
+    ASSERT_NEAR(variance[i], expected_variance[i], 1e-4f * (1.0f + std::fabs(expected_variance[i]))) << "variance " << i;
+  for (size_t i = 0; i < out.size(); ++i) ASSERT_NEAR(out[i], expected[i], 1e-4f * (1.0f + std::fabs(expected[i]))) << i;
+  for (size_t i = 0; i < out_variance.size(); ++i)
+    ASSERT_NEAR(out_variance[i], expected_out_variance[i], 1e-4f * (1.0f + std::fabs(expected_out_variance[i])))
+        << "filtered variance " << i;
+  for (cl_mem m : {m_rgba, m_moments, m_length, m_depth, m_normal, m_variance, m_out, m_out_variance})
+    clReleaseMemObject(m);
+  }
+  clReleaseKernel(variance_kernel);
+  clReleaseKernel(pass_kernel);
 #endif
 }

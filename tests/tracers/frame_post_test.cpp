@@ -67,20 +67,32 @@ double max_relative_difference(const core::FrameBuffer& a, const core::FrameBuff
 }  // namespace
 
 TEST(FramePost, HostRunsReprojectionThenTheFilter) {
-  core::HostFramePost post(both());
-  core::TemporalReprojection reprojection;
-  core::AtrousFilter filter(both().atrous_options);
-  core::FrameBuffer frame, filtered;
-  core::GBuffer g;
-  for (int f = 0; f < 4; ++f) {
-    make_frame(f, frame, g);
-    post.process(frame, g);
-    reprojection.accumulate(frame, g);
-    filter.apply(reprojection.image(), g, filtered);
-    ASSERT_EQ(post.image().rgba, filtered.rgba) << "frame " << f;
-    EXPECT_DOUBLE_EQ(post.mean_history_length(), reprojection.mean_history_length());
+  for (core::AtrousGuide guide :
+       {core::AtrousGuide::variance, core::AtrousGuide::variance_of_mean, core::AtrousGuide::fixed}) {
+    core::FramePostOptions options = both();
+    options.atrous_options.guide = guide;
+    core::HostFramePost post(options);
+    // The variance guide reads the history's luminance moments, which only it switches on.
+    core::ReprojectionOptions reprojection_options;
+    reprojection_options.luminance_moments = guide != core::AtrousGuide::fixed;
+    EXPECT_EQ(core::with_history_moments(options).reprojection.luminance_moments, reprojection_options.luminance_moments);
+    core::TemporalReprojection reprojection(reprojection_options);
+    core::AtrousFilter filter(options.atrous_options);
+    core::FrameBuffer frame, filtered;
+    core::GBuffer g;
+    for (int f = 0; f < 5; ++f) {
+      make_frame(f, frame, g);
+      post.process(frame, g);
+      reprojection.accumulate(frame, g);
+      core::AtrousHistory history;
+      if (reprojection_options.luminance_moments)
+        history = {reprojection.luminance_moments().data(), reprojection.history_length().data()};
+      filter.apply(reprojection.image(), g, filtered, history);
+      ASSERT_EQ(post.image().rgba, filtered.rgba) << "frame " << f << " " << core::atrous_guide_name(guide);
+      EXPECT_DOUBLE_EQ(post.mean_history_length(), reprojection.mean_history_length());
+    }
+    EXPECT_GT(post.mean_history_length(), 2.0) << "the sliding floor keeps its history";
   }
-  EXPECT_GT(post.mean_history_length(), 2.0) << "the sliding floor keeps its history";
 }
 
 TEST(FramePost, HostWithNeitherStepShowsTheFrame) {
@@ -111,9 +123,16 @@ TEST(FramePost, PlacesAreNamedOrRefused) {
 TEST(FramePost, CudaMatchesTheHostOverAMovingSequence) {
   if (tracers::device_count("cuda") == 0) GTEST_SKIP() << "no CUDA device (or a build without CUDA)";
   EXPECT_EQ(tracers::auto_frame_post_place(tracers::parse_tracer_list("embree,cuda:0")), "cuda:0");
-  for (bool atrous : {false, true}) {
+  // No filter, the fixed guide, the variance guide over the history's moments, the variance guide alone
+  // (spatial estimate only), and the variance of the mean.
+  for (int variant = 0; variant < 5; ++variant) {
+    const bool atrous = variant > 0;
     core::FramePostOptions options = both();
     options.atrous = atrous;
+    options.reproject = variant != 3;
+    options.atrous_options.guide = variant == 1   ? core::AtrousGuide::fixed
+                                   : variant == 4 ? core::AtrousGuide::variance_of_mean
+                                                  : core::AtrousGuide::variance;
     core::HostFramePost host(options);
     std::unique_ptr<core::FramePost> gpu = tracers::make_frame_post("cuda:0", options);
     EXPECT_EQ(gpu->where(), "cuda:0");
@@ -125,7 +144,7 @@ TEST(FramePost, CudaMatchesTheHostOverAMovingSequence) {
       gpu->process(frame, g);
       ASSERT_EQ(gpu->image().width, kW);
       // Same arithmetic; only the device's exp/sqrt/FMA contraction differ.
-      EXPECT_LT(max_relative_difference(gpu->image(), host.image()), 2e-3) << "frame " << f << " atrous " << atrous;
+      EXPECT_LT(max_relative_difference(gpu->image(), host.image()), 2e-3) << "frame " << f << " variant " << variant;
       EXPECT_NEAR(gpu->mean_history_length(), host.mean_history_length(), 1e-3) << "frame " << f;
       EXPECT_TRUE(gpu->device_times().measured);
       EXPECT_GT(gpu->device_times().passes_ms, 0.0);

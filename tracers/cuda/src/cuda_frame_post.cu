@@ -9,6 +9,7 @@
 
 #include "cohort/kernel/atrous.h"
 #include "cohort/kernel/reproject.h"
+#include "cohort/kernel/svgf.h"
 #include "cuda_check.h"
 #include "device_array.h"
 #include "host_registrations.h"
@@ -76,9 +77,26 @@ __global__ void atrous_kernel(const float* in, float* out, const float* depth, c
     k_atrous_pixel(in, out, depth, normal, &params, p % params.width, p / params.width);
 }
 
+__global__ void svgf_variance_kernel(const float* illumination, const float* moments, const float* length,
+                                     const float* depth, const float* normal, float* variance,
+                                     KSvgfVarianceParams params) {
+  const int p = blockIdx.x * blockDim.x + threadIdx.x;
+  if (p < params.width * params.height)
+    k_svgf_variance_pixel(illumination, moments, length, depth, normal, variance, &params, p % params.width,
+                          p / params.width);
+}
+
+__global__ void svgf_atrous_kernel(const float* in, const float* in_variance, float* out, float* out_variance,
+                                   const float* depth, const float* normal, KAtrousParams params) {
+  const int p = blockIdx.x * blockDim.x + threadIdx.x;
+  if (p < params.width * params.height)
+    k_svgf_atrous_pixel(in, in_variance, out, out_variance, depth, normal, &params, p % params.width, p / params.width);
+}
+
 class CudaFramePost final : public core::FramePost {
  public:
-  CudaFramePost(int device, const core::FramePostOptions& options) : device_(device), options_(options) {
+  CudaFramePost(int device, const core::FramePostOptions& options)
+      : device_(device), options_(core::with_history_moments(options)) {
     int count = 0;
     if (cudaGetDeviceCount(&count) != cudaSuccess || device < 0 || device >= count) {
       cudaGetLastError();
@@ -117,7 +135,7 @@ class CudaFramePost final : public core::FramePost {
       upload(g.motion, motion_);
       upload(g.id, id_);
     }
-    if (options_.atrous) upload(g.albedo, albedo_);
+    if (options_.atrous) upload(g.albedo, albedo_);  // the history's moments read it too (only with atrous)
     COHORT_CUDA(cudaEventRecord(events_[1], stream_));
     run(fresh.width, fresh.height);
   }
@@ -165,7 +183,7 @@ class CudaFramePost final : public core::FramePost {
     if (options_.reproject) {
       State& from = state_[parity_];
       State& to = state_[parity_ ^ 1];
-      for (State* s : {&from, &to}) s->resize(pixels);
+      for (State* s : {&from, &to}) s->resize(pixels, options_.reprojection.luminance_moments);
       KReprojectParams params{};
       params.width = width, params.height = height, params.have_history = have_history_ ? 1 : 0;
       const core::ReprojectionOptions& o = options_.reprojection;
@@ -174,13 +192,15 @@ class CudaFramePost final : public core::FramePost {
       params.normal_cos = o.normal_cos;
       params.clamp_sigma = o.clamp_sigma;
       params.still_motion = o.still_motion;
+      params.moments = o.luminance_moments ? 1 : 0;
       float* ycocgw = ycocgw_.scratch(4 * pixels);
       prepare_kernel<<<blocks_for(pixels), kThreads, 0, stream_>>>(frame_.data(), ycocgw, static_cast<int>(pixels));
       const KReprojectFresh planes{frame_.data(), ycocgw,      depth_.data(), prev_depth_.data(),
-                                   motion_.data(), normal_.data(), id_.data()};
+                                   motion_.data(), normal_.data(), id_.data(),    albedo_.data()};
       const KReprojectHistory history{from.rgba.data(), from.length.data(), from.depth.data(), from.normal.data(),
-                                      from.id.data()};
-      const KReprojectState next{to.rgba.data(), to.length.data(), to.depth.data(), to.normal.data(), to.id.data()};
+                                      from.id.data(),   from.moments.data()};
+      const KReprojectState next{to.rgba.data(), to.length.data(), to.depth.data(), to.normal.data(), to.id.data(),
+                                 to.moments.data()};
       double* sum = length_sum_.scratch(1);
       COHORT_CUDA(cudaMemsetAsync(sum, 0, sizeof(double), stream_));
       reproject_kernel<<<blocks_for(pixels), kThreads, 0, stream_>>>(params, planes, history, next, sum);
@@ -195,15 +215,38 @@ class CudaFramePost final : public core::FramePost {
       float* pong = pong_.scratch(4 * pixels);
       modulate_kernel<<<blocks_for(pixels), kThreads, 0, stream_>>>(current, albedo_.data(), ping,
                                                                        static_cast<int>(pixels), 0);
+      const core::AtrousOptions& ao = options_.atrous_options;
+      const bool variance = core::atrous_guide_uses_variance(ao.guide);
       KAtrousParams params{};
       params.width = width, params.height = height;
       params.normal_squarings = normal_squarings_;
-      params.depth_sigma = options_.atrous_options.depth_sigma;
-      params.color_sigma = options_.atrous_options.color_sigma;
-      for (int pass = 0; pass < std::max(options_.atrous_options.passes, 0); ++pass) {
+      params.depth_sigma = ao.depth_sigma;
+      params.color_sigma = variance ? ao.variance_sigma : ao.color_sigma;
+      float* variance_ping = nullptr;
+      float* variance_pong = nullptr;
+      if (variance) {
+        variance_ping = variance_ping_.scratch(pixels);
+        variance_pong = variance_pong_.scratch(pixels);
+        KSvgfVarianceParams v{};
+        v.width = width, v.height = height, v.normal_squarings = normal_squarings_;
+        v.have_history = options_.reproject ? 1 : 0;
+        v.depth_sigma = ao.depth_sigma;
+        v.short_history = ao.short_history;
+        v.of_mean = ao.guide == core::AtrousGuide::variance_of_mean ? 1 : 0;
+        const State& history = state_[parity_];  // the state the reprojection just wrote
+        svgf_variance_kernel<<<blocks_for(pixels), kThreads, 0, stream_>>>(
+            ping, options_.reproject ? history.moments.data() : nullptr,
+            options_.reproject ? history.length.data() : nullptr, depth_.data(), normal_.data(), variance_ping, v);
+      }
+      for (int pass = 0; pass < std::max(ao.passes, 0); ++pass) {
         params.step = 1 << pass;
-        atrous_kernel<<<blocks_for(pixels), kThreads, 0, stream_>>>(ping, pong, depth_.data(), normal_.data(), params);
+        if (variance)
+          svgf_atrous_kernel<<<blocks_for(pixels), kThreads, 0, stream_>>>(ping, variance_ping, pong, variance_pong,
+                                                                            depth_.data(), normal_.data(), params);
+        else
+          atrous_kernel<<<blocks_for(pixels), kThreads, 0, stream_>>>(ping, pong, depth_.data(), normal_.data(), params);
         std::swap(ping, pong);
+        std::swap(variance_ping, variance_pong);
       }
       float* shown = shown_device_.scratch(4 * pixels);
       modulate_kernel<<<blocks_for(pixels), kThreads, 0, stream_>>>(ping, albedo_.data(), shown,
@@ -242,10 +285,11 @@ class CudaFramePost final : public core::FramePost {
  private:
   // One frame's history on the device (kernel/reproject.h's state).
   struct State {
-    DeviceArray<float> rgba, length, depth, normal;
+    DeviceArray<float> rgba, length, depth, normal, moments;
     DeviceArray<kuint> id;
-    void resize(size_t pixels) {
+    void resize(size_t pixels, bool with_moments) {
       rgba.scratch(4 * pixels);
+      if (with_moments) moments.scratch(2 * pixels);
       length.scratch(pixels);
       depth.scratch(pixels);
       normal.scratch(3 * pixels);
@@ -270,6 +314,7 @@ class CudaFramePost final : public core::FramePost {
   int normal_squarings_ = 0;
   State state_[2];
   DeviceArray<float> frame_, depth_, prev_depth_, motion_, normal_, albedo_, ycocgw_, ping_, pong_, shown_device_;
+  DeviceArray<float> variance_ping_, variance_pong_;
   DeviceArray<kuint> id_;
   DeviceArray<unsigned char> packed_colour_;
   DeviceArray<KAuxTexel> packed_aux_;

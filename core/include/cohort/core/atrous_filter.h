@@ -3,18 +3,48 @@
 // not colour: the frame is divided by the G-buffer's albedo before the passes and multiplied back
 // after, so textures stay sharp while the lighting's noise is smoothed (as SVGF does). Runs after the
 // merge (and after temporal accumulation), so band boundaries cannot show.
+// Luminance stops (AtrousGuide): `variance`, SVGF's (kernel/svgf.h): each pixel's luminance variance,
+// from the reprojected history's temporal moments where it is at least `short_history` frames long and
+// from its neighbourhood elsewhere, sets how far luminance may differ, and is filtered along with the
+// colour; `variance_of_mean` (the default), the same over the history length: the noise the accumulated
+// frame still has, so converged pixels are left alone; `fixed`, the relative difference of luminance with
+// one scale everywhere (kernel/atrous.h).
 #pragma once
+
+#include <string>
+#include <vector>
 
 #include "cohort/core/frame_buffer.h"
 #include "cohort/core/gbuffer.h"
 
 namespace cohort::core {
 
+// variance: SVGF's, the luminance variance of one frame's sample; variance_of_mean: that over the history
+// length, the variance of the accumulated mean the filter sees (converged pixels are left alone).
+enum class AtrousGuide { variance, variance_of_mean, fixed };
+
 struct AtrousOptions {
   int passes = 1;             // steps 1, 2, 4, ...: 1 pass is a 5x5 filter, 4 a 61-pixel one
   int normal_power = 64;      // cosine exponent of the normal stop; a power of two (squared, not pow)
   float depth_sigma = 0.1f;   // relative depth difference per step of tap distance
-  float color_sigma = 2.0f;   // relative luminance difference of the illumination
+  float color_sigma = 2.0f;   // fixed guide: relative luminance difference of the illumination
+  AtrousGuide guide = AtrousGuide::variance_of_mean;  // measured best on the test map (docs/denoising.md)
+  float variance_sigma = 2.0f;  // variance guide: luminance difference in standard deviations (SVGF: 4; 2
+                                // measured better on the test map, docs/denoising.md)
+  float short_history = 4.0f;   // variance guide: frames of history below which variance is estimated spatially
+};
+
+// "variance", "variance-of-mean" or "fixed" (std::invalid_argument otherwise, naming the word).
+AtrousGuide parse_atrous_guide(const std::string& name);
+const char* atrous_guide_name(AtrousGuide guide);
+// Whether the guide reads a variance (and the history's luminance moments when reprojecting).
+bool atrous_guide_uses_variance(AtrousGuide guide);
+
+// The reprojected history the variance guide reads (TemporalReprojection with luminance moments, two
+// floats a pixel, and its history lengths); null: no history, the variance is estimated spatially.
+struct AtrousHistory {
+  const float* moments = nullptr;
+  const float* length = nullptr;
 };
 
 // Passes whose footprint is about the same share of the image at any size: 1 up to 360 rows, one more
@@ -28,12 +58,17 @@ int atrous_normal_squarings(int power);
 class AtrousFilter {
  public:
   explicit AtrousFilter(AtrousOptions options = {}) : options_(options) {}
-  // `frame` and `gbuffer` have one size; `out` is resized to it.
-  void apply(const FrameBuffer& frame, const GBuffer& gbuffer, FrameBuffer& out);
+  // `frame` and `gbuffer` have one size; `out` is resized to it. `history` (the same size) is read by the
+  // variance guide only.
+  void apply(const FrameBuffer& frame, const GBuffer& gbuffer, FrameBuffer& out, const AtrousHistory& history = {});
+  // Variance guide: the illumination's luminance variance per pixel the first pass started from.
+  const std::vector<float>& estimated_variance() const { return estimated_variance_; }
+  const AtrousOptions& options() const { return options_; }
 
  private:
   AtrousOptions options_;
   FrameBuffer ping_, pong_;
+  std::vector<float> estimated_variance_, variance_ping_, variance_pong_;
 };
 
 }  // namespace cohort::core

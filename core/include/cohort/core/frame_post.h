@@ -22,6 +22,10 @@ struct FramePostOptions {
   AtrousOptions atrous_options;
 };
 
+// The options with the reprojection's luminance moments switched on exactly when the variance-guided
+// a-trous filter reads them (every place calls this, so they agree).
+FramePostOptions with_history_moments(FramePostOptions options);
+
 // A GPU place's own clock for the last frame (CUDA events), to tell the bus from the passes.
 struct FramePostDeviceTimes {
   bool measured = false;  // false on the host

@@ -10,6 +10,8 @@
 // is exactly the running average of its frames (up to max_history). Blend: C = H + (S - H) / n, n the
 // history length (capped at max_history). Samples that are not finite (NaN, Inf) never enter the
 // history: the pixel keeps its history (or shows its neighbourhood's mean when it has none).
+// With luminance_moments, the history also keeps the first and second moments of the illumination's
+// luminance (colour over albedo), blended like the colour, for the a-trous filter's variance guide.
 // The per-pixel arithmetic is the portable kernel's (kernel/reproject.h); this class runs it on the host's
 // threads and keeps the history.
 #pragma once
@@ -28,6 +30,7 @@ struct ReprojectionOptions {
   float normal_cos = 0.8f;        // least cosine between the normals of a pixel and its history tap
   float clamp_sigma = 1.5f;       // neighbourhood box half-width in standard deviations (moving pixels)
   float still_motion = 0.01f;     // pixels: motion below this counts as no motion (no clamp)
+  bool luminance_moments = false; // also keep M1, M2 of the illumination's luminance (SVGF's variance)
 };
 
 class TemporalReprojection {
@@ -40,6 +43,9 @@ class TemporalReprojection {
   const FrameBuffer& image() const { return image_; }
   // Per pixel, the number of frames its colour is worth.
   const std::vector<float>& history_length() const { return length_; }
+  // Per pixel, the illumination luminance's first and second moments (M1, M2), with luminance_moments.
+  const std::vector<float>& luminance_moments() const { return moments_; }
+  const ReprojectionOptions& options() const { return options_; }
   // Mean history length over the frame (a scalar for stats: 1 = nothing reused).
   double mean_history_length() const;
   void reset();
@@ -48,6 +54,7 @@ class TemporalReprojection {
   ReprojectionOptions options_;
   FrameBuffer image_, next_image_;
   std::vector<float> length_, next_length_;
+  std::vector<float> moments_, next_moments_;
   // The previous frame's surfaces, to test history taps against.
   std::vector<float> depth_, normal_, next_depth_, next_normal_;
   std::vector<uint32_t> id_, next_id_;

@@ -1,6 +1,6 @@
 /* The edge-aware a-trous wavelet filter (Dammertz et al., "Edge-Avoiding A-Trous Wavelet Transform for
- * fast Global Illumination Filtering", HPG 2010; the spatial filter of SVGF without its variance
- * estimate), one pass at one pixel. Passes run with step 1, 2, 4, ...: each is a 5x5 B3-spline kernel
+ * fast Global Illumination Filtering", HPG 2010; the spatial filter of SVGF with a fixed, relative
+ * luminance stop instead of SVGF's variance: kernel/svgf.h has that one), one pass at one pixel. Passes run with step 1, 2, 4, ...: each is a 5x5 B3-spline kernel
  * whose taps lie `step` pixels apart, so four passes cover a 61-pixel footprint for 100 taps a pixel.
  * A tap's weight is the spline's times three edge stops, so that light does not leak across geometry:
  *   normal      max(0, n_p . n_q) ^ (2 ^ normal_squarings)   (squarings, not pow: 64 is 6 multiplies)
@@ -13,6 +13,7 @@
  * RGBA floats. */
 #ifndef COHORT_KERNEL_ATROUS_H
 #define COHORT_KERNEL_ATROUS_H
+#include "illumination.h"
 #include "vec.h"
 
 typedef struct KAtrousParams {
@@ -22,7 +23,7 @@ typedef struct KAtrousParams {
 
 /* Illumination = colour / albedo before the passes, colour = illumination * albedo after (multiply = 1),
  * so textures stay sharp; black surfaces divide by the least albedo and multiply back by the same. */
-#define K_ATROUS_LEAST_ALBEDO 0.01f
+#define K_ATROUS_LEAST_ALBEDO K_ILLUMINATION_LEAST_ALBEDO
 KFN void k_atrous_modulate(KGLOBAL const float* in_rgba, KGLOBAL const float* albedo, KGLOBAL float* out_rgba, kint p,
                            int multiply) {
   for (int k = 0; k < 3; ++k) {
@@ -32,7 +33,27 @@ KFN void k_atrous_modulate(KGLOBAL const float* in_rgba, KGLOBAL const float* al
   out_rgba[4 * p + 3] = 1.0f;
 }
 
-KFN float k_atrous_luminance(KGLOBAL const float* c) { return 0.2126f * c[0] + 0.7152f * c[1] + 0.0722f * c[2]; }
+KFN float k_atrous_luminance(KGLOBAL const float* c) { return k_luminance3(c[0], c[1], c[2]); }
+
+/* The geometric stops of tap q seen from a pixel at depth zp (0: a miss) with normal np: returns the normal
+ * stop's factor (0: the tap lies across an edge, or is a surface where the pixel is a miss or the other way
+ * round) and adds the depth stop's argument to *exponent. Shared by both luminance stops (kernel/svgf.h). */
+KFN float k_atrous_geometry(float zp, KVec3 np, float inv_depth_scale, kint normal_squarings, KGLOBAL const float* depth,
+                            KGLOBAL const float* normal, kint q, float* exponent) {
+  float zq = depth[q];
+  if ((zp > 0.0f) != (zq > 0.0f)) return 0.0f; /* a surface and a miss */
+  if (!(zp > 0.0f)) return 1.0f;
+  KVec3 nq = v3(normal[3 * q], normal[3 * q + 1], normal[3 * q + 2]);
+  float cosine = k_fmax(v3_dot(np, nq), 0.0f);
+  for (kint s = 0; s < normal_squarings; ++s) cosine *= cosine;
+  if (cosine < 1e-4f) return 0.0f; /* across an edge; and the squarings would reach subnormals */
+  *exponent += k_fabs(zp - zq) * inv_depth_scale;
+  return cosine;
+}
+
+KFN float k_atrous_inv_depth_scale(float depth_sigma, float zp, kint step) {
+  return zp > 0.0f ? 1.0f / (depth_sigma * zp * (float)step + 1e-6f) : 0.0f;
+}
 
 KFN void k_atrous_pixel(KGLOBAL const float* in_rgba, KGLOBAL float* out_rgba, KGLOBAL const float* depth,
                         KGLOBAL const float* normal, const KAtrousParams* p, kint x, kint y) {
@@ -44,7 +65,7 @@ KFN void k_atrous_pixel(KGLOBAL const float* in_rgba, KGLOBAL float* out_rgba, K
   KVec3 np = v3(normal[3 * centre], normal[3 * centre + 1], normal[3 * centre + 2]);
   int centre_ok = k_finite3(c[0], c[1], c[2]);
   float lp = centre_ok ? k_atrous_luminance(c) : 0.0f;
-  float inv_depth_scale = zp > 0.0f ? 1.0f / (p->depth_sigma * zp * (float)p->step + 1e-6f) : 0.0f;
+  float inv_depth_scale = k_atrous_inv_depth_scale(p->depth_sigma, zp, p->step);
   float sum[3] = {0.0f, 0.0f, 0.0f};
   float weight_sum = 0.0f;
   for (kint dy = -2; dy <= 2; ++dy) {
@@ -58,17 +79,10 @@ KFN void k_atrous_pixel(KGLOBAL const float* in_rgba, KGLOBAL float* out_rgba, K
       if (!k_finite3(cq[0], cq[1], cq[2])) continue;
       float w = spline[dx < 0 ? -dx : dx] * spline[dy < 0 ? -dy : dy];
       if (q != centre) {
-        float zq = depth[q];
         float exponent = 0.0f;
-        if ((zp > 0.0f) != (zq > 0.0f)) continue;  /* a surface and a miss */
-        if (zp > 0.0f) {
-          KVec3 nq = v3(normal[3 * q], normal[3 * q + 1], normal[3 * q + 2]);
-          float cosine = k_fmax(v3_dot(np, nq), 0.0f);
-          for (kint s = 0; s < p->normal_squarings; ++s) cosine *= cosine;
-          if (cosine < 1e-4f) continue; /* across an edge; and the squarings would reach subnormals */
-          w *= cosine;
-          exponent += k_fabs(zp - zq) * inv_depth_scale;
-        }
+        float geometry = k_atrous_geometry(zp, np, inv_depth_scale, p->normal_squarings, depth, normal, q, &exponent);
+        if (!(geometry > 0.0f)) continue;
+        w *= geometry;
         if (centre_ok) {
           float lq = k_atrous_luminance(cq);
           exponent += k_fabs(lp - lq) / (p->color_sigma * 0.5f * (k_fabs(lp) + k_fabs(lq)) + 1e-4f);

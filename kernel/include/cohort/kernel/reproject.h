@@ -7,13 +7,20 @@
  *   k_reproject_prepare  the fresh frame in YCoCg, w = 1 where the sample is finite, 0 where it is not;
  *   k_reproject_pixel    reads the previous frame's state and writes the next state (ping-pong).
  * Planes follow the host's G-buffer layout (core/gbuffer.h): one float a pixel for depths, two for
- * motion, three for normals, one kuint for ids; colours are RGBA floats. */
+ * motion, three for normals, one kuint for ids; colours are RGBA floats.
+ *
+ * With `moments` set, the history also keeps the first and second moments of the illumination's luminance
+ * (kernel/illumination.h; two floats a pixel), fetched through the same taps and blended with the same
+ * weight as the colour, so that M2 - M1^2 is the pixel's temporal variance (SVGF, Schied et al. 2017; the
+ * a-trous filter's luminance stop, kernel/svgf.h). Non-finite samples never enter them either. */
 #ifndef COHORT_KERNEL_REPROJECT_H
 #define COHORT_KERNEL_REPROJECT_H
+#include "illumination.h"
 #include "vec.h"
 
 typedef struct KReprojectParams {
-  kint width; kint height; kint have_history; kint pad0;
+  kint width; kint height; kint have_history;
+  kint moments;           /* 1: keep the luminance moments too (reads the fresh albedo and both moment planes) */
   float max_history;      /* frames: 1 / max_history is the least weight of a new sample */
   float depth_tolerance;  /* relative depth difference above which a history tap is another surface */
   float normal_cos;       /* least cosine between the normals of a pixel and its history tap */
@@ -31,6 +38,7 @@ typedef struct KReprojectFresh {
   KGLOBAL const float* motion;
   KGLOBAL const float* normal;
   KGLOBAL const kuint* id;
+  KGLOBAL const float* albedo;  /* read only with moments */
 } KReprojectFresh;
 
 /* The history a pixel reads (the previous frame's state). */
@@ -40,6 +48,7 @@ typedef struct KReprojectHistory {
   KGLOBAL const float* depth;
   KGLOBAL const float* normal;
   KGLOBAL const kuint* id;
+  KGLOBAL const float* moments; /* luminance M1, M2; read only with moments */
 } KReprojectHistory;
 
 /* The state a pixel writes (the next frame's history). */
@@ -49,6 +58,7 @@ typedef struct KReprojectState {
   KGLOBAL float* depth;
   KGLOBAL float* normal;
   KGLOBAL kuint* id;
+  KGLOBAL float* moments;       /* written only with moments */
 } KReprojectState;
 
 KFN void k_reproject_prepare(KGLOBAL const float* rgba, KGLOBAL float* ycocgw, kint p) {
@@ -107,6 +117,7 @@ KFN void k_reproject_pixel(const KReprojectParams* p, const KReprojectFresh* fre
   /* The history, reprojected: bilinear over the taps that saw the same surface. */
   KVec3 h = v3s(0.0f);
   float history_length = 0.0f;
+  float h1 = 0.0f, h2 = 0.0f; /* the history's luminance moments */
   float mx = fresh->motion[2 * pix], my = fresh->motion[2 * pix + 1];
   int moved = k_fabs(mx) > p->still_motion || k_fabs(my) > p->still_motion;
   if (p->have_history && k_fabs(mx) < 1e8f) {
@@ -131,11 +142,17 @@ KFN void k_reproject_pixel(const KReprojectParams* p, const KReprojectFresh* fre
       h = v3_madd(h, v3_load_g(history->rgba + 4 * q), w);
       length_sum += w * history->length[q];
       weight_sum += w;
+      if (p->moments) {
+        h1 += w * history->moments[2 * q];
+        h2 += w * history->moments[2 * q + 1];
+      }
     }
     if (weight_sum > 1e-3f) {
       float inv = 1.0f / weight_sum;
       h = v3_scale(h, inv);
       history_length = length_sum * inv;
+      h1 *= inv;
+      h2 *= inv;
     }
   }
   KVec3 m1, m2;
@@ -162,9 +179,21 @@ KFN void k_reproject_pixel(const KReprojectParams* p, const KReprojectFresh* fre
     out[1] = h.y + f * (sample[1] - h.y);
     out[2] = h.z + f * (sample[2] - h.z);
     next->length[pix] = history_length > 0.0f ? count : 1.0f;
+    if (p->moments) {
+      /* A finite sample over a dark albedo can still overflow l^2: such a sample stays out of them. */
+      float l = k_illumination_luminance(fresh->rgba, fresh->albedo, pix);
+      float fl = k_fabs(l) < 1e18f ? f : 0.0f;
+      if (!(fl > 0.0f)) l = 0.0f;
+      next->moments[2 * pix] = h1 + fl * (l - h1);
+      next->moments[2 * pix + 1] = h2 + fl * (l * l - h2);
+    }
   } else if (history_length > 0.0f) {
     out[0] = h.x; out[1] = h.y; out[2] = h.z;
     next->length[pix] = history_length;
+    if (p->moments) {
+      next->moments[2 * pix] = h1;
+      next->moments[2 * pix + 1] = h2;
+    }
   } else {
     /* No usable sample and no history: show the neighbourhood's mean, keep no history. */
     int count = k_reproject_moments(p, fresh->ycocgw, x, y, &m1, &m2);
@@ -172,6 +201,10 @@ KFN void k_reproject_pixel(const KReprojectParams* p, const KReprojectFresh* fre
     KVec3 c = k_reproject_from_ycocg(mean);
     out[0] = c.x; out[1] = c.y; out[2] = c.z;
     next->length[pix] = 0.0f;
+    if (p->moments) {
+      next->moments[2 * pix] = 0.0f;
+      next->moments[2 * pix + 1] = 0.0f;
+    }
   }
 }
 
