@@ -439,7 +439,8 @@ void add_render_command(CLI::App& app, int& exit_code) {
   cmd->add_option("--spec-boost", a->spec_boost, "specular boost of light interactions")->capture_default_str();
   cmd->add_option("--shadow-rr", a->shadow_rr,
                   "Russian roulette on shadow rays: a light sample adding less than this to the pixel traces its "
-                  "ray with probability contribution / this (unbiased; 0: every sample's ray is traced)")
+                  "ray with probability contribution / this (unbiased: such samples count threshold / contribution "
+                  "times; 0: every sample's ray is traced)")
       ->capture_default_str()
       ->check(CLI::NonNegativeNumber);
   cmd->add_option("--soft-shadows", a->soft_shadow_scale, "scale of the lights' soft-shadow extent")
