@@ -63,15 +63,21 @@ case "${1:-}" in
     done
     export LD_LIBRARY_PATH="$PWD/$stage/cmp/new/lib${LD_LIBRARY_PATH:+:$LD_LIBRARY_PATH}"
     nvidia-smi --query-gpu=index,name --format=csv,noheader
-    [ -f /tmp/largemap.cpk ] || { python3 tools/gen_testmap.py --large --out /tmp/largemap >/dev/null &&
-      "$stage/cmp/new/bin/cohort" pack /tmp/largemap/maps/largemap.map --out /tmp/largemap.cpk | tail -n 1; }
-    COHORT_PACK="$stage/testmap.cpk" "$stage/cmp/new/bin/cohort_tracers_tests" --gtest_filter="${COHORT_GPU_TEST_FILTER:-*Cuda*}" 2>&1 |
+    # Each payload packs both maps itself: pack versions change between commits.
+    [ -d /tmp/largemap/maps ] || python3 tools/gen_testmap.py --large --out /tmp/largemap >/dev/null
+    for name in "${names[@]}"; do
+      for map in large test; do
+        src=/tmp/largemap/maps/largemap.map; [ $map = test ] && src=assets/testmap/maps/testmap.map
+        "$stage/cmp/$name/bin/cohort" pack $src --out /tmp/cmp_${name}_$map.cpk >/dev/null
+      done
+    done
+    [ -x "$stage/cmp/new/bin/cohort_tracers_tests" ] && COHORT_PACK=/tmp/cmp_new_test.cpk "$stage/cmp/new/bin/cohort_tracers_tests" --gtest_filter="${COHORT_GPU_TEST_FILTER:-*Cuda*}" 2>&1 |
       grep -E "^\[  (PASSED|FAILED) |^\[  FAILED|tests? ran" || true
     for round in 1 2 3; do
       for name in "${names[@]}"; do
         for map in large test; do
-          if [ $map = large ]; then args=(/tmp/largemap.cpk --width 1920 --height 1080 --camera 1690 300 80 5 -12)
-          else args=("$stage/testmap.cpk" --width 1280 --height 720); fi
+          if [ $map = large ]; then args=(/tmp/cmp_${name}_large.cpk --width 1920 --height 1080 --camera 1690 300 80 5 -12)
+          else args=(/tmp/cmp_${name}_test.cpk --width 1280 --height 720); fi
           run=/tmp/cmp_${name}_${map}_$round
           "$stage/cmp/$name/bin/cohort" render "${args[@]}" --tracers cuda:0 --spp 1 --bounces 1 --convergence brigade \
             --frames 60 --camera-path spin-slow ${COHORT_GPU_COMPARE_ARGS:-} --write last --out $run >/dev/null 2>&1
