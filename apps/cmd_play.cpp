@@ -97,6 +97,7 @@ struct Notice {
 int run_play(PlayArgs a) {
   using clock = std::chrono::steady_clock;
   a.session.bases = bases_or_test_map(a.session.bases);
+  a.session.window_height = a.height;
   std::unique_ptr<PlaySession> session;
   try {
     session = std::make_unique<PlaySession>(a.session);
@@ -124,6 +125,9 @@ int run_play(PlayArgs a) {
   settings.mode = debug_mode_from_name(a.mode).value_or(K_MODE_PATH);
   settings.tone_curve = a.tone;
   settings.reproject = resolve_convergence(a.convergence, session->any_gpu_tracer(), session->frame_post_place()) == "reproject";
+  if (session->denoising())
+    spdlog::info("{}reprojection and the a-trous filter on {}", settings.reproject ? "" : "(not used: Brigade's blend) ",
+                 session->frame_post_place());
   float scale = a.scale;
   // A frame-rate target: spp and render scale follow the measured frame time (core/workload_scaler.h)
   // until the user picks either by hand.
@@ -341,6 +345,12 @@ void add_play_command(CLI::App& app, int& exit_code) {
                   "for the host's reprojection); see `cohort render --help`")
       ->capture_default_str()
       ->check(CLI::IsMember({"auto", "brigade", "reproject"}));
+  cmd->add_option("--denoise", a->session.denoise,
+                  "the real-time a-trous filter after the reprojection: atrous, none, or auto (atrous where the "
+                  "reprojection runs on a CUDA GPU, about 1-3 ms a frame; none on the host's threads, where it "
+                  "would set the frame rate); see docs/denoising.md")
+      ->capture_default_str()
+      ->check(CLI::IsMember({"auto", "atrous", "none"}));
   cmd->add_option("--target-fps", a->target_fps,
                   "hold this frame rate by choosing spp and render scale from the measured frame time (0: off; "
                   "default: 30 when only CPU tracers render and neither --spp nor --scale is given, off with a GPU); "

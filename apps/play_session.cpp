@@ -7,6 +7,7 @@
 #include <spdlog/spdlog.h>
 
 #include "cohort/commit/commit_buffer.h"
+#include "cohort/core/atrous_filter.h"
 #include "cohort/core/convergence.h"
 #include "cohort/core/frame_post.h"
 #include "cohort/core/frame_defaults.h"
@@ -80,6 +81,7 @@ struct PlaySession::State {
   std::string map_name;
   bool any_gpu_tracer = false;
   std::string post_place;
+  bool denoising = false;
 };
 
 PlaySession::PlaySession(const SessionOptions& options) {
@@ -113,9 +115,14 @@ PlaySession::PlaySession(const SessionOptions& options) {
   s.renderer = std::make_unique<core::Renderer>(std::move(tracers), renderer_options);
   s.renderer->submit_commit(commit::CommitBuffer::full(initial_scene, 0));
   s.pipeline = std::make_unique<core::FramePipeline>(*s.renderer);
-  core::FramePostOptions post_options;  // reprojection alone: the HUD view is not filtered
   s.post_place = tracers::auto_frame_post_place(started);
-  s.reprojection = tracers::make_frame_post(s.post_place, post_options);
+  core::FramePostOptions post_options;
+  if (options.denoise != "auto" && options.denoise != "atrous" && options.denoise != "none")
+    throw std::invalid_argument("--denoise '" + options.denoise + "': choose auto, atrous or none");
+  post_options.atrous = options.denoise == "atrous" || (options.denoise == "auto" && s.post_place != "host");
+  post_options.atrous_options.passes = core::atrous_passes_for_height(options.window_height);
+  s.denoising = post_options.atrous;
+  s.reprojection = tracers::make_frame_post(s.post_place, core::with_history_moments(post_options));
 
   if (options.scenario) {
     try {
@@ -242,6 +249,8 @@ const std::string& PlaySession::map_name() const { return state_->map_name; }
 
 bool PlaySession::any_gpu_tracer() const { return state_->any_gpu_tracer; }
 const std::string& PlaySession::frame_post_place() const { return state_->post_place; }
+
+bool PlaySession::denoising() const { return state_->denoising; }
 
 std::vector<std::string> PlaySession::tracer_names() const {
   std::vector<std::string> names;

@@ -22,6 +22,11 @@ struct SessionOptions {
   std::string tracers;              // empty: "all" (parse_tracer_list: Embree plus every GPU once)
   std::string balancer = "whole-cost";  // benches a tracer that would slow the frame (docs/balancing.md)
   bool scenario = true;
+  // The a-trous filter after the reprojection: "atrous", "none", or "auto" (atrous where the
+  // post-processing runs on a CUDA GPU, where it costs 1-3 ms; none on the host, where it would set the
+  // frame rate). Passes as `cohort render` picks them for the window's height.
+  std::string denoise = "auto";
+  int window_height = 360;
 };
 
 struct FrameSettings {
@@ -67,6 +72,7 @@ class PlaySession {
   bool any_gpu_tracer() const;
   // Where the reprojection runs: "host" or "cuda:N" (the first CUDA tracer's GPU).
   const std::string& frame_post_place() const;
+  bool denoising() const;  // whether the reprojected frame also goes through the a-trous filter
   // Tracers that did not start, a scenario that cannot run: things the HUD and log should say.
   const std::vector<std::string>& warnings() const { return warnings_; }
   const std::string& map_name() const;

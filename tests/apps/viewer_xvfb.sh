@@ -37,3 +37,14 @@ rm -f "$auto_shot"
 xvfb-run -a -s "-screen 0 1024x768x24" "$cohort" play "$map" --tracers embree --frames 12 --width 160 --height 120 \
   --window-screenshot "$auto_shot" || { echo "FAIL: cohort play (frame-rate target) exited with $?"; exit 1; }
 python3 "$checker" "$auto_shot" 160 120
+# The a-trous filter after the reprojection (host threads here): it still shows a whole window, and it is
+# smoother than the same frames reprojected alone (the scenario off, so both see the same scene).
+atrous_shot="${shot%.*}_atrous.${shot##*.}" plain_shot="${shot%.*}_reproject.${shot##*.}"
+rm -f "$atrous_shot" "$plain_shot"
+for denoise in atrous none; do
+  out=$atrous_shot; [ $denoise = none ] && out=$plain_shot
+  xvfb-run -a -s "-screen 0 1024x768x24" "$cohort" play "$map" --tracers embree --frames 6 --width 160 --height 120 \
+    --scale 1 --spp 1 --no-scenario --convergence reproject --denoise $denoise --screenshot "$out" ||
+    { echo "FAIL: cohort play --denoise $denoise exited with $?"; exit 1; }
+done
+python3 "$checker" "$atrous_shot" 160 120 && python3 "$(dirname "$checker")/smoother_than.py" "$atrous_shot" "$plain_shot"
