@@ -102,6 +102,8 @@ bool blas_needs_rebuild(float built_sah, float refit_sah, float threshold) {
   return built_sah > 0.0f && refit_sah > built_sah * threshold;
 }
 
+constexpr size_t kSerialTlasInstances = 4096;
+
 std::vector<KBvhNode> build_tlas(std::vector<KInstance>& instances, const std::vector<KBvhNode>& blas_roots) {
   if (instances.empty()) return {};
   std::vector<RTCBuildPrimitive> prims(instances.size());
@@ -118,6 +120,9 @@ std::vector<KBvhNode> build_tlas(std::vector<KInstance>& instances, const std::v
   settings.quality = detail::BuildQuality::morton;
   settings.max_leaf_size = 1;
   settings.keep_memory = true;
+  // Below a few thousand instances the build is a fraction of a millisecond and handing its steps to
+  // every core costs more than it saves (measured on 16 cores, docs/bvh.md): one thread builds it.
+  if (instances.size() < kSerialTlasInstances) settings.threads = 1;
   detail::FlatBuild built = detail::build_flat_bvh(prims, settings);
   // An instance of an empty BLAS keeps an empty leaf box: rays never test it.
   for (KBvhNode& n : built.nodes)
