@@ -260,6 +260,10 @@ int run_play(PlayArgs a) {
       hud.render_height = settings.height;
       hud.tone_mapper = settings.tone_curve;
       hud.balancer = session->balancer();
+      hud.accumulation = settings.reproject
+                             ? std::string(session->denoising() ? "REPROJECT+ATROUS ON " : "REPROJECT ON ") +
+                                   session->frame_post_place()
+                             : "BRIGADE";
       hud.commit_bytes = last.commit_bytes;
       hud.scenario_running = session->scenario_running();
       hud.scenario_paused = session->scenario_paused();

@@ -37,6 +37,7 @@ std::vector<std::string> hud_lines(const HudState& s) {
   if (s.stats) {
     lines.push_back(format("BALANCER %s  IDLE %.1f%%  CONV F %.2f  COMMIT %s", s.balancer.c_str(),
                            s.stats->idle_percent, s.stats->convergence_f, format_bytes(s.commit_bytes).c_str()));
+    if (!s.accumulation.empty()) lines.back() += "  " + s.accumulation;
     for (const core::TracerFrameStats& t : s.stats->tracers) {
       std::string line = format("%-10.10s ROWS %4d-%-4d %6.1f MS", t.name.c_str(), t.row_begin, t.row_end, t.ms);
       if (t.outcome != core::TracerOutcome::rendered) line += std::string("  ") + core::to_string(t.outcome);

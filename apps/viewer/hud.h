@@ -22,6 +22,7 @@ struct HudState {
   int target_fps = 0;                     // > 0: spp and scale are chosen to hold this frame rate
   std::string tone_mapper;
   std::string balancer;
+  std::string accumulation;               // how frames accumulate, e.g. "REPROJECT+ATROUS ON cuda:0", "BRIGADE"
   uint64_t commit_bytes = 0;              // bytes of the commit sent this frame
   bool scenario_paused = false;
   bool scenario_running = false;

@@ -13,6 +13,7 @@ TEST(Hud, LinesCarryTheFrameStats) {
   s.tone_mapper = "aces";
   s.balancer = "perfect-smooth";
   s.commit_bytes = 3 * 1024;
+  s.accumulation = "REPROJECT+ATROUS ON cuda:0";
   core::FrameStats stats;
   stats.frame_ms = 16.5;
   stats.idle_percent = 12.5;
@@ -34,6 +35,7 @@ TEST(Hud, LinesCarryTheFrameStats) {
   EXPECT_NE(all.find("FPS 59.9"), std::string::npos) << all;
   EXPECT_NE(all.find("IDLE 12.5%"), std::string::npos) << all;
   EXPECT_NE(all.find("CONV F 0.25"), std::string::npos) << all;
+  EXPECT_NE(all.find("REPROJECT+ATROUS ON cuda:0"), std::string::npos) << all;
   EXPECT_NE(all.find("COMMIT 3.0 KB"), std::string::npos) << all;
   EXPECT_NE(all.find("embree"), std::string::npos) << all;
   EXPECT_NE(all.find("timed_out"), std::string::npos) << all;
