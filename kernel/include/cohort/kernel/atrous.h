@@ -55,9 +55,14 @@ KFN float k_atrous_inv_depth_scale(float depth_sigma, float zp, kint step) {
   return zp > 0.0f ? 1.0f / (depth_sigma * zp * (float)step + 1e-6f) : 0.0f;
 }
 
-KFN void k_atrous_pixel(KGLOBAL const float* in_rgba, KGLOBAL float* out_rgba, KGLOBAL const float* depth,
-                        KGLOBAL const float* normal, const KAtrousParams* p, kint x, kint y) {
+/* One pass at one pixel, for either luminance stop. With variance planes, the stop is
+ * |l_p - l_q| * inv_luminance_scale (kernel/svgf.h's, from the pixel's variance) and in_variance is
+ * filtered into out_variance with the weights squared; without (both 0), the fixed relative stop above. */
+KFN void k_atrous_pass_pixel(KGLOBAL const float* in_rgba, KGLOBAL const float* in_variance, KGLOBAL float* out_rgba,
+                             KGLOBAL float* out_variance, KGLOBAL const float* depth, KGLOBAL const float* normal,
+                             const KAtrousParams* p, float inv_luminance_scale, kint x, kint y) {
   const float spline[3] = {0.375f, 0.25f, 0.0625f};
+  int guided = in_variance != 0;
   kint centre = y * p->width + x;
   KGLOBAL const float* c = in_rgba + 4 * centre;
   KGLOBAL float* out = out_rgba + 4 * centre;
@@ -67,7 +72,7 @@ KFN void k_atrous_pixel(KGLOBAL const float* in_rgba, KGLOBAL float* out_rgba, K
   float lp = centre_ok ? k_atrous_luminance(c) : 0.0f;
   float inv_depth_scale = k_atrous_inv_depth_scale(p->depth_sigma, zp, p->step);
   float sum[3] = {0.0f, 0.0f, 0.0f};
-  float weight_sum = 0.0f;
+  float weight_sum = 0.0f, variance_sum = 0.0f;
   for (kint dy = -2; dy <= 2; ++dy) {
     kint qy = y + dy * p->step;
     if (qy < 0 || qy >= p->height) continue;
@@ -85,7 +90,8 @@ KFN void k_atrous_pixel(KGLOBAL const float* in_rgba, KGLOBAL float* out_rgba, K
         w *= geometry;
         if (centre_ok) {
           float lq = k_atrous_luminance(cq);
-          exponent += k_fabs(lp - lq) / (p->color_sigma * 0.5f * (k_fabs(lp) + k_fabs(lq)) + 1e-4f);
+          exponent += guided ? k_fabs(lp - lq) * inv_luminance_scale
+                             : k_fabs(lp - lq) / (p->color_sigma * 0.5f * (k_fabs(lp) + k_fabs(lq)) + 1e-4f);
         }
         if (!(w > 0.0f) || exponent > 12.0f) continue; /* weight below 6e-6 of the stops' best: left out, and
                                                           so are exp's subnormal results, slow on CPUs */
@@ -96,6 +102,7 @@ KFN void k_atrous_pixel(KGLOBAL const float* in_rgba, KGLOBAL float* out_rgba, K
       sum[1] += w * cq[1];
       sum[2] += w * cq[2];
       weight_sum += w;
+      if (guided) variance_sum += w * w * in_variance[q];
     }
   }
   float inv = weight_sum > 0.0f ? 1.0f / weight_sum : 0.0f;
@@ -103,6 +110,13 @@ KFN void k_atrous_pixel(KGLOBAL const float* in_rgba, KGLOBAL float* out_rgba, K
   out[1] = sum[1] * inv;
   out[2] = sum[2] * inv;
   out[3] = 1.0f;
+  if (guided) out_variance[centre] = variance_sum * inv * inv;
+}
+
+/* One pass with the fixed relative luminance stop. */
+KFN void k_atrous_pixel(KGLOBAL const float* in_rgba, KGLOBAL float* out_rgba, KGLOBAL const float* depth,
+                        KGLOBAL const float* normal, const KAtrousParams* p, kint x, kint y) {
+  k_atrous_pass_pixel(in_rgba, 0, out_rgba, 0, depth, normal, p, 0.0f, x, y);
 }
 
 #endif

@@ -115,53 +115,10 @@ KFN float k_svgf_blurred_variance(KGLOBAL const float* variance, const KAtrousPa
 KFN void k_svgf_atrous_pixel(KGLOBAL const float* in_rgba, KGLOBAL const float* in_variance, KGLOBAL float* out_rgba,
                              KGLOBAL float* out_variance, KGLOBAL const float* depth, KGLOBAL const float* normal,
                              const KAtrousParams* p, kint x, kint y) {
-  const float spline[3] = {0.375f, 0.25f, 0.0625f};
-  kint centre = y * p->width + x;
-  KGLOBAL const float* c = in_rgba + 4 * centre;
-  KGLOBAL float* out = out_rgba + 4 * centre;
-  float zp = depth[centre];
-  KVec3 np = v3(normal[3 * centre], normal[3 * centre + 1], normal[3 * centre + 2]);
-  int centre_ok = k_finite3(c[0], c[1], c[2]);
-  float lp = centre_ok ? k_atrous_luminance(c) : 0.0f;
-  float inv_depth_scale = k_atrous_inv_depth_scale(p->depth_sigma, zp, p->step);
   float inv_luminance_scale =
       1.0f / (p->color_sigma * k_sqrt(k_fmax(k_svgf_blurred_variance(in_variance, p, x, y), 0.0f)) +
               K_SVGF_LUMINANCE_EPSILON);
-  float sum[3] = {0.0f, 0.0f, 0.0f};
-  float weight_sum = 0.0f, variance_sum = 0.0f;
-  for (kint dy = -2; dy <= 2; ++dy) {
-    kint qy = y + dy * p->step;
-    if (qy < 0 || qy >= p->height) continue;
-    for (kint dx = -2; dx <= 2; ++dx) {
-      kint qx = x + dx * p->step;
-      if (qx < 0 || qx >= p->width) continue;
-      kint q = qy * p->width + qx;
-      KGLOBAL const float* cq = in_rgba + 4 * q;
-      if (!k_finite3(cq[0], cq[1], cq[2])) continue;
-      float w = spline[dx < 0 ? -dx : dx] * spline[dy < 0 ? -dy : dy];
-      if (q != centre) {
-        float exponent = 0.0f;
-        float geometry = k_atrous_geometry(zp, np, inv_depth_scale, p->normal_squarings, depth, normal, q, &exponent);
-        if (!(geometry > 0.0f)) continue;
-        w *= geometry;
-        if (centre_ok) exponent += k_fabs(lp - k_atrous_luminance(cq)) * inv_luminance_scale;
-        if (!(w > 0.0f) || exponent > 12.0f) continue; /* as kernel/atrous.h: negligible, and exp's subnormals */
-        w *= k_exp(-exponent);
-      }
-      if (!(w > 0.0f)) continue;
-      sum[0] += w * cq[0];
-      sum[1] += w * cq[1];
-      sum[2] += w * cq[2];
-      weight_sum += w;
-      variance_sum += w * w * in_variance[q];
-    }
-  }
-  float inv = weight_sum > 0.0f ? 1.0f / weight_sum : 0.0f;
-  out[0] = sum[0] * inv;
-  out[1] = sum[1] * inv;
-  out[2] = sum[2] * inv;
-  out[3] = 1.0f;
-  out_variance[centre] = variance_sum * inv * inv;
+  k_atrous_pass_pixel(in_rgba, in_variance, out_rgba, out_variance, depth, normal, p, inv_luminance_scale, x, y);
 }
 
 #endif
