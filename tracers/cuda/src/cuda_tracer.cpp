@@ -56,6 +56,7 @@ struct CudaTracer::Impl {
   DeviceArray<kuint> refit_scratch;
   cudaTextureObject_t texel_texture = 0;
   DeviceArray<float> previous_transforms;
+  DeviceArray<KJoint> previous_joints;
   DeviceArray<KAuxTexel> aux_texels;
   float4* band = nullptr;
   unsigned short* band_rgb16f = nullptr;   // the band as RGB halves, for RGB16F targets
@@ -229,9 +230,16 @@ core::BandResult CudaTracer::render_band(const core::BandJob& job, core::BandBuf
     // an H100).
     const KCamera previous = job.previous_camera.width > 0 ? job.previous_camera : camera;
     m.previous_transforms.upload(previous_transforms(), 0, m.stream);
+    m.previous_joints.upload(previous_joints(), 0, m.stream);
+    KAuxHistory history{};
+    history.object_to_world = previous_transforms().empty() ? nullptr : m.previous_transforms.data();
+    history.skins = m.skins.data();
+    history.skin_vertices = m.skin_vertices.data();
+    history.skin_weights = m.skin_weights.data();
+    history.joints = previous_joints().empty() ? nullptr : m.previous_joints.data();
+    history.skin_count = static_cast<kuint>(scene().skins.size());
     KAuxTexel* texels = m.aux_texels.scratch(pixels);
-    launch_aux_band(m.view(params), params, camera, previous,
-                    previous_transforms().empty() ? nullptr : m.previous_transforms.data(), texels, m.stream);
+    launch_aux_band(m.view(params), params, camera, previous, history, texels, m.stream);
     COHORT_CUDA(cudaEventRecord(m.aux_ready, m.stream));
     COHORT_CUDA(cudaStreamWaitEvent(m.aux_copy_stream, m.aux_ready, 0));
     COHORT_CUDA(cudaMemcpyAsync(target.aux_row(int(params.row_begin)), texels, pixels * sizeof(KAuxTexel),
