@@ -7,7 +7,6 @@
 
 #include <cmath>
 
-#include "cohort/core/gbuffer.h"
 #include "cohort/core/view.h"
 #include "cohort/core/world_sync.h"
 #include "cohort/scene/map_loader.h"
@@ -35,21 +34,6 @@ glm::vec3 point_at(const KCamera& c, float px, float py, float depth) {
   const float sx = (2.0f * px / float(c.width) - 1.0f) * c.tan_half_fov_x;
   const float sy = (1.0f - 2.0f * py / float(c.height)) * c.tan_half_fov_y;
   return load(c.origin) + depth * (load(c.forward) + sx * load(c.right) + sy * load(c.up));
-}
-
-core::GBuffer render_aux_band(core::Tracer& tracer, const KCamera& camera) {
-  core::BandBuffer band(int(camera.width), int(camera.height), core::BandFormat::rgba32f);
-  band.enable_aux(true);
-  core::BandJob job;
-  job.params = frame_params(K_MODE_PATH, 1, 1, int(camera.height));
-  job.params.aux_outputs = 1u;
-  job.camera = camera;
-  job.previous_camera = camera;
-  tracer.render_band(job, band);
-  core::GBuffer g;
-  g.resize(band.width(), band.height());
-  band.copy_aux_rows_to(g, 0, band.height());
-  return g;
 }
 
 }  // namespace
@@ -88,7 +72,7 @@ TEST_P(SkinnedMotion, FollowsThePreviousPoseOfTheJoints) {
   const commit::CommitBuffer lifted = sync.sync(world.TakeChanges(), 2);
   ASSERT_EQ(lifted.skin_joints().size(), 1u);
   tracer->apply(lifted);
-  const core::GBuffer g = render_aux_band(*tracer, camera);
+  const core::GBuffer g = render_aux_band(*tracer, camera, camera);
 
   const uint32_t walker = uint32_t(handle) + 1u;  // the id plane holds the entity handle + 1 (aux_outputs.h)
   int checked = 0;
