@@ -17,6 +17,7 @@
 #include "default_map.h"
 #include "convergence_choice.h"
 #include "workload_choice.h"
+#include "play_rate.h"
 #include "play_session.h"
 #include "viewer/hud.h"
 #include "viewer/viewer_actions.h"
@@ -152,6 +153,8 @@ int run_play(PlayArgs a) {
   int exit_code = kExitOk;
   std::unique_ptr<core::ChromeTraceWriter> trace;
   if (!a.trace.empty()) trace = std::make_unique<core::ChromeTraceWriter>(a.trace);
+  // With --frames, the rate held is printed at the end; a sixth of the run (at least 10 frames) is warm-up.
+  PlayRate rate(a.frames > 0 ? std::max<size_t>(10, static_cast<size_t>(a.frames) / 6) : 0);
 
   while (!window->should_close()) {
     window->poll_events();
@@ -281,11 +284,18 @@ int run_play(PlayArgs a) {
       viewer::draw_hud(hud_layer, hud, fb_h >= 700 ? 2 : 1);
     }
     ++frames_done;
+    rate.frame(1000.0 * frame_s);
     const bool last_frame = a.frames > 0 && frames_done >= a.frames;
     const bool read_back = last_frame && !a.window_shot.empty();
     window->present(frame_image, show_hud ? &hud_layer : nullptr, read_back ? &window_image : nullptr);
     if (last_frame) window->request_close();
   }
+
+  if (a.frames > 0)
+    std::cout << rate.summary(static_cast<size_t>(frames_done), window->framebuffer_width(),
+                              window->framebuffer_height(), settings.width, settings.height, scale, settings.spp,
+                              target_fps)
+              << "\n";
 
   if (!a.window_shot.empty() && window_image.width > 0) {
     try {
@@ -366,7 +376,7 @@ void add_play_command(CLI::App& app, int& exit_code) {
       ->check(CLI::IsMember(debug_mode_names()));
   cmd->add_option("--tone", a->tone, "tone mapper at start")->capture_default_str()->check(CLI::IsMember(tone_curve_names()));
   cmd->add_flag("!--no-scenario", a->session.scenario, "leave the door, fan, flicker and flashlight still");
-  cmd->add_option("--frames", a->frames, "quit after this many frames (0: when the window closes)")
+  cmd->add_option("--frames", a->frames, "quit after this many frames (0: when the window closes) and print the frame rate held (median and p95 after a warm-up) with the render size and spp it ended on")
       ->capture_default_str()
       ->check(CLI::NonNegativeNumber);
   cmd->add_option("--screenshot", a->screenshot, "write the last frame to this image file on exit");
