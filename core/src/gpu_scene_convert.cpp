@@ -94,6 +94,8 @@ KMaterial to_kmaterial(const scene::Material& material, const scene::Scene& scen
   k.normal_tex = texture_slot(material.normal_image, TextureUse::Surface, scene);
   k.specular_tex = texture_slot(material.specular_image, TextureUse::Surface, scene);
   k.emissive_tex = texture_slot(material.emissive_image, TextureUse::Surface, scene);
+  const uint32_t blend_diffuse = texture_slot(material.blend_diffuse_image, TextureUse::Surface, scene);
+  k.blend_diffuse_tex1 = blend_diffuse != K_NONE && k.diffuse_tex != K_NONE ? blend_diffuse + 1u : 0u;
   k.blend = to_kblend(material.blend);
   k.alpha_ref = material.alpha_ref;
   uint32_t flags = 0;

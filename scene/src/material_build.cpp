@@ -126,6 +126,13 @@ static Material build_material_look(const MaterialDecl& decl, ImageLibrary& imag
     switch (s.role) {
       case StageRole::Diffuse:
         lit = true;
+        if (m.diffuse_image >= 0 && m.blend_diffuse_image < 0 && draws_image(s) &&
+            (m.vertex_color || m.inverse_vertex_color) && s.vertex_color == m.inverse_vertex_color &&
+            s.inverse_vertex_color == m.vertex_color) {
+          // The engine draws both interactions, each weighted by its stage's vertex colour mode.
+          m.blend_diffuse_image = images.get(s.image, ImageRole::Color, context);
+          break;
+        }
         if (m.diffuse_image >= 0 || !draws_image(s)) break;
         m.diffuse_image = images.get(s.image, ImageRole::Color, context);
         m.diffuse_color = s.color;

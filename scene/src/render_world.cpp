@@ -206,7 +206,7 @@ void RenderWorld::FreeLightDef(int handle) { free_def(lights_, light_names_, han
 int RenderWorld::DefineMaterial(const Material& material) {
   auto image_ok = [&](int i) { return i >= -1 && i < int(scene_.images.size()); };
   for (int i : {material.diffuse_image, material.normal_image, material.specular_image, material.emissive_image,
-                material.light_image, material.falloff_image})
+                material.light_image, material.falloff_image, material.blend_diffuse_image})
     if (!image_ok(i))
       throw RenderWorldError(fmt::format("DefineMaterial '{}': image {} out of range ({} images)", material.name, i,
                                          scene_.images.size()));

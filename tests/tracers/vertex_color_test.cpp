@@ -122,6 +122,37 @@ TEST_P(VertexColors, LitSurfaceTakesTheVertexColour) {
   EXPECT_NEAR(plain.y, plain.x, 1e-4f);
 }
 
+// A terrain blend: one quad whose vertex colour ramps from black (x = -100) to white (x = 100) under a
+// material with a green `vertexColor` diffuse stage and a blue `inverseVertexColor` one: the albedo goes
+// from blue to green, each weighed by its stage's vertex colour, and the two always sum to the albedo.
+TEST_P(VertexColors, TerrainBlendShowsEachStageWhereItsVertexColourLeavesRoom) {
+  scene::Scene s;
+  s.name = "terrain_blend";
+  const int material = add_material(s, "terrain", true, false);
+  s.materials[size_t(material)].diffuse_image = add_image(s, "green", 4, 4, [](int, int) { return glm::u8vec4(0, 255, 0, 255); });
+  s.materials[size_t(material)].blend_diffuse_image =
+      add_image(s, "blue", 4, 4, [](int, int) { return glm::u8vec4(0, 0, 255, 255); });
+  scene::Mesh world;
+  world.name = "_area0";
+  add_coloured_quad(world, material, -100, 100, kBlack, kWhite);
+  add_world_mesh(s, std::move(world));
+  s.lights.push_back(point_light({0, 0, 150}, {600, 600, 600}));
+  const core::FrameBuffer fb =
+      render(*tracer_, s, camera_looking_down({0, 0, 400}, 0.5f, kSize, kSize), frame_params(K_MODE_ALBEDO, 16, 0, kSize));
+  int checked = 0;
+  for (int px = pixel_of(-95, 0).x; px <= pixel_of(95, 0).x; ++px) {
+    const float x = pixel_centre_x(px);
+    if (x < -96.0f || x > 96.0f) continue;
+    const float t = (x + 100.0f) / 200.0f;   // the vertex colour's value here
+    const glm::vec3 got = pixel(fb, px, kSize / 2);
+    EXPECT_NEAR(got.x, 0.0f, 1e-4f) << "x = " << x;
+    EXPECT_NEAR(got.y, kAlbedo * t, 0.01f) << "green stage at x = " << x;
+    EXPECT_NEAR(got.z, kAlbedo * (1.0f - t), 0.01f) << "blue stage at x = " << x;
+    ++checked;
+  }
+  EXPECT_GE(checked, 20);
+}
+
 INSTANTIATE_TEST_SUITE_P(Tracers, VertexColors, ::testing::ValuesIn(built_tracers()),
                          [](const ::testing::TestParamInfo<std::string>& info) { return info.param; });
 

@@ -95,7 +95,9 @@ typedef struct KMaterial {
   kuint flags;
   kuint blend;              /* K_BLEND_* */
   float alpha_ref;          /* alphaTest threshold */
-  kuint pad;
+  kuint blend_diffuse_tex1; /* terrain blends: 1 + the texture shown where the vertex colour leaves room
+                               (x (1 - vertex RGB) where diffuse_tex is x vertex RGB, and the other way
+                               round); 0: none, so zeroed materials and earlier packs have none */
 } KMaterial;
 
 /* ---- Textures: RGBA8 texels (R in the low byte) in one buffer, mip levels stored one after another. */

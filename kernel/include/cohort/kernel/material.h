@@ -197,6 +197,15 @@ KFN KSurface k_surface_eval(const KSceneView* scene, KHit hit, KVec3 ray_org, KV
   KVec4 vertex_color = k_hit_vertex_color(scene, hit.triangle, u, v, m->flags);
   diffuse = v4(diffuse.x * vertex_color.x, diffuse.y * vertex_color.y, diffuse.z * vertex_color.z,
                diffuse.w * vertex_color.w);
+  if (m->blend_diffuse_tex1 != 0u) {
+    /* A terrain blend: the second diffuse stage takes what the first one's vertex colour leaves. Its
+     * interaction's specular is the first's, not weighed again. */
+    KVec4 d2 = k_texture_sample_footprint(scene, m->blend_diffuse_tex1 - 1u, s, t, footprint);
+    diffuse.x += m->diffuse_color[0] * d2.x * (1.0f - vertex_color.x);
+    diffuse.y += m->diffuse_color[1] * d2.y * (1.0f - vertex_color.y);
+    diffuse.z += m->diffuse_color[2] * d2.z * (1.0f - vertex_color.z);
+    vertex_color = v4(1.0f, 1.0f, 1.0f, vertex_color.w);
+  }
   sf.albedo = v4_rgb(diffuse);
   sf.alpha = diffuse.w;
 

@@ -42,6 +42,10 @@ struct Material {
   bool emitter = false;        // ambient-only stages: emits its stage image
   bool vertex_color = false;         // a stage is `vertexColor`: colours x the vertex colour
   bool inverse_vertex_color = false; // a stage is `inverseVertexColor`: colours x (1 - vertex RGB)
+  // A second diffuse stage in the other vertex colour mode (terrain blends: one stage `vertexColor`, the
+  // next `inverseVertexColor`): shown where the first one's vertex colour leaves room. Its colour is the
+  // first stage's (one diffuse colour per material here).
+  int blend_diffuse_image = -1;
   bool no_self_shadow = false; // noSelfShadow: never shadows, nor is shadowed by, other noSelfShadow surfaces
   BlendClass blend = BlendClass::Opaque;
   // Sky: six consecutive Scene::images, the cube faces +X, -X, +Y, -Y, +Z, -Z (GL order), and the
