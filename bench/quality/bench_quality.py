@@ -345,6 +345,48 @@ def main():
     fig.tight_layout()
     fig.savefig(plot_path, dpi=100)
     print(f"wrote {plot_path}")
+    if masks:
+        crops_path = write_object_crops(args, ref_dir, masks, methods, plt)
+        if crops_path:
+            print(f"wrote {crops_path}")
+
+
+def write_object_crops(args, ref_dir, masks, methods, plt):
+    """Side by side, the reference and each method around the object's swept path, at the frame it started
+    moving, halfway, its last moving frame and N still frames after (rows), 3x enlarged."""
+    last = masks["last_moving_frame"]
+    if last is None:
+        return None
+    first = masks["moving_frames"][0]
+    frames = sorted({first, (first + last) // 2, last, min(last + args.still_frames, args.frames - 1)})
+    union = np.zeros_like(masks["swept"][0])
+    for f in frames:
+        union |= masks["swept"][f]
+    ys, xs = np.nonzero(union)
+    if len(xs) == 0:
+        return None
+    margin = 6
+    y0, y1 = max(ys.min() - margin, 0), min(ys.max() + margin + 1, union.shape[0])
+    x0, x1 = max(xs.min() - margin, 0), min(xs.max() + margin + 1, union.shape[1])
+    dirs = [ref_dir] + [os.path.join(args.out, m.replace("+", "_")) for m in methods]
+    rows = []
+    for f in frames:
+        row = []
+        for d in dirs:
+            img = plt.imread(frame_path(d, f))[..., :3].astype(np.float32)
+            if img.max() > 1.0:
+                img /= 255.0
+            row.append(img[y0:y1, x0:x1])
+            row.append(np.ones((y1 - y0, 1, 3), np.float32))
+        rows.append(np.concatenate(row[:-1], axis=1))
+        rows.append(np.ones((1, rows[-1].shape[1], 3), np.float32))
+    tile = np.concatenate(rows[:-1], axis=0)
+    tile = np.repeat(np.repeat(tile, 3, axis=0), 3, axis=1)
+    path = os.path.join(args.out, f"bench_quality_{args.mask_entity}.png")
+    plt.imsave(path, np.clip(tile, 0.0, 1.0))
+    with open(os.path.splitext(path)[0] + ".txt", "w") as f:
+        f.write(f"columns: reference, {', '.join(methods)}; rows: frames {', '.join(map(str, frames))}\n")
+    return path
 
 
 if __name__ == "__main__":
