@@ -66,6 +66,7 @@ struct RenderArgs {
   int atrous_passes = 0;  // 0: from the image height (core/atrous_filter.h)
   std::string atrous_guide = core::atrous_guide_name(core::AtrousOptions{}.guide);
   float atrous_sigma = 0.0f;  // 0: the guide's default
+  float anti_lag = -1.0f;     // < 0: ReprojectionOptions' default
   std::string post_on = "auto";
   std::string band_format = "rgb16f";
   bool frames_given = false;
@@ -166,6 +167,7 @@ int run_render(const RenderArgs& a) {
     core::FramePostOptions post_options;
     post_options.reproject = reproject;
     post_options.atrous = atrous;
+    if (a.anti_lag >= 0.0f) post_options.reprojection.anti_lag_sigma = a.anti_lag;
     post_options.atrous_options.passes =
         a.atrous_passes > 0 ? a.atrous_passes : core::atrous_passes_for_height(a.height);
     core::AtrousOptions& ao = post_options.atrous_options;
@@ -430,6 +432,12 @@ void add_render_command(CLI::App& app, int& exit_code) {
                   "luminance stop's scale of --denoise atrous: standard deviations with the variance guide "
                   "(default 2), relative difference with the fixed one (default 2); 0 keeps the default")
       ->capture_default_str()
+      ->check(CLI::Range(0.0f, 1000.0f));
+  cmd->add_option("--anti-lag", a->anti_lag,
+                  "reprojection's anti-lag: a moving pixel's history whose 5x5 mean luma is off the fresh frame's by "
+                  "more than this many standard errors of that mean is shortened in proportion (stale lighting: a "
+                  "flashlight, a flicker, a door letting light in); 0 turns it off; default " +
+                      std::to_string(core::ReprojectionOptions{}.anti_lag_sigma).substr(0, 4))
       ->check(CLI::Range(0.0f, 1000.0f));
   cmd->add_option("--post-on", a->post_on,
                   "where reprojection and the a-trous filter run: host (the CPU's threads), cuda:N (a GPU; the "

@@ -16,9 +16,10 @@ per-frame FLIP plot and the milliseconds each method's extra stages took (from s
 With --scenario (the test map's scenario, recorded first by `cohort record-scenario`) or --replay FILE,
 the frames follow the stream, and the reference run also writes its id plane (`cohort render --write-ids`):
 FLIP is then also measured on one object's pixels (--mask-entity, default door_main): the pixels it covers
-in the reference frame or covered in the --mask-history frames before (the pixels it just left, where a
-ghost would trail), grown by one pixel. The object's last moving frame L is the last frame whose
-placement differs from the one before (stats.json's moved_entities); "after N still frames" (--still-frames)
+in the reference frame, and those it covered in any of the --mask-history frames before if it moved since
+(the pixels it just left, where a ghost would trail), grown by one pixel. Once it has stood still that
+many frames, the mask is its own pixels (grown by one: the edges, where history bleeds). The object's last moving
+frame L is the last frame whose placement differs from the one before (stats.json's moved_entities); "after N still frames" (--still-frames)
 is frame L + N, the N-th frame in which it stood where frame L left it. The "swept" figures use every pixel it
 covered since it started moving instead (its whole path, as seen from each frame's camera).
 
@@ -139,11 +140,13 @@ def object_masks(args, ref_dir):
     moving = [i for i, fr in enumerate(stats["frames"]) if args.mask_entity in fr.get("moved_entities", [])]
     covered = [load_id_plane(os.path.join(ref_dir, f"ids_{f:04d}.pgm")) == entity_id for f in range(args.frames)]
     first_moving = moving[0] if moving else None
+    moved_in = set(moving)
     recent, swept = [], []
     for f in range(args.frames):
         m = covered[f].copy()
         for k in range(1, args.mask_history + 1):
-            if f - k >= 0:
+            # Where it was k frames ago counts only if it moved since: once still, its pixels are its own.
+            if f - k >= 0 and any(j in moved_in for j in range(f - k + 1, f + 1)):
                 m |= covered[f - k]
         recent.append(grow(m, 1))
         s = covered[f].copy()
@@ -209,7 +212,7 @@ def main():
     p.add_argument("--mask-entity", default="door_main",
                    help="with --scenario/--replay: the entity whose pixels get their own FLIP")
     p.add_argument("--mask-history", type=int, default=4,
-                   help="the entity's mask also holds the pixels it covered in this many frames before")
+                   help="the entity's mask also holds the pixels it covered in this many frames before, if it moved since")
     p.add_argument("--still-frames", type=int, default=4,
                    help="report the entity's FLIP this many frames after its last moving frame")
     args = p.parse_args()

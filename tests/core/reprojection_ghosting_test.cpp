@@ -68,9 +68,11 @@ struct RegionMean {
 
 TEST(ReprojectionGhosting, TheDoorLeavesNoTrailAndKeepsItsColourAfterFourStillFrames) {
   for (const float behind_depth : {30.0f, 10.5f})
-  for (const bool moments : {false, true}) {
+  for (const bool moments : {false, true})
+  for (const bool anti_lag : {false, true}) {
     ReprojectionOptions o;
     o.luminance_moments = moments;
+    if (!anti_lag) o.anti_lag_sigma = 0.0f;
     TemporalReprojection r(o);
     std::mt19937 rng(5);
     FrameBuffer image;
@@ -94,7 +96,7 @@ TEST(ReprojectionGhosting, TheDoorLeavesNoTrailAndKeepsItsColourAfterFourStillFr
           if (s == Surface::wall && (wx < kDoorX0 - 1 || wx > kDoorX1) && x < kW - 1) wall.sum += v, ++wall.count;
         }
       SCOPED_TRACE(testing::Message() << "frame " << frame << ", behind the door at depth " << behind_depth
-                                      << (moments ? ", with moments" : ""));
+                                      << (moments ? ", with moments" : "") << (anti_lag ? ", anti-lag" : ""));
       if (frame > 0) {
         ASSERT_GT(uncovered.count, 0);
         // A ghost: any share of the door's history (100x brighter) in the far room shows at once.
@@ -104,8 +106,55 @@ TEST(ReprojectionGhosting, TheDoorLeavesNoTrailAndKeepsItsColourAfterFourStillFr
       EXPECT_NEAR(door.mean(), kDoor, 0.1 * kDoor) << "the door takes another surface's colour";
       EXPECT_NEAR(wall.mean(), kWall, 0.1 * kWall);
     }
-    // After 4 still frames the door's history has grown with it: it kept its samples while it moved.
+    // After 4 still frames the door's history has grown with it: it kept its samples while it moved (the
+    // anti-lag, which cannot tell this noise from a lighting change of its size, trims some of it).
     const size_t door_pixel = static_cast<size_t>(kDoorY0 + 2) * kW + (kDoorX0 + 4 - last_frame);
-    EXPECT_GE(r.history_length()[door_pixel], static_cast<float>(last_frame)) << "the door lost its history";
+    EXPECT_GE(r.history_length()[door_pixel], anti_lag ? 2.0f : static_cast<float>(last_frame))
+        << "the door lost its history";
   }
+}
+
+// Ghosting of lighting: the light on a wall rises fivefold (a door letting light in, a flashlight's pool
+// arriving, a flicker) while the camera pans. At 1 spp the fresh samples are sparse (0 or 4x the mean),
+// so the 3x3 clamp box reaches down to 0 and keeps the old, darker history: a long history would fade in
+// the new light over tens of frames. The anti-lag (kernel/reproject.h, k_reproject_anti_lag) sees the
+// 5x5 means part and lets it in.
+TEST(ReprojectionGhosting, ALightThatBrightensIsNotHeldBackByTheHistory) {
+  constexpr int kBefore = 20, kAfter = 4;
+  constexpr float kDim = 2.0f, kBright = 10.0f;
+  auto run = [&](bool anti_lag) {
+    ReprojectionOptions o;
+    if (!anti_lag) o.anti_lag_sigma = 0.0f;
+    TemporalReprojection r(o);
+    std::mt19937 rng(9);
+    std::uniform_real_distribution<float> u(0.0f, 1.0f);
+    GBuffer g;
+    g.resize(kW, kH);
+    FrameBuffer image;
+    image.resize(kW, kH);
+    for (size_t p = 0; p < g.pixels(); ++p) {
+      g.depth[p] = g.prev_depth[p] = kWallDepth;
+      g.normal[3 * p] = 1.0f;
+      g.id[p] = kWorldId;
+    }
+    RegionMean wall;
+    for (int frame = 0; frame < kBefore + kAfter; ++frame) {
+      const float level = frame < kBefore ? kDim : kBright;
+      for (size_t p = 0; p < g.pixels(); ++p) {
+        g.motion[2 * p] = frame > 0 ? 1.0f : 0.0f;  // panning: every pixel moves
+        const float sample = u(rng) < 0.25f ? 4.0f * level : 0.0f;
+        for (int k = 0; k < 3; ++k) image.rgba[4 * p + k] = sample;
+        image.rgba[4 * p + 3] = 1.0f;
+      }
+      r.accumulate(image, g);
+    }
+    for (int y = 2; y < kH - 2; ++y)
+      for (int x = 2; x < kW - 3; ++x) wall.sum += r.image().rgba[4 * (static_cast<size_t>(y) * kW + x) + 1], ++wall.count;
+    return wall.mean();
+  };
+  const double with_anti_lag = run(true), without = run(false);
+  EXPECT_GT(with_anti_lag, 0.75 * kBright) << kAfter << " frames after the light rose";  // 8.5 measured
+  EXPECT_LT(with_anti_lag, 1.2 * kBright);
+  // The case the anti-lag is for: without it the old light stays (the clamp alone cannot catch it).
+  EXPECT_LT(without, 0.5 * kBright);  // 3.1 measured
 }

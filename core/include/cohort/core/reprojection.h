@@ -30,6 +30,11 @@ struct ReprojectionOptions {
   float normal_cos = 0.8f;        // least cosine between the normals of a pixel and its history tap
   float clamp_sigma = 1.5f;       // neighbourhood box half-width in standard deviations (moving pixels)
   float still_motion = 0.01f;     // pixels: motion below this counts as no motion (no clamp)
+  // Moving pixels: history whose 5x5 mean luma is off the fresh frame's by more than anti_lag_sigma
+  // standard errors of that mean (plus anti_lag_relative of it) is shortened in proportion (kernel/reproject.h's
+  // k_reproject_anti_lag); 0 turns it off.
+  float anti_lag_sigma = 0.75f;
+  float anti_lag_relative = 0.0f;
   bool luminance_moments = false; // also keep M1, M2 of the illumination's luminance (SVGF's variance)
 };
 
