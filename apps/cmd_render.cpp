@@ -231,9 +231,9 @@ int run_render(const RenderArgs& a) {
       if (reproject) stats.convergence_f = 1.0 / std::max(post->mean_history_length(), 1.0);
     }
     const bool writes_frame = !(a.write == "last" && f + 1 < a.frames && !player);
-    if (post_runs) {
-      shown_image = &post->image();
-    } else if (denoiser && writes_frame) {
+    if (post_runs) shown_image = &post->image();
+    // OIDN filters what the reprojection (or the blend) shows; the a-trous filter runs inside the post.
+    if (denoiser && writes_frame) {
       core::ScopedStage denoising(stats.stages, core::kCoreTrack, "denoise");
       core::DenoiseGuides guides;
       if (!gbuffer.empty()) {  // the aux planes guide the filter where the frame has them
