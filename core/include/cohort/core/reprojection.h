@@ -7,7 +7,10 @@
 // (disocclusion). Where the pixel moved, the history is clamped to the fresh frame's 3x3 neighbourhood
 // box in YCoCg (mean +- clamp_sigma standard deviations), which bounds the ghosting of lighting that
 // reprojection cannot follow; a pixel that did not move keeps its history untouched, so a still view
-// is exactly the running average of its frames (up to max_history). Blend: C = H + (S - H) / n, n the
+// is exactly the running average of its frames (up to max_history). Where the pixel moved, an anti-lag
+// also shortens the history when the 5x5 mean luma around the reprojected point has drifted from the
+// fresh frame's by more than that mean's noise explains (stale lighting the 1-spp clamp box is too wide
+// to catch). Blend: C = H + (S - H) / n, n the
 // history length (capped at max_history). Samples that are not finite (NaN, Inf) never enter the
 // history: the pixel keeps its history (or shows its neighbourhood's mean when it has none).
 // With luminance_moments, the history also keeps the first and second moments of the illumination's
