@@ -32,6 +32,7 @@
 #include "camera_path.h"
 #include "convergence_choice.h"
 #include "default_map.h"
+#include "id_plane_output.h"
 #include "progress_bar.h"
 #include "render_scene_source.h"
 
@@ -65,9 +66,11 @@ struct RenderArgs {
   int atrous_passes = 0;  // 0: from the image height (core/atrous_filter.h)
   std::string atrous_guide = core::atrous_guide_name(core::AtrousOptions{}.guide);
   float atrous_sigma = 0.0f;  // 0: the guide's default
+  float anti_lag = -1.0f;     // < 0: ReprojectionOptions' default
   std::string post_on = "auto";
   std::string band_format = "rgb16f";
   bool frames_given = false;
+  bool write_ids = false;  // the G-buffer's id plane of every written frame, and which entities moved
 };
 
 // ACES and gamma 2.2 after --exposure (a factor), encoded exactly: the bytes `cohort render` has
@@ -164,6 +167,7 @@ int run_render(const RenderArgs& a) {
     core::FramePostOptions post_options;
     post_options.reproject = reproject;
     post_options.atrous = atrous;
+    if (a.anti_lag >= 0.0f) post_options.reprojection.anti_lag_sigma = a.anti_lag;
     post_options.atrous_options.passes =
         a.atrous_passes > 0 ? a.atrous_passes : core::atrous_passes_for_height(a.height);
     core::AtrousOptions& ao = post_options.atrous_options;
@@ -178,7 +182,8 @@ int run_render(const RenderArgs& a) {
   }
   // A GPU post-processing reprojection takes the bands as the tracers packed them: half the bytes cross
   // the bus and the host skips its conversions (the float frame and G-buffer are not made).
-  const bool packed = post && reproject && post->where() != "host" && a.denoise != "oidn" && a.denoise != "oidn-cuda";
+  const bool packed = post && reproject && post->where() != "host" && a.denoise != "oidn" && a.denoise != "oidn-cuda" &&
+                      !a.write_ids;
   renderer.set_packed_merge(packed);
   if (a.denoise != "none" && !atrous) {
     denoiser = core::OidnDenoiser::open(core::parse_oidn_device(a.denoise == "oidn-cuda" ? "cuda" : "cpu"),
@@ -192,6 +197,9 @@ int run_render(const RenderArgs& a) {
   core::FramePipeline pipeline(renderer);
   std::map<uint64_t, core::TimelineClock::time_point> started;  // frames in the pipeline: when their world sync began
   core::TimelineClock::time_point previous_delivery{};
+  // --write-ids: per frame in the pipeline, the entities whose placement changed since the previous frame.
+  MovedEntities moved_entities;
+  std::map<uint64_t, std::vector<std::string>> moved_by_frame;
   auto finish = [&](core::FramePipeline::Delivered done) {
     core::FrameStats& stats = done.stats;
     const core::FrameBuffer& frame = pipeline.image();
@@ -223,9 +231,9 @@ int run_render(const RenderArgs& a) {
       if (reproject) stats.convergence_f = 1.0 / std::max(post->mean_history_length(), 1.0);
     }
     const bool writes_frame = !(a.write == "last" && f + 1 < a.frames && !player);
-    if (post_runs) {
-      shown_image = &post->image();
-    } else if (denoiser && writes_frame) {
+    if (post_runs) shown_image = &post->image();
+    // OIDN filters what the reprojection (or the blend) shows; the a-trous filter runs inside the post.
+    if (denoiser && writes_frame) {
       core::ScopedStage denoising(stats.stages, core::kCoreTrack, "denoise");
       core::DenoiseGuides guides;
       if (!gbuffer.empty()) {  // the aux planes guide the filter where the frame has them
@@ -249,6 +257,10 @@ int run_render(const RenderArgs& a) {
       core::ScopedStage writing(stats.stages, core::kCoreTrack, "output");
       core::write_ldr_image(base.string() + (oiio ? ".png" : ".ppm"), shown.width, shown.height, display);
       core::write_hdr_image(base.string() + (oiio ? ".exr" : ".pfm"), shown);
+      if (a.write_ids && !gbuffer.empty()) {
+        std::snprintf(stem, sizeof stem, "ids_%04d.pgm", f);
+        write_id_plane_pgm((std::filesystem::path(a.out) / stem).string(), gbuffer.width, gbuffer.height, gbuffer.id);
+      }
     }
     const auto now = core::TimelineClock::now();
     const auto frame_start = started.at(stats.frame);
@@ -264,6 +276,11 @@ int run_render(const RenderArgs& a) {
     spdlog::debug("frame {}: {:.1f} ms ({} tracers, idle {:.1f}%)", f, stats.frame_ms, stats.tracers.size(),
                   stats.idle_percent);
     stats_json.push_back(nlohmann::json(stats));
+    if (a.write_ids) {
+      auto moved = moved_by_frame.find(stats.frame);
+      stats_json.back()["moved_entities"] = moved == moved_by_frame.end() ? std::vector<std::string>() : moved->second;
+      if (moved != moved_by_frame.end()) moved_by_frame.erase(moved);
+    }
   };
   for (int f = 0; f < frames; ++f) {
     const auto frame_start = core::TimelineClock::now();
@@ -271,6 +288,7 @@ int run_render(const RenderArgs& a) {
     core::BandJob job;
     if (player) {
       if (!player->play_frame(*world)) break;
+      if (a.write_ids) moved_by_frame[uint64_t(f)] = moved_entities.update(*world);
       core::ScopedStage syncing(stages, core::kCoreTrack, "world sync");
       renderer.submit_commit(sync->sync(world->TakeChanges(), uint64_t(f) + 1), [&] { return sync->snapshot(); });
       syncing.finish();
@@ -301,7 +319,7 @@ int run_render(const RenderArgs& a) {
     p.mode = modes().at(a.mode);
     p.soft_shadow_scale = a.soft_shadow_scale;
     p.shadow_rr = a.shadow_rr;
-    if (reproject || atrous) {
+    if (reproject || atrous || a.write_ids) {
       p.aux_outputs = 1u;
       job.previous_camera = previous_camera;
       previous_camera = job.camera;
@@ -317,6 +335,10 @@ int run_render(const RenderArgs& a) {
                            {"light_sampling", a.light_sampling}, {"light_samples", a.light_samples},    {"mode", a.mode},
                            {"camera_path", a.camera_path}, {"denoise", a.denoise},
                            {"convergence", a.no_convergence ? "none" : convergence_mode}, {"frames", stats_json}};
+  if (a.write_ids) {
+    const scene::RenderWorld* ids_world = world ? world.get() : scene.world.get();
+    report["entity_ids"] = ids_world ? entity_plane_ids(*ids_world) : std::map<std::string, uint32_t>();
+  }
   std::ofstream(std::filesystem::path(a.out) / "stats.json") << report.dump(2) << "\n";
   std::cout << "wrote " << rendered << " frame(s) and stats.json to " << a.out << "\n";
   return kExitOk;
@@ -347,13 +369,13 @@ void add_render_command(CLI::App& app, int& exit_code) {
   cmd->add_option("--width", a->width, "image width")->capture_default_str()->check(CLI::PositiveNumber);
   cmd->add_option("--height", a->height, "image height")->capture_default_str()->check(CLI::PositiveNumber);
   cmd->add_option("--spp", a->spp, "samples per pixel per frame")->capture_default_str()->check(CLI::PositiveNumber);
+  cmd->add_option("--time", a->time, "game time of frame 0 in seconds, for the materials' registers (time, "
+                                     "tables: flicker, scrolling, pulsing); maps only, scene packs are fixed")
+      ->capture_default_str();
+  cmd->add_option("--time-step", a->time_step_ms, "game time between frames in ms (0 freezes the materials)")
+      ->capture_default_str()
+      ->check(CLI::NonNegativeNumber);
   auto* frames_option =
-      cmd->add_option("--time", a->time, "game time of frame 0 in seconds, for the materials' registers (time, "
-                                         "tables: flicker, scrolling, pulsing); maps only, scene packs are fixed")
-          ->capture_default_str();
-      cmd->add_option("--time-step", a->time_step_ms, "game time between frames in ms (0 freezes the materials)")
-          ->capture_default_str()
-          ->check(CLI::NonNegativeNumber);
       cmd->add_option("--frames", a->frames, "frames to render (with --replay: at most this many; default all)")
           ->capture_default_str()
           ->check(CLI::PositiveNumber);
@@ -411,6 +433,12 @@ void add_render_command(CLI::App& app, int& exit_code) {
                   "(default 2), relative difference with the fixed one (default 2); 0 keeps the default")
       ->capture_default_str()
       ->check(CLI::Range(0.0f, 1000.0f));
+  cmd->add_option("--anti-lag", a->anti_lag,
+                  "reprojection's anti-lag: a moving pixel's history whose 5x5 mean luma is off the fresh frame's by "
+                  "more than this many standard errors of that mean is shortened in proportion (stale lighting: a "
+                  "flashlight, a flicker, a door letting light in); 0 turns it off; default " +
+                      std::to_string(core::ReprojectionOptions{}.anti_lag_sigma).substr(0, 4))
+      ->check(CLI::Range(0.0f, 1000.0f));
   cmd->add_option("--post-on", a->post_on,
                   "where reprojection and the a-trous filter run: host (the CPU's threads), cuda:N (a GPU; the "
                   "frame and its G-buffer cross the bus each frame) or auto (the first CUDA tracer's GPU, else the "
@@ -428,6 +456,10 @@ void add_render_command(CLI::App& app, int& exit_code) {
                   "where it would set the frame rate (docs/denoising.md)")
       ->capture_default_str()
       ->check(CLI::IsMember({"auto", "brigade", "reproject"}));
+  cmd->add_flag("--write-ids", a->write_ids,
+                "also write each frame's id plane as ids_NNNN.pgm (16-bit: 0 the world, entity handle + 1, 65535 a "
+                "miss; the tracers' auxiliary outputs) and, in stats.json, the map entities' ids and per frame of "
+                "a --replay the entities that moved since the previous frame (bench/quality/bench_quality.py)");
   cmd->add_flag("--no-convergence", a->no_convergence,
                  "write each frame as rendered instead of blending frames with adaptive convergence");
   cmd->add_option("--write", a->write, "images of every frame, or only the last (stats.json always has every frame)")

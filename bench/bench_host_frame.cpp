@@ -10,6 +10,7 @@
 // long after 4 frames) and, the worst case of a frame with no history, from the 7x7 spatial estimate.
 //
 //   bench_host_frame [--width 1920] [--height 1080] [--frames 40] [--json FILE]   (out/bench_host_frame.json)
+//                    [--anti-lag SIGMA]   (the reprojection's; 0 turns it off, default ReprojectionOptions')
 #include <algorithm>
 #include <cstdio>
 #include <filesystem>
@@ -32,6 +33,8 @@ using namespace cohort;
 using namespace cohort::core;
 
 namespace {
+
+float anti_lag_sigma = -1.0f;  // --anti-lag; < 0: the default of ReprojectionOptions
 
 double median(std::vector<double> v) {
   if (v.empty()) return 0.0;
@@ -61,8 +64,10 @@ nlohmann::json run(BandFormat format, int width, int height, int frames) {
   FramePipeline pipeline(renderer);
   AdaptiveConvergence convergence;
   ToneMapOptions tone_options;
-  TemporalReprojection reprojection;
-  ReprojectionOptions moment_options;
+  ReprojectionOptions reprojection_options;
+  if (anti_lag_sigma >= 0.0f) reprojection_options.anti_lag_sigma = anti_lag_sigma;
+  TemporalReprojection reprojection(reprojection_options);
+  ReprojectionOptions moment_options = reprojection_options;
   moment_options.luminance_moments = true;
   TemporalReprojection reprojection_with_moments(moment_options);
   AtrousOptions fixed_options, variance_options;
@@ -141,6 +146,7 @@ int main(int argc, char** argv) {
     else if (arg == "--height") height = std::stoi(argv[i + 1]);
     else if (arg == "--frames") frames = std::max(6, std::stoi(argv[i + 1]));
     else if (arg == "--json") json_path = argv[i + 1];
+    else if (arg == "--anti-lag") anti_lag_sigma = std::stof(argv[i + 1]);
     else {
       std::fprintf(stderr, "bench_host_frame: unknown option %s\n", arg.c_str());
       return 2;

@@ -57,6 +57,8 @@ void TemporalReprojection::accumulate(const FrameBuffer& fresh, const GBuffer& g
   params.normal_cos = o.normal_cos;
   params.clamp_sigma = o.clamp_sigma;
   params.still_motion = o.still_motion;
+  params.anti_lag_sigma = o.anti_lag_sigma;
+  params.anti_lag_relative = o.anti_lag_relative;
 
   ycocgw_.resize(4 * pixels);
   const KReprojectFresh fresh_planes{fresh.rgba.data(), ycocgw_.data(),     gbuffer.depth.data(), gbuffer.prev_depth.data(),

@@ -195,6 +195,8 @@ class CudaFramePost final : public core::FramePost {
       params.normal_cos = o.normal_cos;
       params.clamp_sigma = o.clamp_sigma;
       params.still_motion = o.still_motion;
+      params.anti_lag_sigma = o.anti_lag_sigma;
+      params.anti_lag_relative = o.anti_lag_relative;
       params.moments = o.luminance_moments ? 1 : 0;
       float* ycocgw = ycocgw_.scratch(4 * pixels);
       prepare_kernel<<<blocks_for(pixels), kThreads, 0, stream_>>>(frame_.data(), ycocgw, static_cast<int>(pixels));

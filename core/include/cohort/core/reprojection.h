@@ -7,7 +7,10 @@
 // (disocclusion). Where the pixel moved, the history is clamped to the fresh frame's 3x3 neighbourhood
 // box in YCoCg (mean +- clamp_sigma standard deviations), which bounds the ghosting of lighting that
 // reprojection cannot follow; a pixel that did not move keeps its history untouched, so a still view
-// is exactly the running average of its frames (up to max_history). Blend: C = H + (S - H) / n, n the
+// is exactly the running average of its frames (up to max_history). Where the pixel moved, an anti-lag
+// also shortens the history when the 5x5 mean luma around the reprojected point has drifted from the
+// fresh frame's by more than that mean's noise explains (stale lighting the 1-spp clamp box is too wide
+// to catch). Blend: C = H + (S - H) / n, n the
 // history length (capped at max_history). Samples that are not finite (NaN, Inf) never enter the
 // history: the pixel keeps its history (or shows its neighbourhood's mean when it has none).
 // With luminance_moments, the history also keeps the first and second moments of the illumination's
@@ -30,6 +33,11 @@ struct ReprojectionOptions {
   float normal_cos = 0.8f;        // least cosine between the normals of a pixel and its history tap
   float clamp_sigma = 1.5f;       // neighbourhood box half-width in standard deviations (moving pixels)
   float still_motion = 0.01f;     // pixels: motion below this counts as no motion (no clamp)
+  // Moving pixels: history whose 5x5 mean luma is off the fresh frame's by more than anti_lag_sigma
+  // standard errors of that mean (plus anti_lag_relative of it) is shortened in proportion (kernel/reproject.h's
+  // k_reproject_anti_lag); 0 turns it off.
+  float anti_lag_sigma = 0.75f;
+  float anti_lag_relative = 0.0f;
   bool luminance_moments = false; // also keep M1, M2 of the illumination's luminance (SVGF's variance)
 };
 

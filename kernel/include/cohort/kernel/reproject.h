@@ -26,7 +26,10 @@ typedef struct KReprojectParams {
   float normal_cos;       /* least cosine between the normals of a pixel and its history tap */
   float clamp_sigma;      /* neighbourhood box half-width in standard deviations (moving pixels) */
   float still_motion;     /* pixels: motion below this counts as no motion (no clamp) */
-  float pad1; float pad2; float pad3;
+  float anti_lag_sigma;   /* moving pixels: history luma off the fresh 5x5 mean by more than this many standard
+                             errors (plus anti_lag_relative of the mean) is stale lighting; 0: off */
+  float anti_lag_relative;
+  float pad3;
 } KReprojectParams;
 
 /* The fresh planes of one frame. */
@@ -105,6 +108,44 @@ KFN int k_reproject_moments(const KReprojectParams* p, KGLOBAL const float* ycoc
   return count;
 }
 
+/* Anti-lag (moving pixels): has the lighting changed under the history? The clamp's 3x3 box spans the
+ * noise of one sample (at 1 spp wider than most lighting changes: a flashlight that moves with the camera,
+ * a flickering light, a door casting new light), so a long history lags. Compared here: the mean luma of
+ * the 5x5 fresh samples around the pixel and of the history around the reprojected point, over the same
+ * taps (pairs on the same object), so textures and edges cancel and only the change and the noise of the
+ * fresh mean remain. Returns the factor (0, 1] to scale the history length by: 1 while the difference is
+ * within anti_lag_sigma standard errors of the fresh mean (plus anti_lag_relative of it), the ratio of
+ * that bound to the difference beyond. */
+KFN float k_reproject_anti_lag(const KReprojectParams* p, const KReprojectFresh* fresh,
+                               const KReprojectHistory* history, kint x, kint y, float hx, float hy) {
+  kint cx = (kint)k_floor(hx + 0.5f), cy = (kint)k_floor(hy + 0.5f);
+  float sf = 0.0f, sf2 = 0.0f, sh = 0.0f;
+  int count = 0;
+  for (kint dy = -2; dy <= 2; ++dy) {
+    kint fy = y + dy, ty = cy + dy;
+    if (fy < 0 || fy >= p->height || ty < 0 || ty >= p->height) continue;
+    for (kint dx = -2; dx <= 2; ++dx) {
+      kint fx = x + dx, tx = cx + dx;
+      if (fx < 0 || fx >= p->width || tx < 0 || tx >= p->width) continue;
+      kint f = fy * p->width + fx, q = ty * p->width + tx;
+      KGLOBAL const float* v = fresh->ycocgw + 4 * f;
+      if (v[3] == 0.0f || history->id[q] != fresh->id[f] || !(history->length[q] > 0.0f)) continue;
+      KGLOBAL const float* h = history->rgba + 4 * q;
+      sf += v[0];
+      sf2 += v[0] * v[0];
+      sh += 0.25f * h[0] + 0.5f * h[1] + 0.25f * h[2];
+      ++count;
+    }
+  }
+  if (count < 4) return 1.0f;
+  float inv = 1.0f / (float)count;
+  float mean = sf * inv;
+  float standard_error = k_sqrt(k_fmax(sf2 * inv - mean * mean, 0.0f) * inv);
+  float bound = p->anti_lag_sigma * standard_error + p->anti_lag_relative * k_fabs(mean) + 1e-6f;
+  float difference = k_fabs(sh * inv - mean);
+  return difference > bound ? bound / difference : 1.0f;
+}
+
 KFN void k_reproject_pixel(const KReprojectParams* p, const KReprojectFresh* fresh, const KReprojectHistory* history,
                            const KReprojectState* next, kint x, kint y) {
   kint pix = y * p->width + x;
@@ -155,6 +196,8 @@ KFN void k_reproject_pixel(const KReprojectParams* p, const KReprojectFresh* fre
       h2 *= inv;
     }
   }
+  if (history_length > 0.0f && moved && p->anti_lag_sigma > 0.0f)
+    history_length *= k_reproject_anti_lag(p, fresh, history, x, y, (float)x + mx, (float)y + my);
   KVec3 m1, m2;
   if (history_length > 0.0f && moved) {
     int count = k_reproject_moments(p, fresh->ycocgw, x, y, &m1, &m2);
