@@ -41,6 +41,11 @@ double path_pattern_scale(const PathPattern& pattern) {
 
 void upsample_sparse(const FrameBuffer& sparse, const GBuffer& gbuffer, PathPattern pattern, UpsampleMethod method,
                      FrameBuffer& out) {
+  SparseUpsampler().upsample(sparse, gbuffer, pattern, method, out);
+}
+
+void SparseUpsampler::upsample(const FrameBuffer& sparse, const GBuffer& gbuffer, PathPattern pattern,
+                               UpsampleMethod method, FrameBuffer& out) {
   if (method == UpsampleMethod::bilinear)
     throw std::invalid_argument("upsample_sparse: bilinear stretches a small frame (stretch_bilinear)");
   if (gbuffer.width != sparse.width || gbuffer.height != sparse.height)
@@ -50,11 +55,24 @@ void upsample_sparse(const FrameBuffer& sparse, const GBuffer& gbuffer, PathPatt
   if (out.width != sparse.width || out.height != sparse.height) out.resize(sparse.width, sparse.height);
   const KUpsampleParams params = k_upsample_params(sparse.width, sparse.height, pattern.pixels, pattern.phase);
   const int kernel_method = method == UpsampleMethod::nearest ? K_UPSAMPLE_NEAREST : K_UPSAMPLE_JOINT_BILATERAL;
-  HostThreads::shared().for_ranges(static_cast<size_t>(sparse.height), 4, [&](size_t row_begin, size_t row_end) {
+  HostThreads& threads = HostThreads::shared();
+  const float* illumination = sparse.rgba.data();  // nearest reads colour
+  if (method == UpsampleMethod::joint_bilateral) {
+    illumination_.resize(sparse.rgba.size());
+    threads.for_ranges(static_cast<size_t>(sparse.height), 16, [&](size_t row_begin, size_t row_end) {
+      for (size_t y = row_begin; y < row_end; ++y)
+        for (int x = 0; x < sparse.width; ++x)
+          k_upsample_demodulate_pixel(sparse.rgba.data(), gbuffer.albedo.data(), illumination_.data(), &params, x,
+                                      static_cast<kint>(y));
+    });
+    illumination = illumination_.data();
+  }
+  threads.for_ranges(static_cast<size_t>(sparse.height), 4, [&](size_t row_begin, size_t row_end) {
     for (size_t y = row_begin; y < row_end; ++y)
       for (int x = 0; x < sparse.width; ++x)
-        k_upsample_pixel(sparse.rgba.data(), gbuffer.depth.data(), gbuffer.normal.data(), gbuffer.albedo.data(),
-                         gbuffer.id.data(), out.rgba.data(), &params, kernel_method, x, static_cast<kint>(y));
+        k_upsample_pixel(sparse.rgba.data(), illumination, gbuffer.depth.data(), gbuffer.normal.data(),
+                         gbuffer.albedo.data(), gbuffer.id.data(), out.rgba.data(), &params, kernel_method, x,
+                         static_cast<kint>(y));
   });
 }
 

@@ -19,12 +19,17 @@ namespace {
 
 [[maybe_unused]] const char* kProgram = R"CL(
 #include "cohort/kernel/upsample.h"
-__kernel void upsample_frame(__global const float* in_rgba, __global const float* depth, __global const float* normal,
-                       __global const float* albedo, __global const uint* id, __global float* out_rgba,
-                       KUpsampleParams params, int method) {
+__kernel void demodulate(__global const float* in_rgba, __global const float* albedo, __global float* illumination,
+                         KUpsampleParams params) {
+  kint x = (kint)get_global_id(0), y = (kint)get_global_id(1);
+  if (x < params.width && y < params.height) k_upsample_demodulate_pixel(in_rgba, albedo, illumination, &params, x, y);
+}
+__kernel void upsample_frame(__global const float* in_rgba, __global const float* illumination,
+                             __global const float* depth, __global const float* normal, __global const float* albedo,
+                             __global const uint* id, __global float* out_rgba, KUpsampleParams params, int method) {
   kint x = (kint)get_global_id(0), y = (kint)get_global_id(1);
   if (x < params.width && y < params.height)
-    k_upsample_pixel(in_rgba, depth, normal, albedo, id, out_rgba, &params, method, x, y);
+    k_upsample_pixel(in_rgba, illumination, depth, normal, albedo, id, out_rgba, &params, method, x, y);
 }
 )CL";
 
@@ -39,6 +44,8 @@ TEST(UpsampleOpenCL, ReconstructionMatchesTheCppBuildOfTheSameHeader) {
   ASSERT_TRUE(cl.problem.empty()) << "upsample.h: " << cl.problem;
   cl_int err = CL_SUCCESS;
   cl_kernel kernel = clCreateKernel(cl.program, "upsample_frame", &err);
+  ASSERT_EQ(err, CL_SUCCESS);
+  cl_kernel demodulate = clCreateKernel(cl.program, "demodulate", &err);
   ASSERT_EQ(err, CL_SUCCESS);
 
   // Noisy light over a miss, two walls (a crease), a depth ramp, an object of its own and a texture.
@@ -60,25 +67,35 @@ TEST(UpsampleOpenCL, ReconstructionMatchesTheCppBuildOfTheSameHeader) {
     for (kuint pixels : {1u, 4u, 8u}) {
       SCOPED_TRACE(testing::Message() << "method " << method << ", " << pixels << " pixels of 16");
       const KUpsampleParams params = k_upsample_params(w, h, pixels, 3u);
-      std::vector<float> expected(4 * w * h), out(4 * w * h, -1.0f);
+      std::vector<float> expected(4 * w * h), out(4 * w * h, -1.0f), illumination(4 * w * h, 0.0f),
+          device_illumination(4 * w * h, 0.0f);
+      for (int y = 0; y < h; ++y)
+        for (int x = 0; x < w; ++x) k_upsample_demodulate_pixel(rgba.data(), albedo.data(), illumination.data(), &params, x, y);
       for (int y = 0; y < h; ++y)
         for (int x = 0; x < w; ++x)
-          k_upsample_pixel(rgba.data(), depth.data(), normal.data(), albedo.data(), id.data(), expected.data(), &params,
-                           method, x, y);
+          k_upsample_pixel(rgba.data(), illumination.data(), depth.data(), normal.data(), albedo.data(), id.data(),
+                           expected.data(), &params, method, x, y);
       auto buffer = [&](void* data, size_t bytes) {
         cl_mem m = clCreateBuffer(cl.context, CL_MEM_READ_WRITE | CL_MEM_COPY_HOST_PTR, bytes, data, &err);
         EXPECT_EQ(err, CL_SUCCESS);
         return m;
       };
-      cl_mem mems[6] = {buffer(rgba.data(), rgba.size() * 4), buffer(depth.data(), depth.size() * 4),
-                        buffer(normal.data(), normal.size() * 4), buffer(albedo.data(), albedo.size() * 4),
-                        buffer(id.data(), id.size() * 4), buffer(out.data(), out.size() * 4)};
-      for (cl_uint i = 0; i < 6; ++i) ASSERT_EQ(clSetKernelArg(kernel, i, sizeof(cl_mem), &mems[i]), CL_SUCCESS);
-      ASSERT_EQ(clSetKernelArg(kernel, 6, sizeof(KUpsampleParams), &params), CL_SUCCESS);
-      ASSERT_EQ(clSetKernelArg(kernel, 7, sizeof(int), &method), CL_SUCCESS);
+      cl_mem mems[7] = {buffer(rgba.data(), rgba.size() * 4), buffer(device_illumination.data(), illumination.size() * 4),
+                        buffer(depth.data(), depth.size() * 4), buffer(normal.data(), normal.size() * 4),
+                        buffer(albedo.data(), albedo.size() * 4), buffer(id.data(), id.size() * 4),
+                        buffer(out.data(), out.size() * 4)};
+      cl_mem demodulate_args[3] = {mems[0], mems[4], mems[1]};
+      for (cl_uint i = 0; i < 3; ++i)
+        ASSERT_EQ(clSetKernelArg(demodulate, i, sizeof(cl_mem), &demodulate_args[i]), CL_SUCCESS);
+      ASSERT_EQ(clSetKernelArg(demodulate, 3, sizeof(KUpsampleParams), &params), CL_SUCCESS);
+      for (cl_uint i = 0; i < 7; ++i) ASSERT_EQ(clSetKernelArg(kernel, i, sizeof(cl_mem), &mems[i]), CL_SUCCESS);
+      ASSERT_EQ(clSetKernelArg(kernel, 7, sizeof(KUpsampleParams), &params), CL_SUCCESS);
+      ASSERT_EQ(clSetKernelArg(kernel, 8, sizeof(int), &method), CL_SUCCESS);
       const size_t global[2] = {size_t(w), size_t(h)};
+      ASSERT_EQ(clEnqueueNDRangeKernel(cl.queue, demodulate, 2, nullptr, global, nullptr, 0, nullptr, nullptr),
+                CL_SUCCESS);
       ASSERT_EQ(clEnqueueNDRangeKernel(cl.queue, kernel, 2, nullptr, global, nullptr, 0, nullptr, nullptr), CL_SUCCESS);
-      ASSERT_EQ(clEnqueueReadBuffer(cl.queue, mems[5], CL_TRUE, 0, out.size() * sizeof(float), out.data(), 0, nullptr,
+      ASSERT_EQ(clEnqueueReadBuffer(cl.queue, mems[6], CL_TRUE, 0, out.size() * sizeof(float), out.data(), 0, nullptr,
                                     nullptr),
                 CL_SUCCESS);
       for (size_t i = 0; i < out.size(); ++i)
@@ -86,5 +103,6 @@ TEST(UpsampleOpenCL, ReconstructionMatchesTheCppBuildOfTheSameHeader) {
       for (cl_mem m : mems) clReleaseMemObject(m);
     }
   clReleaseKernel(kernel);
+  clReleaseKernel(demodulate);
 #endif
 }

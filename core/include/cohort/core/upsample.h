@@ -7,6 +7,7 @@
 
 #include <cstdint>
 #include <string>
+#include <vector>
 
 #include "cohort/core/frame_buffer.h"
 #include "cohort/core/gbuffer.h"
@@ -35,7 +36,18 @@ PathPattern path_pattern_for_scale(double scale, uint64_t frame);
 double path_pattern_scale(const PathPattern& pattern);
 
 // Fills `out` (resized to the frame's size) from the pattern's traced pixels of `sparse` guided by
-// `gbuffer` (same size; std::invalid_argument otherwise). method: joint_bilateral or nearest.
+// `gbuffer` (same size; std::invalid_argument otherwise), on the host's threads. method: joint_bilateral
+// or nearest. Keeps its scratch plane (the traced pixels' illumination) between frames.
+class SparseUpsampler {
+ public:
+  void upsample(const FrameBuffer& sparse, const GBuffer& gbuffer, PathPattern pattern, UpsampleMethod method,
+                FrameBuffer& out);
+
+ private:
+  std::vector<float> illumination_;
+};
+
+// The same with a scratch plane of its own (tests, one-off frames).
 void upsample_sparse(const FrameBuffer& sparse, const GBuffer& gbuffer, PathPattern pattern, UpsampleMethod method,
                      FrameBuffer& out);
 
