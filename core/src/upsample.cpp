@@ -56,7 +56,7 @@ void SparseUpsampler::upsample(const FrameBuffer& sparse, const GBuffer& gbuffer
   const KUpsampleParams params = k_upsample_params(sparse.width, sparse.height, pattern.pixels, pattern.phase);
   const int kernel_method = method == UpsampleMethod::nearest ? K_UPSAMPLE_NEAREST : K_UPSAMPLE_JOINT_BILATERAL;
   HostThreads& threads = HostThreads::shared();
-  const float* illumination = sparse.rgba.data();  // nearest reads colour
+  const float* illumination = sparse.rgba.data();  // nearest reads the colour only
   if (method == UpsampleMethod::joint_bilateral) {
     illumination_.resize(sparse.rgba.size());
     threads.for_ranges(static_cast<size_t>(sparse.height), 16, [&](size_t row_begin, size_t row_end) {

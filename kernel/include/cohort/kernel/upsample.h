@@ -66,14 +66,12 @@ KFN float k_upsample_channel_albedo(KGLOBAL const float* albedo, kint p, int k) 
   return k_fmax(albedo[3 * p + k], K_ILLUMINATION_LEAST_ALBEDO);
 }
 
-/* How far two albedos lie apart, relative to their size: 0 for equal ones, 1 for black against any colour. */
-KFN float k_upsample_albedo_difference(KGLOBAL const float* albedo, kint p, kint q) {
-  float difference = 0.0f, size = 0.06f;
-  for (int k = 0; k < 3; ++k) {
-    difference += k_fabs(albedo[3 * p + k] - albedo[3 * q + k]);
-    size += albedo[3 * p + k] + albedo[3 * q + k];
-  }
-  return difference / size;
+/* How far albedo ap and tap q's lie apart, relative to their size: 0 for equal ones, 1 for black against
+ * any colour. */
+KFN float k_upsample_albedo_difference(KVec3 ap, KGLOBAL const float* albedo, kint q) {
+  KVec3 aq = v3(albedo[3 * q], albedo[3 * q + 1], albedo[3 * q + 2]);
+  float difference = k_fabs(ap.x - aq.x) + k_fabs(ap.y - aq.y) + k_fabs(ap.z - aq.z);
+  return difference / (0.06f + ap.x + ap.y + ap.z + aq.x + aq.y + aq.z);
 }
 
 /* Pass 1, at traced pixels only: the illumination (colour over albedo) the sweeps read, so each traced
@@ -95,17 +93,19 @@ KFN kint k_upsample_first(kint from, kint phase) { return from + (((phase - from
 #define K_UPSAMPLE_CLOSEST 3     /* the closest tap only (sum = its colour) */
 
 /* One sweep over the traced pixels of the window around centre (x, y), weighted as `weights` says: adds
- * weighted illumination (colour for K_UPSAMPLE_CLOSEST) to sum and returns the summed weight. The pattern
- * repeats every 4 pixels, so the sweep visits each of the block's traced positions and steps by 4 from
- * there: only traced pixels are read, whatever the share. */
-KFN float k_upsample_sweep(KGLOBAL const float* in_rgba, KGLOBAL const float* illumination, KGLOBAL const float* depth, KGLOBAL const float* normal,
+ * the weighted RGBA `samples` (illumination; colour for K_UPSAMPLE_CLOSEST) to sum, leaving out those that
+ * are not finite, and returns the summed weight. The pattern repeats every 4 pixels, so the sweep visits
+ * each of the block's traced positions and steps by 4 from there: only traced pixels are read. */
+KFN float k_upsample_sweep(KGLOBAL const float* samples, KGLOBAL const float* depth, KGLOBAL const float* normal,
                            KGLOBAL const float* albedo, KGLOBAL const kuint* id, const KUpsampleParams* p, kint x,
                            kint y, int weights, float* sum) {
   kint centre = y * p->width + x;
   float zp = depth[centre];
   kuint idp = id[centre];
   KVec3 np = v3(normal[3 * centre], normal[3 * centre + 1], normal[3 * centre + 2]);
+  KVec3 ap = v3(albedo[3 * centre], albedo[3 * centre + 1], albedo[3 * centre + 2]);
   float inv_depth_scale = zp > 0.0f ? 1.0f / (p->depth_sigma * zp) : 0.0f;
+  float inv_albedo_sigma = 1.0f / p->albedo_sigma;
   float weight = 0.0f, closest_d2 = 1e30f;
   kint r = p->radius;
   float reach2 = ((float)r + 0.5f) * ((float)r + 0.5f); /* a round window: the corners weigh little */
@@ -117,10 +117,10 @@ KFN float k_upsample_sweep(KGLOBAL const float* in_rgba, KGLOBAL const float* il
         for (kint qx = k_upsample_first(x - r, bx); qx <= x + r; qx += 4) {
           if (qx < 0 || qx >= p->width) continue;
           kint q = qy * p->width + qx;
-          KGLOBAL const float* cq = in_rgba + 4 * q;
-          if (!k_finite3(cq[0], cq[1], cq[2])) continue;
           float d2 = (float)((qx - x) * (qx - x) + (qy - y) * (qy - y));
           if (d2 > reach2) continue;
+          KGLOBAL const float* cq = samples + 4 * q;
+          if (!k_finite3(cq[0], cq[1], cq[2])) continue;
           if (weights == K_UPSAMPLE_CLOSEST) {
             if (d2 < closest_d2) {
               closest_d2 = d2;
@@ -138,12 +138,11 @@ KFN float k_upsample_sweep(KGLOBAL const float* in_rgba, KGLOBAL const float* il
             float distance_exponent = 0.0f;
             w = k_atrous_geometry(zp, np, inv_depth_scale, p->normal_squarings, depth, normal, q, &distance_exponent);
             if (!(w > 0.0f)) continue;
-            exponent += distance_exponent / k_sqrt(d2) + k_upsample_albedo_difference(albedo, centre, q) / p->albedo_sigma;
+            exponent += distance_exponent / k_sqrt(d2) + k_upsample_albedo_difference(ap, albedo, q) * inv_albedo_sigma;
             if (exponent > 12.0f) continue; /* below 6e-6: left out, and so are exp's slow subnormals */
           }
           w *= k_exp(-exponent);
-          KGLOBAL const float* iq = illumination + 4 * q;
-          for (int k = 0; k < 3; ++k) sum[k] += w * iq[k];
+          for (int k = 0; k < 3; ++k) sum[k] += w * cq[k];
           weight += w;
         }
       }
@@ -151,7 +150,7 @@ KFN float k_upsample_sweep(KGLOBAL const float* in_rgba, KGLOBAL const float* il
   return weight;
 }
 
-/* Pass 2, at every pixel: the reconstruction. illumination: pass 1's plane. */
+/* Pass 2, at every pixel: the reconstruction. illumination: pass 1's plane (not read by nearest). */
 KFN void k_upsample_pixel(KGLOBAL const float* in_rgba, KGLOBAL const float* illumination, KGLOBAL const float* depth, KGLOBAL const float* normal,
                           KGLOBAL const float* albedo, KGLOBAL const kuint* id, KGLOBAL float* out_rgba,
                           const KUpsampleParams* p, int method, kint x, kint y) {
@@ -160,14 +159,14 @@ KFN void k_upsample_pixel(KGLOBAL const float* in_rgba, KGLOBAL const float* ill
   float sum[3] = {0.0f, 0.0f, 0.0f};
   out[3] = 1.0f;
   if (method == K_UPSAMPLE_NEAREST) {
-    k_upsample_sweep(in_rgba, illumination, depth, normal, albedo, id, p, x, y, K_UPSAMPLE_CLOSEST, sum);
+    k_upsample_sweep(in_rgba, depth, normal, albedo, id, p, x, y, K_UPSAMPLE_CLOSEST, sum);
     out[0] = sum[0], out[1] = sum[1], out[2] = sum[2];
     return;
   }
-  float weight = k_upsample_sweep(in_rgba, illumination, depth, normal, albedo, id, p, x, y, K_UPSAMPLE_GUIDED, sum);
+  float weight = k_upsample_sweep(illumination, depth, normal, albedo, id, p, x, y, K_UPSAMPLE_GUIDED, sum);
   for (int fallback = K_UPSAMPLE_SAME_KIND; !(weight > 1e-4f) && fallback <= K_UPSAMPLE_SPATIAL; ++fallback) {
     sum[0] = sum[1] = sum[2] = 0.0f;
-    weight = k_upsample_sweep(in_rgba, illumination, depth, normal, albedo, id, p, x, y, fallback, sum);
+    weight = k_upsample_sweep(illumination, depth, normal, albedo, id, p, x, y, fallback, sum);
   }
   float inv = weight > 0.0f ? 1.0f / weight : 0.0f;
   for (int k = 0; k < 3; ++k) out[k] = sum[k] * inv * k_upsample_channel_albedo(albedo, centre, k);
