@@ -69,10 +69,8 @@ inline core::FrameBuffer render(core::Tracer& tracer, const scene::Scene& scene,
   return fb;
 }
 
-// Renders one frame's auxiliary planes (kernel/aux_outputs.h) after a full commit of `scene` at `frame`.
-inline core::GBuffer render_aux(core::Tracer& tracer, const std::shared_ptr<commit::TracerScene>& scene, uint64_t frame,
-                         const KCamera& camera, const KCamera& previous) {
-  tracer.apply(commit::CommitBuffer::full(scene, frame));
+// The auxiliary planes (kernel/aux_outputs.h) of one whole-frame band from the tracer's current scene.
+inline core::GBuffer render_aux_band(core::Tracer& tracer, const KCamera& camera, const KCamera& previous) {
   core::BandBuffer band(static_cast<int>(camera.width), static_cast<int>(camera.height), core::BandFormat::rgba32f);
   band.enable_aux(true);
   core::BandJob job;
@@ -85,6 +83,13 @@ inline core::GBuffer render_aux(core::Tracer& tracer, const std::shared_ptr<comm
   g.resize(band.width(), band.height());
   band.copy_aux_rows_to(g, 0, band.height());
   return g;
+}
+
+// The same after a full commit of `scene` at `frame`.
+inline core::GBuffer render_aux(core::Tracer& tracer, const std::shared_ptr<commit::TracerScene>& scene, uint64_t frame,
+                                const KCamera& camera, const KCamera& previous) {
+  tracer.apply(commit::CommitBuffer::full(scene, frame));
+  return render_aux_band(tracer, camera, previous);
 }
 
 // Where the ray through image point (px, py) of a camera_looking_down meets z = 0.

@@ -8,9 +8,12 @@ namespace cohort::tracers {
 
 void TracerBase::apply(const commit::CommitBuffer& commit) {
   const std::vector<KInstance> before = scene_.instances;
+  const std::vector<KSkin> skins_before = scene_.skins;
+  std::vector<KJoint> joints_before = scene_.joints;
   commit::ChangeSet changes = commit::apply_commit(
       commit, scene_, skins_on_device() ? commit::Skinning::by_tracer : commit::Skinning::on_host);
   remember_previous_transforms(before);
+  remember_previous_joints(skins_before, std::move(joints_before));
   if (!has_scene_) changes.full_resync = true;
   upload(changes);
   has_scene_ = true;   // only now: after a failed first upload the next commit is sent whole again
@@ -28,6 +31,16 @@ void TracerBase::remember_previous_transforms(const std::vector<KInstance>& befo
     const float* from = found != old.end() ? found->second->object_to_world : inst.object_to_world;
     std::copy(from, from + 12, previous_transforms_.begin() + static_cast<std::ptrdiff_t>(12 * i));
   }
+}
+
+// The joint pool before the commit, where it still lines up with the new one (the same skins over the same
+// joint ranges); otherwise the current joints: no skinned motion across a change of characters.
+void TracerBase::remember_previous_joints(const std::vector<KSkin>& skins_before, std::vector<KJoint> joints_before) {
+  bool same_layout = skins_before.size() == scene_.skins.size() && joints_before.size() == scene_.joints.size();
+  for (size_t i = 0; same_layout && i < scene_.skins.size(); ++i)
+    same_layout = skins_before[i].joint_offset == scene_.skins[i].joint_offset &&
+                  skins_before[i].joint_count == scene_.skins[i].joint_count && skins_before[i].blas == scene_.skins[i].blas;
+  previous_joints_ = same_layout ? std::move(joints_before) : scene_.joints;
 }
 
 KFrameParams TracerBase::frame_params(const core::BandJob& job) const {

@@ -71,26 +71,29 @@ __global__ void modulate_kernel(const float* rgba, const float* albedo, float* o
   if (p < pixels) k_atrous_modulate(rgba, albedo, out, p, multiply);
 }
 
+// The filter's kernels run on 16x16 tiles: a tap footprint reaches rows above and below, which a tile's
+// neighbours in L1 share, where a row of 256 pixels shares only its own row.
+dim3 tile_grid(int width, int height) { return dim3((width + 15) / 16, (height + 15) / 16); }
+const dim3 kTile(16, 16);
+
 __global__ void atrous_kernel(const float* in, float* out, const float* depth, const float* normal, KAtrousParams params) {
-  const int p = blockIdx.x * blockDim.x + threadIdx.x;
-  if (p < params.width * params.height)
-    k_atrous_pixel(in, out, depth, normal, &params, p % params.width, p / params.width);
+  const int x = blockIdx.x * blockDim.x + threadIdx.x, y = blockIdx.y * blockDim.y + threadIdx.y;
+  if (x < params.width && y < params.height) k_atrous_pixel(in, out, depth, normal, &params, x, y);
 }
 
 __global__ void svgf_variance_kernel(const float* illumination, const float* moments, const float* length,
                                      const float* depth, const float* normal, float* variance,
                                      KSvgfVarianceParams params) {
-  const int p = blockIdx.x * blockDim.x + threadIdx.x;
-  if (p < params.width * params.height)
-    k_svgf_variance_pixel(illumination, moments, length, depth, normal, variance, &params, p % params.width,
-                          p / params.width);
+  const int x = blockIdx.x * blockDim.x + threadIdx.x, y = blockIdx.y * blockDim.y + threadIdx.y;
+  if (x < params.width && y < params.height)
+    k_svgf_variance_pixel(illumination, moments, length, depth, normal, variance, &params, x, y);
 }
 
 __global__ void svgf_atrous_kernel(const float* in, const float* in_variance, float* out, float* out_variance,
                                    const float* depth, const float* normal, KAtrousParams params) {
-  const int p = blockIdx.x * blockDim.x + threadIdx.x;
-  if (p < params.width * params.height)
-    k_svgf_atrous_pixel(in, in_variance, out, out_variance, depth, normal, &params, p % params.width, p / params.width);
+  const int x = blockIdx.x * blockDim.x + threadIdx.x, y = blockIdx.y * blockDim.y + threadIdx.y;
+  if (x < params.width && y < params.height)
+    k_svgf_atrous_pixel(in, in_variance, out, out_variance, depth, normal, &params, x, y);
 }
 
 class CudaFramePost final : public core::FramePost {
@@ -234,17 +237,17 @@ class CudaFramePost final : public core::FramePost {
         v.short_history = ao.short_history;
         v.of_mean = ao.guide == core::AtrousGuide::variance_of_mean ? 1 : 0;
         const State& history = state_[parity_];  // the state the reprojection just wrote
-        svgf_variance_kernel<<<blocks_for(pixels), kThreads, 0, stream_>>>(
+        svgf_variance_kernel<<<tile_grid(width, height), kTile, 0, stream_>>>(
             ping, options_.reproject ? history.moments.data() : nullptr,
             options_.reproject ? history.length.data() : nullptr, depth_.data(), normal_.data(), variance_ping, v);
       }
       for (int pass = 0; pass < std::max(ao.passes, 0); ++pass) {
         params.step = 1 << pass;
         if (variance)
-          svgf_atrous_kernel<<<blocks_for(pixels), kThreads, 0, stream_>>>(ping, variance_ping, pong, variance_pong,
+          svgf_atrous_kernel<<<tile_grid(width, height), kTile, 0, stream_>>>(ping, variance_ping, pong, variance_pong,
                                                                             depth_.data(), normal_.data(), params);
         else
-          atrous_kernel<<<blocks_for(pixels), kThreads, 0, stream_>>>(ping, pong, depth_.data(), normal_.data(), params);
+          atrous_kernel<<<tile_grid(width, height), kTile, 0, stream_>>>(ping, pong, depth_.data(), normal_.data(), params);
         std::swap(ping, pong);
         std::swap(variance_ping, variance_pong);
       }

@@ -1,6 +1,7 @@
 // CUDA entry point: one thread per pixel of the band, running the shared integrator over the portable
 // two-level BVH, exactly as the OpenCL kernel does. Texels are read through a texture object (the
 // read-only texture cache); everything else through plain global loads.
+#include <cuda_fp16.h>
 #include <cuda_runtime.h>
 
 #define K_CUDA_DEVICE_ONLY 1
@@ -53,9 +54,10 @@ __global__ void __launch_bounds__(128, 4) render_band_kernel(KSceneView scene, K
   }
 }
 
-// Auxiliary outputs (aux_outputs.h), launched only for frames that ask for them.
+// Auxiliary outputs (aux_outputs.h), launched only for frames that ask for them, written straight in the
+// 32-byte texel the host's BandBuffer keeps (halves for normal and albedo).
 __global__ void aux_band_kernel(KSceneView scene, KFrameParams params, KCamera camera, KCamera previous_camera,
-                                const float* previous_transforms, KAux* band_aux) {
+                                KAuxHistory history, KAuxTexel* band_aux) {
   const kuint x = blockIdx.x * blockDim.x + threadIdx.x;
   const kuint row = blockIdx.y * blockDim.y + threadIdx.y;
   const kuint y = params.row_begin + row;
@@ -65,17 +67,27 @@ __global__ void aux_band_kernel(KSceneView scene, KFrameParams params, KCamera c
   ctx.closest_rays = 0u;
   ctx.occlusion_rays = 0u;
   KAux a;
-  k_pixel_aux(&ctx, &camera, &previous_camera, previous_transforms, x, y, &a);
-  band_aux[size_t(row) * camera.width + x] = a;
+  k_pixel_aux(&ctx, &camera, &previous_camera, &history, x, y, &a);
+  KAuxTexel t;
+  t.depth = a.depth;
+  t.prev_depth = a.prev_depth;
+  t.motion[0] = a.motion[0];
+  t.motion[1] = a.motion[1];
+  for (int k = 0; k < 3; ++k) {
+    t.normal[k] = __half_as_ushort(__float2half_rn(a.normal[k]));
+    t.albedo[k] = __half_as_ushort(__float2half_rn(a.albedo[k]));
+  }
+  t.id = a.id;
+  band_aux[size_t(row) * camera.width + x] = t;
 }
 
 void launch_aux_band(const KSceneView& scene, const KFrameParams& params, const KCamera& camera,
-                     const KCamera& previous_camera, const float* previous_transforms, KAux* band_aux,
+                     const KCamera& previous_camera, const KAuxHistory& history, KAuxTexel* band_aux,
                      cudaStream_t stream) {
   const kuint rows = params.row_end - params.row_begin;
   const dim3 block(16, 8);
   const dim3 grid((camera.width + block.x - 1) / block.x, (rows + block.y - 1) / block.y);
-  aux_band_kernel<<<grid, block, 0, stream>>>(scene, params, camera, previous_camera, previous_transforms, band_aux);
+  aux_band_kernel<<<grid, block, 0, stream>>>(scene, params, camera, previous_camera, history, band_aux);
   COHORT_CUDA(cudaGetLastError());
 }
 

@@ -3,6 +3,7 @@
 #include <cuda_runtime.h>
 
 #include "cuda_check.h"
+#include "cohort/kernel/aux_history.h"
 #include "cohort/kernel/scene_view.h"
 
 namespace cohort::tracers {
@@ -12,14 +13,13 @@ void set_texel_texture(cudaTextureObject_t texture);
 // ray_counts (closest, occlusion) and row_rays (one per band row, zeroed by the caller) may be null.
 void launch_render_band(const KSceneView& scene, const KFrameParams& params, const KCamera& camera, float4* band,
                         unsigned long long* ray_counts, unsigned* row_rays, cudaStream_t stream);
-// The band's auxiliary planes (kernel/aux_outputs.h), one KAux per pixel; previous_transforms: 12 floats
-// per instance, or null (no object motion).
+// The band's auxiliary planes (kernel/aux_outputs.h) as the 32-byte KAuxTexel the host's BandBuffer
+// keeps (halves for normal and albedo); history: the previous frame's transforms and joints (device
+// pointers, kernel/aux_history.h).
 void launch_aux_band(const KSceneView& scene, const KFrameParams& params, const KCamera& camera,
-                     const KCamera& previous_camera, const float* previous_transforms, KAux* band_aux,
+                     const KCamera& previous_camera, const KAuxHistory& history, KAuxTexel* band_aux,
                      cudaStream_t stream);
 // Converts a rendered band (float4 per pixel) to RGB halves (3 x 16 bits per pixel) on the stream.
 void launch_band_to_rgb16f(const float4* band, unsigned short* rgb, size_t pixels, cudaStream_t stream);
-// KAux -> the 32-byte KAuxTexel the host's BandBuffer keeps (halves for normal and albedo).
-void launch_aux_to_texels(const KAux* aux, KAuxTexel* texels, size_t pixels, cudaStream_t stream);
 
 }  // namespace cohort::tracers

@@ -72,7 +72,7 @@ void write_aux(const Frame& frame, const Tile& tile, Arena& a, embree_kernel::Tr
       ctx.primed_hit = &a.hits[i];
       ctx.primed_found = a.found[i];
       ctx.primed_dir = a.dirs[i];
-      k_pixel_aux(&ctx, &frame.camera, &frame.previous_camera, frame.object_history,
+      k_pixel_aux(&ctx, &frame.camera, &frame.previous_camera, &frame.history,
                   static_cast<kuint>(tile.x0 + x), static_cast<kuint>(y), &a.aux[x]);
       ctx.primed_hit = nullptr;
     }

@@ -10,6 +10,7 @@
 
 #include "cohort/core/band_buffer.h"
 #include "cohort/kernel/rng.h"
+#include "cohort/kernel/aux_history.h"
 #include "embree_kernel.h"
 
 namespace cohort::tracers::embree_tiles {
@@ -25,7 +26,7 @@ struct Frame {
   KFrameParams params;
   KCamera camera;
   KCamera previous_camera;
-  const float* object_history;  // previous object-to-world transforms, or null
+  KAuxHistory history;  // the previous frame's transforms and joints (host pointers), for motion vectors
   bool write_aux;
   embree_kernel::TraceCtx base;
   core::BandBuffer* target;  // null: render without storing (recording rays)

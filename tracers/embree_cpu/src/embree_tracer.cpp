@@ -224,12 +224,12 @@ void EmbreeTracer::upload(const commit::ChangeSet& changes) {
 namespace {
 
 embree_tiles::Frame make_frame(const KFrameParams& params, const core::BandJob& job, const KSceneView& scene,
-                               RTCScene top, const float* object_history, core::BandBuffer* target) {
+                               RTCScene top, const KAuxHistory& history, core::BandBuffer* target) {
   embree_tiles::Frame frame;
   frame.params = params;
   frame.camera = job.camera;
   frame.previous_camera = job.previous_camera.width > 0 ? job.previous_camera : job.camera;
-  frame.object_history = object_history;
+  frame.history = history;
   frame.write_aux = target && params.aux_outputs != 0u && target->has_aux();
   frame.base = embree_kernel::TraceCtx{scene, top, 0, nullptr, 0, v3s(0.0f), nullptr};
   frame.target = target;
@@ -246,9 +246,15 @@ core::BandResult EmbreeTracer::render_band(const core::BandJob& job, core::BandB
   const int row_end = std::min(static_cast<int>(params.row_end), target.height());
   const int width = std::min(static_cast<int>(job.camera.width), target.width());
   const KSceneView scene = host_scene_view(params);
-  const embree_tiles::Frame frame =
-      make_frame(params, job, scene, impl_->top,
-                 previous_transforms().empty() ? nullptr : previous_transforms().data(), &target);
+  const commit::TracerScene& s = this->scene();
+  KAuxHistory history{};
+  history.object_to_world = previous_transforms().empty() ? nullptr : previous_transforms().data();
+  history.skins = s.skins.data();
+  history.skin_vertices = s.skin_vertices.data();
+  history.skin_weights = s.skin_weights.data();
+  history.joints = previous_joints().empty() ? nullptr : previous_joints().data();
+  history.skin_count = static_cast<kuint>(s.skins.size());
+  const embree_tiles::Frame frame = make_frame(params, job, scene, impl_->top, history, &target);
   // Rays traced per row: the balancer's per-row work proxy (BandResult::row_work), as the GPU tracers count it.
   std::vector<std::atomic<uint64_t>> row_rays(static_cast<size_t>(std::max(row_end - row_begin, 0)));
   std::atomic<uint64_t> rays{0};
@@ -293,7 +299,7 @@ EmbreeRaySet EmbreeTracer::record_rays(const core::BandJob& job) {
   if (!impl_->top) throw std::runtime_error("EmbreeTracer: record_rays before any commit was applied");
   const KFrameParams params = frame_params(job);
   const KSceneView scene = host_scene_view(params);
-  const embree_tiles::Frame frame = make_frame(params, job, scene, impl_->top, nullptr, nullptr);
+  const embree_tiles::Frame frame = make_frame(params, job, scene, impl_->top, KAuxHistory{}, nullptr);
   auto arena = std::make_unique<embree_tiles::Arena>();
   embree_kernel::RayLog log;
   log.camera_dir = v3s(0.0f);

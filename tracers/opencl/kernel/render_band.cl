@@ -44,7 +44,8 @@ __kernel void cohort_render_band(__global const KVertex* vertices, __global cons
 
 /* Auxiliary outputs (aux_outputs.h), launched only for frames that ask for them: one work item per
  * pixel of the band, writing a KAux each. prev_transforms: 12 floats per instance (the host always
- * passes one; with no instance moved it equals the current transforms). */
+ * passes one; with no instance moved it equals the current transforms); prev_joints: the joint pool of
+ * the previous frame, read when skin_count > 0 (aux_history.h). */
 __kernel void cohort_aux_band(__global const KVertex* vertices, __global const KVertexColor* vertex_colors,
                                  __global const KTriangle* triangles,
                               __global const KBvhNode* blas_nodes, __global const KBlas* blases,
@@ -54,7 +55,9 @@ __kernel void cohort_aux_band(__global const KVertex* vertices, __global const K
                               __global const KLightNode* light_nodes, __global const KEmissiveTriangle* emissive,
                               __global const KFrameParams* params_in, __global const KCamera* camera_in,
                               __global const KCamera* prev_camera_in, __global const float* prev_transforms,
-                              __global KAux* band_aux) {
+                              __global const KSkin* skins, __global const KSkinVertex* skin_vertices,
+                              __global const KSkinWeight* skin_weights, __global const KJoint* prev_joints,
+                              kuint skin_count, __global KAux* band_aux) {
   KFrameParams params = *params_in;
   KCamera camera = *camera_in;
   KCamera prev_camera = *prev_camera_in;
@@ -67,8 +70,15 @@ __kernel void cohort_aux_band(__global const KVertex* vertices, __global const K
                            lights, light_nodes, emissive, &params);
   ctx.closest_rays = 0u;
   ctx.occlusion_rays = 0u;
+  KAuxHistory history;
+  history.object_to_world = params.instance_count > 0u ? prev_transforms : 0;
+  history.skins = skins;
+  history.skin_vertices = skin_vertices;
+  history.skin_weights = skin_weights;
+  history.joints = skin_count > 0u ? prev_joints : 0;
+  history.skin_count = skin_count;
   KAux a;
-  k_pixel_aux(&ctx, &camera, &prev_camera, params.instance_count > 0u ? prev_transforms : 0, x, y, &a);
+  k_pixel_aux(&ctx, &camera, &prev_camera, &history, x, y, &a);
   band_aux[(size_t)row * camera.width + x] = a;
 }
 

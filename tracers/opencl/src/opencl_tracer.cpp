@@ -103,7 +103,7 @@ struct OpenCLTracer::Impl {
   cl_command_queue queue = nullptr;
   cl_program program = nullptr;
   cl_kernel kernel = nullptr, aux_kernel = nullptr;
-  DeviceBuffer previous_transforms;
+  DeviceBuffer previous_transforms, previous_joints;
   DeviceBuffer vertices, vertex_colors, triangles, blas_nodes, blases, instances, tlas_nodes, materials, textures, texels, lights, light_nodes,
       emissive;
   DeviceBuffer skins, skin_vertices, skin_weights, skin_triangles, skin_adjacency, skin_faces, joints;
@@ -402,13 +402,23 @@ void OpenCLTracer::render_aux(const core::BandJob& job, const KFrameParams& para
   check(clEnqueueWriteBuffer(m.queue, m.previous_camera, CL_FALSE, 0, sizeof previous, &previous, 0, nullptr, nullptr),
         "writing the previous camera");
   m.previous_transforms.upload(m.context, m.queue, previous_transforms(), "uploading previous transforms");
+  m.previous_joints.upload(m.context, m.queue, previous_joints(), "uploading previous joints");
+  // Skinned motion only where every array it reads is on the device (a scene without skins never sized them).
+  const bool skinned = !previous_joints().empty() && m.skins.mem() && m.skin_vertices.mem() && m.skin_weights.mem();
+  const cl_uint skin_count = skinned ? static_cast<cl_uint>(scene().skins.size()) : 0u;
+  cl_mem skin_args[] = {m.skins.mem(), m.skin_vertices.mem(), m.skin_weights.mem(), m.previous_joints.mem()};
+  if (!skinned)
+    for (cl_mem& a : skin_args) a = m.previous_transforms.mem();  // never read: any valid buffer
   cl_mem args[] = {m.vertices.mem(),  m.vertex_colors.mem(), m.triangles.mem(),  m.blas_nodes.mem(),  m.blases.mem(),
                    m.instances.mem(), m.tlas_nodes.mem(), m.materials.mem(),   m.textures.mem(),
                    m.texels.mem(),    m.lights.mem(),     m.light_nodes.mem(), m.emissive.mem(),
                    m.params,          m.camera,           m.previous_camera,   m.previous_transforms.mem(),
-                   m.aux};
-  for (cl_uint i = 0; i < sizeof(args) / sizeof(args[0]); ++i)
-    check(clSetKernelArg(m.aux_kernel, i, sizeof(cl_mem), &args[i]), "clSetKernelArg(aux)");
+                   skin_args[0],      skin_args[1],       skin_args[2],        skin_args[3]};
+  cl_uint arg = 0;
+  for (; arg < sizeof(args) / sizeof(args[0]); ++arg)
+    check(clSetKernelArg(m.aux_kernel, arg, sizeof(cl_mem), &args[arg]), "clSetKernelArg(aux)");
+  check(clSetKernelArg(m.aux_kernel, arg++, sizeof skin_count, &skin_count), "clSetKernelArg(aux skin count)");
+  check(clSetKernelArg(m.aux_kernel, arg, sizeof(cl_mem), &m.aux), "clSetKernelArg(aux output)");
   const size_t local[2] = {8, 8};
   const size_t global[2] = {(camera.width + 7) / 8 * 8, (rows + 7) / 8 * 8};
   check(clEnqueueNDRangeKernel(m.queue, m.aux_kernel, 2, nullptr, global, local, 0, nullptr, nullptr),

@@ -16,12 +16,35 @@
  *               surface (treated as a miss otherwise) the sky's colour
  *   id          the instance's entity + 1 (0 for the world), K_NONE on a miss: stable across frames,
  *               unlike instance indices, which follow the TLAS leaf order
- * Object motion: prev_object_to_world holds, per instance (the KInstance array's order), the 3x4
- * row-major object-to-world transform of the previous frame (12 floats each); a null pointer means no
- * object moved. The host keeps it (tracers/common's TracerBase, from the transforms before each commit). */
+ * Object motion (KAuxHistory): object_to_world holds, per instance (the KInstance array's order), the
+ * 3x4 row-major object-to-world transform of the previous frame (12 floats each); a null pointer means
+ * no object moved. A skinned character's point (a hit on a BLAS some KSkin poses) was where the same
+ * barycentrics of its triangle lay in the previous pose: its three corners skinned again with the
+ * previous frame's joints (`joints`, the joint pool as it was; null: no skin moved). The host keeps both
+ * (tracers/common's TracerBase, from the scene copy before each commit). */
 #ifndef COHORT_KERNEL_AUX_OUTPUTS_H
 #define COHORT_KERNEL_AUX_OUTPUTS_H
+#include "aux_history.h"
 #include "integrator.h"
+
+/* Where a hit's point was in the previous frame, in the instance's object space. */
+KFN KVec3 k_aux_previous_object_point(const KSceneView* scene, const KAuxHistory* history, KHit hit, KVec3 p_world) {
+  KGLOBAL const KInstance* inst = &scene->instances[hit.instance];
+  if (history->joints) {
+    for (kuint s = 0u; s < history->skin_count; ++s) {
+      KSkin skin = history->skins[s];
+      if (skin.blas != inst->blas) continue;
+      KTriangle tri = scene->triangles[hit.triangle];
+      kuint i0 = tri.v0 - skin.vertex_offset, i1 = tri.v1 - skin.vertex_offset, i2 = tri.v2 - skin.vertex_offset;
+      if (i0 >= skin.vertex_count || i1 >= skin.vertex_count || i2 >= skin.vertex_count) break;
+      KVec3 p0 = k_skinned_point(history->skin_vertices, history->skin_weights, history->joints, skin, i0);
+      KVec3 p1 = k_skinned_point(history->skin_vertices, history->skin_weights, history->joints, skin, i1);
+      KVec3 p2 = k_skinned_point(history->skin_vertices, history->skin_weights, history->joints, skin, i2);
+      return v3_add(v3_add(v3_scale(p0, 1.0f - hit.u - hit.v), v3_scale(p1, hit.u)), v3_scale(p2, hit.v));
+    }
+  }
+  return xform_point_g(inst->world_to_object, p_world);
+}
 
 
 /* Where a world point lands on the camera's image, in pixels (y down), and its depth; 0 when it lies
@@ -49,8 +72,8 @@ KFN int k_project_direction(const KCamera* cam, KVec3 dir, float* px, float* py)
   return 1;
 }
 
-KFN void k_pixel_aux(KTraceCtx* ctx, const KCamera* cam, const KCamera* prev_cam,
-                     KGLOBAL const float* prev_object_to_world, kuint x, kuint y, KAux* out) {
+KFN void k_pixel_aux(KTraceCtx* ctx, const KCamera* cam, const KCamera* prev_cam, const KAuxHistory* history, kuint x,
+                     kuint y, KAux* out) {
   const KSceneView* scene = K_CTX_SCENE(ctx);
   float cx = (float)x + 0.5f, cy = (float)y + 0.5f;
   KVec3 org = v3_load(cam->origin);
@@ -85,8 +108,11 @@ KFN void k_pixel_aux(KTraceCtx* ctx, const KCamera* cam, const KCamera* prev_cam
     KGLOBAL const KInstance* inst = &scene->instances[hit.instance];
     KVec3 p = sf.position;
     KVec3 p_prev = p;
-    if (prev_object_to_world)
-      p_prev = xform_point_g(prev_object_to_world + 12u * hit.instance, xform_point_g(inst->world_to_object, p));
+    if (history->object_to_world || history->joints) {
+      KVec3 p_object = k_aux_previous_object_point(scene, history, hit, p);
+      p_prev = history->object_to_world ? xform_point_g(history->object_to_world + 12u * hit.instance, p_object)
+                                        : xform_point_g(inst->object_to_world, p_object);
+    }
     out->depth = v3_dot(v3_sub(p, org), v3_load(cam->forward));
     out->normal[0] = sf.normal.x;
     out->normal[1] = sf.normal.y;

@@ -88,8 +88,9 @@ KFN KVec3 k_joint_rotate(KGLOBAL const KJoint* j, KVec3 v) {
 KFN int k_skin_finite(float x) { return x == x && k_fabs(x) <= 3.402823466e+38f; }
 
 /* Pass 1, vertex i of the skin (0 <= i < vertex_count): its position. */
-KFN void k_skin_position(KGLOBAL KVertex* vertices, KGLOBAL const KSkinVertex* skin_vertices,
-                         KGLOBAL const KSkinWeight* weights, KGLOBAL const KJoint* joints, KSkin skin, kuint i) {
+/* Vertex i of a skin (relative to its vertex_offset) posed by `joints` (the joint pool, any frame's). */
+KFN KVec3 k_skinned_point(KGLOBAL const KSkinVertex* skin_vertices, KGLOBAL const KSkinWeight* weights,
+                          KGLOBAL const KJoint* joints, KSkin skin, kuint i) {
   KGLOBAL const KSkinVertex* sv = skin_vertices + skin.skin_vertex_offset + i;
   KVec3 p = v3s(0.0f);
   for (kuint w = 0; w < sv->weight_count; ++w) {
@@ -99,6 +100,12 @@ KFN void k_skin_position(KGLOBAL KVertex* vertices, KGLOBAL const KSkinVertex* s
     KVec3 moved = v3_add(k_joint_rotate(j, v3_load_g(weight->offset)), v3_load_g(j->position));
     p = v3_add(p, v3_scale(moved, weight->bias));
   }
+  return p;
+}
+
+KFN void k_skin_position(KGLOBAL KVertex* vertices, KGLOBAL const KSkinVertex* skin_vertices,
+                         KGLOBAL const KSkinWeight* weights, KGLOBAL const KJoint* joints, KSkin skin, kuint i) {
+  KVec3 p = k_skinned_point(skin_vertices, weights, joints, skin, i);
   KGLOBAL KVertex* out = vertices + skin.vertex_offset + i;
   out->pos[0] = p.x;
   out->pos[1] = p.y;

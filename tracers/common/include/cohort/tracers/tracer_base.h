@@ -37,12 +37,17 @@ class TracerBase : public core::Tracer {
   // Instances are matched across commits by (entity, BLAS), since TLAS rebuilds reorder them; a new
   // one gets its current transform (no motion).
   const std::vector<float>& previous_transforms() const { return previous_transforms_; }
+  // The joint pool (scene().joints' layout) before the last applied commit: the previous frame's pose of
+  // every skinned character, for their motion vectors (kernel/aux_outputs.h's KAuxHistory).
+  const std::vector<KJoint>& previous_joints() const { return previous_joints_; }
 
  private:
   void remember_previous_transforms(const std::vector<KInstance>& before);
+  void remember_previous_joints(const std::vector<KSkin>& skins_before, std::vector<KJoint> joints_before);
 
   commit::TracerScene scene_;
   std::vector<float> previous_transforms_;
+  std::vector<KJoint> previous_joints_;
   bool has_scene_ = false;
 };
 
