@@ -43,13 +43,17 @@ void expect_sparse_copy(const core::FrameBuffer& sparse, const core::FrameBuffer
         ASSERT_TRUE(std::isfinite(s[k])) << what;
         error += (double(s[k]) - f[k]) * (double(s[k]) - f[k]);
         sum += f[k];
-        if (tolerance == 0.0) ASSERT_NEAR(s[k], f[k], 1e-5f * (1.0f + std::fabs(f[k]))) << what << " " << x << "," << y;
+        if (tolerance == 0.0) {
+          ASSERT_NEAR(s[k], f[k], 1e-5f * (1.0f + std::fabs(f[k]))) << what << " " << x << "," << y;
+        }
       }
     }
   EXPECT_EQ(traced, kW * kH * int(pixels) / 16) << what;
   mean = sum / (3.0 * traced);
   EXPECT_GT(mean, 0.01) << what << ": the room should be lit";
-  if (tolerance > 0.0) EXPECT_LT(std::sqrt(error / (3.0 * traced)), tolerance * mean) << what;
+  if (tolerance > 0.0) {
+    EXPECT_LT(std::sqrt(error / (3.0 * traced)), tolerance * mean) << what;
+  }
 }
 
 }  // namespace
