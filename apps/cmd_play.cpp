@@ -381,7 +381,7 @@ void add_play_command(CLI::App& app, int& exit_code) {
   cmd->add_option("--upsample", a->upsample,
                   "how a --scale below 1 reaches the window: joint-bilateral (paths for about scale^2 of the "
                   "window's pixels, a moving pattern, the rest reconstructed with weights from the full-resolution "
-                  "depth, normal and object id, textures from the full-resolution albedo), nearest (the nearest "
+                  "depth, normal, object id and albedo, textures from the full-resolution albedo), nearest (the nearest "
                   "traced pixel) or bilinear (a smaller frame stretched by the GPU); the frame-rate target's scale "
                   "drives it too. docs/denoising.md")
       ->capture_default_str()

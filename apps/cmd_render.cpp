@@ -491,7 +491,7 @@ void add_render_command(CLI::App& app, int& exit_code) {
       ->check(CLI::Range(0.05, 1.0));
   cmd->add_option("--upsample", a->upsample,
                   "reconstruction at --render-scale below 1: joint-bilateral (weights from the full-resolution "
-                  "depth, normal and object id; illumination times each pixel's albedo), nearest (the nearest "
+                  "depth, normal, object id and albedo; illumination times each pixel's albedo), nearest (the nearest "
                   "traced pixel), or bilinear (render a scale * width x scale * height frame and stretch it, as "
                   "`play` did with GL_LINEAR)")
       ->capture_default_str()
