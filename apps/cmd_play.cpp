@@ -1,6 +1,7 @@
 // `cohort play <map>`: a window showing the live path-traced frame, a fly camera, the scenario moving
 // and keys to change what is rendered and how (apps/viewer/viewer_actions.h lists them).
 #include <algorithm>
+#include <cctype>
 #include <chrono>
 #include <cmath>
 #include <filesystem>
@@ -44,6 +45,10 @@ struct PlayArgs {
   std::string screenshot;    // written from the last frame
   std::string window_shot;   // the last frame as the window showed it, HUD included
   std::string trace;         // Chrome trace event file of every frame's timeline
+  // How a scale below 1 reaches the window (core/upsample.h). Bilinear by default: the joint-bilateral
+  // reconstruction traces a G-buffer ray at every window pixel and runs on the host, which costs more
+  // than it gives at play's frame rates (docs/denoising.md, "Dynamic resolution").
+  std::string upsample = "bilinear";
 };
 
 std::string key_help() {
@@ -59,6 +64,14 @@ std::string key_help() {
 #ifdef COHORT_HAVE_VIEWER
 
 constexpr float kScaleSteps[] = {0.125f, 0.25f, 0.375f, 0.5f, 0.625f, 0.75f, 0.875f, 1.0f};
+
+// The HUD's words for how the scaled frame reaches the window: "JOINT-BILATERAL TO 1280X720".
+std::string upsample_label(core::UpsampleMethod method, int window_width, int window_height) {
+  std::string name = core::upsample_method_name(method);
+  for (char& c : name) c = static_cast<char>(std::toupper(static_cast<unsigned char>(c)));
+  if (method == core::UpsampleMethod::bilinear) return name + " (GPU STRETCH)";
+  return name + " TO " + std::to_string(window_width) + "X" + std::to_string(window_height);
+}
 
 float step_scale(float current, int direction) {
   const auto* begin = std::begin(kScaleSteps);
@@ -125,6 +138,7 @@ int run_play(PlayArgs a) {
   settings.light_sampling = core::light_sampling_mode(a.light_sampling);
   settings.mode = debug_mode_from_name(a.mode).value_or(K_MODE_PATH);
   settings.tone_curve = a.tone;
+  settings.upsample = core::parse_upsample_method(a.upsample);
   settings.reproject = resolve_convergence(a.convergence, session->any_gpu_tracer(), session->frame_post_place()) == "reproject";
   if (session->denoising())
     spdlog::info("{}reprojection and the a-trous filter on {}", settings.reproject ? "" : "(not used: Brigade's blend) ",
@@ -226,8 +240,13 @@ int run_play(PlayArgs a) {
     camera.update(window->take_move_input(), static_cast<float>(dt));
 
     const int fb_w = std::max(window->framebuffer_width(), 1), fb_h = std::max(window->framebuffer_height(), 1);
-    settings.width = std::max(16, static_cast<int>(std::lround(fb_w * scale)));
-    settings.height = std::max(16, static_cast<int>(std::lround(fb_h * scale)));
+    // Below scale 1 the reconstruction renders at the window's size (paths at scale^2 of the pixels, the
+    // G-buffer at all); the bilinear baseline renders a smaller frame that the window stretches.
+    const bool stretch = settings.upsample == core::UpsampleMethod::bilinear;
+    const float frame_scale = stretch ? scale : 1.0f;
+    settings.render_scale = scale;
+    settings.width = std::max(16, static_cast<int>(std::lround(fb_w * frame_scale)));
+    settings.height = std::max(16, static_cast<int>(std::lround(fb_h * frame_scale)));
     try {
       SessionFrame next = session->frame(camera, dt, settings);
       if (!next.ready) continue;  // the pipeline's first frame: it comes back with the next call
@@ -259,8 +278,9 @@ int run_play(PlayArgs a) {
       hud.spp = settings.spp;
       hud.render_scale = scale;
       hud.target_fps = target_fps;
-      hud.render_width = settings.width;
-      hud.render_height = settings.height;
+      hud.render_width = static_cast<int>(std::lround(fb_w * scale));
+      hud.render_height = static_cast<int>(std::lround(fb_h * scale));
+      hud.upsample = upsample_label(settings.upsample, fb_w, fb_h);
       hud.tone_mapper = settings.tone_curve;
       hud.balancer = session->balancer();
       hud.accumulation = settings.reproject
@@ -371,6 +391,15 @@ void add_play_command(CLI::App& app, int& exit_code) {
                   "the spp and scale keys take over")
       ->default_str("auto")
       ->check(CLI::Range(0, 1000));
+  cmd->add_option("--upsample", a->upsample,
+                  "how a --scale below 1 reaches the window: joint-bilateral (paths for about scale^2 of the "
+                  "window's pixels, a moving pattern, the rest reconstructed with weights from the full-resolution "
+                  "depth, normal, object id and albedo, textures from the full-resolution albedo), nearest (the nearest "
+                  "traced pixel) or bilinear (a smaller frame stretched by the GPU, the default: the other two trace a "
+                  "G-buffer ray at every window pixel and reconstruct on the host); the frame-rate target's scale "
+                  "drives it too. docs/denoising.md")
+      ->capture_default_str()
+      ->check(CLI::IsMember({"joint-bilateral", "nearest", "bilinear"}));
   cmd->add_option("--mode", a->mode, "debug mode at start")
       ->capture_default_str()
       ->check(CLI::IsMember(debug_mode_names()));

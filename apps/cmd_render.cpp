@@ -17,6 +17,7 @@
 #include "cohort/core/convergence.h"
 #include "cohort/core/frame_post.h"
 #include "cohort/core/oidn_denoiser.h"
+#include "cohort/core/upsample.h"
 #include "cohort/core/frame_defaults.h"
 #include "cohort/core/frame_pipeline.h"
 #include "cohort/core/view.h"
@@ -71,6 +72,8 @@ struct RenderArgs {
   std::string band_format = "rgb16f";
   bool frames_given = false;
   bool write_ids = false;  // the G-buffer's id plane of every written frame, and which entities moved
+  double render_scale = 1.0;  // dynamic resolution (core/upsample.h)
+  std::string upsample = "joint-bilateral";
 };
 
 // ACES and gamma 2.2 after --exposure (a factor), encoded exactly: the bytes `cohort render` has
@@ -106,6 +109,20 @@ int run_render(const RenderArgs& a) {
   options.band_format = a.band_format == "rgba32f" ? core::BandFormat::rgba32f : core::BandFormat::rgb16f;
   options.frame_timeout = std::chrono::milliseconds(600000);
   core::Renderer renderer(std::move(tracers), options);
+  // Dynamic resolution: sparse paths over the full-size G-buffer, reconstructed after the merge; or, for
+  // the bilinear baseline, a smaller frame stretched before it is written.
+  const core::UpsampleMethod upsample = core::parse_upsample_method(a.upsample);
+  const bool scaled = a.render_scale < 1.0;
+  const bool sparse = scaled && upsample != core::UpsampleMethod::bilinear;
+  const bool stretched = scaled && upsample == core::UpsampleMethod::bilinear;
+  const int render_width = stretched ? std::max(1, int(std::lround(a.width * a.render_scale))) : a.width;
+  const int render_height = stretched ? std::max(1, int(std::lround(a.height * a.render_scale))) : a.height;
+  if (scaled)
+    spdlog::info("render scale {:.2f}: {}", a.render_scale,
+                 sparse ? fmt::format("paths at {} of each 16 pixels, {} reconstruction from the G-buffer",
+                                      core::path_pattern_for_scale(a.render_scale, 0).pixels, a.upsample)
+                        : fmt::format("{}x{} stretched bilinearly to {}x{}", render_width, render_height, a.width,
+                                      a.height));
 
   // --replay: a recorded delta stream drives a RenderWorld over the map; WorldSync turns each frame's
   // changes into commit records and the recorded view into the camera.
@@ -119,8 +136,8 @@ int run_render(const RenderArgs& a) {
     for (const std::string& base : bases_or_test_map(a.bases)) vfs.add_search_path(base);
     world = std::make_unique<scene::RenderWorld>(scene::load_map(vfs, a.map.empty() ? player->header().map_name : a.map));
     core::WorldSyncOptions sync_options;
-    sync_options.width = uint32_t(a.width);
-    sync_options.height = uint32_t(a.height);
+    sync_options.width = uint32_t(render_width);
+    sync_options.height = uint32_t(render_height);
     sync = std::make_unique<core::WorldSync>(*world, sync_options);
     renderer.submit_commit(commit::CommitBuffer::full(sync->snapshot(), 0));
     frames = a.frames_given ? a.frames : std::numeric_limits<int>::max();
@@ -128,8 +145,8 @@ int run_render(const RenderArgs& a) {
     // A map: its materials' registers (time, tables) are evaluated at each frame's time, and only the
     // materials that changed travel (core/world_sync.h).
     core::WorldSyncOptions sync_options;
-    sync_options.width = uint32_t(a.width);
-    sync_options.height = uint32_t(a.height);
+    sync_options.width = uint32_t(render_width);
+    sync_options.height = uint32_t(render_height);
     sync = std::make_unique<core::WorldSync>(*scene.world, sync_options);
     sync->set_time(a.time);
     renderer.submit_commit(commit::CommitBuffer::full(sync->snapshot(), 0));
@@ -169,7 +186,7 @@ int run_render(const RenderArgs& a) {
     post_options.atrous = atrous;
     if (a.anti_lag >= 0.0f) post_options.reprojection.anti_lag_sigma = a.anti_lag;
     post_options.atrous_options.passes =
-        a.atrous_passes > 0 ? a.atrous_passes : core::atrous_passes_for_height(a.height);
+        a.atrous_passes > 0 ? a.atrous_passes : core::atrous_passes_for_height(render_height);
     core::AtrousOptions& ao = post_options.atrous_options;
     ao.guide = core::parse_atrous_guide(a.atrous_guide);
     if (a.atrous_sigma > 0.0f)
@@ -182,8 +199,8 @@ int run_render(const RenderArgs& a) {
   }
   // A GPU post-processing reprojection takes the bands as the tracers packed them: half the bytes cross
   // the bus and the host skips its conversions (the float frame and G-buffer are not made).
-  const bool packed = post && reproject && post->where() != "host" && a.denoise != "oidn" && a.denoise != "oidn-cuda" &&
-                      !a.write_ids;
+  const bool packed = post && reproject && post->where() != "host" && a.denoise != "oidn" &&
+                      a.denoise != "oidn-cuda" && !a.write_ids && !sparse;  // the reconstruction runs on the host's frame
   renderer.set_packed_merge(packed);
   if (a.denoise != "none" && !atrous) {
     denoiser = core::OidnDenoiser::open(core::parse_oidn_device(a.denoise == "oidn-cuda" ? "cuda" : "cpu"),
@@ -192,6 +209,7 @@ int run_render(const RenderArgs& a) {
                  denoiser->library_path());
   }
   int rendered = 0;
+  core::FrameBuffer upsampled;
   // The overlapped pipeline (core/frame_pipeline.h): frame f+1 is synced and handed out while frame f
   // renders; f is then blended, tone-mapped and written while f+1 renders.
   core::FramePipeline pipeline(renderer);
@@ -202,8 +220,16 @@ int run_render(const RenderArgs& a) {
   std::map<uint64_t, std::vector<std::string>> moved_by_frame;
   auto finish = [&](core::FramePipeline::Delivered done) {
     core::FrameStats& stats = done.stats;
-    const core::FrameBuffer& frame = pipeline.image();
     const int f = static_cast<int>(stats.frame);
+    const core::FrameBuffer* merged = &pipeline.image();
+    if (sparse && !pipeline.gbuffer().empty()) {
+      core::ScopedStage upsampling(stats.stages, core::kCoreTrack, "upsample");
+      core::upsample_sparse(*merged, pipeline.gbuffer(),
+                            core::PathPattern{done.job.params.path_pixels, done.job.params.path_phase}, upsample,
+                            upsampled);
+      merged = &upsampled;
+    }
+    const core::FrameBuffer& frame = *merged;
     // Adaptive convergence: a still camera accumulates every frame; motion raises f (see convergence.h).
     // Reprojection (--convergence reproject): per-pixel history through the frame's motion vectors.
     const core::GBuffer& gbuffer = pipeline.gbuffer();
@@ -244,6 +270,11 @@ int run_render(const RenderArgs& a) {
       }
       denoiser->denoise(*shown_image, denoised, guides);
       shown_image = &denoised;
+    }
+    if (stretched) {
+      core::ScopedStage upsampling(stats.stages, core::kCoreTrack, "upsample");
+      core::stretch_bilinear(*shown_image, a.width, a.height, upsampled);
+      shown_image = &upsampled;
     }
     const core::FrameBuffer& shown = *shown_image;
     ++rendered;
@@ -301,9 +332,10 @@ int run_render(const RenderArgs& a) {
       }
       if (path) {
         const CameraPose pose = camera_path_pose(*path, eye, angles.yaw, f);
-        job.camera = core::make_camera(pose.origin, {pose.yaw, angles.pitch}, a.fov, a.width, a.height);
+        job.camera = core::make_camera(pose.origin, {pose.yaw, angles.pitch}, a.fov, render_width, render_height);
       } else {
-        job.camera = core::make_camera(eye, {angles.yaw + a.yaw_step * float(f), angles.pitch}, a.fov, a.width, a.height);
+        job.camera = core::make_camera(eye, {angles.yaw + a.yaw_step * float(f), angles.pitch}, a.fov, render_width,
+                                       render_height);
       }
     }
     KFrameParams& p = job.params;
@@ -319,7 +351,12 @@ int run_render(const RenderArgs& a) {
     p.mode = modes().at(a.mode);
     p.soft_shadow_scale = a.soft_shadow_scale;
     p.shadow_rr = a.shadow_rr;
-    if (reproject || atrous || a.write_ids) {
+    if (sparse) {
+      const core::PathPattern pattern = core::path_pattern_for_scale(a.render_scale, uint64_t(f));
+      p.path_pixels = pattern.pixels;
+      p.path_phase = pattern.phase;
+    }
+    if (reproject || atrous || sparse || a.write_ids) {
       p.aux_outputs = 1u;
       job.previous_camera = previous_camera;
       previous_camera = job.camera;
@@ -334,6 +371,7 @@ int run_render(const RenderArgs& a) {
                            {"spp", a.spp},       {"bounces", a.bounces},
                            {"light_sampling", a.light_sampling}, {"light_samples", a.light_samples},    {"mode", a.mode},
                            {"camera_path", a.camera_path}, {"denoise", a.denoise},
+                           {"render_scale", a.render_scale}, {"upsample", a.upsample},
                            {"convergence", a.no_convergence ? "none" : convergence_mode}, {"frames", stats_json}};
   if (a.write_ids) {
     const scene::RenderWorld* ids_world = world ? world.get() : scene.world.get();
@@ -477,6 +515,18 @@ void add_render_command(CLI::App& app, int& exit_code) {
       ->check(CLI::NonNegativeNumber);
   cmd->add_option("--soft-shadows", a->soft_shadow_scale, "scale of the lights' soft-shadow extent")
       ->capture_default_str();
+  cmd->add_option("--render-scale", a->render_scale,
+                  "dynamic resolution: trace paths for about scale^2 of the pixels (a pattern that moves every "
+                  "frame; every pixel still gets its G-buffer) and reconstruct the rest with --upsample")
+      ->capture_default_str()
+      ->check(CLI::Range(0.05, 1.0));
+  cmd->add_option("--upsample", a->upsample,
+                  "reconstruction at --render-scale below 1: joint-bilateral (weights from the full-resolution "
+                  "depth, normal, object id and albedo; illumination times each pixel's albedo), nearest (the nearest "
+                  "traced pixel), or bilinear (render a scale * width x scale * height frame and stretch it, as "
+                  "`play` did with GL_LINEAR)")
+      ->capture_default_str()
+      ->check(CLI::IsMember({"joint-bilateral", "nearest", "bilinear"}));
   cmd->add_option("--out", a->out, "output folder")->capture_default_str();
   cmd->callback([a, frames_option, &exit_code] {
     a->frames_given = frames_option->count() > 0;

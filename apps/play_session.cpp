@@ -75,6 +75,7 @@ struct PlaySession::State {
   std::unique_ptr<core::FramePost> reprojection;  // on the first CUDA tracer's GPU, else the host
   KCamera previous_camera{};   // of the frame handed out last, for motion vectors
   std::vector<float> moving_mask;
+  core::FrameBuffer upsampled;  // the reconstructed frame at a render scale below 1
   double scenario_seconds = 0.0;
   uint64_t frame_index = 0;
   kuint last_mode = K_MODE_PATH;
@@ -181,7 +182,13 @@ SessionFrame PlaySession::frame(const viewer::FlyCamera& camera, double seconds,
   p.max_bounces = static_cast<kuint>(settings.max_bounces);
   p.light_sampling = settings.light_sampling;
   p.mode = settings.mode;
-  if (settings.reproject) {
+  const bool sparse = settings.render_scale < 1.0 && settings.upsample != core::UpsampleMethod::bilinear;
+  if (sparse) {
+    const core::PathPattern pattern = core::path_pattern_for_scale(settings.render_scale, s.frame_index);
+    p.path_pixels = pattern.pixels;
+    p.path_phase = pattern.phase;
+  }
+  if (settings.reproject || sparse) {
     p.aux_outputs = 1u;
     job.previous_camera = s.previous_camera;
   }
@@ -197,7 +204,15 @@ SessionFrame PlaySession::frame(const viewer::FlyCamera& camera, double seconds,
   out.ready = true;
   out.stats = std::move(done->stats);
   out.commit_bytes = prepared.commit_bytes;
-  const core::FrameBuffer& hdr = s.pipeline->image();
+  const core::FrameBuffer* merged = &s.pipeline->image();
+  const core::GBuffer& gbuffer = s.pipeline->gbuffer();
+  const core::PathPattern pattern{done->job.params.path_pixels, done->job.params.path_phase};
+  if (pattern.sparse() && !gbuffer.empty()) {
+    core::ScopedStage upsampling(out.stats.stages, core::kCoreTrack, "upsample");
+    core::upsample_sparse(*merged, gbuffer, pattern, settings.upsample, s.upsampled);
+    merged = &s.upsampled;
+  }
+  const core::FrameBuffer& hdr = *merged;
   const kuint mode = done->job.params.mode;
 
   if (mode != s.last_mode) {  // another view of the scene entirely
@@ -205,8 +220,7 @@ SessionFrame PlaySession::frame(const viewer::FlyCamera& camera, double seconds,
     s.reprojection->reset();
   }
   s.last_mode = mode;
-  const core::GBuffer& gbuffer = s.pipeline->gbuffer();
-  if (done->job.params.aux_outputs != 0u && !gbuffer.empty()) {
+  if (settings.reproject && done->job.params.aux_outputs != 0u && !gbuffer.empty()) {
     // Per-pixel history: moving objects carry their own motion, so no mask is needed.
     core::ScopedStage blending(out.stats.stages, core::kCoreTrack, "convergence");
     s.reprojection->process(hdr, gbuffer);

@@ -11,6 +11,7 @@
 
 #include "cohort/core/frame_buffer.h"
 #include "cohort/core/frame_stats.h"
+#include "cohort/core/upsample.h"
 #include "cohort/kernel/layout.h"
 #include "viewer/fly_camera.h"
 
@@ -37,6 +38,11 @@ struct FrameSettings {
   kuint light_sampling = K_LIGHTS_TREE;
   std::string tone_curve = "aces";
   bool reproject = false;           // per-pixel reprojection (core/reprojection.h) instead of Brigade's blend
+  // Dynamic resolution (core/upsample.h): below 1 with joint_bilateral or nearest, width x height is the
+  // window's and paths are traced for about render_scale^2 of its pixels, the rest reconstructed from the
+  // G-buffer; with bilinear the caller passes the smaller size and the window stretches it.
+  double render_scale = 1.0;
+  core::UpsampleMethod upsample = core::UpsampleMethod::bilinear;
 };
 
 struct SessionFrame {

@@ -32,6 +32,7 @@ std::vector<std::string> hud_lines(const HudState& s) {
   }
   lines.push_back(format("MODE %s  SPP %d  SCALE %.2f (%dX%d)  TONE %s", s.mode.c_str(), s.spp, s.render_scale,
                          s.render_width, s.render_height, s.tone_mapper.c_str()));
+  if (s.render_scale < 1.0f && !s.upsample.empty()) lines.back() += "  UPSAMPLE " + s.upsample;
   if (s.target_fps > 0)
     lines.back() += format("  AUTO %d FPS", s.target_fps);
   if (s.stats) {

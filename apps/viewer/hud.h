@@ -19,6 +19,7 @@ struct HudState {
   int spp = 1;
   float render_scale = 1.0f;
   int render_width = 0, render_height = 0;
+  std::string upsample;                   // how a scale below 1 reaches the window, e.g. "JOINT-BILATERAL"
   int target_fps = 0;                     // > 0: spp and scale are chosen to hold this frame rate
   std::string tone_mapper;
   std::string balancer;

@@ -42,7 +42,7 @@ inline constexpr KeyHelp kKeyHelp[] = {
     {"M / Shift+M", "next / previous debug mode"},
     {"B", "next balancer"},
     {"] / [", "samples per pixel up / down"},
-    {". / ,", "render scale up / down"},
+    {". / ,", "render scale up / down (paths for scale^2 of the pixels, upsampled to the window: --upsample)"},
     {"T", "next tone mapper"},
     {"P", "pause / resume the scenario (door, fan, flicker)"},
     {"R", "put the camera back at the start"},

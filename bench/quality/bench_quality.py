@@ -55,6 +55,13 @@ METHODS = {
     "reproject+atrous-variance": ["--convergence", "reproject", "--denoise", "atrous", "--atrous-guide", "variance"],
     "reproject+atrous-variance-of-mean": ["--convergence", "reproject", "--denoise", "atrous", "--atrous-guide",
                                           "variance-of-mean"],
+    # Dynamic resolution (docs/denoising.md): paths at a quarter of the pixels, reconstructed at full size.
+    "half-bilinear": ["--no-convergence", "--render-scale", "0.5", "--upsample", "bilinear"],
+    "half-nearest": ["--no-convergence", "--render-scale", "0.5", "--upsample", "nearest"],
+    "half-joint-bilateral": ["--no-convergence", "--render-scale", "0.5", "--upsample", "joint-bilateral"],
+    "half-bilinear+reproject": ["--convergence", "reproject", "--render-scale", "0.5", "--upsample", "bilinear"],
+    "half-joint-bilateral+reproject": ["--convergence", "reproject", "--render-scale", "0.5", "--upsample",
+                                       "joint-bilateral"],
 }
 EXTRA_STAGES = ("convergence", "denoise", "convergence+denoise")
 

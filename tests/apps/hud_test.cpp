@@ -50,6 +50,20 @@ TEST(Hud, LinesCarryTheFrameStats) {
   EXPECT_EQ(layer.rgba[(199 * 400 + 399) * 4 + 3], 0) << "the corner away from the HUD stays transparent";
 }
 
+// Below scale 1 the HUD says how the frame reaches the window; at scale 1 there is nothing to upsample.
+TEST(Hud, NamesTheUpsamplingBelowScaleOne) {
+  HudState s;
+  s.mode = "PATH";
+  s.render_scale = 0.5f;
+  s.render_width = 320;
+  s.render_height = 180;
+  s.target_fps = 30;
+  s.upsample = "JOINT-BILATERAL TO 640X360";
+  EXPECT_EQ(hud_lines(s)[1], "MODE PATH  SPP 1  SCALE 0.50 (320X180)  TONE   UPSAMPLE JOINT-BILATERAL TO 640X360  AUTO 30 FPS");
+  s.render_scale = 1.0f;
+  EXPECT_EQ(hud_lines(s)[1].find("UPSAMPLE"), std::string::npos);
+}
+
 TEST(Hud, DrawsTheFramesTimelineAsABarPerTrack) {
   HudState s;
   core::FrameStats stats;

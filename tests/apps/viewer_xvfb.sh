@@ -47,4 +47,13 @@ for denoise in atrous none; do
     --scale 1 --spp 1 --no-scenario --convergence reproject --denoise $denoise --screenshot "$out" ||
     { echo "FAIL: cohort play --denoise $denoise exited with $?"; exit 1; }
 done
-python3 "$checker" "$atrous_shot" 160 120 && python3 "$(dirname "$checker")/smoother_than.py" "$atrous_shot" "$plain_shot"
+python3 "$checker" "$atrous_shot" 160 120 && python3 "$(dirname "$checker")/smoother_than.py" "$atrous_shot" "$plain_shot" ||
+  exit 1
+# Dynamic resolution: at scale 0.5 the joint-bilateral reconstruction renders at the window's size (paths
+# at a quarter of the pixels), so the frame itself is 160x120, not the 80x60 the bilinear stretch renders.
+upsample_shot="${shot%.*}_upsample.${shot##*.}"
+rm -f "$upsample_shot"
+xvfb-run -a -s "-screen 0 1024x768x24" "$cohort" play "$map" --tracers embree --frames 6 --width 160 --height 120 \
+  --scale 0.5 --spp 1 --upsample joint-bilateral --screenshot "$upsample_shot" ||
+  { echo "FAIL: cohort play --upsample joint-bilateral exited with $?"; exit 1; }
+python3 "$checker" "$upsample_shot" 160 120

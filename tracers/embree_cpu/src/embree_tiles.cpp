@@ -123,19 +123,30 @@ void COHORT_RENDER_TILE(const Frame& frame, const Tile& tile, Arena& a, embree_k
   const kuint spp = params->spp > 0u ? params->spp : 1u;
   const KVec3 org = v3_load(camera->origin);
   const float pixel_spread = k_pixel_spread(camera);
-  for (int i = 0; i < n; ++i) a.sums[i] = v3s(0.0f);
+  // Sparse paths (dynamic resolution): only the pattern's pixels trace, packed so packets stay full;
+  // the others stay black (their aux planes are written anyway).
+  int traced = 0;
+  for (int i = 0; i < n; ++i) {
+    a.sums[i] = v3s(0.0f);
+    if (k_pixel_traces_path(params->path_pixels, params->path_phase, static_cast<kuint>(tile.x0 + i % w),
+                            static_cast<kuint>(tile.y0 + i / w)))
+      a.traced[traced++] = i;
+  }
   for (kuint s = 0u; s < spp; ++s) {
-    for (int i = 0; i < n; ++i)
-      a.dirs[i] = k_camera_sample(params, camera, static_cast<kuint>(tile.x0 + i % w),
+    for (int j = 0; j < traced; ++j) {
+      const int i = a.traced[j];
+      a.dirs[j] = k_camera_sample(params, camera, static_cast<kuint>(tile.x0 + i % w),
                                   static_cast<kuint>(tile.y0 + i / w), s, &a.rngs[i]);
-    trace_camera_packets(ctx, org, n, a);
-    for (int i = 0; i < n; ++i) {
+    }
+    trace_camera_packets(ctx, org, traced, a);
+    for (int j = 0; j < traced; ++j) {
+      const int i = a.traced[j];
       const uint64_t before = ctx.rays;
-      ctx.primed_hit = &a.hits[i];
-      ctx.primed_found = a.found[i];
-      ctx.primed_dir = a.dirs[i];
-      if (log) log->camera_dir = a.dirs[i];
-      a.sums[i] = v3_add(a.sums[i], k_trace_path(&ctx, params, org, a.dirs[i], pixel_spread, &a.rngs[i]));
+      ctx.primed_hit = &a.hits[j];
+      ctx.primed_found = a.found[j];
+      ctx.primed_dir = a.dirs[j];
+      if (log) log->camera_dir = a.dirs[j];
+      a.sums[i] = v3_add(a.sums[i], k_trace_path(&ctx, params, org, a.dirs[j], pixel_spread, &a.rngs[i]));
       ctx.primed_hit = nullptr;
       row_rays[i / w] += ctx.rays - before;
     }

@@ -43,6 +43,7 @@ struct Arena {
   KVec3 dirs[kTilePixels];
   KRng rngs[kTilePixels];
   KVec3 sums[kTilePixels];
+  int traced[kTilePixels];  // the tile's pixels that trace paths (kernel/path_pattern.h), packed
   float rgba[kTileWidth * 4];
   KAux aux[kTileWidth];
 };

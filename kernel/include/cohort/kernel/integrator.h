@@ -18,6 +18,7 @@
 #include "fog.h"
 #include "light_tree.h"
 #include "rng.h"
+#include "path_pattern.h"
 #include "sky.h"
 
 #ifndef K_CTX_SCENE
@@ -340,7 +341,9 @@ KFN KVec3 k_camera_sample(const KFrameParams* params, const KCamera* cam, kuint 
   return k_camera_direction(cam, (float)x + jx, (float)y + jy);
 }
 
+/* A pixel's colour; black, at no cost, where the sparse path pattern (path_pattern.h) leaves it out. */
 KFN KVec3 k_render_pixel(KTraceCtx* ctx, const KFrameParams* params, const KCamera* cam, kuint x, kuint y) {
+  if (!k_pixel_traces_path(params->path_pixels, params->path_phase, x, y)) return v3s(0.0f);
   kuint spp = params->spp > 0u ? params->spp : 1u;
   KVec3 sum = v3s(0.0f);
   KVec3 org = v3_load(cam->origin);

@@ -193,14 +193,15 @@ typedef struct KCamera {
  * the band's auxiliary planes (aux_outputs.h: depth, normal, albedo, id, motion), 0 = it does not (no cost).
  * [volume_light_begin, volume_light_end): the index range holding every fog and blend light
  * (K_LIGHT_VOLUME_EFFECT), empty when the map has none: rays and hits test only those lights' volumes,
- * not every light of a map with thousands. */
+ * not every light of a map with thousands. path_pixels, path_phase: sparse paths for dynamic resolution
+ * (path_pattern.h: which pixels trace paths; 0 = every pixel; the aux planes cover every pixel anyway). */
 typedef struct KFrameParams {
   kuint frame_index;  kuint spp;          kuint max_bounces;   kuint light_samples;
   float firefly_clamp; float spec_boost;  kuint mode;          kuint light_count;
   kuint row_begin;    kuint row_end;      kuint instance_count; kuint tlas_node_count;
   float soft_shadow_scale; float rr_start; kuint light_sampling; kuint light_node_count;
   kuint emissive_count; kuint emissive_samples; kuint aux_outputs; kuint volume_light_begin;
-  kuint volume_light_end; float shadow_rr;  kuint pad2;        kuint pad3;
+  kuint volume_light_end; float shadow_rr;  kuint path_pixels; kuint path_phase;
 } KFrameParams;
 
 /* One pixel's auxiliary outputs (aux_outputs.h says what each field means). */
