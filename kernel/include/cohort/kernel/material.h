@@ -188,24 +188,26 @@ KFN KSurface k_surface_eval(const KSceneView* scene, KHit hit, KVec3 ray_org, KV
   }
   sf.normal = n;
 
-  KVec4 diffuse = v4(m->diffuse_color[0], m->diffuse_color[1], m->diffuse_color[2], m->diffuse_color[3]);
-  if (m->diffuse_tex != K_NONE) {
-    KVec4 d = k_texture_sample_footprint(scene, m->diffuse_tex, s, t, footprint);
-    diffuse = v4(diffuse.x * d.x, diffuse.y * d.y, diffuse.z * d.z, diffuse.w * d.w);
-  }
   /* The engine multiplies the whole interaction (diffuse and specular) and the ambient stages by it. */
   KVec4 vertex_color = k_hit_vertex_color(scene, hit.triangle, u, v, m->flags);
-  diffuse = v4(diffuse.x * vertex_color.x, diffuse.y * vertex_color.y, diffuse.z * vertex_color.z,
-               diffuse.w * vertex_color.w);
-  if (m->blend_diffuse_tex1 != 0u) {
-    /* A terrain blend: the second diffuse stage takes what the first one's vertex colour leaves. Its
-     * interaction's specular is the first's, not weighed again. */
-    KVec4 d2 = k_texture_sample_footprint(scene, m->blend_diffuse_tex1 - 1u, s, t, footprint);
-    diffuse.x += m->diffuse_color[0] * d2.x * (1.0f - vertex_color.x);
-    diffuse.y += m->diffuse_color[1] * d2.y * (1.0f - vertex_color.y);
-    diffuse.z += m->diffuse_color[2] * d2.z * (1.0f - vertex_color.z);
-    vertex_color = v4(1.0f, 1.0f, 1.0f, vertex_color.w);
+  /* A terrain blend's second diffuse stage takes what the first one's vertex colour leaves (its specular
+   * is the material's, untinted). One texture read site for both stages: each inlined read costs the
+   * GPU kernel registers and code. */
+  KVec4 diffuse = v4(0.0f, 0.0f, 0.0f, 0.0f);
+  KVec4 weight = vertex_color;
+  kuint stages = m->blend_diffuse_tex1 != 0u ? 2u : 1u;
+  for (kuint stage = 0u; stage < stages; ++stage) {
+    KVec4 c = v4(m->diffuse_color[0], m->diffuse_color[1], m->diffuse_color[2], m->diffuse_color[3]);
+    kuint tex = stage == 0u ? m->diffuse_tex : m->blend_diffuse_tex1 - 1u;
+    if (tex != K_NONE) {
+      KVec4 d = k_texture_sample_footprint(scene, tex, s, t, footprint);
+      c = v4(c.x * d.x, c.y * d.y, c.z * d.z, c.w * d.w);
+    }
+    diffuse = v4(diffuse.x + c.x * weight.x, diffuse.y + c.y * weight.y, diffuse.z + c.z * weight.z,
+                 stage == 0u ? c.w * weight.w : diffuse.w);
+    weight = v4(1.0f - vertex_color.x, 1.0f - vertex_color.y, 1.0f - vertex_color.z, 0.0f);
   }
+  if (stages == 2u) vertex_color = v4(1.0f, 1.0f, 1.0f, vertex_color.w);
   sf.albedo = v4_rgb(diffuse);
   sf.alpha = diffuse.w;
 
