@@ -71,17 +71,23 @@ TEST(SparsePaths, EmbreeTracesExactlyThePatternsPixelsAsAFullFrameWould) {
     }
 }
 
-// The OpenCL kernel asks the same predicate (k_render_pixel): its traced pixels agree with Embree's full
-// frame as the two tracers agree on full frames (agreement_test.cpp), and its untraced pixels are black.
-TEST(SparsePaths, OpenCLTracesThePatternsPixelsLikeEmbree) {
-  if (!tracer_runs_here("embree") || !tracer_runs_here("opencl")) GTEST_SKIP() << "needs Embree and OpenCL";
+// The GPU kernels ask the same predicate (k_render_pixel): their traced pixels agree with Embree's full
+// frame as the tracers agree on full frames (agreement_test.cpp), and their untraced pixels are black.
+class SparsePathsOnDevices : public ::testing::TestWithParam<std::string> {};
+
+TEST_P(SparsePathsOnDevices, TraceThePatternsPixelsLikeEmbree) {
+  const std::string device = GetParam();
+  if (!tracer_runs_here("embree") || !tracer_runs_here(device)) GTEST_SKIP() << "needs Embree and " << device;
   auto embree = make_test_tracer("embree");
-  auto opencl = make_test_tracer("opencl");
+  auto other = make_test_tracer(device);
   const KCamera cam = test_room_camera(kW, kH);
   const core::FrameBuffer full = render(*embree, test_room(), cam, sparse_params(0, 0));
-  const core::FrameBuffer sparse = render(*opencl, test_room(), cam, sparse_params(4, 8));
-  expect_sparse_copy(sparse, full, 4, 8, 0.02, "opencl 4 of 16");
+  const core::FrameBuffer sparse = render(*other, test_room(), cam, sparse_params(4, 8));
+  expect_sparse_copy(sparse, full, 4, 8, 0.02, device + " 4 of 16");
 }
+
+INSTANTIATE_TEST_SUITE_P(Devices, SparsePathsOnDevices, ::testing::Values("opencl", "cuda"),
+                         [](const auto& info) { return info.param; });
 
 // Sparse frames still write every pixel's aux planes (the reconstruction's guide), the same as a full frame's.
 TEST(SparsePaths, AuxPlanesCoverEveryPixel) {
