@@ -8,13 +8,4 @@ if(TARGET cohort_kernel_tests)
   endif()
 endif()
 
-set(_nvcc "${CMAKE_CUDA_COMPILER}")
-if(NOT _nvcc)
-  find_program(_nvcc nvcc PATHS /usr/local/cuda/bin)
-endif()
-if(_nvcc)
-  add_test(NAME kernel.bvh_traverse_nvcc_compiles
-           COMMAND ${_nvcc} -x cu -c ${CMAKE_CURRENT_LIST_DIR}/bvh_traverse_cuda_check.cu
-                   -I ${CMAKE_SOURCE_DIR}/kernel/include -o ${CMAKE_BINARY_DIR}/bvh_traverse_cuda_check.o)
-  set_tests_properties(kernel.bvh_traverse_nvcc_compiles PROPERTIES LABELS kernel TIMEOUT 300)
-endif()
+cohort_nvcc_compile_check(kernel.bvh_traverse_nvcc_compiles ${CMAKE_CURRENT_LIST_DIR}/bvh_traverse_cuda_check.cu)
