@@ -18,6 +18,9 @@ namespace cohort::tracers {
 // At least 4 blocks of 128 threads per SM: caps the kernel at 128 registers (25% occupancy) instead of
 // 164. Measured on one H100 (docs/integrator.md, "CUDA kernel shape"): 3 blocks 15.8 ms, 4 blocks 13.7 ms,
 // 5-6 blocks 13.2-13.4 ms on the large map at 1080p but slower on the test map, where spills cost more.
+// Two builds: with every pixel tracing paths the sparse pattern's test is compiled out, since in this
+// 128-register kernel even that early exit cost 1.5-2% of a full frame (nvidia-h100-x1, docs/integrator.md).
+template <bool kSparse>
 __global__ void __launch_bounds__(128, 4) render_band_kernel(KSceneView scene, KFrameParams params, KCamera camera,
                                                           float4* band, unsigned long long* ray_counts,
                                                           unsigned* row_rays) {
@@ -30,7 +33,7 @@ __global__ void __launch_bounds__(128, 4) render_band_kernel(KSceneView scene, K
   ctx.closest_rays = 0u;
   ctx.occlusion_rays = 0u;
   if (inside) {
-    KVec3 c = k_render_pixel(&ctx, &params, &camera, x, y);
+    KVec3 c = kSparse ? k_render_pixel(&ctx, &params, &camera, x, y) : k_render_pixel_paths(&ctx, &params, &camera, x, y);
     band[size_t(row) * camera.width + x] = make_float4(c.x, c.y, c.z, 1.0f);
   }
   if (ray_counts) {
@@ -100,7 +103,10 @@ void launch_render_band(const KSceneView& scene, const KFrameParams& params, con
   const kuint rows = params.row_end - params.row_begin;
   const dim3 block(16, 8);  // 16 wide: the row ray counts rely on two rows per warp
   const dim3 grid((camera.width + block.x - 1) / block.x, (rows + block.y - 1) / block.y);
-  render_band_kernel<<<grid, block, 0, stream>>>(scene, params, camera, band, ray_counts, row_rays);
+  if (params.path_pixels == 0u || params.path_pixels >= K_PATH_PATTERN_PIXELS)
+    render_band_kernel<false><<<grid, block, 0, stream>>>(scene, params, camera, band, ray_counts, row_rays);
+  else
+    render_band_kernel<true><<<grid, block, 0, stream>>>(scene, params, camera, band, ray_counts, row_rays);
   COHORT_CUDA(cudaGetLastError());
 }
 

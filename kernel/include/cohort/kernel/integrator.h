@@ -341,9 +341,8 @@ KFN KVec3 k_camera_sample(const KFrameParams* params, const KCamera* cam, kuint 
   return k_camera_direction(cam, (float)x + jx, (float)y + jy);
 }
 
-/* A pixel's colour; black, at no cost, where the sparse path pattern (path_pattern.h) leaves it out. */
-KFN KVec3 k_render_pixel(KTraceCtx* ctx, const KFrameParams* params, const KCamera* cam, kuint x, kuint y) {
-  if (!k_pixel_traces_path(params->path_pixels, params->path_phase, x, y)) return v3s(0.0f);
+/* A pixel's colour, its paths traced whatever the sparse path pattern says (k_render_pixel asks it). */
+KFN KVec3 k_render_pixel_paths(KTraceCtx* ctx, const KFrameParams* params, const KCamera* cam, kuint x, kuint y) {
   kuint spp = params->spp > 0u ? params->spp : 1u;
   KVec3 sum = v3s(0.0f);
   KVec3 org = v3_load(cam->origin);
@@ -354,6 +353,12 @@ KFN KVec3 k_render_pixel(KTraceCtx* ctx, const KFrameParams* params, const KCame
     sum = v3_add(sum, k_trace_path(ctx, params, org, dir, pixel_spread, &rng));
   }
   return v3_scale(sum, 1.0f / (float)spp);
+}
+
+/* A pixel's colour; black, at no cost, where the sparse path pattern (path_pattern.h) leaves it out. */
+KFN KVec3 k_render_pixel(KTraceCtx* ctx, const KFrameParams* params, const KCamera* cam, kuint x, kuint y) {
+  if (!k_pixel_traces_path(params->path_pixels, params->path_phase, x, y)) return v3s(0.0f);
+  return k_render_pixel_paths(ctx, params, cam, x, y);
 }
 
 #endif
