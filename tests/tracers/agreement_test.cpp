@@ -22,20 +22,6 @@ using namespace cohort::test;
 
 namespace {
 
-double rmse(const core::FrameBuffer& a, const core::FrameBuffer& b, double* mean) {
-  double sum = 0.0, sum_sq = 0.0;
-  size_t n = 0;
-  for (size_t i = 0; i < a.rgba.size(); ++i) {
-    if (i % 4 == 3) continue;
-    double d = double(a.rgba[i]) - double(b.rgba[i]);
-    sum_sq += d * d;
-    sum += 0.5 * (double(a.rgba[i]) + double(b.rgba[i]));
-    ++n;
-  }
-  *mean = sum / double(n);
-  return std::sqrt(sum_sq / double(n));
-}
-
 struct Case {
   uint32_t mode;
   uint32_t bounces;
@@ -72,7 +58,7 @@ TEST_P(Agreement, EmbreeAndOpenCLImagesMatch) {
   for (float v : a.rgba) ASSERT_TRUE(std::isfinite(v)) << "embree wrote a non-finite value";
   for (float v : b.rgba) ASSERT_TRUE(std::isfinite(v)) << "opencl wrote a non-finite value";
   double mean = 0.0;
-  double error = rmse(a, b, &mean);
+  double error = rgb_rmse(a, b, &mean);
   EXPECT_GT(mean, 0.01) << "the room should be lit";
   EXPECT_LT(error, 0.005 * mean) << c.name << ": RMSE " << error << " vs mean " << mean;
 
@@ -82,7 +68,7 @@ TEST_P(Agreement, EmbreeAndOpenCLImagesMatch) {
   other.frame_index = 8;
   core::FrameBuffer noise = render(*embree, room, cam, other);
   double noise_mean = 0.0;
-  double noise_error = rmse(a, noise, &noise_mean);
+  double noise_error = rgb_rmse(a, noise, &noise_mean);
   if (c.mode == K_MODE_PATH) {
     EXPECT_GT(noise_error, 2.0 * error) << "sample noise " << noise_error;
   }
@@ -120,7 +106,7 @@ TEST(AgreementManyLights, EmbreeAndOpenCLImagesMatch) {
   core::FrameBuffer a = render(*embree, s, cam, params);
   core::FrameBuffer b = render(*opencl, s, cam, params);
   double mean = 0.0;
-  double error = rmse(a, b, &mean);
+  double error = rgb_rmse(a, b, &mean);
   std::cout << "many lights, tree: RMSE embree/opencl " << error << ", mean " << mean << "\n";
   EXPECT_GT(mean, 0.05);
   EXPECT_LT(error, 0.005 * mean);
@@ -178,7 +164,7 @@ TEST(AgreementOnTestMap, EmbreeAndOpenCLImagesMatch) {
   core::FrameBuffer a = render(*embree, map, cam, params);
   core::FrameBuffer b = render(*opencl, map, cam, params);
   double mean = 0.0;
-  double error = rmse(a, b, &mean);
+  double error = rgb_rmse(a, b, &mean);
   std::cout << "testmap on " << opencl->name() << ": RMSE embree/opencl " << error << ", mean " << mean << "\n";
   EXPECT_GT(mean, 0.01);
   EXPECT_LT(error, 0.005 * mean);

@@ -20,20 +20,6 @@ using namespace cohort::test;
 
 namespace {
 
-double rmse(const core::FrameBuffer& a, const core::FrameBuffer& b, double* mean) {
-  double sum = 0.0, sum_sq = 0.0;
-  size_t n = 0;
-  for (size_t i = 0; i < a.rgba.size(); ++i) {
-    if (i % 4 == 3) continue;
-    const double d = double(a.rgba[i]) - double(b.rgba[i]);
-    sum_sq += d * d;
-    sum += 0.5 * (double(a.rgba[i]) + double(b.rgba[i]));
-    ++n;
-  }
-  *mean = sum / double(n);
-  return std::sqrt(sum_sq / double(n));
-}
-
 core::FrameBuffer render_frame(core::Tracer& tracer, const KCamera& camera, const KFrameParams& params) {
   core::FrameBuffer fb;
   fb.resize(int(camera.width), int(camera.height));
@@ -95,8 +81,8 @@ TEST_P(SkinningAgreement, WalkerPosedMatchesEmbree) {
     const core::FrameBuffer a = render_frame(*embree, camera, params);
     const core::FrameBuffer b = render_frame(*opencl, camera, params);
     double mean = 0.0, moved_mean = 0.0;
-    const double error = rmse(a, b, &mean);
-    const double moved = rmse(a, bind, &moved_mean);
+    const double error = rgb_rmse(a, b, &mean);
+    const double moved = rgb_rmse(a, bind, &moved_mean);
     std::cout << "walker at " << time_ms << " ms: RMSE embree/" << device << " " << error << ", against the bind pose " << moved
               << ", mean " << mean << "\n";
     EXPECT_GT(mean, 0.01);

@@ -105,6 +105,22 @@ inline glm::vec3 pixel(const core::FrameBuffer& fb, int x, int y) {
   return {p[0], p[1], p[2]};
 }
 
+// RMSE over the RGB channels of two frames of one size; *mean gets the mean of both frames' channels
+// (the scale the agreement tests hold the error against).
+inline double rgb_rmse(const core::FrameBuffer& a, const core::FrameBuffer& b, double* mean) {
+  double sum = 0.0, sum_sq = 0.0;
+  size_t n = 0;
+  for (size_t i = 0; i < a.rgba.size(); ++i) {
+    if (i % 4 == 3) continue;
+    const double d = double(a.rgba[i]) - double(b.rgba[i]);
+    sum_sq += d * d;
+    sum += 0.5 * (double(a.rgba[i]) + double(b.rgba[i]));
+    ++n;
+  }
+  *mean = sum / double(n);
+  return std::sqrt(sum_sq / double(n));
+}
+
 inline double mean_luminance(const core::FrameBuffer& fb) {
   double sum = 0.0;
   for (int y = 0; y < fb.height; ++y)

@@ -166,30 +166,17 @@ TEST(VertexColorsAgreement, EveryTracerMatchesEmbree) {
   KFrameParams params = frame_params(K_MODE_PATH, 16, 2, kSize);
   params.frame_index = 7;
   const core::FrameBuffer reference = render(*embree, four_quads(), cam, params);
-  auto rmse = [](const core::FrameBuffer& a, const core::FrameBuffer& b, double* mean) {
-    double sum = 0.0, sum_sq = 0.0;
-    size_t n = 0;
-    for (size_t i = 0; i < a.rgba.size(); ++i) {
-      if (i % 4 == 3) continue;
-      const double d = double(a.rgba[i]) - double(b.rgba[i]);
-      sum_sq += d * d;
-      sum += 0.5 * (double(a.rgba[i]) + double(b.rgba[i]));
-      ++n;
-    }
-    *mean = sum / double(n);
-    return std::sqrt(sum_sq / double(n));
-  };
   KFrameParams other = params;
   other.frame_index = 8;
   double noise_mean = 0.0;
-  const double noise = rmse(reference, render(*embree, four_quads(), cam, other), &noise_mean);
+  const double noise = rgb_rmse(reference, render(*embree, four_quads(), cam, other), &noise_mean);
   int checked = 0;
   for (const std::string& kind : built_tracers()) {
     if (kind == "embree" || !tracer_runs_here(kind)) continue;
     SCOPED_TRACE(kind);
     auto tracer = make_test_tracer(kind);
     double mean = 0.0;
-    const double error = rmse(reference, render(*tracer, four_quads(), cam, params), &mean);
+    const double error = rgb_rmse(reference, render(*tracer, four_quads(), cam, params), &mean);
     EXPECT_GT(mean, 0.01) << "the quads should be lit";
     EXPECT_LT(error, 0.005 * mean) << "RMSE " << error << " vs mean " << mean;
     EXPECT_GT(noise, 2.0 * error) << "frame-to-frame noise " << noise;
