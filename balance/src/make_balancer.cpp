@@ -1,6 +1,7 @@
 #include <stdexcept>
 
 #include "balancers.h"
+#include "sit_out_trials.h"
 
 namespace cohort::balance {
 
@@ -25,7 +26,14 @@ std::unique_ptr<Balancer> make_balancer(std::string_view name, const BalancerOpt
     if (!(options.min_gain >= 0.0 && options.min_gain < 1.0)) throw std::invalid_argument("whole-cost: min_gain must be in [0, 1)");
     if (options.probe_interval < 1) throw std::invalid_argument("whole-cost: probe_interval must be >= 1");
     if (options.fine_below_rows < 0) throw std::invalid_argument("whole-cost: fine_below_rows must be >= 0");
-    return std::make_unique<WholeCostBalancer>(options);
+    if (!options.frame_trials) return std::make_unique<WholeCostBalancer>(options);
+    if (!(options.trial_share > 0.0 && options.trial_share < 1.0) || options.trial_window < 2 ||
+        options.trial_settle < 0 || options.trial_settle >= options.trial_window || options.trial_pairs < 1 ||
+        !(options.trial_min_gain >= 0.0 && options.trial_min_gain < 1.0) || options.trial_warmup < 0 ||
+        options.trial_every < 1)
+      throw std::invalid_argument("whole-cost: sit-out trial options out of range (share in (0, 1), window >= 2, "
+                                  "0 <= settle < window, pairs >= 1, min_gain in [0, 1), warmup >= 0, every >= 1)");
+    return std::make_unique<SitOutTrials>(std::make_unique<WholeCostBalancer>(options), options);
   }
   std::string known;
   for (const std::string& n : balancer_names()) known += (known.empty() ? "" : ", ") + n;

@@ -412,8 +412,22 @@ void Renderer::begin_frame(const BandJob& job, FrameBuffer& out, const std::vect
   row_work_.assign(static_cast<size_t>(rows), 0.0f);
   row_work_known_.assign(static_cast<size_t>(rows), 0);
   ScopedStage balancing(stats.stages, kCoreTrack, "balance");
-  const std::vector<balance::Band> bands = balancer_->divide({rows, ready, last_measurements_, std::move(proxy)});
+  // The interval since the previous frame began is what the loop delivers (with a virtual clock it
+  // means nothing, and the balancer gets none).
+  double interval_ms = 0.0;
+  if (last_frame_start_ && !options_.use_reported_time)
+    interval_ms = std::chrono::duration<double, std::milli>(frame_start - *last_frame_start_).count();
+  last_frame_start_ = frame_start;
+  const std::vector<balance::Band> bands =
+      balancer_->divide({rows, ready, last_measurements_, std::move(proxy), interval_ms});
   const std::vector<balance::Band> probes = balancer_->probe_bands();
+  for (const balance::SitOutVerdict& v : balancer_->take_verdicts()) {
+    const std::string& name = workers_[static_cast<size_t>(v.tracer)]->name;
+    spdlog::info("{} {}: frames took {:.3f} ms with its rows, {:.3f} ms with them handed to the others (medians of {} "
+                 "frames each); tried again in {} frames",
+                 name, v.sits_out ? "sits out" : "keeps its rows", v.with_ms, v.without_ms, v.frames_each,
+                 v.next_trial_in);
+  }
   balancing.finish();
   std::vector<Assignment> assignments, side_jobs;
   for (size_t i = 0; i < ready.size(); ++i) {

@@ -24,6 +24,20 @@ struct DivideInput {
   std::vector<TracerMeasurement> previous;     // last frame; may lack ids (new, dropped) or hold extra ones (removed)
   std::vector<float> row_cost_proxy;           // optional per-row relative cost estimate (size == rows), e.g.
                                                // last frame's per-row sample count; empty when there is none
+  double last_interval_ms = 0.0;               // wall time from the previous frame's start to this one's: the
+                                               // delivered-frame interval of a steady loop; 0 when unknown
+                                               // (a virtual clock), which leaves sit-out trials off
+};
+
+// What a sit-out trial found: the frame interval with a small taker rendering its share and with its
+// rows handed to the others (medians over the trial's frames), and what was decided.
+struct SitOutVerdict {
+  int tracer = 0;
+  double with_ms = 0.0;
+  double without_ms = 0.0;
+  int frames_each = 0;       // intervals behind each median
+  bool sits_out = false;     // true: no rows (and no probes) until the next trial
+  int next_trial_in = 0;     // frames until it is tried again
 };
 
 class Balancer {
@@ -40,6 +54,8 @@ class Balancer {
   // whether it is worth rows again); its time comes back in a later DivideInput::previous with that
   // band. Empty (or all bands empty) when nothing is to be probed.
   virtual std::vector<Band> probe_bands() const { return {}; }
+  // Verdicts of sit-out trials reached since the last call (whole-cost with frame_trials), for the log.
+  virtual std::vector<SitOutVerdict> take_verdicts() { return {}; }
   // Forget everything learnt (a cut, a resolution change). Balancers also reset themselves when the
   // row count changes.
   virtual void reset() = 0;
@@ -65,6 +81,21 @@ struct BalancerOptions {
   int probe_interval = 30;
   int fine_below_rows = 32;
   bool fine_cuts = true;
+  // Whole Cost's sit-out trials. Its model sees each tracer's band time, not what a tracer costs the
+  // others (a CPU tracer's threads slow the host's merge and the GPU drivers' threads): so a taker with
+  // at most trial_share of the rows is tried out end to end. Windows of trial_window frames alternate,
+  // its share rendered / its rows handed to the others in proportion, trial_pairs times; the first
+  // trial_settle intervals of each window are not counted (the pipeline still carries the other mode).
+  // It keeps its rows only when the median interval is at least trial_min_gain shorter with it; either
+  // way it is tried again after trial_every frames. Needs DivideInput::last_interval_ms.
+  bool frame_trials = true;
+  double trial_share = 0.2;
+  int trial_window = 8;
+  int trial_settle = 2;
+  int trial_pairs = 4;
+  double trial_min_gain = 0.01;
+  int trial_warmup = 60;
+  int trial_every = 600;
 };
 
 // "none", "robin-hood", "perfect", "perfect-smooth", "row-cost", "whole-cost". Throws std::invalid_argument naming

@@ -23,6 +23,7 @@
 #include <cstdint>
 #include <functional>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -169,6 +170,7 @@ class Renderer {
   std::unique_ptr<PendingFrame> pending_;    // begun, not yet waited for
   std::unique_ptr<PendingFrame> unmerged_;   // waited for, bands not yet merged
   int next_slot_ = 0;
+  std::optional<std::chrono::steady_clock::time_point> last_frame_start_;  // for the balancer's frame interval
   GBuffer gbuffer_;
   bool packed_merge_ = false;
   BandBuffer packed_;
