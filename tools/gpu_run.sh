@@ -116,6 +116,8 @@ case "${1:-}" in
     # Issue 14 on a machine with several GPUs: end-to-end frame times of each mix (the test map at
     # 1280x720 and the large map at 1920x1080, 1 spp, NEE + 1 bounce, spin-slow, 100 frames, medians of
     # frames 20-99; default convergence, then Brigade's blend), bench devices, and Table 1 with real GPUs.
+    # COHORT_GPU_FRAMES / COHORT_GPU_SKIP change the 100 / 20 (Whole Cost's sit-out trials end after
+    # frame 124: use 400 / 150 to see what they decided); the sit-out verdicts are printed.
     [ -d "$stage/bin" ] || tar -C "$stage" -xJf "$stage/payload.tar.xz"
     export LD_LIBRARY_PATH="$PWD/$stage/lib${LD_LIBRARY_PATH:+:$LD_LIBRARY_PATH}"
     mkdir -p /tmp/icd && echo libnvidia-opencl.so.1 > /tmp/icd/nvidia.icd
@@ -134,11 +136,12 @@ case "${1:-}" in
         for mix in ${COHORT_GPU_MIXES:-cuda:0 cuda:0,cuda:1 embree,cuda:0 embree,cuda:0,cuda:1 cuda:0,opencl:0 embree,cuda:0,opencl:0}; do
           run=/tmp/mg_${map}_${convergence}_$(echo "$mix" | tr ',:' '__')
           timeout 120 "$stage/bin/cohort" render "${args[@]}" --tracers "$mix" --spp 1 --light-samples 1 --bounces 1 \
-            ${COHORT_GPU_RENDER_ARGS:-} --convergence $convergence --frames 100 --camera-path spin-slow --write last --out $run >/dev/null 2>&1 ||
-            { echo "== $map $convergence $mix: failed"; continue; }
+            ${COHORT_GPU_RENDER_ARGS:-} --convergence $convergence --frames ${COHORT_GPU_FRAMES:-100} --camera-path spin-slow \
+            --write last --out $run >$run.log 2>&1 || { echo "== $map $convergence $mix: failed"; tail -n 3 $run.log; continue; }
           echo "== $map map, $convergence, $mix"
-          python3 tools/frame_times.py $run/stats.json --skip 20 --json $out/$(basename $run).json > $run/summary.txt
+          python3 tools/frame_times.py $run/stats.json --skip ${COHORT_GPU_SKIP:-20} --json $out/$(basename $run).json > $run/summary.txt
           head -n 1 $run/summary.txt
+          grep -E "sits out|keeps its rows" $run.log | sed 's/^.*\] //' | head -n 3 || true
         done
       done
       [ "${COHORT_GPU_SKIP_DEVICES:-0}" = 1 ] || timeout 300 "$stage/bin/cohort" bench devices --scene "${args[0]}" --width "${args[2]}" --height "${args[4]}" \
