@@ -151,11 +151,11 @@ class CudaFramePost final : public core::FramePost {
     if (!begin(width, height)) return;
     const size_t pixels = size_t(width) * size_t(height);
     COHORT_CUDA(cudaEventRecord(events_[0], stream_));
-    registered_.ensure(packed.row(0), packed.bytes());
+    registered_.ensure(packed.row(0), packed.bytes(), "the packed frame's colour");
     unsigned char* colour = packed_colour_.scratch(packed.bytes());
     COHORT_CUDA(cudaMemcpyAsync(colour, packed.row(0), packed.bytes(), cudaMemcpyHostToDevice, stream_));
     const KAuxTexel* host_texels = const_cast<core::BandBuffer&>(packed).aux_row(0);
-    registered_.ensure(host_texels, packed.aux_bytes());
+    registered_.ensure(host_texels, packed.aux_bytes(), "the packed frame's aux texels");
     KAuxTexel* texels = packed_aux_.scratch(pixels);
     COHORT_CUDA(cudaMemcpyAsync(texels, host_texels, packed.aux_bytes(), cudaMemcpyHostToDevice, stream_));
     COHORT_CUDA(cudaEventRecord(events_[1], stream_));
@@ -305,7 +305,7 @@ class CudaFramePost final : public core::FramePost {
   // the callers keep their planes between frames, so the registrations are cached.
   template <class T>
   void upload(const std::vector<T>& host, DeviceArray<T>& device) {
-    registered_.ensure(host.data(), host.size() * sizeof(T));
+    registered_.ensure(host.data(), host.size() * sizeof(T), "a G-buffer plane");
     T* d = device.scratch(host.size());
     COHORT_CUDA(cudaMemcpyAsync(d, host.data(), host.size() * sizeof(T), cudaMemcpyHostToDevice, stream_));
   }

@@ -74,8 +74,8 @@ struct CudaTracer::Impl {
   HostRegistrations registered{4};
 
   void register_target(core::BandBuffer& target) {
-    registered.ensure(target.data(), target.bytes());
-    if (target.has_aux()) registered.ensure(target.aux_data(), target.aux_bytes());
+    registered.ensure(target.data(), target.bytes(), "a band target");
+    if (target.has_aux()) registered.ensure(target.aux_data(), target.aux_bytes(), "a band target's aux texels");
   }
 
   void rebind_texel_texture() {
