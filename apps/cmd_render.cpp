@@ -72,6 +72,7 @@ struct RenderArgs {
   std::string band_format = "rgb16f";
   bool frames_given = false;
   bool write_ids = false;  // the G-buffer's id plane of every written frame, and which entities moved
+  bool bands_through_host = false;  // A/B: CUDA bands go down and back up even where the post could take them on the GPU
   double render_scale = 1.0;  // dynamic resolution (core/upsample.h)
   std::string upsample = "joint-bilateral";
 };
@@ -202,6 +203,7 @@ int run_render(const RenderArgs& a) {
   const bool packed = post && reproject && post->where() != "host" && a.denoise != "oidn" &&
                       a.denoise != "oidn-cuda" && !a.write_ids && !sparse;  // the reconstruction runs on the host's frame
   renderer.set_packed_merge(packed);
+  if (packed && !a.bands_through_host) renderer.set_device_bands(post->cuda_device());
   if (a.denoise != "none" && !atrous) {
     denoiser = core::OidnDenoiser::open(core::parse_oidn_device(a.denoise == "oidn-cuda" ? "cuda" : "cpu"),
                                          core::parse_oidn_quality(a.denoise_quality));
@@ -243,7 +245,7 @@ int run_render(const RenderArgs& a) {
       // One stage: on a GPU the two steps share one upload and one download.
       core::ScopedStage posting(stats.stages, core::kCoreTrack,
                                 !atrous ? "convergence" : reproject ? "convergence+denoise" : "denoise");
-      if (packed) post->process_packed(renderer.packed_frame());
+      if (packed) post->process_packed(renderer.packed_frame(), renderer.packed_device_rows());
       else post->process(reproject ? frame : *shown_image, gbuffer);
       // On a GPU its own clock tells the bus from the passes (a track of its own in the timeline).
       if (const core::FramePostDeviceTimes t = post->device_times(); t.measured) {
@@ -482,6 +484,9 @@ void add_render_command(CLI::App& app, int& exit_code) {
                   "frame and its G-buffer cross the bus each frame) or auto (the first CUDA tracer's GPU, else the "
                   "host)")
       ->capture_default_str();
+  cmd->add_flag("--bands-through-host", a->bands_through_host,
+               "with the post-processing on a CUDA GPU, copy CUDA tracers' bands down to the host and back up "
+               "like any other (by default they stay on the GPUs: device to device, or over NVLink from a peer)");
   cmd->add_option("--denoise-quality", a->denoise_quality,
                   "Open Image Denoise's filter quality: high, balanced or fast (several times quicker)")
       ->capture_default_str()

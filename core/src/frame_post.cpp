@@ -4,7 +4,9 @@
 
 namespace cohort::core {
 
-void FramePost::process_packed(const BandBuffer& packed) {
+void FramePost::process_packed(const BandBuffer& packed, const std::vector<DeviceBandRows>& on_device) {
+  if (!on_device.empty())
+    throw std::invalid_argument("FramePost::process_packed: bands on a GPU reached the post-processing on " + where());
   if (!packed.has_aux())
     throw std::invalid_argument("FramePost::process_packed: the packed frame has no aux planes (render with aux outputs)");
   const int width = packed.width(), height = packed.height();

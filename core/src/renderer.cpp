@@ -68,6 +68,7 @@ struct Renderer::Worker {
   double reported_ms = 0.0;
   double apply_ms = 0.0;
   std::vector<float> row_work;
+  DeviceBand device_band;        // the last job's band, when it stayed on a GPU
   std::vector<StageSpan> spans;  // the last job's apply and render stages
 
   // The tracer's private targets, one per frame parity, so that the core merges frame N from one
@@ -100,6 +101,7 @@ struct Renderer::Worker {
       std::string what;
       double wall = 0.0, reported = 0.0, applied = 0.0;
       std::vector<float> work;
+      DeviceBand kept;
       std::vector<StageSpan> job_spans;
       const std::string track = tracer_track(id, name);
       try {
@@ -116,6 +118,7 @@ struct Renderer::Worker {
           rendering.finish();
           reported = result.device_ms;
           if (result.row_work.size() == current.params.row_end - current.params.row_begin) work = result.row_work;
+          if (current.keep_on_device >= 0) kept = result.device;
         } else {
           wall = applied;
         }
@@ -135,6 +138,7 @@ struct Renderer::Worker {
         reported_ms = reported;
         apply_ms = applied;
         row_work = std::move(work);
+        device_band = kept;
         spans = std::move(job_spans);
       }
       completion->cv.notify_all();
@@ -303,6 +307,8 @@ std::vector<uint64_t> Renderer::assign(const std::vector<Assignment>& assignment
     w.job_is_recovery = !with_commits;
     w.job_slot = slot;
     w.job_is_probe = assignments[i].probe;
+    // Only a frame's own bands may stay on a GPU: re-rendered rows and probes come through the host.
+    w.job.keep_on_device = with_commits && !assignments[i].probe && packed_merge_ ? device_bands_for_ : -1;
     w.has_job = true;
     // What was published so far belongs to this frame; commits submitted from now on wait for the
     // next. Re-rendering a dropped tracer's rows happens within the same frame, so it takes none.
@@ -345,6 +351,7 @@ Renderer::RoundResult Renderer::collect(const std::vector<Assignment>& assignmen
     } else {
       result.finished.push_back(w.id);
       result.delivered.push_back(assignments[i]);
+      result.delivered.back().device = w.device_band;
       const balance::Band& band = assignments[i].band;
       if (w.row_work.size() == static_cast<size_t>(band.rows())) {
         std::copy(w.row_work.begin(), w.row_work.end(), row_work_.begin() + band.begin);
@@ -439,9 +446,9 @@ void Renderer::begin_frame(const BandJob& job, FrameBuffer& out, const std::vect
       t.outcome = TracerOutcome::no_rows;
       const balance::Band probe = probes.size() == ready.size() ? probes[i] : balance::Band{};
       t.probe_rows = probe.rows();
-      side_jobs.push_back({ready[i], probe, !probe.empty()});
+      side_jobs.push_back({ready[i], probe, !probe.empty(), {}});
     } else {
-      assignments.push_back({ready[i], bands[i]});
+      assignments.push_back({ready[i], bands[i], false, {}});
     }
   }
 
@@ -481,7 +488,13 @@ void Renderer::merge_frame(FrameStats& stats) {
   if (packed_merge_) {
     packed_.resize(width, height, options_.band_format);  // keeps its storage (and registration) when unchanged
     packed_.enable_aux(aux);
-    for_band_rows(frame->delivered, frame->slot,
+    packed_device_rows_.clear();
+    std::vector<Assignment> on_host;
+    for (const Assignment& a : frame->delivered) {
+      if (a.device.cuda_device >= 0) packed_device_rows_.push_back({a.band.begin, a.band.end, a.device});
+      else on_host.push_back(a);
+    }
+    for_band_rows(on_host, frame->slot,
                   [&](const BandBuffer& target, int begin, int end) { packed_.copy_rows_from(target, begin, end); });
   } else {
     if (out.width != width || out.height != height) out.resize(width, height);
@@ -591,7 +604,7 @@ FrameStats Renderer::wait_frame() {
     std::vector<balance::Band> parts = balance::bands_from_shares(band.rows(), speeds);
     std::vector<Assignment> round;
     for (size_t i = 0; i < helpers.size(); ++i) {
-      if (!parts[i].empty()) round.push_back({helpers[i], {band.begin + parts[i].begin, band.begin + parts[i].end}});
+      if (!parts[i].empty()) round.push_back({helpers[i], {band.begin + parts[i].begin, band.begin + parts[i].end}, false, {}});
     }
     // Helpers that have not had this frame's commits yet get them first (their assignments lead).
     std::stable_partition(round.begin(), round.end(), [&](const Assignment& a) {

@@ -211,3 +211,49 @@ TEST(FramePost, PackedMergeUnpacksToTheFloatMergeEverywhere) {
     EXPECT_LT(max_relative_difference(gpu->image(), from_floats.image()), 2e-3) << "packed frame on cuda:0";
   }
 }
+
+// CUDA tracers' bands can stay on their GPUs (Renderer::set_device_bands): the post-processing on cuda:0
+// copies them device to device or from the peer GPU, host bands (Embree's rows) come up between them,
+// and the picture is the one the bands give through the host.
+TEST(FramePost, CudaBandsStayingOnTheGpusGiveTheHostRoundTripsPicture) {
+  using namespace cohort::test;
+  const int gpus = tracers::device_count("cuda");
+  if (gpus == 0) GTEST_SKIP() << "no CUDA device (or a build without CUDA)";
+  auto room = std::make_shared<commit::TracerScene>(core::compile_scene(test_room()).tracer_scene);
+  const int w = 64, h = 48;
+  core::BandJob job;
+  job.camera = test_room_camera(w, h);
+  job.previous_camera = job.camera;
+  job.params = frame_params(K_MODE_PATH, 1, 1, h);
+  job.params.aux_outputs = 1u;
+  std::vector<std::string> kinds = {"cuda:0", "embree"};
+  if (gpus > 1) kinds.push_back("cuda:1");
+  std::vector<core::FrameBuffer> shown[2];
+  for (int on_device = 0; on_device < 2; ++on_device) {
+    std::vector<std::unique_ptr<core::Tracer>> list;
+    for (const std::string& k : kinds) list.push_back(make_test_tracer(k));
+    core::RendererOptions options;
+    options.balancer = "none";
+    options.band_format = core::BandFormat::rgb16f;
+    core::Renderer renderer(std::move(list), options);
+    renderer.submit_commit(commit::CommitBuffer::full(room, 1));
+    std::unique_ptr<core::FramePost> post = tracers::make_frame_post("cuda:0", both());
+    ASSERT_EQ(post->cuda_device(), 0);
+    renderer.set_packed_merge(true);
+    if (on_device) renderer.set_device_bands(post->cuda_device());
+    core::FrameBuffer untouched;
+    for (int f = 0; f < 3; ++f) {
+      job.params.frame_index = static_cast<kuint>(f + 1);
+      renderer.render(job, untouched);
+      const std::vector<core::DeviceBandRows>& rows = renderer.packed_device_rows();
+      EXPECT_EQ(rows.size(), on_device ? kinds.size() - 1 : 0u) << "every CUDA band, and only those";
+      for (const core::DeviceBandRows& r : rows) EXPECT_LT(r.row_begin, r.row_end);
+      post->process_packed(renderer.packed_frame(), rows);
+      shown[on_device].push_back(post->image());
+    }
+    core::HostFramePost host(both());
+    if (on_device) EXPECT_THROW(host.process_packed(renderer.packed_frame(), renderer.packed_device_rows()), std::invalid_argument);
+  }
+  for (size_t f = 0; f < shown[0].size(); ++f)
+    EXPECT_EQ(shown[1][f].rgba, shown[0][f].rgba) << "frame " << f;
+}

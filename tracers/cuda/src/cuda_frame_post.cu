@@ -1,6 +1,7 @@
 #include "cohort/tracers/cuda_frame_post.h"
 
 #include <algorithm>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -143,21 +144,44 @@ class CudaFramePost final : public core::FramePost {
     run(fresh.width, fresh.height);
   }
 
-  // About 38 bytes a pixel cross the bus (RGB halves and 32-byte aux texels) instead of 76 in floats.
-  void process_packed(const core::BandBuffer& packed) override {
+  // About 38 bytes a pixel cross the bus (RGB halves and 32-byte aux texels) instead of 76 in floats;
+  // none for rows a CUDA tracer left on its GPU (`on_device`): those are copied device to device, or from
+  // a peer GPU (over NVLink where the GPUs have it).
+  void process_packed(const core::BandBuffer& packed, const std::vector<core::DeviceBandRows>& on_device) override {
     if (!packed.has_aux())
       throw std::invalid_argument("CudaFramePost: the packed frame has no aux planes (render with aux outputs)");
     const int width = packed.width(), height = packed.height();
     if (!begin(width, height)) return;
     const size_t pixels = size_t(width) * size_t(height);
+    const size_t row_bytes = packed.row_bytes(), aux_row_bytes = size_t(width) * sizeof(KAuxTexel);
     COHORT_CUDA(cudaEventRecord(events_[0], stream_));
-    registered_.ensure(packed.row(0), packed.bytes(), "the packed frame's colour");
     unsigned char* colour = packed_colour_.scratch(packed.bytes());
-    COHORT_CUDA(cudaMemcpyAsync(colour, packed.row(0), packed.bytes(), cudaMemcpyHostToDevice, stream_));
-    const KAuxTexel* host_texels = const_cast<core::BandBuffer&>(packed).aux_row(0);
-    registered_.ensure(host_texels, packed.aux_bytes(), "the packed frame's aux texels");
     KAuxTexel* texels = packed_aux_.scratch(pixels);
-    COHORT_CUDA(cudaMemcpyAsync(texels, host_texels, packed.aux_bytes(), cudaMemcpyHostToDevice, stream_));
+    auto& host = const_cast<core::BandBuffer&>(packed);
+    registered_.ensure(packed.row(0), packed.bytes(), "the packed frame's colour");
+    registered_.ensure(host.aux_row(0), packed.aux_bytes(), "the packed frame's aux texels");
+    // Rows from the host: every range no device band covers.
+    std::vector<core::DeviceBandRows> bands = on_device;
+    std::sort(bands.begin(), bands.end(), [](const auto& a, const auto& b) { return a.row_begin < b.row_begin; });
+    auto upload_rows = [&](int from, int to) {
+      if (to <= from) return;
+      const size_t rows = size_t(to - from);
+      COHORT_CUDA(cudaMemcpyAsync(colour + size_t(from) * row_bytes, packed.row(from), rows * row_bytes,
+                                  cudaMemcpyHostToDevice, stream_));
+      COHORT_CUDA(cudaMemcpyAsync(texels + size_t(from) * width, host.aux_row(from), rows * aux_row_bytes,
+                                  cudaMemcpyHostToDevice, stream_));
+    };
+    int row = 0;
+    for (const core::DeviceBandRows& b : bands) {
+      if (b.row_begin < row || b.row_end > height || b.row_end < b.row_begin || !b.band.colour || !b.band.aux)
+        throw std::invalid_argument("CudaFramePost: a band on a GPU overlaps another, lies outside the frame or has no aux texels");
+      upload_rows(row, b.row_begin);
+      const size_t rows = size_t(b.row_end - b.row_begin);
+      copy_from_device(colour + size_t(b.row_begin) * row_bytes, b.band.colour, rows * row_bytes, b.band.cuda_device);
+      copy_from_device(texels + size_t(b.row_begin) * width, b.band.aux, rows * aux_row_bytes, b.band.cuda_device);
+      row = b.row_end;
+    }
+    upload_rows(row, height);
     COHORT_CUDA(cudaEventRecord(events_[1], stream_));
     unpack_kernel<<<blocks_for(pixels), kThreads, 0, stream_>>>(
         colour, packed.format() == core::BandFormat::rgb16f ? 1 : 0, texels, frame_.scratch(4 * pixels),
@@ -167,7 +191,28 @@ class CudaFramePost final : public core::FramePost {
     run(width, height);
   }
 
+  int cuda_device() const override { return device_; }
+
  private:
+  // A band's bytes from a tracer's GPU: on this one device to device; from another through peer access
+  // (enabled once where the pair has it; without it the driver stages through the host).
+  void copy_from_device(void* to, const void* from, size_t bytes, int from_device) {
+    if (from_device == device_) {
+      COHORT_CUDA(cudaMemcpyAsync(to, from, bytes, cudaMemcpyDeviceToDevice, stream_));
+      return;
+    }
+    if (peers_.insert(from_device).second) {
+      int can = 0;
+      COHORT_CUDA(cudaDeviceCanAccessPeer(&can, device_, from_device));
+      if (can) {
+        const cudaError_t e = cudaDeviceEnablePeerAccess(from_device, 0);
+        if (e != cudaSuccess && e != cudaErrorPeerAccessAlreadyEnabled) COHORT_CUDA(e);
+        cudaGetLastError();
+      }
+    }
+    COHORT_CUDA(cudaMemcpyPeerAsync(to, device_, from, from_device, bytes, stream_));
+  }
+
   // Starts a frame on the device; false when there is nothing to do (an empty frame).
   bool begin(int width, int height) {
     COHORT_CUDA(cudaSetDevice(device_));
@@ -331,6 +376,7 @@ class CudaFramePost final : public core::FramePost {
   core::FrameBuffer shown_;
   void* shown_registered_ = nullptr;
   HostRegistrations registered_{kRegistrations};
+  std::set<int> peers_;  // devices whose bands were copied here (peer access tried once)
 };
 
 }  // namespace

@@ -72,6 +72,14 @@ struct CudaTracer::Impl {
   // (about 3 ms of a 1080p frame otherwise). The Renderer alternates two targets by frame parity (the
   // pipeline), so the last two stay registered, with their auxiliary planes when they have them.
   HostRegistrations registered{4};
+  // Bands left on this GPU for the frame's post-processing (BandJob::keep_on_device): two, so that the
+  // post reads frame N's while frame N+1 renders into the other (the Renderer's slots likewise).
+  struct KeptBand {
+    DeviceArray<unsigned char> colour;
+    DeviceArray<KAuxTexel> aux;
+  };
+  KeptBand kept[2];
+  int next_kept = 0;
 
   void register_target(core::BandBuffer& target) {
     registered.ensure(target.data(), target.bytes(), "a band target");
@@ -221,7 +229,11 @@ core::BandResult CudaTracer::render_band(const core::BandJob& job, core::BandBuf
     if (!m.ray_counts) COHORT_CUDA(cudaMalloc(&m.ray_counts, 2 * sizeof(unsigned long long)));
     COHORT_CUDA(cudaMemsetAsync(m.ray_counts, 0, 2 * sizeof(unsigned long long), m.stream));
   }
-  m.register_target(target);
+  // Kept on the GPU, the band skips both copies: nothing goes down, and the post-processing takes it
+  // device to device (or over NVLink from a peer).
+  Impl::KeptBand* kept = job.keep_on_device >= 0 ? &m.kept[m.next_kept] : nullptr;
+  if (kept) m.next_kept ^= 1;
+  else m.register_target(target);
   COHORT_CUDA(cudaEventRecord(m.start, m.stream));
   const bool write_aux = params.aux_outputs != 0u && target.has_aux();
   if (write_aux) {
@@ -238,36 +250,44 @@ core::BandResult CudaTracer::render_band(const core::BandJob& job, core::BandBuf
     history.skin_weights = m.skin_weights.data();
     history.joints = previous_joints().empty() ? nullptr : m.previous_joints.data();
     history.skin_count = static_cast<kuint>(scene().skins.size());
-    KAuxTexel* texels = m.aux_texels.scratch(pixels);
+    KAuxTexel* texels = kept ? kept->aux.scratch(pixels) : m.aux_texels.scratch(pixels);
     launch_aux_band(m.view(params), params, camera, previous, history, texels, m.stream);
-    COHORT_CUDA(cudaEventRecord(m.aux_ready, m.stream));
-    COHORT_CUDA(cudaStreamWaitEvent(m.aux_copy_stream, m.aux_ready, 0));
-    COHORT_CUDA(cudaMemcpyAsync(target.aux_row(int(params.row_begin)), texels, pixels * sizeof(KAuxTexel),
-                                cudaMemcpyDeviceToHost, m.aux_copy_stream));
+    if (!kept) {
+      COHORT_CUDA(cudaEventRecord(m.aux_ready, m.stream));
+      COHORT_CUDA(cudaStreamWaitEvent(m.aux_copy_stream, m.aux_ready, 0));
+      COHORT_CUDA(cudaMemcpyAsync(target.aux_row(int(params.row_begin)), texels, pixels * sizeof(KAuxTexel),
+                                  cudaMemcpyDeviceToHost, m.aux_copy_stream));
+    }
   }
   launch_render_band(m.view(params), params, camera, m.band, m.count_rays ? m.ray_counts : nullptr, m.row_rays, m.stream);
   COHORT_CUDA(cudaEventRecord(m.stop, m.stream));
   // The band's rows are contiguous in the target: one copy straight into place, in its format.
+  const size_t colour_bytes = pixels * core::bytes_per_pixel(target.format());
   const void* source = m.band;
   if (half) {
-    launch_band_to_rgb16f(m.band, m.band_rgb16f, pixels, m.stream);
-    source = m.band_rgb16f;
+    unsigned short* rgb = kept ? reinterpret_cast<unsigned short*>(kept->colour.scratch(colour_bytes)) : m.band_rgb16f;
+    launch_band_to_rgb16f(m.band, rgb, pixels, m.stream);
+    source = rgb;
+  } else if (kept) {
+    COHORT_CUDA(cudaMemcpyAsync(kept->colour.scratch(colour_bytes), m.band, colour_bytes, cudaMemcpyDeviceToDevice, m.stream));
+    source = kept->colour.data();
   }
-  COHORT_CUDA(cudaMemcpyAsync(target.row(int(params.row_begin)), source, pixels * core::bytes_per_pixel(target.format()),
-                              cudaMemcpyDeviceToHost, m.stream));
+  if (!kept)
+    COHORT_CUDA(cudaMemcpyAsync(target.row(int(params.row_begin)), source, colour_bytes, cudaMemcpyDeviceToHost, m.stream));
   m.host_row_rays.resize(rows);
   COHORT_CUDA(cudaMemcpyAsync(m.host_row_rays.data(), m.row_rays, rows * sizeof(unsigned), cudaMemcpyDeviceToHost, m.stream));
   unsigned long long counts[2] = {0, 0};
   if (m.count_rays)
     COHORT_CUDA(cudaMemcpyAsync(counts, m.ray_counts, sizeof counts, cudaMemcpyDeviceToHost, m.stream));
   COHORT_CUDA(cudaStreamSynchronize(m.stream));
-  if (write_aux) COHORT_CUDA(cudaStreamSynchronize(m.aux_copy_stream));
+  if (write_aux && !kept) COHORT_CUDA(cudaStreamSynchronize(m.aux_copy_stream));
   m.last_counts = RayCounts{counts[0], counts[1]};
   float kernel_ms = 0.0f;
   COHORT_CUDA(cudaEventElapsedTime(&kernel_ms, m.start, m.stop));
   core::BandResult result;
   result.device_ms = kernel_ms;
   result.row_work.assign(m.host_row_rays.begin(), m.host_row_rays.end());
+  if (kept) result.device = {m.device, source, write_aux ? kept->aux.data() : nullptr};
   return result;
 }
 

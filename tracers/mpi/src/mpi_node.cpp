@@ -175,6 +175,7 @@ class Node {
     auto render_part = [&](size_t i, uint32_t from, uint32_t to) {
       if (from >= to) return;
       core::BandJob part = job;
+      part.keep_on_device = -1;  // the node sends rows, whatever rank 0 asked
       part.params.row_begin = from;
       part.params.row_end = to;
       const auto start = MpiClock::now();

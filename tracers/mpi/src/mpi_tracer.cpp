@@ -204,6 +204,7 @@ core::BandResult MpiTracer::render_band(const core::BandJob& job, core::BandBuff
   const uint64_t id = next_band_job++;
   wire::BandRequest request;
   request.job = job;
+  request.job.keep_on_device = -1;  // rank 0's GPUs are not the node's: the rows travel
   request.format = target.format();
   request.aux = target.has_aux();
   const auto start = MpiClock::now();

@@ -17,6 +17,22 @@
 namespace cohort::core {
 
 enum class BandFormat { rgba32f, rgb16f };
+
+// A band a GPU tracer left in its device memory instead of copying it into its target
+// (BandJob::keep_on_device): its rows as the target would hold them (the target's format, row_begin
+// first) and its aux texels. Valid until that tracer's next job but one that keeps its band (it
+// alternates two buffers, as the Renderer alternates targets by frame parity).
+struct DeviceBand {
+  int cuda_device = -1;            // -1: none, the rows are in the target
+  const void* colour = nullptr;
+  const KAuxTexel* aux = nullptr;  // null when the frame has no aux outputs
+};
+
+// Rows [row_begin, row_end) of a packed frame that lie on a GPU (Renderer::packed_device_rows).
+struct DeviceBandRows {
+  int row_begin = 0, row_end = 0;
+  DeviceBand band;
+};
 const char* to_string(BandFormat format);
 size_t bytes_per_pixel(BandFormat format);
 

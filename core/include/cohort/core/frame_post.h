@@ -39,7 +39,11 @@ class FramePost {
   virtual void process(const FrameBuffer& fresh, const GBuffer& gbuffer) = 0;
   // The same from the Renderer's packed merge (Renderer::set_packed_merge): the frame in its band format
   // with its aux texels. Here: unpacked on the host, then process(); a GPU place unpacks on the device.
-  virtual void process_packed(const BandBuffer& packed);
+  // `on_device` lists rows that GPU tracers left on their devices (Renderer::packed_device_rows): their
+  // rows in `packed` are stale. Only a place on a CUDA device (cuda_device() >= 0) takes them.
+  virtual void process_packed(const BandBuffer& packed, const std::vector<DeviceBandRows>& on_device = {});
+  // The CUDA device the passes run on, -1 on the host.
+  virtual int cuda_device() const { return -1; }
   // The frame to show: reprojected, then filtered, as the options ask.
   virtual const FrameBuffer& image() const = 0;
   // Mean history length over the frame (1 = nothing reused; 1 when not reprojecting).

@@ -103,6 +103,12 @@ class Renderer {
   void set_packed_merge(bool on) { packed_merge_ = on; }
   bool packed_merge() const { return packed_merge_; }
   const BandBuffer& packed_frame() const { return packed_; }
+  // With a packed merge whose consumer runs on CUDA device `device` (-1: off): each frame's bands are
+  // offered to stay on their GPUs (BandJob::keep_on_device); those a tracer kept are listed in
+  // packed_device_rows() instead of being copied (their rows in packed_frame() are stale). Re-rendered
+  // rows and probes always come through the host. Call between frames.
+  void set_device_bands(int device) { device_bands_for_ = device; }
+  const std::vector<DeviceBandRows>& packed_device_rows() const { return packed_device_rows_; }
 
   int tracer_count() const;
   std::string tracer_name(int tracer) const;
@@ -119,6 +125,7 @@ class Renderer {
     int worker;
     balance::Band band;
     bool probe = false;  // rendered to be measured only: nobody waits for it, its rows are not merged
+    DeviceBand device;   // where its rows are when the tracer kept them on a GPU (set once delivered)
   };
   struct RoundResult {
     std::vector<int> finished;   // workers that rendered their band
@@ -174,6 +181,8 @@ class Renderer {
   GBuffer gbuffer_;
   bool packed_merge_ = false;
   BandBuffer packed_;
+  int device_bands_for_ = -1;
+  std::vector<DeviceBandRows> packed_device_rows_;
 };
 
 }  // namespace cohort::core

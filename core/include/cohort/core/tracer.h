@@ -18,6 +18,11 @@ struct BandJob {
   // The previous frame's camera, for motion vectors when params.aux_outputs is set; a width of 0 means
   // none (the frame is its own previous: camera motion 0).
   KCamera previous_camera{};
+  // The CUDA device the core will take this band from (the GPU post-processing's, set by the Renderer
+  // for a packed merge): a tracer that can hand its rows over there leaves them on its GPU and reports
+  // them in BandResult::device instead of writing the target (the rows never cross the bus twice);
+  // -1: write the target, as always. Remote tracers clear it before the job travels.
+  int keep_on_device = -1;
 };
 
 struct BandResult {
@@ -25,6 +30,8 @@ struct BandResult {
   // Optional: a work count per row of the band, row_begin first (e.g. rays traced in that row). The
   // core hands it to the balancer as an image-space cost map for the next frame. Empty if not counted.
   std::vector<float> row_work;
+  // Set when the tracer kept its band on a GPU (BandJob::keep_on_device): the target's rows are stale.
+  DeviceBand device;
 };
 
 class Tracer {
