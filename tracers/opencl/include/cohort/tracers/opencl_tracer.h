@@ -34,9 +34,14 @@ class OpenCLTracer : public TracerBase {
  private:
   void upload(const commit::ChangeSet& changes) override;
   bool skins_on_device() const override { return true; }
-  // The band's auxiliary planes (kernel/aux_outputs.h), by a second kernel, into target.
-  void render_aux(const core::BandJob& job, const KFrameParams& params, const KCamera& camera, size_t rows,
-                  core::BandBuffer& target);
+  // The band's auxiliary planes (kernel/aux_outputs.h), in three steps around the band's kernel: the aux
+  // kernel (and the packing to texels when the band spans the target's width, `straight`) enqueued before
+  // it; the read into page-locked memory on the second queue, overlapping it; the copy into the target
+  // once that read is done.
+  void enqueue_aux(const core::BandJob& job, const KCamera& camera, size_t rows, bool straight);
+  void read_aux_when_packed(size_t pixels, bool straight);
+  void copy_aux_into(core::BandBuffer& target, const KFrameParams& params, const KCamera& camera, size_t rows,
+                     bool straight);
 
   struct Impl;
   std::unique_ptr<Impl> impl_;
