@@ -37,6 +37,45 @@ std::string info_string(cl_int (*query)(Object, Info, size_t, void*, size_t*), O
 std::string platform_info(cl_platform_id p, cl_platform_info what) { return info_string(&clGetPlatformInfo, p, what); }
 std::string device_info(cl_device_id d, cl_device_info what) { return info_string(&clGetDeviceInfo, d, what); }
 
+bool lists_extension(const std::string& extensions, const std::string& name) {
+  size_t at = 0;
+  while ((at = extensions.find(name, at)) != std::string::npos) {
+    const size_t end = at + name.size();
+    if ((at == 0 || extensions[at - 1] == ' ') && (end == extensions.size() || extensions[end] == ' ')) return true;
+    at = end;
+  }
+  return false;
+}
+
+// The extensions' query values, spelled out: older OpenCL headers lack them.
+constexpr cl_device_info kPciBusInfoKhr = 0x410F;  // cl_khr_pci_bus_info: cl_device_pci_bus_info_khr
+constexpr cl_device_info kPciBusIdNv = 0x4008;     // cl_nv_device_attribute_query
+constexpr cl_device_info kPciSlotIdNv = 0x4009;    // device << 3 | function
+constexpr cl_device_info kPciDomainIdNv = 0x400A;  // newer drivers only
+
+// The device's PCI address where it lists an extension that tells it; asked only then, since drivers
+// answer unknown queries inconsistently.
+PciBusId pci_bus_id(cl_device_id d) {
+  const std::string extensions = device_info(d, CL_DEVICE_EXTENSIONS);
+  if (lists_extension(extensions, "cl_khr_pci_bus_info")) {
+    struct {
+      cl_uint domain, bus, device, function;
+    } info{};
+    if (clGetDeviceInfo(d, kPciBusInfoKhr, sizeof info, &info, nullptr) == CL_SUCCESS)
+      return PciBusId::of(info.domain, info.bus, info.device, info.function);
+  }
+  if (lists_extension(extensions, "cl_nv_device_attribute_query")) {
+    cl_uint bus = 0, slot = 0, domain = 0;
+    if (clGetDeviceInfo(d, kPciBusIdNv, sizeof bus, &bus, nullptr) == CL_SUCCESS &&
+        clGetDeviceInfo(d, kPciSlotIdNv, sizeof slot, &slot, nullptr) == CL_SUCCESS) {
+      if (clGetDeviceInfo(d, kPciDomainIdNv, sizeof domain, &domain, nullptr) == CL_SUCCESS)
+        return PciBusId::of(domain, bus & 0xffu, (slot >> 3) & 0x1fu, slot & 7u);
+      return PciBusId::without_domain(bus & 0xffu, (slot >> 3) & 0x1fu, slot & 7u);
+    }
+  }
+  return {};
+}
+
 struct DeviceEntry {
   cl_platform_id platform;
   cl_device_id device;
@@ -272,6 +311,20 @@ struct OpenCLTracer::Impl {
 std::vector<std::string> OpenCLTracer::list_devices() {
   std::vector<std::string> out;
   for (const DeviceEntry& d : all_devices()) out.push_back(d.label);
+  return out;
+}
+
+std::vector<OpenCLTracer::DeviceDescription> OpenCLTracer::describe_devices() {
+  std::vector<DeviceDescription> out;
+  for (const DeviceEntry& d : all_devices()) {
+    DeviceDescription description;
+    description.label = d.label;
+    cl_device_type type = 0;
+    if (clGetDeviceInfo(d.device, CL_DEVICE_TYPE, sizeof(type), &type, nullptr) == CL_SUCCESS)
+      description.kind = (type & CL_DEVICE_TYPE_GPU) ? DeviceKind::gpu : (type & CL_DEVICE_TYPE_CPU) ? DeviceKind::cpu : DeviceKind::other;
+    description.pci = pci_bus_id(d.device);
+    out.push_back(description);
+  }
   return out;
 }
 

@@ -6,6 +6,7 @@
 #include <string>
 #include <vector>
 
+#include "cohort/tracers/device_identity.h"
 #include "cohort/tracers/tracer_base.h"
 
 namespace cohort::tracers {
@@ -30,6 +31,15 @@ class OpenCLTracer : public TracerBase {
 
   // "platform / device" for every OpenCL device on this machine, in the order Options::device counts.
   static std::vector<std::string> list_devices();
+  struct DeviceDescription {
+    std::string label;   // as list_devices() gives it
+    DeviceKind kind = DeviceKind::other;
+    // From cl_khr_pci_bus_info or NVIDIA's cl_nv_device_attribute_query where the device lists one;
+    // unknown otherwise (PoCL's CPU device).
+    PciBusId pci;
+  };
+  // The same devices in the same order, with their kind and PCI address.
+  static std::vector<DeviceDescription> describe_devices();
 
  private:
   void upload(const commit::ChangeSet& changes) override;
