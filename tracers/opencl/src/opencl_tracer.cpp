@@ -111,8 +111,10 @@ class DeviceBuffer {
     mem_ = nullptr;
     bytes_ = 0;
   }
+  // blocking: CL_FALSE only where `data` stays untouched until the queue is finished.
   template <class T>
-  void upload(cl_context context, cl_command_queue queue, const std::vector<T>& data, const char* what) {
+  void upload(cl_context context, cl_command_queue queue, const std::vector<T>& data, const char* what,
+              cl_bool blocking = CL_TRUE) {
     size_t bytes = std::max<size_t>(data.size() * sizeof(T), 16);
     if (bytes > bytes_) {
       reset();
@@ -123,7 +125,7 @@ class DeviceBuffer {
       bytes_ = bytes;
     }
     if (!data.empty())
-      check(clEnqueueWriteBuffer(queue, mem_, CL_TRUE, 0, data.size() * sizeof(T), data.data(), 0, nullptr, nullptr),
+      check(clEnqueueWriteBuffer(queue, mem_, blocking, 0, data.size() * sizeof(T), data.data(), 0, nullptr, nullptr),
             what);
   }
   cl_mem mem() const { return mem_; }
@@ -270,6 +272,7 @@ struct OpenCLTracer::Impl {
   // The aux band in flight: its kernel (timed: the band's device time starts there, as on CUDA), the
   // packing the read waits on, the read into `aux_staging`.
   Event aux_kernel_done, aux_packed, aux_read;
+  KCamera previous_camera_host{};
   PinnedStaging aux_staging;
 
   // A device buffer of at least `bytes`, reallocated (contents lost) when it is smaller.
@@ -468,6 +471,17 @@ core::BandResult OpenCLTracer::render_band(const core::BandJob& job, core::BandB
     check(err, "clCreateBuffer(row rays)");
     m.row_rays_rows = rows;
   }
+  std::vector<float> band;  // a band narrower than the target, read before it is stored row by row
+  std::vector<cl_uint> row_rays(rows);
+  // The reads and writes below run from and into this function's locals without blocking: whatever way
+  // it leaves (a failed check throws), both queues are done first (the guard goes before those locals).
+  struct FinishQueues {
+    cl_command_queue a, b;
+    ~FinishQueues() {
+      clFinish(a);
+      clFinish(b);
+    }
+  } finish_queues{m.queue, m.aux_queue};
   const cl_uint zero = 0;
   check(clEnqueueFillBuffer(m.queue, m.row_rays, &zero, sizeof zero, 0, rows * sizeof(cl_uint), 0, nullptr, nullptr),
         "clearing the row ray counts");
@@ -495,7 +509,6 @@ core::BandResult OpenCLTracer::render_band(const core::BandJob& job, core::BandB
   const size_t pixels = rows * camera.width;
   size_t band_bytes = bytes;
   cl_mem band_mem = m.output;
-  std::vector<float> band;
   if (!straight) {
     band.resize(pixels * 4);
   } else if (target.format() == core::BandFormat::rgb16f) {
@@ -510,7 +523,6 @@ core::BandResult OpenCLTracer::render_band(const core::BandJob& job, core::BandB
   void* band_destination = straight ? target.row(int(params.row_begin)) : band.data();
   check(clEnqueueReadBuffer(m.queue, band_mem, CL_FALSE, 0, band_bytes, band_destination, 0, nullptr, nullptr),
         "reading the band");
-  std::vector<cl_uint> row_rays(rows);
   check(clEnqueueReadBuffer(m.queue, m.row_rays, CL_FALSE, 0, rows * sizeof(cl_uint), row_rays.data(), 0, nullptr, nullptr),
         "reading the row ray counts");
   check(clFlush(m.queue), "clFlush");
@@ -538,11 +550,15 @@ void OpenCLTracer::enqueue_aux(const core::BandJob& job, const KCamera& camera, 
     check(err, "clCreateBuffer(aux)");
     m.aux_bytes = bytes;
   }
-  const KCamera previous = job.previous_camera.width > 0 ? job.previous_camera : job.camera;
-  check(clEnqueueWriteBuffer(m.queue, m.previous_camera, CL_FALSE, 0, sizeof previous, &previous, 0, nullptr, nullptr),
+  // Written without blocking: from the tracer's own copy, which outlives the write (a local would not).
+  m.previous_camera_host = job.previous_camera.width > 0 ? job.previous_camera : job.camera;
+  check(clEnqueueWriteBuffer(m.queue, m.previous_camera, CL_FALSE, 0, sizeof(KCamera), &m.previous_camera_host, 0,
+                             nullptr, nullptr),
         "writing the previous camera");
-  m.previous_transforms.upload(m.context, m.queue, previous_transforms(), "uploading previous transforms");
-  m.previous_joints.upload(m.context, m.queue, previous_joints(), "uploading previous joints");
+  // Not blocking: the previous frame's transforms and joints stay as they are until the next commit, and
+  // render_band finishes the queue before it returns.
+  m.previous_transforms.upload(m.context, m.queue, previous_transforms(), "uploading previous transforms", CL_FALSE);
+  m.previous_joints.upload(m.context, m.queue, previous_joints(), "uploading previous joints", CL_FALSE);
   // Skinned motion only where every array it reads is on the device (a scene without skins never sized them).
   const bool skinned = !previous_joints().empty() && m.skins.mem() && m.skin_vertices.mem() && m.skin_weights.mem();
   const cl_uint skin_count = skinned ? static_cast<cl_uint>(scene().skins.size()) : 0u;
