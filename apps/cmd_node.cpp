@@ -79,7 +79,7 @@ void add_node_command(CLI::App& app, int& exit_code) {
                                  "without one, rank 0 sends the whole scene)");
   cmd->add_option("--base", a->bases, "extra game folder(s) to search (loose files and .pk4s)");
   cmd->add_option("--tracers", a->tracers, "this node's tracers: embree, opencl[:N], cuda[:N], all; several split "
-                                           "the node's band by their speed")
+                                           "the node's band by their speed (`cohort devices` lists them)")
       ->capture_default_str();
   cmd->add_option("--time", a->time, "game time rank 0 renders frame 0 at (its --time), for the materials")
       ->capture_default_str();

@@ -356,7 +356,8 @@ void add_play_command(CLI::App& app, int& exit_code) {
   cmd->add_option("--base", a->session.bases, "game folder with loose files and .pk4 archives (e.g. Doom 3's base/); "
                                               "repeat it (default: assets/testmap)");
   cmd->add_option("--tracers", a->session.tracers, "comma-separated: embree, opencl[:N|:all], cuda[:N|:all], or "
-                                                   "all (the default: Embree plus every GPU once)");
+                                                   "all (the default: Embree plus every GPU once); `cohort devices` "
+                                                   "lists which device each opencl:N is");
   cmd->add_option("--balancer", a->session.balancer, "row balancer (B cycles)")
       ->capture_default_str()
       ->check(CLI::IsMember(balance::balancer_names()));

@@ -399,7 +399,8 @@ void add_render_command(CLI::App& app, int& exit_code) {
                   "write every frame's timeline (world sync, each tracer's apply and render, merge, convergence, "
                   "tone map, output) as a Chrome trace event file: open it in ui.perfetto.dev or chrome://tracing");
   cmd->add_option("--tracers", a->tracers,
-                  "comma-separated: embree, opencl[:N|:all], cuda[:N|:all], or all (Embree on the CPU plus every GPU once)")
+                  "comma-separated: embree, opencl[:N|:all], cuda[:N|:all], or all (Embree on the CPU plus every GPU once); "
+                  "`cohort devices` lists which device each opencl:N is")
       ->capture_default_str();
   cmd->add_option("--balancer", a->balancer, "row balancer when there are several tracers")->capture_default_str();
   cmd->add_option("--band-format", a->band_format,

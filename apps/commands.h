@@ -8,6 +8,8 @@
 namespace cohort::app {
 
 void add_info_command(CLI::App& app, int& exit_code);
+// `cohort devices`: the tracers' devices with kind and PCI bus id.
+void add_devices_command(CLI::App& app, int& exit_code);
 void add_render_command(CLI::App& app, int& exit_code);
 void add_play_command(CLI::App& app, int& exit_code);
 void add_bench_command(CLI::App& app, int& exit_code);

@@ -22,6 +22,7 @@ int main(int argc, char** argv) {
 
   int exit_code = cohort::app::kExitOk;
   cohort::app::add_info_command(app, exit_code);
+  cohort::app::add_devices_command(app, exit_code);
   cohort::app::add_render_command(app, exit_code);
   cohort::app::add_play_command(app, exit_code);
   cohort::app::add_bench_command(app, exit_code);

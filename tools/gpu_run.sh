@@ -8,7 +8,10 @@
 #                              registers NVIDIA's OpenCL, runs the GPU tests and benchmarks, writes
 #                              results (logs, JSON, PPM frames) to $OUT
 #   tools/gpu_run.sh multigpu  there, on a several-GPU kind: issue 14's end-to-end mixes (two GPUs, each with
-#                              Embree and OpenCL), bench devices on both maps, Table 1 with two real GPUs
+#                              Embree and OpenCL), bench devices on both maps, Table 1 with two real GPUs. The
+#                              OpenCL tracer of the mixes is the OpenCL device on the second GPU (the one cuda:1
+#                              drives), found by PCI bus id in `cohort devices --json`; COHORT_GPU_OPENCL=opencl:N
+#                              names another (opencl:N counts every platform's devices: PoCL's CPU may be one)
 #   tools/gpu_run.sh compare BASE.tar.xz [MORE.tar.xz ...]  there: A/B of payloads on one machine (the staged
 #                              one against earlier stages' payload.tar.xz, renamed and carried in .gpu/): the CUDA
 #                              tracer tests of the staged one, then end-to-end ms per frame, cuda:0, both maps,
@@ -124,7 +127,16 @@ case "${1:-}" in
     export OCL_ICD_VENDORS=/tmp/icd
     out="${OUT:-/tmp/cohort-out}"; mkdir -p "$out"
     nvidia-smi --query-gpu=index,name --format=csv,noheader; nproc
-    (clinfo -l 2>&1 || true) | head -n 6
+    "$stage/bin/cohort" devices || true
+    # OpenCL on the GPU that cuda:0 does not drive: never a second tracer on cuda:0's GPU, nor PoCL.
+    opencl="${COHORT_GPU_OPENCL:-$("$stage/bin/cohort" devices --json 2>/dev/null | python3 -c '
+import json, sys
+devices = json.load(sys.stdin)["devices"]
+gpus = [d for d in devices if d["tracer"].startswith("opencl:") and d["kind"] == "GPU"]
+pick = [d for d in gpus if "cuda:1" in d["same_gpu_as"]] or [d for d in gpus if "cuda:0" not in d["same_gpu_as"]]
+print(pick[0]["tracer"] if pick else "")' || true)}"
+    echo "OpenCL tracer of the mixes: ${opencl:-none found (COHORT_GPU_OPENCL names one)}"
+    opencl_mixes=""; [ -n "$opencl" ] && opencl_mixes="cuda:0,$opencl embree,cuda:0,$opencl"
     [ -f /tmp/largemap.cpk ] || { python3 tools/gen_testmap.py --large --out /tmp/largemap >/dev/null &&
       "$stage/bin/cohort" pack /tmp/largemap/maps/largemap.map --out /tmp/largemap.cpk | tail -n 1; }
     COHORT_PACK="$stage/testmap.cpk" "$stage/bin/cohort_tracers_tests" --gtest_filter='CudaMultiGpu*:FramePost*' 2>&1 |
@@ -133,7 +145,7 @@ case "${1:-}" in
       if [ $map = large ]; then args=(/tmp/largemap.cpk --width 1920 --height 1080 --camera 1690 300 80 5 -12)
       else args=("$stage/testmap.cpk" --width 1280 --height 720); fi
       for convergence in ${COHORT_GPU_CONVERGENCE:-auto brigade}; do
-        for mix in ${COHORT_GPU_MIXES:-cuda:0 cuda:0,cuda:1 embree,cuda:0 embree,cuda:0,cuda:1 cuda:0,opencl:0 embree,cuda:0,opencl:0}; do
+        for mix in ${COHORT_GPU_MIXES:-cuda:0 cuda:0,cuda:1 embree,cuda:0 embree,cuda:0,cuda:1 $opencl_mixes}; do
           run=/tmp/mg_${map}_${convergence}_$(echo "$mix" | tr ',:' '__')
           timeout 120 "$stage/bin/cohort" render "${args[@]}" --tracers "$mix" --spp 1 --light-samples 1 --bounces 1 \
             ${COHORT_GPU_RENDER_ARGS:-} --convergence $convergence --frames ${COHORT_GPU_FRAMES:-100} --camera-path spin-slow \
@@ -222,5 +234,5 @@ case "${1:-}" in
     exit $status
     ;;
   *)
-    sed -n '2,17p' "$0"; exit 2 ;;
+    sed -n '2,23p' "$0"; exit 2 ;;
 esac

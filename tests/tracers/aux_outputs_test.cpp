@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstring>
 #include <memory>
 
 #include "test_scenes.h"
@@ -106,4 +107,53 @@ TEST(AuxOutputs, ObjectMotionFollowsTheInstanceTransform) {
   const core::GBuffer g = render_aux(*tracer, after, 2, cam, cam);
   expect_floor_motion(g, cam, cam, offset);
   EXPECT_NEAR(g.motion[0], -offset.x / (kHeight * kTan) * 0.5f * kW, 1e-3f);
+}
+
+// The aux planes travel beside the band (GPU tracers: their own kernel and read, overlapping the band's):
+// a band with them has the same colours as one without, and bands of a frame in two parts (the second
+// larger, so device buffers grow between them) write exactly the whole frame's planes, on every tracer.
+TEST(AuxOutputs, SplitBandsWriteTheWholeFramesPlanesAndTheSameColours) {
+  const int w = 40, h = 24, split = 9;
+  const KCamera cam = test_room_camera(w, h);
+  const KCamera prev = core::make_camera({-180, -130, 125}, {33.0f, 21.0f}, 90.0f, w, h);
+  auto room = std::make_shared<commit::TracerScene>(core::compile_scene(test_room()).tracer_scene);
+  int checked = 0;
+  for (const std::string& kind : built_tracers()) {
+    if (!tracer_runs_here(kind)) continue;
+    auto tracer = make_test_tracer(kind);
+    tracer->apply(commit::CommitBuffer::full(room, 1));
+    auto render = [&](core::BandBuffer& band, bool aux, int begin, int end) {
+      core::BandJob job;
+      job.params = frame_params(K_MODE_PATH, 1, 1, h);
+      job.params.row_begin = kuint(begin);
+      job.params.row_end = kuint(end);
+      job.params.aux_outputs = aux ? 1u : 0u;
+      job.camera = cam;
+      job.previous_camera = prev;
+      tracer->render_band(job, band);
+    };
+    for (core::BandFormat format : {core::BandFormat::rgb16f, core::BandFormat::rgba32f}) {
+      core::BandBuffer whole(w, h, format), parts(w, h, format), plain(w, h, format);
+      whole.enable_aux(true);
+      parts.enable_aux(true);
+      render(whole, true, 0, h);
+      render(parts, true, 0, split);
+      render(parts, true, split, h);
+      render(plain, false, 0, h);
+      ASSERT_EQ(std::memcmp(whole.data(), plain.data(), whole.bytes()), 0) << kind << ": the aux planes changed the colours";
+      ASSERT_EQ(std::memcmp(whole.data(), parts.data(), whole.bytes()), 0) << kind << ": split bands' colours differ";
+      ASSERT_EQ(std::memcmp(whole.aux_data(), parts.aux_data(), whole.aux_bytes()), 0) << kind << ": split bands' planes differ";
+      const core::GBuffer g = [&] {
+        core::GBuffer out;
+        out.resize(w, h);
+        whole.copy_aux_rows_to(out, 0, h);
+        return out;
+      }();
+      size_t hits = 0;
+      for (size_t p = 0; p < g.pixels(); ++p) hits += g.depth[p] > 0.0f ? 1u : 0u;
+      EXPECT_GT(hits, g.pixels() / 2) << kind << ": the planes are mostly empty";
+    }
+    ++checked;
+  }
+  EXPECT_GT(checked, 0);
 }

@@ -27,6 +27,15 @@ std::string cuda_device_name(int device) {
   return prop.name;
 }
 
+PciBusId cuda_device_pci_bus_id(int device) {
+  cudaDeviceProp prop{};
+  if (cudaGetDeviceProperties(&prop, device) != cudaSuccess) {
+    cudaGetLastError();
+    return {};
+  }
+  return PciBusId::of(unsigned(prop.pciDomainID), unsigned(prop.pciBusID), unsigned(prop.pciDeviceID));
+}
+
 struct CudaTracer::Impl {
   int device = 0;
   std::string name;

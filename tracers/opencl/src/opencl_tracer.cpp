@@ -37,6 +37,45 @@ std::string info_string(cl_int (*query)(Object, Info, size_t, void*, size_t*), O
 std::string platform_info(cl_platform_id p, cl_platform_info what) { return info_string(&clGetPlatformInfo, p, what); }
 std::string device_info(cl_device_id d, cl_device_info what) { return info_string(&clGetDeviceInfo, d, what); }
 
+bool lists_extension(const std::string& extensions, const std::string& name) {
+  size_t at = 0;
+  while ((at = extensions.find(name, at)) != std::string::npos) {
+    const size_t end = at + name.size();
+    if ((at == 0 || extensions[at - 1] == ' ') && (end == extensions.size() || extensions[end] == ' ')) return true;
+    at = end;
+  }
+  return false;
+}
+
+// The extensions' query values, spelled out: older OpenCL headers lack them.
+constexpr cl_device_info kPciBusInfoKhr = 0x410F;  // cl_khr_pci_bus_info: cl_device_pci_bus_info_khr
+constexpr cl_device_info kPciBusIdNv = 0x4008;     // cl_nv_device_attribute_query
+constexpr cl_device_info kPciSlotIdNv = 0x4009;    // device << 3 | function
+constexpr cl_device_info kPciDomainIdNv = 0x400A;  // newer drivers only
+
+// The device's PCI address where it lists an extension that tells it; asked only then, since drivers
+// answer unknown queries inconsistently.
+PciBusId pci_bus_id(cl_device_id d) {
+  const std::string extensions = device_info(d, CL_DEVICE_EXTENSIONS);
+  if (lists_extension(extensions, "cl_khr_pci_bus_info")) {
+    struct {
+      cl_uint domain, bus, device, function;
+    } info{};
+    if (clGetDeviceInfo(d, kPciBusInfoKhr, sizeof info, &info, nullptr) == CL_SUCCESS)
+      return PciBusId::of(info.domain, info.bus, info.device, info.function);
+  }
+  if (lists_extension(extensions, "cl_nv_device_attribute_query")) {
+    cl_uint bus = 0, slot = 0, domain = 0;
+    if (clGetDeviceInfo(d, kPciBusIdNv, sizeof bus, &bus, nullptr) == CL_SUCCESS &&
+        clGetDeviceInfo(d, kPciSlotIdNv, sizeof slot, &slot, nullptr) == CL_SUCCESS) {
+      if (clGetDeviceInfo(d, kPciDomainIdNv, sizeof domain, &domain, nullptr) == CL_SUCCESS)
+        return PciBusId::of(domain, bus & 0xffu, (slot >> 3) & 0x1fu, slot & 7u);
+      return PciBusId::without_domain(bus & 0xffu, (slot >> 3) & 0x1fu, slot & 7u);
+    }
+  }
+  return {};
+}
+
 struct DeviceEntry {
   cl_platform_id platform;
   cl_device_id device;
@@ -72,8 +111,10 @@ class DeviceBuffer {
     mem_ = nullptr;
     bytes_ = 0;
   }
+  // blocking: CL_FALSE only where `data` stays untouched until the queue is finished.
   template <class T>
-  void upload(cl_context context, cl_command_queue queue, const std::vector<T>& data, const char* what) {
+  void upload(cl_context context, cl_command_queue queue, const std::vector<T>& data, const char* what,
+              cl_bool blocking = CL_TRUE) {
     size_t bytes = std::max<size_t>(data.size() * sizeof(T), 16);
     if (bytes > bytes_) {
       reset();
@@ -84,13 +125,80 @@ class DeviceBuffer {
       bytes_ = bytes;
     }
     if (!data.empty())
-      check(clEnqueueWriteBuffer(queue, mem_, CL_TRUE, 0, data.size() * sizeof(T), data.data(), 0, nullptr, nullptr),
+      check(clEnqueueWriteBuffer(queue, mem_, blocking, 0, data.size() * sizeof(T), data.data(), 0, nullptr, nullptr),
             what);
   }
   cl_mem mem() const { return mem_; }
 
  private:
   cl_mem mem_ = nullptr;
+  size_t bytes_ = 0;
+};
+
+// An event the tracer waits on or times, released when it goes out of scope (also on a throw).
+class Event {
+ public:
+  Event() = default;
+  Event(const Event&) = delete;
+  Event& operator=(const Event&) = delete;
+  ~Event() {
+    if (event_) clReleaseEvent(event_);
+  }
+  cl_event* out() {
+    if (event_) clReleaseEvent(event_);
+    event_ = nullptr;
+    return &event_;
+  }
+  cl_event get() const { return event_; }
+  // The command's start or end on the device clock (the queue profiles), 0 when unknown.
+  cl_ulong time(cl_profiling_info which) const {
+    cl_ulong t = 0;
+    if (event_ && clGetEventProfilingInfo(event_, which, sizeof t, &t, nullptr) != CL_SUCCESS) t = 0;
+    return t;
+  }
+
+ private:
+  cl_event event_ = nullptr;
+};
+
+// Page-locked host memory the device copies into by DMA while kernels run (CL_MEM_ALLOC_HOST_PTR, mapped
+// once and kept mapped: the drivers' pattern for asynchronous reads; a read into pageable memory goes
+// through the driver's own staging and may not overlap anything).
+class PinnedStaging {
+ public:
+  PinnedStaging() = default;
+  PinnedStaging(const PinnedStaging&) = delete;
+  PinnedStaging& operator=(const PinnedStaging&) = delete;
+  ~PinnedStaging() { reset(); }
+  void reset() {
+    if (mem_ && host_) {
+      clEnqueueUnmapMemObject(queue_, mem_, host_, 0, nullptr, nullptr);
+      clFinish(queue_);
+    }
+    if (mem_) clReleaseMemObject(mem_);
+    mem_ = nullptr;
+    host_ = nullptr;
+    bytes_ = 0;
+  }
+  // At least `bytes` of it (contents lost when it grows); queue: where it is mapped and unmapped.
+  void* reserve(cl_context context, cl_command_queue queue, size_t bytes, const char* what) {
+    if (bytes <= bytes_) return host_;
+    reset();
+    cl_int err = CL_SUCCESS;
+    mem_ = clCreateBuffer(context, CL_MEM_READ_WRITE | CL_MEM_ALLOC_HOST_PTR, bytes, nullptr, &err);
+    check(err, what);
+    queue_ = queue;
+    host_ = clEnqueueMapBuffer(queue, mem_, CL_TRUE, CL_MAP_READ | CL_MAP_WRITE, 0, bytes, 0, nullptr, nullptr, &err);
+    check(err, what);
+    bytes_ = bytes;
+    return host_;
+  }
+  void* host() const { return host_; }
+
+ private:
+  cl_mem mem_ = nullptr;
+  cl_command_queue queue_ = nullptr;
+  void* host_ = nullptr;
   size_t bytes_ = 0;
 };
 
@@ -101,6 +209,9 @@ struct OpenCLTracer::Impl {
   bool gpu = false;
   cl_context context = nullptr;
   cl_command_queue queue = nullptr;
+  // The aux texels' read runs on this second in-order queue, behind the aux kernel's event, while the
+  // band's kernel runs on `queue` (CUDA's aux copy stream).
+  cl_command_queue aux_queue = nullptr;
   cl_program program = nullptr;
   cl_kernel kernel = nullptr, aux_kernel = nullptr;
   DeviceBuffer previous_transforms, previous_joints;
@@ -158,6 +269,11 @@ struct OpenCLTracer::Impl {
   cl_kernel to_rgb16f = nullptr, to_texels = nullptr;
   cl_mem packed = nullptr, packed_aux = nullptr;
   size_t packed_bytes = 0, packed_aux_bytes = 0;
+  // The aux band in flight: its kernel (timed: the band's device time starts there, as on CUDA), the
+  // packing the read waits on, the read into `aux_staging`.
+  Event aux_kernel_done, aux_packed, aux_read;
+  KCamera previous_camera_host{};
+  PinnedStaging aux_staging;
 
   // A device buffer of at least `bytes`, reallocated (contents lost) when it is smaller.
   cl_mem& grow(cl_mem& mem, size_t& capacity, size_t bytes, const char* what) {
@@ -171,22 +287,25 @@ struct OpenCLTracer::Impl {
     return mem;
   }
   // Runs a 1-D packing kernel (source, destination, pixel count) over `pixels`.
-  void pack(cl_kernel k, cl_mem from, cl_mem to, size_t pixels, const char* what) {
+  void pack(cl_kernel k, cl_mem from, cl_mem to, size_t pixels, const char* what, cl_event* done = nullptr) {
     const cl_uint n = static_cast<cl_uint>(pixels);
     check(clSetKernelArg(k, 0, sizeof(cl_mem), &from), what);
     check(clSetKernelArg(k, 1, sizeof(cl_mem), &to), what);
     check(clSetKernelArg(k, 2, sizeof n, &n), what);
     const size_t local = 64, global = (pixels + local - 1) / local * local;
-    check(clEnqueueNDRangeKernel(queue, k, 1, nullptr, &global, &local, 0, nullptr, nullptr), what);
+    check(clEnqueueNDRangeKernel(queue, k, 1, nullptr, &global, &local, 0, nullptr, done), what);
   }
 
   ~Impl() {
+    if (aux_queue) clFinish(aux_queue);
+    aux_staging.reset();
     for (cl_mem m : {params, camera, previous_camera, output, row_rays, aux, packed, packed_aux})
       if (m) clReleaseMemObject(m);
     for (cl_kernel k : {kernel, aux_kernel, skin_positions, skin_faces_kernel, skin_normals, refit_leaves, refit_blas,
                         to_rgb16f, to_texels})
       if (k) clReleaseKernel(k);
     if (program) clReleaseProgram(program);
+    if (aux_queue) clReleaseCommandQueue(aux_queue);
     if (queue) clReleaseCommandQueue(queue);
     if (context) clReleaseContext(context);
   }
@@ -195,6 +314,20 @@ struct OpenCLTracer::Impl {
 std::vector<std::string> OpenCLTracer::list_devices() {
   std::vector<std::string> out;
   for (const DeviceEntry& d : all_devices()) out.push_back(d.label);
+  return out;
+}
+
+std::vector<OpenCLTracer::DeviceDescription> OpenCLTracer::describe_devices() {
+  std::vector<DeviceDescription> out;
+  for (const DeviceEntry& d : all_devices()) {
+    DeviceDescription description;
+    description.label = d.label;
+    cl_device_type type = 0;
+    if (clGetDeviceInfo(d.device, CL_DEVICE_TYPE, sizeof(type), &type, nullptr) == CL_SUCCESS)
+      description.kind = (type & CL_DEVICE_TYPE_GPU) ? DeviceKind::gpu : (type & CL_DEVICE_TYPE_CPU) ? DeviceKind::cpu : DeviceKind::other;
+    description.pci = pci_bus_id(d.device);
+    out.push_back(description);
+  }
   return out;
 }
 
@@ -218,10 +351,12 @@ OpenCLTracer::OpenCLTracer(const Options& options) : impl_(std::make_unique<Impl
 #pragma GCC diagnostic ignored "-Wdeprecated-declarations"
 #endif
   impl_->queue = clCreateCommandQueue(impl_->context, dev.device, CL_QUEUE_PROFILING_ENABLE, &err);
+  check(err, "clCreateCommandQueue");
+  impl_->aux_queue = clCreateCommandQueue(impl_->context, dev.device, 0, &err);
+  check(err, "clCreateCommandQueue(aux)");
 #if defined(__GNUC__)
 #pragma GCC diagnostic pop
 #endif
-  check(err, "clCreateCommandQueue");
   const char* source = opencl_source::kRenderBand;
   impl_->program = clCreateProgramWithSource(impl_->context, 1, &source, nullptr, &err);
   check(err, "clCreateProgramWithSource");
@@ -336,6 +471,17 @@ core::BandResult OpenCLTracer::render_band(const core::BandJob& job, core::BandB
     check(err, "clCreateBuffer(row rays)");
     m.row_rays_rows = rows;
   }
+  std::vector<float> band;  // a band narrower than the target, read before it is stored row by row
+  std::vector<cl_uint> row_rays(rows);
+  // The reads and writes below run from and into this function's locals without blocking: whatever way
+  // it leaves (a failed check throws), both queues are done first (the guard goes before those locals).
+  struct FinishQueues {
+    cl_command_queue a, b;
+    ~FinishQueues() {
+      clFinish(a);
+      clFinish(b);
+    }
+  } finish_queues{m.queue, m.aux_queue};
   const cl_uint zero = 0;
   check(clEnqueueFillBuffer(m.queue, m.row_rays, &zero, sizeof zero, 0, rows * sizeof(cl_uint), 0, nullptr, nullptr),
         "clearing the row ray counts");
@@ -343,6 +489,11 @@ core::BandResult OpenCLTracer::render_band(const core::BandJob& job, core::BandB
         "writing frame parameters");
   check(clEnqueueWriteBuffer(m.queue, m.camera, CL_FALSE, 0, sizeof camera, &camera, 0, nullptr, nullptr),
         "writing the camera");
+  // Only frames that ask pay for the aux planes: a short kernel before the band's, whose texels go down
+  // on the second queue while the band's kernel runs (the CUDA tracer's order).
+  const bool write_aux = params.aux_outputs != 0u && target.has_aux();
+  const bool straight = target.width() == static_cast<int>(camera.width);
+  if (write_aux) enqueue_aux(job, camera, rows, straight);
   cl_mem args[] = {m.vertices.mem(),  m.vertex_colors.mem(), m.triangles.mem(), m.blas_nodes.mem(), m.blases.mem(),
                    m.instances.mem(), m.tlas_nodes.mem(), m.materials.mem(), m.textures.mem(),
                    m.texels.mem(),    m.lights.mem(),     m.light_nodes.mem(), m.emissive.mem(),
@@ -351,58 +502,63 @@ core::BandResult OpenCLTracer::render_band(const core::BandJob& job, core::BandB
     check(clSetKernelArg(m.kernel, i, sizeof(cl_mem), &args[i]), "clSetKernelArg");
   const size_t local[2] = {8, 8};
   const size_t global[2] = {(camera.width + 7) / 8 * 8, (rows + 7) / 8 * 8};
-  cl_event done = nullptr;
-  check(clEnqueueNDRangeKernel(m.queue, m.kernel, 2, nullptr, global, local, 0, nullptr, &done), "launching the kernel");
+  Event band_done;
+  check(clEnqueueNDRangeKernel(m.queue, m.kernel, 2, nullptr, global, local, 0, nullptr, band_done.out()),
+        "launching the kernel");
   // The band goes straight into its rows of the target, converted on the device to the target's format.
   const size_t pixels = rows * camera.width;
-  const bool straight = target.width() == static_cast<int>(camera.width);
-  std::vector<float> band;
+  size_t band_bytes = bytes;
+  cl_mem band_mem = m.output;
   if (!straight) {
     band.resize(pixels * 4);
-    check(clEnqueueReadBuffer(m.queue, m.output, CL_TRUE, 0, bytes, band.data(), 0, nullptr, nullptr), "reading the band");
   } else if (target.format() == core::BandFormat::rgb16f) {
-    cl_mem packed = m.grow(m.packed, m.packed_bytes, pixels * 6, "clCreateBuffer(half band)");
-    m.pack(m.to_rgb16f, m.output, packed, pixels, "converting the band to half floats");
-    check(clEnqueueReadBuffer(m.queue, packed, CL_TRUE, 0, pixels * 6, target.row(int(params.row_begin)), 0, nullptr,
-                              nullptr),
-          "reading the band");
-  } else {
-    check(clEnqueueReadBuffer(m.queue, m.output, CL_TRUE, 0, bytes, target.row(int(params.row_begin)), 0, nullptr,
-                              nullptr),
-          "reading the band");
+    band_mem = m.grow(m.packed, m.packed_bytes, pixels * 6, "clCreateBuffer(half band)");
+    m.pack(m.to_rgb16f, m.output, band_mem, pixels, "converting the band to half floats");
+    band_bytes = pixels * 6;
   }
-  std::vector<cl_uint> row_rays(rows);
-  check(clEnqueueReadBuffer(m.queue, m.row_rays, CL_TRUE, 0, rows * sizeof(cl_uint), row_rays.data(), 0, nullptr, nullptr),
+  // Both kernels are on the device before any read is enqueued: a driver that copies into pageable
+  // memory at enqueue time then still overlaps the aux read with the band's kernel.
+  check(clFlush(m.queue), "clFlush");
+  if (write_aux) read_aux_when_packed(rows * camera.width, straight);
+  void* band_destination = straight ? target.row(int(params.row_begin)) : band.data();
+  check(clEnqueueReadBuffer(m.queue, band_mem, CL_FALSE, 0, band_bytes, band_destination, 0, nullptr, nullptr),
+        "reading the band");
+  check(clEnqueueReadBuffer(m.queue, m.row_rays, CL_FALSE, 0, rows * sizeof(cl_uint), row_rays.data(), 0, nullptr, nullptr),
         "reading the row ray counts");
-  cl_ulong start = 0, end = 0;
-  clGetEventProfilingInfo(done, CL_PROFILING_COMMAND_START, sizeof start, &start, nullptr);
-  clGetEventProfilingInfo(done, CL_PROFILING_COMMAND_END, sizeof end, &end, nullptr);
-  clReleaseEvent(done);
+  check(clFlush(m.queue), "clFlush");
+  // The host's share of the aux planes (out of page-locked memory into the target) while the band renders.
+  if (write_aux) copy_aux_into(target, params, camera, rows, straight);
+  check(clFinish(m.queue), "waiting for the band");
   for (size_t r = 0; r < rows && !straight; ++r)
     target.store(static_cast<int>(params.row_begin + r), 0, band.data() + r * camera.width * 4, camera.width);
-  if (params.aux_outputs != 0u && target.has_aux()) render_aux(job, params, camera, rows, target);
+  // Device time from the first kernel (the aux one when it ran, as the CUDA tracer times it) to the band's end.
+  const cl_ulong start = (write_aux ? m.aux_kernel_done : band_done).time(CL_PROFILING_COMMAND_START);
+  const cl_ulong end = band_done.time(CL_PROFILING_COMMAND_END);
   core::BandResult result;
-  result.device_ms = end > start ? double(end - start) * 1e-6 : 0.0;
+  result.device_ms = end > start && start != 0 ? double(end - start) * 1e-6 : 0.0;
   if (params.row_end == frame_params(job).row_end) result.row_work.assign(row_rays.begin(), row_rays.end());
   return result;
 }
 
-void OpenCLTracer::render_aux(const core::BandJob& job, const KFrameParams& params, const KCamera& camera, size_t rows,
-                              core::BandBuffer& target) {
+void OpenCLTracer::enqueue_aux(const core::BandJob& job, const KCamera& camera, size_t rows, bool straight) {
   Impl& m = *impl_;
   const size_t bytes = rows * camera.width * sizeof(KAux);
   cl_int err = CL_SUCCESS;
   if (bytes > m.aux_bytes) {
     if (m.aux) clReleaseMemObject(m.aux);
-    m.aux = clCreateBuffer(m.context, CL_MEM_WRITE_ONLY, bytes, nullptr, &err);
+    m.aux = clCreateBuffer(m.context, CL_MEM_READ_WRITE, bytes, nullptr, &err);
     check(err, "clCreateBuffer(aux)");
     m.aux_bytes = bytes;
   }
-  const KCamera previous = job.previous_camera.width > 0 ? job.previous_camera : job.camera;
-  check(clEnqueueWriteBuffer(m.queue, m.previous_camera, CL_FALSE, 0, sizeof previous, &previous, 0, nullptr, nullptr),
+  // Written without blocking: from the tracer's own copy, which outlives the write (a local would not).
+  m.previous_camera_host = job.previous_camera.width > 0 ? job.previous_camera : job.camera;
+  check(clEnqueueWriteBuffer(m.queue, m.previous_camera, CL_FALSE, 0, sizeof(KCamera), &m.previous_camera_host, 0,
+                             nullptr, nullptr),
         "writing the previous camera");
-  m.previous_transforms.upload(m.context, m.queue, previous_transforms(), "uploading previous transforms");
-  m.previous_joints.upload(m.context, m.queue, previous_joints(), "uploading previous joints");
+  // Not blocking: the previous frame's transforms and joints stay as they are until the next commit, and
+  // render_band finishes the queue before it returns.
+  m.previous_transforms.upload(m.context, m.queue, previous_transforms(), "uploading previous transforms", CL_FALSE);
+  m.previous_joints.upload(m.context, m.queue, previous_joints(), "uploading previous joints", CL_FALSE);
   // Skinned motion only where every array it reads is on the device (a scene without skins never sized them).
   const bool skinned = !previous_joints().empty() && m.skins.mem() && m.skin_vertices.mem() && m.skin_weights.mem();
   const cl_uint skin_count = skinned ? static_cast<cl_uint>(scene().skins.size()) : 0u;
@@ -421,21 +577,45 @@ void OpenCLTracer::render_aux(const core::BandJob& job, const KFrameParams& para
   check(clSetKernelArg(m.aux_kernel, arg, sizeof(cl_mem), &m.aux), "clSetKernelArg(aux output)");
   const size_t local[2] = {8, 8};
   const size_t global[2] = {(camera.width + 7) / 8 * 8, (rows + 7) / 8 * 8};
-  check(clEnqueueNDRangeKernel(m.queue, m.aux_kernel, 2, nullptr, global, local, 0, nullptr, nullptr),
+  check(clEnqueueNDRangeKernel(m.queue, m.aux_kernel, 2, nullptr, global, local, 0, nullptr, m.aux_kernel_done.out()),
         "launching the aux kernel");
   const size_t pixels = rows * camera.width;
-  if (target.width() == static_cast<int>(camera.width)) {
+  if (straight) {
     cl_mem packed = m.grow(m.packed_aux, m.packed_aux_bytes, pixels * sizeof(KAuxTexel), "clCreateBuffer(aux texels)");
-    m.pack(m.to_texels, m.aux, packed, pixels, "packing the aux records");
-    check(clEnqueueReadBuffer(m.queue, packed, CL_TRUE, 0, pixels * sizeof(KAuxTexel), target.aux_row(int(params.row_begin)),
-                              0, nullptr, nullptr),
-          "reading the aux band");
+    m.pack(m.to_texels, m.aux, packed, pixels, "packing the aux records", m.aux_packed.out());
+  } else {
+    // A narrower band keeps the full records (the target converts them row by row): the read waits on
+    // the aux kernel itself.
+    check(clRetainEvent(m.aux_kernel_done.get()), "clRetainEvent");
+    *m.aux_packed.out() = m.aux_kernel_done.get();
+  }
+}
+
+void OpenCLTracer::read_aux_when_packed(size_t pixels, bool straight) {
+  Impl& m = *impl_;
+  const size_t bytes = pixels * (straight ? sizeof(KAuxTexel) : sizeof(KAux));
+  void* staging = m.aux_staging.reserve(m.context, m.aux_queue, bytes, "allocating page-locked aux memory");
+  const cl_event packed = m.aux_packed.get();
+  check(clEnqueueReadBuffer(m.aux_queue, straight ? m.packed_aux : m.aux, CL_FALSE, 0, bytes, staging, 1, &packed,
+                            m.aux_read.out()),
+        "reading the aux band");
+  check(clFlush(m.aux_queue), "clFlush(aux)");
+}
+
+void OpenCLTracer::copy_aux_into(core::BandBuffer& target, const KFrameParams& params, const KCamera& camera,
+                                 size_t rows, bool straight) {
+  Impl& m = *impl_;
+  const cl_event read = m.aux_read.get();
+  check(clWaitForEvents(1, &read), "waiting for the aux band");
+  const size_t pixels = rows * camera.width;
+  const void* staging = m.aux_staging.host();
+  if (straight) {
+    std::memcpy(target.aux_row(int(params.row_begin)), staging, pixels * sizeof(KAuxTexel));
     return;
   }
-  std::vector<KAux> aux(pixels);
-  check(clEnqueueReadBuffer(m.queue, m.aux, CL_TRUE, 0, bytes, aux.data(), 0, nullptr, nullptr), "reading the aux band");
+  const KAux* aux = static_cast<const KAux*>(staging);
   for (size_t r = 0; r < rows; ++r)
-    target.store_aux(static_cast<int>(params.row_begin + r), 0, aux.data() + r * camera.width, camera.width);
+    target.store_aux(static_cast<int>(params.row_begin + r), 0, aux + r * camera.width, camera.width);
 }
 
 }  // namespace cohort::tracers

@@ -4,6 +4,10 @@
 #include <stdexcept>
 #include <thread>
 
+#include <spdlog/spdlog.h>
+
+#include "cohort/tracers/device_listing.h"
+
 #ifdef COHORT_HAVE_EMBREE
 #include "cohort/tracers/embree_tracer.h"
 #endif
@@ -16,8 +20,6 @@
 #endif
 #ifdef COHORT_HAVE_MPI
 #include <cstdlib>
-
-#include <spdlog/spdlog.h>
 
 #include "cohort/tracers/mpi_tracer.h"
 #endif
@@ -34,19 +36,8 @@ TracerSpec spec_of(const std::string& kind, int device) {
   return spec;
 }
 
-// OpenCL devices that are not PoCL's CPU device: the CPU already has the Embree tracer.
-std::vector<int> opencl_accelerators() {
-  std::vector<int> found;
-#ifdef COHORT_HAVE_OPENCL
-  auto names = OpenCLTracer::list_devices();
-  for (size_t i = 0; i < names.size(); ++i)
-    if (names[i].find("Portable Computing Language") == std::string::npos) found.push_back(int(i));
-#endif
-  return found;
-}
-
-// "all": Embree on the CPU plus every GPU once: CUDA devices when there are any, else OpenCL
-// accelerators. "cuda:all" / "opencl:all": every device of that kind (PoCL's CPU device included).
+// "all": Embree on the CPU plus every GPU once (gpu_tracers_for_all: CUDA devices, then OpenCL devices
+// on other GPUs). "cuda:all" / "opencl:all": every device of that kind (PoCL's CPU device included).
 std::vector<TracerSpec> expand_all(const std::string& item) {
   std::vector<TracerSpec> specs;
   if (item == "cuda:all") {
@@ -62,16 +53,31 @@ std::vector<TracerSpec> expand_all(const std::string& item) {
 #ifdef COHORT_HAVE_EMBREE
   specs.push_back(spec_of("embree", 0));
 #endif
-  if (int n = device_count("cuda"); n > 0) {
-    for (int d = 0; d < n; ++d) specs.push_back(spec_of("cuda", d));
-  } else {
-    for (int d : opencl_accelerators()) specs.push_back(spec_of("opencl", d));
+  for (const std::string& gpu : gpu_tracers_for_all(list_tracer_devices())) {
+    const size_t colon = gpu.find(':');
+    specs.push_back(spec_of(gpu.substr(0, colon), std::stoi(gpu.substr(colon + 1))));
   }
   if (specs.empty()) {
     // A build without Embree on a machine without GPUs: PoCL's CPU device is all there is.
     for (TracerSpec& s : expand_all("opencl:all")) specs.push_back(s);
   }
   return specs;
+}
+
+// Warns about requested tracers that would share a GPU (cuda:0 and opencl:1 are often one device).
+void warn_about_shared_gpus(const std::vector<TracerSpec>& specs) {
+  size_t gpu_specs = 0;
+  for (const TracerSpec& s : specs) gpu_specs += s.kind == "cuda" || s.kind == "opencl" ? 1u : 0u;
+  if (gpu_specs < 2) return;
+  const std::vector<TracerDevice> devices = list_tracer_devices();
+  std::vector<TracerDevice> requested;
+  for (const TracerSpec& s : specs) {
+    if (s.kind != "cuda" && s.kind != "opencl") continue;
+    const std::string name = s.kind + ":" + std::to_string(s.device);
+    auto found = std::find_if(devices.begin(), devices.end(), [&](const TracerDevice& d) { return d.tracer == name; });
+    requested.push_back(found != devices.end() ? *found : TracerDevice{name, "", DeviceKind::other, {}});
+  }
+  for (const SharedGpu& shared : tracers_sharing_a_gpu(requested)) spdlog::warn("{}", shared_gpu_warning(shared));
 }
 
 }  // namespace
@@ -157,6 +163,7 @@ std::vector<std::unique_ptr<core::Tracer>> make_tracers(const std::string& list)
 }
 
 std::vector<std::unique_ptr<core::Tracer>> make_tracers(const std::vector<TracerSpec>& specs) {
+  warn_about_shared_gpus(specs);
   std::vector<std::unique_ptr<core::Tracer>> out;
   std::vector<std::string> left;
   for (const TracerSpec& spec : specs) {

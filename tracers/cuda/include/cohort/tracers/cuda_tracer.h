@@ -6,6 +6,7 @@
 #include <memory>
 #include <string>
 
+#include "cohort/tracers/device_identity.h"
 #include "cohort/tracers/tracer_base.h"
 
 namespace cohort::tracers {
@@ -13,6 +14,9 @@ namespace cohort::tracers {
 // Number of usable CUDA devices; 0 when there is no driver or no GPU (never throws).
 int cuda_device_count();
 std::string cuda_device_name(int device);
+// The device's PCI address (unknown when the driver cannot say): how the registry sees that an OpenCL
+// device is the same GPU.
+PciBusId cuda_device_pci_bus_id(int device);
 
 class CudaTracer final : public TracerBase {
  public:

@@ -6,6 +6,7 @@
 #include <string>
 #include <vector>
 
+#include "cohort/tracers/device_identity.h"
 #include "cohort/tracers/tracer_base.h"
 
 namespace cohort::tracers {
@@ -30,13 +31,27 @@ class OpenCLTracer : public TracerBase {
 
   // "platform / device" for every OpenCL device on this machine, in the order Options::device counts.
   static std::vector<std::string> list_devices();
+  struct DeviceDescription {
+    std::string label;   // as list_devices() gives it
+    DeviceKind kind = DeviceKind::other;
+    // From cl_khr_pci_bus_info or NVIDIA's cl_nv_device_attribute_query where the device lists one;
+    // unknown otherwise (PoCL's CPU device).
+    PciBusId pci;
+  };
+  // The same devices in the same order, with their kind and PCI address.
+  static std::vector<DeviceDescription> describe_devices();
 
  private:
   void upload(const commit::ChangeSet& changes) override;
   bool skins_on_device() const override { return true; }
-  // The band's auxiliary planes (kernel/aux_outputs.h), by a second kernel, into target.
-  void render_aux(const core::BandJob& job, const KFrameParams& params, const KCamera& camera, size_t rows,
-                  core::BandBuffer& target);
+  // The band's auxiliary planes (kernel/aux_outputs.h), in three steps around the band's kernel: the aux
+  // kernel (and the packing to texels when the band spans the target's width, `straight`) enqueued before
+  // it; the read into page-locked memory on the second queue, overlapping it; the copy into the target
+  // once that read is done.
+  void enqueue_aux(const core::BandJob& job, const KCamera& camera, size_t rows, bool straight);
+  void read_aux_when_packed(size_t pixels, bool straight);
+  void copy_aux_into(core::BandBuffer& target, const KFrameParams& params, const KCamera& camera, size_t rows,
+                     bool straight);
 
   struct Impl;
   std::unique_ptr<Impl> impl_;

@@ -26,16 +26,18 @@ struct TracerSpec {
 // every thread, Embree slowed the two GPUs' frame by 70% at 1080p with reprojection (docs/balancing.md).
 int embree_threads_beside_gpus(unsigned hardware_threads);
 
-// Splits "embree,opencl:1" and expands "all", "cuda:all" and "opencl:all" by probing the devices;
-// throws std::invalid_argument naming a malformed entry. An Embree entry in a list with a CUDA tracer gets
-// embree_threads_beside_gpus threads.
+// Splits "embree,opencl:1" and expands "all", "cuda:all" and "opencl:all" by probing the devices ("all":
+// Embree plus each GPU once, gpu_tracers_for_all in device_listing.h); throws std::invalid_argument naming
+// a malformed entry. An Embree entry in a list with a CUDA tracer gets embree_threads_beside_gpus threads.
 std::vector<TracerSpec> parse_tracer_list(const std::string& list);
 
 // Throws std::runtime_error when this build lacks the tracer or the device cannot be opened. A remote
 // tracer whose node cannot serve is logged and left out of make_tracers' list (it throws when none is left).
 std::unique_ptr<core::Tracer> make_tracer(const TracerSpec& spec);
 std::vector<std::unique_ptr<core::Tracer>> make_tracers(const std::string& list);
-// The same for a list already parsed (parse_tracer_list probes devices for "all": parse once).
+// The same for a list already parsed (parse_tracer_list probes devices for "all": parse once). Logs a
+// warning naming both tracers and the PCI bus id when two of them would render on one GPU (cuda:0 and the
+// OpenCL device of the same GPU), and still makes them: it may be meant, as a measurement.
 std::vector<std::unique_ptr<core::Tracer>> make_tracers(const std::vector<TracerSpec>& specs);
 
 // The tracer kinds this binary was built with that render in this process (the remote `mpi` kind is
