@@ -72,7 +72,8 @@ struct RenderArgs {
   std::string band_format = "rgb16f";
   bool frames_given = false;
   bool write_ids = false;  // the G-buffer's id plane of every written frame, and which entities moved
-  bool bands_through_host = false;  // A/B: CUDA bands go down and back up even where the post could take them on the GPU
+  bool bands_through_host = false;
+  int benched_commit_every = 8;  // RendererOptions::benched_commit_every  // A/B: CUDA bands go down and back up even where the post could take them on the GPU
   double render_scale = 1.0;  // dynamic resolution (core/upsample.h)
   std::string upsample = "joint-bilateral";
 };
@@ -107,6 +108,7 @@ int run_render(const RenderArgs& a) {
   const std::string convergence_mode = resolve_convergence(a.convergence, any_gpu_tracer, post_place);
   core::RendererOptions options;
   options.balancer = a.balancer;
+  options.benched_commit_every = a.benched_commit_every;
   options.band_format = a.band_format == "rgba32f" ? core::BandFormat::rgba32f : core::BandFormat::rgb16f;
   options.frame_timeout = std::chrono::milliseconds(600000);
   core::Renderer renderer(std::move(tracers), options);
@@ -485,6 +487,11 @@ void add_render_command(CLI::App& app, int& exit_code) {
                   "frame and its G-buffer cross the bus each frame) or auto (the first CUDA tracer's GPU, else the "
                   "host)")
       ->capture_default_str();
+  cmd->add_option("--benched-commit-every", a->benched_commit_every,
+                  "a tracer the balancer benches (no rows) applies the world's changes every N frames, coalesced, "
+                  "instead of every frame (1: every frame); it catches up before it renders again")
+      ->capture_default_str()
+      ->check(CLI::Range(1, 1000));
   cmd->add_flag("--bands-through-host", a->bands_through_host,
                "with the post-processing on a CUDA GPU, copy CUDA tracers' bands down to the host and back up "
                "like any other (by default they stay on the GPUs: device to device, or over NVLink from a peer)");

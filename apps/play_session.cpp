@@ -113,6 +113,7 @@ PlaySession::PlaySession(const SessionOptions& options) {
   core::RendererOptions renderer_options;
   renderer_options.balancer = options.balancer;
   renderer_options.band_format = core::BandFormat::rgb16f;  // half the bytes; the HUD image cannot tell
+  renderer_options.benched_commit_every = 8;  // as `cohort render`'s default
   s.renderer = std::make_unique<core::Renderer>(std::move(tracers), renderer_options);
   s.renderer->submit_commit(commit::CommitBuffer::full(initial_scene, 0));
   s.pipeline = std::make_unique<core::FramePipeline>(*s.renderer);

@@ -58,6 +58,7 @@ struct Renderer::Worker {
   uint64_t side_job = 0;
   balance::Band side_band;
   double rows_per_ms = 0.0;
+  int benched_frames_without_job = 0;  // frames benched since its last side job (RendererOptions::benched_commit_every)
 
   // Outcome of the last job, guarded by completion->mutex.
   bool busy = false;
@@ -446,6 +447,9 @@ void Renderer::begin_frame(const BandJob& job, FrameBuffer& out, const std::vect
       t.outcome = TracerOutcome::no_rows;
       const balance::Band probe = probes.size() == ready.size() ? probes[i] : balance::Band{};
       t.probe_rows = probe.rows();
+      Worker& w = *workers_[static_cast<size_t>(ready[i])];
+      if (probe.empty() && ++w.benched_frames_without_job < options_.benched_commit_every) continue;
+      w.benched_frames_without_job = 0;
       side_jobs.push_back({ready[i], probe, !probe.empty(), {}});
     } else {
       assignments.push_back({ready[i], bands[i], false, {}});

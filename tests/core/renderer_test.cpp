@@ -1,5 +1,7 @@
 #include <gtest/gtest.h>
 
+#include <set>
+
 #include <atomic>
 #include <future>
 #include <thread>
@@ -461,6 +463,31 @@ TEST(Renderer, ABenchedTracerKeepsApplyingCommitsAndIsProbedOnTheSide) {
     std::this_thread::sleep_for(std::chrono::milliseconds(1));
   }
   EXPECT_EQ(slow_commit->load(), 40u);
+}
+
+TEST(Renderer, ABenchedTracerTakesItsCommitsCoalescedEveryNFrames) {
+  auto slow_commit = std::make_shared<std::atomic<uint64_t>>(0);
+  RendererOptions options = whole_cost_options();
+  options.balancer_options.probe_interval = 100000;  // no probes: only the commit side jobs
+  options.benched_commit_every = 6;
+  Renderer renderer(fast_and_hopeless(slow_commit), options);
+  auto scene = std::make_shared<cohort::commit::TracerScene>();
+  FrameBuffer fb;
+  uint64_t behind = 0;
+  for (uint64_t f = 0; f < 60; ++f) {
+    renderer.submit_commit(cohort::commit::CommitBuffer::full(scene, f + 1));
+    const FrameStats stats = renderer.render(job_for(f), fb);
+    expect_complete(fb, f, stats, {1, 2});
+    if (f >= 10) EXPECT_EQ(stats.tracers[1].row_end - stats.tracers[1].row_begin, 0) << "frame " << f;
+    std::this_thread::sleep_for(std::chrono::milliseconds(1));  // a side job, if any, lands
+    if (f >= 10) behind = std::max<uint64_t>(behind, f + 1 - slow_commit->load());
+  }
+  // Benched from about frame 5: a side job every 6th frame, carrying the commits since the last.
+  const cohort::commit::CommitStats c = renderer.commit_stats(1);
+  EXPECT_LE(c.commits_taken, 20u) << "it took a commit nearly every frame";
+  EXPECT_GE(c.frames_coalesced, 35u);
+  EXPECT_EQ(c.overflows, 0u);
+  EXPECT_LE(behind, 6u) << "never more than 6 frames behind";
 }
 
 TEST(Renderer, ABenchedTracerReRendersTheRowsOfATracerThatFailed) {

@@ -54,6 +54,11 @@ struct RendererOptions {
   // What the tracers render their bands into (core/band_buffer.h); the merge converts to the float
   // frame. The apps take RGB16F; RGBA32F keeps values exact.
   BandFormat band_format = BandFormat::rgba32f;
+  // A benched tracer with no probe to render gets its commits every this many frames (they coalesce in
+  // its channel meanwhile), not every frame: applying them is pure overhead while it sits out, and a CPU
+  // tracer's apply (skinning, refits, its TLAS on every core) slows the host's part of the frame. 1: every
+  // frame. Whatever it skipped is applied before it renders again.
+  int benched_commit_every = 1;
 };
 
 class Renderer {
