@@ -112,7 +112,11 @@ void SitOutTrials::start_trial_if_due(const DivideInput& in, const std::vector<B
     if (due != next_trial_at_.end() && frames_ < due->second) continue;
     // Out by verdict and due again: back in; the inner balancer's band says whether it is a candidate.
     sitting_out_.erase(id);
-    if (bands[i].empty() || bands[i].rows() > options_.trial_share * in.rows) continue;
+    // A small taker: at most trial_share of the frame and half an even share (four GPUs' quarters are
+    // not tried beside a CPU tracer's sliver).
+    if (bands[i].empty() || bands[i].rows() > options_.trial_share * in.rows ||
+        bands[i].rows() > 0.5 * in.rows / takers)
+      continue;
     trial_ = Trial{id, 0, {}, {}};
     return;
   }

@@ -146,3 +146,21 @@ TEST(SitOutTrials, RejectsBadOptions) {
   bad.trial_share = 1.5;
   EXPECT_THROW(make_balancer("whole-cost", bad), std::invalid_argument);
 }
+
+TEST(SitOutTrials, EvenSharesAreNotTried) {
+  // Four equal GPU-like tracers, each a quarter: no trial, whatever the hidden cost.
+  HiddenCostFrame f{720, {0.006, 0.006, 0.006, 0.006}, {0.0, 0.0, 0.0, 0.0}, {0.5, 0.5, 0.5, 0.5}, 0.02};
+  BalancerOptions options;
+  options.trial_share = 0.3;
+  auto b = make_balancer("whole-cost", options);
+  std::mt19937 rng(3);
+  std::vector<TracerMeasurement> previous;
+  double interval = 0.0;
+  for (int frame = 0; frame < 300; ++frame) {
+    const std::vector<Band> bands = b->divide({f.rows, {0, 1, 2, 3}, previous, {}, interval});
+    previous = f.measure(bands);
+    interval = f.interval(bands, rng);
+    EXPECT_TRUE(b->take_verdicts().empty()) << "frame " << frame;
+    for (const Band& band : bands) EXPECT_GE(band.rows(), 150) << "frame " << frame;
+  }
+}
