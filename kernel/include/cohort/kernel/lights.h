@@ -89,15 +89,20 @@ KFN KVec3 k_light_jittered_direction(KGLOBAL const KLight* light, KVec3 p, float
 KFN KVec3 k_light_unshadowed(const KSceneView* scene, KGLOBAL const KLight* light, const KSurface* sf, KVec3 wo,
                              float spec_boost) {
   if (light->flags & K_LIGHT_VOLUME_EFFECT) return v3s(0.0f);   /* fog and blend lights: fog.h */
-  KVec3 radiance = v3_scale(k_light_radiance_at(scene, light, sf->position), K_PI);
-  if (v3_max_component(radiance) <= 0.0f) return v3s(0.0f);
   if (light->flags & K_LIGHT_AMBIENT) {
     /* The engine's ambient interaction lights from the `_ambient` cube's constant tangent-space vector
      * (about (0, -0.77, 0.78)), no specular: a flat surface gets N.L = 0.78 whichever way it faces. */
+    KVec3 radiance = v3_scale(k_light_radiance_at(scene, light, sf->position), K_PI);
+    if (v3_max_component(radiance) <= 0.0f) return v3s(0.0f);
     return v3_scale(v3_mul(radiance, k_brdf_eval_cos(sf, wo, sf->normal, 0.0f)), K_AMBIENT_N_DOT_L);
   }
+  /* A light behind the surface (k_brdf_eval_cos's own test) contributes nothing: known before its
+   * falloff and light images are read, which the light tree's gather does for up to 16 lights a hit. */
   float dist;
   KVec3 wi = k_light_direction(light, sf->position, &dist);
+  if (v3_dot(sf->normal, wi) <= 0.0f || v3_dot(sf->geo_normal, wi) <= 0.0f) return v3s(0.0f);
+  KVec3 radiance = v3_scale(k_light_radiance_at(scene, light, sf->position), K_PI);
+  if (v3_max_component(radiance) <= 0.0f) return v3s(0.0f);
   float spec_scale = (light->flags & K_LIGHT_NO_SPECULAR) ? 0.0f : spec_boost;
   return v3_mul(radiance, k_brdf_eval_cos(sf, wo, wi, spec_scale));
 }
