@@ -13,6 +13,7 @@
 //
 //   bench_tracers [scene.pack | map] [--large MAP|none] [--width W] [--height H] [--spp S]
 //                 [--light-samples L] [--bounces B] [--threads T] [--repeats R] [--json FILE] [--others]
+//                 [--frame-only]
 // Default: the generated test map (assets/testmap) from the player start, then the large map
 // (tools/gen_testmap.py --large) when it has been generated into the build folder.
 #include <time.h>
@@ -51,6 +52,7 @@ struct Config {
   int width = 640, height = 360, spp = 1, light_samples = 1, bounces = 1, threads = 1, repeats = 3;
   std::string json;
   bool others = false;
+  bool frame_only = false;
 };
 
 Config parse(int argc, char** argv) {
@@ -72,6 +74,9 @@ Config parse(int argc, char** argv) {
       ->check(CLI::PositiveNumber)->capture_default_str();
   app.add_option("--json", c.json, "also write the results as JSON to this file");
   app.add_flag("--others", c.others, "also time whole frames on every other tracer this build has");
+  app.add_flag("--frame-only", c.frame_only,
+               "only the whole path-mode frame's best CPU time per scene (no ray classes, no raw rays): a quick "
+               "before/after comparison");
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -166,7 +171,22 @@ struct ClassRow {
   RawTimes raw;
 };
 
+nlohmann::json measure_embree_frame(const Config& cfg, const LoadedScene& s) {
+  tracers::EmbreeTracer embree(cfg.threads);
+  embree.apply(commit::CommitBuffer::full(s.scene, 1));
+  const core::BandJob path = make_job(cfg, s.camera, K_MODE_PATH);
+  core::FrameBuffer fb;
+  fb.resize(cfg.width, cfg.height);
+  const double t_path = best_cpu_seconds(cfg.repeats, [&] { embree.render_band(path, fb); });
+  std::printf("\nscene %s: %dx%d, %d spp, %d light sample(s), %d bounce(s), %s\n", s.name.c_str(), cfg.width,
+              cfg.height, cfg.spp, cfg.light_samples, cfg.bounces,
+              cfg.threads == 1 ? "1 thread" : (std::to_string(cfg.threads) + " threads (0: all)").c_str());
+  std::printf("whole frame: %.1f ms CPU (best of %d)\n", t_path * 1e3, cfg.repeats);
+  return {{"scene", s.name}, {"frame_cpu_ms", t_path * 1e3}};
+}
+
 nlohmann::json measure_embree(const Config& cfg, const LoadedScene& s) {
+  if (cfg.frame_only) return measure_embree_frame(cfg, s);
   tracers::EmbreeTracer embree(cfg.threads);
   embree.apply(commit::CommitBuffer::full(s.scene, 1));
   const core::BandJob albedo = make_job(cfg, s.camera, K_MODE_ALBEDO);

@@ -9,6 +9,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "cohort/tracers/embree_texture.h"  // before the kernel headers: K_TEXEL_BILINEAR
 #include "cohort/kernel/material.h"
 #include "cohort/tracers/embree_tracer.h"
 

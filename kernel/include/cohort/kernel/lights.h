@@ -22,33 +22,44 @@ KFN float k_window_falloff(float d2) {
 
 KFN int k_inside01(float x) { return x >= 0.0f && x <= 1.0f; }
 
-/* Light colour times attenuation at p, before N.L and shadows. */
-KFN KVec3 k_light_radiance_at(const KSceneView* scene, KGLOBAL const KLight* light, KVec3 p) {
-  float s = k_plane_eval(light->plane_s, p);
-  float t = k_plane_eval(light->plane_t, p);
-  float f = k_plane_eval(light->plane_f, p);
-  float atten = 1.0f;
-  KVec3 tint = v3s(1.0f);
+/* Where p lies in the light's volume: its S and T coordinates (divided by Q for projected lights) and
+ * F. Returns 0 when p lies outside the volume, where the light is zero. */
+KFN int k_light_coords(KGLOBAL const KLight* light, KVec3 p, float* s, float* t, float* f) {
+  *s = k_plane_eval(light->plane_s, p);
+  *t = k_plane_eval(light->plane_t, p);
+  *f = k_plane_eval(light->plane_f, p);
   if (light->type == K_LIGHT_PROJECTED) {
     float q = k_plane_eval(light->plane_q, p);
-    if (q <= 0.0f) return v3s(0.0f);
-    s /= q;
-    t /= q;
-    if (!k_inside01(s) || !k_inside01(t) || !k_inside01(f)) return v3s(0.0f);
-    atten = light->falloff_tex != K_NONE ? k_texture_sample(scene, light->falloff_tex, f, 0.5f).x
-                                         : k_window_falloff(f * f);
-  } else {
-    if (!k_inside01(s) || !k_inside01(t) || !k_inside01(f)) return v3s(0.0f);
-    if (light->falloff_tex != K_NONE) {
-      atten = k_texture_sample(scene, light->falloff_tex, f, 0.5f).x;
-    } else if (light->type == K_LIGHT_POINT) {
-      float ds = 2.0f * s - 1.0f, dt = 2.0f * t - 1.0f, df = 2.0f * f - 1.0f;
-      atten = k_window_falloff(ds * ds + dt * dt + df * df);
-    }
+    if (q <= 0.0f) return 0;
+    *s /= q;
+    *t /= q;
+  }
+  return k_inside01(*s) && k_inside01(*t) && k_inside01(*f);
+}
+
+/* Light colour times attenuation at volume coordinates (k_light_coords) inside the volume: the falloff
+ * and light images are read here. */
+KFN KVec3 k_light_radiance_in(const KSceneView* scene, KGLOBAL const KLight* light, float s, float t, float f) {
+  float atten = 1.0f;
+  KVec3 tint = v3s(1.0f);
+  if (light->falloff_tex != K_NONE) {
+    atten = k_texture_sample(scene, light->falloff_tex, f, 0.5f).x;
+  } else if (light->type == K_LIGHT_PROJECTED) {
+    atten = k_window_falloff(f * f);
+  } else if (light->type == K_LIGHT_POINT) {
+    float ds = 2.0f * s - 1.0f, dt = 2.0f * t - 1.0f, df = 2.0f * f - 1.0f;
+    atten = k_window_falloff(ds * ds + dt * dt + df * df);
   }
   if (atten <= 0.0f) return v3s(0.0f);
   if (light->light_tex != K_NONE) tint = v4_rgb(k_texture_sample(scene, light->light_tex, s, t));
   return v3_scale(v3_mul(v3_load_g(light->color), tint), atten);
+}
+
+/* Light colour times attenuation at p, before N.L and shadows. */
+KFN KVec3 k_light_radiance_at(const KSceneView* scene, KGLOBAL const KLight* light, KVec3 p) {
+  float s, t, f;
+  if (!k_light_coords(light, p, &s, &t, &f)) return v3s(0.0f);
+  return k_light_radiance_in(scene, light, s, t, f);
 }
 
 /* Direction from p toward the light's (unjittered) emission point and the distance to it. */
@@ -89,15 +100,23 @@ KFN KVec3 k_light_jittered_direction(KGLOBAL const KLight* light, KVec3 p, float
 KFN KVec3 k_light_unshadowed(const KSceneView* scene, KGLOBAL const KLight* light, const KSurface* sf, KVec3 wo,
                              float spec_boost) {
   if (light->flags & K_LIGHT_VOLUME_EFFECT) return v3s(0.0f);   /* fog and blend lights: fog.h */
-  KVec3 radiance = v3_scale(k_light_radiance_at(scene, light, sf->position), K_PI);
-  if (v3_max_component(radiance) <= 0.0f) return v3s(0.0f);
   if (light->flags & K_LIGHT_AMBIENT) {
     /* The engine's ambient interaction lights from the `_ambient` cube's constant tangent-space vector
      * (about (0, -0.77, 0.78)), no specular: a flat surface gets N.L = 0.78 whichever way it faces. */
+    KVec3 radiance = v3_scale(k_light_radiance_at(scene, light, sf->position), K_PI);
+    if (v3_max_component(radiance) <= 0.0f) return v3s(0.0f);
     return v3_scale(v3_mul(radiance, k_brdf_eval_cos(sf, wo, sf->normal, 0.0f)), K_AMBIENT_N_DOT_L);
   }
+  /* Outside the volume (plane tests), then behind the surface (k_brdf_eval_cos's own test): both known
+   * before the falloff and light images are read, which the light tree's gather does for up to 16
+   * lights a hit. */
+  float s, t, f;
+  if (!k_light_coords(light, sf->position, &s, &t, &f)) return v3s(0.0f);
   float dist;
   KVec3 wi = k_light_direction(light, sf->position, &dist);
+  if (v3_dot(sf->normal, wi) <= 0.0f || v3_dot(sf->geo_normal, wi) <= 0.0f) return v3s(0.0f);
+  KVec3 radiance = v3_scale(k_light_radiance_in(scene, light, s, t, f), K_PI);
+  if (v3_max_component(radiance) <= 0.0f) return v3s(0.0f);
   float spec_scale = (light->flags & K_LIGHT_NO_SPECULAR) ? 0.0f : spec_boost;
   return v3_mul(radiance, k_brdf_eval_cos(sf, wo, wi, spec_scale));
 }
