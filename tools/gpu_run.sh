@@ -17,6 +17,8 @@
 #                              tracer tests of the staged one, then end-to-end ms per frame, cuda:0, both maps,
 #                              Brigade's blend, each payload in turn, three rounds (COHORT_GPU_COMPARE_ARGS adds
 #                              render options)
+#   tools/gpu_run.sh stage-mpi here: the travelling cohort built against PyPI's MPICH, with its libraries (.gpu/mpi.tar.xz)
+#   tools/gpu_run.sh cluster   there, on a two-GPU kind: two ranks with one GPU each against the in-process two GPUs
 #   tools/gpu_run.sh frametimes  there: only the end-to-end frame times (large map 1080p generated there,
 #                              test map 720p; cuda:0, 1 spp, NEE + 1 bounce; reprojection on the GPU with and
 #                              without the a-trous filter, on the host, and Brigade's blend; per-stage medians;
@@ -54,6 +56,47 @@ case "${1:-}" in
     fi
     tar -C "$stage" -cJf "$stage/payload.tar.xz" bin lib && rm -rf "$stage/bin" "$stage/lib"
     du -sh "$stage"
+    ;;
+  stage-mpi)
+    # Here: the travelling cohort built against MPICH from PyPI (docs/cluster.md), with MPICH's libraries and
+    # launcher beside it, as .gpu/mpi.tar.xz (~16 MB; carried with the payload). `cluster` runs it there.
+    venv=${COHORT_MPICH_VENV:-/tmp/cohort-mpich}
+    [ -x "$venv/bin/mpicxx" ] || { python3 -m venv "$venv" && "$venv/bin/pip" install -q mpich; }
+    cmake --preset gpu-travel -B build/gpu-mpi -DCOHORT_WITH_MPI=ON -DMPI_HOME="$venv" \
+      -DMPI_CXX_COMPILER="$venv/bin/mpicxx" -DMPIEXEC_EXECUTABLE="$venv/bin/mpiexec" >/dev/null
+    cmake --build build/gpu-mpi -j2 --target cohort
+    mpi_stage=$(mktemp -d); mkdir -p "$mpi_stage/bin" "$mpi_stage/lib" "$stage"
+    strip -o "$mpi_stage/bin/cohort" build/gpu-mpi/bin/cohort
+    for lib in libembree3.so.3 libtbb.so.12 libzip.so.4; do cp -L "/usr/lib/x86_64-linux-gnu/$lib" "$mpi_stage/lib/"; done
+    cp -a "$venv/lib/libmpi.so.12" "$venv/lib/mpich" "$mpi_stage/lib/"
+    cp "$venv/bin/mpiexec.hydra" "$venv/bin/hydra_pmi_proxy" "$mpi_stage/bin/"
+    tar -C "$mpi_stage" -cJf "$stage/mpi.tar.xz" bin lib && rm -rf "$mpi_stage"
+    du -sh "$stage/mpi.tar.xz"
+    ;;
+  cluster)
+    # There, on a two-GPU kind: issue 19's first target, two ranks with one GPU each (cohort node) against
+    # the in-process two-GPU frame, both maps, Brigade's blend (rank 0 then has no GPU of its own), two rounds.
+    mkdir -p "$stage/mpi" && tar -C "$stage/mpi" -xJf "$stage/mpi.tar.xz"
+    export PATH="$PWD/$stage/mpi/bin:$PATH"
+    cohort="$PWD/$stage/mpi/bin/cohort"
+    [ -f /tmp/largemap.cpk ] || { python3 tools/gen_testmap.py --large --out /tmp/largemap >/dev/null &&
+      "$cohort" pack /tmp/largemap/maps/largemap.map --out /tmp/largemap.cpk | tail -n 1; }
+    for round in 1 2; do
+      for map in large test; do
+        if [ $map = large ]; then pack=/tmp/largemap.cpk; size=(--width 1920 --height 1080 --camera 1690 300 80 5 -12)
+        else pack="$PWD/$stage/testmap.cpk"; size=(--width 1280 --height 720); fi
+        common=(--spp 1 --light-samples 1 --bounces 1 --convergence brigade --frames 200 --camera-path spin-slow --write last)
+        timeout 120 "$cohort" render "$pack" "${size[@]}" "${common[@]}" --tracers cuda:0,cuda:1 --out /tmp/in_$map >/tmp/in_$map.log 2>&1 ||
+          tail -n 3 /tmp/in_$map.log
+        echo "round $round, $map map, in-process: $(python3 tools/frame_times.py /tmp/in_$map/stats.json --skip 50 | head -n 1)"
+        timeout 180 mpiexec.hydra -np 1 "$cohort" render "$pack" "${size[@]}" "${common[@]}" --tracers mpi:1,mpi:2 --out /tmp/mpi_$map : \
+          -np 1 "$cohort" node "$pack" --tracers cuda:0 : -np 1 "$cohort" node "$pack" --tracers cuda:1 >/tmp/mpi_$map.log 2>&1 ||
+          { echo "two-rank run failed"; tail -n 8 /tmp/mpi_$map.log; }
+        [ -f /tmp/mpi_$map/stats.json ] &&
+          echo "round $round, $map map, two ranks: $(python3 tools/frame_times.py /tmp/mpi_$map/stats.json --skip 50 | head -n 1)"
+        grep -E "round trip" /tmp/mpi_$map.log | sed 's/^.*\] //' || true
+      done
+    done
     ;;
   compare)
     # Each payload unpacks into .gpu/cmp/NAME (NAME: its file name without .tar.xz; the staged one is "new").
