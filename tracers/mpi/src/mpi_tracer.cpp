@@ -120,9 +120,11 @@ void MpiTracer::adopt(const wire::Hello& hello) {
 MpiTracer::~MpiTracer() {
   const MpiLinkStats s = link_stats();
   if (s.bands > 0)
-    spdlog::info("mpi:{}: {} band(s), {:.1f} KiB sent and {:.1f} KiB received a band, round trip {:.2f} ms a band",
+    spdlog::info("mpi:{}: {} band(s), {:.1f} KiB sent and {:.1f} KiB received a band, round trip {:.2f} ms a band "
+                 "({:.2f} ms of it rendering on the node)",
                  options_.rank, s.bands, double(s.bytes_sent) / double(s.bands) / 1024.0,
-                 double(s.bytes_received) / double(s.bands) / 1024.0, s.total_round_trip_ms / double(s.bands));
+                 double(s.bytes_received) / double(s.bands) / 1024.0, s.total_round_trip_ms / double(s.bands),
+                 s.total_node_ms / double(s.bands));
   // The node stays for later tracers of this run; the session's end tells every node to leave.
   try {
     MpiSession& mpi = MpiSession::get();
