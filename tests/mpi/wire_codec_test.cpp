@@ -197,6 +197,34 @@ TEST(WireCodec, BandRowsTravelAsTheBandFormatsBytes) {
   EXPECT_NE(refusal([&] { wire::decode_band_rows(payload); }).find("pixel bytes"), std::string::npos);
 }
 
+TEST(WireCodec, TheNodesOneBufferMessageIsTheFramedPayloadAndDecodesInPlace) {
+  core::BandBuffer band(8, 6, core::BandFormat::rgb16f);
+  band.enable_aux(true);
+  for (int y = 0; y < 6; ++y)
+    for (int x = 0; x < 8; ++x) {
+      const float rgba[4] = {float(x), float(y), 0.5f, 1.0f};
+      band.store(y, x, rgba, 1);
+      band.aux_row(y)[x].depth = float(10 * y + x);
+    }
+  const std::vector<float> work = {1.0f, 2.0f};
+  const std::vector<uint8_t> message = wire::band_rows_message(77, band, 2, 4, 1.5, work);
+  EXPECT_EQ(message, wire::frame_message(wire::Kind::band_rows, 77, wire::encode_band_rows(band, 2, 4, 1.5, work)));
+  const wire::Message m = wire::parse_message(message.data(), message.size());
+  EXPECT_EQ(m.kind, wire::Kind::band_rows);
+  EXPECT_EQ(m.sequence, 77u);
+  const wire::BandRowsView v = wire::decode_band_rows_view(m.payload);
+  EXPECT_EQ(v.row_begin, 2u);
+  EXPECT_EQ(v.row_end, 4u);
+  EXPECT_EQ(v.row_work, work);
+  ASSERT_EQ(v.pixel_bytes, 2 * band.row_bytes());
+  EXPECT_EQ(std::memcmp(v.pixels, band.row(2), v.pixel_bytes), 0);
+  ASSERT_EQ(v.aux_bytes, 2 * 8 * sizeof(KAuxTexel));
+  EXPECT_EQ(std::memcmp(v.aux, band.aux_row(2), v.aux_bytes), 0);
+  EXPECT_GE(v.pixels, m.payload.data());
+  EXPECT_LT(v.aux, m.payload.data() + m.payload.size()) << "views into the payload, not copies";
+  expect_every_prefix_refused(m.payload, [](const auto& p) { return wire::decode_band_rows_view(p); });
+}
+
 TEST(WireCodec, BandJobsOutsideTheFrameAreRefused) {
   wire::BandRequest request;
   request.job.camera.width = 64;

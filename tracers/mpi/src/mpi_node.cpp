@@ -153,7 +153,7 @@ class Node {
       return;
     }
     const double ms = std::chrono::duration<double, std::milli>(MpiClock::now() - start).count();
-    send(mpi, wire::Kind::band_rows, m.sequence, wire::encode_band_rows(target_, p.row_begin, p.row_end, ms, row_work));
+    mpi.send(kRank0, wire::band_rows_message(m.sequence, target_, p.row_begin, p.row_end, ms, row_work));
     ++bands_;
   }
 

@@ -269,9 +269,9 @@ core::BandResult MpiTracer::render_band(const core::BandJob& job, core::BandBuff
       }
       throw std::runtime_error(fmt::format("mpi:{}: {}", options_.rank, failure.reason));
     }
-    wire::BandRows rows;
+    wire::BandRowsView rows;
     try {
-      rows = wire::decode_band_rows(m.payload);
+      rows = wire::decode_band_rows_view(m.payload);
     } catch (const wire::WireError& e) {
       std::lock_guard lock(stats_mutex_);
       ++stats_.refused_messages;
@@ -279,15 +279,14 @@ core::BandResult MpiTracer::render_band(const core::BandJob& job, core::BandBuff
     }
     if (rows.row_begin != job.params.row_begin || rows.row_end != job.params.row_end ||
         int(rows.width) != target.width() || rows.format != target.format() ||
-        job.params.row_end > uint32_t(target.height()) || (target.has_aux() && rows.aux.empty()))
+        job.params.row_end > uint32_t(target.height()) || (target.has_aux() && rows.aux_bytes == 0))
       throw std::runtime_error(fmt::format("mpi:{}: refused the band's rows: rows [{}, {}) of {} {} pixels, asked "
                                            "for [{}, {}) of {} {}{}", options_.rank, rows.row_begin, rows.row_end,
                                            rows.width, core::to_string(rows.format), job.params.row_begin,
                                            job.params.row_end, target.width(), core::to_string(target.format()),
                                            target.has_aux() ? " with aux planes" : ""));
-    if (!rows.pixels.empty()) std::memcpy(target.row(int(rows.row_begin)), rows.pixels.data(), rows.pixels.size());
-    if (target.has_aux() && !rows.aux.empty())
-      std::memcpy(target.aux_row(int(rows.row_begin)), rows.aux.data(), rows.aux.size());
+    if (rows.pixel_bytes > 0) std::memcpy(target.row(int(rows.row_begin)), rows.pixels, rows.pixel_bytes);
+    if (target.has_aux() && rows.aux_bytes > 0) std::memcpy(target.aux_row(int(rows.row_begin)), rows.aux, rows.aux_bytes);
     const double round_trip = ms_since(start);
     after_full_resync_ = false;
     {

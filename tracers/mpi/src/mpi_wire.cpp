@@ -72,6 +72,14 @@ class Reader {
     if (pos_ != bytes_.size()) fail(fmt::format("{} bytes left over after the last field", bytes_.size() - pos_));
   }
   size_t left() const { return bytes_.size() - pos_; }
+  // The next n bytes where they lie (no copy); valid while the message is.
+  const uint8_t* view(uint64_t n, const char* name) {
+    if (n > bytes_.size() - pos_)
+      fail(fmt::format("{}: {} bytes do not fit in the {} bytes left", name, n, bytes_.size() - pos_));
+    const uint8_t* p = bytes_.data() + pos_;
+    pos_ += n;
+    return p;
+  }
 
  private:
   const std::vector<uint8_t>& bytes_;
@@ -406,30 +414,57 @@ BandRequest decode_band_request(const std::vector<uint8_t>& payload) {
   return q;
 }
 
-std::vector<uint8_t> encode_band_rows(const core::BandBuffer& source, uint32_t row_begin, uint32_t row_end,
-                                      double device_ms, const std::vector<float>& row_work) {
-  Writer w;
+namespace {
+
+// A band's rows as the payload holds them; `w` may already hold a header (band_rows_message).
+void write_band_rows(Writer& w, const core::BandBuffer& source, uint32_t row_begin, uint32_t row_end, double device_ms,
+                     const std::vector<float>& row_work) {
+  const size_t rows = row_end - row_begin;
+  const size_t aux_row_bytes = size_t(source.width()) * sizeof(KAuxTexel);
+  const uint64_t pixel_bytes = rows * source.row_bytes();
+  const uint64_t aux_bytes = source.has_aux() ? rows * aux_row_bytes : 0;
+  // One allocation for the whole message: the band is megabytes, and a growing vector copies it again.
+  w.out.reserve(w.out.size() + 4 * sizeof(uint32_t) + sizeof(double) + 3 * sizeof(uint64_t) +
+                row_work.size() * sizeof(float) + pixel_bytes + aux_bytes);
   w.scalar(row_begin);
   w.scalar(row_end);
   w.scalar(uint32_t(source.width()));
   w.scalar(uint32_t(source.format()));
   w.scalar(device_ms);
   w.array(row_work);
-  const size_t rows = row_end - row_begin;
-  w.scalar(uint64_t(rows * source.row_bytes()));
-  if (rows > 0) w.raw(source.row(int(row_begin)), rows * source.row_bytes());
-  const size_t aux_row_bytes = size_t(source.width()) * sizeof(KAuxTexel);
-  const uint64_t aux_bytes = source.has_aux() ? rows * aux_row_bytes : 0;
+  w.scalar(pixel_bytes);
+  if (rows > 0) w.raw(source.row(int(row_begin)), pixel_bytes);
   w.scalar(aux_bytes);
   if (aux_bytes > 0)
     w.raw(static_cast<const uint8_t*>(const_cast<core::BandBuffer&>(source).aux_data()) + row_begin * aux_row_bytes,
           aux_bytes);
+}
+
+}  // namespace
+
+std::vector<uint8_t> encode_band_rows(const core::BandBuffer& source, uint32_t row_begin, uint32_t row_end,
+                                      double device_ms, const std::vector<float>& row_work) {
+  Writer w;
+  write_band_rows(w, source, row_begin, row_end, device_ms, row_work);
   return std::move(w.out);
 }
 
-BandRows decode_band_rows(const std::vector<uint8_t>& payload) {
+std::vector<uint8_t> band_rows_message(uint64_t sequence, const core::BandBuffer& source, uint32_t row_begin,
+                                       uint32_t row_end, double device_ms, const std::vector<float>& row_work) {
+  Writer w;
+  w.out.resize(sizeof(Header));
+  write_band_rows(w, source, row_begin, row_end, device_ms, row_work);
+  Header h;
+  h.kind = uint16_t(Kind::band_rows);
+  h.sequence = sequence;
+  h.payload_bytes = w.out.size() - sizeof h;
+  std::memcpy(w.out.data(), &h, sizeof h);
+  return std::move(w.out);
+}
+
+BandRowsView decode_band_rows_view(const std::vector<uint8_t>& payload) {
   Reader r(payload, "band_rows");
-  BandRows b;
+  BandRowsView b;
   b.row_begin = r.scalar<uint32_t>();
   b.row_end = r.scalar<uint32_t>();
   b.width = r.scalar<uint32_t>();
@@ -440,16 +475,32 @@ BandRows decode_band_rows(const std::vector<uint8_t>& payload) {
   const uint64_t rows = b.row_end - b.row_begin;
   if (!b.row_work.empty() && b.row_work.size() != rows)
     r.fail(fmt::format("{} row work values for {} rows", b.row_work.size(), rows));
-  b.pixels = r.array<uint8_t>("pixels");
+  b.pixel_bytes = r.scalar<uint64_t>();
+  b.pixels = r.view(b.pixel_bytes, "pixels");
   const uint64_t expected = rows * b.width * core::bytes_per_pixel(b.format);
-  if (b.pixels.size() != expected)
-    r.fail(fmt::format("{} pixel bytes; {} rows of {} {} pixels are {}", b.pixels.size(), rows, b.width,
+  if (b.pixel_bytes != expected)
+    r.fail(fmt::format("{} pixel bytes; {} rows of {} {} pixels are {}", b.pixel_bytes, rows, b.width,
                        core::to_string(b.format), expected));
-  b.aux = r.array<uint8_t>("aux planes");
-  if (!b.aux.empty() && b.aux.size() != rows * b.width * sizeof(KAuxTexel))
-    r.fail(fmt::format("{} aux bytes; {} rows of {} texels are {}", b.aux.size(), rows, b.width,
+  b.aux_bytes = r.scalar<uint64_t>();
+  b.aux = r.view(b.aux_bytes, "aux planes");
+  if (b.aux_bytes != 0 && b.aux_bytes != rows * b.width * sizeof(KAuxTexel))
+    r.fail(fmt::format("{} aux bytes; {} rows of {} texels are {}", b.aux_bytes, rows, b.width,
                        rows * b.width * sizeof(KAuxTexel)));
   r.expect_end();
+  return b;
+}
+
+BandRows decode_band_rows(const std::vector<uint8_t>& payload) {
+  BandRowsView v = decode_band_rows_view(payload);
+  BandRows b;
+  b.row_begin = v.row_begin;
+  b.row_end = v.row_end;
+  b.width = v.width;
+  b.format = v.format;
+  b.device_ms = v.device_ms;
+  b.row_work = std::move(v.row_work);
+  b.pixels.assign(v.pixels, v.pixels + v.pixel_bytes);
+  b.aux.assign(v.aux, v.aux + v.aux_bytes);
   return b;
 }
 

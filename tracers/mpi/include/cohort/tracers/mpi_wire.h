@@ -108,6 +108,22 @@ struct BandRows {
 std::vector<uint8_t> encode_band_rows(const core::BandBuffer& source, uint32_t row_begin, uint32_t row_end,
                                       double device_ms, const std::vector<float>& row_work);
 BandRows decode_band_rows(const std::vector<uint8_t>& payload);
+// The same, pixels and aux texels left where they lie in `payload` (valid while it is): the remote tracer
+// copies them once, into its target.
+struct BandRowsView {
+  uint32_t row_begin = 0, row_end = 0, width = 0;
+  core::BandFormat format = core::BandFormat::rgb16f;
+  double device_ms = 0.0;
+  std::vector<float> row_work;
+  const uint8_t* pixels = nullptr;
+  uint64_t pixel_bytes = 0;
+  const uint8_t* aux = nullptr;
+  uint64_t aux_bytes = 0;
+};
+BandRowsView decode_band_rows_view(const std::vector<uint8_t>& payload);
+// A whole band_rows message (header included) built in one buffer: what the node sends.
+std::vector<uint8_t> band_rows_message(uint64_t sequence, const core::BandBuffer& source, uint32_t row_begin,
+                                       uint32_t row_end, double device_ms, const std::vector<float>& row_work);
 
 struct BandFailure {
   bool needs_full_resync = false;  // the node's scene is behind or diverged: the next commit must be whole
