@@ -231,34 +231,38 @@ core::BandResult MpiTracer::render_band(const core::BandJob& job, core::BandBuff
       std::lock_guard lock(stats_mutex_);
       stats_.bytes_received += bytes->size();
     }
-    wire::Message m;
+    // The header only: a band's rows stay where they arrived and are copied once, into the target.
+    wire::Header header;
     try {
-      m = wire::parse_message(bytes->data(), bytes->size());
+      header = wire::parse_header(bytes->data(), bytes->size());
     } catch (const wire::WireError& e) {
       std::lock_guard lock(stats_mutex_);
       ++stats_.refused_messages;
       spdlog::warn("mpi:{}: refused a message: {}", options_.rank, e.what());
       continue;
     }
-    if (m.kind != wire::Kind::band_rows && m.kind != wire::Kind::band_failed) {
-      spdlog::warn("mpi:{}: ignored an unexpected {} message", options_.rank, wire::to_string(m.kind));
+    const wire::Kind kind = wire::Kind(header.kind);
+    const uint8_t* payload = bytes->data() + sizeof(wire::Header);
+    const size_t payload_size = bytes->size() - sizeof(wire::Header);
+    if (kind != wire::Kind::band_rows && kind != wire::Kind::band_failed) {
+      spdlog::warn("mpi:{}: ignored an unexpected {} message", options_.rank, wire::to_string(kind));
       continue;
     }
-    if (m.sequence != id) {  // the answer to a job that timed out before
+    if (header.sequence != id) {  // the answer to a job that timed out before
       std::lock_guard lock(stats_mutex_);
       ++stats_.stale_answers;
       // A band that merely took longer than the timeout teaches the next deadline how long bands take.
-      if (m.sequence == timed_out_job_) {
+      if (header.sequence == timed_out_job_) {
         stats_.last_round_trip_ms = std::max(stats_.last_round_trip_ms, ms_since(timed_out_start_));
         timed_out_job_ = 0;
       }
-      spdlog::debug("mpi:{}: dropped the late answer to job {}", options_.rank, m.sequence);
+      spdlog::debug("mpi:{}: dropped the late answer to job {}", options_.rank, header.sequence);
       continue;
     }
-    if (m.kind == wire::Kind::band_failed) {
+    if (kind == wire::Kind::band_failed) {
       wire::BandFailure failure;
       try {
-        failure = wire::decode_band_failure(m.payload);
+        failure = wire::decode_band_failure(std::vector<uint8_t>(payload, payload + payload_size));
       } catch (const wire::WireError& e) {
         failure.reason = std::string("(unreadable reason: ") + e.what() + ")";
       }
@@ -271,7 +275,7 @@ core::BandResult MpiTracer::render_band(const core::BandJob& job, core::BandBuff
     }
     wire::BandRowsView rows;
     try {
-      rows = wire::decode_band_rows_view(m.payload);
+      rows = wire::decode_band_rows_view(payload, payload_size);
     } catch (const wire::WireError& e) {
       std::lock_guard lock(stats_mutex_);
       ++stats_.refused_messages;

@@ -41,7 +41,8 @@ class Writer {
 
 class Reader {
  public:
-  Reader(const std::vector<uint8_t>& bytes, const char* what) : bytes_(bytes), what_(what) {}
+  Reader(const std::vector<uint8_t>& bytes, const char* what) : Reader(bytes.data(), bytes.size(), what) {}
+  Reader(const uint8_t* data, size_t size, const char* what) : bytes_{data, size}, what_(what) {}
   [[noreturn]] void fail(const std::string& why) const {
     throw WireError(fmt::format("{} message: byte {} of {}: {}", what_, pos_, bytes_.size(), why));
   }
@@ -82,7 +83,12 @@ class Reader {
   }
 
  private:
-  const std::vector<uint8_t>& bytes_;
+  struct Bytes {
+    const uint8_t* ptr;
+    size_t count;
+    size_t size() const { return count; }
+    const uint8_t* data() const { return ptr; }
+  } bytes_;
   const char* what_;
   size_t pos_ = 0;
 };
@@ -164,7 +170,7 @@ std::vector<uint8_t> frame_message(Kind kind, uint64_t sequence, const std::vect
   return out;
 }
 
-Message parse_message(const uint8_t* bytes, size_t size) {
+Header parse_header(const uint8_t* bytes, size_t size) {
   Header h;
   if (size < sizeof h)
     throw WireError(fmt::format("message of {} bytes is shorter than the {}-byte header", size, sizeof h));
@@ -177,6 +183,11 @@ Message parse_message(const uint8_t* bytes, size_t size) {
   if (h.payload_bytes != size - sizeof h)
     throw WireError(fmt::format("{} header announces {} payload bytes but {} arrived", to_string(Kind(h.kind)),
                                 h.payload_bytes, size - sizeof h));
+  return h;
+}
+
+Message parse_message(const uint8_t* bytes, size_t size) {
+  const Header h = parse_header(bytes, size);
   Message m;
   m.kind = Kind(h.kind);
   m.sequence = h.sequence;
@@ -463,7 +474,11 @@ std::vector<uint8_t> band_rows_message(uint64_t sequence, const core::BandBuffer
 }
 
 BandRowsView decode_band_rows_view(const std::vector<uint8_t>& payload) {
-  Reader r(payload, "band_rows");
+  return decode_band_rows_view(payload.data(), payload.size());
+}
+
+BandRowsView decode_band_rows_view(const uint8_t* payload, size_t size) {
+  Reader r(payload, size, "band_rows");
   BandRowsView b;
   b.row_begin = r.scalar<uint32_t>();
   b.row_end = r.scalar<uint32_t>();

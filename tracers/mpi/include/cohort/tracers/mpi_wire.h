@@ -58,6 +58,8 @@ struct Message {
 std::vector<uint8_t> frame_message(Kind kind, uint64_t sequence, const std::vector<uint8_t>& payload);
 // Checks the header (magic, protocol, known kind, payload size equal to what arrived) and splits it off.
 Message parse_message(const uint8_t* bytes, size_t size);
+// The same checks, the payload left in place after the header (a band's rows are decoded there).
+Header parse_header(const uint8_t* bytes, size_t size);
 
 // ---- Payloads. Each encode_* has a decode_* that throws WireError naming what is wrong. ----
 
@@ -121,6 +123,7 @@ struct BandRowsView {
   uint64_t aux_bytes = 0;
 };
 BandRowsView decode_band_rows_view(const std::vector<uint8_t>& payload);
+BandRowsView decode_band_rows_view(const uint8_t* payload, size_t size);
 // A whole band_rows message (header included) built in one buffer: what the node sends.
 std::vector<uint8_t> band_rows_message(uint64_t sequence, const core::BandBuffer& source, uint32_t row_begin,
                                        uint32_t row_end, double device_ms, const std::vector<float>& row_work);
