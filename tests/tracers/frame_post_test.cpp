@@ -57,6 +57,16 @@ core::FramePostOptions both() {
   return o;
 }
 
+// A still path-traced frame of the test room with its aux planes (the camera its own previous one).
+core::BandJob aux_room_job(int w, int h) {
+  core::BandJob job;
+  job.camera = test::test_room_camera(w, h);
+  job.previous_camera = job.camera;
+  job.params = test::frame_params(K_MODE_PATH, 1, 1, h);
+  job.params.aux_outputs = 1u;
+  return job;
+}
+
 double max_relative_difference(const core::FrameBuffer& a, const core::FrameBuffer& b) {
   double worst = 0.0;
   for (size_t i = 0; i < a.rgba.size(); ++i)
@@ -174,11 +184,7 @@ TEST(FramePost, PackedMergeUnpacksToTheFloatMergeEverywhere) {
   core::Renderer renderer(std::move(list), options);
   renderer.submit_commit(commit::CommitBuffer::full(room, 1));
   const int w = 48, h = 32;
-  core::BandJob job;
-  job.camera = test_room_camera(w, h);
-  job.previous_camera = job.camera;
-  job.params = frame_params(K_MODE_PATH, 1, 1, h);
-  job.params.aux_outputs = 1u;
+  const core::BandJob job = aux_room_job(w, h);
   core::FrameBuffer floats;
   renderer.render(job, floats);
   const core::GBuffer g = renderer.gbuffer();
@@ -221,11 +227,7 @@ TEST(FramePost, CudaBandsStayingOnTheGpusGiveTheHostRoundTripsPicture) {
   if (gpus == 0) GTEST_SKIP() << "no CUDA device (or a build without CUDA)";
   auto room = std::make_shared<commit::TracerScene>(core::compile_scene(test_room()).tracer_scene);
   const int w = 64, h = 48;
-  core::BandJob job;
-  job.camera = test_room_camera(w, h);
-  job.previous_camera = job.camera;
-  job.params = frame_params(K_MODE_PATH, 1, 1, h);
-  job.params.aux_outputs = 1u;
+  core::BandJob job = aux_room_job(w, h);
   std::vector<std::string> kinds = {"cuda:0", "embree"};
   if (gpus > 1) kinds.push_back("cuda:1");
   std::vector<core::FrameBuffer> shown[2];
