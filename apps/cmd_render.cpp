@@ -72,8 +72,8 @@ struct RenderArgs {
   std::string band_format = "rgb16f";
   bool frames_given = false;
   bool write_ids = false;  // the G-buffer's id plane of every written frame, and which entities moved
-  bool bands_through_host = false;
-  int benched_commit_every = 8;  // RendererOptions::benched_commit_every  // A/B: CUDA bands go down and back up even where the post could take them on the GPU
+  bool bands_through_host = false;  // A/B: CUDA bands go down and back up even where the post could take them on the GPU
+  int benched_commit_every = 8;     // RendererOptions::benched_commit_every
   double render_scale = 1.0;  // dynamic resolution (core/upsample.h)
   std::string upsample = "joint-bilateral";
 };
