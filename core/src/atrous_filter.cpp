@@ -70,12 +70,13 @@ void AtrousFilter::apply(const FrameBuffer& frame, const GBuffer& gbuffer, Frame
         for (int x = 0; x < width; ++x) pixel(x, y);
     });
   };
-  float* variance_from = nullptr;
-  float* variance_to = nullptr;
+  geometry_.resize(4 * pixels);
+  threads.for_ranges(pixels, 16384, [&](size_t begin, size_t end) {
+    for (size_t p = begin; p < end; ++p)
+      k_atrous_pack_geometry(gbuffer.depth.data(), gbuffer.normal.data(), geometry_.data(), static_cast<kint>(p));
+  });
   if (variance) {
     estimated_variance_.resize(pixels);
-    variance_ping_.resize(pixels);
-    variance_pong_.resize(pixels);
     KSvgfVarianceParams v{};
     v.width = width;
     v.height = height;
@@ -88,25 +89,18 @@ void AtrousFilter::apply(const FrameBuffer& frame, const GBuffer& gbuffer, Frame
       k_svgf_variance_pixel(ping_.rgba.data(), history.moments, history.length, gbuffer.depth.data(),
                             gbuffer.normal.data(), estimated_variance_.data(), &v, x, y);
     });
-    std::copy(estimated_variance_.begin(), estimated_variance_.end(), variance_ping_.begin());
-    variance_from = variance_ping_.data();
-    variance_to = variance_pong_.data();
+    // The passes carry the variance in the illumination's alpha.
+    for (size_t p = 0; p < pixels; ++p) ping_.rgba[4 * p + 3] = estimated_variance_[p];
   }
   FrameBuffer* from = &ping_;
   FrameBuffer* to = &pong_;
   for (int pass = 0; pass < std::max(options_.passes, 0); ++pass) {
     params.step = 1 << pass;
     if (variance)
-      rows([&](int x, int y) {
-        k_svgf_atrous_pixel(from->rgba.data(), variance_from, to->rgba.data(), variance_to, gbuffer.depth.data(),
-                            gbuffer.normal.data(), &params, x, y);
-      });
+      rows([&](int x, int y) { k_svgf_atrous_pixel(from->rgba.data(), to->rgba.data(), geometry_.data(), &params, x, y); });
     else
-      rows([&](int x, int y) {
-        k_atrous_pixel(from->rgba.data(), to->rgba.data(), gbuffer.depth.data(), gbuffer.normal.data(), &params, x, y);
-      });
+      rows([&](int x, int y) { k_atrous_pixel(from->rgba.data(), to->rgba.data(), geometry_.data(), &params, x, y); });
     std::swap(from, to);
-    std::swap(variance_from, variance_to);
   }
   threads.for_ranges(pixels, 16384, [&](size_t begin, size_t end) {
     for (size_t p = begin; p < end; ++p)

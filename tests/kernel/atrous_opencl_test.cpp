@@ -22,10 +22,10 @@ namespace {
 
 [[maybe_unused]] const char* kProgram = R"CL(
 #include "cohort/kernel/atrous.h"
-__kernel void atrous(__global const float* in_rgba, __global float* out_rgba, __global const float* depth,
-                     __global const float* normal, KAtrousParams params) {
+__kernel void atrous(__global const float* in_rgba, __global float* out_rgba, __global const float* geometry,
+                     KAtrousParams params) {
   kint x = (kint)get_global_id(0), y = (kint)get_global_id(1);
-  if (x < params.width && y < params.height) k_atrous_pixel(in_rgba, out_rgba, depth, normal, &params, x, y);
+  if (x < params.width && y < params.height) k_atrous_pixel(in_rgba, out_rgba, geometry, &params, x, y);
 }
 /* kernel/reproject.h goes through the same OpenCL C compiler here (its planes travel in private structs
    of __global pointers, which OpenCL C 1.2 allows inside a kernel but not as arguments). */
@@ -52,12 +52,10 @@ __kernel void svgf_variance(__global const float* illumination, __global const f
   if (x < params.width && y < params.height)
     k_svgf_variance_pixel(illumination, moments, length, depth, normal, variance, &params, x, y);
 }
-__kernel void svgf_atrous(__global const float* in_rgba, __global const float* in_variance, __global float* out_rgba,
-                          __global float* out_variance, __global const float* depth, __global const float* normal,
+__kernel void svgf_atrous(__global const float* in_rgba, __global float* out_rgba, __global const float* geometry,
                           KAtrousParams params) {
   kint x = (kint)get_global_id(0), y = (kint)get_global_id(1);
-  if (x < params.width && y < params.height)
-    k_svgf_atrous_pixel(in_rgba, in_variance, out_rgba, out_variance, depth, normal, &params, x, y);
+  if (x < params.width && y < params.height) k_svgf_atrous_pixel(in_rgba, out_rgba, geometry, &params, x, y);
 }
 )CL";
 
@@ -93,18 +91,19 @@ TEST(AtrousOpenCL, APassMatchesTheCppBuildOfTheSameHeader) {
   KAtrousParams params{};
   params.width = w, params.height = h, params.step = 2;
   params.normal_squarings = 6, params.depth_sigma = 0.1f, params.color_sigma = 2.0f;
+  std::vector<float> geometry(4 * w * h);
+  for (int p = 0; p < w * h; ++p) k_atrous_pack_geometry(depth.data(), normal.data(), geometry.data(), p);
   for (int y = 0; y < h; ++y)
-    for (int x = 0; x < w; ++x) k_atrous_pixel(rgba.data(), expected.data(), depth.data(), normal.data(), &params, x, y);
+    for (int x = 0; x < w; ++x) k_atrous_pixel(rgba.data(), expected.data(), geometry.data(), &params, x, y);
 
   auto buffer = [&](std::vector<float>& v, cl_mem_flags flags) {
     cl_mem m = clCreateBuffer(context, flags | CL_MEM_COPY_HOST_PTR, v.size() * sizeof(float), v.data(), &err);
     EXPECT_EQ(err, CL_SUCCESS);
     return m;
   };
-  cl_mem mems[4] = {buffer(rgba, CL_MEM_READ_ONLY), buffer(out, CL_MEM_WRITE_ONLY), buffer(depth, CL_MEM_READ_ONLY),
-                    buffer(normal, CL_MEM_READ_ONLY)};
-  for (cl_uint i = 0; i < 4; ++i) ASSERT_EQ(clSetKernelArg(kernel, i, sizeof(cl_mem), &mems[i]), CL_SUCCESS);
-  ASSERT_EQ(clSetKernelArg(kernel, 4, sizeof(KAtrousParams), &params), CL_SUCCESS);
+  cl_mem mems[3] = {buffer(rgba, CL_MEM_READ_ONLY), buffer(out, CL_MEM_WRITE_ONLY), buffer(geometry, CL_MEM_READ_ONLY)};
+  for (cl_uint i = 0; i < 3; ++i) ASSERT_EQ(clSetKernelArg(kernel, i, sizeof(cl_mem), &mems[i]), CL_SUCCESS);
+  ASSERT_EQ(clSetKernelArg(kernel, 3, sizeof(KAtrousParams), &params), CL_SUCCESS);
   const size_t global[2] = {size_t(w), size_t(h)};
   ASSERT_EQ(clEnqueueNDRangeKernel(queue, kernel, 2, nullptr, global, nullptr, 0, nullptr, nullptr), CL_SUCCESS);
   ASSERT_EQ(clEnqueueReadBuffer(queue, mems[1], CL_TRUE, 0, out.size() * sizeof(float), out.data(), 0, nullptr, nullptr),
@@ -152,16 +151,20 @@ TEST(AtrousOpenCL, TheVarianceGuideMatchesTheCppBuildOfTheSameHeader) {
   KAtrousParams params{};
   params.width = w, params.height = h, params.step = 2;
   params.normal_squarings = 6, params.depth_sigma = 0.1f, params.color_sigma = 4.0f;
-  std::vector<float> variance(w * h), out(4 * w * h), out_variance(w * h);
-  std::vector<float> expected_variance(w * h), expected(4 * w * h), expected_out_variance(w * h);
+  std::vector<float> variance(w * h), out(4 * w * h);
+  std::vector<float> expected_variance(w * h), expected(4 * w * h);
   for (int y = 0; y < h; ++y)
     for (int x = 0; x < w; ++x)
       k_svgf_variance_pixel(rgba.data(), moments.data(), length.data(), depth.data(), normal.data(),
                             expected_variance.data(), &vp, x, y);
+  // The pass reads the variance from the illumination's alpha and writes the filtered one there.
+  std::vector<float> rgba_variance = rgba, geometry(4 * w * h);
+  for (int p = 0; p < w * h; ++p) {
+    rgba_variance[4 * p + 3] = expected_variance[p];
+    k_atrous_pack_geometry(depth.data(), normal.data(), geometry.data(), p);
+  }
   for (int y = 0; y < h; ++y)
-    for (int x = 0; x < w; ++x)
-      k_svgf_atrous_pixel(rgba.data(), expected_variance.data(), expected.data(), expected_out_variance.data(),
-                          depth.data(), normal.data(), &params, x, y);
+    for (int x = 0; x < w; ++x) k_svgf_atrous_pixel(rgba_variance.data(), expected.data(), geometry.data(), &params, x, y);
 
   auto buffer = [&](std::vector<float>& v) {
     cl_mem m = clCreateBuffer(cl.context, CL_MEM_READ_WRITE | CL_MEM_COPY_HOST_PTR, v.size() * sizeof(float), v.data(),
@@ -171,13 +174,13 @@ TEST(AtrousOpenCL, TheVarianceGuideMatchesTheCppBuildOfTheSameHeader) {
   };
   cl_mem m_rgba = buffer(rgba), m_moments = buffer(moments), m_length = buffer(length), m_depth = buffer(depth),
          m_normal = buffer(normal), m_variance = buffer(variance), m_out = buffer(out),
-         m_out_variance = buffer(out_variance);
+         m_rgba_variance = buffer(rgba_variance), m_geometry = buffer(geometry);
   cl_mem variance_args[6] = {m_rgba, m_moments, m_length, m_depth, m_normal, m_variance};
   for (cl_uint i = 0; i < 6; ++i) ASSERT_EQ(clSetKernelArg(variance_kernel, i, sizeof(cl_mem), &variance_args[i]), CL_SUCCESS);
   ASSERT_EQ(clSetKernelArg(variance_kernel, 6, sizeof(KSvgfVarianceParams), &vp), CL_SUCCESS);
-  cl_mem pass_args[6] = {m_rgba, m_variance, m_out, m_out_variance, m_depth, m_normal};
-  for (cl_uint i = 0; i < 6; ++i) ASSERT_EQ(clSetKernelArg(pass_kernel, i, sizeof(cl_mem), &pass_args[i]), CL_SUCCESS);
-  ASSERT_EQ(clSetKernelArg(pass_kernel, 6, sizeof(KAtrousParams), &params), CL_SUCCESS);
+  cl_mem pass_args[3] = {m_rgba_variance, m_out, m_geometry};
+  for (cl_uint i = 0; i < 3; ++i) ASSERT_EQ(clSetKernelArg(pass_kernel, i, sizeof(cl_mem), &pass_args[i]), CL_SUCCESS);
+  ASSERT_EQ(clSetKernelArg(pass_kernel, 3, sizeof(KAtrousParams), &params), CL_SUCCESS);
   const size_t global[2] = {size_t(w), size_t(h)};
   ASSERT_EQ(clEnqueueNDRangeKernel(cl.queue, variance_kernel, 2, nullptr, global, nullptr, 0, nullptr, nullptr), CL_SUCCESS);
   ASSERT_EQ(clEnqueueNDRangeKernel(cl.queue, pass_kernel, 2, nullptr, global, nullptr, 0, nullptr, nullptr), CL_SUCCESS);
@@ -185,15 +188,11 @@ TEST(AtrousOpenCL, TheVarianceGuideMatchesTheCppBuildOfTheSameHeader) {
                                 nullptr, nullptr), CL_SUCCESS);
   ASSERT_EQ(clEnqueueReadBuffer(cl.queue, m_out, CL_TRUE, 0, out.size() * sizeof(float), out.data(), 0, nullptr, nullptr),
             CL_SUCCESS);
-  ASSERT_EQ(clEnqueueReadBuffer(cl.queue, m_out_variance, CL_TRUE, 0, out_variance.size() * sizeof(float),
-                                out_variance.data(), 0, nullptr, nullptr), CL_SUCCESS);
   for (size_t i = 0; i < variance.size(); ++i)
     ASSERT_NEAR(variance[i], expected_variance[i], 1e-4f * (1.0f + std::fabs(expected_variance[i]))) << "variance " << i;
-  for (size_t i = 0; i < out.size(); ++i) ASSERT_NEAR(out[i], expected[i], 1e-4f * (1.0f + std::fabs(expected[i]))) << i;
-  for (size_t i = 0; i < out_variance.size(); ++i)
-    ASSERT_NEAR(out_variance[i], expected_out_variance[i], 1e-4f * (1.0f + std::fabs(expected_out_variance[i])))
-        << "filtered variance " << i;
-  for (cl_mem m : {m_rgba, m_moments, m_length, m_depth, m_normal, m_variance, m_out, m_out_variance})
+  for (size_t i = 0; i < out.size(); ++i)  // alpha: the filtered variance
+    ASSERT_NEAR(out[i], expected[i], 1e-4f * (1.0f + std::fabs(expected[i]))) << i;
+  for (cl_mem m : {m_rgba, m_moments, m_length, m_depth, m_normal, m_variance, m_out, m_rgba_variance, m_geometry})
     clReleaseMemObject(m);
   }
   clReleaseKernel(variance_kernel);

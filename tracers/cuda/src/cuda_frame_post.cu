@@ -77,24 +77,29 @@ __global__ void modulate_kernel(const float* rgba, const float* albedo, float* o
 dim3 tile_grid(int width, int height) { return dim3((width + 15) / 16, (height + 15) / 16); }
 const dim3 kTile(16, 16);
 
-__global__ void atrous_kernel(const float* in, float* out, const float* depth, const float* normal, KAtrousParams params) {
-  const int x = blockIdx.x * blockDim.x + threadIdx.x, y = blockIdx.y * blockDim.y + threadIdx.y;
-  if (x < params.width && y < params.height) k_atrous_pixel(in, out, depth, normal, &params, x, y);
+__global__ void pack_geometry_kernel(const float* depth, const float* normal, float* geometry, int pixels) {
+  const int p = blockIdx.x * blockDim.x + threadIdx.x;
+  if (p < pixels) k_atrous_pack_geometry(depth, normal, geometry, p);
 }
 
-__global__ void svgf_variance_kernel(const float* illumination, const float* moments, const float* length,
-                                     const float* depth, const float* normal, float* variance,
-                                     KSvgfVarianceParams params) {
+__global__ void atrous_kernel(const float* in, float* out, const float* geometry, KAtrousParams params) {
   const int x = blockIdx.x * blockDim.x + threadIdx.x, y = blockIdx.y * blockDim.y + threadIdx.y;
-  if (x < params.width && y < params.height)
-    k_svgf_variance_pixel(illumination, moments, length, depth, normal, variance, &params, x, y);
+  if (x < params.width && y < params.height) k_atrous_pixel(in, out, geometry, &params, x, y);
 }
 
-__global__ void svgf_atrous_kernel(const float* in, const float* in_variance, float* out, float* out_variance,
-                                   const float* depth, const float* normal, KAtrousParams params) {
+// The estimate goes into the illumination's alpha, where the passes read it: each pixel writes only its
+// own alpha and reads only its neighbours' RGB.
+__global__ void svgf_variance_kernel(float* illumination, const float* moments, const float* length,
+                                     const float* depth, const float* normal, KSvgfVarianceParams params) {
   const int x = blockIdx.x * blockDim.x + threadIdx.x, y = blockIdx.y * blockDim.y + threadIdx.y;
   if (x < params.width && y < params.height)
-    k_svgf_atrous_pixel(in, in_variance, out, out_variance, depth, normal, &params, x, y);
+    illumination[4 * (y * params.width + x) + 3] =
+        k_svgf_variance_estimate(illumination, moments, length, depth, normal, &params, x, y);
+}
+
+__global__ void svgf_atrous_kernel(const float* in, float* out, const float* geometry, KAtrousParams params) {
+  const int x = blockIdx.x * blockDim.x + threadIdx.x, y = blockIdx.y * blockDim.y + threadIdx.y;
+  if (x < params.width && y < params.height) k_svgf_atrous_pixel(in, out, geometry, &params, x, y);
 }
 
 class CudaFramePost final : public core::FramePost {
@@ -272,11 +277,10 @@ class CudaFramePost final : public core::FramePost {
       params.normal_squarings = normal_squarings_;
       params.depth_sigma = ao.depth_sigma;
       params.color_sigma = variance ? ao.variance_sigma : ao.color_sigma;
-      float* variance_ping = nullptr;
-      float* variance_pong = nullptr;
+      float* geometry = geometry_.scratch(4 * pixels);
+      pack_geometry_kernel<<<blocks_for(pixels), kThreads, 0, stream_>>>(depth_.data(), normal_.data(), geometry,
+                                                                          static_cast<int>(pixels));
       if (variance) {
-        variance_ping = variance_ping_.scratch(pixels);
-        variance_pong = variance_pong_.scratch(pixels);
         KSvgfVarianceParams v{};
         v.width = width, v.height = height, v.normal_squarings = normal_squarings_;
         v.have_history = options_.reproject ? 1 : 0;
@@ -286,17 +290,15 @@ class CudaFramePost final : public core::FramePost {
         const State& history = state_[parity_];  // the state the reprojection just wrote
         svgf_variance_kernel<<<tile_grid(width, height), kTile, 0, stream_>>>(
             ping, options_.reproject ? history.moments.data() : nullptr,
-            options_.reproject ? history.length.data() : nullptr, depth_.data(), normal_.data(), variance_ping, v);
+            options_.reproject ? history.length.data() : nullptr, depth_.data(), normal_.data(), v);
       }
       for (int pass = 0; pass < std::max(ao.passes, 0); ++pass) {
         params.step = 1 << pass;
         if (variance)
-          svgf_atrous_kernel<<<tile_grid(width, height), kTile, 0, stream_>>>(ping, variance_ping, pong, variance_pong,
-                                                                            depth_.data(), normal_.data(), params);
+          svgf_atrous_kernel<<<tile_grid(width, height), kTile, 0, stream_>>>(ping, pong, geometry, params);
         else
-          atrous_kernel<<<tile_grid(width, height), kTile, 0, stream_>>>(ping, pong, depth_.data(), normal_.data(), params);
+          atrous_kernel<<<tile_grid(width, height), kTile, 0, stream_>>>(ping, pong, geometry, params);
         std::swap(ping, pong);
-        std::swap(variance_ping, variance_pong);
       }
       float* shown = shown_device_.scratch(4 * pixels);
       modulate_kernel<<<blocks_for(pixels), kThreads, 0, stream_>>>(ping, albedo_.data(), shown,
@@ -364,7 +366,7 @@ class CudaFramePost final : public core::FramePost {
   int normal_squarings_ = 0;
   State state_[2];
   DeviceArray<float> frame_, depth_, prev_depth_, motion_, normal_, albedo_, ycocgw_, ping_, pong_, shown_device_;
-  DeviceArray<float> variance_ping_, variance_pong_;
+  DeviceArray<float> geometry_;  // normal and depth packed for the a-trous passes (kernel/atrous.h)
   DeviceArray<kuint> id_;
   DeviceArray<unsigned char> packed_colour_;
   DeviceArray<KAuxTexel> packed_aux_;

@@ -68,7 +68,7 @@ class AtrousFilter {
  private:
   AtrousOptions options_;
   FrameBuffer ping_, pong_;
-  std::vector<float> estimated_variance_, variance_ping_, variance_pong_;
+  std::vector<float> estimated_variance_, geometry_;  // geometry: normal and depth packed (kernel/atrous.h)
 };
 
 }  // namespace cohort::core

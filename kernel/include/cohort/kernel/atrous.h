@@ -9,8 +9,8 @@
  * Camera misses (depth 0) only mix with misses. Taps whose colour is not finite are left out; the centre
  * always counts, so a pixel keeps its colour where every neighbour is across an edge. The two exponential
  * stops are one exp of their summed arguments: transcendental calls set this filter's cost on the CPU.
- * Planes are the host's G-buffer layout (core/gbuffer.h): depth one float a pixel, normal three, colour
- * RGBA floats. */
+ * Colour planes are RGBA floats; the passes read normal and depth packed into one RGBA plane
+ * (k_atrous_pack_geometry from the host's G-buffer layout, core/gbuffer.h). */
 #ifndef COHORT_KERNEL_ATROUS_H
 #define COHORT_KERNEL_ATROUS_H
 #include "illumination.h"
@@ -35,15 +35,13 @@ KFN void k_atrous_modulate(KGLOBAL const float* in_rgba, KGLOBAL const float* al
 
 KFN float k_atrous_luminance(KGLOBAL const float* c) { return k_luminance3(c[0], c[1], c[2]); }
 
-/* The geometric stops of tap q seen from a pixel at depth zp (0: a miss) with normal np: returns the normal
- * stop's factor (0: the tap lies across an edge, or is a surface where the pixel is a miss or the other way
- * round) and adds the depth stop's argument to *exponent. Shared by both luminance stops (kernel/svgf.h). */
-KFN float k_atrous_geometry(float zp, KVec3 np, float inv_depth_scale, kint normal_squarings, KGLOBAL const float* depth,
-                            KGLOBAL const float* normal, kint q, float* exponent) {
-  float zq = depth[q];
+/* The geometric stops between a pixel at depth zp (0: a miss) with normal np and a tap at depth zq with
+ * normal nq: returns the normal stop's factor (0: the tap lies across an edge, or is a surface where the
+ * pixel is a miss or the other way round) and adds the depth stop's argument to *exponent. */
+KFN float k_atrous_geometry_stop(float zp, KVec3 np, float zq, KVec3 nq, float inv_depth_scale, kint normal_squarings,
+                                 float* exponent) {
   if ((zp > 0.0f) != (zq > 0.0f)) return 0.0f; /* a surface and a miss */
   if (!(zp > 0.0f)) return 1.0f;
-  KVec3 nq = v3(normal[3 * q], normal[3 * q + 1], normal[3 * q + 2]);
   float cosine = k_fmax(v3_dot(np, nq), 0.0f);
   for (kint s = 0; s < normal_squarings; ++s) cosine *= cosine;
   if (cosine < 1e-4f) return 0.0f; /* across an edge; and the squarings would reach subnormals */
@@ -51,25 +49,43 @@ KFN float k_atrous_geometry(float zp, KVec3 np, float inv_depth_scale, kint norm
   return cosine;
 }
 
+/* The same stops for tap q of the G-buffer's depth and normal planes (the variance estimate and the
+ * upsampler read those). */
+KFN float k_atrous_geometry(float zp, KVec3 np, float inv_depth_scale, kint normal_squarings, KGLOBAL const float* depth,
+                            KGLOBAL const float* normal, kint q, float* exponent) {
+  KVec3 nq = v3(normal[3 * q], normal[3 * q + 1], normal[3 * q + 2]);
+  return k_atrous_geometry_stop(zp, np, depth[q], nq, inv_depth_scale, normal_squarings, exponent);
+}
+
+/* The passes read normal and depth of a tap as one 16-byte load from a packed plane (x, y, z: the
+ * normal; w: the depth), where the planes take four loads: on GPUs the taps' loads set the cost. */
+KFN void k_atrous_pack_geometry(KGLOBAL const float* depth, KGLOBAL const float* normal, KGLOBAL float* geometry,
+                                kint p) {
+  geometry[4 * p] = normal[3 * p];
+  geometry[4 * p + 1] = normal[3 * p + 1];
+  geometry[4 * p + 2] = normal[3 * p + 2];
+  geometry[4 * p + 3] = depth[p];
+}
+
 KFN float k_atrous_inv_depth_scale(float depth_sigma, float zp, kint step) {
   return zp > 0.0f ? 1.0f / (depth_sigma * zp * (float)step + 1e-6f) : 0.0f;
 }
 
-/* One pass at one pixel, for either luminance stop. With variance planes, the stop is
- * |l_p - l_q| * inv_luminance_scale (kernel/svgf.h's, from the pixel's variance) and in_variance is
- * filtered into out_variance with the weights squared; without (both 0), the fixed relative stop above. */
-KFN void k_atrous_pass_pixel(KGLOBAL const float* in_rgba, KGLOBAL const float* in_variance, KGLOBAL float* out_rgba,
-                             KGLOBAL float* out_variance, KGLOBAL const float* depth, KGLOBAL const float* normal,
-                             const KAtrousParams* p, float inv_luminance_scale, kint x, kint y) {
+/* One pass at one pixel, for either luminance stop. `geometry` is the packed plane above. Guided (the
+ * variance guide, kernel/svgf.h): the colour planes carry each pixel's luminance variance in alpha, the
+ * stop is |l_p - l_q| * inv_luminance_scale (from the pixel's variance) and the variance is filtered along
+ * with the colour, weights squared, into out's alpha; unguided (inv_luminance_scale unused), the fixed
+ * relative stop above and alpha 1. */
+KFN void k_atrous_pass_pixel(KGLOBAL const float* in_rgba, KGLOBAL float* out_rgba, KGLOBAL const float* geometry,
+                             const KAtrousParams* p, int guided, float inv_luminance_scale, kint x, kint y) {
   const float spline[3] = {0.375f, 0.25f, 0.0625f};
-  int guided = in_variance != 0;
   kint centre = y * p->width + x;
-  KGLOBAL const float* c = in_rgba + 4 * centre;
-  KGLOBAL float* out = out_rgba + 4 * centre;
-  float zp = depth[centre];
-  KVec3 np = v3(normal[3 * centre], normal[3 * centre + 1], normal[3 * centre + 2]);
-  int centre_ok = k_finite3(c[0], c[1], c[2]);
-  float lp = centre_ok ? k_atrous_luminance(c) : 0.0f;
+  KFloat4 c = k_load4(in_rgba + 4 * centre);
+  KFloat4 gp = k_load4(geometry + 4 * centre);
+  float zp = gp.w;
+  KVec3 np = v3(gp.x, gp.y, gp.z);
+  int centre_ok = k_finite3(c.x, c.y, c.z);
+  float lp = centre_ok ? k_luminance3(c.x, c.y, c.z) : 0.0f;
   float inv_depth_scale = k_atrous_inv_depth_scale(p->depth_sigma, zp, p->step);
   float sum[3] = {0.0f, 0.0f, 0.0f};
   float weight_sum = 0.0f, variance_sum = 0.0f;
@@ -80,14 +96,16 @@ KFN void k_atrous_pass_pixel(KGLOBAL const float* in_rgba, KGLOBAL const float* 
       kint qx = x + dx * p->step;
       if (qx < 0 || qx >= p->width) continue;
       kint q = qy * p->width + qx;
-      KFloat4 cq = k_load4(in_rgba + 4 * q); /* one 16-byte load: on GPUs the taps' loads set the cost */
+      KFloat4 cq = k_load4(in_rgba + 4 * q);
       if (!k_finite3(cq.x, cq.y, cq.z)) continue;
       float w = spline[dx < 0 ? -dx : dx] * spline[dy < 0 ? -dy : dy];
       if (q != centre) {
         float exponent = 0.0f;
-        float geometry = k_atrous_geometry(zp, np, inv_depth_scale, p->normal_squarings, depth, normal, q, &exponent);
-        if (!(geometry > 0.0f)) continue;
-        w *= geometry;
+        KFloat4 gq = k_load4(geometry + 4 * q);
+        float stop = k_atrous_geometry_stop(zp, np, gq.w, v3(gq.x, gq.y, gq.z), inv_depth_scale, p->normal_squarings,
+                                            &exponent);
+        if (!(stop > 0.0f)) continue;
+        w *= stop;
         if (centre_ok) {
           float lq = k_luminance3(cq.x, cq.y, cq.z);
           exponent += guided ? k_fabs(lp - lq) * inv_luminance_scale
@@ -102,21 +120,21 @@ KFN void k_atrous_pass_pixel(KGLOBAL const float* in_rgba, KGLOBAL const float* 
       sum[1] += w * cq.y;
       sum[2] += w * cq.z;
       weight_sum += w;
-      if (guided) variance_sum += w * w * in_variance[q];
+      if (guided) variance_sum += w * w * cq.w;
     }
   }
   float inv = weight_sum > 0.0f ? 1.0f / weight_sum : 0.0f;
+  KGLOBAL float* out = out_rgba + 4 * centre;
   out[0] = sum[0] * inv;
   out[1] = sum[1] * inv;
   out[2] = sum[2] * inv;
-  out[3] = 1.0f;
-  if (guided) out_variance[centre] = variance_sum * inv * inv;
+  out[3] = guided ? variance_sum * inv * inv : 1.0f;
 }
 
 /* One pass with the fixed relative luminance stop. */
-KFN void k_atrous_pixel(KGLOBAL const float* in_rgba, KGLOBAL float* out_rgba, KGLOBAL const float* depth,
-                        KGLOBAL const float* normal, const KAtrousParams* p, kint x, kint y) {
-  k_atrous_pass_pixel(in_rgba, 0, out_rgba, 0, depth, normal, p, 0.0f, x, y);
+KFN void k_atrous_pixel(KGLOBAL const float* in_rgba, KGLOBAL float* out_rgba, KGLOBAL const float* geometry,
+                        const KAtrousParams* p, kint x, kint y) {
+  k_atrous_pass_pixel(in_rgba, out_rgba, geometry, p, 0, 0.0f, x, y);
 }
 
 #endif

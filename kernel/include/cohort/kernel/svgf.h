@@ -15,8 +15,9 @@
  *                          with the colour (weights squared: the variance of the weighted mean), so later
  *                          passes see the noise that is left.
  *
- * Planes: illumination RGBA floats, variance one float a pixel, moments two, history length one; depth and
- * normal as core/gbuffer.h. */
+ * Planes: illumination RGBA floats (the passes keep the variance in alpha), moments two floats a pixel,
+ * history length one; depth and normal as core/gbuffer.h for the estimate, packed for the passes
+ * (k_atrous_pack_geometry). */
 #ifndef COHORT_KERNEL_SVGF_H
 #define COHORT_KERNEL_SVGF_H
 #include "atrous.h"
@@ -35,18 +36,16 @@ typedef struct KSvgfVarianceParams {
 #define K_SVGF_LUMINANCE_EPSILON 1e-4f
 #define K_SVGF_SPATIAL_RADIUS 3
 
-/* `illumination` is the demodulated frame the passes filter; moments and length are the reprojected
- * history's (read only with have_history). */
-KFN void k_svgf_variance_pixel(KGLOBAL const float* illumination, KGLOBAL const float* moments,
-                               KGLOBAL const float* length, KGLOBAL const float* depth, KGLOBAL const float* normal,
-                               KGLOBAL float* variance, const KSvgfVarianceParams* p, kint x, kint y) {
+/* The pixel's variance. `illumination` is the demodulated frame the passes filter (only its RGB is read);
+ * moments and length are the reprojected history's (read only with have_history). */
+KFN float k_svgf_variance_estimate(KGLOBAL const float* illumination, KGLOBAL const float* moments,
+                                   KGLOBAL const float* length, KGLOBAL const float* depth, KGLOBAL const float* normal,
+                                   const KSvgfVarianceParams* p, kint x, kint y) {
   kint centre = y * p->width + x;
   float history = p->have_history ? length[centre] : 0.0f;
   float of_mean = p->of_mean ? 1.0f / k_fmax(history, 1.0f) : 1.0f;
-  if (history >= p->short_history) {
-    variance[centre] = k_fmax(moments[2 * centre + 1] - moments[2 * centre] * moments[2 * centre], 0.0f) * of_mean;
-    return;
-  }
+  if (history >= p->short_history)
+    return k_fmax(moments[2 * centre + 1] - moments[2 * centre] * moments[2 * centre], 0.0f) * of_mean;
   float zp = depth[centre];
   KVec3 np = v3(normal[3 * centre], normal[3 * centre + 1], normal[3 * centre + 2]);
   float inv_depth_scale = k_atrous_inv_depth_scale(p->depth_sigma, zp, 1);
@@ -89,12 +88,19 @@ KFN void k_svgf_variance_pixel(KGLOBAL const float* illumination, KGLOBAL const 
     float mean = s1 / weight_sum;
     v = k_fmax(s2 / weight_sum - mean * mean, 0.0f);
   }
-  variance[centre] = v * (p->short_history / k_fmax(history, 1.0f)) * of_mean;
+  return v * (p->short_history / k_fmax(history, 1.0f)) * of_mean;
 }
 
-/* The pixel's variance seen through a 3x3 Gaussian (1/4 centre, 1/8 sides, 1/16 corners; SVGF), which
- * steadies the luminance stop against the estimate's own noise. */
-KFN float k_svgf_blurred_variance(KGLOBAL const float* variance, const KAtrousParams* p, kint x, kint y) {
+/* The estimate into a plane of one float a pixel. */
+KFN void k_svgf_variance_pixel(KGLOBAL const float* illumination, KGLOBAL const float* moments,
+                               KGLOBAL const float* length, KGLOBAL const float* depth, KGLOBAL const float* normal,
+                               KGLOBAL float* variance, const KSvgfVarianceParams* p, kint x, kint y) {
+  variance[y * p->width + x] = k_svgf_variance_estimate(illumination, moments, length, depth, normal, p, x, y);
+}
+
+/* The pixel's variance (the alpha of the passes' RGBA planes) seen through a 3x3 Gaussian (1/4 centre, 1/8
+ * sides, 1/16 corners; SVGF), which steadies the luminance stop against the estimate's own noise. */
+KFN float k_svgf_blurred_variance(KGLOBAL const float* rgba_variance, const KAtrousParams* p, kint x, kint y) {
   const float gauss[2] = {0.25f, 0.125f};
   float sum = 0.0f, weight_sum = 0.0f;
   for (kint dy = -1; dy <= 1; ++dy) {
@@ -104,21 +110,21 @@ KFN float k_svgf_blurred_variance(KGLOBAL const float* variance, const KAtrousPa
       kint qx = x + dx;
       if (qx < 0 || qx >= p->width) continue;
       float w = gauss[dx != 0] * gauss[dy != 0] * 4.0f;
-      sum += w * variance[qy * p->width + qx];
+      sum += w * rgba_variance[4 * (qy * p->width + qx) + 3];
       weight_sum += w;
     }
   }
   return sum / weight_sum;
 }
 
-/* One pass; p->color_sigma is the luminance stop in standard deviations (SVGF: 4). */
-KFN void k_svgf_atrous_pixel(KGLOBAL const float* in_rgba, KGLOBAL const float* in_variance, KGLOBAL float* out_rgba,
-                             KGLOBAL float* out_variance, KGLOBAL const float* depth, KGLOBAL const float* normal,
+/* One pass over illumination planes whose alpha holds the variance (k_atrous_pass_pixel, guided);
+ * p->color_sigma is the luminance stop in standard deviations (SVGF: 4). */
+KFN void k_svgf_atrous_pixel(KGLOBAL const float* in_rgba, KGLOBAL float* out_rgba, KGLOBAL const float* geometry,
                              const KAtrousParams* p, kint x, kint y) {
   float inv_luminance_scale =
-      1.0f / (p->color_sigma * k_sqrt(k_fmax(k_svgf_blurred_variance(in_variance, p, x, y), 0.0f)) +
+      1.0f / (p->color_sigma * k_sqrt(k_fmax(k_svgf_blurred_variance(in_rgba, p, x, y), 0.0f)) +
               K_SVGF_LUMINANCE_EPSILON);
-  k_atrous_pass_pixel(in_rgba, in_variance, out_rgba, out_variance, depth, normal, p, inv_luminance_scale, x, y);
+  k_atrous_pass_pixel(in_rgba, out_rgba, geometry, p, 1, inv_luminance_scale, x, y);
 }
 
 #endif
