@@ -5,26 +5,17 @@
 
 #include <fmt/format.h>
 
+#include "cohort/balance/order_statistics.h"
+
 namespace cohort::app {
-
-namespace {
-
-double percentile(std::vector<double> values, double q) {
-  if (values.empty()) return 0.0;
-  std::sort(values.begin(), values.end());
-  const size_t index = static_cast<size_t>(std::lround(q * static_cast<double>(values.size() - 1)));
-  return values[std::min(index, values.size() - 1)];
-}
-
-}  // namespace
 
 void PlayRate::frame(double interval_ms) {
   if (seen_++ < warmup_ || !(interval_ms > 0.0) || !std::isfinite(interval_ms)) return;
   intervals_.push_back(interval_ms);
 }
 
-double PlayRate::median_ms() const { return percentile(intervals_, 0.5); }
-double PlayRate::p95_ms() const { return percentile(intervals_, 0.95); }
+double PlayRate::median_ms() const { return median(intervals_); }
+double PlayRate::p95_ms() const { return quantile(intervals_, 0.95); }
 
 std::string PlayRate::summary(size_t frames, int window_width, int window_height, int render_width, int render_height,
                               double scale, int spp, int target_fps) const {

@@ -13,6 +13,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "cohort/balance/order_statistics.h"
 #include "cohort/core/gpu_scene.h"
 #include "cohort/core/scene_pack.h"
 #include "cohort/core/frame_defaults.h"
@@ -26,11 +27,6 @@ using Clock = std::chrono::steady_clock;
 
 #ifdef COHORT_HAVE_CUDA
 namespace {
-
-double median(std::vector<double> v) {
-  std::sort(v.begin(), v.end());
-  return v.empty() ? 0.0 : v[v.size() / 2];
-}
 
 KFrameParams bench_params(uint32_t mode, uint32_t bounces, int height) {
   KFrameParams p = core::default_frame_params();

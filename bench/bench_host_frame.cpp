@@ -20,6 +20,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "cohort/balance/order_statistics.h"
 #include "cohort/core/convergence.h"
 #include "cohort/core/frame_pipeline.h"
 #include "cohort/core/host_threads.h"
@@ -35,12 +36,6 @@ using namespace cohort::core;
 namespace {
 
 float anti_lag_sigma = -1.0f;  // --anti-lag; < 0: the default of ReprojectionOptions
-
-double median(std::vector<double> v) {
-  if (v.empty()) return 0.0;
-  std::sort(v.begin(), v.end());
-  return v[v.size() / 2];
-}
 
 double stage_ms(const FrameStats& stats, const std::string& stage) {
   double ms = 0.0;

@@ -21,6 +21,7 @@
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
 
+#include "cohort/balance/order_statistics.h"
 #include "cohort/commit/commit_buffer.h"
 #include "cohort/commit/host_skinning.h"
 #include "cohort/core/tracer.h"
@@ -106,12 +107,7 @@ std::vector<scene::JointTransform> wave_pose(int joints, double t, int character
 struct Series {
   std::vector<double> values;
   void add(double v) { values.push_back(v); }
-  double median() const {
-    if (values.empty()) return 0.0;
-    std::vector<double> v = values;
-    std::nth_element(v.begin(), v.begin() + long(v.size() / 2), v.end());
-    return v[v.size() / 2];
-  }
+  double median() const { return cohort::median(values); }
 };
 
 }  // namespace

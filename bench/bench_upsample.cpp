@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "cohort/balance/order_statistics.h"
 #include "cohort/core/host_threads.h"
 #include "cohort/core/upsample.h"
 
@@ -24,8 +25,7 @@ double median_ms(int frames, F&& run) {
     run(f);
     ms.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count());
   }
-  std::sort(ms.begin(), ms.end());
-  return ms[ms.size() / 2];
+  return cohort::median(ms);
 }
 
 }  // namespace

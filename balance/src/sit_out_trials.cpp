@@ -3,20 +3,9 @@
 #include <algorithm>
 #include <cmath>
 
+#include "cohort/balance/order_statistics.h"
+
 namespace cohort::balance {
-
-namespace {
-
-double median(std::vector<double> v) {
-  if (v.empty()) return 0.0;
-  const size_t mid = v.size() / 2;
-  std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(mid), v.end());
-  const double upper = v[mid];
-  if (v.size() % 2 == 1) return upper;
-  return 0.5 * (upper + *std::max_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(mid)));
-}
-
-}  // namespace
 
 std::vector<Band> without_bands(const std::vector<Band>& bands, const std::vector<bool>& drop, int rows, int row_unit) {
   const int unit = std::max(row_unit, 1);

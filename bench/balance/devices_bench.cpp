@@ -8,6 +8,7 @@
 #include <spdlog/spdlog.h>
 
 #include "camera_path.h"
+#include "cohort/balance/order_statistics.h"
 #include "cohort/core/frame_defaults.h"
 #include "cohort/core/renderer.h"
 #include "cohort/core/view.h"
@@ -25,15 +26,6 @@ std::string join(const std::vector<std::string>& names) {
   std::string out;
   for (const std::string& n : names) out += (out.empty() ? "" : "+") + n;
   return out;
-}
-
-double percentile(std::vector<double> values, double p) {
-  if (values.empty()) return 0.0;
-  std::sort(values.begin(), values.end());
-  const double at = p * static_cast<double>(values.size() - 1);
-  const size_t lo = static_cast<size_t>(at);
-  const size_t hi = std::min(lo + 1, values.size() - 1);
-  return values[lo] + (at - static_cast<double>(lo)) * (values[hi] - values[lo]);
 }
 
 DevicesBenchRun run_mix(const DevicesBenchConfig& config, const std::vector<std::string>& names) {
@@ -92,8 +84,8 @@ DevicesBenchRun run_mix(const DevicesBenchConfig& config, const std::vector<std:
 #endif
   run.mean_idle_percent /= counted;
   run.mean_rendering_tracers /= counted;
-  run.median_ms = percentile(run.wall_ms, 0.5);
-  run.p95_ms = percentile(run.wall_ms, 0.95);
+  run.median_ms = median(run.wall_ms);
+  run.p95_ms = quantile(run.wall_ms, 0.95);
   run.fps = run.median_ms > 0.0 ? 1000.0 / run.median_ms : 0.0;
   spdlog::info("bench devices: {}: median {:.3f} ms, p95 {:.3f} ms, mean idle {:.2f} %", join(names), run.median_ms,
                run.p95_ms, run.mean_idle_percent);

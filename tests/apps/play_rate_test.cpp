@@ -12,8 +12,8 @@ TEST(PlayRate, LeavesTheWarmUpOutAndTakesMedianAndP95) {
   for (double ms : {500.0, 400.0, 300.0}) rate.frame(ms);  // warm-up: loading and the first frames
   for (int i = 1; i <= 100; ++i) rate.frame(static_cast<double>(i));
   EXPECT_EQ(rate.counted(), 100u);
-  EXPECT_DOUBLE_EQ(rate.median_ms(), 51.0);  // index round(0.5 * 99) = 50 of 1..100
-  EXPECT_DOUBLE_EQ(rate.p95_ms(), 95.0);     // index round(0.95 * 99) = 94
+  EXPECT_DOUBLE_EQ(rate.median_ms(), 50.5);  // between ranks 49 and 50 of 1..100 (order_statistics.h)
+  EXPECT_NEAR(rate.p95_ms(), 95.05, 1e-9);   // rank 0.95 * 99 = 94.05
 }
 
 TEST(PlayRate, IgnoresIntervalsThatAreNotTimes) {
