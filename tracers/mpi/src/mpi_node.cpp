@@ -3,6 +3,8 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <atomic>
+#include <exception>
 #include <csignal>
 #include <optional>
 #include <thread>
@@ -20,6 +22,10 @@ namespace cohort::tracers {
 namespace {
 
 constexpr int kRank0 = 0;
+
+double ms_since(MpiClock::time_point start) {
+  return std::chrono::duration<double, std::milli>(MpiClock::now() - start).count();
+}
 
 std::string host_name() {
   char name[256] = {};
@@ -143,24 +149,113 @@ class Node {
       std::this_thread::sleep_for(std::chrono::milliseconds(options_.stall_ms));
     }
     const auto start = MpiClock::now();
+    wire::NodeTiming timing;
+    // The pieces of the last band are sent from target_ itself: before its rows are written again,
+    // they must have left (they have, unless rank 0 stopped reading: then this band goes to a fresh
+    // buffer, and the old one stays with its sends).
+    const auto send_start = MpiClock::now();
+    if (!mpi.flush_sends(kRank0, MpiClock::now() + std::chrono::seconds(2))) {
+      spdlog::warn("node {}: the last band's rows have not left after 2 s; rendering into a new buffer", mpi.rank());
+      retired_.push_back(std::move(target_));
+      target_ = core::BandBuffer();
+    }
+    timing.send_ms += ms_since(send_start);
     target_.resize(int(request.job.camera.width), int(request.job.camera.height), request.format);
     target_.enable_aux(request.aux);
+    // The band in pieces: each goes out, straight from target_ (page-locked by a CUDA tracer, which
+    // downloads into it), as soon as it is rendered, and travels while the next renders.
+    const uint32_t width = request.job.camera.width;
     std::vector<float> row_work;
-    try {
-      row_work = render_split(request.job);
-    } catch (const std::exception& e) {
-      send(mpi, wire::Kind::band_failed, m.sequence, wire::encode_band_failure({false, e.what()}));
-      return;
+    bool complete_work = true;
+    for (uint32_t i = 0; i < request.pieces; ++i) {
+      const wire::RowRange rows = wire::piece_rows(p.row_begin, p.row_end, request.pieces, i);
+      core::BandJob piece = request.job;
+      piece.params.row_begin = rows.begin;
+      piece.params.row_end = rows.end;
+      const auto render_start = MpiClock::now();
+      PartResult part;
+      try {
+        part = render_while_sending(mpi, piece);
+      } catch (const std::exception& e) {
+        send(mpi, wire::Kind::band_failed, m.sequence, wire::encode_band_failure({false, e.what()}));
+        return;
+      }
+      timing.render_ms += ms_since(render_start);
+      timing.send_ms += part.mpi_ms;
+      timing.device_ms += part.tracer_ms;
+      if (part.row_work.size() == rows.end - rows.begin)
+        row_work.insert(row_work.end(), part.row_work.begin(), part.row_work.end());
+      else
+        complete_work = false;
+      const auto post_start = MpiClock::now();
+      if (i == 0) timing.first_piece_ms = ms_since(start);
+      const uint32_t count = rows.end - rows.begin;
+      mpi.send_in_place(kRank0, wire::piece_tag(m.sequence, i, wire::Plane::colour), target_.row(int(rows.begin)),
+                        wire::piece_bytes(count, width, request.format, wire::Plane::colour));
+      if (request.aux)
+        mpi.send_in_place(kRank0, wire::piece_tag(m.sequence, i, wire::Plane::aux), target_.aux_row(int(rows.begin)),
+                          wire::piece_bytes(count, width, request.format, wire::Plane::aux));
+      timing.send_ms += ms_since(post_start);
     }
-    const double ms = std::chrono::duration<double, std::milli>(MpiClock::now() - start).count();
-    mpi.send(kRank0, wire::band_rows_message(m.sequence, target_, p.row_begin, p.row_end, ms, row_work));
+    if (!complete_work) row_work.clear();
+    wire::BandRows done;
+    done.row_begin = p.row_begin;
+    done.row_end = p.row_end;
+    done.width = width;
+    done.format = request.format;
+    done.pieces = request.pieces;
+    done.aux = request.aux;
+    done.row_work = std::move(row_work);
+    timing.total_ms = ms_since(start);
+    done.device_ms = timing.total_ms;
+    done.timing = timing;
+    send(mpi, wire::Kind::band_rows, m.sequence, wire::encode_band_rows(done));
     ++bands_;
+  }
+
+  struct PartResult {
+    std::vector<float> row_work;
+    double tracer_ms = 0.0;  // what the tracers measured themselves (the slowest part's)
+    double mpi_ms = 0.0;     // in MPI calls moving the pieces sent before, meanwhile
+  };
+
+  // Renders one piece while the pieces sent before it travel: a library may move a large message only
+  // inside MPI calls, so while the tracers render on a thread of their own, this one keeps the sends
+  // going (with naps, so as not to take a core from a CPU tracer).
+  PartResult render_while_sending(MpiSession& mpi, const core::BandJob& piece) {
+    PartResult part;
+    if (mpi.progress_sends() == 0) {
+      part.row_work = render_split(piece, part.tracer_ms);
+      return part;
+    }
+    std::atomic<bool> finished{false};
+    std::exception_ptr error;
+    std::thread renderer([&] {
+      try {
+        part.row_work = render_split(piece, part.tracer_ms);
+      } catch (...) {
+        error = std::current_exception();
+      }
+      finished = true;
+    });
+    bool sending = true;
+    while (!finished.load()) {
+      if (sending) {
+        const auto call = MpiClock::now();
+        sending = mpi.progress_sends() > 0;
+        part.mpi_ms += ms_since(call);
+      }
+      std::this_thread::sleep_for(std::chrono::microseconds(sending ? 30 : 100));
+    }
+    renderer.join();
+    if (error) std::rethrow_exception(error);
+    return part;
   }
 
   // The band split among the node's tracers by their last speed, rendered in parallel; a tracer that
   // fails has its rows re-rendered by one that did not. Returns the per-row work when every part
   // reported it.
-  std::vector<float> render_split(const core::BandJob& job) {
+  std::vector<float> render_split(const core::BandJob& job, double& tracer_ms) {
     const uint32_t begin = job.params.row_begin, end = job.params.row_end, rows = end - begin;
     const size_t n = tracers_.size();
     // Shares in proportion to speed (the balancer module's Perfect division, in its 4-row units): the
@@ -199,6 +294,8 @@ class Node {
       const double speed = std::max(double(cuts[i + 1] - cuts[i]) / std::max(ms[i], 1e-3), 1e-3);
       rows_per_ms_[i] = 0.5 * rows_per_ms_[i] + 0.5 * speed;  // smoothed like Perfect Smooth's alpha 0.5
     }
+    tracer_ms = 0.0;
+    for (size_t i = 0; i < n; ++i) tracer_ms = std::max(tracer_ms, results[i].device_ms);
     bool complete_work = true;
     for (size_t i = 0; i < n; ++i) {
       if (errors[i].empty()) {
@@ -226,6 +323,7 @@ class Node {
   NodeOptions options_;
   std::vector<double> rows_per_ms_;
   core::BandBuffer target_;
+  std::vector<core::BandBuffer> retired_;  // band buffers whose pieces had not left (rank 0 stopped reading)
   bool diverged_ = false;
   std::string divergence_;
   bool stalled_ = false;
