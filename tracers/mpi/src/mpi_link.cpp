@@ -218,7 +218,8 @@ bool MpiSession::flush_sends(int destination, MpiClock::time_point deadline) {
 
 std::optional<std::vector<uint8_t>> MpiSession::receive(int source, MpiClock::time_point deadline, PieceSink* pieces) {
   // Polls: yields at first (a band's answer is often close), then sleeps briefly so that a waiting
-  // tracer thread does not take a core from the ones rendering.
+  // tracer thread does not take a core from the ones rendering. A piece that came starts it over: the
+  // band's next piece, or its end, follows.
   for (int polls = 0;; ++polls) {
     {
       std::lock_guard lock(mutex_);
@@ -240,6 +241,7 @@ std::optional<std::vector<uint8_t>> MpiSession::receive(int source, MpiClock::ti
           pending = impl_->receives.find(source);
           break;
         }
+        polls = 0;
         Impl::Piece& piece = impl_->pieces[source].emplace_back();
         void* into = pieces->place(status.MPI_TAG, size_t(count));
         if (!into) {

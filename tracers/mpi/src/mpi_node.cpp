@@ -190,8 +190,14 @@ class Node {
       const auto post_start = MpiClock::now();
       if (i == 0) timing.first_piece_ms = ms_since(start);
       const uint32_t count = rows.end - rows.begin;
+      uint64_t colour_bytes = wire::piece_bytes(count, width, request.format, wire::Plane::colour);
+      if (i == 0 && int(p.frame_index) == options_.short_piece_frame && colour_bytes > 0) {
+        spdlog::warn("node {}: sending piece 0 of frame {} a byte short (--short-piece-frame)", mpi.rank(),
+                     p.frame_index);
+        --colour_bytes;
+      }
       mpi.send_in_place(kRank0, wire::piece_tag(m.sequence, i, wire::Plane::colour), target_.row(int(rows.begin)),
-                        wire::piece_bytes(count, width, request.format, wire::Plane::colour));
+                        colour_bytes);
       if (request.aux)
         mpi.send_in_place(kRank0, wire::piece_tag(m.sequence, i, wire::Plane::aux), target_.aux_row(int(rows.begin)),
                           wire::piece_bytes(count, width, request.format, wire::Plane::aux));
