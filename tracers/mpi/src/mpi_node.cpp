@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <atomic>
 #include <exception>
+#include <functional>
 #include <csignal>
 #include <optional>
 #include <thread>
@@ -165,45 +166,40 @@ class Node {
     // The band in pieces: each goes out, straight from target_ (page-locked by a CUDA tracer, which
     // downloads into it), as soon as it is rendered, and travels while the next renders.
     const uint32_t width = request.job.camera.width;
-    std::vector<float> row_work;
-    bool complete_work = true;
-    for (uint32_t i = 0; i < request.pieces; ++i) {
-      const wire::RowRange rows = wire::piece_rows(p.row_begin, p.row_end, request.pieces, i);
-      core::BandJob piece = request.job;
-      piece.params.row_begin = rows.begin;
-      piece.params.row_end = rows.end;
-      const auto render_start = MpiClock::now();
-      PartResult part;
-      try {
-        part = render_while_sending(mpi, piece);
-      } catch (const std::exception& e) {
-        send(mpi, wire::Kind::band_failed, m.sequence, wire::encode_band_failure({false, e.what()}));
-        return;
-      }
-      timing.render_ms += ms_since(render_start);
-      timing.send_ms += part.mpi_ms;
-      timing.device_ms += part.tracer_ms;
-      if (part.row_work.size() == rows.end - rows.begin)
-        row_work.insert(row_work.end(), part.row_work.begin(), part.row_work.end());
-      else
-        complete_work = false;
+    std::vector<int> cuts;
+    for (uint32_t i = 0; i < request.pieces; ++i)
+      cuts.push_back(int(wire::piece_rows(p.row_begin, p.row_end, request.pieces, i).begin));
+    cuts.push_back(int(p.row_end));
+    // Called on the rendering thread as each piece lands in target_.
+    auto post_piece = [&](size_t i) {
       const auto post_start = MpiClock::now();
       if (i == 0) timing.first_piece_ms = ms_since(start);
-      const uint32_t count = rows.end - rows.begin;
+      const uint32_t count = uint32_t(cuts[i + 1] - cuts[i]);
       uint64_t colour_bytes = wire::piece_bytes(count, width, request.format, wire::Plane::colour);
       if (i == 0 && int(p.frame_index) == options_.short_piece_frame && colour_bytes > 0) {
         spdlog::warn("node {}: sending piece 0 of frame {} a byte short (--short-piece-frame)", mpi.rank(),
                      p.frame_index);
         --colour_bytes;
       }
-      mpi.send_in_place(kRank0, wire::piece_tag(m.sequence, i, wire::Plane::colour), target_.row(int(rows.begin)),
+      mpi.send_in_place(kRank0, wire::piece_tag(m.sequence, uint32_t(i), wire::Plane::colour), target_.row(cuts[i]),
                         colour_bytes);
       if (request.aux)
-        mpi.send_in_place(kRank0, wire::piece_tag(m.sequence, i, wire::Plane::aux), target_.aux_row(int(rows.begin)),
+        mpi.send_in_place(kRank0, wire::piece_tag(m.sequence, uint32_t(i), wire::Plane::aux), target_.aux_row(cuts[i]),
                           wire::piece_bytes(count, width, request.format, wire::Plane::aux));
       timing.send_ms += ms_since(post_start);
+    };
+    const auto render_start = MpiClock::now();
+    Rendered rendered;
+    try {
+      rendered = render_while_sending(mpi, request.job, cuts, post_piece);
+    } catch (const std::exception& e) {
+      // Pieces already sent are this job's: rank 0 takes them, then this failure.
+      send(mpi, wire::Kind::band_failed, m.sequence, wire::encode_band_failure({false, e.what()}));
+      return;
     }
-    if (!complete_work) row_work.clear();
+    timing.render_ms = ms_since(render_start);
+    timing.send_ms += rendered.mpi_ms;
+    timing.device_ms = rendered.tracer_ms;
     wire::BandRows done;
     done.row_begin = p.row_begin;
     done.row_end = p.row_end;
@@ -211,7 +207,7 @@ class Node {
     done.format = request.format;
     done.pieces = request.pieces;
     done.aux = request.aux;
-    done.row_work = std::move(row_work);
+    done.row_work = std::move(rendered.row_work);
     timing.total_ms = ms_since(start);
     done.device_ms = timing.total_ms;
     done.timing = timing;
@@ -219,43 +215,56 @@ class Node {
     ++bands_;
   }
 
-  struct PartResult {
+  struct Rendered {
     std::vector<float> row_work;
-    double tracer_ms = 0.0;  // what the tracers measured themselves (the slowest part's)
-    double mpi_ms = 0.0;     // in MPI calls moving the pieces sent before, meanwhile
+    double tracer_ms = 0.0;  // what the tracers measured themselves (summed over pieces; the slowest part's)
+    double mpi_ms = 0.0;     // in MPI calls moving the pieces sent, meanwhile
   };
 
-  // Renders one piece while the pieces sent before it travel: a library may move a large message only
-  // inside MPI calls, so while the tracers render on a thread of their own, this one keeps the sends
-  // going (with naps, so as not to take a core from a CPU tracer).
-  PartResult render_while_sending(MpiSession& mpi, const core::BandJob& piece) {
-    PartResult part;
-    if (mpi.progress_sends() == 0) {
-      part.row_work = render_split(piece, part.tracer_ms);
-      return part;
-    }
+  // Renders the band's pieces on a thread of their own, `post_piece(i)` sending each as it lands, while
+  // this thread keeps the sends going: a library may move a large message only inside MPI calls (with
+  // naps, so as not to take a core from a CPU tracer). One tracer renders the pieces itself (a GPU
+  // downloads each while the next renders); several split each piece by their speed.
+  Rendered render_while_sending(MpiSession& mpi, const core::BandJob& job, const std::vector<int>& cuts,
+                                const std::function<void(size_t)>& post_piece) {
+    Rendered rendered;
     std::atomic<bool> finished{false};
     std::exception_ptr error;
     std::thread renderer([&] {
       try {
-        part.row_work = render_split(piece, part.tracer_ms);
+        if (tracers_.size() == 1) {
+          core::BandResult result = tracers_.front()->render_band_in_pieces(job, target_, cuts, post_piece);
+          rendered.tracer_ms = result.device_ms;
+          rendered.row_work = std::move(result.row_work);
+        } else {
+          bool complete_work = true;
+          for (size_t i = 0; i + 1 < cuts.size(); ++i) {
+            core::BandJob piece = job;
+            piece.params.row_begin = uint32_t(cuts[i]);
+            piece.params.row_end = uint32_t(cuts[i + 1]);
+            double ms = 0.0;
+            std::vector<float> work = render_split(piece, ms);
+            rendered.tracer_ms += ms;
+            complete_work = complete_work && work.size() == size_t(cuts[i + 1] - cuts[i]);
+            if (complete_work) rendered.row_work.insert(rendered.row_work.end(), work.begin(), work.end());
+            post_piece(i);
+          }
+          if (!complete_work) rendered.row_work.clear();
+        }
       } catch (...) {
         error = std::current_exception();
       }
       finished = true;
     });
-    bool sending = true;
     while (!finished.load()) {
-      if (sending) {
-        const auto call = MpiClock::now();
-        sending = mpi.progress_sends() > 0;
-        part.mpi_ms += ms_since(call);
-      }
-      std::this_thread::sleep_for(std::chrono::microseconds(sending ? 30 : 100));
+      const auto call = MpiClock::now();
+      const bool sending = mpi.progress_sends() > 0;
+      rendered.mpi_ms += ms_since(call);
+      std::this_thread::sleep_for(std::chrono::microseconds(sending ? 30 : 60));
     }
     renderer.join();
     if (error) std::rethrow_exception(error);
-    return part;
+    return rendered;
   }
 
   // The band split among the node's tracers by their last speed, rendered in parallel; a tracer that
