@@ -307,11 +307,11 @@ core::BandResult CudaTracer::render_band(const core::BandJob& job, core::BandBuf
 core::BandResult CudaTracer::render_band_in_pieces(const core::BandJob& job, core::BandBuffer& target,
                                                   const std::vector<int>& cuts, const std::function<void(size_t)>& ready) {
   Impl& m = *impl_;
-  const KFrameParams params = frame_params(job);
-  const bool write_aux = params.aux_outputs != 0u && target.has_aux();
+  const bool write_aux = job.params.aux_outputs != 0u && target.has_aux();
   if (cuts.size() < 3 || write_aux) return core::Tracer::render_band_in_pieces(job, target, cuts, ready);
   COHORT_CUDA(cudaSetDevice(m.device));
   if (!has_scene()) throw std::runtime_error(m.name + ": render_band before any commit was applied");
+  const KFrameParams params = frame_params(job);
   const KCamera& camera = job.camera;
   if (cuts.front() != int(params.row_begin) || cuts.back() != int(params.row_end))
     throw std::invalid_argument(m.name + ": the pieces do not cover the band");
