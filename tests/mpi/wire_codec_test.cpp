@@ -179,10 +179,10 @@ TEST(WireCodec, BandRowsCloseABandAndEveryFieldIsChecked) {
   done.pieces = 3;
   done.aux = true;
   done.device_ms = 2.5;
-  done.timing = {2.5, 2.0, 1.5, 0.25, 0.75};
+  done.timing = {2.5, 2.0, 1.5, 0.25, 0.75, 0.5};
   done.row_work = {3.0f, 4.0f, 5.0f};
   const std::vector<uint8_t> payload = wire::encode_band_rows(done);
-  EXPECT_EQ(payload.size(), 6 * 4 + 8 + 40 + 8 + 3 * 4) << "no pixels: they went ahead as pieces";
+  EXPECT_EQ(payload.size(), 6 * 4 + 8 + 48 + 8 + 3 * 4) << "no pixels: they went ahead as pieces";
   const wire::BandRows back = wire::decode_band_rows(payload);
   EXPECT_EQ(back.row_begin, 10u);
   EXPECT_EQ(back.row_end, 13u);
@@ -193,6 +193,7 @@ TEST(WireCodec, BandRowsCloseABandAndEveryFieldIsChecked) {
   EXPECT_EQ(back.device_ms, 2.5);
   EXPECT_EQ(back.timing.render_ms, 2.0);
   EXPECT_EQ(back.timing.first_piece_ms, 0.75);
+  EXPECT_EQ(back.timing.commit_ms, 0.5);
   EXPECT_EQ(back.row_work, done.row_work);
   expect_every_prefix_refused(payload, [](const auto& p) { return wire::decode_band_rows(p); });
 

@@ -66,8 +66,8 @@ class Node {
       }
       wire::Message& m = *received;
       switch (m.kind) {
-        case wire::Kind::commit: apply_commit(m); break;
-        case wire::Kind::full_local: apply_full_local(m); break;
+        case wire::Kind::commit: timed_commit([&] { apply_commit(m); }); break;
+        case wire::Kind::full_local: timed_commit([&] { apply_full_local(m); }); break;
         case wire::Kind::band_job: render(mpi, m); break;
         case wire::Kind::shutdown:
           spdlog::info("node {}: shutdown from rank 0 after {} band(s)", mpi.rank(), bands_);
@@ -80,6 +80,12 @@ class Node {
   }
 
  private:
+  template <class Apply> void timed_commit(Apply&& apply) {
+    const auto start = MpiClock::now();
+    apply();
+    commit_ms_ += ms_since(start);
+  }
+
   // A refused or failed commit leaves the scene behind rank 0's: every band fails, asking for a full
   // resync, until one arrives.
   void apply_commit(const wire::Message& m) {
@@ -151,6 +157,8 @@ class Node {
     }
     const auto start = MpiClock::now();
     wire::NodeTiming timing;
+    timing.commit_ms = commit_ms_;
+    commit_ms_ = 0.0;
     // The pieces of the last band are sent from target_ itself: before its rows are written again,
     // they must have left (they have, unless rank 0 stopped reading: then this band goes to a fresh
     // buffer, and the old one stays with its sends).
@@ -342,6 +350,7 @@ class Node {
   bool diverged_ = false;
   std::string divergence_;
   bool stalled_ = false;
+  double commit_ms_ = 0.0;  // applying commits since the last band
   uint64_t bands_ = 0;
 };
 

@@ -206,11 +206,14 @@ MpiTracer::~MpiTracer() {
     const double round_trip = s.total_round_trip_ms / n, node = s.total_node_ms / n;
     spdlog::info("mpi:{}: {} band(s), {:.1f} KiB sent and {:.1f} KiB received a band ({} pieces), round trip {:.2f} ms "
                  "a band: on the node {:.2f} ms (its tracers' render_band {:.2f} ms, of it their own {:.2f} ms; MPI "
-                 "calls {:.2f} ms), rank 0 matched the first piece after {:.2f} ms; {:.2f} ms beyond the node's time "
-                 "(the job out, the last piece and band_rows back)",
+                 "calls {:.2f} ms; first piece sent after {:.2f} ms), rank 0 matched it after {:.2f} ms; {:.2f} ms "
+                 "beyond the node's time, "
+                 "of it {:.2f} ms applying the commit before the job (the rest: the job out, the last piece and "
+                 "band_rows back)",
                  options_.rank, s.bands, double(s.bytes_sent) / n / 1024.0, double(s.bytes_received) / n / 1024.0,
                  s.last_pieces, round_trip, node, s.total_node_render_ms / n, s.total_node_tracer_ms / n,
-                 s.total_node_send_ms / n, s.total_first_piece_ms / n, round_trip - node);
+                 s.total_node_send_ms / n, s.total_node_first_piece_ms / n, s.total_first_piece_ms / n, round_trip - node,
+                 s.total_node_commit_ms / n);
   }
   // The node stays for later tracers of this run; the session's end tells every node to leave.
   try {
@@ -420,6 +423,8 @@ core::BandResult MpiTracer::render_band(const core::BandJob& job, core::BandBuff
       stats_.total_node_render_ms += rows.timing.render_ms;
       stats_.total_node_tracer_ms += rows.timing.device_ms;
       stats_.total_node_send_ms += rows.timing.send_ms;
+      stats_.total_node_commit_ms += rows.timing.commit_ms;
+      stats_.total_node_first_piece_ms += rows.timing.first_piece_ms;
       stats_.total_first_piece_ms +=
           std::chrono::duration<double, std::milli>(pieces.first_matched - start).count();
       stats_.last_pieces = request.pieces;

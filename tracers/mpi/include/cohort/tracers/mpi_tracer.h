@@ -51,11 +51,14 @@ struct MpiLinkStats {
   // Where the round trip goes, summed over bands (divide by `bands`): on the node, its tracers'
   // render_band calls (GPU: kernel, download into its band buffer and waits), of that what the tracers
   // measured themselves (GPU: kernel time), and its MPI calls; on rank 0, job sent -> first piece
-  // matched. round trip - node time is the job's way out and the last piece's and band_rows' way back.
+  // matched. round trip - node time is the commits' and job's way out, the node applying the commits,
+  // and the last piece's and band_rows' way back.
   double total_node_render_ms = 0.0;
   double total_node_tracer_ms = 0.0;
   double total_node_send_ms = 0.0;
+  double total_node_commit_ms = 0.0;  // decoding and applying the commits before the job (not in node time)
   double total_first_piece_ms = 0.0;
+  double total_node_first_piece_ms = 0.0;  // on the node: job taken -> first piece posted
   uint32_t last_pieces = 0;
   uint64_t stale_answers = 0;       // late answers to jobs that had timed out, dropped
   uint64_t refused_messages = 0;    // malformed answers, refused

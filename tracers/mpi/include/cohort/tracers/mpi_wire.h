@@ -140,8 +140,11 @@ struct NodeTiming {
   // render_ms), and the wait for the last band's pieces to have left.
   double send_ms = 0.0;
   double first_piece_ms = 0.0;  // job taken -> first piece posted
+  // Decoding and applying the commits that came since the last band (before this job, on the same
+  // ordered stream, so part of the round trip but not of total_ms).
+  double commit_ms = 0.0;
 };
-static_assert(sizeof(NodeTiming) == 40, "NodeTiming travels as it lies: five doubles");
+static_assert(sizeof(NodeTiming) == 48, "NodeTiming travels as it lies: six doubles");
 
 // The band_rows message: the band is done. Its pieces went ahead on their own tags: `pieces` of colour
 // rows in the band format (6 bytes a pixel as rgb16f), and as many of aux texels when `aux`.
