@@ -4,9 +4,9 @@
 
 #include <algorithm>
 #include <atomic>
+#include <csignal>
 #include <exception>
 #include <functional>
-#include <csignal>
 #include <optional>
 #include <thread>
 
