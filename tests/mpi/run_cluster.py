@@ -223,6 +223,12 @@ def bench(a):
     # Alone, mpi:1 renders every row: at least the whole frame's pixels (16 bytes each as RGBA32F) come back.
     if len(links) != 1 or links[0]["received_bytes_per_frame"] < 64 * 48 * 16 or links[0]["mean_round_trip_ms"] <= 0:
         sys.exit("mpi:1 alone: bytes per frame or round trip not reported")
+    # Where the round trip went: the node rendered within it, and its first piece came before the end.
+    link = links[0]
+    if not 0 < link["mean_node_render_ms"] <= link["mean_node_ms"] <= link["mean_round_trip_ms"]:
+        sys.exit(f"mpi:1 alone: the node's render time should lie within its time and the round trip: {link}")
+    if not 0 < link["mean_first_piece_ms"] <= link["mean_round_trip_ms"]:
+        sys.exit(f"mpi:1 alone: rank 0's wait for the first piece should lie within the round trip: {link}")
     if len(mix[0]["remote"]) != 2:
         sys.exit("the mix should report both remote tracers")
     print("bench: ok")
