@@ -89,12 +89,17 @@ case "${1:-}" in
         timeout 120 "$cohort" render "$pack" "${size[@]}" "${common[@]}" --tracers cuda:0,cuda:1 --out /tmp/in_$map >/tmp/in_$map.log 2>&1 ||
           tail -n 3 /tmp/in_$map.log
         echo "round $round, $map map, in-process: $(python3 tools/frame_times.py /tmp/in_$map/stats.json --skip 50 | head -n 1)"
-        timeout 180 mpiexec.hydra -np 1 "$cohort" render "$pack" "${size[@]}" "${common[@]}" --tracers mpi:1,mpi:2 --out /tmp/mpi_$map : \
-          -np 1 "$cohort" node "$pack" --tracers cuda:0 : -np 1 "$cohort" node "$pack" --tracers cuda:1 >/tmp/mpi_$map.log 2>&1 ||
-          { echo "two-rank run failed"; tail -n 8 /tmp/mpi_$map.log; }
-        [ -f /tmp/mpi_$map/stats.json ] &&
-          echo "round $round, $map map, two ranks: $(python3 tools/frame_times.py /tmp/mpi_$map/stats.json --skip 50 | head -n 1)"
-        grep -E "round trip" /tmp/mpi_$map.log | sed 's/^.*\] //' || true
+        # COHORT_CLUSTER_PIECES="1 2 4 8": the two-rank run once per piece count a band's rows travel in.
+        for pieces in ${COHORT_CLUSTER_PIECES:-4}; do
+          rm -rf /tmp/mpi_$map
+          COHORT_MPI_BAND_PIECES=$pieces timeout 180 mpiexec.hydra -np 1 "$cohort" render "$pack" "${size[@]}" "${common[@]}" \
+            --tracers mpi:1,mpi:2 --out /tmp/mpi_$map : \
+            -np 1 "$cohort" node "$pack" --tracers cuda:0 : -np 1 "$cohort" node "$pack" --tracers cuda:1 >/tmp/mpi_$map.log 2>&1 ||
+            { echo "two-rank run failed"; tail -n 8 /tmp/mpi_$map.log; }
+          [ -f /tmp/mpi_$map/stats.json ] &&
+            echo "round $round, $map map, two ranks, $pieces piece(s) a band: $(python3 tools/frame_times.py /tmp/mpi_$map/stats.json --skip 50 | head -n 1)"
+          grep -E "round trip" /tmp/mpi_$map.log | sed 's/^.*\] //' || true
+        done
       done
     done
     ;;

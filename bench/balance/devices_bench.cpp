@@ -78,6 +78,10 @@ DevicesBenchRun run_mix(const DevicesBenchConfig& config, const std::vector<std:
     if (bands > 0) {
       link.mean_round_trip_ms = (after.total_round_trip_ms - before[i].total_round_trip_ms) / double(bands);
       link.mean_node_ms = (after.total_node_ms - before[i].total_node_ms) / double(bands);
+      link.mean_node_render_ms = (after.total_node_render_ms - before[i].total_node_render_ms) / double(bands);
+      link.mean_node_tracer_ms = (after.total_node_tracer_ms - before[i].total_node_tracer_ms) / double(bands);
+      link.mean_node_commit_ms = (after.total_node_commit_ms - before[i].total_node_commit_ms) / double(bands);
+      link.mean_first_piece_ms = (after.total_first_piece_ms - before[i].total_first_piece_ms) / double(bands);
     }
     run.remote.push_back(link);
   }
@@ -179,7 +183,11 @@ nlohmann::json remote_json(const std::vector<RemoteLinkRun>& links) {
                    {"sent_bytes_per_frame", l.sent_bytes_per_frame},
                    {"received_bytes_per_frame", l.received_bytes_per_frame},
                    {"mean_round_trip_ms", l.mean_round_trip_ms},
-                   {"mean_node_ms", l.mean_node_ms}});
+                   {"mean_node_ms", l.mean_node_ms},
+                   {"mean_node_render_ms", l.mean_node_render_ms},
+                   {"mean_node_tracer_ms", l.mean_node_tracer_ms},
+                   {"mean_node_commit_ms", l.mean_node_commit_ms},
+                   {"mean_first_piece_ms", l.mean_first_piece_ms}});
   return out;
 }
 }  // namespace

@@ -29,6 +29,11 @@ struct RemoteLinkRun {
   double sent_bytes_per_frame = 0.0, received_bytes_per_frame = 0.0;
   double mean_round_trip_ms = 0.0;  // band job sent -> rows received
   double mean_node_ms = 0.0;        // the node's own time for its band
+  // Where the round trip went (tracers::MpiLinkStats): the node's tracers' render calls (GPU: kernel,
+  // downloads, waits), of that what they measured themselves, the node applying the commit before the
+  // job, and rank 0's wait for the band's first piece.
+  double mean_node_render_ms = 0.0, mean_node_tracer_ms = 0.0, mean_node_commit_ms = 0.0;
+  double mean_first_piece_ms = 0.0;
 };
 
 struct DevicesBenchRun {

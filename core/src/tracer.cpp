@@ -15,4 +15,27 @@ BandResult Tracer::render_band(const BandJob& job, FrameBuffer& target) {
   return result;
 }
 
+BandResult Tracer::render_band_in_pieces(const BandJob& job, BandBuffer& target, const std::vector<int>& cuts,
+                                         const std::function<void(size_t)>& ready) {
+  BandResult total;
+  bool complete_work = true;
+  for (size_t i = 0; i + 1 < cuts.size(); ++i) {
+    if (cuts[i + 1] <= cuts[i]) {  // an empty piece has nothing to render
+      ready(i);
+      continue;
+    }
+    BandJob piece = job;
+    piece.keep_on_device = -1;
+    piece.params.row_begin = static_cast<kuint>(cuts[i]);
+    piece.params.row_end = static_cast<kuint>(cuts[i + 1]);
+    BandResult part = render_band(piece, target);
+    total.device_ms += part.device_ms;
+    complete_work = complete_work && part.row_work.size() == static_cast<size_t>(cuts[i + 1] - cuts[i]);
+    if (complete_work) total.row_work.insert(total.row_work.end(), part.row_work.begin(), part.row_work.end());
+    ready(i);
+  }
+  if (!complete_work) total.row_work.clear();
+  return total;
+}
+
 }  // namespace cohort::core

@@ -16,7 +16,9 @@ per frame and round trip), protocol (protocol_check.cpp on 2 ranks: malformed me
 real node), replay (the test map's recorded scenario: door, fan, flicker, a skinned walker; instance,
 TLAS, light and joint records cross the wire every frame, and every frame matches), play (`cohort play`
 under a virtual display with remote tracers: the scenario runs, the screenshot is written and not
-uniform; skipped with status 77 without xvfb-run or the viewer).
+uniform; skipped with status 77 without xvfb-run or the viewer), bad_piece (rank 2 sends a piece of its
+band's rows a byte short once: rank 0 refuses that band with the sizes, its rows are re-rendered by the
+others, and every frame matches).
 """
 import argparse
 import json
@@ -132,6 +134,30 @@ def stall(a, killed=False):
     print(f"{a.case}: ok")
 
 
+def bad_piece(a):
+    """Rank 2 sends piece 0 of its band of frame 1 a byte short: rank 0 refuses the band with the reason
+    (never taking the piece into its rows), re-renders those rows on the others, and every frame, that
+    one too, matches the single-process render; rank 2 renders the next frames."""
+    args = RENDER_ARGS + ["--tracers", "embree,mpi:1,mpi:2"]
+    single, cluster = os.path.join(a.out, "single"), os.path.join(a.out, "cluster")
+    run([a.cohort, "render", a.map, "--out", single] + RENDER_ARGS + ["--tracers", "embree"])
+    flags = mpiexec_flags(a.mpiexec)
+    run([a.mpiexec] + flags + ["-np", "1", a.cohort, "render", a.map, "--out", cluster] + args +
+        [":"] + flags + ["-np", "1", a.cohort, "node", a.map, "--tracers", "embree"] +
+        [":"] + flags + ["-np", "1", a.cohort, "node", a.map, "--tracers", "embree", "--short-piece-frame", "1"])
+    compare_frames(single, cluster)
+    with open(os.path.join(cluster, "stats.json")) as f:
+        stats = json.load(f)["frames"]
+    outcome = [{t["name"]: (t["outcome"], t.get("error", "")) for t in f["tracers"]} for f in stats]
+    print("mpi:2 per frame:", [o["mpi:2"] for o in outcome])
+    status, error = outcome[1]["mpi:2"]
+    if status != "threw" or "refused the band's rows: piece 0 of" not in error or "bytes; they are" not in error:
+        sys.exit(f"frame 1: the short piece should have been refused with its sizes: {outcome[1]['mpi:2']}")
+    if any(o["mpi:2"][0] != "rendered" for i, o in enumerate(outcome) if i != 1):
+        sys.exit("rank 2 should render every other frame")
+    print("bad_piece: ok")
+
+
 def replay(a):
     os.makedirs(a.out)
     stream = os.path.join(a.out, "scenario.cdelta")
@@ -197,6 +223,12 @@ def bench(a):
     # Alone, mpi:1 renders every row: at least the whole frame's pixels (16 bytes each as RGBA32F) come back.
     if len(links) != 1 or links[0]["received_bytes_per_frame"] < 64 * 48 * 16 or links[0]["mean_round_trip_ms"] <= 0:
         sys.exit("mpi:1 alone: bytes per frame or round trip not reported")
+    # Where the round trip went: the node rendered within it, and its first piece came before the end.
+    link = links[0]
+    if not 0 < link["mean_node_render_ms"] <= link["mean_node_ms"] <= link["mean_round_trip_ms"]:
+        sys.exit(f"mpi:1 alone: the node's render time should lie within its time and the round trip: {link}")
+    if not 0 < link["mean_first_piece_ms"] <= link["mean_round_trip_ms"]:
+        sys.exit(f"mpi:1 alone: rank 0's wait for the first piece should lie within the round trip: {link}")
     if len(mix[0]["remote"]) != 2:
         sys.exit("the mix should report both remote tracers")
     print("bench: ok")
@@ -205,7 +237,7 @@ def bench(a):
 def main():
     parser = argparse.ArgumentParser()
     parser.add_argument("case", choices=["match", "mixed", "stall", "killed", "version", "load_error", "bench", "protocol", "replay",
-                                           "play"])
+                                           "play", "bad_piece"])
     parser.add_argument("--mpiexec", required=True)
     parser.add_argument("--cohort", required=True)
     parser.add_argument("--map", required=True)
@@ -228,6 +260,9 @@ def main():
         return
     if a.case == "play":
         play(a)
+        return
+    if a.case == "bad_piece":
+        bad_piece(a)
         return
     if a.case == "protocol":
         _, output = run([a.mpiexec] + mpiexec_flags(a.mpiexec) + ["-np", "2", a.protocol_check])

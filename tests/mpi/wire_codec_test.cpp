@@ -2,6 +2,8 @@
 // changes, and every malformed or truncated message is refused with a reason instead of being applied.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
 #include <cstring>
 #include <functional>
 
@@ -168,61 +170,100 @@ TEST(WireCodec, HeadersAreCheckedBeforeThePayload) {
               std::string::npos);
 }
 
-TEST(WireCodec, BandRowsTravelAsTheBandFormatsBytes) {
-  for (core::BandFormat format : {core::BandFormat::rgb16f, core::BandFormat::rgba32f}) {
-    core::BandBuffer band(8, 5, format);
-    for (int y = 0; y < 5; ++y)
-      for (int x = 0; x < 8; ++x) {
-        const float rgba[4] = {float(x), float(y) * 0.5f, 0.25f, 1.0f};
-        band.store(y, x, rgba, 1);
-      }
-    const std::vector<float> work = {3.0f, 4.0f, 5.0f};
-    const std::vector<uint8_t> payload = wire::encode_band_rows(band, 1, 4, 2.5, work);
-    EXPECT_EQ(payload.size(), 4 * 4 + 8 + 8 + 3 * 4 + 8 + 3 * band.row_bytes() + 8);
-    const wire::BandRows rows = wire::decode_band_rows(payload);
-    EXPECT_EQ(rows.row_begin, 1u);
-    EXPECT_EQ(rows.row_end, 4u);
-    EXPECT_EQ(rows.format, format);
-    EXPECT_EQ(rows.device_ms, 2.5);
-    EXPECT_EQ(rows.row_work, work);
-    ASSERT_EQ(rows.pixels.size(), 3 * band.row_bytes());
-    EXPECT_EQ(std::memcmp(rows.pixels.data(), band.row(1), rows.pixels.size()), 0);
-    expect_every_prefix_refused(payload, [](const auto& p) { return wire::decode_band_rows(p); });
-  }
-  // Rows whose pixel bytes do not match their announced size are refused.
-  core::BandBuffer band(8, 5, core::BandFormat::rgb16f);
-  std::vector<uint8_t> payload = wire::encode_band_rows(band, 0, 2, 1.0, {});
-  const uint32_t wider = 9;
-  std::memcpy(payload.data() + 8, &wider, 4);
-  EXPECT_NE(refusal([&] { wire::decode_band_rows(payload); }).find("pixel bytes"), std::string::npos);
+TEST(WireCodec, BandRowsCloseABandAndEveryFieldIsChecked) {
+  wire::BandRows done;
+  done.row_begin = 10;
+  done.row_end = 13;
+  done.width = 8;
+  done.format = core::BandFormat::rgba32f;
+  done.pieces = 3;
+  done.aux = true;
+  done.device_ms = 2.5;
+  done.timing = {2.5, 2.0, 1.5, 0.25, 0.75, 0.5};
+  done.row_work = {3.0f, 4.0f, 5.0f};
+  const std::vector<uint8_t> payload = wire::encode_band_rows(done);
+  EXPECT_EQ(payload.size(), 6 * 4 + 8 + 48 + 8 + 3 * 4) << "no pixels: they went ahead as pieces";
+  const wire::BandRows back = wire::decode_band_rows(payload);
+  EXPECT_EQ(back.row_begin, 10u);
+  EXPECT_EQ(back.row_end, 13u);
+  EXPECT_EQ(back.width, 8u);
+  EXPECT_EQ(back.format, core::BandFormat::rgba32f);
+  EXPECT_EQ(back.pieces, 3u);
+  EXPECT_TRUE(back.aux);
+  EXPECT_EQ(back.device_ms, 2.5);
+  EXPECT_EQ(back.timing.render_ms, 2.0);
+  EXPECT_EQ(back.timing.first_piece_ms, 0.75);
+  EXPECT_EQ(back.timing.commit_ms, 0.5);
+  EXPECT_EQ(back.row_work, done.row_work);
+  expect_every_prefix_refused(payload, [](const auto& p) { return wire::decode_band_rows(p); });
+
+  auto changed = [&](auto change) {
+    wire::BandRows bad = done;
+    change(bad);
+    return refusal([&] { wire::decode_band_rows(wire::encode_band_rows(bad)); });
+  };
+  EXPECT_NE(changed([](wire::BandRows& b) { b.pieces = 4; }).find("4 pieces for a band of 3 rows"), std::string::npos);
+  EXPECT_NE(changed([](wire::BandRows& b) { b.pieces = 0; }).find("0 pieces"), std::string::npos);
+  EXPECT_NE(changed([](wire::BandRows& b) { b.row_work.pop_back(); }).find("2 row work values for 3 rows"),
+            std::string::npos);
+  EXPECT_NE(changed([](wire::BandRows& b) { b.row_end = 9; }).find("end before they begin"), std::string::npos);
+  EXPECT_NE(changed([](wire::BandRows& b) { b.width = 0; }).find("width 0"), std::string::npos);
+  EXPECT_NE(changed([](wire::BandRows& b) { b.timing.send_ms = std::nan(""); }).find("not a duration"),
+            std::string::npos);
+  EXPECT_NE(changed([](wire::BandRows& b) { b.device_ms = -1.0; }).find("not a duration"), std::string::npos);
+  std::vector<uint8_t> bad_aux = payload;
+  bad_aux[20] = 2;  // the aux flag
+  EXPECT_NE(refusal([&] { wire::decode_band_rows(bad_aux); }).find("aux flag 2"), std::string::npos);
+  std::vector<uint8_t> bad_format = payload;
+  bad_format[12] = 9;
+  EXPECT_NE(refusal([&] { wire::decode_band_rows(bad_format); }).find("unknown band format 9"), std::string::npos);
+  std::vector<uint8_t> longer = payload;
+  longer.push_back(0);
+  EXPECT_NE(refusal([&] { wire::decode_band_rows(longer); }).find("left over"), std::string::npos);
 }
 
-TEST(WireCodec, TheNodesOneBufferMessageIsTheFramedPayloadAndDecodesInPlace) {
-  core::BandBuffer band(8, 6, core::BandFormat::rgb16f);
-  band.enable_aux(true);
-  for (int y = 0; y < 6; ++y)
-    for (int x = 0; x < 8; ++x) {
-      const float rgba[4] = {float(x), float(y), 0.5f, 1.0f};
-      band.store(y, x, rgba, 1);
-      band.aux_row(y)[x].depth = float(10 * y + x);
+TEST(WireCodec, PiecesCoverTheBandInOrderAndTheirTagsNameJobPieceAndPlane) {
+  for (uint32_t rows : {1u, 3u, 4u, 7u, 540u, 1080u}) {
+    for (uint32_t wanted : {1u, 2u, 4u, 5u, 32u, 100u}) {
+      const uint32_t pieces = wire::band_pieces(rows, wanted);
+      EXPECT_GE(pieces, 1u);
+      EXPECT_LE(pieces, std::min({wanted, rows, wire::kMaxPieces}));
+      uint32_t next = 100;
+      for (uint32_t i = 0; i < pieces; ++i) {
+        const wire::RowRange r = wire::piece_rows(100, 100 + rows, pieces, i);
+        EXPECT_EQ(r.begin, next) << rows << " rows in " << pieces;
+        EXPECT_GT(r.end, r.begin) << "no piece is empty";
+        EXPECT_LE(r.end - r.begin, rows / pieces + 1) << "as even as whole rows allow";
+        next = r.end;
+      }
+      EXPECT_EQ(next, 100 + rows);
     }
-  const std::vector<float> work = {1.0f, 2.0f};
-  const std::vector<uint8_t> message = wire::band_rows_message(77, band, 2, 4, 1.5, work);
-  EXPECT_EQ(message, wire::frame_message(wire::Kind::band_rows, 77, wire::encode_band_rows(band, 2, 4, 1.5, work)));
-  const wire::Message m = wire::parse_message(message.data(), message.size());
-  EXPECT_EQ(m.kind, wire::Kind::band_rows);
-  EXPECT_EQ(m.sequence, 77u);
-  const wire::BandRowsView v = wire::decode_band_rows_view(m.payload);
-  EXPECT_EQ(v.row_begin, 2u);
-  EXPECT_EQ(v.row_end, 4u);
-  EXPECT_EQ(v.row_work, work);
-  ASSERT_EQ(v.pixel_bytes, 2 * band.row_bytes());
-  EXPECT_EQ(std::memcmp(v.pixels, band.row(2), v.pixel_bytes), 0);
-  ASSERT_EQ(v.aux_bytes, 2 * 8 * sizeof(KAuxTexel));
-  EXPECT_EQ(std::memcmp(v.aux, band.aux_row(2), v.aux_bytes), 0);
-  EXPECT_GE(v.pixels, m.payload.data());
-  EXPECT_LT(v.aux, m.payload.data() + m.payload.size()) << "views into the payload, not copies";
-  expect_every_prefix_refused(m.payload, [](const auto& p) { return wire::decode_band_rows_view(p); });
+  }
+  EXPECT_EQ(wire::band_pieces(0, 4), 1u) << "an empty band still closes with one (empty) piece";
+  EXPECT_EQ(wire::piece_bytes(3, 8, core::BandFormat::rgb16f, wire::Plane::colour), 3u * 8u * 6u);
+  EXPECT_EQ(wire::piece_bytes(3, 8, core::BandFormat::rgba32f, wire::Plane::aux), 3u * 8u * sizeof(KAuxTexel));
+
+  std::vector<bool> used(32768, false);
+  wire::PieceTag decoded;
+  EXPECT_FALSE(wire::decode_piece_tag(wire::kControlTag, decoded)) << "the control tag is no piece's";
+  for (uint64_t job : {uint64_t(1), uint64_t(63), uint64_t(64), uint64_t(1) << 40})
+    for (uint32_t piece = 0; piece < wire::kMaxPieces; ++piece)
+      for (wire::Plane plane : {wire::Plane::colour, wire::Plane::aux}) {
+        const int tag = wire::piece_tag(job, piece, plane);
+        ASSERT_GT(tag, wire::kControlTag);
+        ASSERT_LE(tag, 32767) << "within the tags every MPI library offers";
+        ASSERT_TRUE(wire::decode_piece_tag(tag, decoded));
+        EXPECT_TRUE(decoded.of_job(job));
+        EXPECT_FALSE(decoded.of_job(job + 1));
+        EXPECT_EQ(decoded.piece, piece);
+        EXPECT_EQ(decoded.plane, plane);
+        if (job < wire::kPieceJobSlots) {
+          EXPECT_FALSE(used[size_t(tag)]) << "tag " << tag << " twice";
+          used[size_t(tag)] = true;
+        }
+      }
+  EXPECT_FALSE(wire::decode_piece_tag(wire::kPieceTagBase - 1, decoded));
+  EXPECT_FALSE(wire::decode_piece_tag(wire::kPieceTagBase + int(wire::kPieceJobSlots * wire::kMaxPieces * 2), decoded));
 }
 
 TEST(WireCodec, BandJobsOutsideTheFrameAreRefused) {
@@ -232,9 +273,18 @@ TEST(WireCodec, BandJobsOutsideTheFrameAreRefused) {
   request.job.params.row_begin = 8;
   request.job.params.row_end = 16;
   request.aux = true;
+  request.pieces = 4;
   const wire::BandRequest back = wire::decode_band_request(wire::encode_band_request(request));
   EXPECT_EQ(back.job.params.row_end, 16u);
   EXPECT_TRUE(back.aux);
+  EXPECT_EQ(back.pieces, 4u);
+  request.pieces = 9;
+  EXPECT_NE(refusal([&] { wire::decode_band_request(wire::encode_band_request(request)); }).find("9 pieces for a band of 8 rows"),
+            std::string::npos);
+  request.pieces = 0;
+  EXPECT_NE(refusal([&] { wire::decode_band_request(wire::encode_band_request(request)); }).find("0 pieces"),
+            std::string::npos);
+  request.pieces = 4;
   EXPECT_EQ(back.format, core::BandFormat::rgb16f);
   request.job.params.row_end = 49;
   EXPECT_NE(refusal([&] { wire::decode_band_request(wire::encode_band_request(request)); }).find("do not fit"),

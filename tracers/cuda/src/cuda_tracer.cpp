@@ -43,6 +43,8 @@ struct CudaTracer::Impl {
   // The aux planes' download runs here, on the copy engine, while the band's kernel runs on `stream`.
   cudaStream_t aux_copy_stream = nullptr;
   cudaEvent_t start = nullptr, stop = nullptr, aux_ready = nullptr;
+  // render_band_in_pieces: per piece, its rows rendered (the copy stream waits for it) and downloaded.
+  std::vector<cudaEvent_t> piece_rendered, piece_downloaded;
   DeviceArray<KVertex> vertices;
   DeviceArray<KVertexColor> vertex_colors;
   DeviceArray<KTriangle> triangles;
@@ -140,6 +142,8 @@ CudaTracer::~CudaTracer() {
   if (impl_->start) cudaEventDestroy(impl_->start);
   if (impl_->stop) cudaEventDestroy(impl_->stop);
   if (impl_->aux_ready) cudaEventDestroy(impl_->aux_ready);
+  for (cudaEvent_t e : impl_->piece_rendered) cudaEventDestroy(e);
+  for (cudaEvent_t e : impl_->piece_downloaded) cudaEventDestroy(e);
   if (impl_->stream) cudaStreamDestroy(impl_->stream);
   if (impl_->aux_copy_stream) cudaStreamDestroy(impl_->aux_copy_stream);
 }
@@ -297,6 +301,110 @@ core::BandResult CudaTracer::render_band(const core::BandJob& job, core::BandBuf
   result.device_ms = kernel_ms;
   result.row_work.assign(m.host_row_rays.begin(), m.host_row_rays.end());
   if (kept) result.device = {m.device, source, write_aux ? kept->aux.data() : nullptr};
+  return result;
+}
+
+core::BandResult CudaTracer::render_band_in_pieces(const core::BandJob& job, core::BandBuffer& target,
+                                                  const std::vector<int>& cuts, const std::function<void(size_t)>& ready) {
+  Impl& m = *impl_;
+  const bool write_aux = job.params.aux_outputs != 0u && target.has_aux();
+  if (cuts.size() < 3 || write_aux) return core::Tracer::render_band_in_pieces(job, target, cuts, ready);
+  COHORT_CUDA(cudaSetDevice(m.device));
+  if (!has_scene()) throw std::runtime_error(m.name + ": render_band before any commit was applied");
+  const KFrameParams params = frame_params(job);
+  const KCamera& camera = job.camera;
+  if (cuts.front() != int(params.row_begin) || cuts.back() != int(params.row_end))
+    throw std::invalid_argument(m.name + ": the pieces do not cover the band");
+  for (size_t i = 0; i + 1 < cuts.size(); ++i)
+    if (cuts[i + 1] < cuts[i]) throw std::invalid_argument(m.name + ": the pieces' rows are out of order");
+  if (params.row_end <= params.row_begin) return {};
+  if (camera.width != kuint(target.width()) || params.row_end > kuint(target.height()))
+    throw std::invalid_argument(m.name + ": band does not fit the frame buffer");
+  const size_t width = camera.width;
+  const size_t rows = params.row_end - params.row_begin;
+  const size_t pixels = width * rows;
+  if (pixels > m.band_capacity) {
+    if (m.band) COHORT_CUDA(cudaFree(m.band));
+    if (m.band_rgb16f) COHORT_CUDA(cudaFree(m.band_rgb16f));
+    m.band_rgb16f = nullptr;
+    COHORT_CUDA(cudaMalloc(&m.band, pixels * sizeof(float4)));
+    m.band_capacity = pixels;
+  }
+  const bool half = target.format() == core::BandFormat::rgb16f;
+  if (half && !m.band_rgb16f) COHORT_CUDA(cudaMalloc(&m.band_rgb16f, m.band_capacity * 3 * sizeof(unsigned short)));
+  if (rows > m.row_rays_capacity) {
+    if (m.row_rays) COHORT_CUDA(cudaFree(m.row_rays));
+    COHORT_CUDA(cudaMalloc(&m.row_rays, rows * sizeof(unsigned)));
+    m.row_rays_capacity = rows;
+  }
+  const size_t pieces = cuts.size() - 1;
+  while (m.piece_rendered.size() < pieces) {
+    cudaEvent_t rendered = nullptr, downloaded = nullptr;
+    COHORT_CUDA(cudaEventCreateWithFlags(&rendered, cudaEventDisableTiming));
+    m.piece_rendered.push_back(rendered);
+    COHORT_CUDA(cudaEventCreateWithFlags(&downloaded, cudaEventDisableTiming));
+    m.piece_downloaded.push_back(downloaded);
+  }
+  COHORT_CUDA(cudaMemsetAsync(m.row_rays, 0, rows * sizeof(unsigned), m.stream));
+  if (m.count_rays) {
+    if (!m.ray_counts) COHORT_CUDA(cudaMalloc(&m.ray_counts, 2 * sizeof(unsigned long long)));
+    COHORT_CUDA(cudaMemsetAsync(m.ray_counts, 0, 2 * sizeof(unsigned long long), m.stream));
+  }
+  m.register_target(target);
+  // Each piece renders (and converts) into its own part of the band's device buffers, so a piece's
+  // download never races the next piece's kernel: the copy stream takes piece i while `stream` runs
+  // piece i + 1.
+  const size_t pixel_bytes = core::bytes_per_pixel(target.format());
+  COHORT_CUDA(cudaEventRecord(m.start, m.stream));
+  for (size_t i = 0; i < pieces; ++i) {
+    KFrameParams piece = params;
+    piece.row_begin = kuint(cuts[i]);
+    piece.row_end = kuint(cuts[i + 1]);
+    const size_t first_row = size_t(cuts[i]) - params.row_begin;
+    const size_t piece_pixels = width * size_t(cuts[i + 1] - cuts[i]);
+    float4* band = m.band + first_row * width;
+    if (piece_pixels > 0)
+      launch_render_band(m.view(piece), piece, camera, band, m.count_rays ? m.ray_counts : nullptr,
+                         m.row_rays + first_row, m.stream);
+    const void* source = band;
+    if (half) {
+      unsigned short* rgb = m.band_rgb16f + first_row * width * 3;
+      if (piece_pixels > 0) launch_band_to_rgb16f(band, rgb, piece_pixels, m.stream);
+      source = rgb;
+    }
+    COHORT_CUDA(cudaEventRecord(m.piece_rendered[i], m.stream));
+    COHORT_CUDA(cudaStreamWaitEvent(m.aux_copy_stream, m.piece_rendered[i], 0));
+    if (piece_pixels > 0)
+      COHORT_CUDA(cudaMemcpyAsync(target.row(cuts[i]), source, piece_pixels * pixel_bytes, cudaMemcpyDeviceToHost,
+                                  m.aux_copy_stream));
+    COHORT_CUDA(cudaEventRecord(m.piece_downloaded[i], m.aux_copy_stream));
+  }
+  COHORT_CUDA(cudaEventRecord(m.stop, m.stream));
+  try {
+    for (size_t i = 0; i < pieces; ++i) {
+      COHORT_CUDA(cudaEventSynchronize(m.piece_downloaded[i]));
+      ready(i);
+    }
+  } catch (...) {
+    // Nothing of this band may still be landing in the target once it is given up.
+    cudaStreamSynchronize(m.stream);
+    cudaStreamSynchronize(m.aux_copy_stream);
+    throw;
+  }
+  // Only now: these small copies go to pageable memory, and such a copy returns only once it is done,
+  // which would hold every piece back until the last kernel.
+  m.host_row_rays.resize(rows);
+  COHORT_CUDA(cudaMemcpyAsync(m.host_row_rays.data(), m.row_rays, rows * sizeof(unsigned), cudaMemcpyDeviceToHost, m.stream));
+  unsigned long long counts[2] = {0, 0};
+  if (m.count_rays)
+    COHORT_CUDA(cudaMemcpyAsync(counts, m.ray_counts, sizeof counts, cudaMemcpyDeviceToHost, m.stream));
+  COHORT_CUDA(cudaStreamSynchronize(m.stream));
+  m.last_counts = RayCounts{counts[0], counts[1]};
+  float kernel_ms = 0.0f;
+  COHORT_CUDA(cudaEventElapsedTime(&kernel_ms, m.start, m.stop));
+  core::BandResult result;
+  result.device_ms = kernel_ms;
+  result.row_work.assign(m.host_row_rays.begin(), m.host_row_rays.end());
   return result;
 }
 

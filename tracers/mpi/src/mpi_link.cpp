@@ -12,10 +12,12 @@
 
 #include <mpi.h>
 
+#include "cohort/tracers/mpi_wire.h"
+
 namespace cohort::tracers {
 
 namespace {
-constexpr int kTag = 0x434f;  // every Cohort message; the header says what it is
+constexpr int kTag = wire::kControlTag;  // every control message; the header says what it is
 
 int finalize_timeout_seconds() {
   const char* text = std::getenv("COHORT_MPI_FINALIZE_TIMEOUT_S");
@@ -29,7 +31,7 @@ struct MpiSession::Impl {
   bool we_initialized = false;
   struct Outgoing {
     int destination;
-    std::vector<uint8_t> bytes;
+    std::vector<uint8_t> bytes;  // empty for a send in place
     MPI_Request request;
   };
   std::list<Outgoing> sends;
@@ -37,7 +39,31 @@ struct MpiSession::Impl {
     std::vector<uint8_t> bytes;
     MPI_Request request;
   };
-  std::map<int, Incoming> receives;  // per source: a matched message still arriving
+  std::map<int, Incoming> receives;  // per source: a matched control message still arriving
+  struct Piece {
+    MPI_Request request = MPI_REQUEST_NULL;
+    std::vector<uint8_t> dropped;  // scratch for a piece nobody placed
+  };
+  std::map<int, std::list<Piece>> pieces;  // per source: pieces matched, still arriving
+
+  // Completes what has arrived of `source`'s pieces; true when none is left.
+  bool test_pieces(int source) {
+    auto found = pieces.find(source);
+    if (found == pieces.end()) return true;
+    for (auto it = found->second.begin(); it != found->second.end();) {
+      int done = 0;
+      MPI_Test(&it->request, &done, MPI_STATUS_IGNORE);
+      it = done ? found->second.erase(it) : std::next(it);
+    }
+    return found->second.empty();
+  }
+  void test_sends() {
+    for (auto it = sends.begin(); it != sends.end();) {
+      int done = 0;
+      MPI_Test(&it->request, &done, MPI_STATUS_IGNORE);
+      it = done ? sends.erase(it) : std::next(it);
+    }
+  }
   std::vector<uint8_t> farewell;
   std::vector<bool> released;
 };
@@ -99,6 +125,9 @@ void MpiSession::finalize() {
   impl_->sends.clear();
   for (auto& [source, r] : impl_->receives) MPI_Request_free(&r.request);
   impl_->receives.clear();
+  for (auto& [source, list] : impl_->pieces)
+    for (auto& piece : list) MPI_Request_free(&piece.request);
+  impl_->pieces.clear();
   MPI_Comm_free(&impl_->comm);
   int mpi_finalized = 0;
   MPI_Finalized(&mpi_finalized);
@@ -135,6 +164,21 @@ void MpiSession::send(int destination, std::vector<uint8_t> bytes) {
   }
 }
 
+void MpiSession::send_in_place(int destination, int tag, const void* data, size_t size) {
+  if (size > size_t(std::numeric_limits<int>::max()))
+    throw std::runtime_error("MPI message of " + std::to_string(size) + " bytes is over the 2 GiB a send takes");
+  std::lock_guard lock(mutex_);
+  if (finalized_) throw std::runtime_error("MPI send after the session was finalized");
+  impl_->sends.push_back({destination, {}, MPI_REQUEST_NULL});
+  Impl::Outgoing& out = impl_->sends.back();
+  // MPI-3 takes a const buffer; the cast is for MPI-2 headers that still declare void*.
+  if (MPI_Isend(const_cast<void*>(data), int(size), MPI_BYTE, destination, tag, impl_->comm, &out.request) !=
+      MPI_SUCCESS) {
+    impl_->sends.pop_back();
+    throw std::runtime_error("MPI_Isend to rank " + std::to_string(destination) + " failed");
+  }
+}
+
 void MpiSession::set_farewell(std::vector<uint8_t> bytes) {
   std::lock_guard lock(mutex_);
   impl_->farewell = std::move(bytes);
@@ -148,11 +192,8 @@ void MpiSession::released(int rank) {
 
 size_t MpiSession::progress_sends() {
   std::lock_guard lock(mutex_);
-  for (auto it = impl_->sends.begin(); it != impl_->sends.end();) {
-    int done = 0;
-    MPI_Test(&it->request, &done, MPI_STATUS_IGNORE);
-    it = done ? impl_->sends.erase(it) : std::next(it);
-  }
+  if (finalized_) return 0;
+  impl_->test_sends();
   return impl_->sends.size();
 }
 
@@ -175,49 +216,71 @@ bool MpiSession::flush_sends(int destination, MpiClock::time_point deadline) {
   }
 }
 
-std::optional<std::vector<uint8_t>> MpiSession::receive(int source, MpiClock::time_point deadline) {
+std::optional<std::vector<uint8_t>> MpiSession::receive(int source, MpiClock::time_point deadline, PieceSink* pieces) {
   // Polls: yields at first (a band's answer is often close), then sleeps briefly so that a waiting
-  // tracer thread does not take a core from the ones rendering.
+  // tracer thread does not take a core from the ones rendering. A piece that came starts it over: the
+  // band's next piece, or its end, follows.
   for (int polls = 0;; ++polls) {
     {
       std::lock_guard lock(mutex_);
       if (finalized_) throw std::runtime_error("MPI receive after the session was finalized");
       auto pending = impl_->receives.find(source);
-      if (pending == impl_->receives.end()) {
+      // Match what has come, in order, up to the next control message: pieces go where the sink says.
+      while (pending == impl_->receives.end()) {
         int found = 0;
         MPI_Message message;
         MPI_Status status;
-        MPI_Improbe(source, kTag, impl_->comm, &found, &message, &status);
-        if (found) {
-          int count = 0;
-          MPI_Get_count(&status, MPI_BYTE, &count);
+        MPI_Improbe(source, pieces ? MPI_ANY_TAG : kTag, impl_->comm, &found, &message, &status);
+        if (!found) break;
+        int count = 0;
+        MPI_Get_count(&status, MPI_BYTE, &count);
+        if (status.MPI_TAG == kTag) {
           Impl::Incoming& in = impl_->receives[source];
           in.bytes.resize(size_t(count));
           MPI_Imrecv(in.bytes.data(), count, MPI_BYTE, &message, &in.request);
           pending = impl_->receives.find(source);
+          break;
         }
+        polls = 0;
+        Impl::Piece& piece = impl_->pieces[source].emplace_back();
+        void* into = pieces->place(status.MPI_TAG, size_t(count));
+        if (!into) {
+          piece.dropped.resize(std::max(count, 1));
+          into = piece.dropped.data();
+        }
+        MPI_Imrecv(into, count, MPI_BYTE, &message, &piece.request);
       }
+      const bool pieces_landed = impl_->test_pieces(source);
       if (pending != impl_->receives.end()) {
         int done = 0;
         MPI_Test(&pending->second.request, &done, MPI_STATUS_IGNORE);
-        if (done) {
+        if (done) pending->second.request = MPI_REQUEST_NULL;
+        if (pending->second.request == MPI_REQUEST_NULL && pieces_landed) {
           std::vector<uint8_t> bytes = std::move(pending->second.bytes);
           impl_->receives.erase(pending);
           return bytes;
         }
       }
       // Sends progress too while we wait (a library may move data only inside MPI calls).
-      for (auto it = impl_->sends.begin(); it != impl_->sends.end();) {
-        int done = 0;
-        MPI_Test(&it->request, &done, MPI_STATUS_IGNORE);
-        it = done ? impl_->sends.erase(it) : std::next(it);
-      }
+      impl_->test_sends();
     }
     if (MpiClock::now() >= deadline) return std::nullopt;
     if (polls < 200)
       std::this_thread::yield();
     else
       std::this_thread::sleep_for(std::chrono::microseconds(polls < 2000 ? 20 : 200));
+  }
+}
+
+bool MpiSession::settle_pieces(int source, MpiClock::time_point deadline) {
+  for (;;) {
+    {
+      std::lock_guard lock(mutex_);
+      if (finalized_ || impl_->test_pieces(source)) return true;
+      impl_->test_sends();
+    }
+    if (MpiClock::now() >= deadline) return false;
+    std::this_thread::sleep_for(std::chrono::microseconds(20));
   }
 }
 

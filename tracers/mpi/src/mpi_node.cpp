@@ -3,7 +3,10 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <atomic>
 #include <csignal>
+#include <exception>
+#include <functional>
 #include <optional>
 #include <thread>
 
@@ -20,6 +23,10 @@ namespace cohort::tracers {
 namespace {
 
 constexpr int kRank0 = 0;
+
+double ms_since(MpiClock::time_point start) {
+  return std::chrono::duration<double, std::milli>(MpiClock::now() - start).count();
+}
 
 std::string host_name() {
   char name[256] = {};
@@ -59,8 +66,8 @@ class Node {
       }
       wire::Message& m = *received;
       switch (m.kind) {
-        case wire::Kind::commit: apply_commit(m); break;
-        case wire::Kind::full_local: apply_full_local(m); break;
+        case wire::Kind::commit: timed_commit([&] { apply_commit(m); }); break;
+        case wire::Kind::full_local: timed_commit([&] { apply_full_local(m); }); break;
         case wire::Kind::band_job: render(mpi, m); break;
         case wire::Kind::shutdown:
           spdlog::info("node {}: shutdown from rank 0 after {} band(s)", mpi.rank(), bands_);
@@ -73,6 +80,12 @@ class Node {
   }
 
  private:
+  template <class Apply> void timed_commit(Apply&& apply) {
+    const auto start = MpiClock::now();
+    apply();
+    commit_ms_ += ms_since(start);
+  }
+
   // A refused or failed commit leaves the scene behind rank 0's: every band fails, asking for a full
   // resync, until one arrives.
   void apply_commit(const wire::Message& m) {
@@ -143,24 +156,129 @@ class Node {
       std::this_thread::sleep_for(std::chrono::milliseconds(options_.stall_ms));
     }
     const auto start = MpiClock::now();
+    wire::NodeTiming timing;
+    timing.commit_ms = commit_ms_;
+    commit_ms_ = 0.0;
+    // The pieces of the last band are sent from target_ itself: before its rows are written again,
+    // they must have left (they have, unless rank 0 stopped reading: then this band goes to a fresh
+    // buffer, and the old one stays with its sends).
+    const auto send_start = MpiClock::now();
+    if (!mpi.flush_sends(kRank0, MpiClock::now() + std::chrono::seconds(2))) {
+      spdlog::warn("node {}: the last band's rows have not left after 2 s; rendering into a new buffer", mpi.rank());
+      retired_.push_back(std::move(target_));
+      target_ = core::BandBuffer();
+    }
+    timing.send_ms += ms_since(send_start);
     target_.resize(int(request.job.camera.width), int(request.job.camera.height), request.format);
     target_.enable_aux(request.aux);
-    std::vector<float> row_work;
+    // The band in pieces: each goes out, straight from target_ (page-locked by a CUDA tracer, which
+    // downloads into it), as soon as it is rendered, and travels while the next renders.
+    const uint32_t width = request.job.camera.width;
+    std::vector<int> cuts;
+    for (uint32_t i = 0; i < request.pieces; ++i)
+      cuts.push_back(int(wire::piece_rows(p.row_begin, p.row_end, request.pieces, i).begin));
+    cuts.push_back(int(p.row_end));
+    // Called on the rendering thread as each piece lands in target_.
+    auto post_piece = [&](size_t i) {
+      const auto post_start = MpiClock::now();
+      if (i == 0) timing.first_piece_ms = ms_since(start);
+      const uint32_t count = uint32_t(cuts[i + 1] - cuts[i]);
+      uint64_t colour_bytes = wire::piece_bytes(count, width, request.format, wire::Plane::colour);
+      if (i == 0 && int(p.frame_index) == options_.short_piece_frame && colour_bytes > 0) {
+        spdlog::warn("node {}: sending piece 0 of frame {} a byte short (--short-piece-frame)", mpi.rank(),
+                     p.frame_index);
+        --colour_bytes;
+      }
+      mpi.send_in_place(kRank0, wire::piece_tag(m.sequence, uint32_t(i), wire::Plane::colour), target_.row(cuts[i]),
+                        colour_bytes);
+      if (request.aux)
+        mpi.send_in_place(kRank0, wire::piece_tag(m.sequence, uint32_t(i), wire::Plane::aux), target_.aux_row(cuts[i]),
+                          wire::piece_bytes(count, width, request.format, wire::Plane::aux));
+      timing.send_ms += ms_since(post_start);
+    };
+    const auto render_start = MpiClock::now();
+    Rendered rendered;
     try {
-      row_work = render_split(request.job);
+      rendered = render_while_sending(mpi, request.job, cuts, post_piece);
     } catch (const std::exception& e) {
+      // Pieces already sent are this job's: rank 0 takes them, then this failure.
       send(mpi, wire::Kind::band_failed, m.sequence, wire::encode_band_failure({false, e.what()}));
       return;
     }
-    const double ms = std::chrono::duration<double, std::milli>(MpiClock::now() - start).count();
-    mpi.send(kRank0, wire::band_rows_message(m.sequence, target_, p.row_begin, p.row_end, ms, row_work));
+    timing.render_ms = ms_since(render_start);
+    timing.send_ms += rendered.mpi_ms;
+    timing.device_ms = rendered.tracer_ms;
+    wire::BandRows done;
+    done.row_begin = p.row_begin;
+    done.row_end = p.row_end;
+    done.width = width;
+    done.format = request.format;
+    done.pieces = request.pieces;
+    done.aux = request.aux;
+    done.row_work = std::move(rendered.row_work);
+    timing.total_ms = ms_since(start);
+    done.device_ms = timing.total_ms;
+    done.timing = timing;
+    send(mpi, wire::Kind::band_rows, m.sequence, wire::encode_band_rows(done));
     ++bands_;
+  }
+
+  struct Rendered {
+    std::vector<float> row_work;
+    double tracer_ms = 0.0;  // what the tracers measured themselves (summed over pieces; the slowest part's)
+    double mpi_ms = 0.0;     // in MPI calls moving the pieces sent, meanwhile
+  };
+
+  // Renders the band's pieces on a thread of their own, `post_piece(i)` sending each as it lands, while
+  // this thread keeps the sends going: a library may move a large message only inside MPI calls (with
+  // naps, so as not to take a core from a CPU tracer). One tracer renders the pieces itself (a GPU
+  // downloads each while the next renders); several split each piece by their speed.
+  Rendered render_while_sending(MpiSession& mpi, const core::BandJob& job, const std::vector<int>& cuts,
+                                const std::function<void(size_t)>& post_piece) {
+    Rendered rendered;
+    std::atomic<bool> finished{false};
+    std::exception_ptr error;
+    std::thread renderer([&] {
+      try {
+        if (tracers_.size() == 1) {
+          core::BandResult result = tracers_.front()->render_band_in_pieces(job, target_, cuts, post_piece);
+          rendered.tracer_ms = result.device_ms;
+          rendered.row_work = std::move(result.row_work);
+        } else {
+          bool complete_work = true;
+          for (size_t i = 0; i + 1 < cuts.size(); ++i) {
+            core::BandJob piece = job;
+            piece.params.row_begin = uint32_t(cuts[i]);
+            piece.params.row_end = uint32_t(cuts[i + 1]);
+            double ms = 0.0;
+            std::vector<float> work = render_split(piece, ms);
+            rendered.tracer_ms += ms;
+            complete_work = complete_work && work.size() == size_t(cuts[i + 1] - cuts[i]);
+            if (complete_work) rendered.row_work.insert(rendered.row_work.end(), work.begin(), work.end());
+            post_piece(i);
+          }
+          if (!complete_work) rendered.row_work.clear();
+        }
+      } catch (...) {
+        error = std::current_exception();
+      }
+      finished = true;
+    });
+    while (!finished.load()) {
+      const auto call = MpiClock::now();
+      const bool sending = mpi.progress_sends() > 0;
+      rendered.mpi_ms += ms_since(call);
+      std::this_thread::sleep_for(std::chrono::microseconds(sending ? 30 : 60));
+    }
+    renderer.join();
+    if (error) std::rethrow_exception(error);
+    return rendered;
   }
 
   // The band split among the node's tracers by their last speed, rendered in parallel; a tracer that
   // fails has its rows re-rendered by one that did not. Returns the per-row work when every part
   // reported it.
-  std::vector<float> render_split(const core::BandJob& job) {
+  std::vector<float> render_split(const core::BandJob& job, double& tracer_ms) {
     const uint32_t begin = job.params.row_begin, end = job.params.row_end, rows = end - begin;
     const size_t n = tracers_.size();
     // Shares in proportion to speed (the balancer module's Perfect division, in its 4-row units): the
@@ -199,6 +317,8 @@ class Node {
       const double speed = std::max(double(cuts[i + 1] - cuts[i]) / std::max(ms[i], 1e-3), 1e-3);
       rows_per_ms_[i] = 0.5 * rows_per_ms_[i] + 0.5 * speed;  // smoothed like Perfect Smooth's alpha 0.5
     }
+    tracer_ms = 0.0;
+    for (size_t i = 0; i < n; ++i) tracer_ms = std::max(tracer_ms, results[i].device_ms);
     bool complete_work = true;
     for (size_t i = 0; i < n; ++i) {
       if (errors[i].empty()) {
@@ -226,9 +346,11 @@ class Node {
   NodeOptions options_;
   std::vector<double> rows_per_ms_;
   core::BandBuffer target_;
+  std::vector<core::BandBuffer> retired_;  // band buffers whose pieces had not left (rank 0 stopped reading)
   bool diverged_ = false;
   std::string divergence_;
   bool stalled_ = false;
+  double commit_ms_ = 0.0;  // applying commits since the last band
   uint64_t bands_ = 0;
 };
 

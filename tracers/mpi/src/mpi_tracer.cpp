@@ -29,6 +29,88 @@ std::map<int, JoinedNode>& joined_nodes() {
   return nodes;
 }
 
+// Pieces that belong to no band this tracer waits for (the late answer to a band that timed out):
+// received into scratch and dropped.
+struct DropPieces : PieceSink {
+  void* place(int, size_t size) override {
+    bytes += size;
+    return nullptr;
+  }
+  uint64_t bytes = 0;
+};
+
+// The pieces of the current band: each one checked against the band (its tag names this job, a piece
+// and plane that exist, its size that of its rows) and received straight into its rows of the target;
+// anything else is dropped, and a piece of this band that does not fit makes the band fail when its
+// band_rows comes.
+class BandPieces : public PieceSink {
+ public:
+  BandPieces(uint64_t job, uint32_t row_begin, uint32_t row_end, uint32_t pieces, core::BandBuffer& target)
+      : job_(job), row_begin_(row_begin), row_end_(row_end), pieces_(pieces), target_(target) {}
+
+  void* place(int tag, size_t size) override {
+    bytes += size;
+    if (first_matched == MpiClock::time_point{}) first_matched = MpiClock::now();
+    wire::PieceTag piece;
+    if (!wire::decode_piece_tag(tag, piece)) {
+      ++refused;
+      refuse(fmt::format("a message on tag {}, which is neither the control tag nor a piece's", tag));
+      return nullptr;
+    }
+    if (!piece.of_job(job_)) {
+      ++stale;  // a piece of an earlier job's late answer
+      return nullptr;
+    }
+    const bool aux = piece.plane == wire::Plane::aux;
+    if (piece.piece >= pieces_ || (aux && !target_.has_aux())) {
+      ++refused;
+      refuse(fmt::format("piece {} of {}{} was not asked for", piece.piece, pieces_, aux ? " (aux planes)" : ""));
+      return nullptr;
+    }
+    const wire::RowRange rows = wire::piece_rows(row_begin_, row_end_, pieces_, piece.piece);
+    const uint64_t expected = wire::piece_bytes(rows.end - rows.begin, uint32_t(target_.width()), target_.format(),
+                                                piece.plane);
+    if (size != expected) {
+      ++refused;
+      refuse(fmt::format("piece {} of {} ({}rows [{}, {})) has {} bytes; they are {}", piece.piece, pieces_,
+                         aux ? "aux texels of " : "", rows.begin, rows.end, size, expected));
+      return nullptr;
+    }
+    const uint64_t bit = uint64_t(1) << (piece.piece * 2 + uint32_t(piece.plane));
+    if (landed_ & bit) {
+      ++refused;
+      refuse(fmt::format("piece {} of {}{} came twice", piece.piece, pieces_, aux ? " (aux planes)" : ""));
+      return nullptr;
+    }
+    landed_ |= bit;
+    if (aux) return target_.aux_row(int(rows.begin));
+    return target_.row(int(rows.begin));
+  }
+
+  // Why the band's rows cannot be taken (a piece refused or missing), or empty.
+  std::string problem() const {
+    if (!problem_.empty()) return problem_;
+    for (uint32_t i = 0; i < pieces_; ++i)
+      for (uint32_t plane = 0; plane < (target_.has_aux() ? 2u : 1u); ++plane)
+        if (!(landed_ & (uint64_t(1) << (i * 2 + plane))))
+          return fmt::format("piece {} of {}{} never came", i, pieces_, plane == 1 ? " (aux planes)" : "");
+    return {};
+  }
+
+  uint64_t bytes = 0, refused = 0, stale = 0;
+  MpiClock::time_point first_matched{};
+
+ private:
+  void refuse(std::string why) {
+    if (problem_.empty()) problem_ = std::move(why);
+  }
+  uint64_t job_;
+  uint32_t row_begin_, row_end_, pieces_;
+  core::BandBuffer& target_;
+  uint64_t landed_ = 0;
+  std::string problem_;
+};
+
 // Band job ids are unique over the run, so that a late answer to an earlier tracer's job is never
 // taken for the current one.
 std::atomic<uint64_t> next_band_job{1};
@@ -119,12 +201,20 @@ void MpiTracer::adopt(const wire::Hello& hello) {
 
 MpiTracer::~MpiTracer() {
   const MpiLinkStats s = link_stats();
-  if (s.bands > 0)
-    spdlog::info("mpi:{}: {} band(s), {:.1f} KiB sent and {:.1f} KiB received a band, round trip {:.2f} ms a band "
-                 "({:.2f} ms of it rendering on the node)",
-                 options_.rank, s.bands, double(s.bytes_sent) / double(s.bands) / 1024.0,
-                 double(s.bytes_received) / double(s.bands) / 1024.0, s.total_round_trip_ms / double(s.bands),
-                 s.total_node_ms / double(s.bands));
+  if (s.bands > 0) {
+    const double n = double(s.bands);
+    const double round_trip = s.total_round_trip_ms / n, node = s.total_node_ms / n;
+    spdlog::info("mpi:{}: {} band(s), {:.1f} KiB sent and {:.1f} KiB received a band ({} pieces), round trip {:.2f} ms "
+                 "a band: on the node {:.2f} ms (its tracers' render_band {:.2f} ms, of it their own {:.2f} ms; MPI "
+                 "calls {:.2f} ms; first piece sent after {:.2f} ms), rank 0 matched it after {:.2f} ms; {:.2f} ms "
+                 "beyond the node's time, "
+                 "of it {:.2f} ms applying the commit before the job (the rest: the job out, the last piece and "
+                 "band_rows back)",
+                 options_.rank, s.bands, double(s.bytes_sent) / n / 1024.0, double(s.bytes_received) / n / 1024.0,
+                 s.last_pieces, round_trip, node, s.total_node_render_ms / n, s.total_node_tracer_ms / n,
+                 s.total_node_send_ms / n, s.total_node_first_piece_ms / n, s.total_first_piece_ms / n, round_trip - node,
+                 s.total_node_commit_ms / n);
+  }
   // The node stays for later tracers of this run; the session's end tells every node to leave.
   try {
     MpiSession& mpi = MpiSession::get();
@@ -172,9 +262,11 @@ void MpiTracer::apply(const commit::CommitBuffer& commit) {
 void MpiTracer::take_late_answers() {
   MpiSession& mpi = MpiSession::get();
   while (timed_out_job_ != 0) {
-    std::optional<std::vector<uint8_t>> bytes = mpi.receive(options_.rank, MpiClock::now());
-    if (!bytes) return;
+    DropPieces dropped;
+    std::optional<std::vector<uint8_t>> bytes = mpi.receive(options_.rank, MpiClock::now(), &dropped);
     std::lock_guard lock(stats_mutex_);
+    stats_.bytes_received += dropped.bytes;
+    if (!bytes) return;
     stats_.bytes_received += bytes->size();
     try {
       const wire::Message m = wire::parse_message(bytes->data(), bytes->size());
@@ -192,6 +284,18 @@ void MpiTracer::take_late_answers() {
   }
 }
 
+void MpiTracer::fail_timed_out(uint64_t id, MpiClock::time_point start, const core::BandJob& job) {
+  timed_out_job_ = id;
+  timed_out_start_ = start;
+  // A piece matched before the deadline is being received into the target's rows, which the Renderer
+  // now hands to the other tracers: let it land first (it is in flight; this takes microseconds).
+  if (!MpiSession::get().settle_pieces(options_.rank, MpiClock::now() + std::chrono::milliseconds(500)))
+    spdlog::warn("mpi:{}: a piece of rows [{}, {}) is still arriving after the band timed out", options_.rank,
+                 job.params.row_begin, job.params.row_end);
+  throw std::runtime_error(fmt::format("mpi:{}: no answer for rows [{}, {}) within {:.0f} ms (node stalled?)",
+                                       options_.rank, job.params.row_begin, job.params.row_end, ms_since(start)));
+}
+
 core::BandResult MpiTracer::render_band(const core::BandJob& job, core::BandBuffer& target) {
   MpiSession& mpi = MpiSession::get();
   if (timed_out_job_ != 0) {
@@ -203,12 +307,18 @@ core::BandResult MpiTracer::render_band(const core::BandJob& job, core::BandBuff
                                            "(stalled or gone); its rows go to the others", options_.rank,
                                            ms_since(timed_out_start_)));
   }
+  if (job.params.row_end > uint32_t(target.height()) || job.params.row_begin > job.params.row_end ||
+      job.camera.width != uint32_t(target.width()))
+    throw std::invalid_argument(fmt::format("mpi:{}: rows [{}, {}) of a {}-wide frame do not fit the {}x{} target",
+                                            options_.rank, job.params.row_begin, job.params.row_end, job.camera.width,
+                                            target.width(), target.height()));
   const uint64_t id = next_band_job++;
   wire::BandRequest request;
   request.job = job;
   request.job.keep_on_device = -1;  // rank 0's GPUs are not the node's: the rows travel
   request.format = target.format();
   request.aux = target.has_aux();
+  request.pieces = wire::band_pieces(job.params.row_end - job.params.row_begin, options_.pieces);
   const auto start = MpiClock::now();
   send(int(wire::Kind::band_job), id, wire::encode_band_request(request));
   double expected_ms;
@@ -219,19 +329,26 @@ core::BandResult MpiTracer::render_band(const core::BandJob& job, core::BandBuff
   // The first band after a full resync also waits for the node to build its acceleration structures.
   const auto allowance = options_.band_timeout * (after_full_resync_ ? 10 : 1);
   const auto deadline = start + allowance + std::chrono::microseconds(int64_t(4000.0 * expected_ms));
+  // The rows arrive as pieces, each received straight into its rows of the target; band_rows closes
+  // the band once every piece has landed.
+  BandPieces pieces(id, job.params.row_begin, job.params.row_end, request.pieces, target);
+  uint64_t counted_piece_bytes = 0;
+  auto count_pieces = [&] {
+    std::lock_guard lock(stats_mutex_);
+    stats_.bytes_received += pieces.bytes - counted_piece_bytes;
+    stats_.refused_messages += pieces.refused;
+    stats_.stale_answers += pieces.stale;
+    counted_piece_bytes = pieces.bytes;
+    pieces.refused = pieces.stale = 0;
+  };
   for (;;) {
-    std::optional<std::vector<uint8_t>> bytes = mpi.receive(options_.rank, deadline);
-    if (!bytes) {
-      timed_out_job_ = id;
-      timed_out_start_ = start;
-      throw std::runtime_error(fmt::format("mpi:{}: no answer for rows [{}, {}) within {:.0f} ms (node stalled?)",
-                                           options_.rank, job.params.row_begin, job.params.row_end, ms_since(start)));
-    }
+    std::optional<std::vector<uint8_t>> bytes = mpi.receive(options_.rank, deadline, &pieces);
+    count_pieces();
+    if (!bytes) fail_timed_out(id, start, job);
     {
       std::lock_guard lock(stats_mutex_);
       stats_.bytes_received += bytes->size();
     }
-    // The header only: a band's rows stay where they arrived and are copied once, into the target.
     wire::Header header;
     try {
       header = wire::parse_header(bytes->data(), bytes->size());
@@ -273,24 +390,27 @@ core::BandResult MpiTracer::render_band(const core::BandJob& job, core::BandBuff
       }
       throw std::runtime_error(fmt::format("mpi:{}: {}", options_.rank, failure.reason));
     }
-    wire::BandRowsView rows;
+    wire::BandRows rows;
     try {
-      rows = wire::decode_band_rows_view(payload, payload_size);
+      rows = wire::decode_band_rows(payload, payload_size);
     } catch (const wire::WireError& e) {
       std::lock_guard lock(stats_mutex_);
       ++stats_.refused_messages;
       throw std::runtime_error(fmt::format("mpi:{}: refused the band's rows: {}", options_.rank, e.what()));
     }
     if (rows.row_begin != job.params.row_begin || rows.row_end != job.params.row_end ||
-        int(rows.width) != target.width() || rows.format != target.format() ||
-        job.params.row_end > uint32_t(target.height()) || (target.has_aux() && rows.aux_bytes == 0))
-      throw std::runtime_error(fmt::format("mpi:{}: refused the band's rows: rows [{}, {}) of {} {} pixels, asked "
-                                           "for [{}, {}) of {} {}{}", options_.rank, rows.row_begin, rows.row_end,
-                                           rows.width, core::to_string(rows.format), job.params.row_begin,
+        int(rows.width) != target.width() || rows.format != target.format() || rows.pieces != request.pieces ||
+        rows.aux != target.has_aux())
+      throw std::runtime_error(fmt::format("mpi:{}: refused the band's rows: rows [{}, {}) of {} {} pixels in {} "
+                                           "pieces{}, asked for [{}, {}) of {} {} in {}{}", options_.rank,
+                                           rows.row_begin, rows.row_end, rows.width, core::to_string(rows.format),
+                                           rows.pieces, rows.aux ? " with aux planes" : "", job.params.row_begin,
                                            job.params.row_end, target.width(), core::to_string(target.format()),
-                                           target.has_aux() ? " with aux planes" : ""));
-    if (rows.pixel_bytes > 0) std::memcpy(target.row(int(rows.row_begin)), rows.pixels, rows.pixel_bytes);
-    if (target.has_aux() && rows.aux_bytes > 0) std::memcpy(target.aux_row(int(rows.row_begin)), rows.aux, rows.aux_bytes);
+                                           request.pieces, target.has_aux() ? " with aux planes" : ""));
+    // Every piece matched before band_rows has landed (MpiSession::receive); one that was refused or
+    // never came leaves rows unwritten: the band fails and the Renderer re-renders them elsewhere.
+    if (const std::string problem = pieces.problem(); !problem.empty())
+      throw std::runtime_error(fmt::format("mpi:{}: refused the band's rows: {}", options_.rank, problem));
     const double round_trip = ms_since(start);
     after_full_resync_ = false;
     {
@@ -298,10 +418,18 @@ core::BandResult MpiTracer::render_band(const core::BandJob& job, core::BandBuff
       ++stats_.bands;
       stats_.last_round_trip_ms = round_trip;
       stats_.total_round_trip_ms += round_trip;
-      stats_.last_node_ms = rows.device_ms;
-      stats_.total_node_ms += rows.device_ms;
+      stats_.last_node_ms = rows.timing.total_ms;
+      stats_.total_node_ms += rows.timing.total_ms;
+      stats_.total_node_render_ms += rows.timing.render_ms;
+      stats_.total_node_tracer_ms += rows.timing.device_ms;
+      stats_.total_node_send_ms += rows.timing.send_ms;
+      stats_.total_node_commit_ms += rows.timing.commit_ms;
+      stats_.total_node_first_piece_ms += rows.timing.first_piece_ms;
+      stats_.total_first_piece_ms +=
+          std::chrono::duration<double, std::milli>(pieces.first_matched - start).count();
+      stats_.last_pieces = request.pieces;
       stats_.last_band_bytes_sent = pending_sent_;
-      stats_.last_band_bytes_received = bytes->size();
+      stats_.last_band_bytes_received = pieces.bytes + bytes->size();
       pending_sent_ = 0;
     }
     core::BandResult result;

@@ -1,5 +1,6 @@
 #include "cohort/tracers/mpi_wire.h"
 
+#include <algorithm>
 #include <cstring>
 #include <type_traits>
 
@@ -401,6 +402,7 @@ std::vector<uint8_t> encode_band_request(const BandRequest& request) {
   w.scalar(request.job);
   w.scalar(uint32_t(request.format));
   w.scalar(uint32_t(request.aux ? 1 : 0));
+  w.scalar(request.pieces);
   return std::move(w.out);
 }
 
@@ -416,106 +418,88 @@ BandRequest decode_band_request(const std::vector<uint8_t>& payload) {
   const uint32_t aux = r.scalar<uint32_t>();
   if (aux > 1) r.fail(fmt::format("aux flag {} is neither 0 nor 1", aux));
   q.aux = aux == 1;
+  q.pieces = r.scalar<uint32_t>();
   r.expect_end();
   const KFrameParams& p = q.job.params;
   if (q.job.camera.width == 0 || q.job.camera.height == 0 || q.job.camera.width > 65536 || q.job.camera.height > 65536)
     r.fail(fmt::format("camera size {}x{} is out of range", q.job.camera.width, q.job.camera.height));
   if (p.row_begin > p.row_end || p.row_end > q.job.camera.height)
     r.fail(fmt::format("rows [{}, {}) do not fit a frame of {} rows", p.row_begin, p.row_end, q.job.camera.height));
+  if (q.pieces != band_pieces(p.row_end - p.row_begin, q.pieces))
+    r.fail(fmt::format("{} pieces for a band of {} rows (1 to {}, at most one a row)", q.pieces, p.row_end - p.row_begin,
+                       kMaxPieces));
   return q;
 }
 
-namespace {
-
-// A band's rows as the payload holds them; `w` may already hold a header (band_rows_message).
-void write_band_rows(Writer& w, const core::BandBuffer& source, uint32_t row_begin, uint32_t row_end, double device_ms,
-                     const std::vector<float>& row_work) {
-  const size_t rows = row_end - row_begin;
-  const size_t aux_row_bytes = size_t(source.width()) * sizeof(KAuxTexel);
-  const uint64_t pixel_bytes = rows * source.row_bytes();
-  const uint64_t aux_bytes = source.has_aux() ? rows * aux_row_bytes : 0;
-  // One allocation for the whole message: the band is megabytes, and a growing vector copies it again.
-  w.out.reserve(w.out.size() + 4 * sizeof(uint32_t) + sizeof(double) + 3 * sizeof(uint64_t) +
-                row_work.size() * sizeof(float) + pixel_bytes + aux_bytes);
-  w.scalar(row_begin);
-  w.scalar(row_end);
-  w.scalar(uint32_t(source.width()));
-  w.scalar(uint32_t(source.format()));
-  w.scalar(device_ms);
-  w.array(row_work);
-  w.scalar(pixel_bytes);
-  if (rows > 0) w.raw(source.row(int(row_begin)), pixel_bytes);
-  w.scalar(aux_bytes);
-  if (aux_bytes > 0)
-    w.raw(static_cast<const uint8_t*>(const_cast<core::BandBuffer&>(source).aux_data()) + row_begin * aux_row_bytes,
-          aux_bytes);
+int piece_tag(uint64_t job, uint32_t piece, Plane plane) {
+  return kPieceTagBase + int(((job % kPieceJobSlots) * kMaxPieces + piece % kMaxPieces) * 2 + uint32_t(plane));
 }
 
-}  // namespace
+bool decode_piece_tag(int tag, PieceTag& out) {
+  if (tag < kPieceTagBase || tag >= kPieceTagBase + int(kPieceJobSlots * kMaxPieces * 2)) return false;
+  const uint32_t index = uint32_t(tag - kPieceTagBase);
+  out.plane = Plane(index % 2);
+  out.piece = (index / 2) % kMaxPieces;
+  out.job_slot = index / 2 / kMaxPieces;
+  return true;
+}
 
-std::vector<uint8_t> encode_band_rows(const core::BandBuffer& source, uint32_t row_begin, uint32_t row_end,
-                                      double device_ms, const std::vector<float>& row_work) {
+RowRange piece_rows(uint32_t row_begin, uint32_t row_end, uint32_t pieces, uint32_t index) {
+  const uint64_t rows = row_end - row_begin;
+  pieces = pieces == 0 ? 1 : pieces;
+  return {row_begin + uint32_t(rows * index / pieces), row_begin + uint32_t(rows * (index + 1) / pieces)};
+}
+
+uint32_t band_pieces(uint32_t rows, uint32_t wanted) {
+  return std::max(1u, std::min({wanted, kMaxPieces, rows}));
+}
+
+uint64_t piece_bytes(uint32_t rows, uint32_t width, core::BandFormat format, Plane plane) {
+  return uint64_t(rows) * width * (plane == Plane::aux ? sizeof(KAuxTexel) : core::bytes_per_pixel(format));
+}
+
+std::vector<uint8_t> encode_band_rows(const BandRows& rows) {
   Writer w;
-  write_band_rows(w, source, row_begin, row_end, device_ms, row_work);
+  w.scalar(rows.row_begin);
+  w.scalar(rows.row_end);
+  w.scalar(rows.width);
+  w.scalar(uint32_t(rows.format));
+  w.scalar(rows.pieces);
+  w.scalar(uint32_t(rows.aux ? 1 : 0));
+  w.scalar(rows.device_ms);
+  w.scalar(rows.timing);
+  w.array(rows.row_work);
   return std::move(w.out);
 }
 
-std::vector<uint8_t> band_rows_message(uint64_t sequence, const core::BandBuffer& source, uint32_t row_begin,
-                                       uint32_t row_end, double device_ms, const std::vector<float>& row_work) {
-  Writer w;
-  w.out.resize(sizeof(Header));
-  write_band_rows(w, source, row_begin, row_end, device_ms, row_work);
-  Header h;
-  h.kind = uint16_t(Kind::band_rows);
-  h.sequence = sequence;
-  h.payload_bytes = w.out.size() - sizeof h;
-  std::memcpy(w.out.data(), &h, sizeof h);
-  return std::move(w.out);
-}
+BandRows decode_band_rows(const std::vector<uint8_t>& payload) { return decode_band_rows(payload.data(), payload.size()); }
 
-BandRowsView decode_band_rows_view(const std::vector<uint8_t>& payload) {
-  return decode_band_rows_view(payload.data(), payload.size());
-}
-
-BandRowsView decode_band_rows_view(const uint8_t* payload, size_t size) {
+BandRows decode_band_rows(const uint8_t* payload, size_t size) {
   Reader r(payload, size, "band_rows");
-  BandRowsView b;
+  BandRows b;
   b.row_begin = r.scalar<uint32_t>();
   b.row_end = r.scalar<uint32_t>();
   b.width = r.scalar<uint32_t>();
   b.format = band_format_of(r.scalar<uint32_t>(), r);
+  b.pieces = r.scalar<uint32_t>();
+  const uint32_t aux = r.scalar<uint32_t>();
+  if (aux > 1) r.fail(fmt::format("aux flag {} is neither 0 nor 1", aux));
+  b.aux = aux == 1;
   b.device_ms = r.scalar<double>();
+  b.timing = r.scalar<NodeTiming>();
   b.row_work = r.array<float>("row work");
+  r.expect_end();
   if (b.row_end < b.row_begin) r.fail(fmt::format("rows [{}, {}) end before they begin", b.row_begin, b.row_end));
-  const uint64_t rows = b.row_end - b.row_begin;
+  if (b.width == 0 || b.width > 65536) r.fail(fmt::format("width {} is out of range", b.width));
+  const uint32_t rows = b.row_end - b.row_begin;
+  if (b.pieces != band_pieces(rows, b.pieces))
+    r.fail(fmt::format("{} pieces for a band of {} rows (1 to {}, at most one a row)", b.pieces, rows, kMaxPieces));
   if (!b.row_work.empty() && b.row_work.size() != rows)
     r.fail(fmt::format("{} row work values for {} rows", b.row_work.size(), rows));
-  b.pixel_bytes = r.scalar<uint64_t>();
-  b.pixels = r.view(b.pixel_bytes, "pixels");
-  const uint64_t expected = rows * b.width * core::bytes_per_pixel(b.format);
-  if (b.pixel_bytes != expected)
-    r.fail(fmt::format("{} pixel bytes; {} rows of {} {} pixels are {}", b.pixel_bytes, rows, b.width,
-                       core::to_string(b.format), expected));
-  b.aux_bytes = r.scalar<uint64_t>();
-  b.aux = r.view(b.aux_bytes, "aux planes");
-  if (b.aux_bytes != 0 && b.aux_bytes != rows * b.width * sizeof(KAuxTexel))
-    r.fail(fmt::format("{} aux bytes; {} rows of {} texels are {}", b.aux_bytes, rows, b.width,
-                       rows * b.width * sizeof(KAuxTexel)));
-  r.expect_end();
-  return b;
-}
-
-BandRows decode_band_rows(const std::vector<uint8_t>& payload) {
-  BandRowsView v = decode_band_rows_view(payload);
-  BandRows b;
-  b.row_begin = v.row_begin;
-  b.row_end = v.row_end;
-  b.width = v.width;
-  b.format = v.format;
-  b.device_ms = v.device_ms;
-  b.row_work = std::move(v.row_work);
-  b.pixels.assign(v.pixels, v.pixels + v.pixel_bytes);
-  b.aux.assign(v.aux, v.aux + v.aux_bytes);
+  const double times[] = {b.device_ms, b.timing.total_ms, b.timing.render_ms, b.timing.device_ms, b.timing.send_ms,
+                          b.timing.first_piece_ms, b.timing.commit_ms};
+  for (double t : times)
+    if (!(t >= 0.0 && t < 1e9)) r.fail(fmt::format("time {} ms is not a duration", t));
   return b;
 }
 

@@ -151,6 +151,8 @@ std::unique_ptr<core::Tracer> make_tracer(const TracerSpec& spec) {
     options.rank = spec.device;
     if (const char* ms = std::getenv("COHORT_MPI_BAND_TIMEOUT_MS"); ms && *ms)
       options.band_timeout = std::chrono::milliseconds(std::max(1L, std::atol(ms)));
+    if (const char* pieces = std::getenv("COHORT_MPI_BAND_PIECES"); pieces && *pieces)
+      options.pieces = uint32_t(std::clamp(std::atol(pieces), 1L, long(wire::kMaxPieces)));
     return std::make_unique<MpiTracer>(options);
   }
 #endif

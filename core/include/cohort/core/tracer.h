@@ -2,6 +2,8 @@
 // started the core does not talk to it until it reports its band done (Brigade, §4.2).
 #pragma once
 
+#include <cstddef>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -46,6 +48,14 @@ class Tracer {
   // Render rows [row_begin, row_end) of the frame into target (full frame size, in the format it
   // has; only those rows are written).
   virtual BandResult render_band(const BandJob& job, BandBuffer& target) = 0;
+  // The band as consecutive pieces of rows, [cuts[i], cuts[i + 1]) with cuts[0] = row_begin and
+  // cuts.back() = row_end, calling `ready(i)` on this thread once piece i's rows (and aux texels) are in
+  // the target, in order, while the pieces after it still render: a remote node (tracers/mpi) sends each
+  // piece as soon as it is ready. The rows always go to the target (keep_on_device is ignored); the
+  // result's device_ms sums the pieces'. By default one render_band per piece; a GPU tracer overrides
+  // it to queue every piece at once and download each while the next renders.
+  virtual BandResult render_band_in_pieces(const BandJob& job, BandBuffer& target, const std::vector<int>& cuts,
+                                           const std::function<void(size_t)>& ready);
   // The same into a float frame (tests, benches): rendered as RGBA32F and copied into those rows of
   // target, which is resized to the camera's size when it differs. Derived classes say
   // `using core::Tracer::render_band;` so that it is not hidden.

@@ -26,6 +26,10 @@ class CudaTracer final : public TracerBase {
   bool renders_on_gpu() const override { return true; }
   using core::Tracer::render_band;
   core::BandResult render_band(const core::BandJob& job, core::BandBuffer& target) override;
+  // Every piece's kernel queued at once, each piece downloaded on the copy engine while the next renders
+  // (a remote node's band, tracers/mpi); frames with aux outputs take the default, piece by piece.
+  core::BandResult render_band_in_pieces(const core::BandJob& job, core::BandBuffer& target, const std::vector<int>& cuts,
+                                         const std::function<void(size_t)>& ready) override;
 
   // Ray counting for benchmarks (off by default: it costs a reduction per warp).
   struct RayCounts {

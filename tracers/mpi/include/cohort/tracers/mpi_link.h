@@ -16,6 +16,17 @@ namespace cohort::tracers {
 
 using MpiClock = std::chrono::steady_clock;
 
+// Where a band's pieces go as they arrive (rank 0's remote tracer, docs/cluster.md): messages on a tag
+// other than the control tag are raw rows that the receiver places itself. Called with the session's
+// lock held, so it must not call the session.
+class PieceSink {
+ public:
+  virtual ~PieceSink() = default;
+  // A message of `bytes` bytes on `tag` has been matched: the memory to receive it into (all of it), or
+  // null to receive it into scratch and drop it.
+  virtual void* place(int tag, size_t bytes) = 0;
+};
+
 class MpiSession {
  public:
   // Initializes MPI on first use (MPI_Init_thread) unless the program already did; finalizes at exit.
@@ -28,14 +39,24 @@ class MpiSession {
 
   // Queues `bytes` for `destination`; the session keeps them until the send has completed.
   void send(int destination, std::vector<uint8_t> bytes);
+  // Sends `size` bytes from where they lie on `tag` (a band's piece, straight from the node's band
+  // buffer): they must stay valid and unchanged until flush_sends(destination) returns true.
+  void send_in_place(int destination, int tag, const void* data, size_t size);
   // Progresses the queued sends; returns how many are still in flight.
   size_t progress_sends();
   // Waits until every queued send to `destination` (or all, with -1) has completed, at most until the
   // deadline; false if some had not.
   bool flush_sends(int destination, MpiClock::time_point deadline);
-  // The next message from `source`, or nothing when none has fully arrived by the deadline. A message
-  // whose receipt began and did not finish is picked up by the next call for that source.
-  std::optional<std::vector<uint8_t>> receive(int source, MpiClock::time_point deadline);
+  // The next control message from `source`, or nothing when none has fully arrived by the deadline. A
+  // message whose receipt began and did not finish is picked up by the next call for that source.
+  // With `pieces`, messages on piece tags that come first are received where it places them, and a
+  // control message is returned only once every piece matched before it has landed (messages from
+  // one source are matched in the order they were sent, so a band's pieces are in place when the
+  // band_rows that closes it is returned). Without, pieces wait unmatched.
+  std::optional<std::vector<uint8_t>> receive(int source, MpiClock::time_point deadline, PieceSink* pieces = nullptr);
+  // Waits at most until the deadline for the pieces from `source` that are being received into place
+  // to land; false when some have not (they still land where they were placed, later).
+  bool settle_pieces(int source, MpiClock::time_point deadline);
 
   // Rank 0: the message finalize() sends to every rank above 0 that was not released, so that nodes
   // no tracer talked to (or whose tracer failed to start) leave too.

@@ -31,6 +31,8 @@ struct NodeOptions {
   int stall_ms = 0;
   // Tests: before rendering the band of this frame index, the process kills itself (a lost node).
   int die_frame = -1;
+  // Tests: piece 0 of this frame index's band goes out a byte short (a malformed piece).
+  int short_piece_frame = -1;
   // Rank 0 silent this long: the node leaves.
   std::chrono::seconds idle_timeout{600};
 };

@@ -19,6 +19,7 @@
 #include <string>
 
 #include "cohort/core/tracer.h"
+#include "cohort/tracers/mpi_link.h"
 #include "cohort/tracers/mpi_wire.h"
 
 namespace cohort::tracers {
@@ -31,6 +32,11 @@ struct MpiTracerOptions {
   std::chrono::milliseconds band_timeout{2000};
   // How long the constructor waits for the node's hello (it loads its scene first).
   std::chrono::milliseconds hello_timeout{120000};
+  // A band's rows travel in this many pieces (fewer when it has fewer rows; at most wire::kMaxPieces):
+  // the node sends each as soon as it is on its host while it renders the next, and this tracer
+  // receives each straight into its target rows, so the round trip is the node's render plus one
+  // piece's way back instead of the whole band's.
+  uint32_t pieces = 4;
 };
 
 // What crossed the wire for this tracer, for `cohort bench devices` and the logs.
@@ -39,9 +45,21 @@ struct MpiLinkStats {
   uint64_t bytes_sent = 0, bytes_received = 0;  // whole messages, headers included
   uint64_t last_band_bytes_sent = 0, last_band_bytes_received = 0;  // commit(s) and job since the last band, and its rows
   double last_round_trip_ms = 0.0;  // job sent -> rows received
-  double last_node_ms = 0.0;        // the node's own time for the band (apply + render)
+  double last_node_ms = 0.0;        // the node's own time for the band (render, and sending the pieces)
   double total_round_trip_ms = 0.0;
   double total_node_ms = 0.0;
+  // Where the round trip goes, summed over bands (divide by `bands`): on the node, its tracers'
+  // render_band calls (GPU: kernel, download into its band buffer and waits), of that what the tracers
+  // measured themselves (GPU: kernel time), and its MPI calls; on rank 0, job sent -> first piece
+  // matched. round trip - node time is the commits' and job's way out, the node applying the commits,
+  // and the last piece's and band_rows' way back.
+  double total_node_render_ms = 0.0;
+  double total_node_tracer_ms = 0.0;
+  double total_node_send_ms = 0.0;
+  double total_node_commit_ms = 0.0;  // decoding and applying the commits before the job (not in node time)
+  double total_first_piece_ms = 0.0;
+  double total_node_first_piece_ms = 0.0;  // on the node: job taken -> first piece posted
+  uint32_t last_pieces = 0;
   uint64_t stale_answers = 0;       // late answers to jobs that had timed out, dropped
   uint64_t refused_messages = 0;    // malformed answers, refused
 };
@@ -70,6 +88,9 @@ class MpiTracer : public core::Tracer {
   // Reads, without waiting, what the node sent since a band timed out; clears timed_out_job_ once the
   // answer to that band is among it.
   void take_late_answers();
+  // The answer to the current job has not come: its pieces already matched get a moment to land (they
+  // write the target's rows), and the node is sent no band until it answers this one.
+  [[noreturn]] void fail_timed_out(uint64_t id, MpiClock::time_point start, const core::BandJob& job);
 
   MpiTracerOptions options_;
   std::string description_;
@@ -80,7 +101,7 @@ class MpiTracer : public core::Tracer {
   bool node_needs_resync_ = false;
   bool after_full_resync_ = false;
   uint64_t timed_out_job_ = 0;
-  std::chrono::steady_clock::time_point timed_out_start_{};
+  MpiClock::time_point timed_out_start_{};
   std::string node_failure_;
   mutable std::mutex stats_mutex_;
   MpiLinkStats stats_;

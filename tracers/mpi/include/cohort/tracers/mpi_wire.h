@@ -18,7 +18,9 @@
 namespace cohort::tracers::wire {
 
 constexpr uint32_t kMagic = 0x504d4843u;  // "CHMP" in memory order
-constexpr uint16_t kProtocolVersion = 3;  // 2: vertex colours in scenes and BLAS uploads; 3: BandJob::keep_on_device
+// 2: vertex colours in scenes and BLAS uploads; 3: BandJob::keep_on_device; 4: a band's rows travel in
+// pieces, raw, on tags of their own (band_job names the piece count, band_rows closes the band).
+constexpr uint16_t kProtocolVersion = 4;
 
 enum class Kind : uint16_t {
   hello = 1,        // node -> 0: versions, what scene it loaded, its tracers
@@ -28,7 +30,7 @@ enum class Kind : uint16_t {
   commit = 5,       // 0 -> node: a commit buffer (records, or a whole scene)
   full_local = 6,   // 0 -> node: a full resync to the scene the node loaded itself (same fingerprint)
   band_job = 7,     // 0 -> node: render these rows
-  band_rows = 8,    // node -> 0: the band's rows
+  band_rows = 8,    // node -> 0: the band is done (its rows went ahead as pieces): row work and timing
   band_failed = 9,  // node -> 0: the band could not be rendered (the reason)
   shutdown = 10,    // 0 -> node: leave cleanly
 };
@@ -89,44 +91,77 @@ std::vector<uint8_t> encode_full_local(const commit::CommitBuffer& full);
 commit::CommitBuffer decode_full_local(const std::vector<uint8_t>& payload,
                                        std::shared_ptr<const commit::TracerScene> own_scene);
 
+// A band's rows travel as pieces: runs of whole rows, each sent as soon as the node has it on the host
+// while it renders the next, raw (no header) on an MPI tag of its own that names the band job, the
+// piece and the plane, so that rank 0 receives each straight into its target rows. The band_rows
+// message that follows the pieces closes the band. Tags of the control messages and of the pieces do
+// not overlap, and all of them fit the 32767 that every MPI library offers (MPI_TAG_UB).
+constexpr int kControlTag = 0x434f;
+constexpr int kPieceTagBase = 0x4400;
+constexpr uint32_t kMaxPieces = 32;
+// Piece tags tell apart the jobs of the last kPieceJobSlots to a node; a node has at most one band in
+// flight (a remote tracer sends it no other while it has not answered), so a late piece is never
+// taken for the current job's.
+constexpr uint32_t kPieceJobSlots = 64;
+enum class Plane : uint32_t { colour = 0, aux = 1 };
+int piece_tag(uint64_t job, uint32_t piece, Plane plane);
+struct PieceTag {
+  uint32_t job_slot = 0, piece = 0;
+  Plane plane = Plane::colour;
+  bool of_job(uint64_t job) const { return job_slot == job % kPieceJobSlots; }
+};
+// False for a tag that is no piece's (the control tag, or out of the range).
+bool decode_piece_tag(int tag, PieceTag& out);
+// Rows [begin, end) of piece `index` of `pieces` over rows [row_begin, row_end): as even as whole rows
+// allow, in order, none empty while there are at least as many rows as pieces.
+struct RowRange {
+  uint32_t begin = 0, end = 0;
+};
+RowRange piece_rows(uint32_t row_begin, uint32_t row_end, uint32_t pieces, uint32_t index);
+// How many pieces a band of `rows` rows travels in when `wanted` are asked for: 1 to kMaxPieces, never
+// more than its rows.
+uint32_t band_pieces(uint32_t rows, uint32_t wanted);
+
 struct BandRequest {
   core::BandJob job;
   core::BandFormat format = core::BandFormat::rgb16f;
   bool aux = false;  // send the auxiliary planes too (kernel/aux_outputs.h)
+  uint32_t pieces = 1;  // the rows travel in this many pieces (band_pieces of the band's rows)
 };
 std::vector<uint8_t> encode_band_request(const BandRequest& request);
 BandRequest decode_band_request(const std::vector<uint8_t>& payload);
 
-// A band's rows in the band format (6 bytes a pixel as rgb16f), and its aux planes when asked for.
+// Where a node's time on a band went, for rank 0's log and `cohort bench devices`.
+struct NodeTiming {
+  double total_ms = 0.0;   // job taken -> band_rows sent (commit applied before it is not counted)
+  double render_ms = 0.0;  // in its tracers' render_band calls, wall (GPU: kernel, download and waits)
+  double device_ms = 0.0;  // what the tracers measured themselves (GPU: kernel time; summed over pieces)
+  // In MPI calls: posting the pieces, moving them while the next piece renders (so overlapping
+  // render_ms), and the wait for the last band's pieces to have left.
+  double send_ms = 0.0;
+  double first_piece_ms = 0.0;  // job taken -> first piece posted
+  // Decoding and applying the commits that came since the last band (before this job, on the same
+  // ordered stream, so part of the round trip but not of total_ms).
+  double commit_ms = 0.0;
+};
+static_assert(sizeof(NodeTiming) == 48, "NodeTiming travels as it lies: six doubles");
+
+// The band_rows message: the band is done. Its pieces went ahead on their own tags: `pieces` of colour
+// rows in the band format (6 bytes a pixel as rgb16f), and as many of aux texels when `aux`.
 struct BandRows {
   uint32_t row_begin = 0, row_end = 0, width = 0;
   core::BandFormat format = core::BandFormat::rgb16f;
-  double device_ms = 0.0;
+  uint32_t pieces = 1;
+  bool aux = false;
+  double device_ms = 0.0;  // the node's time for the band, as the balancer takes it
+  NodeTiming timing;
   std::vector<float> row_work;
-  std::vector<uint8_t> pixels;
-  std::vector<uint8_t> aux;
 };
-// Encodes rows [row_begin, row_end) of `source` straight from its storage.
-std::vector<uint8_t> encode_band_rows(const core::BandBuffer& source, uint32_t row_begin, uint32_t row_end,
-                                      double device_ms, const std::vector<float>& row_work);
+std::vector<uint8_t> encode_band_rows(const BandRows& rows);
 BandRows decode_band_rows(const std::vector<uint8_t>& payload);
-// The same, pixels and aux texels left where they lie in `payload` (valid while it is): the remote tracer
-// copies them once, into its target.
-struct BandRowsView {
-  uint32_t row_begin = 0, row_end = 0, width = 0;
-  core::BandFormat format = core::BandFormat::rgb16f;
-  double device_ms = 0.0;
-  std::vector<float> row_work;
-  const uint8_t* pixels = nullptr;
-  uint64_t pixel_bytes = 0;
-  const uint8_t* aux = nullptr;
-  uint64_t aux_bytes = 0;
-};
-BandRowsView decode_band_rows_view(const std::vector<uint8_t>& payload);
-BandRowsView decode_band_rows_view(const uint8_t* payload, size_t size);
-// A whole band_rows message (header included) built in one buffer: what the node sends.
-std::vector<uint8_t> band_rows_message(uint64_t sequence, const core::BandBuffer& source, uint32_t row_begin,
-                                       uint32_t row_end, double device_ms, const std::vector<float>& row_work);
+BandRows decode_band_rows(const uint8_t* payload, size_t size);
+// The bytes of one piece's plane: its rows of colour in `format`, or of aux texels.
+uint64_t piece_bytes(uint32_t rows, uint32_t width, core::BandFormat format, Plane plane);
 
 struct BandFailure {
   bool needs_full_resync = false;  // the node's scene is behind or diverged: the next commit must be whole
