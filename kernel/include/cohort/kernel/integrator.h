@@ -19,7 +19,7 @@
 #include "light_tree.h"
 #include "rng.h"
 #include "path_pattern.h"
-#include "sky.h"
+#include "environment.h"
 
 #ifndef K_CTX_SCENE
 #define K_CTX_SCENE(ctx) (&(ctx)->scene)
@@ -262,7 +262,12 @@ KFN KVec3 k_trace_path(KTraceCtx* ctx, const KFrameParams* params, KVec3 org, KV
     KVec3 wo = v3_neg(dir);
 
     if (sf.blend != K_BLEND_OPAQUE) {
-      /* Transparent layers: shade the layer, carry on through it without consuming a bounce. */
+      /* Transparent layers: shade the layer, carry on through it without consuming a bounce. An
+       * environment stage (glass) adds its reflection on top of whatever the layer does. */
+      if (lit_mode) {
+        KVec3 env = v3_mul(throughput, k_environment_radiance(scene, hit, hit_material, sf.normal, dir));
+        radiance = v3_add(radiance, bounce > 0u ? k_clamp_radiance(env, params->firefly_clamp) : env);
+      }
       if (sf.blend == K_BLEND_ADDITIVE) {
         radiance = v3_add(radiance, v3_mul(throughput, v3_add(sf.albedo, sf.emission)));
       } else if (sf.blend == K_BLEND_MODULATE) {
@@ -295,6 +300,7 @@ KFN KVec3 k_trace_path(KTraceCtx* ctx, const KFrameParams* params, KVec3 org, KV
                                        k_fabs(v3_dot(sf.geo_normal, dir)));
       contribution = v3_scale(contribution, k_power_heuristic(vertex_brdf_pdf, light_pdf));
     }
+    contribution = v3_add(contribution, k_environment_radiance(scene, hit, hit_material, sf.normal, dir));
     float path_weight = v3_max_component(throughput);
     contribution = v3_add(contribution, k_direct_lighting(ctx, &vertex_params, &sf, wo, path_weight, rng));
     if (emissive_nee) {

@@ -18,7 +18,8 @@
 namespace cohort::tracers::wire {
 
 constexpr uint32_t kMagic = 0x504d4843u;  // "CHMP" in memory order
-constexpr uint16_t kProtocolVersion = 3;  // 2: vertex colours in scenes and BLAS uploads; 3: BandJob::keep_on_device
+constexpr uint16_t kProtocolVersion = 4;  // 2: vertex colours in scenes and BLAS uploads; 3: BandJob::keep_on_device;
+                                          // 4: KMaterial carries an environment cube (128 bytes)
 
 enum class Kind : uint16_t {
   hello = 1,        // node -> 0: versions, what scene it loaded, its tracers
