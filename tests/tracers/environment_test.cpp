@@ -107,6 +107,31 @@ TEST_P(Environment, ChromeShowsTheFaceOfTheReflectedViewAndTexgenNormalTheNormal
   }
 }
 
+// The spaces: `texgen reflect` reads the cube by the world direction, `texgen normal` by the normal as
+// the model stores it. A chrome panel facing +X in its model, turned a quarter turn about Z by its entity
+// (so facing +Y in the world) and seen head-on from +Y, reflects the +Y face; by its normal it shows +X.
+TEST_P(Environment, ReflectReadsTheWorldDirectionAndNormalTheModelsNormal) {
+  const int n = 5;
+  for (bool by_normal : {false, true}) {
+    scene::Scene s;
+    s.name = "turned_chrome";
+    const int chrome = add_environment_material(s, "textures/test/chrome", false, by_normal, glm::vec3(1.0f));
+    scene::Mesh panel;
+    panel.name = "panel";
+    add_quad(panel, chrome, {0, -100, -100}, {0, 100, -100}, {0, 100, 100}, {0, -100, 100}, {1, 0, 0});
+    s.meshes.push_back(panel);
+    scene::Entity e;
+    e.name = e.classname = "func_static";
+    e.mesh = int(s.meshes.size() - 1);
+    e.axis = glm::mat3(glm::vec3(0, 1, 0), glm::vec3(-1, 0, 0), glm::vec3(0, 0, 1));   // model +X -> world +Y
+    s.entities.push_back(e);
+    const glm::vec3 got =
+        pixel(render(*tracer_, s, camera_at({0, 300, 0}, n), frame_params(K_MODE_PATH, 2, 0, n)), n / 2, n / 2);
+    expect_colour(got, face_colour(by_normal ? PosX : PosY),
+                  GetParam() + (by_normal ? " texgen normal" : " texgen reflect") + ", turned panel");
+  }
+}
+
 // Glass that is nothing but its reflection adds the reflected face to what is seen through it: a pane
 // in front of a glowing wall shows the wall plus the cube.
 TEST_P(Environment, GlassAddsItsReflectionToWhatIsBehindIt) {
