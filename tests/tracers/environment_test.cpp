@@ -107,6 +107,29 @@ TEST_P(Environment, ChromeShowsTheFaceOfTheReflectedViewAndTexgenNormalTheNormal
   }
 }
 
+// With a bump stage the reflection is about the normal map's normal (the engine's bumpyEnvironment): a
+// panel facing +X whose normal map tilts every normal 60 degrees toward its tangent (+Y) reflects a
+// head-on view to (-1/2, sqrt(3)/2, 0), the +Y face, where the flat panel shows +X.
+TEST_P(Environment, BumpMappedChromeReflectsAboutTheNormalMapsNormal) {
+  const int n = 5;
+  for (bool bumpy : {false, true}) {
+    scene::Scene s;
+    s.name = "bumpy_chrome";
+    const int chrome = add_environment_material(s, "textures/test/chrome", false, false, glm::vec3(1.0f));
+    if (bumpy) {
+      // Tangent-space (sin 60, 0, cos 60), X in R, stored as (n + 1) / 2.
+      const int normal_map = add_image(s, "textures/test/tilted_local", 2, 2,
+                                       [](int, int) { return glm::u8vec4(238, 128, 191, 255); });
+      s.images[size_t(normal_map)].is_normal_map = true;
+      s.materials[size_t(chrome)].normal_image = normal_map;
+    }
+    add_panel_facing_x(s, chrome);
+    const glm::vec3 got =
+        pixel(render(*tracer_, s, camera_at({300, 0, 0}, n), frame_params(K_MODE_PATH, 2, 0, n)), n / 2, n / 2);
+    expect_colour(got, face_colour(bumpy ? PosY : PosX), GetParam() + (bumpy ? " bump-mapped" : " flat") + " chrome");
+  }
+}
+
 // The spaces: `texgen reflect` reads the cube by the world direction, `texgen normal` by the normal as
 // the model stores it. A chrome panel facing +X in its model, turned a quarter turn about Z by its entity
 // (so facing +Y in the world) and seen head-on from +Y, reflects the +Y face; by its normal it shows +X.
