@@ -118,6 +118,7 @@ KMaterial to_kmaterial(const scene::Material& material, const scene::Scene& scen
     k.env_tex1 = environment + 1u;
     store(k.env_color, material.environment_color);
     if (material.environment_by_normal) flags |= K_MAT_ENV_BY_NORMAL;
+    if (material.environment_under_layer) flags |= K_MAT_ENV_UNDER_LAYER;
   }
   if (k.blend == K_BLEND_SKY) {
     to_ksky(material, scene, k);

@@ -89,7 +89,9 @@ bool is_environment_stage(const MaterialStage& s) {
 // The first environment stage (glass, chrome): its cube, texgen and colour, drawn over the surface as
 // the engine draws it after the surface's other stages. Only `blend add` stages (gl_one as the
 // destination factor, Doom 3's usual choice) are drawn; another blend is a warning and is not drawn.
-void build_environment(const MaterialDecl& decl, ImageLibrary& images, Material& m, RegisterSources& sources) {
+// Returns the stage drawn, or null.
+const MaterialStage* build_environment(const MaterialDecl& decl, ImageLibrary& images, Material& m,
+                                       RegisterSources& sources) {
   for (const MaterialStage& s : decl.stages) {
     if (!is_environment_stage(s) || s.blend == StageBlend::None) continue;
     const std::string context = decl.file + ":" + std::to_string(s.line) + ": material " + decl.name;
@@ -103,8 +105,9 @@ void build_environment(const MaterialDecl& decl, ImageLibrary& images, Material&
     m.environment_by_normal = s.texgen == TexGen::Normal;
     m.environment_color = glm::vec3(s.color);
     sources.set(sources.r.environment, s);
-    return;
+    return &s;
   }
+  return nullptr;
 }
 
 void glow_with(Material& m, int image, const MaterialStage& s, RegisterSources& sources) {
@@ -201,7 +204,7 @@ static Material build_material_look(const MaterialDecl& decl, ImageLibrary& imag
     build_sky(decl, s, images, m, sources);
     return m;
   }
-  build_environment(decl, images, m, sources);
+  const MaterialStage* environment = build_environment(decl, images, m, sources);
   if (!first_ambient) {
     if (m.environment_cube_image >= 0) {
       // Glass with nothing but its reflection: a layer that adds the cube and lets the rest through.
@@ -229,6 +232,7 @@ static Material build_material_look(const MaterialDecl& decl, ImageLibrary& imag
     case StageBlend::Modulate:
     case StageBlend::AlphaBlend:
       m.blend = s.blend == StageBlend::Modulate ? BlendClass::Modulate : BlendClass::Alpha;
+      m.environment_under_layer = environment != nullptr && environment < &s;
       m.diffuse_image = image;
       m.diffuse_color = s.color;
       sources.set(sources.r.diffuse, s);

@@ -67,6 +67,7 @@ void drive(RenderWorldApi& world, int frames) {
         if (face == 0) m.environment_cube_image = image;
       }
       m.environment_by_normal = true;
+      m.environment_under_layer = true;
       m.environment_color = {0.25f, 0.5f, 0.75f};
       int mat = world.DefineMaterial(m);
       Mesh crate_mesh = cohort::test::box_mesh("crate", {8, 8, 8}, mat);
@@ -109,6 +110,7 @@ void expect_same_world(const RenderWorld& a, const RenderWorld& b) {
     EXPECT_EQ(a.scene().materials[i].inverse_vertex_color, b.scene().materials[i].inverse_vertex_color);
     EXPECT_EQ(a.scene().materials[i].environment_cube_image, b.scene().materials[i].environment_cube_image);
     EXPECT_EQ(a.scene().materials[i].environment_by_normal, b.scene().materials[i].environment_by_normal);
+    EXPECT_EQ(a.scene().materials[i].environment_under_layer, b.scene().materials[i].environment_under_layer);
     EXPECT_EQ(a.scene().materials[i].environment_color, b.scene().materials[i].environment_color);
   }
   ASSERT_EQ(a.scene().images.size(), b.scene().images.size());
@@ -175,6 +177,7 @@ TEST(DeltaStream, ReplayGivesTheSameStateAsTheDirectCalls) {
   EXPECT_TRUE(replayed.scene().materials[size_t(late)].inverse_vertex_color);
   EXPECT_GE(replayed.scene().materials[size_t(late)].environment_cube_image, 0);
   EXPECT_TRUE(replayed.scene().materials[size_t(late)].environment_by_normal);
+  EXPECT_TRUE(replayed.scene().materials[size_t(late)].environment_under_layer);
   EXPECT_EQ(replayed.scene().materials[size_t(late)].environment_color, glm::vec3(0.25f, 0.5f, 0.75f));
 }
 

@@ -130,6 +130,10 @@ textures/glass/tinted {
 textures/glass/filtered_reflection {
   { blend filter cubeMap env/axis texgen reflect }
 }
+textures/glass/reflection_under_tint {
+  { blend add cubeMap env/axis texgen reflect }
+  { blend filter map textures/glass/tint }
+}
 )";
 
 }  // namespace
@@ -379,6 +383,11 @@ TEST(SkyMaterials, EnvironmentStagesGiveTheMaterialACubeAndKeepItsClass) {
   Material tinted = build_material(*find(f, "textures/glass/tinted"), fx.library, false);
   EXPECT_EQ(tinted.blend, BlendClass::Modulate);
   EXPECT_TRUE(tinted.environment_by_normal);
+  EXPECT_FALSE(tinted.environment_under_layer) << "the filter is drawn first: the reflection goes over it";
+  Material under = build_material(*find(f, "textures/glass/reflection_under_tint"), fx.library, false);
+  EXPECT_EQ(under.blend, BlendClass::Modulate);
+  EXPECT_GE(under.environment_cube_image, 0);
+  EXPECT_TRUE(under.environment_under_layer) << "the reflection is drawn first: the filter darkens it";
   ASSERT_GE(tinted.environment_cube_image, 0);
   EXPECT_EQ(fx.images.at(size_t(tinted.environment_cube_image)).name, "env/camera_forward");
   ASSERT_TRUE(tinted.registers);

@@ -180,6 +180,40 @@ TEST_P(Environment, GlassAddsItsReflectionToWhatIsBehindIt) {
   expect_colour(got, 0.5f * face_colour(PosX) + glm::vec3(0.0f, 0.25f, 0.0f), GetParam() + ", glass over the wall");
 }
 
+// A filter glass (a modulate layer of half the light) with a reflection: written after the filter stage
+// the reflection is added over the filtered wall; written before it, the filter darkens it too (the
+// engine draws stages in order).
+TEST_P(Environment, AReflectionWrittenBeforeTheFilterIsFiltered) {
+  const int n = 5;
+  for (bool under : {false, true}) {
+    scene::Scene s;
+    s.name = "filter_glass";
+    const int glass = add_environment_material(s, "textures/test/filter_glass", true, false, glm::vec3(0.5f));
+    scene::Material& g = s.materials[size_t(glass)];
+    g.blend = scene::BlendClass::Modulate;
+    g.diffuse_color = glm::vec4(0.5f, 0.5f, 0.5f, 1.0f);
+    g.environment_under_layer = under;
+    scene::Material wall;
+    wall.name = "textures/test/glow";
+    wall.emitter = true;
+    wall.emissive_color = glm::vec4(0.0f, 0.25f, 0.0f, 1.0f);
+    wall.diffuse_color = glm::vec4(0.0f, 0.0f, 0.0f, 1.0f);
+    wall.specular_color = glm::vec4(0.0f, 0.0f, 0.0f, 1.0f);
+    s.materials.push_back(wall);
+    scene::Mesh mesh;
+    mesh.name = "_area0";
+    add_quad(mesh, glass, {0, -100, -100}, {0, 100, -100}, {0, 100, 100}, {0, -100, 100}, {1, 0, 0});
+    add_quad(mesh, int(s.materials.size() - 1), {-50, -100, -100}, {-50, 100, -100}, {-50, 100, 100},
+             {-50, -100, 100}, {1, 0, 0});
+    add_world_mesh(s, std::move(mesh));
+    const glm::vec3 got =
+        pixel(render(*tracer_, s, camera_at({300, 0, 0}, n), frame_params(K_MODE_PATH, 2, 0, n)), n / 2, n / 2);
+    const glm::vec3 reflection = 0.5f * face_colour(PosX), filtered_wall(0.0f, 0.125f, 0.0f);
+    expect_colour(got, (under ? 0.5f : 1.0f) * reflection + filtered_wall,
+                  GetParam() + (under ? ", reflection under the filter" : ", reflection over the filter"));
+  }
+}
+
 INSTANTIATE_TEST_SUITE_P(Tracers, Environment, ::testing::ValuesIn(built_tracers()),
                          [](const ::testing::TestParamInfo<std::string>& info) { return info.param; });
 

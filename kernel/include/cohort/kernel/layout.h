@@ -87,6 +87,8 @@ typedef struct KTriangle {
 #define K_MAT_INVERSE_VERTEX_COLOR 512u  /* inverseVertexColor: colours x (1 - vertex RGB), alpha kept */
 #define K_MAT_ENV_BY_NORMAL 1024u  /* the environment stage is `texgen normal`: cube by the model-space
                                     * vertex normal, not by the reflected view */
+#define K_MAT_ENV_UNDER_LAYER 2048u  /* the environment stage comes before the layer's filter / blend stage,
+                                      * which then filters the reflection too */
 
 typedef struct KMaterial {
   float diffuse_color[4];   /* multiplies the diffuse map; rgba */

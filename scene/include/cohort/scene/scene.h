@@ -59,6 +59,9 @@ struct Material {
   int environment_cube_image = -1;
   bool environment_by_normal = false;
   glm::vec3 environment_color{1.0f};
+  // The environment stage comes before the stage that makes the material a filter or blend layer: the
+  // engine draws stages in order, so that layer filters the reflection as it filters what is behind.
+  bool environment_under_layer = false;
   // Light materials (lights/...): the projected image and the falloff image.
   bool is_light_material = false;
   int light_image = -1, falloff_image = -1;
