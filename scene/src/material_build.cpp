@@ -86,10 +86,11 @@ bool is_environment_stage(const MaterialStage& s) {
   return s.cube_kind != CubeMapKind::None && (s.texgen == TexGen::Reflect || s.texgen == TexGen::Normal);
 }
 
-// The first environment stage (glass, chrome): its cube, texgen and colour, drawn over the surface as
-// the engine draws it after the surface's other stages. Only `blend add` stages (gl_one as the
-// destination factor, Doom 3's usual choice) are drawn; another blend is a warning and is not drawn.
-// Returns the stage drawn, or null.
+// The first environment stage (glass, chrome): its cube, texgen and colour. The engine draws it with the
+// unlit stages, after the interactions and in stage order among the unlit ones (the caller notes one
+// written before a layer's filter / blend stage). Only `blend add` stages (gl_one as the destination
+// factor, Doom 3's usual choice) are drawn; another blend is a warning and is not drawn. Returns the
+// stage drawn, or null.
 const MaterialStage* build_environment(const MaterialDecl& decl, ImageLibrary& images, Material& m,
                                        RegisterSources& sources) {
   for (const MaterialStage& s : decl.stages) {
