@@ -41,8 +41,8 @@ int run_info(const std::string& map, std::vector<std::string> bases, size_t max_
             << "  glowing  " << report.emitters << ": " << report.emitting_surfaces
             << " opaque (light sources for next-event estimation), " << report.emitters - report.emitting_surfaces
             << " blended layers (seen, not sampled)\n"
-            << "  sky      " << report.skies << " (cube maps seen by rays that reach them), noSelfShadow "
-            << report.no_self_shadow << "\n"
+            << "  sky      " << report.skies << " (cube maps seen by rays that reach them), environment maps "
+            << report.environment_maps << " (reflect/normal), noSelfShadow " << report.no_self_shadow << "\n"
             << "textures   " << report.images_loaded + report.images_placeholder << " (" << report.images_placeholder
             << " placeholders)\n"
             << "lights     " << loaded.lights.size() << ": " << report.lights_point << " point, "

@@ -15,6 +15,7 @@ PACKAGES=(
   libcli11-dev nlohmann-json3-dev libzip-dev libspdlog-dev libfmt-dev   # CLI, JSON, .pk4, logging
   python3 python3-pip xvfb xauth    # viewer test under a virtual display; pip fetches OIDN
   ccache                              # compile cache (used when present; speeds rebuilds and worktrees)
+  clang libclang-rt-dev               # the parsers' libFuzzer targets (tools/fuzz.sh; CI runs them bounded)
   libopenmpi-dev openmpi-bin          # remote tracers over MPI (cohort node, mpi:N); optional at build time
 )
 

@@ -65,17 +65,21 @@ void box_light_planes(const scene::Light& light, glm::vec4 planes[4]) {
   planes[3] = glm::vec4(0.0f, 0.0f, 0.5f / r.z, 0.5f);
 }
 
-// The sky's cube faces are consecutive images, so their clamped (light-image) slots are consecutive
-// too: the kernel reads face f at emissive_tex + f (sky.h). A cube without six usable faces is its
-// colour alone.
+// A cube's faces are consecutive images, so their clamped (light-image) slots are consecutive too: the
+// kernel reads face f at the first face's slot + f (sky.h k_cube_sample). K_NONE without six usable faces.
+uint32_t cube_slot(int first_face, const scene::Scene& scene) {
+  const uint32_t slot = texture_slot(first_face, TextureUse::LightImage, scene);
+  for (int face = 1; face < 6 && slot != K_NONE; ++face)
+    if (texture_slot(first_face + face, TextureUse::LightImage, scene) != slot + uint32_t(face)) return K_NONE;
+  return slot;
+}
+
+// A sky whose cube has no six usable faces is its colour alone.
 void to_ksky(const scene::Material& material, const scene::Scene& scene, KMaterial& k) {
   k.diffuse_tex = k.normal_tex = k.specular_tex = K_NONE;
   store(k.diffuse_color, glm::vec4(0.0f, 0.0f, 0.0f, 1.0f));
   store(k.specular_color, glm::vec4(0.0f));
-  k.emissive_tex = texture_slot(material.sky_cube_image, TextureUse::LightImage, scene);
-  for (int face = 1; face < 6 && k.emissive_tex != K_NONE; ++face)
-    if (texture_slot(material.sky_cube_image + face, TextureUse::LightImage, scene) != k.emissive_tex + uint32_t(face))
-      k.emissive_tex = K_NONE;
+  k.emissive_tex = cube_slot(material.sky_cube_image, scene);
   store(k.tex_transform, material.sky_axis[0]);
   store(k.tex_transform + 3, material.sky_axis[1]);
   k.tex_transform[6] = k.tex_transform[7] = 0.0f;
@@ -108,6 +112,14 @@ KMaterial to_kmaterial(const scene::Material& material, const scene::Scene& scen
   if (material.vertex_color) flags |= K_MAT_VERTEX_COLOR;
   if (material.inverse_vertex_color) flags |= K_MAT_INVERSE_VERTEX_COLOR;
   if (material.no_self_shadow) flags |= K_MAT_NO_SELF_SHADOW;
+  // An environment stage whose cube has no six usable faces adds nothing.
+  const uint32_t environment = cube_slot(material.environment_cube_image, scene);
+  if (environment != K_NONE && k.blend != K_BLEND_SKY && k.blend != K_BLEND_PASSTHROUGH) {
+    k.env_tex1 = environment + 1u;
+    store(k.env_color, material.environment_color);
+    if (material.environment_by_normal) flags |= K_MAT_ENV_BY_NORMAL;
+    if (material.environment_under_layer) flags |= K_MAT_ENV_UNDER_LAYER;
+  }
   if (k.blend == K_BLEND_SKY) {
     to_ksky(material, scene, k);
     k.flags = flags & ~K_MAT_EMISSIVE;

@@ -209,6 +209,9 @@ PackedScene read_scene_pack(const std::filesystem::path& file) {
   for (const KTexture& t : s.textures)
     if (uint64_t(t.offset) + uint64_t(t.width) * t.height > s.texels.size())
       throw PackError(file.string(), 0, "a texture points outside the texel array");
+  for (const KMaterial& m : s.materials)
+    if (m.env_tex1 != 0u && uint64_t(m.env_tex1) - 1u + 6u > s.textures.size())
+      throw PackError(file.string(), 0, "a material's environment cube map points outside the texture table");
   // The light tree and the emissive triangles are derived from the arrays above, so packs do not carry them.
   rebuild_light_sampling(s);
   return pack;

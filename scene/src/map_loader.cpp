@@ -270,6 +270,7 @@ class SceneBuilder {
       report_.emitters += m.emitter ? 1 : 0;
       report_.emitting_surfaces += m.emitter && m.blend == BlendClass::Opaque ? 1 : 0;
       report_.skies += m.blend == BlendClass::Sky ? 1 : 0;
+      report_.environment_maps += m.environment_cube_image >= 0 ? 1 : 0;
       report_.no_self_shadow += m.no_self_shadow ? 1 : 0;
     }
   }

@@ -14,7 +14,7 @@ struct RegisterSources {
   MaterialRegisters r;
   void set(std::optional<StageRegisters>& slot, const MaterialStage& s) { slot = s.registers; }
   void attach(Material& m) {
-    for (auto* slot : {&r.diffuse, &r.specular, &r.emissive, &r.look, &r.light, &r.sky}) {
+    for (auto* slot : {&r.diffuse, &r.specular, &r.emissive, &r.look, &r.light, &r.sky, &r.environment}) {
       if (!*slot) continue;
       if ((*slot)->depends() == 0) {
         slot->reset();
@@ -80,6 +80,35 @@ void build_sky(const MaterialDecl& decl, const MaterialStage& s, ImageLibrary& i
     m.sky_axis = wobble_sky_axes(s.wobble_sky[0], s.wobble_sky[1], s.wobble_sky[2], 0.0f);
     sources.set(sources.r.sky, s);
   }
+}
+
+bool is_environment_stage(const MaterialStage& s) {
+  return s.cube_kind != CubeMapKind::None && (s.texgen == TexGen::Reflect || s.texgen == TexGen::Normal);
+}
+
+// The first environment stage (glass, chrome): its cube, texgen and colour. The engine draws it with the
+// unlit stages, after the interactions and in stage order among the unlit ones (the caller notes one
+// written before a layer's filter / blend stage). Only `blend add` stages (gl_one as the destination
+// factor, Doom 3's usual choice) are drawn; another blend is a warning and is not drawn. Returns the
+// stage drawn, or null.
+const MaterialStage* build_environment(const MaterialDecl& decl, ImageLibrary& images, Material& m,
+                                       RegisterSources& sources) {
+  for (const MaterialStage& s : decl.stages) {
+    if (!is_environment_stage(s) || s.blend == StageBlend::None) continue;
+    const std::string context = decl.file + ":" + std::to_string(s.line) + ": material " + decl.name;
+    if (s.blend != StageBlend::Add) {
+      images.warn(context + ": environment cube map stage (texgen " +
+                  (s.texgen == TexGen::Reflect ? "reflect" : "normal") +
+                  ") with a blend other than add is not drawn");
+      continue;
+    }
+    m.environment_cube_image = images.get_cube(s.cube_map, s.cube_kind, context);
+    m.environment_by_normal = s.texgen == TexGen::Normal;
+    m.environment_color = glm::vec3(s.color);
+    sources.set(sources.r.environment, s);
+    return &s;
+  }
+  return nullptr;
 }
 
 void glow_with(Material& m, int image, const MaterialStage& s, RegisterSources& sources) {
@@ -160,6 +189,7 @@ static Material build_material_look(const MaterialDecl& decl, ImageLibrary& imag
 
   if (lit) {
     m.blend = BlendClass::Opaque;
+    build_environment(decl, images, m, sources);
     // A lit surface with an added or replacing unlit stage glows: Doom 3's light panels and screens.
     for (const MaterialStage& s : decl.stages) {
       if (s.role != StageRole::Ambient || !draws_image(s)) continue;
@@ -175,7 +205,15 @@ static Material build_material_look(const MaterialDecl& decl, ImageLibrary& imag
     build_sky(decl, s, images, m, sources);
     return m;
   }
+  const MaterialStage* environment = build_environment(decl, images, m, sources);
   if (!first_ambient) {
+    if (m.environment_cube_image >= 0) {
+      // Glass with nothing but its reflection: a layer that adds the cube and lets the rest through.
+      m.blend = BlendClass::Additive;
+      m.translucent = true;
+      m.diffuse_color = glm::vec4(0.0f, 0.0f, 0.0f, 1.0f);
+      return m;
+    }
     m.blend = BlendClass::PassThrough;   // nodraw, caulk, clip, areaportal: nothing drawn
     return m;
   }
@@ -195,6 +233,7 @@ static Material build_material_look(const MaterialDecl& decl, ImageLibrary& imag
     case StageBlend::Modulate:
     case StageBlend::AlphaBlend:
       m.blend = s.blend == StageBlend::Modulate ? BlendClass::Modulate : BlendClass::Alpha;
+      m.environment_under_layer = environment != nullptr && environment < &s;
       m.diffuse_image = image;
       m.diffuse_color = s.color;
       sources.set(sources.r.diffuse, s);

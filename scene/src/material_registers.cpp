@@ -82,6 +82,7 @@ void evaluate_material(const Material& base, const RegisterInputs& r, Material& 
     compose_texture_matrix(g.look->tex_ops, r, out.tex_transform);
     if (g.look->alpha_test) out.alpha_ref = g.look->alpha_ref.evaluate(r);
   }
+  if (g.environment) out.environment_color = glm::clamp(glm::vec3(evaluate_color(*g.environment, r)), glm::vec3(zero), glm::vec3(one));
   if (g.sky && g.sky->wobble_sky.size() == 3)
     out.sky_axis = wobble_sky_axes(g.sky->wobble_sky[0].evaluate(r), g.sky->wobble_sky[1].evaluate(r),
                                    g.sky->wobble_sky[2].evaluate(r), r.time);

@@ -213,6 +213,11 @@ int RenderWorld::DefineMaterial(const Material& material) {
   if (material.sky_cube_image != -1 && !(material.sky_cube_image >= 0 && material.sky_cube_image + 5 < int(scene_.images.size())))
     throw RenderWorldError(fmt::format("DefineMaterial '{}': sky cube faces {}..{} out of range ({} images)", material.name,
                                        material.sky_cube_image, material.sky_cube_image + 5, scene_.images.size()));
+  if (material.environment_cube_image != -1 &&
+      !(material.environment_cube_image >= 0 && material.environment_cube_image + 5 < int(scene_.images.size())))
+    throw RenderWorldError(fmt::format("DefineMaterial '{}': environment cube faces {}..{} out of range ({} images)",
+                                       material.name, material.environment_cube_image,
+                                       material.environment_cube_image + 5, scene_.images.size()));
   return define_by_name(scene_.materials, scene_.find_material(material.name), material, changes_.materials,
                         "DefineMaterial: too many materials");
 }

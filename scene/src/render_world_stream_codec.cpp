@@ -76,7 +76,8 @@ void material_layout(Codec& c, Mat& v) {
           v.vertex_color, v.is_light_material, v.is_default, v.no_self_shadow, v.inverse_vertex_color);
   c.fields(v.alpha_ref, v.blend, v.light_stage_color, v.light_kind, v.light_stage_alpha);
   c.flags("light material", v.light_blend_adds);
-  c.fields(v.sky_cube_image, v.sky_axis, v.blend_diffuse_image);
+  c.fields(v.sky_cube_image, v.sky_axis, v.blend_diffuse_image, v.environment_cube_image, v.environment_color);
+  c.flags("environment", v.environment_by_normal, v.environment_under_layer);
 }
 
 template <class Codec, class Img>

@@ -263,3 +263,38 @@ TEST(AnimatedMaterials, WobblingSkyTurnsWithTime) {
     }
   }
 }
+
+// An environment stage's colour is a register like any stage colour: the chrome's KMaterial carries
+// the colour of the frame's time (env_color, its cube in env_tex1) and is re-sent as it changes; a
+// missing cube still gets six placeholder faces, so the stage is drawn.
+TEST(AnimatedMaterials, EnvironmentStageColourFollowsTime) {
+  scene::Scene s;
+  scene::MaterialTables tables;
+  scene::MaterialFile f = scene::parse_materials(
+      "textures/chrome { diffusemap _white { blend add cubeMap env/none texgen reflect rgb 0.25 * time } }",
+      "chrome.mtr", tables);
+  scene::Vfs vfs;
+  std::vector<std::string> warnings;
+  scene::ImageLibrary images(vfs, s.images, warnings);
+  s.materials.push_back(scene::build_material(f.materials.at(0), images, false));
+  ASSERT_GE(s.materials[0].environment_cube_image, 0);
+  scene::Mesh floor;
+  floor.name = "_area0";
+  test::add_quad(floor, 0, {-64, -64, 0}, {64, -64, 0}, {64, 64, 0}, {-64, 64, 0}, {0, 0, 1});
+  test::add_world_mesh(s, std::move(floor));
+  scene::RenderWorld world(s);
+  WorldSync sync(world);
+  world.TakeChanges();
+  const uint32_t chrome = sync.kmaterial_index(0);
+  EXPECT_NE(sync.master().materials[chrome].env_tex1, 0u);
+  for (int ms : {1000, 3000}) {
+    set_time(world, ms);
+    commit::CommitBuffer frame = sync.sync(world.TakeChanges(), uint64_t(ms));
+    EXPECT_EQ(frame.materials().count(chrome), 1u) << "at " << ms;
+    const KMaterial& k = sync.master().materials[chrome];
+    EXPECT_EQ(k.blend, K_BLEND_OPAQUE);
+    EXPECT_NE(k.env_tex1, 0u);
+    EXPECT_EQ(k.flags & K_MAT_ENV_BY_NORMAL, 0u);
+    for (int c = 0; c < 3; ++c) EXPECT_NEAR(k.env_color[c], 0.25f * float(ms) / 1000.0f, 1e-6f) << "at " << ms;
+  }
+}

@@ -61,6 +61,14 @@ void drive(RenderWorldApi& world, int frames) {
       m.name = "textures/test/late";
       m.diffuse_image = tex;
       m.inverse_vertex_color = true;
+      // An environment stage (texgen normal) over six consecutive faces.
+      for (int face = 0; face < 6; ++face) {
+        const int image = world.DefineTexture(cohort::test::checker("env/late_" + std::to_string(face), 2));
+        if (face == 0) m.environment_cube_image = image;
+      }
+      m.environment_by_normal = true;
+      m.environment_under_layer = true;
+      m.environment_color = {0.25f, 0.5f, 0.75f};
       int mat = world.DefineMaterial(m);
       Mesh crate_mesh = cohort::test::box_mesh("crate", {8, 8, 8}, mat);
       for (size_t v = 0; v < crate_mesh.vertices.size(); ++v) crate_mesh.colors.push_back(0xFF000000u | uint32_t(v * 0x010203u));
@@ -100,6 +108,10 @@ void expect_same_world(const RenderWorld& a, const RenderWorld& b) {
     EXPECT_EQ(a.scene().materials[i].diffuse_image, b.scene().materials[i].diffuse_image);
     EXPECT_EQ(a.scene().materials[i].vertex_color, b.scene().materials[i].vertex_color);
     EXPECT_EQ(a.scene().materials[i].inverse_vertex_color, b.scene().materials[i].inverse_vertex_color);
+    EXPECT_EQ(a.scene().materials[i].environment_cube_image, b.scene().materials[i].environment_cube_image);
+    EXPECT_EQ(a.scene().materials[i].environment_by_normal, b.scene().materials[i].environment_by_normal);
+    EXPECT_EQ(a.scene().materials[i].environment_under_layer, b.scene().materials[i].environment_under_layer);
+    EXPECT_EQ(a.scene().materials[i].environment_color, b.scene().materials[i].environment_color);
   }
   ASSERT_EQ(a.scene().images.size(), b.scene().images.size());
   for (size_t i = 0; i < a.scene().images.size(); ++i) EXPECT_EQ(a.scene().images[i].rgba, b.scene().images[i].rgba);
@@ -163,6 +175,10 @@ TEST(DeltaStream, ReplayGivesTheSameStateAsTheDirectCalls) {
   const int late = replayed.scene().find_material("textures/test/late");
   ASSERT_GE(late, 0);
   EXPECT_TRUE(replayed.scene().materials[size_t(late)].inverse_vertex_color);
+  EXPECT_GE(replayed.scene().materials[size_t(late)].environment_cube_image, 0);
+  EXPECT_TRUE(replayed.scene().materials[size_t(late)].environment_by_normal);
+  EXPECT_TRUE(replayed.scene().materials[size_t(late)].environment_under_layer);
+  EXPECT_EQ(replayed.scene().materials[size_t(late)].environment_color, glm::vec3(0.25f, 0.5f, 0.75f));
 }
 
 TEST(DeltaStream, ModelWithColoursForSomeVerticesIsRefused) {

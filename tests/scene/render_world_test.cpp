@@ -1,5 +1,7 @@
 #include <gtest/gtest.h>
 
+#include <algorithm>
+
 #include "cohort/scene/render_world.h"
 #include "cohort/test_support/scene_builders.h"
 #include "cohort/test_support/test_scenes.h"
@@ -105,5 +107,14 @@ TEST(RenderWorld, CallsThatDoNotFitTheStateAreRejectedWithAClearError) {
   Mesh broken = cohort::test::box_mesh("broken", {1, 1, 1}, 0);
   broken.indices.push_back(100);
   EXPECT_THROW(world.DefineModel(broken), RenderWorldError);
+  Material reflective;
+  reflective.name = "textures/test/reflective";
+  reflective.environment_cube_image = std::max(0, int(world.scene().images.size()) - 2);   // six faces from there
+  try {
+    world.DefineMaterial(reflective);
+    FAIL() << "no error";
+  } catch (const RenderWorldError& e) {
+    EXPECT_NE(std::string(e.what()).find("environment cube faces"), std::string::npos) << e.what();
+  }
   EXPECT_TRUE(world.changes().empty());
 }

@@ -107,6 +107,35 @@ textures/sky/bad_texgen {
 }
 )";
 
+// Environment cube-map stages (glass and chrome): `texgen reflect` and `texgen normal`.
+const char* kEnvironmentMaterials = R"(
+textures/glass/clear {
+  translucent
+  { blend add cubeMap env/axis texgen reflect }
+}
+textures/metal/chrome {
+  diffusemap textures/metal/chrome
+  bumpmap textures/metal/chrome_local
+  {
+    blend gl_dst_alpha, gl_one
+    cubeMap env/axis
+    texgen reflect
+    red 0.5 green 0.25 blue parm4
+  }
+}
+textures/glass/tinted {
+  { blend filter map textures/glass/tint }
+  { blend add cameraCubeMap env/camera texgen normal rgb 0.5 + time }
+}
+textures/glass/filtered_reflection {
+  { blend filter cubeMap env/axis texgen reflect }
+}
+textures/glass/reflection_under_tint {
+  { blend add cubeMap env/axis texgen reflect }
+  { blend filter map textures/glass/tint }
+}
+)";
+
 }  // namespace
 
 TEST(SkyMaterials, CubeMapStagesAndTexgensAreParsed) {
@@ -283,4 +312,98 @@ TEST(SkyMaterials, WobbleSkyAxesStayARotation) {
   glm::mat3 quarter = wobble_sky_axes(0.0f, 0.0f, 0.5f, 30.0f);
   EXPECT_NEAR(quarter[0].y, 1.0f, 1e-5f);
   EXPECT_NEAR(quarter[1].x, -1.0f, 1e-5f);
+}
+
+TEST(SkyMaterials, EnvironmentStagesAreParsed) {
+  MaterialTables tables;
+  MaterialFile f = parse_materials(kEnvironmentMaterials, "env.mtr", tables);
+  EXPECT_TRUE(f.warnings.empty()) << ::testing::PrintToString(f.warnings);
+  const MaterialDecl* clear = find(f, "textures/glass/clear");
+  ASSERT_NE(clear, nullptr);
+  ASSERT_EQ(clear->stages.size(), 1u);
+  EXPECT_EQ(clear->stages[0].cube_kind, CubeMapKind::Axis);
+  EXPECT_EQ(clear->stages[0].cube_map, "env/axis");
+  EXPECT_EQ(clear->stages[0].texgen, TexGen::Reflect);
+  EXPECT_EQ(clear->stages[0].blend, StageBlend::Add);
+  EXPECT_EQ(clear->stages[0].line, 4);
+  const MaterialDecl* chrome = find(f, "textures/metal/chrome");
+  ASSERT_NE(chrome, nullptr);
+  ASSERT_EQ(chrome->stages.size(), 3u);
+  EXPECT_EQ(chrome->stages[2].texgen, TexGen::Reflect);
+  EXPECT_EQ(chrome->stages[2].blend, StageBlend::Add) << "gl_dst_alpha, gl_one adds";
+  EXPECT_FLOAT_EQ(chrome->stages[2].color.r, 0.5f);
+  EXPECT_FLOAT_EQ(chrome->stages[2].color.g, 0.25f);
+  const MaterialDecl* tinted = find(f, "textures/glass/tinted");
+  ASSERT_NE(tinted, nullptr);
+  ASSERT_EQ(tinted->stages.size(), 2u);
+  EXPECT_EQ(tinted->stages[1].cube_kind, CubeMapKind::Camera);
+  EXPECT_EQ(tinted->stages[1].texgen, TexGen::Normal);
+}
+
+// An environment stage gives the material its cube (six faces as a sky's), its texgen and its colour,
+// drawn over the surface; the material keeps its class (lit chrome stays opaque, glass with nothing
+// but a reflection is an additive layer, a filter under it keeps the filter), never a sky. Its colour
+// follows the registers like any stage colour.
+TEST(SkyMaterials, EnvironmentStagesGiveTheMaterialACubeAndKeepItsClass) {
+  Fixture fx("environment_build");
+  fx.write_cube("env/axis", CubeMapKind::Axis);
+  fx.write_cube("env/camera", CubeMapKind::Camera);
+  fx.mount();
+  MaterialTables tables;
+  MaterialFile f = parse_materials(kEnvironmentMaterials, "env.mtr", tables);
+
+  Material clear = build_material(*find(f, "textures/glass/clear"), fx.library, false);
+  EXPECT_EQ(clear.blend, BlendClass::Additive);
+  EXPECT_TRUE(clear.translucent);
+  EXPECT_FALSE(clear.emitter);
+  EXPECT_EQ(clear.sky_cube_image, -1);
+  ASSERT_GE(clear.environment_cube_image, 0);
+  EXPECT_EQ(fx.images.at(size_t(clear.environment_cube_image)).name, "env/axis_px");
+  EXPECT_EQ(fx.images.at(size_t(clear.environment_cube_image + 5)).name, "env/axis_nz");
+  EXPECT_FALSE(clear.environment_by_normal);
+  EXPECT_EQ(clear.environment_color, glm::vec3(1.0f));
+  EXPECT_EQ(glm::vec3(clear.diffuse_color), glm::vec3(0.0f)) << "the layer itself adds nothing";
+  EXPECT_FALSE(clear.registers);
+
+  Material chrome = build_material(*find(f, "textures/metal/chrome"), fx.library, false);
+  EXPECT_EQ(chrome.blend, BlendClass::Opaque);
+  EXPECT_GE(chrome.normal_image, 0);
+  EXPECT_EQ(chrome.environment_cube_image, clear.environment_cube_image) << "one cube, loaded once";
+  EXPECT_EQ(chrome.environment_color, glm::vec3(0.5f, 0.25f, 0.0f));
+  ASSERT_TRUE(chrome.registers) << "blue reads parm4";
+  RegisterInputs parms;
+  parms.parms[4] = 0.75f;
+  Material chrome_tinted;
+  evaluate_material(chrome, parms, chrome_tinted);
+  EXPECT_EQ(chrome_tinted.environment_color, glm::vec3(0.5f, 0.25f, 0.75f));
+  parms.parms[4] = 3.0f;
+  evaluate_material(chrome, parms, chrome_tinted);
+  EXPECT_EQ(chrome_tinted.environment_color.b, 1.0f) << "clamped as the fixed-function colour is";
+
+  Material tinted = build_material(*find(f, "textures/glass/tinted"), fx.library, false);
+  EXPECT_EQ(tinted.blend, BlendClass::Modulate);
+  EXPECT_TRUE(tinted.environment_by_normal);
+  EXPECT_FALSE(tinted.environment_under_layer) << "the filter is drawn first: the reflection goes over it";
+  Material under = build_material(*find(f, "textures/glass/reflection_under_tint"), fx.library, false);
+  EXPECT_EQ(under.blend, BlendClass::Modulate);
+  EXPECT_GE(under.environment_cube_image, 0);
+  EXPECT_TRUE(under.environment_under_layer) << "the reflection is drawn first: the filter darkens it";
+  ASSERT_GE(tinted.environment_cube_image, 0);
+  EXPECT_EQ(fx.images.at(size_t(tinted.environment_cube_image)).name, "env/camera_forward");
+  ASSERT_TRUE(tinted.registers);
+  EXPECT_NE(tinted.registers->depends & kDependsTime, 0u);
+  RegisterInputs at_quarter;
+  at_quarter.time = 0.25f;
+  Material tinted_later;
+  evaluate_material(tinted, at_quarter, tinted_later);
+  EXPECT_NEAR(tinted_later.environment_color.r, 0.75f, 1e-6f);
+  EXPECT_NEAR(tinted.environment_color.r, 0.5f, 1e-6f) << "time 0";
+
+  // Only added reflections are drawn: another blend is a warning naming the stage's file:line.
+  Material filtered = build_material(*find(f, "textures/glass/filtered_reflection"), fx.library, false);
+  EXPECT_EQ(filtered.environment_cube_image, -1);
+  EXPECT_EQ(filtered.blend, BlendClass::PassThrough);
+  EXPECT_TRUE(has_warning(fx.warnings, "env.mtr:21: material textures/glass/filtered_reflection: environment cube "
+                                       "map stage (texgen reflect) with a blend other than add is not drawn"))
+      << ::testing::PrintToString(fx.warnings);
 }

@@ -192,6 +192,13 @@ TEST_F(TestMap, MaterialClasses) {
     EXPECT_FALSE(scene.images.at(static_cast<size_t>(skybox.sky_cube_image + face)).is_placeholder) << face;
   EXPECT_EQ(scene.images.at(static_cast<size_t>(skybox.sky_cube_image + 4)).name, "env/testmap_sky_up");
   EXPECT_TRUE(m("textures/testmap/leaves").no_self_shadow);
+  // The court's chrome pipe: lit and bump-mapped, reflecting the same sky cube (one set of faces).
+  const Material& chrome = m("textures/testmap/chrome");
+  EXPECT_EQ(chrome.blend, BlendClass::Opaque);
+  EXPECT_GE(chrome.normal_image, 0);
+  EXPECT_EQ(chrome.environment_cube_image, skybox.sky_cube_image);
+  EXPECT_FALSE(chrome.environment_by_normal);
+  EXPECT_EQ(chrome.environment_color, glm::vec3(0.7f));
   EXPECT_EQ(m("textures/testmap/floor_tiles").blend, BlendClass::Opaque);
   EXPECT_GE(m("textures/testmap/floor_tiles").normal_image, 0);
   EXPECT_TRUE(scene.images[static_cast<size_t>(m("textures/testmap/floor_tiles").normal_image)].is_normal_map);

@@ -36,7 +36,8 @@ AREA_NOTES = {
     "stairwell": "eight steps (rise 12, run 28) up to the gallery floor at z 96",
     "gallery": "raised room: pedestal with a glass case, gel projector `light_gel`, blue panels, crate",
     "sky_court": "ceiling is sky (`textures/testmap/skybox`: a cameraCubeMap with texgen skybox), a shrub "
-                 "whose leaves are `noSelfShadow`, lit by `light_court`",
+                 "whose leaves are `noSelfShadow`, a chrome pipe reflecting the sky (`texgen reflect`), lit by "
+                 "`light_court`",
 }
 
 # Suggested cameras (origin, yaw degrees, pitch degrees down) for renders and benchmarks.
@@ -141,6 +142,21 @@ def add_details(area_meshes):
     add_box(gallery, M + "glass", (1604, 164, 128), (1660, 220, 176), texel_scale=64.0)
     # A glass screen across part of the atrium.
     add_box(atrium, M + "glass", (832, 250, 0.5), (960, 252, 96), texel_scale=64.0)
+
+    # A chrome pipe from the sky court's floor to its sky, in the court view: it reflects the sky cube.
+    _add_pipe(sky_court, M + "chrome", (1432, 488), 8, 96.25, 255.75)
+
+
+def _add_pipe(mesh, material, centre, radius, z0, z1, sides=8):
+    """A vertical prism of `sides` flat faces round `centre` (each face its own normal), no caps."""
+    def corner(i):
+        a = 2.0 * math.pi * i / sides
+        return (round(centre[0] + radius * math.cos(a), 4), round(centre[1] + radius * math.sin(a), 4))
+    for i in range(sides):
+        (xa, ya), (xb, yb) = corner(i), corner(i + 1)
+        mid = 2.0 * math.pi * (i + 0.5) / sides
+        normal = (round(math.cos(mid), 6), round(math.sin(mid), 6), 0.0)
+        mesh.add_polygon(material, [(xa, ya, z0), (xb, yb, z0), (xb, yb, z1), (xa, ya, z1)], normal, texel_scale=32.0)
 
 
 # --- inline models (model space; entities place them) -------------------------------------------------

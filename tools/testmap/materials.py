@@ -286,6 +286,25 @@ textures/testmap/skybox
 	}
 }
 
+// the sky court's chrome pipe: dark bumpy metal that reflects the court's sky cube (an environment
+// stage, docs/sky.md: the view reflected about the bump-mapped normal, in world space)
+textures/testmap/chrome
+{
+	{
+		blend	diffusemap
+		map		textures/testmap/metal_d.tga
+		rgb		0.2
+	}
+	bumpmap		textures/testmap/metal_local.tga
+	specularmap	textures/testmap/metal_s.tga
+	{
+		blend			add
+		cameraCubeMap	env/testmap_sky
+		texgen			reflect
+		rgb				0.7
+	}
+}
+
 // the shrub's leaves (inline model testmap_shrub): noSelfShadow, so they do not shadow each other
 textures/testmap/leaves
 {

@@ -28,7 +28,7 @@ class PackError : public std::runtime_error {
   PackError(const std::string& file, uint64_t offset, const std::string& what);
 };
 
-constexpr uint32_t kScenePackVersion = 2;  // 2: vertex colours (VCOL)
+constexpr uint32_t kScenePackVersion = 3;  // 2: vertex colours (VCOL); 3: KMaterial's environment cube (128 bytes)
 
 void write_scene_pack(const std::filesystem::path& file, const PackedScene& pack);
 PackedScene read_scene_pack(const std::filesystem::path& file);

@@ -19,7 +19,7 @@
 #include "light_tree.h"
 #include "rng.h"
 #include "path_pattern.h"
-#include "sky.h"
+#include "environment.h"
 
 #ifndef K_CTX_SCENE
 #define K_CTX_SCENE(ctx) (&(ctx)->scene)
@@ -262,7 +262,11 @@ KFN KVec3 k_trace_path(KTraceCtx* ctx, const KFrameParams* params, KVec3 org, KV
     KVec3 wo = v3_neg(dir);
 
     if (sf.blend != K_BLEND_OPAQUE) {
-      /* Transparent layers: shade the layer, carry on through it without consuming a bounce. */
+      /* Transparent layers: shade the layer, carry on through it without consuming a bounce. An
+       * environment stage (glass) adds its reflection over what the layer does, or, drawn before the
+       * layer's stage, under it: filtered by the layer like what is behind. */
+      KVec3 env = lit_mode ? k_environment_radiance(scene, hit, hit_material, sf.normal, dir) : v3s(0.0f);
+      KVec3 env_throughput = throughput;
       if (sf.blend == K_BLEND_ADDITIVE) {
         radiance = v3_add(radiance, v3_mul(throughput, v3_add(sf.albedo, sf.emission)));
       } else if (sf.blend == K_BLEND_MODULATE) {
@@ -271,6 +275,8 @@ KFN KVec3 k_trace_path(KTraceCtx* ctx, const KFrameParams* params, KVec3 org, KV
         radiance = v3_add(radiance, v3_scale(v3_mul(throughput, sf.albedo), sf.alpha));
         throughput = v3_scale(throughput, 1.0f - sf.alpha);
       }
+      env = v3_mul((sf.flags & K_MAT_ENV_UNDER_LAYER) ? throughput : env_throughput, env);
+      radiance = v3_add(radiance, bounce > 0u ? k_clamp_radiance(env, params->firefly_clamp) : env);
       if (++layers > K_MAX_LAYERS || v3_max_component(throughput) <= 0.0f) break;
       org = v3_madd(sf.position, dir, k_ray_epsilon(sf.position));
       continue;
@@ -295,6 +301,7 @@ KFN KVec3 k_trace_path(KTraceCtx* ctx, const KFrameParams* params, KVec3 org, KV
                                        k_fabs(v3_dot(sf.geo_normal, dir)));
       contribution = v3_scale(contribution, k_power_heuristic(vertex_brdf_pdf, light_pdf));
     }
+    contribution = v3_add(contribution, k_environment_radiance(scene, hit, hit_material, sf.normal, dir));
     float path_weight = v3_max_component(throughput);
     contribution = v3_add(contribution, k_direct_lighting(ctx, &vertex_params, &sf, wo, path_weight, rng));
     if (emissive_nee) {

@@ -85,6 +85,10 @@ typedef struct KTriangle {
 #define K_MAT_NO_SPECULAR  128u
 #define K_MAT_NO_SELF_SHADOW 256u  /* noSelfShadow: does not shadow other noSelfShadow surfaces */
 #define K_MAT_INVERSE_VERTEX_COLOR 512u  /* inverseVertexColor: colours x (1 - vertex RGB), alpha kept */
+#define K_MAT_ENV_BY_NORMAL 1024u  /* the environment stage is `texgen normal`: cube by the model-space
+                                    * vertex normal, not by the reflected view */
+#define K_MAT_ENV_UNDER_LAYER 2048u  /* the environment stage comes before the layer's filter / blend stage,
+                                      * which then filters the reflection too */
 
 typedef struct KMaterial {
   float diffuse_color[4];   /* multiplies the diffuse map; rgba */
@@ -98,6 +102,12 @@ typedef struct KMaterial {
   kuint blend_diffuse_tex1; /* terrain blends: 1 + the texture shown where the vertex colour leaves room
                                (x (1 - vertex RGB) where diffuse_tex is x vertex RGB, and the other way
                                round); 0: none, so zeroed materials and earlier packs have none */
+  /* An environment cube-map stage (`texgen reflect`, or `texgen normal` with K_MAT_ENV_BY_NORMAL): at a
+   * camera or bounce hit it adds env_color x the cube along the view reflected about the shading normal
+   * (or along the vertex normal); environment.h. env_tex1: 1 + the texture of face +X, the other five
+   * follow in the texture table as a sky's do; 0: no such stage, so zeroed materials have none. */
+  float env_color[3];
+  kuint env_tex1;
 } KMaterial;
 
 /* ---- Textures: RGBA8 texels (R in the low byte) in one buffer, mip levels stored one after another. */
@@ -227,7 +237,7 @@ static_assert(sizeof(KInstance) == 112, "KInstance layout");
 static_assert(sizeof(KVertex) == 48, "KVertex layout");
 static_assert(sizeof(KVertexColor) == 4, "KVertexColor layout");
 static_assert(sizeof(KTriangle) == 16, "KTriangle layout");
-static_assert(sizeof(KMaterial) == 112, "KMaterial layout");
+static_assert(sizeof(KMaterial) == 128, "KMaterial layout");
 static_assert(sizeof(KTexture) == 16, "KTexture layout");
 static_assert(sizeof(KLight) == 192, "KLight layout");
 static_assert(sizeof(KCamera) == 64, "KCamera layout");

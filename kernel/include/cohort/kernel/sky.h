@@ -38,6 +38,14 @@ KFN kuint k_cube_face(KVec3 d, float* s, float* t) {
   return face;
 }
 
+/* A cube map's colour along d: first_face is its +X face's texture slot, the other five follow. Skies
+ * and environment stages (environment.h) both read their cubes here. */
+KFN KVec3 k_cube_sample(const KSceneView* scene, kuint first_face, KVec3 d) {
+  float s, t;
+  kuint face = k_cube_face(d, &s, &t);
+  return v4_rgb(k_texture_sample(scene, first_face + face, s, t));
+}
+
 /* What a ray along dir sees on a sky surface of this instance: the stage colour times the cube. */
 KFN KVec3 k_sky_radiance(const KSceneView* scene, kuint instance, kuint material, KVec3 dir) {
   KGLOBAL const KMaterial* m = &scene->materials[material];
@@ -46,9 +54,7 @@ KFN KVec3 k_sky_radiance(const KSceneView* scene, kuint instance, kuint material
   KVec3 d = xform_vector_g(scene->instances[instance].world_to_object, dir);
   KVec3 x = v3_load_g(m->tex_transform), y = v3_load_g(m->tex_transform + 3);
   KVec3 lookup = v3(v3_dot(d, x), v3_dot(d, y), v3_dot(d, v3_cross(x, y)));
-  float s, t;
-  kuint face = k_cube_face(lookup, &s, &t);
-  return v3_mul(colour, v4_rgb(k_texture_sample(scene, m->emissive_tex + face, s, t)));
+  return v3_mul(colour, k_cube_sample(scene, m->emissive_tex, lookup));
 }
 
 #endif

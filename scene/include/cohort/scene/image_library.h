@@ -28,6 +28,8 @@ class ImageLibrary {
   // first one's index. A face that is missing, unreadable, not square or not the size of the others
   // fails the whole cube, as in the engine: a warning naming the face, and six placeholder faces.
   int get_cube(const std::string& name, CubeMapKind kind, const std::string& context);
+  // A warning about an image a material uses that is not a load failure ("file:line: material x: ...").
+  void warn(std::string message) { warnings_.push_back(std::move(message)); }
   // Whether a plain image of that name can be found (for materials named after an image).
   bool can_find(const std::string& name) const;
 

@@ -25,6 +25,7 @@ struct LoadReport {
   int emitters = 0;                          // materials that glow (ambient-only stages)
   int emitting_surfaces = 0;                 // of those, opaque ones: light sources for NEE (the rest are layers)
   int skies = 0;                             // sky materials (cube map + texgen skybox/wobbleSky; docs/sky.md)
+  int environment_maps = 0;                  // materials with an environment stage (texgen reflect/normal)
   int no_self_shadow = 0;                    // materials marked noSelfShadow
   int def_files = 0, entity_defs = 0, model_defs = 0, skins = 0;
   int model_files_loaded = 0;                // distinct model files (and skins of them) read

@@ -43,6 +43,7 @@ struct MaterialRegisters {
   std::optional<StageRegisters> look;    // the stage whose texture matrix and alphaTest the Material holds
   std::optional<StageRegisters> light;   // a light shader's projected stage
   std::optional<StageRegisters> sky;     // a sky's stage: its wobbleSky axes (Material::sky_axis)
+  std::optional<StageRegisters> environment;  // an environment stage's colour (Material::environment_color)
   uint32_t depends = 0;                  // kDepends* of all of them
   uint32_t parms_read = 0;               // bit i: parmi is read
 };

@@ -16,9 +16,10 @@
 
 namespace cohort::scene {
 
-constexpr uint32_t kDeltaStreamVersion = 6;  // 2: entities carry joints; 3: materials carry light kinds; 4: sky;
+constexpr uint32_t kDeltaStreamVersion = 7;  // 2: entities carry joints; 3: materials carry light kinds; 4: sky;
                                              // 5: vertex colours (meshes) and inverseVertexColor (materials);
-                                             // 6: materials' second (vertex colour blend) diffuse image
+                                             // 6: materials' second (vertex colour blend) diffuse image;
+                                             // 7: materials' environment (texgen reflect / normal) stage
 constexpr uint32_t kMaxDeltaFrameBytes = 256u << 20;  // one frame chunk's payload
 constexpr uint32_t kMaxDeltaStringBytes = 4096;
 

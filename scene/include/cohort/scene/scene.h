@@ -52,6 +52,16 @@ struct Material {
   // axes the model-space ray direction is read against (identity for skybox, wobbleSky's rotation).
   int sky_cube_image = -1;
   glm::mat3 sky_axis{1.0f};
+  // Environment stage (`cubeMap` / `cameraCubeMap` with `texgen reflect` or `texgen normal`, `blend add`):
+  // glass and chrome. Six consecutive Scene::images like the sky's (-1: none); camera and bounce rays
+  // that hit the surface see environment_color x the cube along the view reflected about the surface
+  // normal, or along the vertex normal when environment_by_normal (docs/sky.md).
+  int environment_cube_image = -1;
+  bool environment_by_normal = false;
+  glm::vec3 environment_color{1.0f};
+  // The environment stage comes before the stage that makes the material a filter or blend layer: the
+  // engine draws stages in order, so that layer filters the reflection as it filters what is behind.
+  bool environment_under_layer = false;
   // Light materials (lights/...): the projected image and the falloff image.
   bool is_light_material = false;
   int light_image = -1, falloff_image = -1;

@@ -19,8 +19,9 @@ namespace cohort::tracers::wire {
 
 constexpr uint32_t kMagic = 0x504d4843u;  // "CHMP" in memory order
 // 2: vertex colours in scenes and BLAS uploads; 3: BandJob::keep_on_device; 4: a band's rows travel in
-// pieces, raw, on tags of their own (band_job names the piece count, band_rows closes the band).
-constexpr uint16_t kProtocolVersion = 4;
+// pieces, raw, on tags of their own (band_job names the piece count, band_rows closes the band);
+// 5: KMaterial carries an environment cube (128 bytes).
+constexpr uint16_t kProtocolVersion = 5;
 
 enum class Kind : uint16_t {
   hello = 1,        // node -> 0: versions, what scene it loaded, its tracers
