@@ -92,6 +92,24 @@ struct CudaTracer::Impl {
   KeptBand kept[2];
   int next_kept = 0;
 
+  // Device storage for a band of `pixels` in `rows`: the float band (and its RGB halves for an RGB16F
+  // target) and the per-row ray counts, grown as bands grow.
+  void ensure_band_storage(size_t pixels, size_t rows, bool half) {
+    if (pixels > band_capacity) {
+      if (band) COHORT_CUDA(cudaFree(band));
+      if (band_rgb16f) COHORT_CUDA(cudaFree(band_rgb16f));
+      band_rgb16f = nullptr;
+      COHORT_CUDA(cudaMalloc(&band, pixels * sizeof(float4)));
+      band_capacity = pixels;
+    }
+    if (half && !band_rgb16f) COHORT_CUDA(cudaMalloc(&band_rgb16f, band_capacity * 3 * sizeof(unsigned short)));
+    if (rows > row_rays_capacity) {
+      if (row_rays) COHORT_CUDA(cudaFree(row_rays));
+      COHORT_CUDA(cudaMalloc(&row_rays, rows * sizeof(unsigned)));
+      row_rays_capacity = rows;
+    }
+  }
+
   void register_target(core::BandBuffer& target) {
     registered.ensure(target.data(), target.bytes(), "a band target");
     if (target.has_aux()) registered.ensure(target.aux_data(), target.aux_bytes(), "a band target's aux texels");
@@ -222,21 +240,9 @@ core::BandResult CudaTracer::render_band(const core::BandJob& job, core::BandBuf
   if (camera.width != kuint(target.width()) || params.row_end > kuint(target.height()))
     throw std::invalid_argument(m.name + ": band does not fit the frame buffer");
   const size_t pixels = size_t(camera.width) * (params.row_end - params.row_begin);
-  if (pixels > m.band_capacity) {
-    if (m.band) COHORT_CUDA(cudaFree(m.band));
-    if (m.band_rgb16f) COHORT_CUDA(cudaFree(m.band_rgb16f));
-    m.band_rgb16f = nullptr;
-    COHORT_CUDA(cudaMalloc(&m.band, pixels * sizeof(float4)));
-    m.band_capacity = pixels;
-  }
   const bool half = target.format() == core::BandFormat::rgb16f;
-  if (half && !m.band_rgb16f) COHORT_CUDA(cudaMalloc(&m.band_rgb16f, m.band_capacity * 3 * sizeof(unsigned short)));
   const size_t rows = params.row_end - params.row_begin;
-  if (rows > m.row_rays_capacity) {
-    if (m.row_rays) COHORT_CUDA(cudaFree(m.row_rays));
-    COHORT_CUDA(cudaMalloc(&m.row_rays, rows * sizeof(unsigned)));
-    m.row_rays_capacity = rows;
-  }
+  m.ensure_band_storage(pixels, rows, half);
   COHORT_CUDA(cudaMemsetAsync(m.row_rays, 0, rows * sizeof(unsigned), m.stream));
   if (m.count_rays) {
     if (!m.ray_counts) COHORT_CUDA(cudaMalloc(&m.ray_counts, 2 * sizeof(unsigned long long)));
@@ -323,20 +329,8 @@ core::BandResult CudaTracer::render_band_in_pieces(const core::BandJob& job, cor
   const size_t width = camera.width;
   const size_t rows = params.row_end - params.row_begin;
   const size_t pixels = width * rows;
-  if (pixels > m.band_capacity) {
-    if (m.band) COHORT_CUDA(cudaFree(m.band));
-    if (m.band_rgb16f) COHORT_CUDA(cudaFree(m.band_rgb16f));
-    m.band_rgb16f = nullptr;
-    COHORT_CUDA(cudaMalloc(&m.band, pixels * sizeof(float4)));
-    m.band_capacity = pixels;
-  }
   const bool half = target.format() == core::BandFormat::rgb16f;
-  if (half && !m.band_rgb16f) COHORT_CUDA(cudaMalloc(&m.band_rgb16f, m.band_capacity * 3 * sizeof(unsigned short)));
-  if (rows > m.row_rays_capacity) {
-    if (m.row_rays) COHORT_CUDA(cudaFree(m.row_rays));
-    COHORT_CUDA(cudaMalloc(&m.row_rays, rows * sizeof(unsigned)));
-    m.row_rays_capacity = rows;
-  }
+  m.ensure_band_storage(pixels, rows, half);
   const size_t pieces = cuts.size() - 1;
   while (m.piece_rendered.size() < pieces) {
     cudaEvent_t rendered = nullptr, downloaded = nullptr;
