@@ -305,3 +305,25 @@ TEST(Balancer, WholeCostRejectsBadOptions) {
   bad.probe_interval = 0;
   EXPECT_THROW(make_balancer("whole-cost", bad), std::invalid_argument);
 }
+
+TEST(Balancer, WholeCostUnlearnsAFirstBandInflatedByTheStartWithinAFewFrames) {
+  // With a per-row proxy (real tracers' row work): tracer 0's first band also paid a 60 ms scene
+  // upload, so it first looks twenty times slower than it is. Equal finish times want the slow tracer
+  // (10x slower per row) to take 720 / 11 = 65 rows; within five frames it must be near that, not
+  // still holding most of the frame while the fast one's estimate creeps down a few percent a frame.
+  const FixedCostFrame f{720, {0.005, 0.05}, {0.0, 0.0}};
+  auto b = make_balancer("whole-cost");
+  const std::vector<int> ids{0, 1};
+  const std::vector<float> proxy(720, 1.0f);
+  std::vector<TracerMeasurement> previous;
+  std::vector<Band> bands;
+  for (int frame = 0; frame < 6; ++frame) {
+    bands = b->divide({f.rows, ids, previous, proxy});
+    previous.clear();
+    for (size_t t = 0; t < ids.size(); ++t)
+      if (!bands[t].empty())
+        previous.push_back({ids[t], bands[t], f.time(ids[t], bands[t]) + (frame == 0 && t == 0 ? 60.0 : 0.0)});
+  }
+  EXPECT_NEAR(bands[1].rows(), 65, 8);
+  EXPECT_LT(idle_fraction(previous), 0.1);
+}
