@@ -85,12 +85,14 @@ void AtrousFilter::apply(const FrameBuffer& frame, const GBuffer& gbuffer, Frame
     v.depth_sigma = options_.depth_sigma;
     v.short_history = options_.short_history;
     v.of_mean = options_.guide == AtrousGuide::variance_of_mean ? 1 : 0;
+    // The passes carry the variance in the illumination's alpha; each pixel writes its own alpha and
+    // reads only its neighbours' RGB.
     rows([&](int x, int y) {
-      k_svgf_variance_pixel(ping_.rgba.data(), history.moments, history.length, gbuffer.depth.data(),
-                            gbuffer.normal.data(), estimated_variance_.data(), &v, x, y);
+      const size_t p = static_cast<size_t>(y) * static_cast<size_t>(width) + static_cast<size_t>(x);
+      estimated_variance_[p] = k_svgf_variance_estimate(ping_.rgba.data(), history.moments, history.length,
+                                                        gbuffer.depth.data(), gbuffer.normal.data(), &v, x, y);
+      ping_.rgba[4 * p + 3] = estimated_variance_[p];
     });
-    // The passes carry the variance in the illumination's alpha.
-    for (size_t p = 0; p < pixels; ++p) ping_.rgba[4 * p + 3] = estimated_variance_[p];
   }
   FrameBuffer* from = &ping_;
   FrameBuffer* to = &pong_;
