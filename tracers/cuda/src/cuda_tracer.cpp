@@ -92,9 +92,9 @@ struct CudaTracer::Impl {
   KeptBand kept[2];
   int next_kept = 0;
 
-  // Device storage for a band of `pixels` in `rows`: the float band (and its RGB halves for an RGB16F
-  // target) and the per-row ray counts, grown as bands grow.
-  void ensure_band_storage(size_t pixels, size_t rows, bool half) {
+  // Device storage for a band of `pixels` in `rows` (the float band, its RGB halves for an RGB16F target,
+  // the per-row ray counts), grown as bands grow, and the band's ray counters cleared on the stream.
+  void prepare_band(size_t pixels, size_t rows, bool half) {
     if (pixels > band_capacity) {
       if (band) COHORT_CUDA(cudaFree(band));
       if (band_rgb16f) COHORT_CUDA(cudaFree(band_rgb16f));
@@ -108,6 +108,29 @@ struct CudaTracer::Impl {
       COHORT_CUDA(cudaMalloc(&row_rays, rows * sizeof(unsigned)));
       row_rays_capacity = rows;
     }
+    COHORT_CUDA(cudaMemsetAsync(row_rays, 0, rows * sizeof(unsigned), stream));
+    if (count_rays) {
+      if (!ray_counts) COHORT_CUDA(cudaMalloc(&ray_counts, 2 * sizeof(unsigned long long)));
+      COHORT_CUDA(cudaMemsetAsync(ray_counts, 0, 2 * sizeof(unsigned long long), stream));
+    }
+  }
+
+  // The band's end: its counters back once the stream has drained (with `wait_aux_copy`, the aux copy
+  // stream too), the ray totals kept, and the kernels' device time and per-row work in the result.
+  core::BandResult finish_band(size_t rows, bool wait_aux_copy) {
+    host_row_rays.resize(rows);
+    COHORT_CUDA(cudaMemcpyAsync(host_row_rays.data(), row_rays, rows * sizeof(unsigned), cudaMemcpyDeviceToHost, stream));
+    unsigned long long counts[2] = {0, 0};
+    if (count_rays) COHORT_CUDA(cudaMemcpyAsync(counts, ray_counts, sizeof counts, cudaMemcpyDeviceToHost, stream));
+    COHORT_CUDA(cudaStreamSynchronize(stream));
+    if (wait_aux_copy) COHORT_CUDA(cudaStreamSynchronize(aux_copy_stream));
+    last_counts = RayCounts{counts[0], counts[1]};
+    float kernel_ms = 0.0f;
+    COHORT_CUDA(cudaEventElapsedTime(&kernel_ms, start, stop));
+    core::BandResult result;
+    result.device_ms = kernel_ms;
+    result.row_work.assign(host_row_rays.begin(), host_row_rays.end());
+    return result;
   }
 
   void register_target(core::BandBuffer& target) {
@@ -242,12 +265,7 @@ core::BandResult CudaTracer::render_band(const core::BandJob& job, core::BandBuf
   const size_t pixels = size_t(camera.width) * (params.row_end - params.row_begin);
   const bool half = target.format() == core::BandFormat::rgb16f;
   const size_t rows = params.row_end - params.row_begin;
-  m.ensure_band_storage(pixels, rows, half);
-  COHORT_CUDA(cudaMemsetAsync(m.row_rays, 0, rows * sizeof(unsigned), m.stream));
-  if (m.count_rays) {
-    if (!m.ray_counts) COHORT_CUDA(cudaMalloc(&m.ray_counts, 2 * sizeof(unsigned long long)));
-    COHORT_CUDA(cudaMemsetAsync(m.ray_counts, 0, 2 * sizeof(unsigned long long), m.stream));
-  }
+  m.prepare_band(pixels, rows, half);
   // Kept on the GPU, the band skips both copies: nothing goes down, and the post-processing takes it
   // device to device (or over NVLink from a peer).
   Impl::KeptBand* kept = job.keep_on_device >= 0 ? &m.kept[m.next_kept] : nullptr;
@@ -293,19 +311,7 @@ core::BandResult CudaTracer::render_band(const core::BandJob& job, core::BandBuf
   }
   if (!kept)
     COHORT_CUDA(cudaMemcpyAsync(target.row(int(params.row_begin)), source, colour_bytes, cudaMemcpyDeviceToHost, m.stream));
-  m.host_row_rays.resize(rows);
-  COHORT_CUDA(cudaMemcpyAsync(m.host_row_rays.data(), m.row_rays, rows * sizeof(unsigned), cudaMemcpyDeviceToHost, m.stream));
-  unsigned long long counts[2] = {0, 0};
-  if (m.count_rays)
-    COHORT_CUDA(cudaMemcpyAsync(counts, m.ray_counts, sizeof counts, cudaMemcpyDeviceToHost, m.stream));
-  COHORT_CUDA(cudaStreamSynchronize(m.stream));
-  if (write_aux && !kept) COHORT_CUDA(cudaStreamSynchronize(m.aux_copy_stream));
-  m.last_counts = RayCounts{counts[0], counts[1]};
-  float kernel_ms = 0.0f;
-  COHORT_CUDA(cudaEventElapsedTime(&kernel_ms, m.start, m.stop));
-  core::BandResult result;
-  result.device_ms = kernel_ms;
-  result.row_work.assign(m.host_row_rays.begin(), m.host_row_rays.end());
+  core::BandResult result = m.finish_band(rows, write_aux && !kept);
   if (kept) result.device = {m.device, source, write_aux ? kept->aux.data() : nullptr};
   return result;
 }
@@ -330,7 +336,7 @@ core::BandResult CudaTracer::render_band_in_pieces(const core::BandJob& job, cor
   const size_t rows = params.row_end - params.row_begin;
   const size_t pixels = width * rows;
   const bool half = target.format() == core::BandFormat::rgb16f;
-  m.ensure_band_storage(pixels, rows, half);
+  m.prepare_band(pixels, rows, half);
   const size_t pieces = cuts.size() - 1;
   while (m.piece_rendered.size() < pieces) {
     cudaEvent_t rendered = nullptr, downloaded = nullptr;
@@ -338,11 +344,6 @@ core::BandResult CudaTracer::render_band_in_pieces(const core::BandJob& job, cor
     m.piece_rendered.push_back(rendered);
     COHORT_CUDA(cudaEventCreateWithFlags(&downloaded, cudaEventDisableTiming));
     m.piece_downloaded.push_back(downloaded);
-  }
-  COHORT_CUDA(cudaMemsetAsync(m.row_rays, 0, rows * sizeof(unsigned), m.stream));
-  if (m.count_rays) {
-    if (!m.ray_counts) COHORT_CUDA(cudaMalloc(&m.ray_counts, 2 * sizeof(unsigned long long)));
-    COHORT_CUDA(cudaMemsetAsync(m.ray_counts, 0, 2 * sizeof(unsigned long long), m.stream));
   }
   m.register_target(target);
   // Each piece renders (and converts) into its own part of the band's device buffers, so a piece's
@@ -387,19 +388,7 @@ core::BandResult CudaTracer::render_band_in_pieces(const core::BandJob& job, cor
   }
   // Only now: these small copies go to pageable memory, and such a copy returns only once it is done,
   // which would hold every piece back until the last kernel.
-  m.host_row_rays.resize(rows);
-  COHORT_CUDA(cudaMemcpyAsync(m.host_row_rays.data(), m.row_rays, rows * sizeof(unsigned), cudaMemcpyDeviceToHost, m.stream));
-  unsigned long long counts[2] = {0, 0};
-  if (m.count_rays)
-    COHORT_CUDA(cudaMemcpyAsync(counts, m.ray_counts, sizeof counts, cudaMemcpyDeviceToHost, m.stream));
-  COHORT_CUDA(cudaStreamSynchronize(m.stream));
-  m.last_counts = RayCounts{counts[0], counts[1]};
-  float kernel_ms = 0.0f;
-  COHORT_CUDA(cudaEventElapsedTime(&kernel_ms, m.start, m.stop));
-  core::BandResult result;
-  result.device_ms = kernel_ms;
-  result.row_work.assign(m.host_row_rays.begin(), m.host_row_rays.end());
-  return result;
+  return m.finish_band(rows, false);
 }
 
 void CudaTracer::set_ray_counting(bool on) { impl_->count_rays = on; }
