@@ -157,11 +157,7 @@ TEST(AgreementOnTestMap, EmbreeAndOpenCLImagesMatch) {
   const KCamera cameras[2] = {
       core::make_camera(core::player_eye(map), {map.player_yaw, 0.0f}, core::kDefaultFovX, w, h),
       core::make_camera({1420, 364, 120}, {60.0f, -35.0f}, core::kDefaultFovX, w, h)};
-  KFrameParams params = frame_params(K_MODE_PATH, 8, 1, h);
-  params.light_samples = 0;
-  params.firefly_clamp = 5.0f;
-  params.soft_shadow_scale = 0.2f;
-  params.rr_start = 2.0f;
+  const KFrameParams params = testmap_agreement_params(h);
   auto embree = make_test_tracer("embree");
   auto opencl = make_test_tracer("opencl");
   for (const KCamera& cam : cameras) {

@@ -19,16 +19,6 @@ using namespace cohort::test;
 
 namespace {
 
-core::FrameBuffer render_frame(core::Tracer& tracer, const KCamera& camera, const KFrameParams& params) {
-  core::FrameBuffer fb;
-  fb.resize(int(camera.width), int(camera.height));
-  core::BandJob job;
-  job.params = params;
-  job.camera = camera;
-  tracer.render_band(job, fb);
-  return fb;
-}
-
 struct View {
   const char* name;
   glm::vec3 eye;
@@ -57,11 +47,7 @@ TEST_P(AnimatedMaterialsAgreement, TestMapAtLaterTimesMatchesEmbree) {
   options.width = w, options.height = h;
   core::WorldSync sync(world, options);
   world.TakeChanges();
-  KFrameParams params = frame_params(K_MODE_PATH, 8, 1, h);
-  params.light_samples = 0;
-  params.firefly_clamp = 5.0f;
-  params.soft_shadow_scale = 0.2f;
-  params.rr_start = 2.0f;
+  const KFrameParams params = testmap_agreement_params(h);
 
   auto embree = make_test_tracer("embree");
   auto other = make_test_tracer(device);

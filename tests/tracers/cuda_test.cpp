@@ -41,13 +41,7 @@ double relative_rmse(const core::FrameBuffer& a, const core::FrameBuffer& b, dou
 core::FrameBuffer render_scene(core::Tracer& tracer, const commit::TracerScene& scene, const KCamera& cam,
                                const KFrameParams& params) {
   tracer.apply(commit::CommitBuffer::full(std::make_shared<commit::TracerScene>(scene), 1));
-  core::FrameBuffer fb;
-  fb.resize(int(cam.width), int(cam.height));
-  core::BandJob job;
-  job.params = params;
-  job.camera = cam;
-  tracer.render_band(job, fb);
-  return fb;
+  return render_frame(tracer, cam, params);
 }
 
 #define REQUIRE_GPU()                                                                                   \

@@ -61,6 +61,23 @@ void add_panel_facing_x(scene::Scene& s, int material) {
   add_world_mesh(s, std::move(panel));
 }
 
+// A pane of `glass` in the plane x = 0 facing +X, and 50 units behind it a wall glowing (0, 0.25, 0).
+void add_pane_over_glowing_wall(scene::Scene& s, int glass) {
+  scene::Material wall;
+  wall.name = "textures/test/glow";
+  wall.emitter = true;
+  wall.emissive_color = glm::vec4(0.0f, 0.25f, 0.0f, 1.0f);
+  wall.diffuse_color = glm::vec4(0.0f, 0.0f, 0.0f, 1.0f);
+  wall.specular_color = glm::vec4(0.0f, 0.0f, 0.0f, 1.0f);
+  s.materials.push_back(wall);
+  scene::Mesh mesh;
+  mesh.name = "_area0";
+  add_quad(mesh, glass, {0, -100, -100}, {0, 100, -100}, {0, 100, 100}, {0, -100, 100}, {1, 0, 0});
+  add_quad(mesh, int(s.materials.size() - 1), {-50, -100, -100}, {-50, 100, -100}, {-50, 100, 100},
+           {-50, -100, 100}, {1, 0, 0});
+  add_world_mesh(s, std::move(mesh));
+}
+
 // A camera at `origin` looking at the world origin, image up +Z.
 KCamera camera_at(glm::vec3 origin, int n) {
   glm::vec3 forward = glm::normalize(-origin), right = glm::normalize(glm::cross(forward, glm::vec3(0, 0, 1)));
@@ -162,19 +179,7 @@ TEST_P(Environment, GlassAddsItsReflectionToWhatIsBehindIt) {
   scene::Scene s;
   s.name = "glass";
   const int glass = add_environment_material(s, "textures/test/glass", true, false, glm::vec3(0.5f));
-  scene::Material wall;
-  wall.name = "textures/test/glow";
-  wall.emitter = true;
-  wall.emissive_color = glm::vec4(0.0f, 0.25f, 0.0f, 1.0f);
-  wall.diffuse_color = glm::vec4(0.0f, 0.0f, 0.0f, 1.0f);
-  wall.specular_color = glm::vec4(0.0f, 0.0f, 0.0f, 1.0f);
-  s.materials.push_back(wall);
-  scene::Mesh mesh;
-  mesh.name = "_area0";
-  add_quad(mesh, glass, {0, -100, -100}, {0, 100, -100}, {0, 100, 100}, {0, -100, 100}, {1, 0, 0});
-  add_quad(mesh, int(s.materials.size() - 1), {-50, -100, -100}, {-50, 100, -100}, {-50, 100, 100},
-           {-50, -100, 100}, {1, 0, 0});
-  add_world_mesh(s, std::move(mesh));
+  add_pane_over_glowing_wall(s, glass);
   const glm::vec3 got = pixel(render(*tracer_, s, camera_at({300, 0, 0}, n), frame_params(K_MODE_PATH, 2, 0, n)),
                               n / 2, n / 2);
   expect_colour(got, 0.5f * face_colour(PosX) + glm::vec3(0.0f, 0.25f, 0.0f), GetParam() + ", glass over the wall");
@@ -193,19 +198,7 @@ TEST_P(Environment, AReflectionWrittenBeforeTheFilterIsFiltered) {
     g.blend = scene::BlendClass::Modulate;
     g.diffuse_color = glm::vec4(0.5f, 0.5f, 0.5f, 1.0f);
     g.environment_under_layer = under;
-    scene::Material wall;
-    wall.name = "textures/test/glow";
-    wall.emitter = true;
-    wall.emissive_color = glm::vec4(0.0f, 0.25f, 0.0f, 1.0f);
-    wall.diffuse_color = glm::vec4(0.0f, 0.0f, 0.0f, 1.0f);
-    wall.specular_color = glm::vec4(0.0f, 0.0f, 0.0f, 1.0f);
-    s.materials.push_back(wall);
-    scene::Mesh mesh;
-    mesh.name = "_area0";
-    add_quad(mesh, glass, {0, -100, -100}, {0, 100, -100}, {0, 100, 100}, {0, -100, 100}, {1, 0, 0});
-    add_quad(mesh, int(s.materials.size() - 1), {-50, -100, -100}, {-50, 100, -100}, {-50, 100, 100},
-             {-50, -100, 100}, {1, 0, 0});
-    add_world_mesh(s, std::move(mesh));
+    add_pane_over_glowing_wall(s, glass);
     const glm::vec3 got =
         pixel(render(*tracer_, s, camera_at({300, 0, 0}, n), frame_params(K_MODE_PATH, 2, 0, n)), n / 2, n / 2);
     const glm::vec3 reflection = 0.5f * face_colour(PosX), filtered_wall(0.0f, 0.125f, 0.0f);
@@ -241,20 +234,5 @@ TEST(EnvironmentAgreement, EmbreeAndOpenCLImagesMatch) {
     s.entities.push_back(e);
   }
   s.lights.push_back(point_light({-40, -30, 100}, {300, 300, 300}));
-  const int w = 48, h = 36;
-  KCamera cam = core::make_camera({-90, -90, 60}, {45.0f, 15.0f}, 90.0f, w, h);
-  KFrameParams params = frame_params(K_MODE_PATH, 16, 3, h);
-  params.firefly_clamp = 10.0f;
-  params.soft_shadow_scale = 1.0f;
-  params.frame_index = 5;
-  auto embree = make_test_tracer("embree");
-  auto opencl = make_test_tracer("opencl");
-  core::FrameBuffer a = render(*embree, s, cam, params);
-  core::FrameBuffer b = render(*opencl, s, cam, params);
-  for (size_t i = 0; i < a.rgba.size(); ++i) ASSERT_TRUE(std::isfinite(a.rgba[i]) && std::isfinite(b.rgba[i])) << i;
-  double mean = 0.0;
-  const double error = rgb_rmse(a, b, &mean);
-  std::cout << "environment room: RMSE embree/opencl " << error << ", mean " << mean << "\n";
-  EXPECT_GT(mean, 0.05);
-  EXPECT_LT(error, 0.005 * mean);
+  expect_embree_and_opencl_agree(s, core::make_camera({-90, -90, 60}, {45.0f, 15.0f}, 90.0f, 48, 36), "environment room");
 }

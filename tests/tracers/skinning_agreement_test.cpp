@@ -20,16 +20,6 @@ using namespace cohort::test;
 
 namespace {
 
-core::FrameBuffer render_frame(core::Tracer& tracer, const KCamera& camera, const KFrameParams& params) {
-  core::FrameBuffer fb;
-  fb.resize(int(camera.width), int(camera.height));
-  core::BandJob job;
-  job.params = params;
-  job.camera = camera;
-  tracer.render_band(job, fb);
-  return fb;
-}
-
 }  // namespace
 
 class SkinningAgreement : public ::testing::TestWithParam<std::string> {};
@@ -56,11 +46,7 @@ TEST_P(SkinningAgreement, WalkerPosedMatchesEmbree) {
   const float yaw = glm::degrees(std::atan2(to.y, to.x));
   const float pitch = glm::degrees(std::atan2(-to.z, std::hypot(to.x, to.y)));
   const KCamera camera = core::make_camera(eye, {yaw, pitch}, 70.0f, w, h);
-  KFrameParams params = frame_params(K_MODE_PATH, 8, 1, h);
-  params.light_samples = 0;
-  params.firefly_clamp = 5.0f;
-  params.soft_shadow_scale = 0.2f;
-  params.rr_start = 2.0f;
+  const KFrameParams params = testmap_agreement_params(h);
 
   auto embree = make_test_tracer("embree");
   auto opencl = make_test_tracer(device);

@@ -227,20 +227,5 @@ TEST(SkyAgreement, EmbreeAndOpenCLImagesMatch) {
     s.entities.push_back(e);
   }
   s.lights.push_back(point_light({-40, 30, 100}, {300, 300, 300}));
-  const int w = 48, h = 36;
-  KCamera cam = core::make_camera({-90, -90, 60}, {45.0f, 10.0f}, 90.0f, w, h);
-  KFrameParams params = frame_params(K_MODE_PATH, 16, 3, h);
-  params.firefly_clamp = 10.0f;
-  params.soft_shadow_scale = 1.0f;
-  params.frame_index = 5;
-  auto embree = make_test_tracer("embree");
-  auto opencl = make_test_tracer("opencl");
-  core::FrameBuffer a = render(*embree, s, cam, params);
-  core::FrameBuffer b = render(*opencl, s, cam, params);
-  for (size_t i = 0; i < a.rgba.size(); ++i) ASSERT_TRUE(std::isfinite(a.rgba[i]) && std::isfinite(b.rgba[i])) << i;
-  double mean = 0.0;
-  const double error = rgb_rmse(a, b, &mean);
-  std::cout << "sky room: RMSE embree/opencl " << error << ", mean " << mean << "\n";
-  EXPECT_GT(mean, 0.05);
-  EXPECT_LT(error, 0.005 * mean);
+  expect_embree_and_opencl_agree(s, core::make_camera({-90, -90, 60}, {45.0f, 10.0f}, 90.0f, 48, 36), "sky room");
 }

@@ -4,11 +4,13 @@
 
 #include <algorithm>
 #include <cmath>
+#include <iostream>
 #include <memory>
 #include <string>
 #include <vector>
 
 #include <glm/glm.hpp>
+#include <gtest/gtest.h>
 
 #include "cohort/commit/commit_buffer.h"
 #include "cohort/core/band_buffer.h"
@@ -22,6 +24,7 @@
 #include "cohort/scene/scene.h"
 #include "cohort/test_support/scene_builders.h"
 #include "cohort/test_support/test_scenes.h"
+#include "test_tracers.h"
 
 namespace cohort::test {
 
@@ -56,10 +59,8 @@ inline KFrameParams frame_params(uint32_t mode, uint32_t spp, uint32_t max_bounc
   return p;
 }
 
-inline core::FrameBuffer render(core::Tracer& tracer, const scene::Scene& scene, const KCamera& camera,
-                                const KFrameParams& params) {
-  auto compiled = std::make_shared<commit::TracerScene>(core::compile_scene(scene).tracer_scene);
-  tracer.apply(commit::CommitBuffer::full(compiled, 1));
+// One whole-frame band from the scene the tracer holds now.
+inline core::FrameBuffer render_frame(core::Tracer& tracer, const KCamera& camera, const KFrameParams& params) {
   core::FrameBuffer fb;
   fb.resize(static_cast<int>(camera.width), static_cast<int>(camera.height));
   core::BandJob job;
@@ -67,6 +68,25 @@ inline core::FrameBuffer render(core::Tracer& tracer, const scene::Scene& scene,
   job.camera = camera;
   tracer.render_band(job, fb);
   return fb;
+}
+
+// The scene compiled and applied as a full resync, then one whole-frame band of it.
+inline core::FrameBuffer render(core::Tracer& tracer, const scene::Scene& scene, const KCamera& camera,
+                                const KFrameParams& params) {
+  auto compiled = std::make_shared<commit::TracerScene>(core::compile_scene(scene).tracer_scene);
+  tracer.apply(commit::CommitBuffer::full(compiled, 1));
+  return render_frame(tracer, camera, params);
+}
+
+// The test map agreements' settings (8 spp, 1 bounce, a shadow ray per light, soft shadows, a firefly
+// clamp and path roulette from the second bounce), at which Embree and the other tracers are compared.
+inline KFrameParams testmap_agreement_params(int height) {
+  KFrameParams params = frame_params(K_MODE_PATH, 8, 1, height);
+  params.light_samples = 0;
+  params.firefly_clamp = 5.0f;
+  params.soft_shadow_scale = 0.2f;
+  params.rr_start = 2.0f;
+  return params;
 }
 
 // The auxiliary planes (kernel/aux_outputs.h) of one whole-frame band from the tracer's current scene.
@@ -119,6 +139,25 @@ inline double rgb_rmse(const core::FrameBuffer& a, const core::FrameBuffer& b, d
   }
   *mean = sum / double(n);
   return std::sqrt(sum_sq / double(n));
+}
+
+// The small rooms' Embree-against-OpenCL check (16 spp, 3 bounces, soft shadows, a firefly clamp): every
+// value finite, a mean above 0.05, and an RMSE under 0.5% of it. `label` names the room in the output.
+inline void expect_embree_and_opencl_agree(const scene::Scene& scene, const KCamera& camera, const std::string& label) {
+  KFrameParams params = frame_params(K_MODE_PATH, 16, 3, static_cast<int>(camera.height));
+  params.firefly_clamp = 10.0f;
+  params.soft_shadow_scale = 1.0f;
+  params.frame_index = 5;
+  auto embree = make_test_tracer("embree");
+  auto opencl = make_test_tracer("opencl");
+  const core::FrameBuffer a = render(*embree, scene, camera, params);
+  const core::FrameBuffer b = render(*opencl, scene, camera, params);
+  for (size_t i = 0; i < a.rgba.size(); ++i) ASSERT_TRUE(std::isfinite(a.rgba[i]) && std::isfinite(b.rgba[i])) << i;
+  double mean = 0.0;
+  const double error = rgb_rmse(a, b, &mean);
+  std::cout << label << ": RMSE embree/opencl " << error << ", mean " << mean << "\n";
+  EXPECT_GT(mean, 0.05);
+  EXPECT_LT(error, 0.005 * mean);
 }
 
 inline double mean_luminance(const core::FrameBuffer& fb) {
