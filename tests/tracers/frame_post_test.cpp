@@ -254,7 +254,9 @@ TEST(FramePost, CudaBandsStayingOnTheGpusGiveTheHostRoundTripsPicture) {
       shown[on_device].push_back(post->image());
     }
     core::HostFramePost host(both());
-    if (on_device) EXPECT_THROW(host.process_packed(renderer.packed_frame(), renderer.packed_device_rows()), std::invalid_argument);
+    if (on_device) {
+      EXPECT_THROW(host.process_packed(renderer.packed_frame(), renderer.packed_device_rows()), std::invalid_argument);
+    }
   }
   for (size_t f = 0; f < shown[0].size(); ++f)
     EXPECT_EQ(shown[1][f].rgba, shown[0][f].rgba) << "frame " << f;
