@@ -17,6 +17,8 @@
 #                              tracer tests of the staged one, then end-to-end ms per frame, cuda:0, both maps,
 #                              Brigade's blend, each payload in turn, three rounds (COHORT_GPU_COMPARE_ARGS adds
 #                              render options)
+#   tools/gpu_run.sh compare-env VARIABLE A B  there: the staged payload with an environment variable at each value
+#                              (e.g. COHORT_BLAS_LAYOUT bvh2 cwbvh): its tracer tests, then ms per frame, three rounds
 #   tools/gpu_run.sh stage-mpi here: the travelling cohort built against PyPI's MPICH, with its libraries (.gpu/mpi.tar.xz)
 #   tools/gpu_run.sh cluster   there, on a two-GPU kind: two ranks with one GPU each against the in-process two GPUs
 #   tools/gpu_run.sh frametimes  there: only the end-to-end frame times (large map 1080p generated there,
@@ -133,6 +135,38 @@ case "${1:-}" in
           "$stage/cmp/$name/bin/cohort" render "${args[@]}" --tracers cuda:0 --spp 1 --bounces 1 --convergence brigade \
             --frames 60 --camera-path spin-slow ${COHORT_GPU_COMPARE_ARGS:-} --write last --out $run >/dev/null 2>&1
           echo "== round $round, $name, $map map: $(python3 tools/frame_times.py $run/stats.json --skip 10 | head -n 1)"
+        done
+      done
+    done
+    ;;
+  compare-env)
+    # A/B of one environment variable's values with the staged payload (e.g. compare-env COHORT_BLAS_LAYOUT
+    # bvh2 cwbvh): the GPU tracer tests with the last value, then end-to-end ms per frame on cuda:0, both
+    # maps, Brigade's blend, the values alternated over three rounds (COHORT_GPU_COMPARE_ARGS adds options).
+    [ $# -ge 4 ] || { echo "usage: gpu_run.sh compare-env VARIABLE VALUE_A VALUE_B [...]"; exit 2; }
+    variable=$2; shift 2
+    [ -d "$stage/bin" ] || tar -C "$stage" -xJf "$stage/payload.tar.xz"
+    export LD_LIBRARY_PATH="$PWD/$stage/lib${LD_LIBRARY_PATH:+:$LD_LIBRARY_PATH}"
+    nvidia-smi --query-gpu=index,name --format=csv,noheader
+    [ -f /tmp/largemap.cpk ] || { [ -f "$stage/largemap.cpk" ] && cp "$stage/largemap.cpk" /tmp/largemap.cpk; } ||
+      { python3 tools/gen_testmap.py --large --out /tmp/largemap >/dev/null &&
+        "$stage/bin/cohort" pack /tmp/largemap/maps/largemap.map --out /tmp/largemap.cpk | tail -n 1; }
+    last=${!#}
+    [ -x "$stage/bin/cohort_tracers_tests" ] && env "$variable=$last" COHORT_PACK="$stage/testmap.cpk" \
+      "$stage/bin/cohort_tracers_tests" --gtest_filter="${COHORT_GPU_TEST_FILTER:-*}" 2>&1 |
+      grep -E "^\[  (PASSED|FAILED) |^\[  FAILED|tests? ran|SKIPPED \]" | head -n 40 || true
+    for round in 1 2 3; do
+      for value in "$@"; do
+        for map in large test; do
+          if [ $map = large ]; then args=(/tmp/largemap.cpk --width 1920 --height 1080 --camera 1690 300 80 5 -12)
+          else args=("$stage/testmap.cpk" --width 1280 --height 720); fi
+          run=/tmp/env_${value}_${map}_$round
+          env "$variable=$value" "$stage/bin/cohort" render "${args[@]}" --tracers "${COHORT_GPU_TRACERS:-cuda:0}" --spp 1 \
+            --bounces 1 --convergence brigade --frames 60 --camera-path spin-slow ${COHORT_GPU_COMPARE_ARGS:-} --write last \
+            --out $run >/dev/null 2>&1
+          echo "== round $round, $variable=$value, $map map: $(python3 tools/frame_times.py $run/stats.json --skip 10 | head -n 1)"
+          [ -n "${OUT:-}" ] && [ $round = 1 ] && mkdir -p "$OUT/frames" &&
+            cp $run/frame_0059.* "$OUT/frames/${map}_$value.$(ls $run/frame_0059.* | head -n1 | sed 's/.*\.//')" 2>/dev/null || true
         done
       done
     done
