@@ -11,6 +11,8 @@
 
 #include <spdlog/spdlog.h>
 
+#include "cohort/core/host_threads.h"
+
 namespace cohort::tracers {
 
 namespace opencl_source {
@@ -214,6 +216,10 @@ struct OpenCLTracer::Impl {
   cl_command_queue aux_queue = nullptr;
   cl_program program = nullptr;
   cl_kernel kernel = nullptr, aux_kernel = nullptr;
+  // The aux texels' copy out of page-locked staging into the target: tens of MB a band at 1080p, which
+  // one thread beside Embree's workers could stretch to 20-30 ms (docs/balancing.md). Its own threads,
+  // not the shared pool, which the core's merge and tone map hold while this band renders.
+  core::HostThreads aux_copy_threads{3};
   DeviceBuffer previous_transforms, previous_joints;
   DeviceBuffer vertices, vertex_colors, triangles, blas_nodes, blases, instances, tlas_nodes, materials, textures, texels, lights, light_nodes,
       emissive;
@@ -610,7 +616,14 @@ void OpenCLTracer::copy_aux_into(core::BandBuffer& target, const KFrameParams& p
   const size_t pixels = rows * camera.width;
   const void* staging = m.aux_staging.host();
   if (straight) {
-    std::memcpy(target.aux_row(int(params.row_begin)), staging, pixels * sizeof(KAuxTexel));
+    const auto started = std::chrono::steady_clock::now();
+    char* to = reinterpret_cast<char*>(target.aux_row(int(params.row_begin)));
+    const char* from = static_cast<const char*>(staging);
+    m.aux_copy_threads.for_ranges(pixels, 16384, [&](size_t begin, size_t end) {
+      std::memcpy(to + begin * sizeof(KAuxTexel), from + begin * sizeof(KAuxTexel), (end - begin) * sizeof(KAuxTexel));
+    });
+    const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - started).count();
+    spdlog::debug("{}: aux texels of {} pixels copied in {:.2f} ms", name(), pixels, ms);
     return;
   }
   const KAux* aux = static_cast<const KAux*>(staging);
