@@ -142,7 +142,8 @@ case "${1:-}" in
   compare-env)
     # A/B of one environment variable's values with the staged payload (e.g. compare-env COHORT_BLAS_LAYOUT
     # bvh2 cwbvh): the GPU tracer tests with the last value, then end-to-end ms per frame on cuda:0, both
-    # maps, Brigade's blend, the values alternated over three rounds (COHORT_GPU_COMPARE_ARGS adds options).
+    # maps, Brigade's blend (COHORT_GPU_CONVERGENCE names another), the values alternated over three rounds
+    # (COHORT_GPU_COMPARE_ARGS adds options).
     [ $# -ge 4 ] || { echo "usage: gpu_run.sh compare-env VARIABLE VALUE_A VALUE_B [...]"; exit 2; }
     variable=$2; shift 2
     [ -d "$stage/bin" ] || tar -C "$stage" -xJf "$stage/payload.tar.xz"
@@ -162,7 +163,7 @@ case "${1:-}" in
           else args=("$stage/testmap.cpk" --width 1280 --height 720); fi
           run=/tmp/env_${value}_${map}_$round
           env "$variable=$value" "$stage/bin/cohort" render "${args[@]}" --tracers "${COHORT_GPU_TRACERS:-cuda:0}" --spp 1 \
-            --bounces 1 --convergence brigade --frames 60 --camera-path spin-slow ${COHORT_GPU_COMPARE_ARGS:-} --write last \
+            --bounces 1 --convergence ${COHORT_GPU_CONVERGENCE:-brigade} --frames 60 --camera-path spin-slow ${COHORT_GPU_COMPARE_ARGS:-} --write last \
             --out $run >/dev/null 2>&1
           echo "== round $round, $variable=$value, $map map: $(python3 tools/frame_times.py $run/stats.json --skip 10 | head -n 1)"
           [ -n "${OUT:-}" ] && [ $round = 1 ] && mkdir -p "$OUT/frames" &&
