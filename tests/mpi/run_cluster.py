@@ -18,7 +18,9 @@ TLAS, light and joint records cross the wire every frame, and every frame matche
 under a virtual display with remote tracers: the scenario runs, the screenshot is written and not
 uniform; skipped with status 77 without xvfb-run or the viewer), bad_piece (rank 2 sends a piece of its
 band's rows a byte short once: rank 0 refuses that band with the sizes, its rows are re-rendered by the
-others, and every frame matches).
+others, and every frame matches), ahead (the scenario on mpi:1 and mpi:2 alone, the nodes taking 40 ms
+longer a band: each frame's commit is submitted while the band before renders, travels behind that band's
+job and is applied once it is rendered; every frame matches the single-process render).
 """
 import argparse
 import json
@@ -180,6 +182,30 @@ def replay(a):
     print("replay: ok")
 
 
+def ahead(a):
+    os.makedirs(a.out)
+    stream = os.path.join(a.out, "scenario.cdelta")
+    run([a.cohort, "record-scenario", "testmap", "--base", a.testmap_base, "--frames", str(FRAMES), "--out", stream])
+    args = ["--replay", stream, "--base", a.testmap_base, "--width", "96", "--height", "54", "--spp", "1"]
+    single, cluster = os.path.join(a.out, "single"), os.path.join(a.out, "cluster")
+    run([a.cohort, "render", "--tracers", "embree", "--out", single] + args)
+    flags = mpiexec_flags(a.mpiexec)
+    _, output = run([a.mpiexec] + flags + ["-np", "1", a.cohort, "render", "--tracers", "mpi:1,mpi:2", "--out", cluster] +
+                    args + [":"] + flags + ["-np", "2", a.cohort, "node", "testmap", "--base", a.testmap_base,
+                                            "--tracers", "embree", "--band-delay-ms", "40"])
+    compare_frames(single, cluster)
+    if any(o.get("mpi:1") != "rendered" or o.get("mpi:2") != "rendered" for o in tracer_outcomes(cluster)):
+        sys.exit("a remote tracer failed a band of the scenario")
+    for rank in (1, 2):
+        found = re.search(rf"mpi:{rank}: .*\((\d+) commit\(s\) sent ahead of their job\)", output)
+        if not found:
+            sys.exit(f"mpi:{rank}: no count of the commits sent ahead in the log")
+        # Frame 0's commit comes with the first job; every later frame's goes ahead of its job.
+        if int(found.group(1)) != FRAMES - 1:
+            sys.exit(f"mpi:{rank}: {found.group(1)} commit(s) went ahead of their job; {FRAMES - 1} should have")
+    print("ahead: ok")
+
+
 def play(a):
     if not shutil.which("xvfb-run"):
         print("SKIP: xvfb-run is not installed")
@@ -237,7 +263,7 @@ def bench(a):
 def main():
     parser = argparse.ArgumentParser()
     parser.add_argument("case", choices=["match", "mixed", "stall", "killed", "version", "load_error", "bench", "protocol", "replay",
-                                           "play", "bad_piece"])
+                                           "play", "bad_piece", "ahead"])
     parser.add_argument("--mpiexec", required=True)
     parser.add_argument("--cohort", required=True)
     parser.add_argument("--map", required=True)
@@ -257,6 +283,9 @@ def main():
         return
     if a.case == "replay":
         replay(a)
+        return
+    if a.case == "ahead":
+        ahead(a)
         return
     if a.case == "play":
         play(a)

@@ -11,6 +11,9 @@
 #include <thread>
 
 #include <mpi.h>
+#ifdef __linux__
+#include <sys/prctl.h>
+#endif
 
 #include "cohort/tracers/mpi_wire.h"
 
@@ -18,6 +21,19 @@ namespace cohort::tracers {
 
 namespace {
 constexpr int kTag = wire::kControlTag;  // every control message; the header says what it is
+
+// The polls nap for tens of microseconds; Linux lets a nap run 50 us late by default (timer slack), which
+// on a band of a few milliseconds is a late job, piece or band_rows noticed. The thread that polls asks
+// for its naps to end on time.
+void nap_on_time() {
+#ifdef __linux__
+  thread_local bool set = false;
+  if (!set) {
+    prctl(PR_SET_TIMERSLACK, 1000UL, 0UL, 0UL, 0UL);  // 1 us
+    set = true;
+  }
+#endif
+}
 
 int finalize_timeout_seconds() {
   const char* text = std::getenv("COHORT_MPI_FINALIZE_TIMEOUT_S");
@@ -198,6 +214,7 @@ size_t MpiSession::progress_sends() {
 }
 
 bool MpiSession::flush_sends(int destination, MpiClock::time_point deadline) {
+  nap_on_time();
   for (;;) {
     bool pending = false;
     {
@@ -216,7 +233,9 @@ bool MpiSession::flush_sends(int destination, MpiClock::time_point deadline) {
   }
 }
 
-std::optional<std::vector<uint8_t>> MpiSession::receive(int source, MpiClock::time_point deadline, PieceSink* pieces) {
+std::optional<std::vector<uint8_t>> MpiSession::receive(int source, MpiClock::time_point deadline, PieceSink* pieces,
+                                                        const std::function<void()>& between_polls) {
+  nap_on_time();
   // Polls: yields at first (a band's answer is often close), then sleeps briefly so that a waiting
   // tracer thread does not take a core from the ones rendering. A piece that came starts it over: the
   // band's next piece, or its end, follows.
@@ -265,11 +284,21 @@ std::optional<std::vector<uint8_t>> MpiSession::receive(int source, MpiClock::ti
       impl_->test_sends();
     }
     if (MpiClock::now() >= deadline) return std::nullopt;
+    if (between_polls) between_polls();
     if (polls < 200)
       std::this_thread::yield();
     else
       std::this_thread::sleep_for(std::chrono::microseconds(polls < 2000 ? 20 : 200));
   }
+}
+
+bool MpiSession::control_waiting(int source) {
+  std::lock_guard lock(mutex_);
+  if (finalized_) return false;
+  if (impl_->receives.count(source)) return true;  // matched, still arriving
+  int found = 0;
+  MPI_Iprobe(source, kTag, impl_->comm, &found, MPI_STATUS_IGNORE);
+  return found != 0;
 }
 
 bool MpiSession::settle_pieces(int source, MpiClock::time_point deadline) {
