@@ -11,9 +11,6 @@
 #include <thread>
 
 #include <mpi.h>
-#ifdef __linux__
-#include <sys/prctl.h>
-#endif
 
 #include "cohort/tracers/mpi_wire.h"
 
@@ -21,19 +18,6 @@ namespace cohort::tracers {
 
 namespace {
 constexpr int kTag = wire::kControlTag;  // every control message; the header says what it is
-
-// The polls nap for tens of microseconds; Linux lets a nap run 50 us late by default (timer slack), which
-// on a band of a few milliseconds is a late job, piece or band_rows noticed. The thread that polls asks
-// for its naps to end on time.
-void nap_on_time() {
-#ifdef __linux__
-  thread_local bool set = false;
-  if (!set) {
-    prctl(PR_SET_TIMERSLACK, 1000UL, 0UL, 0UL, 0UL);  // 1 us
-    set = true;
-  }
-#endif
-}
 
 int finalize_timeout_seconds() {
   const char* text = std::getenv("COHORT_MPI_FINALIZE_TIMEOUT_S");
@@ -214,7 +198,6 @@ size_t MpiSession::progress_sends() {
 }
 
 bool MpiSession::flush_sends(int destination, MpiClock::time_point deadline) {
-  nap_on_time();
   for (;;) {
     bool pending = false;
     {
@@ -235,7 +218,6 @@ bool MpiSession::flush_sends(int destination, MpiClock::time_point deadline) {
 
 std::optional<std::vector<uint8_t>> MpiSession::receive(int source, MpiClock::time_point deadline, PieceSink* pieces,
                                                         const std::function<void()>& between_polls) {
-  nap_on_time();
   // Polls: yields at first (a band's answer is often close), then sleeps briefly so that a waiting
   // tracer thread does not take a core from the ones rendering. A piece that came starts it over: the
   // band's next piece, or its end, follows.
