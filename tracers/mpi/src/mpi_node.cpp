@@ -168,8 +168,9 @@ class Node {
                    p.frame_index);
       std::this_thread::sleep_for(std::chrono::milliseconds(options_.stall_ms));
     }
-    if (options_.band_delay_ms > 0) std::this_thread::sleep_for(std::chrono::milliseconds(options_.band_delay_ms));
     const auto start = MpiClock::now();
+    // A slow node's render, counted in its time.
+    if (options_.band_delay_ms > 0) std::this_thread::sleep_for(std::chrono::milliseconds(options_.band_delay_ms));
     wire::NodeTiming timing;
     timing.commit_ms = commit_ms_;
     timing.commit_ahead_ms = commit_ahead_ms_;
