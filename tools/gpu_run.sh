@@ -100,6 +100,9 @@ case "${1:-}" in
             { echo "two-rank run failed"; tail -n 8 /tmp/mpi_$map.log; }
           [ -f /tmp/mpi_$map/stats.json ] &&
             echo "round $round, $map map, two ranks, $pieces piece(s) a band: $(python3 tools/frame_times.py /tmp/mpi_$map/stats.json --skip 50 | head -n 1)"
+          # Rank 0's own stages (medians): with no GPU there, its merge, blend and tone map run on the host
+          # while the nodes render the next frame; near the frame interval, they set it.
+          [ -f /tmp/mpi_$map/stats.json ] && python3 tools/frame_times.py /tmp/mpi_$map/stats.json --skip 50 | grep " core/" || true
           grep -E "round trip" /tmp/mpi_$map.log | sed 's/^.*\] //' || true
         done
       done

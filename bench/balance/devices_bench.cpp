@@ -74,13 +74,16 @@ DevicesBenchRun run_mix(const DevicesBenchConfig& config, const std::vector<std:
     link.tracer = remote[i]->name();
     link.sent_bytes_per_frame = double(after.bytes_sent - before[i].bytes_sent) / counted;
     link.received_bytes_per_frame = double(after.bytes_received - before[i].bytes_received) / counted;
-    const uint64_t bands = after.bands - before[i].bands;
+    const uint64_t bands = after.steady_bands - before[i].steady_bands;  // not the first after a full resync
     if (bands > 0) {
       link.mean_round_trip_ms = (after.total_round_trip_ms - before[i].total_round_trip_ms) / double(bands);
       link.mean_node_ms = (after.total_node_ms - before[i].total_node_ms) / double(bands);
       link.mean_node_render_ms = (after.total_node_render_ms - before[i].total_node_render_ms) / double(bands);
       link.mean_node_tracer_ms = (after.total_node_tracer_ms - before[i].total_node_tracer_ms) / double(bands);
       link.mean_node_commit_ms = (after.total_node_commit_ms - before[i].total_node_commit_ms) / double(bands);
+      link.mean_node_commit_ahead_ms =
+          (after.total_node_commit_ahead_ms - before[i].total_node_commit_ahead_ms) / double(bands);
+      link.commits_ahead = after.commits_ahead - before[i].commits_ahead;
       link.mean_first_piece_ms = (after.total_first_piece_ms - before[i].total_first_piece_ms) / double(bands);
     }
     run.remote.push_back(link);
@@ -187,6 +190,8 @@ nlohmann::json remote_json(const std::vector<RemoteLinkRun>& links) {
                    {"mean_node_render_ms", l.mean_node_render_ms},
                    {"mean_node_tracer_ms", l.mean_node_tracer_ms},
                    {"mean_node_commit_ms", l.mean_node_commit_ms},
+                   {"mean_node_commit_ahead_ms", l.mean_node_commit_ahead_ms},
+                   {"commits_ahead", l.commits_ahead},
                    {"mean_first_piece_ms", l.mean_first_piece_ms}});
   return out;
 }

@@ -4,6 +4,7 @@
 // fast as its tracers' speeds added up.
 #pragma once
 
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -30,9 +31,12 @@ struct RemoteLinkRun {
   double mean_round_trip_ms = 0.0;  // band job sent -> rows received
   double mean_node_ms = 0.0;        // the node's own time for its band
   // Where the round trip went (tracers::MpiLinkStats): the node's tracers' render calls (GPU: kernel,
-  // downloads, waits), of that what they measured themselves, the node applying the commit before the
-  // job, and rank 0's wait for the band's first piece.
+  // downloads, waits), of that what they measured themselves, the node applying commits with the job
+  // waiting (in the round trip's way) and before it came (hidden: commits ahead), and rank 0's wait for
+  // the band's first piece. Bands right after a full resync are left out.
   double mean_node_render_ms = 0.0, mean_node_tracer_ms = 0.0, mean_node_commit_ms = 0.0;
+  double mean_node_commit_ahead_ms = 0.0;
+  uint64_t commits_ahead = 0;  // commits sent behind a band's job while it rendered, over the counted frames
   double mean_first_piece_ms = 0.0;
 };
 

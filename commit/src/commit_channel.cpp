@@ -52,6 +52,11 @@ void CommitChannel::request_resync() {
   ++stats_.resyncs_requested;
 }
 
+bool CommitChannel::has_pending() const {
+  std::lock_guard lock(mutex_);
+  return !pending_taken_;
+}
+
 bool CommitChannel::resync_requested() const {
   std::lock_guard lock(mutex_);
   return resync_requested_;

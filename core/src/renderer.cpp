@@ -47,12 +47,19 @@ struct Renderer::Worker {
   // Taken from the channel by the core when it hands out a job; the buffer stays valid (and untouched
   // by the core) until the next hand-over, which happens only once this job has ended.
   const commit::CommitBuffer* job_commit = nullptr;
+  // The channel the job's tracer may take commits ahead from (Tracer::takes_commits_ahead), handed over
+  // with the job: the core creates a channel on its first submit_commit, which may come while a job runs.
+  commit::CommitChannel* job_channel = nullptr;
 
   // Created by the first submit_commit; publish and take are the core's, the channel locks itself.
   std::shared_ptr<commit::CommitChannel> channel;
   // Worker thread only: an apply threw, so the tracer's scene no longer matches the core's until a
   // full resync has been applied.
   bool scene_diverged = false;
+  // Worker thread only: while a job of a tracer that takes commits ahead renders, its channel, and the
+  // stages of what it applied ahead.
+  commit::CommitChannel* ahead_channel = nullptr;
+  std::vector<StageSpan> ahead_spans;
   // Core thread only: the unwaited job of a benched tracer (0: none) and its probe band, and the rows
   // per ms this tracer showed last (how much of a dropped tracer's rows it is given).
   uint64_t side_job = 0;
@@ -85,6 +92,7 @@ struct Renderer::Worker {
       bool recovery = false, probe = false;
       int slot = 0;
       const commit::CommitBuffer* to_apply = nullptr;
+      commit::CommitChannel* channel_of_job = nullptr;
       {
         std::unique_lock lock(inbox_mutex);
         inbox_cv.wait(lock, [&] { return quit || has_job; });
@@ -97,6 +105,7 @@ struct Renderer::Worker {
         has_job = false;
         to_apply = job_commit;
         job_commit = nullptr;
+        channel_of_job = job_channel;
       }
       bool success = false;
       std::string what;
@@ -114,7 +123,15 @@ struct Renderer::Worker {
           throw std::runtime_error("its scene diverged after a failed commit; waiting for a full resync");
         if (current.params.row_end > current.params.row_begin) {  // a benched tracer may only apply
           ScopedStage rendering(job_spans, track, recovery ? "re-render" : probe ? "probe" : "render");
-          const BandResult result = tracer->render_band(current, targets[slot]);
+          if (tracer->takes_commits_ahead()) ahead_channel = channel_of_job;
+          BandResult result;
+          try {
+            result = tracer->render_band(current, targets[slot]);
+          } catch (...) {
+            end_ahead(job_spans);
+            throw;
+          }
+          end_ahead(job_spans);
           wall = std::chrono::duration<double, std::milli>(Clock::now() - start).count();
           rendering.finish();
           reported = result.device_ms;
@@ -146,8 +163,30 @@ struct Renderer::Worker {
     }
   }
 
-  void apply(const commit::CommitBuffer& commit, std::vector<StageSpan>& spans, const std::string& track) {
-    ScopedStage applying(spans, track, commit.is_full_resync() ? "apply (full resync)" : "apply");
+  // Tracer::apply_commits_ahead, on this worker's thread inside render_band: what the core published
+  // since the job was handed out is applied now; the next job brings what is published after it. Not
+  // while a resync is asked for or the scene diverged: the next job's commit answers those, as always.
+  void apply_ahead() {
+    commit::CommitChannel* channel = ahead_channel;
+    if (!channel || scene_diverged || !channel->has_pending() || channel->resync_requested()) return;
+    const commit::CommitBuffer& commit = channel->begin_frame();
+    if (commit.empty()) return;
+    try {
+      apply(commit, ahead_spans, tracer_track(id, name), " ahead");
+    } catch (...) {
+      // apply() marked the scene diverged and asked for a resync: the next job fails until it comes.
+    }
+  }
+  void end_ahead(std::vector<StageSpan>& spans) {
+    ahead_channel = nullptr;
+    spans.insert(spans.end(), std::make_move_iterator(ahead_spans.begin()), std::make_move_iterator(ahead_spans.end()));
+    ahead_spans.clear();
+  }
+
+  void apply(const commit::CommitBuffer& commit, std::vector<StageSpan>& spans, const std::string& track,
+             const char* when = "") {
+    ScopedStage applying(spans, track,
+                         std::string(commit.is_full_resync() ? "apply (full resync)" : "apply") + when);
     try {
       tracer->apply(commit);
     } catch (...) {
@@ -171,6 +210,8 @@ Renderer::Renderer(std::vector<std::unique_ptr<Tracer>> tracers, RendererOptions
     w->tracer = std::move(tracers[i]);
     w->name = w->tracer->name();
     w->completion = completion;
+    // The worker owns the tracer, so the hook never outlives what it points at.
+    if (w->tracer->takes_commits_ahead()) w->tracer->set_commits_ahead([worker = w.get()] { worker->apply_ahead(); });
     workers_.push_back(std::move(w));
   }
   // Each thread shares its worker, so a worker whose tracer never returns can be left behind at
@@ -305,6 +346,7 @@ std::vector<uint64_t> Renderer::assign(const std::vector<Assignment>& assignment
     w.job.params.row_begin = static_cast<kuint>(assignments[i].band.begin);
     w.job.params.row_end = static_cast<kuint>(assignments[i].band.end);
     w.job_id = ids[i];
+    w.job_channel = w.channel.get();
     w.job_is_recovery = !with_commits;
     w.job_slot = slot;
     w.job_is_probe = assignments[i].probe;

@@ -172,3 +172,135 @@ TEST(FramePipeline, CallsOutOfOrderAreRefused) {
   EXPECT_EQ(b.row(kRows - 1)[0], 4.0f);
   EXPECT_EQ(four.frame, 4u);
 }
+
+namespace {
+
+// Records, in order, each band's start and each commit applied, and whether a band was rendering then.
+// With `ahead`, it takes commits ahead (Tracer::takes_commits_ahead, as a remote tracer does) while it
+// waits for its frame's gate.
+class CommitLoggingTracer final : public Tracer {
+ public:
+  struct Event {
+    bool band = false;  // a band's start (frame: its frame index), else a commit applied (frame: the commit's)
+    uint64_t frame = 0;
+    bool during_band = false;
+  };
+  struct Log {
+    std::mutex mutex;
+    std::vector<Event> events;
+    void add(Event e) {
+      std::lock_guard lock(mutex);
+      events.push_back(e);
+    }
+    std::vector<Event> read() {
+      std::lock_guard lock(mutex);
+      return events;
+    }
+  };
+  CommitLoggingTracer(bool ahead, std::shared_ptr<FrameGates> gates, std::shared_ptr<Log> log)
+      : ahead_(ahead), gates_(std::move(gates)), log_(std::move(log)) {}
+  std::string name() const override { return ahead_ ? "ahead" : "with-job"; }
+  bool takes_commits_ahead() const override { return ahead_; }
+  void apply(const cohort::commit::CommitBuffer& commit) override {
+    log_->add({false, commit.frame(), rendering_});
+  }
+  using Tracer::render_band;
+  BandResult render_band(const BandJob& job, BandBuffer& target) override {
+    log_->add({true, job.params.frame_index, false});
+    rendering_ = true;
+    const auto give_up = std::chrono::steady_clock::now() + FrameGates::kPatience;
+    for (;;) {
+      apply_commits_ahead();
+      {
+        std::lock_guard lock(gates_->mutex);
+        if (gates_->open_through >= static_cast<int64_t>(job.params.frame_index)) break;
+      }
+      if (std::chrono::steady_clock::now() > give_up) {
+        gates_->gave_up = true;
+        break;
+      }
+      std::this_thread::sleep_for(std::chrono::microseconds(200));
+    }
+    rendering_ = false;
+    std::vector<float> row(static_cast<size_t>(target.width()) * 4, static_cast<float>(job.params.frame_index));
+    for (kuint y = job.params.row_begin; y < job.params.row_end; ++y)
+      target.store(static_cast<int>(y), 0, row.data(), static_cast<size_t>(target.width()));
+    return {};
+  }
+
+ private:
+  bool ahead_;
+  bool rendering_ = false;
+  std::shared_ptr<FrameGates> gates_;
+  std::shared_ptr<Log> log_;
+};
+
+}  // namespace
+
+TEST(FramePipeline, ATracerThatTakesCommitsAheadAppliesThemWhileItRendersTheOthersWithTheirNextJob) {
+  auto gates = std::make_shared<FrameGates>();
+  auto ahead_log = std::make_shared<CommitLoggingTracer::Log>();
+  auto job_log = std::make_shared<CommitLoggingTracer::Log>();
+  std::vector<std::unique_ptr<Tracer>> tracers;
+  tracers.push_back(std::make_unique<CommitLoggingTracer>(true, gates, ahead_log));
+  tracers.push_back(std::make_unique<CommitLoggingTracer>(false, gates, job_log));
+  RendererOptions options;
+  options.balancer = "none";
+  Renderer renderer(std::move(tracers), options);
+  FramePipeline pipeline(renderer);
+  auto scene = std::make_shared<cohort::commit::TracerScene>();
+  renderer.submit_commit(cohort::commit::CommitBuffer::full(scene, 0));
+  constexpr uint64_t kFrames = 6;
+  uint64_t delivered = 0;
+  for (uint64_t f = 0; f < kFrames; ++f) {
+    // Frame f's commit (frame number f + 1) is submitted while frame f - 1 renders, as the core does.
+    cohort::commit::CommitBuffer commit;
+    commit.set_frame(f + 1);
+    commit.set_camera(job_for(f).camera);
+    renderer.submit_commit(commit, [&] { return scene; });
+    if (f > 0) {
+      // The tracer that takes commits ahead has this one before frame f - 1 may finish.
+      auto has_it = [&] {
+        const auto events = ahead_log->read();
+        return !events.empty() && !events.back().band && events.back().frame == f + 1;
+      };
+      for (int i = 0; i < 5000 && !has_it(); ++i)
+        std::this_thread::sleep_for(std::chrono::microseconds(200));
+      gates->open(f - 1);
+    }
+    if (std::optional<FramePipeline::Delivered> done = pipeline.push(job_for(f))) {
+      for (int y = 0; y < kRows; ++y) ASSERT_EQ(pipeline.image().row(y)[0], static_cast<float>(done->stats.frame));
+      EXPECT_EQ(done->stats.dropped, 0);
+      ++delivered;
+    }
+  }
+  gates->open(kFrames - 1);
+  ASSERT_TRUE(pipeline.drain().has_value());
+  EXPECT_EQ(delivered + 1, kFrames);
+  EXPECT_FALSE(gates->gave_up);
+
+  // Each log: the commit of frame f + 1 (with the full resync of frame 0 first) against the band starts.
+  auto applied_before_band = [](const std::vector<CommitLoggingTracer::Event>& log, uint64_t commit) {
+    int64_t last_band = -1;
+    for (const auto& e : log) {
+      if (e.band) last_band = static_cast<int64_t>(e.frame);
+      else if (e.frame == commit) return std::make_pair(last_band, e.during_band);
+    }
+    return std::make_pair(int64_t(-2), false);
+  };
+  const std::vector<CommitLoggingTracer::Event> ahead_events = ahead_log->read(), job_events = job_log->read();
+  for (uint64_t f = 1; f < kFrames; ++f) {
+    // Ahead: applied while frame f - 1's band rendered, after that band's start, never under an earlier one.
+    EXPECT_EQ(applied_before_band(ahead_events, f + 1), std::make_pair(static_cast<int64_t>(f) - 1, true)) << f;
+    // With its job: after frame f - 1's band was done, before frame f's.
+    EXPECT_EQ(applied_before_band(job_events, f + 1), std::make_pair(static_cast<int64_t>(f) - 1, false)) << f;
+  }
+  EXPECT_EQ(applied_before_band(ahead_events, 1), std::make_pair(int64_t(-1), false)) << "the first commits come with the first job";
+  // Every commit reached both once, in order.
+  for (const auto* log : {&ahead_events, &job_events}) {
+    std::vector<uint64_t> commits;
+    for (const auto& e : *log)
+      if (!e.band) commits.push_back(e.frame);
+    EXPECT_EQ(commits, (std::vector<uint64_t>{1, 2, 3, 4, 5, 6}));
+  }
+}

@@ -18,7 +18,12 @@ TLAS, light and joint records cross the wire every frame, and every frame matche
 under a virtual display with remote tracers: the scenario runs, the screenshot is written and not
 uniform; skipped with status 77 without xvfb-run or the viewer), bad_piece (rank 2 sends a piece of its
 band's rows a byte short once: rank 0 refuses that band with the sizes, its rows are re-rendered by the
-others, and every frame matches).
+others, and every frame matches), ahead (the scenario on mpi:1 and mpi:2 alone, the nodes taking 40 ms
+longer a band: each frame's commit is submitted while the band before renders, travels behind that band's
+job and is applied once it is rendered; every frame matches the single-process render), ahead_recovery
+(the same with rank 2 stalled through frame 1: its rows are re-rendered on mpi:1, whose node has already
+applied the next frame's commit; rank 0 says so, and the frame differs from the single-process render at
+most in those rows, the others match).
 """
 import argparse
 import json
@@ -180,6 +185,65 @@ def replay(a):
     print("replay: ok")
 
 
+def ahead(a, stalled=False):
+    os.makedirs(a.out)
+    stream = os.path.join(a.out, "scenario.cdelta")
+    run([a.cohort, "record-scenario", "testmap", "--base", a.testmap_base, "--frames", str(FRAMES), "--out", stream])
+    args = ["--replay", stream, "--base", a.testmap_base, "--width", "96", "--height", "54", "--spp", "1"]
+    if stalled:
+        args.append("--no-convergence")  # each frame as rendered: a re-rendered row's difference stays in it
+    single, cluster = os.path.join(a.out, "single"), os.path.join(a.out, "cluster")
+    run([a.cohort, "render", "--tracers", "embree", "--out", single] + args)
+    flags = mpiexec_flags(a.mpiexec)
+    node = [a.cohort, "node", "testmap", "--base", a.testmap_base, "--tracers", "embree", "--band-delay-ms",
+            "100" if stalled else "40"]
+    env = dict(os.environ)
+    if stalled:
+        env["COHORT_MPI_BAND_TIMEOUT_MS"] = "1000"
+        nodes = ["-np", "1"] + node + [":"] + flags + ["-np", "1"] + node + ["--stall-frame", "1", "--stall-ms", "2500"]
+    else:
+        nodes = ["-np", "2"] + node
+    _, output = run([a.mpiexec] + flags + ["-np", "1", a.cohort, "render", "--tracers", "mpi:1,mpi:2", "--out", cluster] +
+                    args + [":"] + flags + nodes, env=env)
+    if stalled:
+        ahead_recovery_check(single, cluster, output)
+        return
+    compare_frames(single, cluster)
+    if any(o.get("mpi:1") != "rendered" or o.get("mpi:2") != "rendered" for o in tracer_outcomes(cluster)):
+        sys.exit("a remote tracer failed a band of the scenario")
+    for rank in (1, 2):
+        found = re.search(rf"mpi:{rank}: .*\((\d+) commit\(s\) sent ahead of their job\)", output)
+        if not found:
+            sys.exit(f"mpi:{rank}: no count of the commits sent ahead in the log")
+        # Frame 0's commit comes with the first job; every later frame's goes ahead of its job.
+        if int(found.group(1)) != FRAMES - 1:
+            sys.exit(f"mpi:{rank}: {found.group(1)} commit(s) went ahead of their job; {FRAMES - 1} should have")
+    print("ahead: ok")
+
+
+def ahead_recovery_check(single, cluster, output):
+    with open(os.path.join(cluster, "stats.json")) as f:
+        stats = json.load(f)["frames"]
+    if len(stats) != FRAMES:
+        sys.exit(f"{len(stats)} of {FRAMES} frames delivered")
+    if "no answer for rows" not in stats[1]["tracers"][1].get("error", ""):
+        sys.exit(f"frame 1: rank 2's band should have timed out: {stats[1]['tracers'][1]}")
+    warned = re.findall(r"mpi:1: rows \[\d+, \d+\) of frame (\d+) again \(re-rendering another tracer's rows\)", output)
+    if "1" not in warned:
+        sys.exit("rank 0 should have said that mpi:1 re-rendered rows of frame 1 after the next frame's commit went ahead")
+    for f, frame in enumerate(stats):
+        name = f"frame_{f:04d}.png"
+        (w, h, ca, pa), (_, _, cb, pb) = read_image(os.path.join(single, name)), read_image(os.path.join(cluster, name))
+        rows = {p // w for p in range(w * h) if pa[p * ca:p * ca + 3] != pb[p * cb:p * cb + 3]}
+        stalled_band = frame["tracers"][1]
+        recovered = set(range(stalled_band["row_begin"], stalled_band["row_end"])) \
+            if stalled_band["outcome"] in ("timed_out", "threw") and str(f) in warned else set()
+        print(f"{name}: {len(rows)} row(s) differ; rows re-rendered after a commit ahead: {len(recovered)}")
+        if not rows <= recovered:
+            sys.exit(f"{name}: rows {sorted(rows - recovered)} differ outside the re-rendered ones")
+    print("ahead_recovery: ok")
+
+
 def play(a):
     if not shutil.which("xvfb-run"):
         print("SKIP: xvfb-run is not installed")
@@ -237,7 +301,7 @@ def bench(a):
 def main():
     parser = argparse.ArgumentParser()
     parser.add_argument("case", choices=["match", "mixed", "stall", "killed", "version", "load_error", "bench", "protocol", "replay",
-                                           "play", "bad_piece"])
+                                           "play", "bad_piece", "ahead", "ahead_recovery"])
     parser.add_argument("--mpiexec", required=True)
     parser.add_argument("--cohort", required=True)
     parser.add_argument("--map", required=True)
@@ -257,6 +321,9 @@ def main():
         return
     if a.case == "replay":
         replay(a)
+        return
+    if a.case in ("ahead", "ahead_recovery"):
+        ahead(a, stalled=a.case == "ahead_recovery")
         return
     if a.case == "play":
         play(a)

@@ -179,10 +179,10 @@ TEST(WireCodec, BandRowsCloseABandAndEveryFieldIsChecked) {
   done.pieces = 3;
   done.aux = true;
   done.device_ms = 2.5;
-  done.timing = {2.5, 2.0, 1.5, 0.25, 0.75, 0.5};
+  done.timing = {2.5, 2.0, 1.5, 0.25, 0.75, 0.5, 0.125};
   done.row_work = {3.0f, 4.0f, 5.0f};
   const std::vector<uint8_t> payload = wire::encode_band_rows(done);
-  EXPECT_EQ(payload.size(), 6 * 4 + 8 + 48 + 8 + 3 * 4) << "no pixels: they went ahead as pieces";
+  EXPECT_EQ(payload.size(), 6 * 4 + 8 + 56 + 8 + 3 * 4) << "no pixels: they went ahead as pieces";
   const wire::BandRows back = wire::decode_band_rows(payload);
   EXPECT_EQ(back.row_begin, 10u);
   EXPECT_EQ(back.row_end, 13u);
@@ -194,6 +194,7 @@ TEST(WireCodec, BandRowsCloseABandAndEveryFieldIsChecked) {
   EXPECT_EQ(back.timing.render_ms, 2.0);
   EXPECT_EQ(back.timing.first_piece_ms, 0.75);
   EXPECT_EQ(back.timing.commit_ms, 0.5);
+  EXPECT_EQ(back.timing.commit_ahead_ms, 0.125);
   EXPECT_EQ(back.row_work, done.row_work);
   expect_every_prefix_refused(payload, [](const auto& p) { return wire::decode_band_rows(p); });
 
@@ -211,6 +212,8 @@ TEST(WireCodec, BandRowsCloseABandAndEveryFieldIsChecked) {
   EXPECT_NE(changed([](wire::BandRows& b) { b.timing.send_ms = std::nan(""); }).find("not a duration"),
             std::string::npos);
   EXPECT_NE(changed([](wire::BandRows& b) { b.device_ms = -1.0; }).find("not a duration"), std::string::npos);
+  EXPECT_NE(changed([](wire::BandRows& b) { b.timing.commit_ahead_ms = -0.5; }).find("not a duration"),
+            std::string::npos);
   std::vector<uint8_t> bad_aux = payload;
   bad_aux[20] = 2;  // the aux flag
   EXPECT_NE(refusal([&] { wire::decode_band_rows(bad_aux); }).find("aux flag 2"), std::string::npos);

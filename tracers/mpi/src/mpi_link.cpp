@@ -216,7 +216,8 @@ bool MpiSession::flush_sends(int destination, MpiClock::time_point deadline) {
   }
 }
 
-std::optional<std::vector<uint8_t>> MpiSession::receive(int source, MpiClock::time_point deadline, PieceSink* pieces) {
+std::optional<std::vector<uint8_t>> MpiSession::receive(int source, MpiClock::time_point deadline, PieceSink* pieces,
+                                                        const std::function<void()>& between_polls) {
   // Polls: yields at first (a band's answer is often close), then sleeps briefly so that a waiting
   // tracer thread does not take a core from the ones rendering. A piece that came starts it over: the
   // band's next piece, or its end, follows.
@@ -265,11 +266,21 @@ std::optional<std::vector<uint8_t>> MpiSession::receive(int source, MpiClock::ti
       impl_->test_sends();
     }
     if (MpiClock::now() >= deadline) return std::nullopt;
+    if (between_polls) between_polls();
     if (polls < 200)
       std::this_thread::yield();
     else
       std::this_thread::sleep_for(std::chrono::microseconds(polls < 2000 ? 20 : 200));
   }
+}
+
+bool MpiSession::control_waiting(int source) {
+  std::lock_guard lock(mutex_);
+  if (finalized_) return false;
+  if (impl_->receives.count(source)) return true;  // matched, still arriving
+  int found = 0;
+  MPI_Iprobe(source, kTag, impl_->comm, &found, MPI_STATUS_IGNORE);
+  return found != 0;
 }
 
 bool MpiSession::settle_pieces(int source, MpiClock::time_point deadline) {

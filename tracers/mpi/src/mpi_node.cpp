@@ -4,6 +4,8 @@
 
 #include <algorithm>
 #include <atomic>
+#include <condition_variable>
+#include <mutex>
 #include <csignal>
 #include <exception>
 #include <functional>
@@ -66,8 +68,8 @@ class Node {
       }
       wire::Message& m = *received;
       switch (m.kind) {
-        case wire::Kind::commit: timed_commit([&] { apply_commit(m); }); break;
-        case wire::Kind::full_local: timed_commit([&] { apply_full_local(m); }); break;
+        case wire::Kind::commit: timed_commit(mpi, [&] { apply_commit(m); }); break;
+        case wire::Kind::full_local: timed_commit(mpi, [&] { apply_full_local(m); }); break;
         case wire::Kind::band_job: render(mpi, m); break;
         case wire::Kind::shutdown:
           spdlog::info("node {}: shutdown from rank 0 after {} band(s)", mpi.rank(), bands_);
@@ -80,10 +82,21 @@ class Node {
   }
 
  private:
-  template <class Apply> void timed_commit(Apply&& apply) {
+  // A commit comes after the job of the band it follows (rank 0 sends the commits it takes while a band
+  // renders right behind that band's job: MpiTracer::apply), so it is applied here, once that band is
+  // rendered and never under it, while rank 0 still receives the band and waits for the frame. The
+  // band's last pieces may still be on their way: they keep moving meanwhile (a library may move a large
+  // message only inside MPI calls).
+  template <class Apply> void timed_commit(MpiSession& mpi, Apply&& apply) {
     const auto start = MpiClock::now();
-    apply();
-    commit_ms_ += ms_since(start);
+    if (mpi.progress_sends() > 0)
+      run_while_sending(mpi, apply);
+    else
+      apply();
+    const double ms = ms_since(start);
+    // With the next job already waiting, the commit was in the round trip's way (at most by its time);
+    // otherwise it was hidden.
+    (mpi.control_waiting(kRank0) ? commit_ms_ : commit_ahead_ms_) += ms;
   }
 
   // A refused or failed commit leaves the scene behind rank 0's: every band fails, asking for a full
@@ -156,9 +169,12 @@ class Node {
       std::this_thread::sleep_for(std::chrono::milliseconds(options_.stall_ms));
     }
     const auto start = MpiClock::now();
+    // A slow node's render, counted in its time.
+    if (options_.band_delay_ms > 0) std::this_thread::sleep_for(std::chrono::milliseconds(options_.band_delay_ms));
     wire::NodeTiming timing;
     timing.commit_ms = commit_ms_;
-    commit_ms_ = 0.0;
+    timing.commit_ahead_ms = commit_ahead_ms_;
+    commit_ms_ = commit_ahead_ms_ = 0.0;
     // The pieces of the last band are sent from target_ itself: before its rows are written again,
     // they must have left (they have, unless rank 0 stopped reading: then this band goes to a fresh
     // buffer, and the old one stays with its sends).
@@ -236,43 +252,62 @@ class Node {
   Rendered render_while_sending(MpiSession& mpi, const core::BandJob& job, const std::vector<int>& cuts,
                                 const std::function<void(size_t)>& post_piece) {
     Rendered rendered;
-    std::atomic<bool> finished{false};
-    std::exception_ptr error;
-    std::thread renderer([&] {
-      try {
-        if (tracers_.size() == 1) {
-          core::BandResult result = tracers_.front()->render_band_in_pieces(job, target_, cuts, post_piece);
-          rendered.tracer_ms = result.device_ms;
-          rendered.row_work = std::move(result.row_work);
-        } else {
-          bool complete_work = true;
-          for (size_t i = 0; i + 1 < cuts.size(); ++i) {
-            core::BandJob piece = job;
-            piece.params.row_begin = uint32_t(cuts[i]);
-            piece.params.row_end = uint32_t(cuts[i + 1]);
-            double ms = 0.0;
-            std::vector<float> work = render_split(piece, ms);
-            rendered.tracer_ms += ms;
-            complete_work = complete_work && work.size() == size_t(cuts[i + 1] - cuts[i]);
-            if (complete_work) rendered.row_work.insert(rendered.row_work.end(), work.begin(), work.end());
-            post_piece(i);
-          }
-          if (!complete_work) rendered.row_work.clear();
+    rendered.mpi_ms = run_while_sending(mpi, [&] {
+      if (tracers_.size() == 1) {
+        core::BandResult result = tracers_.front()->render_band_in_pieces(job, target_, cuts, post_piece);
+        rendered.tracer_ms = result.device_ms;
+        rendered.row_work = std::move(result.row_work);
+      } else {
+        bool complete_work = true;
+        for (size_t i = 0; i + 1 < cuts.size(); ++i) {
+          core::BandJob piece = job;
+          piece.params.row_begin = uint32_t(cuts[i]);
+          piece.params.row_end = uint32_t(cuts[i + 1]);
+          double ms = 0.0;
+          std::vector<float> work = render_split(piece, ms);
+          rendered.tracer_ms += ms;
+          complete_work = complete_work && work.size() == size_t(cuts[i + 1] - cuts[i]);
+          if (complete_work) rendered.row_work.insert(rendered.row_work.end(), work.begin(), work.end());
+          post_piece(i);
         }
+        if (!complete_work) rendered.row_work.clear();
+      }
+    });
+    return rendered;
+  }
+
+  // Runs `work` on a thread of its own while this thread keeps the sends going (with naps, so as not to
+  // take a core from a CPU tracer); rethrows what it threw. Returns the time spent in MPI calls.
+  // The work's end wakes this thread at once (band_rows follows it), not at its next nap's end.
+  static double run_while_sending(MpiSession& mpi, const std::function<void()>& work) {
+    std::mutex mutex;
+    std::condition_variable ended;
+    bool finished = false;
+    std::exception_ptr error;
+    std::thread worker([&] {
+      try {
+        work();
       } catch (...) {
         error = std::current_exception();
       }
+      std::lock_guard lock(mutex);
       finished = true;
+      ended.notify_one();
     });
-    while (!finished.load()) {
+    double mpi_ms = 0.0;
+    std::unique_lock lock(mutex);
+    while (!finished) {
+      lock.unlock();
       const auto call = MpiClock::now();
       const bool sending = mpi.progress_sends() > 0;
-      rendered.mpi_ms += ms_since(call);
-      std::this_thread::sleep_for(std::chrono::microseconds(sending ? 30 : 60));
+      mpi_ms += ms_since(call);
+      lock.lock();
+      ended.wait_for(lock, std::chrono::microseconds(sending ? 30 : 60), [&] { return finished; });
     }
-    renderer.join();
+    lock.unlock();
+    worker.join();
     if (error) std::rethrow_exception(error);
-    return rendered;
+    return mpi_ms;
   }
 
   // The band split among the node's tracers by their last speed, rendered in parallel; a tracer that
@@ -350,7 +385,8 @@ class Node {
   bool diverged_ = false;
   std::string divergence_;
   bool stalled_ = false;
-  double commit_ms_ = 0.0;  // applying commits since the last band
+  double commit_ms_ = 0.0;        // applying commits since the last band, with the next job waiting
+  double commit_ahead_ms_ = 0.0;  // applying commits since the last band, before the next job came
   uint64_t bands_ = 0;
 };
 

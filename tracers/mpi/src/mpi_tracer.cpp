@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <atomic>
 #include <cstring>
+#include <functional>
 #include <map>
 
 #include <fmt/format.h>
@@ -201,19 +202,25 @@ void MpiTracer::adopt(const wire::Hello& hello) {
 
 MpiTracer::~MpiTracer() {
   const MpiLinkStats s = link_stats();
-  if (s.bands > 0) {
-    const double n = double(s.bands);
+  if (s.resync_bands > 0)
+    spdlog::info("mpi:{}: {} band(s) right after a full resync (the node applying the scene and building its BVHs), "
+                 "round trip {:.2f} ms each; the figures below leave them out", options_.rank, s.resync_bands,
+                 s.total_resync_round_trip_ms / double(s.resync_bands));
+  if (s.steady_bands > 0) {
+    const double n = double(s.steady_bands);
     const double round_trip = s.total_round_trip_ms / n, node = s.total_node_ms / n;
     spdlog::info("mpi:{}: {} band(s), {:.1f} KiB sent and {:.1f} KiB received a band ({} pieces), round trip {:.2f} ms "
                  "a band: on the node {:.2f} ms (its tracers' render_band {:.2f} ms, of it their own {:.2f} ms; MPI "
                  "calls {:.2f} ms; first piece sent after {:.2f} ms), rank 0 matched it after {:.2f} ms; {:.2f} ms "
                  "beyond the node's time, "
-                 "of it {:.2f} ms applying the commit before the job (the rest: the job out, the last piece and "
-                 "band_rows back)",
-                 options_.rank, s.bands, double(s.bytes_sent) / n / 1024.0, double(s.bytes_received) / n / 1024.0,
+                 "of it {:.2f} ms applying commits with the job waiting (the rest: the job out, the last piece and "
+                 "band_rows back); {:.2f} ms a band applying commits before the job came ({} commit(s) sent ahead of "
+                 "their job)",
+                 options_.rank, s.steady_bands, double(s.bytes_sent) / double(s.bands) / 1024.0,
+                 double(s.bytes_received) / double(s.bands) / 1024.0,
                  s.last_pieces, round_trip, node, s.total_node_render_ms / n, s.total_node_tracer_ms / n,
                  s.total_node_send_ms / n, s.total_node_first_piece_ms / n, s.total_first_piece_ms / n, round_trip - node,
-                 s.total_node_commit_ms / n);
+                 s.total_node_commit_ms / n, s.total_node_commit_ahead_ms / n, s.commits_ahead);
   }
   // The node stays for later tracers of this run; the session's end tells every node to leave.
   try {
@@ -237,6 +244,13 @@ void MpiTracer::send(int kind, uint64_t sequence, const std::vector<uint8_t>& pa
 }
 
 void MpiTracer::apply(const commit::CommitBuffer& commit) {
+  if (in_band_) {
+    // Taken ahead (from inside render_band, after the band's job): the node applies it once that band
+    // is rendered, before the next job comes.
+    commits_ahead_of_band_ = true;
+    std::lock_guard lock(stats_mutex_);
+    ++stats_.commits_ahead;
+  }
   if (!commit.is_full_resync()) {
     if (node_needs_resync_)
       throw std::runtime_error(fmt::format("mpi:{}: {}; it needs a full resync", options_.rank, node_failure_));
@@ -257,6 +271,7 @@ void MpiTracer::apply(const commit::CommitBuffer& commit) {
   }
   node_needs_resync_ = false;
   after_full_resync_ = true;
+  ++full_resyncs_sent_;
 }
 
 void MpiTracer::take_late_answers() {
@@ -312,6 +327,15 @@ core::BandResult MpiTracer::render_band(const core::BandJob& job, core::BandBuff
     throw std::invalid_argument(fmt::format("mpi:{}: rows [{}, {}) of a {}-wide frame do not fit the {}x{} target",
                                             options_.rank, job.params.row_begin, job.params.row_end, job.camera.width,
                                             target.width(), target.height()));
+  if (commits_ahead_of_band_ && job.params.frame_index == band_frame_)
+    spdlog::warn("mpi:{}: rows [{}, {}) of frame {} again (re-rendering another tracer's rows), but the node has "
+                 "already applied the commits that came after its band of that frame: they show the next frame's "
+                 "world (the camera is this frame's)", options_.rank, job.params.row_begin, job.params.row_end,
+                 job.params.frame_index);
+  commits_ahead_of_band_ = false;
+  band_frame_ = job.params.frame_index;
+  const uint64_t resyncs_before = full_resyncs_sent_;
+  const bool first_after_resync = after_full_resync_;
   const uint64_t id = next_band_job++;
   wire::BandRequest request;
   request.job = job;
@@ -321,6 +345,14 @@ core::BandResult MpiTracer::render_band(const core::BandJob& job, core::BandBuff
   request.pieces = wire::band_pieces(job.params.row_end - job.params.row_begin, options_.pieces);
   const auto start = MpiClock::now();
   send(int(wire::Kind::band_job), id, wire::encode_band_request(request));
+  // From here on, what the core submits goes to the node behind this job (Tracer::apply_commits_ahead,
+  // between polls): the node applies it once this band is rendered, while rank 0 waits for the frame.
+  in_band_ = true;
+  struct LeaveBand {
+    bool& in_band;
+    ~LeaveBand() { in_band = false; }
+  } leave_band{in_band_};
+  const std::function<void()> between_polls = [this] { apply_commits_ahead(); };
   double expected_ms;
   {
     std::lock_guard lock(stats_mutex_);
@@ -342,7 +374,7 @@ core::BandResult MpiTracer::render_band(const core::BandJob& job, core::BandBuff
     pieces.refused = pieces.stale = 0;
   };
   for (;;) {
-    std::optional<std::vector<uint8_t>> bytes = mpi.receive(options_.rank, deadline, &pieces);
+    std::optional<std::vector<uint8_t>> bytes = mpi.receive(options_.rank, deadline, &pieces, between_polls);
     count_pieces();
     if (!bytes) fail_timed_out(id, start, job);
     {
@@ -412,25 +444,34 @@ core::BandResult MpiTracer::render_band(const core::BandJob& job, core::BandBuff
     if (const std::string problem = pieces.problem(); !problem.empty())
       throw std::runtime_error(fmt::format("mpi:{}: refused the band's rows: {}", options_.rank, problem));
     const double round_trip = ms_since(start);
-    after_full_resync_ = false;
+    if (full_resyncs_sent_ == resyncs_before) after_full_resync_ = false;  // not when one went ahead of the next band
     {
       std::lock_guard lock(stats_mutex_);
       ++stats_.bands;
       stats_.last_round_trip_ms = round_trip;
-      stats_.total_round_trip_ms += round_trip;
       stats_.last_node_ms = rows.timing.total_ms;
+      stats_.last_pieces = request.pieces;
+      stats_.last_band_bytes_sent = pending_sent_;
+      stats_.last_band_bytes_received = pieces.bytes + bytes->size();
+      pending_sent_ = 0;
+    }
+    if (first_after_resync) {
+      std::lock_guard lock(stats_mutex_);
+      ++stats_.resync_bands;
+      stats_.total_resync_round_trip_ms += round_trip;
+    } else {
+      std::lock_guard lock(stats_mutex_);
+      ++stats_.steady_bands;
+      stats_.total_round_trip_ms += round_trip;
       stats_.total_node_ms += rows.timing.total_ms;
       stats_.total_node_render_ms += rows.timing.render_ms;
       stats_.total_node_tracer_ms += rows.timing.device_ms;
       stats_.total_node_send_ms += rows.timing.send_ms;
       stats_.total_node_commit_ms += rows.timing.commit_ms;
+      stats_.total_node_commit_ahead_ms += rows.timing.commit_ahead_ms;
       stats_.total_node_first_piece_ms += rows.timing.first_piece_ms;
       stats_.total_first_piece_ms +=
           std::chrono::duration<double, std::milli>(pieces.first_matched - start).count();
-      stats_.last_pieces = request.pieces;
-      stats_.last_band_bytes_sent = pending_sent_;
-      stats_.last_band_bytes_received = pieces.bytes + bytes->size();
-      pending_sent_ = 0;
     }
     core::BandResult result;
     result.device_ms = rows.device_ms;

@@ -497,7 +497,7 @@ BandRows decode_band_rows(const uint8_t* payload, size_t size) {
   if (!b.row_work.empty() && b.row_work.size() != rows)
     r.fail(fmt::format("{} row work values for {} rows", b.row_work.size(), rows));
   const double times[] = {b.device_ms, b.timing.total_ms, b.timing.render_ms, b.timing.device_ms, b.timing.send_ms,
-                          b.timing.first_piece_ms, b.timing.commit_ms};
+                          b.timing.first_piece_ms, b.timing.commit_ms, b.timing.commit_ahead_ms};
   for (double t : times)
     if (!(t >= 0.0 && t < 1e9)) r.fail(fmt::format("time {} ms is not a duration", t));
   return b;

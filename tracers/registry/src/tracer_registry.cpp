@@ -153,6 +153,8 @@ std::unique_ptr<core::Tracer> make_tracer(const TracerSpec& spec) {
       options.band_timeout = std::chrono::milliseconds(std::max(1L, std::atol(ms)));
     if (const char* pieces = std::getenv("COHORT_MPI_BAND_PIECES"); pieces && *pieces)
       options.pieces = uint32_t(std::clamp(std::atol(pieces), 1L, long(wire::kMaxPieces)));
+    if (const char* ahead = std::getenv("COHORT_MPI_COMMITS_AHEAD"); ahead && *ahead)
+      options.commits_ahead = std::string(ahead) != "0";
     return std::make_unique<MpiTracer>(options);
   }
 #endif

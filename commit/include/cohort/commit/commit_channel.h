@@ -46,6 +46,9 @@ class CommitChannel {
   // begin_frame on this channel. It is empty (frame() unchanged) when nothing changed.
   const CommitBuffer& begin_frame();
 
+  // Whether something was published since the last begin_frame (a full resync still to be taken, too).
+  bool has_pending() const;
+
   // Tracer thread: the last commit could not be applied; the next publish sends a full resync.
   void request_resync();
   // Whether a resync was requested and no publish has answered it yet.

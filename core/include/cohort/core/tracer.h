@@ -60,6 +60,27 @@ class Tracer {
   // target, which is resized to the camera's size when it differs. Derived classes say
   // `using core::Tracer::render_band;` so that it is not hidden.
   BandResult render_band(const BandJob& job, FrameBuffer& target);
+
+  // Commits ahead. A tracer whose apply() only hands the commit on and whose scene copy changes only
+  // after the band it is rendering (a remote tracer: its node applies what comes after the band's job
+  // once that band is rendered) may take the commits the core submits while it renders, instead of with
+  // its next job, so that they travel, and are applied, while the band renders (docs/cluster.md). Such a
+  // tracer says so here and calls apply_commits_ahead() from inside render_band(), after whatever the
+  // job must see has left; the Renderer then applies, through apply() on this thread, what it has
+  // published for this tracer since the job was handed out. Everything else stays as it is: the next
+  // job still brings what was published after that.
+  virtual bool takes_commits_ahead() const { return false; }
+  using CommitsAhead = std::function<void()>;
+  // The Renderer's hook (set once, before the first job); without one apply_commits_ahead does nothing.
+  void set_commits_ahead(CommitsAhead hook) { commits_ahead_ = std::move(hook); }
+
+ protected:
+  void apply_commits_ahead() {
+    if (commits_ahead_) commits_ahead_();
+  }
+
+ private:
+  CommitsAhead commits_ahead_;
 };
 
 }  // namespace cohort::core

@@ -7,6 +7,7 @@
 
 #include <chrono>
 #include <cstdint>
+#include <functional>
 #include <list>
 #include <mutex>
 #include <optional>
@@ -52,8 +53,12 @@ class MpiSession {
   // With `pieces`, messages on piece tags that come first are received where it places them, and a
   // control message is returned only once every piece matched before it has landed (messages from
   // one source are matched in the order they were sent, so a band's pieces are in place when the
-  // band_rows that closes it is returned). Without, pieces wait unmatched.
-  std::optional<std::vector<uint8_t>> receive(int source, MpiClock::time_point deadline, PieceSink* pieces = nullptr);
+  // band_rows that closes it is returned). Without, pieces wait unmatched. `between_polls`, when given,
+  // runs between polls without the session's lock (it may send: a remote tracer's commits ahead).
+  std::optional<std::vector<uint8_t>> receive(int source, MpiClock::time_point deadline, PieceSink* pieces = nullptr,
+                                              const std::function<void()>& between_polls = {});
+  // Whether a control message from `source` is waiting to be received (MPI_Iprobe; no wait).
+  bool control_waiting(int source);
   // Waits at most until the deadline for the pieces from `source` that are being received into place
   // to land; false when some have not (they still land where they were placed, later).
   bool settle_pieces(int source, MpiClock::time_point deadline);

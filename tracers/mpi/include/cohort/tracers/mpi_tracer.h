@@ -37,11 +37,20 @@ struct MpiTracerOptions {
   // receives each straight into its target rows, so the round trip is the node's render plus one
   // piece's way back instead of the whole band's.
   uint32_t pieces = 4;
+  // Forward the commits the core submits while a band renders right after that band's job
+  // (Tracer::takes_commits_ahead), so that the node applies them once its band is rendered, before the
+  // next job comes, instead of with it. COHORT_MPI_COMMITS_AHEAD=0 turns it off (for comparison).
+  bool commits_ahead = true;
 };
 
 // What crossed the wire for this tracer, for `cohort bench devices` and the logs.
 struct MpiLinkStats {
   uint64_t bands = 0;
+  // The totals below are over the bands in steady state: the first band after a full resync (whose
+  // round trip holds the node applying the whole scene and building its BVHs) is counted apart.
+  uint64_t steady_bands = 0;
+  uint64_t resync_bands = 0;
+  double total_resync_round_trip_ms = 0.0;
   uint64_t bytes_sent = 0, bytes_received = 0;  // whole messages, headers included
   uint64_t last_band_bytes_sent = 0, last_band_bytes_received = 0;  // commit(s) and job since the last band, and its rows
   double last_round_trip_ms = 0.0;  // job sent -> rows received
@@ -56,7 +65,11 @@ struct MpiLinkStats {
   double total_node_render_ms = 0.0;
   double total_node_tracer_ms = 0.0;
   double total_node_send_ms = 0.0;
-  double total_node_commit_ms = 0.0;  // decoding and applying the commits before the job (not in node time)
+  // On the node, decoding and applying commits (not in node time): those it applied when the next job
+  // was already waiting (in the round trip's way), and those applied before it came (hidden).
+  double total_node_commit_ms = 0.0;
+  double total_node_commit_ahead_ms = 0.0;
+  uint64_t commits_ahead = 0;  // commits forwarded while a band rendered, after its job
   double total_first_piece_ms = 0.0;
   double total_node_first_piece_ms = 0.0;  // on the node: job taken -> first piece posted
   uint32_t last_pieces = 0;
@@ -74,6 +87,8 @@ class MpiTracer : public core::Tracer {
 
   std::string name() const override;
   bool renders_on_gpu() const override { return gpu_; }
+  // Its apply() only sends the commit on; the node applies it after the band it renders.
+  bool takes_commits_ahead() const override { return options_.commits_ahead; }
   void apply(const commit::CommitBuffer& commit) override;
   using core::Tracer::render_band;
   core::BandResult render_band(const core::BandJob& job, core::BandBuffer& target) override;
@@ -100,6 +115,10 @@ class MpiTracer : public core::Tracer {
   uint64_t hashed_fingerprint_ = 0;
   bool node_needs_resync_ = false;
   bool after_full_resync_ = false;
+  uint64_t full_resyncs_sent_ = 0;
+  bool in_band_ = false;             // inside render_band, its job sent: apply() is a commit ahead
+  uint32_t band_frame_ = 0;          // the frame index of the last band sent
+  bool commits_ahead_of_band_ = false;  // commits went ahead of the node since the last band's job
   uint64_t timed_out_job_ = 0;
   MpiClock::time_point timed_out_start_{};
   std::string node_failure_;

@@ -20,8 +20,9 @@ namespace cohort::tracers::wire {
 constexpr uint32_t kMagic = 0x504d4843u;  // "CHMP" in memory order
 // 2: vertex colours in scenes and BLAS uploads; 3: BandJob::keep_on_device; 4: a band's rows travel in
 // pieces, raw, on tags of their own (band_job names the piece count, band_rows closes the band);
-// 5: KMaterial carries an environment cube (128 bytes).
-constexpr uint16_t kProtocolVersion = 5;
+// 5: KMaterial carries an environment cube (128 bytes); 6: NodeTiming tells commits applied before the
+// job came from those in its way (commits travel ahead of their job, docs/cluster.md).
+constexpr uint16_t kProtocolVersion = 6;
 
 enum class Kind : uint16_t {
   hello = 1,        // node -> 0: versions, what scene it loaded, its tracers
@@ -142,10 +143,12 @@ struct NodeTiming {
   double send_ms = 0.0;
   double first_piece_ms = 0.0;  // job taken -> first piece posted
   // Decoding and applying the commits that came since the last band (before this job, on the same
-  // ordered stream, so part of the round trip but not of total_ms).
+  // ordered stream; not in total_ms): those after which this job was already waiting (so in the round
+  // trip's way, at most by their time), and those applied before it came (hidden while rank 0 waited).
   double commit_ms = 0.0;
+  double commit_ahead_ms = 0.0;
 };
-static_assert(sizeof(NodeTiming) == 48, "NodeTiming travels as it lies: six doubles");
+static_assert(sizeof(NodeTiming) == 56, "NodeTiming travels as it lies: seven doubles");
 
 // The band_rows message: the band is done. Its pieces went ahead on their own tags: `pieces` of colour
 // rows in the band format (6 bytes a pixel as rgb16f), and as many of aux texels when `aux`.
