@@ -32,6 +32,7 @@ KFN KSceneRef k_trace_scene_ref(const KTraceCtx* ctx) {
   r.tlas_nodes = ctx->scene.tlas_nodes;
   r.instance_count = ctx->scene.instance_count;
   r.tlas_node_count = ctx->scene.tlas_node_count;
+  r.triangle_edges = ctx->scene.triangle_edges;
   return r;
 }
 
