@@ -1,5 +1,10 @@
 // kernel/bvh_traverse.h compiled as C++: closest/any/shadow queries over BLAS + TLAS from core/bvh.h
 // against brute force over every instance's triangles (same triangle test, so t must match exactly).
+// bvh_traverse_edges_test.cpp compiles this file again with K_BVH_TRIANGLE_EDGES (the CUDA build's
+// leaves), as suite BvhTraverseEdges.
+#ifndef BVH_TRAVERSE_SUITE
+#define BVH_TRAVERSE_SUITE BvhTraverse
+#endif
 #include <cmath>
 #include <cstring>
 #include <random>
@@ -72,12 +77,8 @@ Mesh random_soup(int count, uint32_t seed, float extent, float size, int materia
   return m;
 }
 
-// A flat copy of everything the kernel reads, as a tracer would upload it; `edges`: with the triangles'
-// KTriangleEdges, which the CUDA tracer's walk reads instead of the vertices.
+// A flat copy of everything the kernel reads, as a tracer would upload it.
 struct FlatScene {
-  explicit FlatScene(bool with_edges = false) : edges(with_edges) {}
-  bool edges = false;
-  std::vector<KTriangleEdges> triangle_edges;
   std::vector<KVertex> vertices;
   std::vector<KTriangle> triangles;
   std::vector<KBvhNode> blas_nodes;
@@ -113,16 +114,22 @@ struct FlatScene {
     instances.push_back(inst);
   }
 
+  std::vector<KTriangleEdges> triangle_edges;
+
   void build() {
     tlas = build_tlas(instances, blas_roots);
-    triangle_edges.assign(edges ? triangles.size() : 0, KTriangleEdges{});
-    for (size_t t = 0; t < triangle_edges.size(); ++t) k_triangle_edges_write(&triangle_edges[t], vertices.data(), triangles[t]);
+    triangle_edges.resize(triangles.size());
+    for (size_t t = 0; t < triangles.size(); ++t) k_triangle_edges_write(&triangle_edges[t], vertices.data(), triangles[t]);
   }
 
   KSceneRef ref() const {
+#ifdef K_BVH_TRIANGLE_EDGES
+    return KSceneRef{triangle_edges.data(), blas_nodes.data(), blases.data(), instances.data(),
+                     tlas.data(),           kuint(instances.size()), kuint(tlas.size())};
+#else
     return KSceneRef{vertices.data(), triangles.data(), blas_nodes.data(), blases.data(), instances.data(),
-                     tlas.data(),     kuint(instances.size()), kuint(tlas.size()),
-                     edges ? triangle_edges.data() : nullptr};
+                     tlas.data(),     kuint(instances.size()), kuint(tlas.size())};
+#endif
   }
 
   static void invert_affine(const float* m, float* inv) {
@@ -225,20 +232,15 @@ float random_transform(std::mt19937& rng, float* m, float spread) {
 
 }  // namespace
 
-// Every query both ways a leaf's triangles can be read: through their vertex indices, and as KTriangleEdges.
-class BvhTraverse : public ::testing::TestWithParam<bool> {};
-INSTANTIATE_TEST_SUITE_P(Triangles, BvhTraverse, ::testing::Values(false, true),
-                         [](const ::testing::TestParamInfo<bool>& info) { return info.param ? "edges" : "vertices"; });
-
-TEST_P(BvhTraverse, RandomSoupMatchesBruteForce) {
-  FlatScene s(GetParam());
+TEST(BVH_TRAVERSE_SUITE, RandomSoupMatchesBruteForce) {
+  FlatScene s;
   s.add_instance(s.add_mesh(random_soup(3000, 7, 100.0f, 4.0f)), kIdentity, K_MASK_PRIMARY | K_MASK_SHADOW);
   s.build();
   EXPECT_GT(expect_matches_brute_force(s, 3000, 11, 120.0f, K_MASK_PRIMARY), 300);
 }
 
-TEST_P(BvhTraverse, InstancesWithRotationScaleTranslationAndMasks) {
-  FlatScene s(GetParam());
+TEST(BVH_TRAVERSE_SUITE, InstancesWithRotationScaleTranslationAndMasks) {
+  FlatScene s;
   kuint meshes[3] = {s.add_mesh(random_soup(400, 1, 10.0f, 2.0f)), s.add_mesh(random_soup(50, 2, 3.0f, 1.0f)),
                      s.add_mesh(random_soup(1500, 3, 20.0f, 1.5f))};
   std::mt19937 rng(5);
@@ -254,8 +256,8 @@ TEST_P(BvhTraverse, InstancesWithRotationScaleTranslationAndMasks) {
   EXPECT_GT(expect_matches_brute_force(s, 500, 22, 160.0f, K_MASK_SHADOW), 50);
 }
 
-TEST_P(BvhTraverse, ShadowRaysIgnoreNoShadowInstances) {
-  FlatScene s(GetParam());
+TEST(BVH_TRAVERSE_SUITE, ShadowRaysIgnoreNoShadowInstances) {
+  FlatScene s;
   kuint wall = s.add_mesh(Mesh{{vtx(-1, -1, 0), vtx(1, -1, 0), vtx(0, 1, 0)}, {{0, 1, 2, 0}}});
   s.add_instance(wall, kIdentity, K_MASK_PRIMARY);  // noShadows: visible, casts no shadow
   s.build();
@@ -269,10 +271,10 @@ TEST_P(BvhTraverse, ShadowRaysIgnoreNoShadowInstances) {
   EXPECT_EQ(T.x, 1.0f);
 }
 
-TEST_P(BvhTraverse, ShadowTransmittanceIsTheProductOverSurfaces) {
+TEST(BVH_TRAVERSE_SUITE, ShadowTransmittanceIsTheProductOverSurfaces) {
   // Materials 0 (opaque), 1 (tinted) and 2 (pass-through) mixed; the transmittance must equal the
   // product over every surface brute force finds, and an opaque surface must stop the query.
-  FlatScene s(GetParam());
+  FlatScene s;
   kuint mesh = s.add_mesh(random_soup(2000, 13, 60.0f, 6.0f, 3));
   s.add_instance(mesh, kIdentity, K_MASK_PRIMARY | K_MASK_SHADOW);
   float m[12] = {0.5f, 0, 0, 40, 0, 0.5f, 0, 0, 0, 0, 0.5f, 0};
@@ -297,9 +299,9 @@ TEST_P(BvhTraverse, ShadowTransmittanceIsTheProductOverSurfaces) {
   EXPECT_GT(partial, 50) << "the test must see rays through tinted surfaces";
 }
 
-TEST_P(BvhTraverse, RefitAfterDeformationStaysCorrect) {
+TEST(BVH_TRAVERSE_SUITE, RefitAfterDeformationStaysCorrect) {
   Mesh mesh = random_soup(2500, 31, 80.0f, 3.0f);
-  FlatScene s(GetParam());
+  FlatScene s;
   s.add_instance(s.add_mesh(mesh), kIdentity, K_MASK_PRIMARY);
   // Deform the flat copy (the BLAS triangles index it) and refit the uploaded nodes in place.
   std::mt19937 rng(4);
@@ -320,8 +322,8 @@ TEST_P(BvhTraverse, RefitAfterDeformationStaysCorrect) {
   EXPECT_GT(expect_matches_brute_force(s, 1500, 41, 100.0f, K_MASK_PRIMARY), 100);
 }
 
-TEST_P(BvhTraverse, EmptyAndSingleInstanceScenes) {
-  FlatScene empty(GetParam());
+TEST(BVH_TRAVERSE_SUITE, EmptyAndSingleInstanceScenes) {
+  FlatScene empty;
   empty.build();
   EXPECT_TRUE(empty.tlas.empty());
   KHit hit;
@@ -329,7 +331,7 @@ TEST_P(BvhTraverse, EmptyAndSingleInstanceScenes) {
   EXPECT_EQ(hit.instance, K_NONE);
   EXPECT_FALSE(k_bvh_any(empty.ref(), &empty.materials, v3(0, 0, 0), v3(0, 0, 1), 0.0f, 1e30f, ~0u));
 
-  FlatScene one(GetParam());
+  FlatScene one;
   float m[12] = {2, 0, 0, 10, 0, 2, 0, 0, 0, 0, 2, 0};
   one.add_instance(one.add_mesh(random_soup(300, 3, 10.0f, 2.0f)), m, K_MASK_PRIMARY);
   one.build();
@@ -346,8 +348,8 @@ TEST_P(BvhTraverse, EmptyAndSingleInstanceScenes) {
   expect_matches_brute_force(with_empty, 300, 10, 40.0f, K_MASK_PRIMARY);
 }
 
-TEST_P(BvhTraverse, PassThroughSurfacesAreSkippedByClosestHit) {
-  FlatScene s(GetParam());
+TEST(BVH_TRAVERSE_SUITE, PassThroughSurfacesAreSkippedByClosestHit) {
+  FlatScene s;
   // Two parallel quads' worth of triangles: the nearer is pass-through (material 2).
   Mesh mesh{{vtx(-1, -1, 1), vtx(1, -1, 1), vtx(0, 1, 1), vtx(-1, -1, 2), vtx(1, -1, 2),
              vtx(0, 1, 2)},
@@ -359,7 +361,7 @@ TEST_P(BvhTraverse, PassThroughSurfacesAreSkippedByClosestHit) {
   EXPECT_FLOAT_EQ(hit.t, 2.0f);
 }
 
-TEST_P(BvhTraverse, DepthStaysBoundedOnPathologicalInput) {
+TEST(BVH_TRAVERSE_SUITE, DepthStaysBoundedOnPathologicalInput) {
   // Geometrically spaced triangles make every SAH split peel off one triangle: without the depth
   // bound this tree would be ~300 levels deep and overflow the traversal stacks.
   Mesh mesh;
@@ -380,7 +382,7 @@ TEST_P(BvhTraverse, DepthStaysBoundedOnPathologicalInput) {
     max_depth = std::max(max_depth, depth[i] + 1);
   }
   EXPECT_LE(max_depth, K_BVH_MAX_DEPTH);
-  FlatScene s(GetParam());
+  FlatScene s;
   s.add_instance(s.add_mesh(mesh), kIdentity, K_MASK_PRIMARY);
   s.build();
   std::mt19937 rng(3);
@@ -398,7 +400,7 @@ TEST_P(BvhTraverse, DepthStaysBoundedOnPathologicalInput) {
   }
 }
 
-TEST_P(BvhTraverse, CoplanarMeshMatchesBruteForce) {
+TEST(BVH_TRAVERSE_SUITE, CoplanarMeshMatchesBruteForce) {
   // A flat grid: every box is flat in z, every centroid shares z.
   Mesh grid;
   const int n = 40;
@@ -410,7 +412,7 @@ TEST_P(BvhTraverse, CoplanarMeshMatchesBruteForce) {
       grid.triangles.push_back({a, c, b, 0});
       grid.triangles.push_back({b, c, d, 0});
     }
-  FlatScene s(GetParam());
+  FlatScene s;
   s.add_instance(s.add_mesh(grid), kIdentity, K_MASK_PRIMARY);
   s.build();
   EXPECT_GT(expect_matches_brute_force(s, 2000, 5, 30.0f, K_MASK_PRIMARY), 200);

@@ -144,8 +144,7 @@ TEST(Skinning, RefitBlasHitsEqualBruteForce) {
       EXPECT_EQ(root.bmax[a], hi);
     }
     const KSceneRef ref{s.vertices.data(), s.triangles.data(), s.blas_nodes.data(), s.blases.data(),
-                        s.instances.data(), s.tlas_nodes.data(), kuint(s.instances.size()), kuint(s.tlas_nodes.size()),
-                        nullptr};
+                        s.instances.data(), s.tlas_nodes.data(), kuint(s.instances.size()), kuint(s.tlas_nodes.size())};
     const KInstance& inst = s.instances.at(0);
     const KVec3 centre = v3((root.bmin[0] + root.bmax[0]) * 0.5f + inst.object_to_world[3],
                             (root.bmin[1] + root.bmax[1]) * 0.5f + inst.object_to_world[7],

@@ -39,7 +39,6 @@ __kernel void trace(__global const KVertex* vertices, __global const KTriangle* 
   scene.tlas_nodes = tlas_nodes;
   scene.instance_count = instance_count;
   scene.tlas_node_count = tlas_node_count;
-  scene.triangle_edges = 0;
   KVec3 o = v3(rays[8 * i], rays[8 * i + 1], rays[8 * i + 2]);
   KVec3 d = v3(rays[8 * i + 4], rays[8 * i + 5], rays[8 * i + 6]);
   float tmax = rays[8 * i + 3];
@@ -59,7 +58,7 @@ struct Scene {
   std::vector<KBvhNode> tlas;
   KSceneRef ref() const {
     return KSceneRef{vertices.data(), triangles.data(), blas_nodes.data(), blases.data(), instances.data(),
-                     tlas.data(),     kuint(instances.size()), kuint(tlas.size()), nullptr};
+                     tlas.data(),     kuint(instances.size()), kuint(tlas.size())};
   }
 };
 

@@ -3,8 +3,6 @@
 #include <cuda_runtime.h>
 
 #include <algorithm>
-#include <cstdlib>
-#include <cstring>
 #include <vector>
 
 #include "device_array.h"
@@ -51,9 +49,7 @@ struct CudaTracer::Impl {
   DeviceArray<KVertexColor> vertex_colors;
   DeviceArray<KTriangle> triangles;
   // The triangles' corners and edges (KTriangleEdges), made on the device after every geometry upload and
-  // skinning pass: the walk's leaf test reads them instead of following vertex indices. Off with
-  // COHORT_TRIANGLE_EDGES=0 (A/B runs).
-  bool use_triangle_edges = true;
+  // skinning pass: the walk's leaf test reads them instead of following vertex indices (render_band.cu).
   DeviceArray<KTriangleEdges> triangle_edges;
   DeviceArray<KBvhNode> blas_nodes, tlas_nodes;
   DeviceArray<KBlas> blases;
@@ -162,7 +158,7 @@ struct CudaTracer::Impl {
     KSceneView v = k_scene_view(vertices.data(), vertex_colors.data(), triangles.data(), blas_nodes.data(), blases.data(),
                                 instances.data(), tlas_nodes.data(), materials.data(), textures.data(), texels.data(),
                                 lights.data(), light_nodes.data(), emissive.data(), &params);
-    if (use_triangle_edges && triangle_edges.size() == triangles.size()) v.triangle_edges = triangle_edges.data();
+    v.triangle_edges = triangle_edges.data();
     return v;
   }
 };
@@ -173,7 +169,6 @@ CudaTracer::CudaTracer(int device) : impl_(std::make_unique<Impl>()) {
     throw std::runtime_error("CUDA device " + std::to_string(device) + " does not exist (" + std::to_string(count) +
                              " found)");
   impl_->device = device;
-  if (const char* edges = std::getenv("COHORT_TRIANGLE_EDGES")) impl_->use_triangle_edges = std::strcmp(edges, "0") != 0;
   impl_->name = "cuda:" + std::to_string(device) + " (" + cuda_device_name(device) + ")";
   COHORT_CUDA(cudaSetDevice(device));
   COHORT_CUDA(cudaStreamCreateWithFlags(&impl_->stream, cudaStreamNonBlocking));
@@ -214,11 +209,9 @@ void CudaTracer::upload(const commit::ChangeSet& changes) {
     m.triangles.upload(scene.triangles, all ? 0 : changes.triangles_from, s);
     m.blas_nodes.upload(scene.blas_nodes, all ? 0 : changes.blas_nodes_from, s);
     m.blases.upload(scene.blases, all ? 0 : changes.blases_from, s);
-    if (m.use_triangle_edges) {
-      // Every triangle's edges again: one short kernel (a changed vertex may belong to any earlier triangle).
-      m.triangle_edges.upload_size(scene.triangles.size());
-      launch_triangle_edges(m.triangle_edges.data(), m.triangles.data(), m.vertices.data(), 0, scene.triangles.size(), s);
-    }
+    // Every triangle's edges again: one short kernel (a changed vertex may belong to any earlier triangle).
+    m.triangle_edges.upload_size(scene.triangles.size());
+    launch_triangle_edges(m.triangle_edges.data(), m.triangles.data(), m.vertices.data(), 0, scene.triangles.size(), s);
   }
   if (all || changes.instances || changes.tlas) {
     m.instances.upload(scene.instances, 0, s);
@@ -264,7 +257,7 @@ void CudaTracer::upload(const commit::ChangeSet& changes) {
     const SkinBuffers pools{m.skin_vertices.data(), m.skin_weights.data(), m.skin_triangles.data(),
                             m.skin_adjacency.data(), m.skin_faces.data(), m.joints.data()};
     launch_skinning(m.vertices.data(), pools, skin, m.blas_nodes.data(), m.triangles.data(),
-                    m.use_triangle_edges ? m.triangle_edges.data() : nullptr, scene.blases[skin.blas], refit, s);
+                    m.triangle_edges.data(), scene.blases[skin.blas], refit, s);
   }
   COHORT_CUDA(cudaStreamSynchronize(s));
 }

@@ -24,15 +24,18 @@ typedef struct KTraceCtx {
 
 KFN KSceneRef k_trace_scene_ref(const KTraceCtx* ctx) {
   KSceneRef r;
+#ifdef K_BVH_TRIANGLE_EDGES
+  r.triangle_edges = ctx->scene.triangle_edges;
+#else
   r.vertices = ctx->scene.vertices;
   r.triangles = ctx->scene.triangles;
+#endif
   r.blas_nodes = ctx->scene.blas_nodes;
   r.blases = ctx->scene.blases;
   r.instances = ctx->scene.instances;
   r.tlas_nodes = ctx->scene.tlas_nodes;
   r.instance_count = ctx->scene.instance_count;
   r.tlas_node_count = ctx->scene.tlas_node_count;
-  r.triangle_edges = ctx->scene.triangle_edges;
   return r;
 }
 
