@@ -1,5 +1,10 @@
 // kernel/bvh_traverse.h compiled as C++: closest/any/shadow queries over BLAS + TLAS from core/bvh.h
 // against brute force over every instance's triangles (same triangle test, so t must match exactly).
+// bvh_traverse_edges_test.cpp compiles this file again with K_BVH_TRIANGLE_EDGES (the CUDA build's
+// leaves), as suite BvhTraverseEdges.
+#ifndef BVH_TRAVERSE_SUITE
+#define BVH_TRAVERSE_SUITE BvhTraverse
+#endif
 #include <cmath>
 #include <cstring>
 #include <random>
@@ -109,11 +114,22 @@ struct FlatScene {
     instances.push_back(inst);
   }
 
-  void build() { tlas = build_tlas(instances, blas_roots); }
+  std::vector<KTriangleEdges> triangle_edges;
+
+  void build() {
+    tlas = build_tlas(instances, blas_roots);
+    triangle_edges.resize(triangles.size());
+    for (size_t t = 0; t < triangles.size(); ++t) k_triangle_edges_write(&triangle_edges[t], vertices.data(), triangles[t]);
+  }
 
   KSceneRef ref() const {
+#ifdef K_BVH_TRIANGLE_EDGES
+    return KSceneRef{triangle_edges.data(), blas_nodes.data(), blases.data(), instances.data(),
+                     tlas.data(),           kuint(instances.size()), kuint(tlas.size())};
+#else
     return KSceneRef{vertices.data(), triangles.data(), blas_nodes.data(), blases.data(), instances.data(),
                      tlas.data(),     kuint(instances.size()), kuint(tlas.size())};
+#endif
   }
 
   static void invert_affine(const float* m, float* inv) {
@@ -216,14 +232,14 @@ float random_transform(std::mt19937& rng, float* m, float spread) {
 
 }  // namespace
 
-TEST(BvhTraverse, RandomSoupMatchesBruteForce) {
+TEST(BVH_TRAVERSE_SUITE, RandomSoupMatchesBruteForce) {
   FlatScene s;
   s.add_instance(s.add_mesh(random_soup(3000, 7, 100.0f, 4.0f)), kIdentity, K_MASK_PRIMARY | K_MASK_SHADOW);
   s.build();
   EXPECT_GT(expect_matches_brute_force(s, 3000, 11, 120.0f, K_MASK_PRIMARY), 300);
 }
 
-TEST(BvhTraverse, InstancesWithRotationScaleTranslationAndMasks) {
+TEST(BVH_TRAVERSE_SUITE, InstancesWithRotationScaleTranslationAndMasks) {
   FlatScene s;
   kuint meshes[3] = {s.add_mesh(random_soup(400, 1, 10.0f, 2.0f)), s.add_mesh(random_soup(50, 2, 3.0f, 1.0f)),
                      s.add_mesh(random_soup(1500, 3, 20.0f, 1.5f))};
@@ -240,7 +256,7 @@ TEST(BvhTraverse, InstancesWithRotationScaleTranslationAndMasks) {
   EXPECT_GT(expect_matches_brute_force(s, 500, 22, 160.0f, K_MASK_SHADOW), 50);
 }
 
-TEST(BvhTraverse, ShadowRaysIgnoreNoShadowInstances) {
+TEST(BVH_TRAVERSE_SUITE, ShadowRaysIgnoreNoShadowInstances) {
   FlatScene s;
   kuint wall = s.add_mesh(Mesh{{vtx(-1, -1, 0), vtx(1, -1, 0), vtx(0, 1, 0)}, {{0, 1, 2, 0}}});
   s.add_instance(wall, kIdentity, K_MASK_PRIMARY);  // noShadows: visible, casts no shadow
@@ -255,7 +271,7 @@ TEST(BvhTraverse, ShadowRaysIgnoreNoShadowInstances) {
   EXPECT_EQ(T.x, 1.0f);
 }
 
-TEST(BvhTraverse, ShadowTransmittanceIsTheProductOverSurfaces) {
+TEST(BVH_TRAVERSE_SUITE, ShadowTransmittanceIsTheProductOverSurfaces) {
   // Materials 0 (opaque), 1 (tinted) and 2 (pass-through) mixed; the transmittance must equal the
   // product over every surface brute force finds, and an opaque surface must stop the query.
   FlatScene s;
@@ -283,7 +299,7 @@ TEST(BvhTraverse, ShadowTransmittanceIsTheProductOverSurfaces) {
   EXPECT_GT(partial, 50) << "the test must see rays through tinted surfaces";
 }
 
-TEST(BvhTraverse, RefitAfterDeformationStaysCorrect) {
+TEST(BVH_TRAVERSE_SUITE, RefitAfterDeformationStaysCorrect) {
   Mesh mesh = random_soup(2500, 31, 80.0f, 3.0f);
   FlatScene s;
   s.add_instance(s.add_mesh(mesh), kIdentity, K_MASK_PRIMARY);
@@ -306,7 +322,7 @@ TEST(BvhTraverse, RefitAfterDeformationStaysCorrect) {
   EXPECT_GT(expect_matches_brute_force(s, 1500, 41, 100.0f, K_MASK_PRIMARY), 100);
 }
 
-TEST(BvhTraverse, EmptyAndSingleInstanceScenes) {
+TEST(BVH_TRAVERSE_SUITE, EmptyAndSingleInstanceScenes) {
   FlatScene empty;
   empty.build();
   EXPECT_TRUE(empty.tlas.empty());
@@ -332,7 +348,7 @@ TEST(BvhTraverse, EmptyAndSingleInstanceScenes) {
   expect_matches_brute_force(with_empty, 300, 10, 40.0f, K_MASK_PRIMARY);
 }
 
-TEST(BvhTraverse, PassThroughSurfacesAreSkippedByClosestHit) {
+TEST(BVH_TRAVERSE_SUITE, PassThroughSurfacesAreSkippedByClosestHit) {
   FlatScene s;
   // Two parallel quads' worth of triangles: the nearer is pass-through (material 2).
   Mesh mesh{{vtx(-1, -1, 1), vtx(1, -1, 1), vtx(0, 1, 1), vtx(-1, -1, 2), vtx(1, -1, 2),
@@ -345,7 +361,7 @@ TEST(BvhTraverse, PassThroughSurfacesAreSkippedByClosestHit) {
   EXPECT_FLOAT_EQ(hit.t, 2.0f);
 }
 
-TEST(BvhTraverse, DepthStaysBoundedOnPathologicalInput) {
+TEST(BVH_TRAVERSE_SUITE, DepthStaysBoundedOnPathologicalInput) {
   // Geometrically spaced triangles make every SAH split peel off one triangle: without the depth
   // bound this tree would be ~300 levels deep and overflow the traversal stacks.
   Mesh mesh;
@@ -384,7 +400,7 @@ TEST(BvhTraverse, DepthStaysBoundedOnPathologicalInput) {
   }
 }
 
-TEST(BvhTraverse, CoplanarMeshMatchesBruteForce) {
+TEST(BVH_TRAVERSE_SUITE, CoplanarMeshMatchesBruteForce) {
   // A flat grid: every box is flat in z, every centroid shares z.
   Mesh grid;
   const int n = 40;

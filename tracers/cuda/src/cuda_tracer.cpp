@@ -48,6 +48,9 @@ struct CudaTracer::Impl {
   DeviceArray<KVertex> vertices;
   DeviceArray<KVertexColor> vertex_colors;
   DeviceArray<KTriangle> triangles;
+  // The triangles' corners and edges (KTriangleEdges), made on the device after every geometry upload and
+  // skinning pass: the walk's leaf test reads them instead of following vertex indices (render_band.cu).
+  DeviceArray<KTriangleEdges> triangle_edges;
   DeviceArray<KBvhNode> blas_nodes, tlas_nodes;
   DeviceArray<KBlas> blases;
   DeviceArray<KInstance> instances;
@@ -152,9 +155,11 @@ struct CudaTracer::Impl {
   }
 
   KSceneView view(const KFrameParams& params) const {
-    return k_scene_view(vertices.data(), vertex_colors.data(), triangles.data(), blas_nodes.data(), blases.data(), instances.data(),
-                        tlas_nodes.data(), materials.data(), textures.data(), texels.data(), lights.data(), light_nodes.data(),
-                        emissive.data(), &params);
+    KSceneView v = k_scene_view(vertices.data(), vertex_colors.data(), triangles.data(), blas_nodes.data(), blases.data(),
+                                instances.data(), tlas_nodes.data(), materials.data(), textures.data(), texels.data(),
+                                lights.data(), light_nodes.data(), emissive.data(), &params);
+    v.triangle_edges = triangle_edges.data();
+    return v;
   }
 };
 
@@ -204,6 +209,9 @@ void CudaTracer::upload(const commit::ChangeSet& changes) {
     m.triangles.upload(scene.triangles, all ? 0 : changes.triangles_from, s);
     m.blas_nodes.upload(scene.blas_nodes, all ? 0 : changes.blas_nodes_from, s);
     m.blases.upload(scene.blases, all ? 0 : changes.blases_from, s);
+    // Every triangle's edges again: one short kernel (a changed vertex may belong to any earlier triangle).
+    m.triangle_edges.upload_size(scene.triangles.size());
+    launch_triangle_edges(m.triangle_edges.data(), m.triangles.data(), m.vertices.data(), 0, scene.triangles.size(), s);
   }
   if (all || changes.instances || changes.tlas) {
     m.instances.upload(scene.instances, 0, s);
@@ -248,7 +256,8 @@ void CudaTracer::upload(const commit::ChangeSet& changes) {
     if (size_t(skin.joint_offset) + skin.joint_count > scene.joints.size() || skin.blas >= scene.blases.size()) continue;
     const SkinBuffers pools{m.skin_vertices.data(), m.skin_weights.data(), m.skin_triangles.data(),
                             m.skin_adjacency.data(), m.skin_faces.data(), m.joints.data()};
-    launch_skinning(m.vertices.data(), pools, skin, m.blas_nodes.data(), m.triangles.data(), scene.blases[skin.blas], refit, s);
+    launch_skinning(m.vertices.data(), pools, skin, m.blas_nodes.data(), m.triangles.data(),
+                    m.triangle_edges.data(), scene.blases[skin.blas], refit, s);
   }
   COHORT_CUDA(cudaStreamSynchronize(s));
 }

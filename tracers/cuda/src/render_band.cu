@@ -5,6 +5,7 @@
 #include <cuda_runtime.h>
 
 #define K_CUDA_DEVICE_ONLY 1
+#define K_BVH_TRIANGLE_EDGES 1  // leaves read KTriangleEdges (CudaTracer keeps them with the triangles)
 __constant__ cudaTextureObject_t cohort_texel_texture;
 #define K_TEXEL_LOAD(texels, index) tex1Dfetch<unsigned int>(cohort_texel_texture, (int)(index))
 

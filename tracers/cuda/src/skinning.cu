@@ -65,10 +65,26 @@ __global__ void refit_upward_kernel(KBvhNode* nodes, const KTriangle* triangles,
   }
 }
 
+__global__ void triangle_edges_kernel(KTriangleEdges* edges, const KTriangle* triangles, const KVertex* vertices,
+                                      size_t first, size_t count) {
+  const size_t i = size_t(blockIdx.x) * blockDim.x + threadIdx.x;
+  if (i < count) k_triangle_edges_write(edges + first + i, vertices, triangles[first + i]);
+}
+
 }  // namespace
 
+void launch_triangle_edges(KTriangleEdges* edges, const KTriangle* triangles, const KVertex* vertices, size_t first,
+                           size_t count, cudaStream_t stream) {
+  if (count == 0 || !edges) return;
+  const unsigned block = 128;
+  triangle_edges_kernel<<<unsigned((count + block - 1) / block), block, 0, stream>>>(edges, triangles, vertices, first,
+                                                                                     count);
+  COHORT_CUDA(cudaGetLastError());
+}
+
 void launch_skinning(KVertex* vertices, const SkinBuffers& pools, const KSkin& skin, KBvhNode* blas_nodes,
-                     const KTriangle* triangles, const KBlas& blas, const RefitScratch& scratch, cudaStream_t stream) {
+                     const KTriangle* triangles, KTriangleEdges* edges, const KBlas& blas, const RefitScratch& scratch,
+                     cudaStream_t stream) {
   if (skin.vertex_count == 0) return;
   const unsigned block = 128;
   const unsigned vertex_blocks = (skin.vertex_count + block - 1) / block;
@@ -86,6 +102,7 @@ void launch_skinning(KVertex* vertices, const SkinBuffers& pools, const KSkin& s
     refit_parents_kernel<<<node_blocks, block, 0, stream>>>(nodes, blas.node_count, scratch);
     refit_upward_kernel<<<node_blocks, block, 0, stream>>>(nodes, tris, vertices, blas.node_count, scratch);
   }
+  launch_triangle_edges(edges, triangles, vertices, blas.tri_offset, blas.tri_count, stream);
   COHORT_CUDA(cudaGetLastError());
 }
 

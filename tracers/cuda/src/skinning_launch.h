@@ -9,6 +9,7 @@
 #include <cuda_runtime.h>
 
 #include "cohort/kernel/skinning.h"
+#include "cohort/kernel/bvh_traverse.h"
 
 namespace cohort::tracers {
 
@@ -26,7 +27,13 @@ struct RefitScratch {  // two uints per node of the largest skinned BLAS: parent
   kuint* arrivals;
 };
 
+// `edges` (KTriangleEdges parallel to the triangles, or null): the BLAS's triangles' edges follow the pose.
 void launch_skinning(KVertex* vertices, const SkinBuffers& pools, const KSkin& skin, KBvhNode* blas_nodes,
-                     const KTriangle* triangles, const KBlas& blas, const RefitScratch& scratch, cudaStream_t stream);
+                     const KTriangle* triangles, KTriangleEdges* edges, const KBlas& blas, const RefitScratch& scratch,
+                     cudaStream_t stream);
+
+// edges[first, first + count) from the triangles and vertices on the device.
+void launch_triangle_edges(KTriangleEdges* edges, const KTriangle* triangles, const KVertex* vertices, size_t first,
+                           size_t count, cudaStream_t stream);
 
 }  // namespace cohort::tracers

@@ -12,7 +12,10 @@
  *   k_bvh_any(scene, ctx, o, d, tmin, tmax, mask)            1 when an accepted hit lies in (tmin, tmax)
  *   k_bvh_shadow(scene, ctx, o, d, tmin, tmax, mask, &T)     T = product of the transmittances of every
  *                                                            surface in (tmin, tmax); returns 1 when T = 0
- * Triangles are hit from both sides (Möller-Trumbore); the integrator decides what facing means.
+ * Triangles are hit from both sides (Möller-Trumbore); the integrator decides what facing means. With
+ * K_BVH_TRIANGLE_EDGES defined, KSceneRef holds the triangles as KTriangleEdges (parallel to the triangle
+ * array) instead of vertices and triangles: a leaf's test is three adjacent loads, not a triangle load and
+ * three vertex loads that wait on it (the CUDA build; bit-identical hits).
  * (u, v) weight v1 and v2: p = (1-u-v) p0 + u p1 + v p2.
  *
  * Material hooks, so traversal needs no knowledge of materials. Define before including:
@@ -48,8 +51,13 @@
 #endif
 
 typedef struct KSceneRef {
+#ifdef K_BVH_TRIANGLE_EDGES
+  /* The triangles as corners and edges (layout.h's KTriangleEdges), so the walk needs no vertices. */
+  KGLOBAL const KTriangleEdges* triangle_edges;
+#else
   KGLOBAL const KVertex* vertices;
   KGLOBAL const KTriangle* triangles;
+#endif
   KGLOBAL const KBvhNode* blas_nodes;
   KGLOBAL const KBlas* blases;
   KGLOBAL const KInstance* instances;
@@ -142,11 +150,10 @@ KFN int k_bvh_pop(KBvhRay r, KGLOBAL const KBvhNode* nodes, float tmin, float tm
   return 0;
 }
 
-/* Möller-Trumbore, both-sided: 1 and (t, u, v) when tmin < t < tmax. */
-KFN int k_bvh_ray_triangle(KVec3 o, KVec3 d, KVec3 p0, KVec3 p1, KVec3 p2, float tmin, float tmax,
-                           float* t_out, float* u_out, float* v_out) {
-  KVec3 e1 = v3_sub(p1, p0);
-  KVec3 e2 = v3_sub(p2, p0);
+/* Möller-Trumbore, both-sided, from the first corner and the edges to the other two (e1 = p1 - p0,
+ * e2 = p2 - p0): 1 and (t, u, v) when tmin < t < tmax. */
+KFN int k_bvh_ray_triangle_edges(KVec3 o, KVec3 d, KVec3 p0, KVec3 e1, KVec3 e2, float tmin, float tmax,
+                                 float* t_out, float* u_out, float* v_out) {
   KVec3 p = v3_cross(d, e2);
   float det = v3_dot(e1, p);
   if (k_fabs(det) < 1e-20f) return 0;
@@ -165,18 +172,44 @@ KFN int k_bvh_ray_triangle(KVec3 o, KVec3 d, KVec3 p0, KVec3 p1, KVec3 p2, float
   return 1;
 }
 
+KFN int k_bvh_ray_triangle(KVec3 o, KVec3 d, KVec3 p0, KVec3 p1, KVec3 p2, float tmin, float tmax,
+                           float* t_out, float* u_out, float* v_out) {
+  return k_bvh_ray_triangle_edges(o, d, p0, v3_sub(p1, p0), v3_sub(p2, p0), tmin, tmax, t_out, u_out, v_out);
+}
+
+#ifndef K_BVH_TRIANGLE_EDGES
 /* A vertex position: the first three floats of its 16-byte-aligned KVertex. */
 KFN KVec3 k_bvh_vertex_position(KSceneRef scene, kuint vertex) {
   KFloat4 p = k_load4((KGLOBAL const float*)(scene.vertices + vertex));
   return v3(p.x, p.y, p.z);
 }
+#endif
+
+/* The same edges as k_bvh_ray_triangle subtracts (so the same hits, bit for bit), for KTriangleEdges. */
+KFN void k_triangle_edges_write(KGLOBAL KTriangleEdges* out, KGLOBAL const KVertex* vertices, KTriangle tri) {
+  KGLOBAL const float* p0 = vertices[tri.v0].pos;
+  KGLOBAL const float* p1 = vertices[tri.v1].pos;
+  KGLOBAL const float* p2 = vertices[tri.v2].pos;
+  for (int a = 0; a < 3; ++a) {
+    out->p0[a] = p0[a];
+    out->e1[a] = p1[a] - p0[a];
+    out->e2[a] = p2[a] - p0[a];
+  }
+  out->pad0 = out->pad1 = out->pad2 = 0.0f;
+}
 
 KFN int k_bvh_hit_triangle(KSceneRef scene, kuint triangle, KVec3 o, KVec3 d, float tmin, float tmax,
                            float* t, float* u, float* v) {
+#ifdef K_BVH_TRIANGLE_EDGES
+  KGLOBAL const float* e = (KGLOBAL const float*)(scene.triangle_edges + triangle);
+  KFloat4 a = k_load4(e), b = k_load4(e + 4), c = k_load4(e + 8);
+  return k_bvh_ray_triangle_edges(o, d, v3(a.x, a.y, a.z), v3(b.x, b.y, b.z), v3(c.x, c.y, c.z), tmin, tmax, t, u, v);
+#else
   KFloat4 tri = k_load4((KGLOBAL const float*)(scene.triangles + triangle));
   return k_bvh_ray_triangle(o, d, k_bvh_vertex_position(scene, k_as_uint(tri.x)),
                             k_bvh_vertex_position(scene, k_as_uint(tri.y)),
                             k_bvh_vertex_position(scene, k_as_uint(tri.z)), tmin, tmax, t, u, v);
+#endif
 }
 
 /* One candidate hit. CLOSEST records it and shrinks *tmax; ANY reports it; SHADOW multiplies it

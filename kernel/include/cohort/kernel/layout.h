@@ -22,6 +22,16 @@ typedef struct KBvhNode {
  * entries (near-child-first, one push per level) cannot overflow. */
 #define K_BVH_MAX_DEPTH 48
 
+/* A triangle ready for Moller-Trumbore with no vertex indices to follow: its first corner and the edges
+ * to the other two (e1 = p1 - p0, e2 = p2 - p0), object space, parallel to the triangle array (same
+ * index). A GPU tracer keeps it beside the triangles so a leaf's test is three adjacent 16-byte loads
+ * instead of a triangle load and then three vertex loads that wait on it. */
+typedef struct KTriangleEdges {
+  float p0[3]; float pad0;
+  float e1[3]; float pad1;
+  float e2[3]; float pad2;
+} KTriangleEdges;
+
 typedef struct KBlas {
   kuint node_offset; kuint node_count;
   kuint tri_offset;  kuint tri_count;
@@ -233,6 +243,7 @@ static_assert(sizeof(KAux) == 48, "KAux layout");
 static_assert(sizeof(KAuxTexel) == 32, "KAuxTexel layout");
 static_assert(sizeof(KBvhNode) == 32, "KBvhNode layout");
 static_assert(sizeof(KBlas) == 16, "KBlas layout");
+static_assert(sizeof(KTriangleEdges) == 48, "KTriangleEdges layout");
 static_assert(sizeof(KInstance) == 112, "KInstance layout");
 static_assert(sizeof(KVertex) == 48, "KVertex layout");
 static_assert(sizeof(KVertexColor) == 4, "KVertexColor layout");

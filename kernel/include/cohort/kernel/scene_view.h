@@ -20,6 +20,9 @@ typedef struct KSceneView {
   KGLOBAL const KLight* lights;
   KGLOBAL const KLightNode* light_nodes;
   KGLOBAL const KEmissiveTriangle* emissive;
+  /* Optional KTriangleEdges parallel to `triangles` (bvh_traverse.h); null unless a tracer sets it after
+   * k_scene_view. */
+  KGLOBAL const KTriangleEdges* triangle_edges;
   kuint instance_count;
   kuint tlas_node_count;
   kuint light_count;
@@ -53,6 +56,7 @@ KFN KSceneView k_scene_view(KGLOBAL const KVertex* vertices, KGLOBAL const KVert
   v.lights = lights;
   v.light_nodes = light_nodes;
   v.emissive = emissive;
+  v.triangle_edges = 0;
   v.instance_count = params->instance_count;
   v.tlas_node_count = params->tlas_node_count;
   v.light_count = params->light_count;

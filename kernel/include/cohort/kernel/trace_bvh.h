@@ -24,8 +24,12 @@ typedef struct KTraceCtx {
 
 KFN KSceneRef k_trace_scene_ref(const KTraceCtx* ctx) {
   KSceneRef r;
+#ifdef K_BVH_TRIANGLE_EDGES
+  r.triangle_edges = ctx->scene.triangle_edges;
+#else
   r.vertices = ctx->scene.vertices;
   r.triangles = ctx->scene.triangles;
+#endif
   r.blas_nodes = ctx->scene.blas_nodes;
   r.blases = ctx->scene.blases;
   r.instances = ctx->scene.instances;
