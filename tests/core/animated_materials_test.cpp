@@ -123,7 +123,7 @@ TEST(AnimatedMaterials, FlickeringLightFollowsItsTable) {
     const float expected = stage < 0.001f ? 0.0f : stage;
     ASSERT_EQ(sync.master().lights.size(), 1u);
     const KLight& l = sync.master().lights[0];
-    if (expected > 0.0f) EXPECT_NEAR(l.color[1] / l.color[0], 0.5f, 1e-5f) << "at " << ms;   // _color applies
+    if (expected > 0.0f) { EXPECT_NEAR(l.color[1] / l.color[0], 0.5f, 1e-5f) << "at " << ms; }   // _color applies
     EXPECT_NEAR(l.color[0], GpuSceneOptions{}.light_scale * expected, 1e-5f) << "at " << ms;
   }
 }
@@ -173,7 +173,7 @@ TEST(AnimatedMaterials, EntityParmsTintItsOwnMaterialInstance) {
   EXPECT_EQ(used.count(sync.kmaterial_index(w.tint)), 0u);
   ASSERT_EQ(used.size(), 2u);
   for (uint32_t m : used)
-    if (m != sync.kmaterial_index(w.still)) EXPECT_FLOAT_EQ(sync.master().materials.at(m).diffuse_color[0], 0.25f);
+    if (m != sync.kmaterial_index(w.still)) { EXPECT_FLOAT_EQ(sync.master().materials.at(m).diffuse_color[0], 0.25f); }
 
   // New parms: the same slot re-evaluated, one material record, no new BLAS.
   tinted.shader_parms[0] = 0.75f;
@@ -219,7 +219,7 @@ TEST(AnimatedMaterials, TestMapAnimatesAndTintsCrate2) {
   ASSERT_GE(crate2, 0);
   ASSERT_GE(crate1, 0);
   for (const KInstance& i : sync.master().instances) {
-    if (i.entity == uint32_t(crate1)) EXPECT_EQ(i.material_override, K_NONE);
+    if (i.entity == uint32_t(crate1)) { EXPECT_EQ(i.material_override, K_NONE); }
     if (i.entity != uint32_t(crate2)) continue;
     ASSERT_NE(i.material_override, K_NONE);
     const KMaterial& tinted = sync.master().materials.at(i.material_override);

@@ -83,7 +83,7 @@ TEST(FrameTimeline, RendererRecordsEveryTracersApplyAndRenderAndTheCoresStages) 
       ASSERT_NE(render, nullptr) << track << " frame " << f;
       EXPECT_LE(apply->start_ms + apply->ms, render->start_ms + 1e-3);  // commits first, then the band
       EXPECT_NEAR(apply->ms + render->ms, t.ms, 0.5);                   // the tracer's cost is both
-      if (f == 0) EXPECT_EQ(apply->stage, "apply (full resync)");
+      if (f == 0) { EXPECT_EQ(apply->stage, "apply (full resync)"); }
     }
     for (const StageSpan& s : stats.stages) {
       EXPECT_GE(s.start_ms, stats.start_ms - 1e-3) << s.track << " " << s.stage;

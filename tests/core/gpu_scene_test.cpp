@@ -238,8 +238,8 @@ TEST(GpuScene, VertexColoursSitBesideTheirVerticesWhiteWhereAMeshHasNone) {
   // Each mesh's vertices are a run of the pool; find them by height.
   for (size_t v = 0; v < t.vertices.size(); ++v) {
     const float z = t.vertices[v].pos[2];
-    if (z == 1.0f) EXPECT_EQ(t.vertex_colors[v], K_VERTEX_COLOR_WHITE) << "vertex " << v;
-    if (z == 2.0f) EXPECT_EQ(t.vertex_colors[v], 0xFF123456u) << "vertex " << v;
+    if (z == 1.0f) { EXPECT_EQ(t.vertex_colors[v], K_VERTEX_COLOR_WHITE) << "vertex " << v; }
+    if (z == 2.0f) { EXPECT_EQ(t.vertex_colors[v], 0xFF123456u) << "vertex " << v; }
   }
   std::vector<KVertexColor> world_colours;
   for (size_t v = 0; v < t.vertices.size(); ++v)

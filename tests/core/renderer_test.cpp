@@ -478,7 +478,7 @@ TEST(Renderer, ABenchedTracerTakesItsCommitsCoalescedEveryNFrames) {
     renderer.submit_commit(cohort::commit::CommitBuffer::full(scene, f + 1));
     const FrameStats stats = renderer.render(job_for(f), fb);
     expect_complete(fb, f, stats, {1, 2});
-    if (f >= 10) EXPECT_EQ(stats.tracers[1].row_end - stats.tracers[1].row_begin, 0) << "frame " << f;
+    if (f >= 10) { EXPECT_EQ(stats.tracers[1].row_end - stats.tracers[1].row_begin, 0) << "frame " << f; }
     // A commit handed out this frame (the channel counts it at once) lands on the tracer's own thread:
     // wait for it (bounded), so that the next frame finds the tracer idle and the lag is the Renderer's
     // doing, not the machine's load.

@@ -13,11 +13,12 @@ TEST(TracerDeviceKind, EmbreeAndPoclRenderOnTheCpuCudaOnTheGpu) {
     if (!test::tracer_runs_here(kind)) continue;
     std::unique_ptr<core::Tracer> tracer = test::make_test_tracer(kind);
     const std::string name = tracer->name();
-    if (kind == "embree") EXPECT_FALSE(tracer->renders_on_gpu()) << name;
-    if (kind == "cuda") EXPECT_TRUE(tracer->renders_on_gpu()) << name;
+    if (kind == "embree") { EXPECT_FALSE(tracer->renders_on_gpu()) << name; }
+    if (kind == "cuda") { EXPECT_TRUE(tracer->renders_on_gpu()) << name; }
     // PoCL's device is the CPU (a "pthread" or "cpu" device); a real GPU's OpenCL driver says GPU.
-    if (kind == "opencl" && (name.find("pthread") != std::string::npos || name.find("cpu") != std::string::npos))
+    if (kind == "opencl" && (name.find("pthread") != std::string::npos || name.find("cpu") != std::string::npos)) {
       EXPECT_FALSE(tracer->renders_on_gpu()) << name;
+    }
     ++checked;
   }
   EXPECT_GE(checked, 1) << "Embree always runs";
