@@ -20,7 +20,7 @@ TEST(HostThreads, EveryIndexRunsExactlyOnceInContiguousRanges) {
     });
     for (size_t i = 0; i < count; ++i) ASSERT_EQ(visits[i].load(), 1) << "index " << i << " of " << count;
     EXPECT_LE(ranges.load(), static_cast<int>(pool.threads())) << count;
-    if (count >= 40) EXPECT_GT(ranges.load(), 1) << "work this size is split";
+    if (count >= 40) { EXPECT_GT(ranges.load(), 1) << "work this size is split"; }
   }
 }
 

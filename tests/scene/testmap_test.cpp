@@ -138,7 +138,7 @@ TEST_F(TestMap, LoadsWithoutWarningsOrPlaceholders) {
   EXPECT_EQ(report.materials_missing, 0);
   EXPECT_EQ(report.images_placeholder, 0);
   for (const Entity& e : scene.entities)
-    if (e.classname != "info_player_start") EXPECT_GE(e.mesh, 0) << e.name;
+    if (e.classname != "info_player_start") { EXPECT_GE(e.mesh, 0) << e.name; }
 }
 
 TEST_F(TestMap, ProjectedBeamMatchesItsKeys) {
