@@ -210,8 +210,8 @@ void CudaTracer::upload(const commit::ChangeSet& changes) {
     m.blas_nodes.upload(scene.blas_nodes, all ? 0 : changes.blas_nodes_from, s);
     m.blases.upload(scene.blases, all ? 0 : changes.blases_from, s);
     // Every triangle's edges again: one short kernel (a changed vertex may belong to any earlier triangle).
-    m.triangle_edges.upload_size(scene.triangles.size());
-    launch_triangle_edges(m.triangle_edges.data(), m.triangles.data(), m.vertices.data(), 0, scene.triangles.size(), s);
+    launch_triangle_edges(m.triangle_edges.scratch(scene.triangles.size()), m.triangles.data(), m.vertices.data(), 0,
+                          scene.triangles.size(), s);
   }
   if (all || changes.instances || changes.tlas) {
     m.instances.upload(scene.instances, 0, s);

@@ -37,23 +37,6 @@ class DeviceArray {
                                   (size_ - first_changed) * sizeof(T), cudaMemcpyHostToDevice, stream));
     return moved;
   }
-  // Storage of n elements that kernels write (contents kept when it need not grow); true when it moved
-  // (contents lost).
-  bool upload_size(size_t n) {
-    bool moved = false;
-    if (n > capacity_) {
-      size_t capacity = capacity_ ? capacity_ : 64;
-      while (capacity < n) capacity *= 2;
-      T* fresh = nullptr;
-      COHORT_CUDA(cudaMalloc(&fresh, capacity * sizeof(T)));
-      if (ptr_) COHORT_CUDA(cudaFree(ptr_));
-      ptr_ = fresh;
-      capacity_ = capacity;
-      moved = true;
-    }
-    size_ = n;
-    return moved;
-  }
   // Device-only storage of at least n elements (contents undefined), e.g. per-launch scratch.
   T* scratch(size_t n) {
     if (n > capacity_) {

@@ -216,9 +216,9 @@ struct OpenCLTracer::Impl {
   cl_command_queue aux_queue = nullptr;
   cl_program program = nullptr;
   cl_kernel kernel = nullptr, aux_kernel = nullptr;
-  // The aux texels' copy out of page-locked staging into the target: tens of MB a band at 1080p, which
-  // one thread beside Embree's workers could stretch to 20-30 ms (docs/balancing.md). Its own threads,
-  // not the shared pool, which the core's merge and tone map hold while this band renders.
+  // The aux texels' copy out of page-locked staging into the target: tens of MB a band at 1080p, on
+  // threads of its own (1.35 ms median on nvidia-h100-x2, docs/balancing.md), not the shared pool, which
+  // the core's merge and tone map hold while this band renders.
   core::HostThreads aux_copy_threads{3};
   DeviceBuffer previous_transforms, previous_joints;
   DeviceBuffer vertices, vertex_colors, triangles, blas_nodes, blases, instances, tlas_nodes, materials, textures, texels, lights, light_nodes,
