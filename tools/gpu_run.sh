@@ -21,6 +21,8 @@
 #                              (e.g. COHORT_BLAS_LAYOUT bvh2 cwbvh): its tracer tests, then ms per frame, three rounds
 #   tools/gpu_run.sh stage-mpi here: the travelling cohort built against PyPI's MPICH, with its libraries (.gpu/mpi.tar.xz)
 #   tools/gpu_run.sh cluster   there, on a two-GPU kind: two ranks with one GPU each against the in-process two GPUs
+#   tools/gpu_run.sh kernels   there: GPU time kernel by kernel (ncu) on the large map at 1080p, cuda:0, Brigade's
+#                              blend / reprojection / reprojection + a-trous, with the same runs' frame times
 #   tools/gpu_run.sh frametimes  there: only the end-to-end frame times (large map 1080p generated there,
 #                              test map 720p; cuda:0, 1 spp, NEE + 1 bounce; reprojection on the GPU with and
 #                              without the a-trous filter, on the host, and Brigade's blend; per-stage medians;
@@ -173,6 +175,47 @@ case "${1:-}" in
             cp $run/frame_0059.* "$OUT/frames/${map}_$value.$(ls $run/frame_0059.* | head -n1 | sed 's/.*\.//')" 2>/dev/null || true
         done
       done
+    done
+    ;;
+  kernels)
+    # There: where the GPU's time goes, kernel by kernel (Nsight Compute's duration of each launch, kernels
+    # serialised), for cuda:0 on the large map at 1080p with Brigade's blend, reprojection, and reprojection +
+    # the a-trous filter, over 8 frames after 20; then the end-to-end frame times of the same runs without it.
+    [ -d "$stage/bin" ] || tar -C "$stage" -xJf "$stage/payload.tar.xz"
+    export LD_LIBRARY_PATH="$PWD/$stage/lib${LD_LIBRARY_PATH:+:$LD_LIBRARY_PATH}"
+    ncu=$(command -v ncu || ls /usr/local/cuda/bin/ncu 2>/dev/null || true)
+    [ -n "$ncu" ] || { echo "no ncu on this machine"; exit 1; }
+    nvidia-smi --query-gpu=index,name --format=csv,noheader
+    [ -f /tmp/largemap.cpk ] || { [ -f "$stage/largemap.cpk" ] && cp "$stage/largemap.cpk" /tmp/largemap.cpk; } ||
+      { python3 tools/gen_testmap.py --large --out /tmp/largemap >/dev/null &&
+        "$stage/bin/cohort" pack /tmp/largemap/maps/largemap.map --out /tmp/largemap.cpk | tail -n 1; }
+    for variant in ${COHORT_GPU_KERNEL_VARIANTS:-brigade:none reproject:none reproject:atrous}; do
+      convergence=${variant%:*} denoise=${variant#*:}
+      args=(/tmp/largemap.cpk --width 1920 --height 1080 --camera 1690 300 80 5 -12 --tracers cuda:0 --spp 1 --bounces 1
+            --convergence $convergence --denoise $denoise --camera-path spin-slow ${COHORT_GPU_COMPARE_ARGS:-})
+      echo "== large map 1080p, $convergence, denoise $denoise: device ms a frame by kernel (frames 20-27, serialised)"
+      "$ncu" --metrics gpu__time_duration.sum --csv --print-units base "$stage/bin/cohort" render "${args[@]}" --frames 30 \
+        --out /tmp/kernels_run 2>/dev/null | python3 -c '
+import csv, collections, sys
+rows = [r for r in csv.reader(l for l in sys.stdin if l.startswith("\""))]
+head, rows = rows[0], rows[1:]
+name, value, ident = head.index("Kernel Name"), head.index("Metric Value"), head.index("ID")
+launches = sorted({int(r[ident]) for r in rows})
+# The render kernel marks frames: keep the launches from its 21st up to its 29th.
+render = [int(r[ident]) for r in rows if r[name].startswith("render_band_kernel")]
+lo, hi = (render[20], render[28]) if len(render) >= 29 else (launches[0], launches[-1] + 1)
+total = collections.defaultdict(float); count = collections.Counter()
+for r in rows:
+    i = int(r[ident])
+    if not lo <= i < hi: continue
+    key = r[name].split("(")[0][:60]
+    total[key] += float(r[value].replace(",", "")) / 1e6; count[key] += 1
+frames = 8
+for k, v in sorted(total.items(), key=lambda kv: -kv[1]):
+    print(f"  {v / frames:7.3f} ms  {count[k] / frames:4.1f}x  {k}")
+print(f"  {sum(total.values()) / frames:7.3f} ms  all kernels a frame")'
+      "$stage/bin/cohort" render "${args[@]}" --frames 60 --write last --out /tmp/kernels_plain >/dev/null 2>&1
+      echo "  without the profiler: $(python3 tools/frame_times.py /tmp/kernels_plain/stats.json --skip 10 | head -n 1)"
     done
     ;;
   frametimes)

@@ -90,7 +90,7 @@ void AtrousFilter::apply(const FrameBuffer& frame, const GBuffer& gbuffer, Frame
     rows([&](int x, int y) {
       const size_t p = static_cast<size_t>(y) * static_cast<size_t>(width) + static_cast<size_t>(x);
       estimated_variance_[p] = k_svgf_variance_estimate(ping_.rgba.data(), history.moments, history.length,
-                                                        gbuffer.depth.data(), gbuffer.normal.data(), &v, x, y);
+                                                        geometry_.data(), &v, x, y);
       ping_.rgba[4 * p + 3] = estimated_variance_[p];
     });
   }

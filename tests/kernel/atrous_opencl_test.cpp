@@ -46,11 +46,11 @@ __kernel void reproject(KReprojectParams params, __global const float* rgba, __g
 }
 #include "cohort/kernel/svgf.h"
 __kernel void svgf_variance(__global const float* illumination, __global const float* moments,
-                            __global const float* length, __global const float* depth, __global const float* normal,
+                            __global const float* length, __global const float* geometry,
                             __global float* variance, KSvgfVarianceParams params) {
   kint x = (kint)get_global_id(0), y = (kint)get_global_id(1);
   if (x < params.width && y < params.height)
-    k_svgf_variance_pixel(illumination, moments, length, depth, normal, variance, &params, x, y);
+    k_svgf_variance_pixel(illumination, moments, length, geometry, variance, &params, x, y);
 }
 __kernel void svgf_atrous(__global const float* in_rgba, __global float* out_rgba, __global const float* geometry,
                           KAtrousParams params) {
@@ -152,17 +152,15 @@ TEST(AtrousOpenCL, TheVarianceGuideMatchesTheCppBuildOfTheSameHeader) {
   params.width = w, params.height = h, params.step = 2;
   params.normal_squarings = 6, params.depth_sigma = 0.1f, params.color_sigma = 4.0f;
   std::vector<float> variance(w * h), out(4 * w * h);
-  std::vector<float> expected_variance(w * h), expected(4 * w * h);
+  std::vector<float> expected_variance(w * h), expected(4 * w * h), geometry(4 * w * h);
+  for (int p = 0; p < w * h; ++p) k_atrous_pack_geometry(depth.data(), normal.data(), geometry.data(), p);
   for (int y = 0; y < h; ++y)
     for (int x = 0; x < w; ++x)
-      k_svgf_variance_pixel(rgba.data(), moments.data(), length.data(), depth.data(), normal.data(),
-                            expected_variance.data(), &vp, x, y);
+      k_svgf_variance_pixel(rgba.data(), moments.data(), length.data(), geometry.data(), expected_variance.data(), &vp,
+                            x, y);
   // The pass reads the variance from the illumination's alpha and writes the filtered one there.
-  std::vector<float> rgba_variance = rgba, geometry(4 * w * h);
-  for (int p = 0; p < w * h; ++p) {
-    rgba_variance[4 * p + 3] = expected_variance[p];
-    k_atrous_pack_geometry(depth.data(), normal.data(), geometry.data(), p);
-  }
+  std::vector<float> rgba_variance = rgba;
+  for (int p = 0; p < w * h; ++p) rgba_variance[4 * p + 3] = expected_variance[p];
   for (int y = 0; y < h; ++y)
     for (int x = 0; x < w; ++x) k_svgf_atrous_pixel(rgba_variance.data(), expected.data(), geometry.data(), &params, x, y);
 
@@ -172,12 +170,11 @@ TEST(AtrousOpenCL, TheVarianceGuideMatchesTheCppBuildOfTheSameHeader) {
     EXPECT_EQ(err, CL_SUCCESS);
     return m;
   };
-  cl_mem m_rgba = buffer(rgba), m_moments = buffer(moments), m_length = buffer(length), m_depth = buffer(depth),
-         m_normal = buffer(normal), m_variance = buffer(variance), m_out = buffer(out),
-         m_rgba_variance = buffer(rgba_variance), m_geometry = buffer(geometry);
-  cl_mem variance_args[6] = {m_rgba, m_moments, m_length, m_depth, m_normal, m_variance};
-  for (cl_uint i = 0; i < 6; ++i) ASSERT_EQ(clSetKernelArg(variance_kernel, i, sizeof(cl_mem), &variance_args[i]), CL_SUCCESS);
-  ASSERT_EQ(clSetKernelArg(variance_kernel, 6, sizeof(KSvgfVarianceParams), &vp), CL_SUCCESS);
+  cl_mem m_rgba = buffer(rgba), m_moments = buffer(moments), m_length = buffer(length), m_variance = buffer(variance),
+         m_out = buffer(out), m_rgba_variance = buffer(rgba_variance), m_geometry = buffer(geometry);
+  cl_mem variance_args[5] = {m_rgba, m_moments, m_length, m_geometry, m_variance};
+  for (cl_uint i = 0; i < 5; ++i) ASSERT_EQ(clSetKernelArg(variance_kernel, i, sizeof(cl_mem), &variance_args[i]), CL_SUCCESS);
+  ASSERT_EQ(clSetKernelArg(variance_kernel, 5, sizeof(KSvgfVarianceParams), &vp), CL_SUCCESS);
   cl_mem pass_args[3] = {m_rgba_variance, m_out, m_geometry};
   for (cl_uint i = 0; i < 3; ++i) ASSERT_EQ(clSetKernelArg(pass_kernel, i, sizeof(cl_mem), &pass_args[i]), CL_SUCCESS);
   ASSERT_EQ(clSetKernelArg(pass_kernel, 3, sizeof(KAtrousParams), &params), CL_SUCCESS);
@@ -192,7 +189,7 @@ TEST(AtrousOpenCL, TheVarianceGuideMatchesTheCppBuildOfTheSameHeader) {
     ASSERT_NEAR(variance[i], expected_variance[i], 1e-4f * (1.0f + std::fabs(expected_variance[i]))) << "variance " << i;
   for (size_t i = 0; i < out.size(); ++i)  // alpha: the filtered variance
     ASSERT_NEAR(out[i], expected[i], 1e-4f * (1.0f + std::fabs(expected[i]))) << i;
-  for (cl_mem m : {m_rgba, m_moments, m_length, m_depth, m_normal, m_variance, m_out, m_rgba_variance, m_geometry})
+  for (cl_mem m : {m_rgba, m_moments, m_length, m_variance, m_out, m_rgba_variance, m_geometry})
     clReleaseMemObject(m);
   }
   clReleaseKernel(variance_kernel);

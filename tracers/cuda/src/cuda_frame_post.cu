@@ -42,10 +42,12 @@ __global__ void reproject_kernel(KReprojectParams params, KReprojectFresh fresh,
 }
 
 // The Renderer's packed merge unpacked on the device: the colour from RGB halves (or RGBA floats) and the
-// aux texels (core/band_buffer.h, kernel/layout.h's KAuxTexel) into the float planes the passes read.
+// aux texels (core/band_buffer.h, kernel/layout.h's KAuxTexel) into the float planes the passes read; with
+// `ycocgw` and `geometry` (either may be null) also the reprojection's and the a-trous filter's own planes,
+// while the pixel is at hand, instead of two more passes over the frame.
 __global__ void unpack_kernel(const unsigned char* colour, int half_colour, const KAuxTexel* texels, float* rgba,
                               float* depth, float* prev_depth, float* motion, float* normal, float* albedo, kuint* id,
-                              int pixels) {
+                              float* ycocgw, float* geometry, int pixels) {
   const int p = blockIdx.x * blockDim.x + threadIdx.x;
   if (p >= pixels) return;
   if (half_colour) {
@@ -65,6 +67,8 @@ __global__ void unpack_kernel(const unsigned char* colour, int half_colour, cons
     albedo[3 * p + k] = __half2float(__ushort_as_half(t.albedo[k]));
   }
   id[p] = t.id;
+  if (ycocgw) k_reproject_prepare(rgba, ycocgw, p);
+  if (geometry) k_atrous_pack_geometry(depth, normal, geometry, p);
 }
 
 __global__ void modulate_kernel(const float* rgba, const float* albedo, float* out, int pixels, int multiply) {
@@ -90,11 +94,11 @@ __global__ void atrous_kernel(const float* in, float* out, const float* geometry
 // The estimate goes into the illumination's alpha, where the passes read it: each pixel writes only its
 // own alpha and reads only its neighbours' RGB.
 __global__ void svgf_variance_kernel(float* illumination, const float* moments, const float* length,
-                                     const float* depth, const float* normal, KSvgfVarianceParams params) {
+                                     const float* geometry, KSvgfVarianceParams params) {
   const int x = blockIdx.x * blockDim.x + threadIdx.x, y = blockIdx.y * blockDim.y + threadIdx.y;
   if (x < params.width && y < params.height)
     illumination[4 * (y * params.width + x) + 3] =
-        k_svgf_variance_estimate(illumination, moments, length, depth, normal, &params, x, y);
+        k_svgf_variance_estimate(illumination, moments, length, geometry, &params, x, y);
 }
 
 __global__ void svgf_atrous_kernel(const float* in, float* out, const float* geometry, KAtrousParams params) {
@@ -188,12 +192,14 @@ class CudaFramePost final : public core::FramePost {
     }
     upload_rows(row, height);
     COHORT_CUDA(cudaEventRecord(events_[1], stream_));
+    float* ycocgw = options_.reproject ? ycocgw_.scratch(4 * pixels) : nullptr;
+    float* geometry = options_.atrous ? geometry_.scratch(4 * pixels) : nullptr;
     unpack_kernel<<<blocks_for(pixels), kThreads, 0, stream_>>>(
         colour, packed.format() == core::BandFormat::rgb16f ? 1 : 0, texels, frame_.scratch(4 * pixels),
         depth_.scratch(pixels), prev_depth_.scratch(pixels), motion_.scratch(2 * pixels), normal_.scratch(3 * pixels),
-        albedo_.scratch(3 * pixels), id_.scratch(pixels), static_cast<int>(pixels));
+        albedo_.scratch(3 * pixels), id_.scratch(pixels), ycocgw, geometry, static_cast<int>(pixels));
     COHORT_CUDA(cudaGetLastError());
-    run(width, height);
+    run(width, height, /*unpacked_with_planes=*/true);
   }
 
   int cuda_device() const override { return device_; }
@@ -228,8 +234,9 @@ class CudaFramePost final : public core::FramePost {
     return width > 0 && height > 0;
   }
 
-  // The passes over the device planes, then the shown image back to the host.
-  void run(int width, int height) {
+  // The passes over the device planes, then the shown image back to the host. `unpacked_with_planes`: the
+  // unpack kernel already wrote the YCoCg frame and the packed geometry.
+  void run(int width, int height, bool unpacked_with_planes = false) {
     const size_t pixels = static_cast<size_t>(width) * static_cast<size_t>(height);
     float* current = frame_.data();
     mean_length_ = 1.0;
@@ -249,7 +256,8 @@ class CudaFramePost final : public core::FramePost {
       params.anti_lag_relative = o.anti_lag_relative;
       params.moments = o.luminance_moments ? 1 : 0;
       float* ycocgw = ycocgw_.scratch(4 * pixels);
-      prepare_kernel<<<blocks_for(pixels), kThreads, 0, stream_>>>(frame_.data(), ycocgw, static_cast<int>(pixels));
+      if (!unpacked_with_planes)
+        prepare_kernel<<<blocks_for(pixels), kThreads, 0, stream_>>>(frame_.data(), ycocgw, static_cast<int>(pixels));
       const KReprojectFresh planes{frame_.data(), ycocgw,      depth_.data(), prev_depth_.data(),
                                    motion_.data(), normal_.data(), id_.data(),    albedo_.data()};
       const KReprojectHistory history{from.rgba.data(), from.length.data(), from.depth.data(), from.normal.data(),
@@ -278,8 +286,9 @@ class CudaFramePost final : public core::FramePost {
       params.depth_sigma = ao.depth_sigma;
       params.color_sigma = variance ? ao.variance_sigma : ao.color_sigma;
       float* geometry = geometry_.scratch(4 * pixels);
-      pack_geometry_kernel<<<blocks_for(pixels), kThreads, 0, stream_>>>(depth_.data(), normal_.data(), geometry,
-                                                                          static_cast<int>(pixels));
+      if (!unpacked_with_planes)
+        pack_geometry_kernel<<<blocks_for(pixels), kThreads, 0, stream_>>>(depth_.data(), normal_.data(), geometry,
+                                                                            static_cast<int>(pixels));
       if (variance) {
         KSvgfVarianceParams v{};
         v.width = width, v.height = height, v.normal_squarings = normal_squarings_;
@@ -290,7 +299,7 @@ class CudaFramePost final : public core::FramePost {
         const State& history = state_[parity_];  // the state the reprojection just wrote
         svgf_variance_kernel<<<tile_grid(width, height), kTile, 0, stream_>>>(
             ping, options_.reproject ? history.moments.data() : nullptr,
-            options_.reproject ? history.length.data() : nullptr, depth_.data(), normal_.data(), v);
+            options_.reproject ? history.length.data() : nullptr, geometry, v);
       }
       for (int pass = 0; pass < std::max(ao.passes, 0); ++pass) {
         params.step = 1 << pass;

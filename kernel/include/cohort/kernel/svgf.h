@@ -16,8 +16,8 @@
  *                          passes see the noise that is left.
  *
  * Planes: illumination RGBA floats (the passes keep the variance in alpha), moments two floats a pixel,
- * history length one; depth and normal as core/gbuffer.h for the estimate, packed for the passes
- * (k_atrous_pack_geometry). */
+ * history length one; normal and depth packed (k_atrous_pack_geometry) for the estimate and the passes:
+ * one 16-byte load a tap, where the 7x7 estimate's four loads a tap set its cost on GPUs. */
 #ifndef COHORT_KERNEL_SVGF_H
 #define COHORT_KERNEL_SVGF_H
 #include "atrous.h"
@@ -39,15 +39,16 @@ typedef struct KSvgfVarianceParams {
 /* The pixel's variance. `illumination` is the demodulated frame the passes filter (only its RGB is read);
  * moments and length are the reprojected history's (read only with have_history). */
 KFN float k_svgf_variance_estimate(KGLOBAL const float* illumination, KGLOBAL const float* moments,
-                                   KGLOBAL const float* length, KGLOBAL const float* depth, KGLOBAL const float* normal,
+                                   KGLOBAL const float* length, KGLOBAL const float* geometry,
                                    const KSvgfVarianceParams* p, kint x, kint y) {
   kint centre = y * p->width + x;
   float history = p->have_history ? length[centre] : 0.0f;
   float of_mean = p->of_mean ? 1.0f / k_fmax(history, 1.0f) : 1.0f;
   if (history >= p->short_history)
     return k_fmax(moments[2 * centre + 1] - moments[2 * centre] * moments[2 * centre], 0.0f) * of_mean;
-  float zp = depth[centre];
-  KVec3 np = v3(normal[3 * centre], normal[3 * centre + 1], normal[3 * centre + 2]);
+  KFloat4 gp = k_load4(geometry + 4 * centre);
+  float zp = gp.w;
+  KVec3 np = v3(gp.x, gp.y, gp.z);
   float inv_depth_scale = k_atrous_inv_depth_scale(p->depth_sigma, zp, 1);
   float s1 = 0.0f, s2 = 0.0f, weight_sum = 0.0f;
   for (kint dy = -K_SVGF_SPATIAL_RADIUS; dy <= K_SVGF_SPATIAL_RADIUS; ++dy) {
@@ -71,7 +72,9 @@ KFN float k_svgf_variance_estimate(KGLOBAL const float* illumination, KGLOBAL co
       float w = 1.0f;
       if (q != centre) {
         float exponent = 0.0f;
-        w = k_atrous_geometry(zp, np, inv_depth_scale, p->normal_squarings, depth, normal, q, &exponent);
+        KFloat4 gq = k_load4(geometry + 4 * q);
+        w = k_atrous_geometry_stop(zp, np, gq.w, v3(gq.x, gq.y, gq.z), inv_depth_scale, p->normal_squarings,
+                                   &exponent);
         if (!(w > 0.0f)) continue;
         kint ax = dx < 0 ? -dx : dx, ay = dy < 0 ? -dy : dy;
         exponent /= (float)(ax > ay ? ax : ay); /* relative depth per pixel of (Chebyshev) distance */
@@ -93,9 +96,9 @@ KFN float k_svgf_variance_estimate(KGLOBAL const float* illumination, KGLOBAL co
 
 /* The estimate into a plane of one float a pixel. */
 KFN void k_svgf_variance_pixel(KGLOBAL const float* illumination, KGLOBAL const float* moments,
-                               KGLOBAL const float* length, KGLOBAL const float* depth, KGLOBAL const float* normal,
-                               KGLOBAL float* variance, const KSvgfVarianceParams* p, kint x, kint y) {
-  variance[y * p->width + x] = k_svgf_variance_estimate(illumination, moments, length, depth, normal, p, x, y);
+                               KGLOBAL const float* length, KGLOBAL const float* geometry, KGLOBAL float* variance,
+                               const KSvgfVarianceParams* p, kint x, kint y) {
+  variance[y * p->width + x] = k_svgf_variance_estimate(illumination, moments, length, geometry, p, x, y);
 }
 
 /* The pixel's variance (the alpha of the passes' RGBA planes) seen through a 3x3 Gaussian (1/4 centre, 1/8
