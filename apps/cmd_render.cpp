@@ -63,6 +63,7 @@ struct RenderArgs {
   std::string replay;
   std::string trace;
   std::string denoise = "none";
+  std::string aux_rays = "centre";
   std::string denoise_quality = "high";
   int atrous_passes = 0;  // 0: from the image height (core/atrous_filter.h)
   std::string atrous_guide = core::atrous_guide_name(core::AtrousOptions{}.guide);
@@ -361,7 +362,7 @@ int run_render(const RenderArgs& a) {
       p.path_phase = pattern.phase;
     }
     if (reproject || atrous || sparse || a.write_ids) {
-      p.aux_outputs = 1u;
+      p.aux_outputs = a.aux_rays == "first-hit" ? K_AUX_PATH_FIRST_HIT : K_AUX_CENTRE_RAY;
       job.previous_camera = previous_camera;
       previous_camera = job.camera;
     }
@@ -453,6 +454,12 @@ void add_render_command(CLI::App& app, int& exit_code) {
           return std::string(e.what());
         }
       });
+  cmd->add_option("--aux-rays", a->aux_rays,
+                  "where the G-buffer for reprojection and denoising comes from: centre (a ray of its own through "
+                  "each pixel's centre: steady planes) or first-hit (the first sample's own first surface: no "
+                  "extra ray, the planes jittered as the samples are; frames with sparse paths keep centre rays)")
+      ->capture_default_str()
+      ->check(CLI::IsMember({"centre", "first-hit"}));
   cmd->add_option("--denoise", a->denoise,
                   "denoise the shown frame: none, atrous (the real-time edge-aware a-trous filter of the portable "
                   "kernel, every frame), oidn (Intel Open Image Denoise on the CPU) or oidn-cuda (on an NVIDIA GPU); "

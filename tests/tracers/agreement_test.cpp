@@ -172,18 +172,21 @@ TEST(AgreementOnTestMap, EmbreeAndOpenCLImagesMatch) {
 }
 
 // Every tracer this machine runs writes the same planes as Embree for the test room (a known scene with
-// entities, textures, layers and an alpha-tested grate).
-TEST(AgreementAux, EveryTracerWritesEmbreesAuxPlanes) {
+// entities, textures, layers and an alpha-tested grate), from centre rays and from the paths' first hits.
+class AgreementAux : public ::testing::TestWithParam<kuint> {};
+
+TEST_P(AgreementAux, EveryTracerWritesEmbreesAuxPlanes) {
+  const kuint aux_mode = GetParam();
   const KCamera cam = test_room_camera(64, 40);
   KCamera prev = core::make_camera({-180, -130, 125}, {33.0f, 21.0f}, 90.0f, 64, 40);
   auto room = std::make_shared<commit::TracerScene>(core::compile_scene(test_room()).tracer_scene);
   auto embree = make_test_tracer("embree");
-  const core::GBuffer a = render_aux(*embree, room, 1, cam, prev);
+  const core::GBuffer a = render_aux(*embree, room, 1, cam, prev, aux_mode);
   int checked = 0;
   for (const std::string& kind : built_tracers()) {
     if (kind == "embree" || !tracer_runs_here(kind)) continue;
     auto other = make_test_tracer(kind);
-    const core::GBuffer b = render_aux(*other, room, 1, cam, prev);
+    const core::GBuffer b = render_aux(*other, room, 1, cam, prev, aux_mode);
     size_t id_mismatch = 0;
     for (size_t p = 0; p < a.pixels(); ++p) {
       if (a.id[p] != b.id[p]) { ++id_mismatch; continue; }  // a silhouette pixel may go either way
@@ -200,6 +203,11 @@ TEST(AgreementAux, EveryTracerWritesEmbreesAuxPlanes) {
   }
   if (checked == 0) GTEST_SKIP() << "no tracer besides Embree runs here";
 }
+
+INSTANTIATE_TEST_SUITE_P(Modes, AgreementAux, ::testing::Values(K_AUX_CENTRE_RAY, K_AUX_PATH_FIRST_HIT),
+                         [](const ::testing::TestParamInfo<kuint>& info) {
+                           return std::string(info.param == K_AUX_CENTRE_RAY ? "CentreRays" : "FirstHits");
+                         });
 
 // A band in half floats (what `cohort render` and `play` use by default: GPU tracers convert it on the
 // device) equals the same tracer's band in floats within half precision.

@@ -7,6 +7,7 @@
 #include <cstring>
 #include <memory>
 
+#include "cohort/kernel/rng.h"
 #include "test_scenes.h"
 #include "test_tracers.h"
 
@@ -122,12 +123,14 @@ TEST(AuxOutputs, SplitBandsWriteTheWholeFramesPlanesAndTheSameColours) {
     if (!tracer_runs_here(kind)) continue;
     auto tracer = make_test_tracer(kind);
     tracer->apply(commit::CommitBuffer::full(room, 1));
+    for (kuint aux_mode : {K_AUX_CENTRE_RAY, K_AUX_PATH_FIRST_HIT}) {
+    SCOPED_TRACE(aux_mode == K_AUX_CENTRE_RAY ? "centre rays" : "the paths' first hits");
     auto render = [&](core::BandBuffer& band, bool aux, int begin, int end) {
       core::BandJob job;
       job.params = frame_params(K_MODE_PATH, 1, 1, h);
       job.params.row_begin = kuint(begin);
       job.params.row_end = kuint(end);
-      job.params.aux_outputs = aux ? 1u : 0u;
+      job.params.aux_outputs = aux ? aux_mode : 0u;
       job.camera = cam;
       job.previous_camera = prev;
       tracer->render_band(job, band);
@@ -153,7 +156,42 @@ TEST(AuxOutputs, SplitBandsWriteTheWholeFramesPlanesAndTheSameColours) {
       for (size_t p = 0; p < g.pixels(); ++p) hits += g.depth[p] > 0.0f ? 1u : 0u;
       EXPECT_GT(hits, g.pixels() / 2) << kind << ": the planes are mostly empty";
     }
+    }
     ++checked;
   }
   EXPECT_GT(checked, 0);
+}
+
+// K_AUX_PATH_FIRST_HIT: the planes of each pixel are those of its first sample's jittered camera ray, and
+// its motion is measured from that sample's position, on every tracer: a floor under a moving camera.
+TEST(AuxOutputs, FirstHitPlanesFollowTheJitteredSampleOnEveryTracer) {
+  const KCamera cam = camera_looking_down({0, 0, kHeight}, kTan, kW, kH);
+  const KCamera prev = camera_looking_down({7.0f, -4.0f, kHeight + 10.0f}, kTan, kW, kH);
+  const kuint frame_index = frame_params(K_MODE_PATH, 1, 1, kH).frame_index;
+  int checked = 0, off_centre = 0;
+  for (const std::string& kind : built_tracers()) {
+    if (!tracer_runs_here(kind)) continue;
+    SCOPED_TRACE(kind);
+    auto tracer = make_test_tracer(kind);
+    const core::GBuffer g = render_aux(*tracer, compiled_floor(), 1, cam, prev, K_AUX_PATH_FIRST_HIT);
+    for (int y = 0; y < kH; ++y)
+      for (int x = 0; x < kW; ++x) {
+        KRng rng = k_rng_seed(kuint(x), kuint(y), frame_index, 0u);
+        const float sx = float(x) + k_rng_next(&rng), sy = float(y) + k_rng_next(&rng);
+        off_centre += std::fabs(sx - (float(x) + 0.5f)) > 0.1f ? 1 : 0;
+        const size_t p = static_cast<size_t>(y) * kW + x;
+        const glm::vec3 point = floor_point(cam, sx, sy);
+        const glm::vec2 was = project(prev, point);
+        ASSERT_NEAR(g.motion[2 * p], was.x - sx, 2e-3f) << x << "," << y;
+        ASSERT_NEAR(g.motion[2 * p + 1], was.y - sy, 2e-3f) << x << "," << y;
+        ASSERT_NEAR(g.depth[p], kHeight, 1e-2f);
+        ASSERT_NEAR(g.prev_depth[p], kHeight + 10.0f, 1e-2f);
+        ASSERT_NEAR(g.normal[3 * p + 2], 1.0f, 1e-3f);
+        ASSERT_NEAR(g.albedo[3 * p + 1], 0.5f, 2e-3f);
+        ASSERT_EQ(g.id[p], 0u);
+      }
+    ++checked;
+  }
+  EXPECT_GT(checked, 0);
+  EXPECT_GT(off_centre, kW * kH / 2) << "the samples should be jittered off the pixels' centres";
 }

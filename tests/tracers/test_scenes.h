@@ -90,12 +90,14 @@ inline KFrameParams testmap_agreement_params(int height) {
 }
 
 // The auxiliary planes (kernel/aux_outputs.h) of one whole-frame band from the tracer's current scene.
-inline core::GBuffer render_aux_band(core::Tracer& tracer, const KCamera& camera, const KCamera& previous) {
+// aux_mode: K_AUX_CENTRE_RAY or K_AUX_PATH_FIRST_HIT (kernel/layout.h).
+inline core::GBuffer render_aux_band(core::Tracer& tracer, const KCamera& camera, const KCamera& previous,
+                                     kuint aux_mode = K_AUX_CENTRE_RAY) {
   core::BandBuffer band(static_cast<int>(camera.width), static_cast<int>(camera.height), core::BandFormat::rgba32f);
   band.enable_aux(true);
   core::BandJob job;
   job.params = frame_params(K_MODE_PATH, 1, 1, static_cast<int>(camera.height));
-  job.params.aux_outputs = 1u;
+  job.params.aux_outputs = aux_mode;
   job.camera = camera;
   job.previous_camera = previous;
   tracer.render_band(job, band);
@@ -107,9 +109,9 @@ inline core::GBuffer render_aux_band(core::Tracer& tracer, const KCamera& camera
 
 // The same after a full commit of `scene` at `frame`.
 inline core::GBuffer render_aux(core::Tracer& tracer, const std::shared_ptr<commit::TracerScene>& scene, uint64_t frame,
-                                const KCamera& camera, const KCamera& previous) {
+                                const KCamera& camera, const KCamera& previous, kuint aux_mode = K_AUX_CENTRE_RAY) {
   tracer.apply(commit::CommitBuffer::full(scene, frame));
-  return render_aux_band(tracer, camera, previous);
+  return render_aux_band(tracer, camera, previous, aux_mode);
 }
 
 // Where the ray through image point (px, py) of a camera_looking_down meets z = 0.

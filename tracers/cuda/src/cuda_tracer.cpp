@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <vector>
 
+#include "cohort/kernel/aux_mode.h"
 #include "device_array.h"
 #include "host_registrations.h"
 #include "render_band_launch.h"
@@ -72,6 +73,7 @@ struct CudaTracer::Impl {
   DeviceArray<float> previous_transforms;
   DeviceArray<KJoint> previous_joints;
   DeviceArray<KAuxTexel> aux_texels;
+  DeviceArray<KPathFirstHit> first_hits;  // K_AUX_PATH_FIRST_HIT: the band's paths' records
   float4* band = nullptr;
   unsigned short* band_rgb16f = nullptr;   // the band as RGB halves, for RGB16F targets
   bool count_rays = false;
@@ -282,30 +284,42 @@ core::BandResult CudaTracer::render_band(const core::BandJob& job, core::BandBuf
   else m.register_target(target);
   COHORT_CUDA(cudaEventRecord(m.start, m.stream));
   const bool write_aux = params.aux_outputs != 0u && target.has_aux();
+  const bool aux_from_paths = write_aux && k_aux_from_paths(&params);
+  KAuxHistory history{};
+  KAuxTexel* texels = nullptr;
+  const KCamera previous = job.previous_camera.width > 0 ? job.previous_camera : camera;
+  // The planes go down on the copy engine while the next kernel runs (after the band, on its stream,
+  // they added 2.2 ms to a 1080p frame on an H100).
+  auto download_aux = [&] {
+    COHORT_CUDA(cudaEventRecord(m.aux_ready, m.stream));
+    COHORT_CUDA(cudaStreamWaitEvent(m.aux_copy_stream, m.aux_ready, 0));
+    COHORT_CUDA(cudaMemcpyAsync(target.aux_row(int(params.row_begin)), texels, pixels * sizeof(KAuxTexel),
+                                cudaMemcpyDeviceToHost, m.aux_copy_stream));
+  };
   if (write_aux) {
-    // Only frames that ask pay for it: a short kernel before the band's, whose 32 bytes a pixel go down
-    // on the copy engine while the band's kernel runs (after it, they added 2.2 ms to a 1080p frame on
-    // an H100).
-    const KCamera previous = job.previous_camera.width > 0 ? job.previous_camera : camera;
     m.previous_transforms.upload(previous_transforms(), 0, m.stream);
     m.previous_joints.upload(previous_joints(), 0, m.stream);
-    KAuxHistory history{};
     history.object_to_world = previous_transforms().empty() ? nullptr : m.previous_transforms.data();
     history.skins = m.skins.data();
     history.skin_vertices = m.skin_vertices.data();
     history.skin_weights = m.skin_weights.data();
     history.joints = previous_joints().empty() ? nullptr : m.previous_joints.data();
     history.skin_count = static_cast<kuint>(scene().skins.size());
-    KAuxTexel* texels = kept ? kept->aux.scratch(pixels) : m.aux_texels.scratch(pixels);
-    launch_aux_band(m.view(params), params, camera, previous, history, texels, m.stream);
-    if (!kept) {
-      COHORT_CUDA(cudaEventRecord(m.aux_ready, m.stream));
-      COHORT_CUDA(cudaStreamWaitEvent(m.aux_copy_stream, m.aux_ready, 0));
-      COHORT_CUDA(cudaMemcpyAsync(target.aux_row(int(params.row_begin)), texels, pixels * sizeof(KAuxTexel),
-                                  cudaMemcpyDeviceToHost, m.aux_copy_stream));
+    texels = kept ? kept->aux.scratch(pixels) : m.aux_texels.scratch(pixels);
+    // Centre rays: a short kernel of their own before the band's, whose texels go down while it runs.
+    if (!aux_from_paths) {
+      launch_aux_band(m.view(params), params, camera, previous, history, texels, m.stream);
+      if (!kept) download_aux();
     }
   }
-  launch_render_band(m.view(params), params, camera, m.band, m.count_rays ? m.ray_counts : nullptr, m.row_rays, m.stream);
+  KPathFirstHit* first_hits = aux_from_paths ? m.first_hits.scratch(pixels) : nullptr;
+  launch_render_band(m.view(params), params, camera, m.band, m.count_rays ? m.ray_counts : nullptr, m.row_rays,
+                     first_hits, m.stream);
+  if (aux_from_paths) {
+    // From the paths' first hits: after the band's kernel, no ray of their own (counted in the band's time).
+    launch_aux_from_first_hits(m.view(params), params, camera, previous, history, first_hits, texels, m.stream);
+    if (!kept) download_aux();
+  }
   COHORT_CUDA(cudaEventRecord(m.stop, m.stream));
   // The band's rows are contiguous in the target: one copy straight into place, in its format.
   const size_t colour_bytes = pixels * core::bytes_per_pixel(target.format());
@@ -369,7 +383,7 @@ core::BandResult CudaTracer::render_band_in_pieces(const core::BandJob& job, cor
     float4* band = m.band + first_row * width;
     if (piece_pixels > 0)
       launch_render_band(m.view(piece), piece, camera, band, m.count_rays ? m.ray_counts : nullptr,
-                         m.row_rays + first_row, m.stream);
+                         m.row_rays + first_row, nullptr, m.stream);
     const void* source = band;
     if (half) {
       unsigned short* rgb = m.band_rgb16f + first_row * width * 3;

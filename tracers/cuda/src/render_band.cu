@@ -21,10 +21,12 @@ namespace cohort::tracers {
 // 5-6 blocks 13.2-13.4 ms on the large map at 1080p but slower on the test map, where spills cost more.
 // Two builds: with every pixel tracing paths the sparse pattern's test is compiled out, since in this
 // 128-register kernel even that early exit cost 1.5-2% of a full frame (nvidia-h100-x1, docs/integrator.md).
-template <bool kSparse>
+// kFirstHit: the first sample's first surface is recorded for the aux planes (K_AUX_PATH_FIRST_HIT), a
+// build of its own so that the kernel without it stays as it was.
+template <bool kSparse, bool kFirstHit>
 __global__ void __launch_bounds__(128, 4) render_band_kernel(KSceneView scene, KFrameParams params, KCamera camera,
                                                           float4* band, unsigned long long* ray_counts,
-                                                          unsigned* row_rays) {
+                                                          unsigned* row_rays, KPathFirstHit* first_hits) {
   const kuint x = blockIdx.x * blockDim.x + threadIdx.x;
   const kuint row = blockIdx.y * blockDim.y + threadIdx.y;
   const kuint y = params.row_begin + row;
@@ -34,7 +36,9 @@ __global__ void __launch_bounds__(128, 4) render_band_kernel(KSceneView scene, K
   ctx.closest_rays = 0u;
   ctx.occlusion_rays = 0u;
   if (inside) {
-    KVec3 c = kSparse ? k_render_pixel(&ctx, &params, &camera, x, y) : k_render_pixel_paths(&ctx, &params, &camera, x, y);
+    KVec3 c = kSparse ? k_render_pixel(&ctx, &params, &camera, x, y)
+                      : k_render_pixel_paths(&ctx, &params, &camera, x, y,
+                                             kFirstHit ? first_hits + size_t(row) * camera.width + x : nullptr);
     band[size_t(row) * camera.width + x] = make_float4(c.x, c.y, c.z, 1.0f);
   }
   if (ray_counts) {
@@ -58,8 +62,23 @@ __global__ void __launch_bounds__(128, 4) render_band_kernel(KSceneView scene, K
   }
 }
 
-// Auxiliary outputs (aux_outputs.h), launched only for frames that ask for them, written straight in the
-// 32-byte texel the host's BandBuffer keeps (halves for normal and albedo).
+// The 32-byte texel the host's BandBuffer keeps (halves for normal and albedo).
+__device__ void store_aux_texel(const KAux& a, KAuxTexel* out) {
+  KAuxTexel t;
+  t.depth = a.depth;
+  t.prev_depth = a.prev_depth;
+  t.motion[0] = a.motion[0];
+  t.motion[1] = a.motion[1];
+  for (int k = 0; k < 3; ++k) {
+    t.normal[k] = __half_as_ushort(__float2half_rn(a.normal[k]));
+    t.albedo[k] = __half_as_ushort(__float2half_rn(a.albedo[k]));
+  }
+  t.id = a.id;
+  *out = t;
+}
+
+// Auxiliary outputs (aux_outputs.h), launched only for frames that ask for them: K_AUX_CENTRE_RAY, a ray
+// of their own through each pixel's centre.
 __global__ void aux_band_kernel(KSceneView scene, KFrameParams params, KCamera camera, KCamera previous_camera,
                                 KAuxHistory history, KAuxTexel* band_aux) {
   const kuint x = blockIdx.x * blockDim.x + threadIdx.x;
@@ -72,17 +91,21 @@ __global__ void aux_band_kernel(KSceneView scene, KFrameParams params, KCamera c
   ctx.occlusion_rays = 0u;
   KAux a;
   k_pixel_aux(&ctx, &camera, &previous_camera, &history, x, y, &a);
-  KAuxTexel t;
-  t.depth = a.depth;
-  t.prev_depth = a.prev_depth;
-  t.motion[0] = a.motion[0];
-  t.motion[1] = a.motion[1];
-  for (int k = 0; k < 3; ++k) {
-    t.normal[k] = __half_as_ushort(__float2half_rn(a.normal[k]));
-    t.albedo[k] = __half_as_ushort(__float2half_rn(a.albedo[k]));
-  }
-  t.id = a.id;
-  band_aux[size_t(row) * camera.width + x] = t;
+  store_aux_texel(a, band_aux + size_t(row) * camera.width + x);
+}
+
+// K_AUX_PATH_FIRST_HIT: the planes finished from what the band's paths recorded (no ray of their own).
+__global__ void aux_from_first_hits_kernel(KSceneView scene, KFrameParams params, KCamera camera,
+                                           KCamera previous_camera, KAuxHistory history,
+                                           const KPathFirstHit* first_hits, KAuxTexel* band_aux) {
+  const kuint x = blockIdx.x * blockDim.x + threadIdx.x;
+  const kuint row = blockIdx.y * blockDim.y + threadIdx.y;
+  const kuint y = params.row_begin + row;
+  if (x >= camera.width || y >= params.row_end) return;
+  const size_t p = size_t(row) * camera.width + x;
+  KAux a;
+  k_aux_from_first_hit(&scene, &params, &camera, &previous_camera, &history, x, y, first_hits[p], &a);
+  store_aux_texel(a, band_aux + p);
 }
 
 void launch_aux_band(const KSceneView& scene, const KFrameParams& params, const KCamera& camera,
@@ -95,19 +118,36 @@ void launch_aux_band(const KSceneView& scene, const KFrameParams& params, const 
   COHORT_CUDA(cudaGetLastError());
 }
 
+void launch_aux_from_first_hits(const KSceneView& scene, const KFrameParams& params, const KCamera& camera,
+                                const KCamera& previous_camera, const KAuxHistory& history,
+                                const KPathFirstHit* first_hits, KAuxTexel* band_aux, cudaStream_t stream) {
+  const kuint rows = params.row_end - params.row_begin;
+  const dim3 block(16, 8);
+  const dim3 grid((camera.width + block.x - 1) / block.x, (rows + block.y - 1) / block.y);
+  aux_from_first_hits_kernel<<<grid, block, 0, stream>>>(scene, params, camera, previous_camera, history, first_hits,
+                                                         band_aux);
+  COHORT_CUDA(cudaGetLastError());
+}
+
 void set_texel_texture(cudaTextureObject_t texture) {
   COHORT_CUDA(cudaMemcpyToSymbol(cohort_texel_texture, &texture, sizeof texture));
 }
 
 void launch_render_band(const KSceneView& scene, const KFrameParams& params, const KCamera& camera, float4* band,
-                        unsigned long long* ray_counts, unsigned* row_rays, cudaStream_t stream) {
+                        unsigned long long* ray_counts, unsigned* row_rays, KPathFirstHit* first_hits,
+                        cudaStream_t stream) {
   const kuint rows = params.row_end - params.row_begin;
   const dim3 block(16, 8);  // 16 wide: the row ray counts rely on two rows per warp
   const dim3 grid((camera.width + block.x - 1) / block.x, (rows + block.y - 1) / block.y);
-  if (params.path_pixels == 0u || params.path_pixels >= K_PATH_PATTERN_PIXELS)
-    render_band_kernel<false><<<grid, block, 0, stream>>>(scene, params, camera, band, ray_counts, row_rays);
+  const bool sparse = params.path_pixels != 0u && params.path_pixels < K_PATH_PATTERN_PIXELS;
+  if (sparse)
+    render_band_kernel<true, false><<<grid, block, 0, stream>>>(scene, params, camera, band, ray_counts, row_rays, nullptr);
+  else if (first_hits)
+    render_band_kernel<false, true><<<grid, block, 0, stream>>>(scene, params, camera, band, ray_counts, row_rays,
+                                                                first_hits);
   else
-    render_band_kernel<true><<<grid, block, 0, stream>>>(scene, params, camera, band, ray_counts, row_rays);
+    render_band_kernel<false, false><<<grid, block, 0, stream>>>(scene, params, camera, band, ray_counts, row_rays,
+                                                                 nullptr);
   COHORT_CUDA(cudaGetLastError());
 }
 

@@ -11,14 +11,21 @@ namespace cohort::tracers {
 void set_texel_texture(cudaTextureObject_t texture);
 // The scene view holds device pointers (built on the host with k_scene_view, passed by value).
 // ray_counts (closest, occlusion) and row_rays (one per band row, zeroed by the caller) may be null.
+// first_hits (may be null; only for bands where every pixel traces paths): each pixel's record of its first
+// sample's first surface, for launch_aux_from_first_hits.
 void launch_render_band(const KSceneView& scene, const KFrameParams& params, const KCamera& camera, float4* band,
-                        unsigned long long* ray_counts, unsigned* row_rays, cudaStream_t stream);
+                        unsigned long long* ray_counts, unsigned* row_rays, KPathFirstHit* first_hits,
+                        cudaStream_t stream);
 // The band's auxiliary planes (kernel/aux_outputs.h) as the 32-byte KAuxTexel the host's BandBuffer
 // keeps (halves for normal and albedo); history: the previous frame's transforms and joints (device
 // pointers, kernel/aux_history.h).
 void launch_aux_band(const KSceneView& scene, const KFrameParams& params, const KCamera& camera,
                      const KCamera& previous_camera, const KAuxHistory& history, KAuxTexel* band_aux,
                      cudaStream_t stream);
+// The same planes from the band's first-hit records (K_AUX_PATH_FIRST_HIT), after the band's kernel.
+void launch_aux_from_first_hits(const KSceneView& scene, const KFrameParams& params, const KCamera& camera,
+                                const KCamera& previous_camera, const KAuxHistory& history,
+                                const KPathFirstHit* first_hits, KAuxTexel* band_aux, cudaStream_t stream);
 // Converts a rendered band (float4 per pixel) to RGB halves (3 x 16 bits per pixel) on the stream.
 void launch_band_to_rgb16f(const float4* band, unsigned short* rgb, size_t pixels, cudaStream_t stream);
 

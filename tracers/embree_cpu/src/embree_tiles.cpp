@@ -57,10 +57,21 @@ void trace_camera_packets(embree_kernel::TraceCtx& ctx, KVec3 org, int n, Arena&
     for (int i = 0; i < n; ++i) embree_kernel::log_ray(ctx.log, embree_kernel::kCameraRay, org, a.dirs[i], K_INF, K_RAY_PRIMARY);
 }
 
-// The tile's aux planes (depth, normal, albedo, id, motion): one unjittered ray through each pixel's
-// centre, traced ahead in packets like the camera rays, then k_pixel_aux from those hits.
+// The tile's aux planes (depth, normal, albedo, id, motion): from the paths' first hits where the frame
+// asks for that (k_aux_from_paths), else one unjittered ray through each pixel's centre, traced ahead in
+// packets like the camera rays, then k_pixel_aux from those hits.
 void write_aux(const Frame& frame, const Tile& tile, Arena& a, embree_kernel::TraceCtx& ctx, uint64_t* row_rays) {
   const int w = tile.x1 - tile.x0, n = w * (tile.y1 - tile.y0);
+  if (k_aux_from_paths(&frame.params)) {
+    for (int y = tile.y0; y < tile.y1; ++y) {
+      for (int x = 0; x < w; ++x)
+        k_aux_from_first_hit(&ctx.scene, &frame.params, &frame.camera, &frame.previous_camera, &frame.history,
+                             static_cast<kuint>(tile.x0 + x), static_cast<kuint>(y),
+                             a.first_hits[(y - tile.y0) * w + x], &a.aux[x]);
+      frame.target->store_aux(y, tile.x0, a.aux, static_cast<size_t>(w));
+    }
+    return;
+  }
   for (int i = 0; i < n; ++i)
     a.dirs[i] = k_camera_direction(&frame.camera, static_cast<float>(tile.x0 + i % w) + 0.5f,
                                    static_cast<float>(tile.y0 + i / w) + 0.5f);
@@ -132,6 +143,7 @@ void COHORT_RENDER_TILE(const Frame& frame, const Tile& tile, Arena& a, embree_k
                             static_cast<kuint>(tile.y0 + i / w)))
       a.traced[traced++] = i;
   }
+  const bool record_first_hits = frame.write_aux && frame.target && k_aux_from_paths(params);
   for (kuint s = 0u; s < spp; ++s) {
     for (int j = 0; j < traced; ++j) {
       const int i = a.traced[j];
@@ -146,7 +158,8 @@ void COHORT_RENDER_TILE(const Frame& frame, const Tile& tile, Arena& a, embree_k
       ctx.primed_found = a.found[j];
       ctx.primed_dir = a.dirs[j];
       if (log) log->camera_dir = a.dirs[j];
-      a.sums[i] = v3_add(a.sums[i], k_trace_path(&ctx, params, org, a.dirs[j], pixel_spread, &a.rngs[i]));
+      KPathFirstHit* first_hit = s == 0u && record_first_hits ? &a.first_hits[i] : nullptr;
+      a.sums[i] = v3_add(a.sums[i], k_trace_path(&ctx, params, org, a.dirs[j], pixel_spread, &a.rngs[i], first_hit));
       ctx.primed_hit = nullptr;
       row_rays[i / w] += ctx.rays - before;
     }

@@ -46,6 +46,7 @@ struct Arena {
   int traced[kTilePixels];  // the tile's pixels that trace paths (kernel/path_pattern.h), packed
   float rgba[kTileWidth * 4];
   KAux aux[kTileWidth];
+  KPathFirstHit first_hits[kTilePixels];  // K_AUX_PATH_FIRST_HIT: the first sample's first surfaces
 };
 
 // Renders the tile into frame.target and adds the rays traced per row to row_rays[y - tile.y0].

@@ -4,18 +4,18 @@
 #include "cohort/kernel/integrator.h"
 #include "cohort/kernel/aux_outputs.h"
 
-__kernel void cohort_render_band(__global const KVertex* vertices, __global const KVertexColor* vertex_colors,
-                                 __global const KTriangle* triangles,
-                                 __global const KBvhNode* blas_nodes, __global const KBlas* blases,
-                                 __global const KInstance* instances, __global const KBvhNode* tlas_nodes,
-                                 __global const KMaterial* materials, __global const KTexture* textures,
-                                 __global const kuint* texels, __global const KLight* lights,
-                                 __global const KLightNode* light_nodes, __global const KEmissiveTriangle* emissive,
-                                 __global const KFrameParams* params_in, __global const KCamera* camera_in,
-                                 __global float* band_rgba, __global uint* row_rays) {
+/* The band's pixels, recording first hits where first_hits is not null (the kernels below). */
+KFN void render_band_pixels(__global const KVertex* vertices, __global const KVertexColor* vertex_colors,
+                            __global const KTriangle* triangles, __global const KBvhNode* blas_nodes,
+                            __global const KBlas* blases, __global const KInstance* instances,
+                            __global const KBvhNode* tlas_nodes, __global const KMaterial* materials,
+                            __global const KTexture* textures, __global const kuint* texels,
+                            __global const KLight* lights, __global const KLightNode* light_nodes,
+                            __global const KEmissiveTriangle* emissive, __global const KFrameParams* params_in,
+                            __global const KCamera* camera_in, __global float* band_rgba, __global uint* row_rays,
+                            __global KPathFirstHit* first_hits, __local uint* group_row_rays) {
   /* Rays traced per row of the band (the balancer's per-row work), summed in local memory first so
    * that each work group adds once per row. The host launches 8x8 work groups. */
-  __local uint group_row_rays[8];
   KFrameParams params = *params_in;
   KCamera camera = *camera_in;
   kuint x = (kuint)get_global_id(0);
@@ -30,7 +30,9 @@ __kernel void cohort_render_band(__global const KVertex* vertices, __global cons
                              lights, light_nodes, emissive, &params);
     ctx.closest_rays = 0u;
     ctx.occlusion_rays = 0u;
-    KVec3 c = k_render_pixel(&ctx, &params, &camera, x, y);
+    KVec3 c = first_hits ? k_render_pixel_paths(&ctx, &params, &camera, x, y,
+                                                first_hits + (size_t)row * camera.width + x)
+                         : k_render_pixel(&ctx, &params, &camera, x, y);
     __global float* out = band_rgba + ((size_t)row * camera.width + x) * 4u;
     out[0] = c.x;
     out[1] = c.y;
@@ -42,8 +44,40 @@ __kernel void cohort_render_band(__global const KVertex* vertices, __global cons
   if (lx == 0u && y < params.row_end && group_row_rays[ly] != 0u) atomic_add(&row_rays[row], group_row_rays[ly]);
 }
 
+__kernel void cohort_render_band(__global const KVertex* vertices, __global const KVertexColor* vertex_colors,
+                                 __global const KTriangle* triangles,
+                                 __global const KBvhNode* blas_nodes, __global const KBlas* blases,
+                                 __global const KInstance* instances, __global const KBvhNode* tlas_nodes,
+                                 __global const KMaterial* materials, __global const KTexture* textures,
+                                 __global const kuint* texels, __global const KLight* lights,
+                                 __global const KLightNode* light_nodes, __global const KEmissiveTriangle* emissive,
+                                 __global const KFrameParams* params_in, __global const KCamera* camera_in,
+                                 __global float* band_rgba, __global uint* row_rays) {
+  __local uint group_row_rays[8];
+  render_band_pixels(vertices, vertex_colors, triangles, blas_nodes, blases, instances, tlas_nodes, materials, textures,
+                     texels, lights, light_nodes, emissive, params_in, camera_in, band_rgba, row_rays, 0, group_row_rays);
+}
+
+/* The same, recording each pixel's first sample's first surface for the aux planes (K_AUX_PATH_FIRST_HIT):
+ * a kernel of its own, so that the one without it compiles as before. */
+__kernel void cohort_render_band_first_hits(__global const KVertex* vertices, __global const KVertexColor* vertex_colors,
+                                 __global const KTriangle* triangles,
+                                 __global const KBvhNode* blas_nodes, __global const KBlas* blases,
+                                 __global const KInstance* instances, __global const KBvhNode* tlas_nodes,
+                                 __global const KMaterial* materials, __global const KTexture* textures,
+                                 __global const kuint* texels, __global const KLight* lights,
+                                 __global const KLightNode* light_nodes, __global const KEmissiveTriangle* emissive,
+                                 __global const KFrameParams* params_in, __global const KCamera* camera_in,
+                                 __global float* band_rgba, __global uint* row_rays,
+                                 __global KPathFirstHit* first_hits) {
+  __local uint group_row_rays[8];
+  render_band_pixels(vertices, vertex_colors, triangles, blas_nodes, blases, instances, tlas_nodes, materials, textures,
+                     texels, lights, light_nodes, emissive, params_in, camera_in, band_rgba, row_rays, first_hits, group_row_rays);
+}
+
 /* Auxiliary outputs (aux_outputs.h), launched only for frames that ask for them: one work item per
- * pixel of the band, writing a KAux each. prev_transforms: 12 floats per instance (the host always
+ * pixel of the band, writing a KAux each, from a centre ray or (k_aux_from_paths) from the band kernel's
+ * first-hit records. prev_transforms: 12 floats per instance (the host always
  * passes one; with no instance moved it equals the current transforms); prev_joints: the joint pool of
  * the previous frame, read when skin_count > 0 (aux_history.h). */
 __kernel void cohort_aux_band(__global const KVertex* vertices, __global const KVertexColor* vertex_colors,
@@ -57,7 +91,8 @@ __kernel void cohort_aux_band(__global const KVertex* vertices, __global const K
                               __global const KCamera* prev_camera_in, __global const float* prev_transforms,
                               __global const KSkin* skins, __global const KSkinVertex* skin_vertices,
                               __global const KSkinWeight* skin_weights, __global const KJoint* prev_joints,
-                              kuint skin_count, __global KAux* band_aux) {
+                              kuint skin_count, __global const KPathFirstHit* first_hits,
+                              __global KAux* band_aux) {
   KFrameParams params = *params_in;
   KCamera camera = *camera_in;
   KCamera prev_camera = *prev_camera_in;
@@ -78,7 +113,11 @@ __kernel void cohort_aux_band(__global const KVertex* vertices, __global const K
   history.joints = skin_count > 0u ? prev_joints : 0;
   history.skin_count = skin_count;
   KAux a;
-  k_pixel_aux(&ctx, &camera, &prev_camera, &history, x, y, &a);
+  if (k_aux_from_paths(&params))
+    k_aux_from_first_hit(&ctx.scene, &params, &camera, &prev_camera, &history, x, y,
+                         first_hits[(size_t)row * camera.width + x], &a);
+  else
+    k_pixel_aux(&ctx, &camera, &prev_camera, &history, x, y, &a);
   band_aux[(size_t)row * camera.width + x] = a;
 }
 

@@ -12,6 +12,7 @@
 #include <spdlog/spdlog.h>
 
 #include "cohort/core/host_threads.h"
+#include "cohort/kernel/aux_mode.h"
 
 namespace cohort::tracers {
 
@@ -275,6 +276,10 @@ struct OpenCLTracer::Impl {
   cl_kernel to_rgb16f = nullptr, to_texels = nullptr;
   cl_mem packed = nullptr, packed_aux = nullptr;
   size_t packed_bytes = 0, packed_aux_bytes = 0;
+  // K_AUX_PATH_FIRST_HIT: the band kernel that records its paths' first hits, and the records.
+  cl_kernel first_hits_kernel = nullptr;
+  cl_mem first_hits = nullptr;
+  size_t first_hits_bytes = 0;
   // The aux band in flight: its kernel (timed: the band's device time starts there, as on CUDA), the
   // packing the read waits on, the read into `aux_staging`.
   Event aux_kernel_done, aux_packed, aux_read;
@@ -305,9 +310,9 @@ struct OpenCLTracer::Impl {
   ~Impl() {
     if (aux_queue) clFinish(aux_queue);
     aux_staging.reset();
-    for (cl_mem m : {params, camera, previous_camera, output, row_rays, aux, packed, packed_aux})
+    for (cl_mem m : {params, camera, previous_camera, output, row_rays, aux, packed, packed_aux, first_hits})
       if (m) clReleaseMemObject(m);
-    for (cl_kernel k : {kernel, aux_kernel, skin_positions, skin_faces_kernel, skin_normals, refit_leaves, refit_blas,
+    for (cl_kernel k : {kernel, first_hits_kernel, aux_kernel, skin_positions, skin_faces_kernel, skin_normals, refit_leaves, refit_blas,
                         to_rgb16f, to_texels})
       if (k) clReleaseKernel(k);
     if (program) clReleaseProgram(program);
@@ -389,6 +394,8 @@ OpenCLTracer::OpenCLTracer(const Options& options) : impl_(std::make_unique<Impl
   check(err, "clCreateKernel(cohort_refit_blas_leaves)");
   impl_->refit_blas = clCreateKernel(impl_->program, "cohort_refit_blas", &err);
   check(err, "clCreateKernel(cohort_refit_blas)");
+  impl_->first_hits_kernel = clCreateKernel(impl_->program, "cohort_render_band_first_hits", &err);
+  check(err, "clCreateKernel(cohort_render_band_first_hits)");
   impl_->aux_kernel = clCreateKernel(impl_->program, "cohort_aux_band", &err);
   check(err, "clCreateKernel(aux)");
   impl_->to_rgb16f = clCreateKernel(impl_->program, "cohort_band_to_rgb16f", &err);
@@ -495,22 +502,32 @@ core::BandResult OpenCLTracer::render_band(const core::BandJob& job, core::BandB
         "writing frame parameters");
   check(clEnqueueWriteBuffer(m.queue, m.camera, CL_FALSE, 0, sizeof camera, &camera, 0, nullptr, nullptr),
         "writing the camera");
-  // Only frames that ask pay for the aux planes: a short kernel before the band's, whose texels go down
-  // on the second queue while the band's kernel runs (the CUDA tracer's order).
+  // Only frames that ask pay for the aux planes. From centre rays: a short kernel before the band's, whose
+  // texels go down on the second queue while the band's kernel runs (the CUDA tracer's order); from the
+  // paths' first hits: the band's kernel records them and the aux kernel finishes them after it.
   const bool write_aux = params.aux_outputs != 0u && target.has_aux();
+  const bool aux_from_paths = write_aux && k_aux_from_paths(&params);
   const bool straight = target.width() == static_cast<int>(camera.width);
-  if (write_aux) enqueue_aux(job, camera, rows, straight);
+  if (write_aux && !aux_from_paths) enqueue_aux(job, camera, rows, straight);
   cl_mem args[] = {m.vertices.mem(),  m.vertex_colors.mem(), m.triangles.mem(), m.blas_nodes.mem(), m.blases.mem(),
                    m.instances.mem(), m.tlas_nodes.mem(), m.materials.mem(), m.textures.mem(),
                    m.texels.mem(),    m.lights.mem(),     m.light_nodes.mem(), m.emissive.mem(),
                    m.params,          m.camera,           m.output,           m.row_rays};
-  for (cl_uint i = 0; i < sizeof(args) / sizeof(args[0]); ++i)
-    check(clSetKernelArg(m.kernel, i, sizeof(cl_mem), &args[i]), "clSetKernelArg");
+  cl_kernel band_kernel = aux_from_paths ? m.first_hits_kernel : m.kernel;
+  cl_uint arg_count = sizeof(args) / sizeof(args[0]);
+  for (cl_uint i = 0; i < arg_count; ++i)
+    check(clSetKernelArg(band_kernel, i, sizeof(cl_mem), &args[i]), "clSetKernelArg");
+  if (aux_from_paths) {
+    cl_mem records = m.grow(m.first_hits, m.first_hits_bytes, rows * camera.width * sizeof(KPathFirstHit),
+                            "clCreateBuffer(first hits)");
+    check(clSetKernelArg(band_kernel, arg_count, sizeof(cl_mem), &records), "clSetKernelArg(first hits)");
+  }
   const size_t local[2] = {8, 8};
   const size_t global[2] = {(camera.width + 7) / 8 * 8, (rows + 7) / 8 * 8};
   Event band_done;
-  check(clEnqueueNDRangeKernel(m.queue, m.kernel, 2, nullptr, global, local, 0, nullptr, band_done.out()),
+  check(clEnqueueNDRangeKernel(m.queue, band_kernel, 2, nullptr, global, local, 0, nullptr, band_done.out()),
         "launching the kernel");
+  if (aux_from_paths) enqueue_aux(job, camera, rows, straight);  // the in-order queue runs it after the band
   // The band goes straight into its rows of the target, converted on the device to the target's format.
   const size_t pixels = rows * camera.width;
   size_t band_bytes = bytes;
@@ -537,9 +554,11 @@ core::BandResult OpenCLTracer::render_band(const core::BandJob& job, core::BandB
   check(clFinish(m.queue), "waiting for the band");
   for (size_t r = 0; r < rows && !straight; ++r)
     target.store(static_cast<int>(params.row_begin + r), 0, band.data() + r * camera.width * 4, camera.width);
-  // Device time from the first kernel (the aux one when it ran, as the CUDA tracer times it) to the band's end.
-  const cl_ulong start = (write_aux ? m.aux_kernel_done : band_done).time(CL_PROFILING_COMMAND_START);
-  const cl_ulong end = band_done.time(CL_PROFILING_COMMAND_END);
+  // Device time from the first kernel (the aux one when it ran first, as the CUDA tracer times it) to the
+  // last (the aux one when it finished the paths' first hits).
+  const cl_ulong start =
+      (write_aux && !aux_from_paths ? m.aux_kernel_done : band_done).time(CL_PROFILING_COMMAND_START);
+  const cl_ulong end = (aux_from_paths ? m.aux_kernel_done : band_done).time(CL_PROFILING_COMMAND_END);
   core::BandResult result;
   result.device_ms = end > start && start != 0 ? double(end - start) * 1e-6 : 0.0;
   if (params.row_end == frame_params(job).row_end) result.row_work.assign(row_rays.begin(), row_rays.end());
@@ -580,6 +599,9 @@ void OpenCLTracer::enqueue_aux(const core::BandJob& job, const KCamera& camera, 
   for (; arg < sizeof(args) / sizeof(args[0]); ++arg)
     check(clSetKernelArg(m.aux_kernel, arg, sizeof(cl_mem), &args[arg]), "clSetKernelArg(aux)");
   check(clSetKernelArg(m.aux_kernel, arg++, sizeof skin_count, &skin_count), "clSetKernelArg(aux skin count)");
+  // The first-hit records are read only when the frame's aux planes come from the paths (any valid buffer else).
+  cl_mem records = m.first_hits ? m.first_hits : m.previous_transforms.mem();
+  check(clSetKernelArg(m.aux_kernel, arg++, sizeof(cl_mem), &records), "clSetKernelArg(aux first hits)");
   check(clSetKernelArg(m.aux_kernel, arg, sizeof(cl_mem), &m.aux), "clSetKernelArg(aux output)");
   const size_t local[2] = {8, 8};
   const size_t global[2] = {(camera.width + 7) / 8 * 8, (rows + 7) / 8 * 8};

@@ -1,14 +1,20 @@
 /* Auxiliary outputs (a G-buffer) for temporal reprojection and denoising, written once for every tracer.
  * Include after integrator.h (it uses the same KTraceCtx and k_trace_closest).
  *
- * Per pixel, from one ray through the pixel's centre (not the jittered samples: the planes must be the
- * same on every tracer and free of noise), at the first opaque surface (transparent layers are crossed
- * as the path does):
+ * Per pixel, at the first opaque surface (transparent layers are crossed as the path does), from one of
+ * two rays (KFrameParams.aux_outputs, aux_mode.h):
+ *   K_AUX_CENTRE_RAY      a ray of its own through the pixel's centre (k_pixel_aux): steady planes, but
+ *                         a second trace of every first hit;
+ *   K_AUX_PATH_FIRST_HIT  the first sample's own camera ray: its path records which triangle it met
+ *                         (k_trace_path's first_hit) and k_aux_from_first_hit finishes the planes from
+ *                         it without tracing; positions (motion's origin) are the sample's, jittered.
+ * Either way every tracer writes the same planes for the same frame. The planes:
  *   depth       distance along the camera's forward axis; 0 on a miss
  *   prev_depth  the same point's depth in the previous frame's camera (after its object's motion); the
  *               reprojection compares it with the history's depth to find disocclusions
- *   motion      screen offset, in pixels, from this pixel's centre to where the point was in the previous
- *               frame: previous position = (x + 0.5, y + 0.5) + motion. A miss moves with the camera's
+ *   motion      screen offset, in pixels, from where the ray left the image (the pixel's centre, or the
+ *               sample's position) to where the point was in the previous frame: previous position =
+ *               (x + 0.5, y + 0.5) + motion for centre rays. A miss moves with the camera's
  *               rotation only (a point at infinity). K_AUX_NO_MOTION when the point was behind the
  *               previous camera.
  *   normal      world-space shading normal (unit); 0 on a miss
@@ -25,6 +31,7 @@
 #ifndef COHORT_KERNEL_AUX_OUTPUTS_H
 #define COHORT_KERNEL_AUX_OUTPUTS_H
 #include "aux_history.h"
+#include "aux_mode.h"
 #include "integrator.h"
 
 /* Where a hit's point was in the previous frame, in the instance's object space. */
@@ -72,13 +79,35 @@ KFN int k_project_direction(const KCamera* cam, KVec3 dir, float* px, float* py)
   return 1;
 }
 
-KFN void k_pixel_aux(KTraceCtx* ctx, const KCamera* cam, const KCamera* prev_cam, const KAuxHistory* history, kuint x,
-                     kuint y, KAux* out) {
-  const KSceneView* scene = K_CTX_SCENE(ctx);
-  float cx = (float)x + 0.5f, cy = (float)y + 0.5f;
-  KVec3 org = v3_load(cam->origin);
-  KVec3 dir = k_camera_direction(cam, cx, cy);
-  float pixel_spread = 2.0f * cam->tan_half_fov_x / (float)cam->width;
+/* Depth, previous depth and motion of the surface point p of a hit, seen at image position (sx, sy). */
+KFN void k_aux_surface_motion(const KSceneView* scene, const KCamera* cam, const KCamera* prev_cam,
+                              const KAuxHistory* history, KHit hit, KVec3 p, float sx, float sy, KAux* out) {
+  KGLOBAL const KInstance* inst = &scene->instances[hit.instance];
+  KVec3 p_prev = p;
+  if (history->object_to_world || history->joints) {
+    KVec3 p_object = k_aux_previous_object_point(scene, history, hit, p);
+    p_prev = history->object_to_world ? xform_point_g(history->object_to_world + 12u * hit.instance, p_object)
+                                      : xform_point_g(inst->object_to_world, p_object);
+  }
+  out->depth = v3_dot(v3_sub(p, v3_load(cam->origin)), v3_load(cam->forward));
+  float px, py, pz;
+  if (k_project_point(prev_cam, p_prev, &px, &py, &pz)) {
+    out->motion[0] = px - sx;
+    out->motion[1] = py - sy;
+  }
+  out->prev_depth = pz;
+}
+
+/* Motion of a miss seen along dir at image position (sx, sy): the camera's rotation only. */
+KFN void k_aux_miss_motion(const KCamera* prev_cam, KVec3 dir, float sx, float sy, KAux* out) {
+  float px, py;
+  if (k_project_direction(prev_cam, dir, &px, &py)) {
+    out->motion[0] = px - sx;
+    out->motion[1] = py - sy;
+  }
+}
+
+KFN void k_aux_clear(KAux* out) {
   out->depth = 0.0f;
   out->prev_depth = 0.0f;
   out->motion[0] = K_AUX_NO_MOTION;
@@ -87,6 +116,17 @@ KFN void k_pixel_aux(KTraceCtx* ctx, const KCamera* cam, const KCamera* prev_cam
   out->albedo[0] = out->albedo[1] = out->albedo[2] = 0.0f;
   out->id = K_NONE;
   out->pad = 0u;
+}
+
+/* K_AUX_CENTRE_RAY: the aux planes of pixel (x, y) from a ray of its own through the pixel's centre. */
+KFN void k_pixel_aux(KTraceCtx* ctx, const KCamera* cam, const KCamera* prev_cam, const KAuxHistory* history, kuint x,
+                     kuint y, KAux* out) {
+  const KSceneView* scene = K_CTX_SCENE(ctx);
+  float cx = (float)x + 0.5f, cy = (float)y + 0.5f;
+  KVec3 org = v3_load(cam->origin);
+  KVec3 dir = k_camera_direction(cam, cx, cy);
+  float pixel_spread = 2.0f * cam->tan_half_fov_x / (float)cam->width;
+  k_aux_clear(out);
   KVec3 ray_org = org;
   for (kuint layer = 0u; layer <= K_MAX_LAYERS; ++layer) {
     KHit hit;
@@ -105,15 +145,6 @@ KFN void k_pixel_aux(KTraceCtx* ctx, const KCamera* cam, const KCamera* prev_cam
       ray_org = v3_madd(sf.position, dir, k_ray_epsilon(sf.position));
       continue;
     }
-    KGLOBAL const KInstance* inst = &scene->instances[hit.instance];
-    KVec3 p = sf.position;
-    KVec3 p_prev = p;
-    if (history->object_to_world || history->joints) {
-      KVec3 p_object = k_aux_previous_object_point(scene, history, hit, p);
-      p_prev = history->object_to_world ? xform_point_g(history->object_to_world + 12u * hit.instance, p_object)
-                                        : xform_point_g(inst->object_to_world, p_object);
-    }
-    out->depth = v3_dot(v3_sub(p, org), v3_load(cam->forward));
     out->normal[0] = sf.normal.x;
     out->normal[1] = sf.normal.y;
     out->normal[2] = sf.normal.z;
@@ -121,20 +152,75 @@ KFN void k_pixel_aux(KTraceCtx* ctx, const KCamera* cam, const KCamera* prev_cam
     out->albedo[0] = k_saturate(a.x);
     out->albedo[1] = k_saturate(a.y);
     out->albedo[2] = k_saturate(a.z);
-    out->id = inst->entity + 1u;
-    float px, py, pz;
-    if (k_project_point(prev_cam, p_prev, &px, &py, &pz)) {
-      out->motion[0] = px - cx;
-      out->motion[1] = py - cy;
-    }
-    out->prev_depth = pz;
+    out->id = scene->instances[hit.instance].entity + 1u;
+    k_aux_surface_motion(scene, cam, prev_cam, history, hit, sf.position, cx, cy, out);
     return;
   }
-  float px, py;
-  if (k_project_direction(prev_cam, dir, &px, &py)) {
-    out->motion[0] = px - cx;
-    out->motion[1] = py - cy;
+  k_aux_miss_motion(prev_cam, dir, cx, cy, out);
+}
+
+/* K_AUX_PATH_FIRST_HIT: the aux planes of pixel (x, y) from what its first sample's path recorded
+ * (k_trace_path's first_hit: which triangle). The sample's camera ray again (k_camera_sample's jitter, so
+ * the same direction bit for bit), its point on the recorded triangle, the surface there, and depth and
+ * motion as the centre ray works them out but at the sample's position in the pixel: a still camera gives
+ * motion 0, and the history is fetched where the surface was. No ray is traced. */
+KFN void k_aux_from_first_hit(const KSceneView* scene, const KFrameParams* params, const KCamera* cam,
+                              const KCamera* prev_cam, const KAuxHistory* history, kuint x, kuint y,
+                              KPathFirstHit record, KAux* out) {
+  KRng jitter = k_rng_seed(x, y, params->frame_index, 0u);
+  float sx = (float)x + k_rng_next(&jitter);
+  float sy = (float)y + k_rng_next(&jitter);
+  KVec3 dir = k_camera_direction(cam, sx, sy);
+  k_aux_clear(out);
+  if (record.instance == K_NONE) {
+    k_aux_miss_motion(prev_cam, dir, sx, sy, out);
+    return;
   }
+  /* The ray in the instance's object space, as the walk intersected it, against the triangle's plane (no
+   * edge tests: the path found this triangle, rounding must not lose it). */
+  KGLOBAL const KInstance* inst = &scene->instances[record.instance];
+  KVec3 org = v3_load(cam->origin);
+  KVec3 o = xform_point_g(inst->world_to_object, org), d = xform_vector_g(inst->world_to_object, dir);
+  KTriangle tri = scene->triangles[record.triangle];
+  KVec3 p0 = v3_load_g(scene->vertices[tri.v0].pos);
+  KVec3 e1 = v3_sub(v3_load_g(scene->vertices[tri.v1].pos), p0), e2 = v3_sub(v3_load_g(scene->vertices[tri.v2].pos), p0);
+  KVec3 pv = v3_cross(d, e2);
+  float det = v3_dot(e1, pv);
+  KHit hit;
+  hit.instance = record.instance;
+  hit.triangle = record.triangle;
+  hit.cost = 0u;
+  hit.t = 0.0f;
+  hit.u = hit.v = 0.0f;
+  if (k_fabs(det) > 1e-30f) {
+    float inv_det = 1.0f / det;
+    KVec3 s = v3_sub(o, p0), q = v3_cross(s, e1);
+    hit.t = v3_dot(e2, q) * inv_det;
+    hit.u = v3_dot(s, pv) * inv_det;
+    hit.v = v3_dot(d, q) * inv_det;
+  }
+  if (record.sky) {
+    KVec3 sky = k_sky_radiance(scene, record.instance, k_hit_material(scene, record.instance, record.triangle), dir);
+    out->albedo[0] = k_saturate(sky.x);
+    out->albedo[1] = k_saturate(sky.y);
+    out->albedo[2] = k_saturate(sky.z);
+    k_aux_miss_motion(prev_cam, dir, sx, sy, out);
+    return;
+  }
+  if (!(hit.t > 0.0f)) {
+    k_aux_miss_motion(prev_cam, dir, sx, sy, out);
+    return;
+  }
+  KSurface sf = k_surface_eval(scene, hit, org, dir, k_pixel_spread(cam) * hit.t);
+  out->normal[0] = sf.normal.x;
+  out->normal[1] = sf.normal.y;
+  out->normal[2] = sf.normal.z;
+  KVec3 a = v3_add(sf.albedo, sf.emission);
+  out->albedo[0] = k_saturate(a.x);
+  out->albedo[1] = k_saturate(a.y);
+  out->albedo[2] = k_saturate(a.z);
+  out->id = inst->entity + 1u;
+  k_aux_surface_motion(scene, cam, prev_cam, history, hit, sf.position, sx, sy, out);
 }
 
 #endif

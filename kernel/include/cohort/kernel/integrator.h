@@ -221,10 +221,21 @@ KFN KVec3 k_id_color(kuint id) {
   return v3((float)(h & 0xFFu) / 255.0f, (float)((h >> 8) & 0xFFu) / 255.0f, (float)((h >> 16) & 0xFFu) / 255.0f);
 }
 
-/* Radiance along one camera ray; pixel_spread is the angle one pixel subtends (for mip selection). */
+/* Which surface a camera ray met first, for the aux planes (K_AUX_PATH_FIRST_HIT). */
+KFN void k_record_first_hit(KGLOBAL KPathFirstHit* record, kuint instance, kuint triangle, kuint sky) {
+  record->instance = instance;
+  record->triangle = triangle;
+  record->sky = sky;
+  record->pad = 0u;
+}
+
+/* Radiance along one camera ray; pixel_spread is the angle one pixel subtends (for mip selection).
+ * first_hit (may be null): where the ray's first opaque surface is recorded for the aux planes (a miss,
+ * or a ray the path gives up on before one, is recorded as a miss). */
 KFN KVec3 k_trace_path(KTraceCtx* ctx, const KFrameParams* params, KVec3 org, KVec3 dir, float pixel_spread,
-                       KRng* rng) {
+                       KRng* rng, KGLOBAL KPathFirstHit* first_hit) {
   const KSceneView* scene = K_CTX_SCENE(ctx);
+  if (first_hit) k_record_first_hit(first_hit, K_NONE, 0u, 0u);
   KVec3 radiance = v3s(0.0f), throughput = v3s(1.0f);
   float cone_width = 0.0f, spread = pixel_spread;
   kuint bounce = 0u, layers = 0u;
@@ -251,6 +262,7 @@ KFN KVec3 k_trace_path(KTraceCtx* ctx, const KFrameParams* params, KVec3 org, KV
     kuint hit_material = k_hit_material(scene, hit.instance, hit.triangle);
     if (scene->materials[hit_material].blend == K_BLEND_SKY) {
       /* The sky: what its cube shows along the ray, and nothing behind it. */
+      if (first_hit) k_record_first_hit(first_hit, hit.instance, hit.triangle, 1u);
       if (lit_mode || params->mode == K_MODE_ALBEDO) {
         KVec3 sky = v3_mul(throughput, k_sky_radiance(scene, hit.instance, hit_material, dir));
         radiance = v3_add(radiance, bounce > 0u ? k_clamp_radiance(sky, params->firefly_clamp) : sky);
@@ -282,6 +294,10 @@ KFN KVec3 k_trace_path(KTraceCtx* ctx, const KFrameParams* params, KVec3 org, KV
       continue;
     }
 
+    if (first_hit) {
+      k_record_first_hit(first_hit, hit.instance, hit.triangle, 0u);
+      first_hit = 0;
+    }
     if (params->mode == K_MODE_ALBEDO) { radiance = v3_add(sf.albedo, sf.emission); break; }
     if (params->mode == K_MODE_NORMALS) { radiance = v3_add(v3_scale(sf.normal, 0.5f), v3s(0.5f)); break; }
     if (params->mode == K_MODE_SPECULAR) { radiance = sf.specular; break; }
@@ -348,8 +364,10 @@ KFN KVec3 k_camera_sample(const KFrameParams* params, const KCamera* cam, kuint 
   return k_camera_direction(cam, (float)x + jx, (float)y + jy);
 }
 
-/* A pixel's colour, its paths traced whatever the sparse path pattern says (k_render_pixel asks it). */
-KFN KVec3 k_render_pixel_paths(KTraceCtx* ctx, const KFrameParams* params, const KCamera* cam, kuint x, kuint y) {
+/* A pixel's colour, its paths traced whatever the sparse path pattern says (k_render_pixel asks it);
+ * first_hit (may be null): the first sample's first surface, for the aux planes. */
+KFN KVec3 k_render_pixel_paths(KTraceCtx* ctx, const KFrameParams* params, const KCamera* cam, kuint x, kuint y,
+                               KGLOBAL KPathFirstHit* first_hit) {
   kuint spp = params->spp > 0u ? params->spp : 1u;
   KVec3 sum = v3s(0.0f);
   KVec3 org = v3_load(cam->origin);
@@ -357,7 +375,7 @@ KFN KVec3 k_render_pixel_paths(KTraceCtx* ctx, const KFrameParams* params, const
   for (kuint s = 0u; s < spp; ++s) {
     KRng rng;
     KVec3 dir = k_camera_sample(params, cam, x, y, s, &rng);
-    sum = v3_add(sum, k_trace_path(ctx, params, org, dir, pixel_spread, &rng));
+    sum = v3_add(sum, k_trace_path(ctx, params, org, dir, pixel_spread, &rng, s == 0u ? first_hit : 0));
   }
   return v3_scale(sum, 1.0f / (float)spp);
 }
@@ -365,7 +383,7 @@ KFN KVec3 k_render_pixel_paths(KTraceCtx* ctx, const KFrameParams* params, const
 /* A pixel's colour; black, at no cost, where the sparse path pattern (path_pattern.h) leaves it out. */
 KFN KVec3 k_render_pixel(KTraceCtx* ctx, const KFrameParams* params, const KCamera* cam, kuint x, kuint y) {
   if (!k_pixel_traces_path(params->path_pixels, params->path_phase, x, y)) return v3s(0.0f);
-  return k_render_pixel_paths(ctx, params, cam, x, y);
+  return k_render_pixel_paths(ctx, params, cam, x, y, 0);
 }
 
 #endif

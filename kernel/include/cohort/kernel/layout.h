@@ -231,6 +231,20 @@ typedef struct KAux {
   float normal[3]; float albedo[3];  kuint id;       kuint pad;
 } KAux;
 
+/* KFrameParams.aux_outputs: 0 = none; K_AUX_CENTRE_RAY = from one unjittered ray through each pixel's centre
+ * (a pass of its own); K_AUX_PATH_FIRST_HIT = from the first sample's camera ray, recorded by the path as it
+ * goes (KPathFirstHit) and finished afterwards (aux_outputs.h): no ray of its own, the planes jittered as
+ * the samples are. Tracers take the centre ray where paths do not cover every pixel (sparse paths). */
+#define K_AUX_CENTRE_RAY     1u
+#define K_AUX_PATH_FIRST_HIT 2u
+
+/* What a path records of its first opaque surface for the aux planes (K_AUX_PATH_FIRST_HIT): only which
+ * triangle it is (instance K_NONE: a miss; sky 1: the sky's surface), so that the megakernel keeps no more
+ * values live than before; the planes are worked out from it afterwards (aux_outputs.h). */
+typedef struct KPathFirstHit {
+  kuint instance; kuint triangle; kuint sky; kuint pad;
+} KPathFirstHit;
+
 /* KAux as it travels to the host (core's BandBuffer): 32 bytes, the normal and albedo as IEEE half
  * floats (their bits). GPU tracers pack it on the device so that only these bytes cross the bus. */
 typedef struct KAuxTexel {
@@ -241,6 +255,7 @@ typedef struct KAuxTexel {
 #if defined(__cplusplus) && !defined(__CUDACC_RTC__)
 static_assert(sizeof(KAux) == 48, "KAux layout");
 static_assert(sizeof(KAuxTexel) == 32, "KAuxTexel layout");
+static_assert(sizeof(KPathFirstHit) == 16, "KPathFirstHit layout");
 static_assert(sizeof(KBvhNode) == 32, "KBvhNode layout");
 static_assert(sizeof(KBlas) == 16, "KBlas layout");
 static_assert(sizeof(KTriangleEdges) == 48, "KTriangleEdges layout");
