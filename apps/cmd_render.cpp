@@ -428,8 +428,8 @@ void add_render_command(CLI::App& app, int& exit_code) {
                   "through the light tree: cost independent of the light count), all (reference: a pick by "
                   "contribution over every light), every (reference: every light, one shadow ray each), gather (a "
                   "shadow ray for each light whose volume holds the point, found through the light tree, while "
-                  "there are at most --light-samples of them; beyond that about --light-samples rays, the "
-                  "brightest lights first, unbiased)")
+                  "there are at most --light-samples of them; beyond that at most --light-samples rays (16 at "
+                  "most), the brightest lights first, unbiased)")
       ->capture_default_str()
       ->check(CLI::IsMember(core::light_sampling_names()));
   cmd->add_option("--light-samples", a->light_samples,
