@@ -427,11 +427,15 @@ void add_render_command(CLI::App& app, int& exit_code) {
   cmd->add_option("--light-sampling", a->light_sampling,
                   "how each hit picks the map's lights: tree (among the lights whose volume holds the point, "
                   "through the light tree: cost independent of the light count), all (reference: a pick by "
-                  "contribution over every light), every (reference: every light, one shadow ray each)")
+                  "contribution over every light), every (reference: every light, one shadow ray each), gather (a "
+                  "shadow ray for each light whose volume holds the point, found through the light tree, while "
+                  "there are at most --light-samples of them; beyond that at most --light-samples rays (16 at "
+                  "most), the brightest lights first, unbiased)")
       ->capture_default_str()
       ->check(CLI::IsMember(core::light_sampling_names()));
   cmd->add_option("--light-samples", a->light_samples,
-                  "lights sampled per hit with --light-sampling tree or all (0: every light, as --light-sampling every)")
+                  "lights sampled per hit with --light-sampling tree or all, most shadow rays per hit with gather "
+                  "(0: every light, as --light-sampling every)")
       ->capture_default_str()
       ->check(CLI::NonNegativeNumber);
   cmd->add_option("--emissive-samples", a->emissive_samples,

@@ -22,6 +22,7 @@
 
 #include "cohort/core/frame_defaults.h"
 #include "cohort/core/gpu_scene.h"
+#include "cohort/core/scene_pack.h"
 #include "cohort/core/view.h"
 #include "cohort/tracers/tracer_registry.h"
 #ifdef COHORT_HAVE_EMBREE
@@ -41,6 +42,7 @@ struct Config {
   std::vector<int> lights = {8, 64, 256, 1024};
   std::vector<int> triangles = {3000, 300000, 1000000};
   std::string json = "out/bench_scaling.json", plot = "out/bench_scaling.png";
+  std::string write_packs;  // a folder: each room also written as a scene pack, for `cohort render`
 };
 
 Config parse(int argc, char** argv) {
@@ -61,6 +63,9 @@ Config parse(int argc, char** argv) {
       ->check(CLI::Range(1, 1 << 28))->capture_default_str();
   app.add_option("--json", c.json, "JSON output")->capture_default_str();
   app.add_option("--plot", c.plot, "chart output (PNG, or PPM without OpenImageIO)")->capture_default_str();
+  app.add_option("--write-packs", c.write_packs,
+                 "also write each room as a scene pack (scaling_<T>t_<L>l.cpk) into this folder, so that `cohort "
+                 "render` can take it (e.g. the light-sampling noise measurements of docs/integrator.md)");
   bool smoke = false;
   app.add_flag("--smoke", smoke, "tiny sizes, for the ctest that keeps the benchmark running");
   try {
@@ -167,9 +172,23 @@ Result run_one(const Config& cfg, int triangles, int lights) {
   scene::Scene room = make_room(triangles, lights);
   const glm::vec3 eye = room.player_start;
   const float yaw = room.player_yaw;
+  const std::string name = room.name;
   auto t0 = Clock::now();
-  auto scene = std::make_shared<commit::TracerScene>(core::compile_scene(std::move(room)).tracer_scene);
+  core::CompiledScene compiled = core::compile_scene(std::move(room));
   r.compile_ms = ms_since(t0);
+  if (!cfg.write_packs.empty()) {
+    core::PackedScene pack;
+    pack.map_name = name;
+    pack.tracer_scene = compiled.tracer_scene;
+    pack.blas_of_mesh = compiled.blas_of_mesh;
+    pack.world_blas = compiled.world_blas;
+    pack.instance_names.assign(pack.tracer_scene.instances.size(), "world");
+    for (int k = 0; k < 3; ++k) pack.player_start[k] = eye[k];
+    pack.player_yaw = yaw;
+    std::filesystem::create_directories(cfg.write_packs);
+    core::write_scene_pack(std::filesystem::path(cfg.write_packs) / (name + ".cpk"), pack);
+  }
+  auto scene = std::make_shared<commit::TracerScene>(std::move(compiled.tracer_scene));
   r.scene_triangles = scene->triangles.size();
   std::unique_ptr<core::Tracer> tracer = tracers::make_tracer(tracers::parse_tracer_list(cfg.tracer).at(0));
   t0 = Clock::now();

@@ -24,7 +24,7 @@ KFrameParams default_frame_params() {
 }
 
 const std::vector<std::string>& light_sampling_names() {
-  static const std::vector<std::string> names = {"tree", "all", "every"};
+  static const std::vector<std::string> names = {"tree", "all", "every", "gather"};
   return names;
 }
 
@@ -32,7 +32,8 @@ kuint light_sampling_mode(const std::string& name) {
   if (name == "tree") return K_LIGHTS_TREE;
   if (name == "all") return K_LIGHTS_ALL;
   if (name == "every") return K_LIGHTS_EVERY;
-  throw std::invalid_argument("light sampling '" + name + "': choose tree, all or every");
+  if (name == "gather") return K_LIGHTS_GATHER;
+  throw std::invalid_argument("light sampling '" + name + "': choose tree, all, every or gather");
 }
 
 }  // namespace cohort::core

@@ -85,14 +85,15 @@ INSTANTIATE_TEST_SUITE_P(Modes, Agreement,
                                            Case{K_MODE_PATH, 1, "path_all_lights", 0},
                                            Case{K_MODE_PATH, 1, "path_all_pick", 1, K_LIGHTS_ALL},
                                            Case{K_MODE_PATH, 1, "path_no_emissive_nee", 1, K_LIGHTS_TREE, 0},
+                                           Case{K_MODE_PATH, 1, "path_gather", 2, K_LIGHTS_GATHER},
                                            Case{K_MODE_DIRECT, 0, "direct"}, Case{K_MODE_ALBEDO, 0, "albedo"},
                                            Case{K_MODE_NORMALS, 0, "normals"},
                                            // Embree draws its heat map on Cohort's own BVH, as OpenCL does.
                                            Case{K_MODE_BVH, 0, "bvh"}),
                          [](const auto& info) { return std::string(info.param.name); });
 
-// The light tree's descent (more lights than K_LIGHT_TREE_GATHER overlap) and the emissive-triangle
-// sampling give the same image on both tracers.
+// The light tree's descent (more lights than K_LIGHT_TREE_GATHER overlap), the emissive-triangle
+// sampling and gather's choice among more lights than its budget give the same image on both tracers.
 TEST(AgreementManyLights, EmbreeAndOpenCLImagesMatch) {
   std::vector<std::string> names = built_tracers();
   if (names.size() < 2 || !tracer_runs_here("opencl")) GTEST_SKIP() << "needs both the Embree and the OpenCL tracer";
@@ -108,6 +109,15 @@ TEST(AgreementManyLights, EmbreeAndOpenCLImagesMatch) {
   double mean = 0.0;
   double error = rgb_rmse(a, b, &mean);
   std::cout << "many lights, tree: RMSE embree/opencl " << error << ", mean " << mean << "\n";
+  EXPECT_GT(mean, 0.05);
+  EXPECT_LT(error, 0.005 * mean);
+  // Gather with fewer rays than lights in range: the systematic choice and its weights.
+  params.light_sampling = K_LIGHTS_GATHER;
+  params.light_samples = 4;
+  a = render(*embree, s, cam, params);
+  b = render(*opencl, s, cam, params);
+  error = rgb_rmse(a, b, &mean);
+  std::cout << "many lights, gather 4: RMSE embree/opencl " << error << ", mean " << mean << "\n";
   EXPECT_GT(mean, 0.05);
   EXPECT_LT(error, 0.005 * mean);
 }

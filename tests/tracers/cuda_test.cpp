@@ -50,6 +50,8 @@ core::FrameBuffer render_scene(core::Tracer& tracer, const commit::TracerScene& 
 struct ModeCase {
   uint32_t mode, bounces;
   const char* name;
+  uint32_t light_samples = 1;
+  uint32_t light_sampling = K_LIGHTS_TREE;
 };
 
 class CudaAgreement : public ::testing::TestWithParam<ModeCase> {};
@@ -66,6 +68,8 @@ TEST_P(CudaAgreement, MatchesEmbree) {
   params.soft_shadow_scale = 1.0f;
   params.rr_start = 2.0f;
   params.frame_index = 7;
+  params.light_samples = c.light_samples;
+  params.light_sampling = c.light_sampling;
   auto embree = make_test_tracer("embree");
   auto cuda = make_test_tracer("cuda");
   core::FrameBuffer a = render(*embree, room, cam, params);
@@ -82,7 +86,8 @@ TEST_P(CudaAgreement, MatchesEmbree) {
 
 INSTANTIATE_TEST_SUITE_P(Modes, CudaAgreement,
                          ::testing::Values(ModeCase{K_MODE_PATH, 1, "path"}, ModeCase{K_MODE_PATH, 3, "path3"},
-                                           ModeCase{K_MODE_DIRECT, 0, "direct"}, ModeCase{K_MODE_ALBEDO, 0, "albedo"}),
+                                           ModeCase{K_MODE_DIRECT, 0, "direct"}, ModeCase{K_MODE_ALBEDO, 0, "albedo"},
+                                           ModeCase{K_MODE_PATH, 1, "path_gather", 2, K_LIGHTS_GATHER}),
                          [](const auto& info) { return std::string(info.param.name); });
 
 // Several GPUs render different bands of one frame; the merged frame equals one GPU's whole frame.

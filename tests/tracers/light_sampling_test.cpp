@@ -1,6 +1,7 @@
 // Light sampling at a cost that does not grow with the light count, checked for bias against the
-// references: the light tree (the default) and the all-lights pick converge to the every-light image
-// on a floor under 96 overlapping lights; emissive triangles sampled with MIS converge to the
+// references: the light tree (the default), the all-lights pick and gather converge to the every-light
+// image on a floor under 96 overlapping lights; gather is the every-light image where no point has more
+// lights in range than its budget; emissive triangles sampled with MIS converge to the
 // bounce-only estimate with less noise; lights with defects are skipped and no pixel goes NaN.
 #include <gtest/gtest.h>
 
@@ -93,6 +94,83 @@ TEST(LightSampling, TreeAndAllLightsPicksMatchEveryLight) {
   }
 }
 
+// Gather (K_LIGHTS_GATHER) with a budget of N shadow rays: on the 96-light floor most points have more
+// than N lights in range, so each light is traced with probability min(1, N w / W) and weighted by its
+// inverse; on the 328-light floor most have more than K_LIGHT_GATHER_MAX (its most shadow rays a hit). Its block means must match the every-light image as closely as its own noise allows, and its
+// pixel noise must shrink as N grows (the budget is really spent).
+class GatherOnFloor : public ::testing::TestWithParam<int> {};
+
+TEST_P(GatherOnFloor, MatchesEveryLightAndSpendsItsBudget) {
+  if (!tracer_runs_here("embree")) GTEST_SKIP();
+  scene::Scene s = many_lights_floor(GetParam(), 8);
+  const int w = 64, h = 48;
+  const KCamera cam = camera_looking_down({0, 0, 1400}, 0.7f, w, h);
+  auto tracer = make_test_tracer("embree");
+  auto render_with = [&](kuint sampling, kuint samples, kuint frame) {
+    KFrameParams p = frame_params(K_MODE_DIRECT, 64, 0, h);
+    p.light_sampling = sampling;
+    p.light_samples = samples;
+    p.frame_index = frame;
+    return render(*tracer, s, cam, p);
+  };
+  const core::FrameBuffer every = render_with(K_LIGHTS_EVERY, 1, 1);
+  const std::vector<double> reference = block_means(every, 8);
+  const double mean = mean_luminance(every);
+  ASSERT_GT(mean, 0.05) << "the floor should be lit";
+  double previous_noise = 0.0;
+  for (kuint samples : {1u, 2u, 4u}) {
+    const core::FrameBuffer a = render_with(K_LIGHTS_GATHER, samples, 1);
+    const core::FrameBuffer b = render_with(K_LIGHTS_GATHER, samples, 2);
+    expect_finite(a, "gather");
+    const double bias = rms_difference(block_means(a, 8), reference);
+    const double noise = rms_difference(block_means(a, 8), block_means(b, 8));
+    const double mean_error = std::fabs(mean_luminance(a) - mean) / mean;
+    const double pixel_noise = pixel_rmse(a, b);
+    std::cout << "gather " << samples << ": block RMS vs every light " << bias << ", between two seeds " << noise
+              << ", mean error " << 100.0 * mean_error << "%, pixel noise " << pixel_noise << "\n";
+    EXPECT_GT(pixel_rmse(a, every), 0.0) << "with " << samples << " rays the floor's points must be sampled";
+    EXPECT_LT(bias, 0.95 * noise + 1e-4 * mean) << samples << " samples";
+    // The image mean's own noise: about pixel_noise / sqrt(2 pixels); a weight without its cap is 5% off.
+    EXPECT_LT(mean_error * mean, 3.0 * pixel_noise / std::sqrt(2.0 * w * h) + 0.005 * mean) << samples << " samples";
+    if (previous_noise > 0.0) {
+      EXPECT_LT(pixel_noise, 0.85 * previous_noise) << samples << " samples";
+    }
+    previous_noise = pixel_noise;
+  }
+}
+
+// 96 lights: mostly 2-16 in range of a point; 328: mostly more than K_LIGHT_GATHER_MAX.
+INSTANTIATE_TEST_SUITE_P(LightSampling, GatherOnFloor, ::testing::Values(88, 320),
+                         [](const auto& info) { return std::to_string(info.param + 8) + "_lights"; });
+
+// Where no point has more lights in range than the budget, gather traces every one of them in light
+// order with `every`'s random numbers: the same image, here with bounces, soft shadows and the shadow
+// roulette on (all of which draw from the stream that has to stay aligned). With a smaller budget the
+// image differs, so the comparison can fail.
+TEST(LightSampling, GatherIsEveryLightWithinItsBudget) {
+  if (!tracer_runs_here("embree")) GTEST_SKIP();
+  scene::Scene room = test_room();
+  const int w = 64, h = 48;
+  const KCamera cam = test_room_camera(w, h);
+  auto tracer = make_test_tracer("embree");
+  auto render_with = [&](kuint sampling, kuint samples) {
+    KFrameParams p = frame_params(K_MODE_PATH, 4, 2, h);
+    p.soft_shadow_scale = 1.0f;
+    p.shadow_rr = 0.03f;
+    p.light_sampling = sampling;
+    p.light_samples = samples;
+    return render(*tracer, room, cam, p);
+  };
+  const core::FrameBuffer every = render_with(K_LIGHTS_EVERY, 1);
+  ASSERT_EQ(room.lights.size(), 3u);
+  const core::FrameBuffer gather = render_with(K_LIGHTS_GATHER, 3);
+  EXPECT_GT(mean_luminance(every), 0.01) << "the room should be lit";
+  for (size_t i = 0; i < every.rgba.size(); ++i)
+    ASSERT_EQ(gather.rgba[i], every.rgba[i]) << "pixel " << (i / 4) % size_t(w) << "," << (i / 4) / size_t(w);
+  const core::FrameBuffer one = render_with(K_LIGHTS_GATHER, 1);
+  EXPECT_GT(pixel_rmse(one, every), 0.0) << "with one ray per hit, points under two lights must be sampled";
+}
+
 // An emissive panel over a floor, no lights: one bounce finds the panel by chance, NEE with MIS aims at
 // it. Both estimate the same radiance; MIS with far less noise.
 TEST(LightSampling, EmissiveTrianglesWithMisMatchBounceOnly) {
@@ -168,7 +246,7 @@ TEST(LightSampling, LightsWithDefectsAreSkippedAndNoPixelIsNaN) {
   for (const std::string& kind : built_tracers()) {
     if (!tracer_runs_here(kind)) continue;
     auto tracer = make_test_tracer(kind);
-    for (kuint sampling : {K_LIGHTS_TREE, K_LIGHTS_ALL, K_LIGHTS_EVERY}) {
+    for (kuint sampling : {K_LIGHTS_TREE, K_LIGHTS_ALL, K_LIGHTS_EVERY, K_LIGHTS_GATHER}) {
       for (kuint frame = 0; frame < 3; ++frame) {
         KFrameParams p = frame_params(K_MODE_PATH, 2, 2, h);
         p.light_sampling = sampling;

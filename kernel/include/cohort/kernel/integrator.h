@@ -16,6 +16,7 @@
 #include "emissive_tree.h"
 #include "emitters.h"
 #include "fog.h"
+#include "light_gather.h"
 #include "light_tree.h"
 #include "rng.h"
 #include "path_pattern.h"
@@ -67,25 +68,47 @@ KFN int k_light_visible(KTraceCtx* ctx, const KFrameParams* params, const KSurfa
   return tmax <= 0.0f || !k_trace_occluded(ctx, org, dir, tmax, k_shadow_ray_mask(sf->flags));
 }
 
-/* Next-event estimation toward the Doom 3 lights, three ways (KFrameParams.light_sampling):
+/* One light sample traced as K_LIGHTS_EVERY traces each light: `value` (its unshadowed contribution,
+ * over its probability of being sampled) when its shadow ray, and the shadow roulette, let it through.
+ * Every light sample draws its random numbers in this order. */
+KFN KVec3 k_light_sample_traced(KTraceCtx* ctx, const KFrameParams* params, const KSurface* sf,
+                                KGLOBAL const KLight* light, KVec3 value, float path_weight, KRng* rng) {
+  float u1 = k_rng_next(rng), u2 = k_rng_next(rng);
+  float kept = k_shadow_roulette(params->shadow_rr, v3_max_component(value) * path_weight, rng);
+  if (kept > 0.0f && k_light_visible(ctx, params, sf, light, u1, u2)) return v3_scale(value, kept);
+  return v3s(0.0f);
+}
+
+/* Next-event estimation toward the Doom 3 lights, four ways (KFrameParams.light_sampling):
  * - K_LIGHTS_EVERY (or light_samples == 0): every light that reaches the point, one shadow ray each
  *   (as Doom 3 draws every interaction; lowest noise where few lights overlap, cost grows with them).
  * - K_LIGHTS_TREE (default): per light sample, one light picked through the light tree among those
  *   whose volume holds the point (light_tree.h has the pdf), one shadow ray toward it.
  * - K_LIGHTS_ALL: per light sample, one light picked over every light of the map in proportion to its
- *   unshadowed contribution (the reference for the tree: same pick, cost grows with the map). */
+ *   unshadowed contribution (the reference for the tree: same pick, cost grows with the map).
+ * - K_LIGHTS_GATHER: `every` among the lights whose volume holds the point, found through the tree, while
+ *   there are at most light_samples of them; beyond that at most light_samples shadow rays, each light
+ *   with a known probability (light_gather.h). */
 KFN KVec3 k_direct_lighting(KTraceCtx* ctx, const KFrameParams* params, const KSurface* sf, KVec3 wo, float path_weight,
                             KRng* rng) {
   const KSceneView* scene = K_CTX_SCENE(ctx);
   KVec3 sum = v3s(0.0f);
-  if (params->light_samples == 0u || params->light_sampling == K_LIGHTS_EVERY) {
-    for (kuint i = 0u; i < scene->light_count; ++i) {
+  int gather = params->light_sampling == K_LIGHTS_GATHER && params->light_samples > 0u;
+  if (gather || params->light_samples == 0u || params->light_sampling == K_LIGHTS_EVERY) {
+    /* `every` walks the whole light array; gather, the lights k_light_gather chose (outlined, on values,
+     * so that the kernel's other paths keep ctx and sf in registers). One loop traces both. */
+    KLightGather gathered;
+    gathered.count = scene->light_count;
+    if (gather) {
+      gathered = k_light_gather(*scene, *sf, wo, params->spec_boost, params->light_samples, *rng);
+      *rng = gathered.rng;
+    }
+    for (kuint k = 0u; k < gathered.count; ++k) {
+      kuint i = gather ? gathered.light[k] : k;
       KGLOBAL const KLight* light = &scene->lights[i];
-      KVec3 c = k_light_unshadowed(scene, light, sf, wo, params->spec_boost);
+      KVec3 c = gather ? gathered.value[k] : k_light_unshadowed(scene, light, sf, wo, params->spec_boost);
       if (v3_max_component(c) <= 0.0f) continue;
-      float u1 = k_rng_next(rng), u2 = k_rng_next(rng);
-      float kept = k_shadow_roulette(params->shadow_rr, v3_max_component(c) * path_weight, rng);
-      if (kept > 0.0f && k_light_visible(ctx, params, sf, light, u1, u2)) sum = v3_add(sum, v3_scale(c, kept));
+      sum = v3_add(sum, k_light_sample_traced(ctx, params, sf, light, c, path_weight, rng));
     }
     return sum;
   }
