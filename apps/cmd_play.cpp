@@ -300,8 +300,14 @@ int run_play(PlayArgs a) {
       std::erase_if(notices, [&](const Notice& n) { return n.until < clock::now(); });
       for (const Notice& n : notices) hud.notices.push_back(n.text);
       if (!window->mouse_captured()) hud.notices.push_back("RIGHT MOUSE OR TAB: LOOK AROUND");
-      if (hud_layer.width != fb_w || hud_layer.height != fb_h) hud_layer.resize(fb_w, fb_h);
-      viewer::draw_hud(hud_layer, hud, fb_h >= 700 ? 2 : 1);
+      // The layer is only as large as the HUD: present() blends it over its own corner of the window.
+      const int hud_scale = fb_h >= 700 ? 2 : 1;
+      const viewer::HudExtent extent = viewer::hud_extent(hud, hud_scale);
+      // Rounded up to 64 pixels, so that the texture is not re-allocated whenever a number's width changes.
+      auto rounded = [](int n) { return (n + 63) / 64 * 64; };
+      const int hud_w = std::clamp(rounded(extent.width), 1, fb_w), hud_h = std::clamp(rounded(extent.height), 1, fb_h);
+      if (hud_layer.width != hud_w || hud_layer.height != hud_h) hud_layer.resize(hud_w, hud_h);
+      viewer::draw_hud(hud_layer, hud, hud_scale);
     }
     ++frames_done;
     rate.frame(1000.0 * frame_s);
