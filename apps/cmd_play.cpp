@@ -164,6 +164,7 @@ int run_play(PlayArgs a) {
   double fps = 0.0;
   int fps_frames = 0;
   clock::time_point fps_start = clock::now(), previous = clock::now();
+  double previous_cpu_ms = process_cpu_ms();
   int exit_code = kExitOk;
   std::unique_ptr<core::ChromeTraceWriter> trace;
   if (!a.trace.empty()) trace = std::make_unique<core::ChromeTraceWriter>(a.trace);
@@ -232,6 +233,9 @@ int run_play(PlayArgs a) {
     const double frame_s = std::chrono::duration<double>(now - previous).count();
     const double dt = std::min(frame_s, 0.25);
     previous = now;
+    const double cpu_now_ms = process_cpu_ms();
+    const double frame_cpu_ms = cpu_now_ms - previous_cpu_ms;
+    previous_cpu_ms = cpu_now_ms;
     if (workload && have_frame) {
       const core::WorkloadSetting chosen = workload->update(1000.0 * frame_s);
       settings.spp = chosen.spp;
@@ -310,7 +314,7 @@ int run_play(PlayArgs a) {
       viewer::draw_hud(hud_layer, hud, hud_scale);
     }
     ++frames_done;
-    rate.frame(1000.0 * frame_s);
+    rate.frame(1000.0 * frame_s, frame_cpu_ms);
     const bool last_frame = a.frames > 0 && frames_done >= a.frames;
     const bool read_back = last_frame && !a.window_shot.empty();
     window->present(frame_image, show_hud ? &hud_layer : nullptr, read_back ? &window_image : nullptr);
