@@ -256,7 +256,6 @@ int run_play(PlayArgs a) {
       if (!next.ready) continue;  // the pipeline's first frame: it comes back with the next call
       last = std::move(next);
       have_frame = true;
-      if (trace) trace->add(last.stats.frame, last.stats.stages);
     } catch (const std::exception& e) {
       spdlog::error("cohort play: the frame could not be rendered: {}", e.what());
       exit_code = kExitFailure;
@@ -274,7 +273,11 @@ int run_play(PlayArgs a) {
       fps_start = clock::now();
     }
 
+    // The viewer's own serial work, on the core's track of the trace: what the window costs beside the frame.
+    std::vector<core::StageSpan> viewer_stages;
+    std::optional<core::ScopedStage> hud_stage;
     if (show_hud) {
+      hud_stage.emplace(viewer_stages, core::kCoreTrack, "hud");
       viewer::HudState hud;
       hud.fps = fps;
       hud.stats = last.stats;
@@ -313,11 +316,19 @@ int run_play(PlayArgs a) {
       if (hud_layer.width != hud_w || hud_layer.height != hud_h) hud_layer.resize(hud_w, hud_h);
       viewer::draw_hud(hud_layer, hud, hud_scale);
     }
+    hud_stage.reset();
     ++frames_done;
     rate.frame(1000.0 * frame_s, frame_cpu_ms);
     const bool last_frame = a.frames > 0 && frames_done >= a.frames;
     const bool read_back = last_frame && !a.window_shot.empty();
-    window->present(frame_image, show_hud ? &hud_layer : nullptr, read_back ? &window_image : nullptr);
+    {
+      core::ScopedStage presenting(viewer_stages, core::kCoreTrack, "present");
+      window->present(frame_image, show_hud ? &hud_layer : nullptr, read_back ? &window_image : nullptr);
+    }
+    if (trace) {
+      last.stats.stages.insert(last.stats.stages.end(), viewer_stages.begin(), viewer_stages.end());
+      trace->add(last.stats.frame, last.stats.stages);
+    }
     if (last_frame) window->request_close();
   }
 
