@@ -164,6 +164,7 @@ int run_play(PlayArgs a) {
   double fps = 0.0;
   int fps_frames = 0;
   clock::time_point fps_start = clock::now(), previous = clock::now();
+  double previous_cpu_ms = process_cpu_ms();
   int exit_code = kExitOk;
   std::unique_ptr<core::ChromeTraceWriter> trace;
   if (!a.trace.empty()) trace = std::make_unique<core::ChromeTraceWriter>(a.trace);
@@ -232,6 +233,9 @@ int run_play(PlayArgs a) {
     const double frame_s = std::chrono::duration<double>(now - previous).count();
     const double dt = std::min(frame_s, 0.25);
     previous = now;
+    const double cpu_now_ms = process_cpu_ms();
+    const double frame_cpu_ms = cpu_now_ms - previous_cpu_ms;
+    previous_cpu_ms = cpu_now_ms;
     if (workload && have_frame) {
       const core::WorkloadSetting chosen = workload->update(1000.0 * frame_s);
       settings.spp = chosen.spp;
@@ -252,7 +256,6 @@ int run_play(PlayArgs a) {
       if (!next.ready) continue;  // the pipeline's first frame: it comes back with the next call
       last = std::move(next);
       have_frame = true;
-      if (trace) trace->add(last.stats.frame, last.stats.stages);
     } catch (const std::exception& e) {
       spdlog::error("cohort play: the frame could not be rendered: {}", e.what());
       exit_code = kExitFailure;
@@ -270,7 +273,11 @@ int run_play(PlayArgs a) {
       fps_start = clock::now();
     }
 
+    // The viewer's own serial work, on the core's track of the trace: what the window costs beside the frame.
+    std::vector<core::StageSpan> viewer_stages;
+    std::optional<core::ScopedStage> hud_stage;
     if (show_hud) {
+      hud_stage.emplace(viewer_stages, core::kCoreTrack, "hud");
       viewer::HudState hud;
       hud.fps = fps;
       hud.stats = last.stats;
@@ -300,14 +307,28 @@ int run_play(PlayArgs a) {
       std::erase_if(notices, [&](const Notice& n) { return n.until < clock::now(); });
       for (const Notice& n : notices) hud.notices.push_back(n.text);
       if (!window->mouse_captured()) hud.notices.push_back("RIGHT MOUSE OR TAB: LOOK AROUND");
-      if (hud_layer.width != fb_w || hud_layer.height != fb_h) hud_layer.resize(fb_w, fb_h);
-      viewer::draw_hud(hud_layer, hud, fb_h >= 700 ? 2 : 1);
+      // The layer is only as large as the HUD: present() blends it over its own corner of the window.
+      const int hud_scale = fb_h >= 700 ? 2 : 1;
+      const viewer::HudExtent extent = viewer::hud_extent(hud, hud_scale);
+      // Rounded up to 64 pixels, so that the texture is not re-allocated whenever a number's width changes.
+      auto rounded = [](int n) { return (n + 63) / 64 * 64; };
+      const int hud_w = std::clamp(rounded(extent.width), 1, fb_w), hud_h = std::clamp(rounded(extent.height), 1, fb_h);
+      if (hud_layer.width != hud_w || hud_layer.height != hud_h) hud_layer.resize(hud_w, hud_h);
+      viewer::draw_hud(hud_layer, hud, hud_scale);
     }
+    hud_stage.reset();
     ++frames_done;
-    rate.frame(1000.0 * frame_s);
+    rate.frame(1000.0 * frame_s, frame_cpu_ms);
     const bool last_frame = a.frames > 0 && frames_done >= a.frames;
     const bool read_back = last_frame && !a.window_shot.empty();
-    window->present(frame_image, show_hud ? &hud_layer : nullptr, read_back ? &window_image : nullptr);
+    {
+      core::ScopedStage presenting(viewer_stages, core::kCoreTrack, "present");
+      window->present(frame_image, show_hud ? &hud_layer : nullptr, read_back ? &window_image : nullptr);
+    }
+    if (trace) {
+      last.stats.stages.insert(last.stats.stages.end(), viewer_stages.begin(), viewer_stages.end());
+      trace->add(last.stats.frame, last.stats.stages);
+    }
     if (last_frame) window->request_close();
   }
 

@@ -325,24 +325,32 @@ int GlWindow::framebuffer_height() const {
 
 void GlWindow::present(const raster::Image8& frame, const raster::Image8* hud, raster::Image8* read_back) {
   glfwMakeContextCurrent(impl_->window);
-  glViewport(0, 0, framebuffer_width(), framebuffer_height());
-  glClearColor(0.05f, 0.05f, 0.06f, 1.0f);
-  glClear(GL_COLOR_BUFFER_BIT);
+  const int fb_w = framebuffer_width(), fb_h = framebuffer_height();
+  glViewport(0, 0, fb_w, fb_h);
   glActiveTexture(GL_TEXTURE0);
   if (frame.width > 0 && frame.height > 0) {
+    // The opaque frame covers every pixel, so no clear first (a full-window pass under software GL).
     glDisable(GL_BLEND);
     impl_->frame.upload(frame, GL_LINEAR);
     impl_->draw_quad(impl_->frame);
+  } else {
+    glClearColor(0.05f, 0.05f, 0.06f, 1.0f);
+    glClear(GL_COLOR_BUFFER_BIT);
   }
   if (hud && hud->width > 0 && hud->height > 0) {
+    // Pixel for pixel at the top-left corner: the viewport maps the full-screen quad onto the layer's
+    // rectangle, so only the HUD's own pixels are blended.
+    const int hud_w = std::min(hud->width, fb_w), hud_h = std::min(hud->height, fb_h);
+    glViewport(0, fb_h - hud_h, hud_w, hud_h);
     glEnable(GL_BLEND);
     glBlendFunc(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA);
     impl_->hud.upload(*hud, GL_NEAREST);
     impl_->draw_quad(impl_->hud);
     glDisable(GL_BLEND);
+    glViewport(0, 0, fb_w, fb_h);
   }
   if (read_back) {
-    const int w = framebuffer_width(), h = framebuffer_height();
+    const int w = fb_w, h = fb_h;
     read_back->resize(w, h);
     std::vector<uint8_t> bottom_up(static_cast<size_t>(w) * h * 4);
     glPixelStorei(GL_PACK_ALIGNMENT, 1);

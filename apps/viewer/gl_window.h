@@ -1,5 +1,5 @@
 // The viewer's window: GLFW + OpenGL. Each frame the RGBA8 image is uploaded into a texture with
-// glTexSubImage2D and drawn as a full-screen quad, with the HUD layer blended over it. Tries an
+// glTexSubImage2D and drawn as a full-screen quad, with the HUD layer blended over its own corner. Tries an
 // OpenGL 3.3 core context first and falls back to a 2.1 compatibility context (software GL such as
 // Mesa under Xvfb may offer only that).
 #pragma once
@@ -41,7 +41,8 @@ class GlWindow {
 
   int framebuffer_width() const;
   int framebuffer_height() const;
-  // Upload the frame (stretched over the window) and the HUD layer (window-sized; null: none), swap.
+  // Upload the frame (stretched over the window) and the HUD layer (null: none; drawn pixel for pixel
+  // at the window's top-left corner, cut to the window), swap.
   // With read_back, what was drawn is read back into it first (rows top to bottom).
   void present(const raster::Image8& frame, const raster::Image8* hud, raster::Image8* read_back = nullptr);
   void set_title(const std::string& title);

@@ -93,26 +93,55 @@ int draw_timeline(raster::Image8& layer, const core::FrameStats& stats, int x, i
   return static_cast<int>(tracks.size()) * row_height;
 }
 
+// Where draw_hud puts things, so that the layer can be just as large as what it holds.
+struct HudLayout {
+  std::vector<std::string> lines;
+  int pad = 0, box_width = 0, box_height = 0;
+  int timeline_top = 0, timeline_width = 0, timeline_tracks = 0;
+  int width = 0, height = 0;
+};
+
+HudLayout hud_layout(const HudState& state, int scale) {
+  HudLayout l;
+  l.lines = hud_lines(state);
+  int widest = 0;
+  for (const std::string& line : l.lines) widest = std::max(widest, raster::text_width(line, scale));
+  l.pad = 3 * scale;
+  l.box_width = widest + 2 * l.pad;
+  l.box_height = static_cast<int>(l.lines.size()) * raster::kLineAdvance * scale + 2 * l.pad - 2 * scale;
+  l.width = l.box_width;
+  l.height = l.box_height;
+  if (state.stats && !state.stats->stages.empty()) {
+    l.timeline_top = static_cast<int>(l.lines.size()) * raster::kLineAdvance * scale + 3 * l.pad;
+    l.timeline_width = 160 * scale;
+    l.timeline_tracks = 1 + static_cast<int>(state.stats->tracers.size());
+    // draw_timeline's box: from pad left of the labels to pad right of the bars, one row per track.
+    const int label = 11 * raster::kGlyphAdvance * scale;
+    const int row_height = raster::kLineAdvance * scale + 3 * scale;
+    l.width = std::max(l.width, l.pad + label + l.timeline_width + l.pad);
+    l.height = std::max(l.height, l.timeline_top + l.timeline_tracks * row_height);
+  }
+  return l;
+}
+
 }  // namespace
+
+HudExtent hud_extent(const HudState& state, int scale) {
+  const HudLayout l = hud_layout(state, scale);
+  return {l.width, l.height};
+}
 
 void draw_hud(raster::Image8& layer, const HudState& state, int scale) {
   layer.clear();
-  const std::vector<std::string> lines = hud_lines(state);
-  const size_t notice_start = lines.size() - state.notices.size();
-  int widest = 0;
-  for (const std::string& l : lines) widest = std::max(widest, raster::text_width(l, scale));
-  const int pad = 3 * scale;
-  raster::fill_rect(layer, 0, 0, widest + 2 * pad,
-                    static_cast<int>(lines.size()) * raster::kLineAdvance * scale + 2 * pad - 2 * scale,
-                    raster::Rgba8{0, 0, 0, 150});
-  for (size_t i = 0; i < lines.size(); ++i) {
+  const HudLayout l = hud_layout(state, scale);
+  const size_t notice_start = l.lines.size() - state.notices.size();
+  raster::fill_rect(layer, 0, 0, l.box_width, l.box_height, raster::Rgba8{0, 0, 0, 150});
+  for (size_t i = 0; i < l.lines.size(); ++i) {
     const raster::Rgba8 color = i >= notice_start ? raster::Rgba8{255, 220, 60, 255} : raster::Rgba8{230, 235, 240, 255};
-    raster::draw_text(layer, pad, pad + static_cast<int>(i) * raster::kLineAdvance * scale, lines[i], color, scale);
+    raster::draw_text(layer, l.pad, l.pad + static_cast<int>(i) * raster::kLineAdvance * scale, l.lines[i], color,
+                      scale);
   }
-  if (state.stats && !state.stats->stages.empty()) {
-    const int top = static_cast<int>(lines.size()) * raster::kLineAdvance * scale + 3 * pad;
-    draw_timeline(layer, *state.stats, pad, top, 160 * scale, scale);
-  }
+  if (l.timeline_tracks > 0) draw_timeline(layer, *state.stats, l.pad, l.timeline_top, l.timeline_width, scale);
 }
 
 }  // namespace cohort::viewer

@@ -39,6 +39,13 @@ std::string format_bytes(uint64_t bytes);
 // The colour a timeline stage is drawn in; the legend under the bars names them.
 raster::Rgba8 stage_color(const std::string& stage);
 
+// The top-left box draw_hud draws into: everything outside it stays transparent, so the layer need
+// not be larger (a window-sized layer costs a full-window blend per frame under software GL).
+struct HudExtent {
+  int width = 0, height = 0;
+};
+HudExtent hud_extent(const HudState& state, int scale = 1);
+
 // Draw onto `layer` (cleared first): a translucent box with the lines, top-left, and under it the
 // last frame's timeline: a bar per track (the core, then each tracer) with its stages along a shared
 // time axis, so a tracer that waits or a serial core stage shows at a glance.

@@ -2,6 +2,8 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+
 namespace cohort::viewer {
 namespace {
 
@@ -88,6 +90,46 @@ TEST(Hud, DrawsTheFramesTimelineAsABarPerTrack) {
   const size_t render = count(stage_color("render")), tone = count(stage_color("tone map"));
   EXPECT_EQ(render, 160u * 5u) << "the render stage spans the whole 160-pixel axis, 5 pixels high";
   EXPECT_EQ(tone, 40u * 5u) << "tone map: a quarter of the axis";
+}
+
+// cohort play sizes the HUD layer by hud_extent instead of the window: nothing drawn may fall outside it,
+// and it must not be much larger than what is drawn (the point is to blend fewer pixels).
+TEST(Hud, ExtentHoldsEverythingDrawn) {
+  for (const int scale : {1, 2}) {
+    for (const bool with_timeline : {false, true}) {
+      HudState s;
+      s.mode = "PATH";
+      s.notices.push_back("RIGHT MOUSE OR TAB: LOOK AROUND");
+      if (with_timeline) {
+        core::FrameStats stats;
+        stats.start_ms = 0.0;
+        for (int id : {0, 1}) {
+          core::TracerFrameStats t;
+          t.id = id;
+          t.name = id == 0 ? "embree" : "opencl:0";
+          stats.tracers.push_back(t);
+          stats.stages.push_back({core::tracer_track(id, t.name), "render", 0.0, 8.0});
+        }
+        stats.stages.push_back({core::kCoreTrack, "tone map", 6.0, 2.0});
+        s.stats = stats;
+      }
+      raster::Image8 layer;
+      layer.resize(2000, 600);
+      draw_hud(layer, s, scale);
+      int right = -1, bottom = -1;
+      for (int y = 0; y < layer.height; ++y)
+        for (int x = 0; x < layer.width; ++x)
+          if (layer.rgba[(static_cast<size_t>(y) * layer.width + x) * 4 + 3] != 0) {
+            right = std::max(right, x);
+            bottom = std::max(bottom, y);
+          }
+      const HudExtent extent = hud_extent(s, scale);
+      ASSERT_GE(right, 0);
+      EXPECT_EQ(extent.width, right + 1) << "scale " << scale << (with_timeline ? ", timeline" : "");
+      EXPECT_EQ(extent.height, bottom + 1) << "scale " << scale << (with_timeline ? ", timeline" : "");
+      EXPECT_LT(extent.width, 1280 / 2);
+    }
+  }
 }
 
 TEST(Hud, FormatsBytes) {

@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <limits>
 
 namespace cohort::app {
@@ -36,6 +37,33 @@ TEST(PlayRate, SummaryNamesRateSizeAndTarget) {
   EXPECT_NE(text.find("median 25.0 ms (40.0 fps)"), std::string::npos) << text;
   EXPECT_NE(text.find("rendering 320x180 (scale 0.25), 2 spp, target 30 fps"), std::string::npos) << text;
   EXPECT_NE(PlayRate(5).summary(2, 64, 64, 16, 16, 0.25, 1, 0).find("too few to time"), std::string::npos);
+}
+
+TEST(PlayRate, CpuTimePerFrameAndCoresOverTheCountedFrames) {
+  PlayRate rate(2);
+  rate.frame(100.0, 500.0);  // warm-up: not counted
+  rate.frame(100.0, 500.0);
+  rate.frame(50.0, 90.0);
+  rate.frame(50.0, 70.0);
+  rate.frame(40.0);  // no CPU time: counts for the rate only
+  EXPECT_EQ(rate.counted(), 3u);
+  EXPECT_DOUBLE_EQ(rate.cpu_ms_per_frame(), 80.0);
+  EXPECT_DOUBLE_EQ(rate.cores_busy(), 1.6);  // 160 ms of CPU in 100 ms
+  EXPECT_NE(rate.summary(5, 1280, 720, 320, 180, 0.25, 1, 30).find("over the last 3, CPU 80.0 ms a frame (1.60 cores)"),
+            std::string::npos)
+      << rate.summary(5, 1280, 720, 320, 180, 0.25, 1, 30);
+  PlayRate no_cpu(0);
+  no_cpu.frame(30.0);
+  EXPECT_EQ(no_cpu.summary(1, 64, 64, 16, 16, 1.0, 1, 0).find("CPU"), std::string::npos);
+}
+
+TEST(PlayRate, ProcessCpuTimeAdvancesWithWork) {
+  const double before = process_cpu_ms();
+  volatile double sink = 0.0;
+  while (process_cpu_ms() - before < 20.0)
+    for (int i = 0; i < 100000; ++i) sink = sink + std::sqrt(static_cast<double>(i));
+  EXPECT_GE(process_cpu_ms() - before, 20.0);
+  EXPECT_GT(before, 0.0);
 }
 
 }  // namespace

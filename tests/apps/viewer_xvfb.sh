@@ -30,6 +30,18 @@ if [ $rc -ne 0 ]; then
 fi
 # The rendered frame, and the window as drawn through the GL texture upload with the HUD over it.
 python3 "$checker" "$shot" 160 120 && python3 "$checker" "$window_shot" 160 120 || exit 1
+# The HUD layer is only as large as the HUD and sits at the top-left corner: below its rows the window
+# shows the frame untouched. The trace names the viewer's own stages (the HUD and the present).
+hud_window="${shot%.*}_hud_window.${shot##*.}" hud_frame="${shot%.*}_hud_frame.${shot##*.}"
+trace="$(dirname "$shot")/play_trace.json"
+rm -f "$hud_window" "$hud_frame" "$trace"
+xvfb-run -a -s "-screen 0 1024x768x24" "$cohort" play "$map" --tracers embree --frames 4 --width 320 --height 240 \
+  --scale 1 --spp 1 --no-scenario --screenshot "$hud_frame" --window-screenshot "$hud_window" --trace "$trace" ||
+  { echo "FAIL: cohort play (HUD corner) exited with $?"; exit 1; }
+python3 "$(dirname "$checker")/hud_in_corner.py" "$hud_window" "$hud_frame" 150 || exit 1
+for stage in '"hud"' '"present"'; do
+  grep -q "$stage" "$trace" || { echo "FAIL: no $stage stage in the play trace $trace"; exit 1; }
+done
 # With neither --spp nor --scale on CPU tracers the session holds 30 fps (spp and scale follow the frame
 # time): it still shows a whole window.
 auto_shot="${shot%.*}_auto_window.${shot##*.}"
