@@ -66,6 +66,7 @@ struct PlaySession::State {
   std::unique_ptr<scene::Scenario> scenario;
   std::unique_ptr<core::Renderer> renderer;
   std::unique_ptr<core::FramePipeline> pipeline;  // after the renderer: it finishes the frame in flight first
+  kuint aux_mode = K_AUX_CENTRE_RAY;  // KFrameParams.aux_outputs when a frame wants the G-buffer
   // What the frame in flight was prepared with, for when it comes back.
   struct Prepared {
     size_t commit_bytes = 0;
@@ -119,6 +120,9 @@ PlaySession::PlaySession(const SessionOptions& options) {
   s.pipeline = std::make_unique<core::FramePipeline>(*s.renderer);
   s.post_place = tracers::auto_frame_post_place(started);
   core::FramePostOptions post_options;
+  if (options.aux_rays != "centre" && options.aux_rays != "first-hit")
+    throw std::invalid_argument("--aux-rays '" + options.aux_rays + "': choose centre or first-hit");
+  s.aux_mode = options.aux_rays == "first-hit" ? K_AUX_PATH_FIRST_HIT : K_AUX_CENTRE_RAY;
   if (options.denoise != "auto" && options.denoise != "atrous" && options.denoise != "none")
     throw std::invalid_argument("--denoise '" + options.denoise + "': choose auto, atrous or none");
   post_options.atrous = options.denoise == "atrous" || (options.denoise == "auto" && s.post_place != "host");
@@ -190,7 +194,7 @@ SessionFrame PlaySession::frame(const viewer::FlyCamera& camera, double seconds,
     p.path_phase = pattern.phase;
   }
   if (settings.reproject || sparse) {
-    p.aux_outputs = 1u;
+    p.aux_outputs = s.aux_mode;
     job.previous_camera = s.previous_camera;
   }
   s.previous_camera = job.camera;

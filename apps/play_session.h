@@ -27,6 +27,9 @@ struct SessionOptions {
   // post-processing runs on a CUDA GPU, where it costs 1-3 ms; none on the host, where it would set the
   // frame rate). Passes as `cohort render` picks them for the window's height.
   std::string denoise = "auto";
+  // Where the G-buffer comes from: "centre" (a ray of its own through each pixel's centre) or "first-hit"
+  // (the first sample's own first surface: no extra ray; kernel/aux_outputs.h).
+  std::string aux_rays = "centre";
   int window_height = 360;
 };
 
