@@ -4,16 +4,22 @@
 #include "cohort/kernel/integrator.h"
 #include "cohort/kernel/aux_outputs.h"
 
+/* The band kernels' parameters (the scene, the frame, the band and its row ray counts), for both entries. */
+#define COHORT_BAND_KERNEL_PARAMS                                                                               \
+      __global const KVertex* vertices, __global const KVertexColor* vertex_colors,                      \
+      __global const KTriangle* triangles, __global const KBvhNode* blas_nodes, __global const KBlas* blases,          \
+      __global const KInstance* instances, __global const KBvhNode* tlas_nodes, __global const KMaterial* materials,   \
+      __global const KTexture* textures, __global const kuint* texels, __global const KLight* lights,                \
+      __global const KLightNode* light_nodes, __global const KEmissiveTriangle* emissive,                             \
+      __global const KFrameParams* params_in, __global const KCamera* camera_in, __global float* band_rgba,           \
+      __global uint* row_rays
+#define COHORT_BAND_KERNEL_ARGS                                                                                 \
+  vertices, vertex_colors, triangles, blas_nodes, blases, instances, tlas_nodes, materials, textures, texels,     \
+      lights, light_nodes, emissive, params_in, camera_in, band_rgba, row_rays
+
 /* The band's pixels, recording first hits where first_hits is not null (the kernels below). */
-KFN void render_band_pixels(__global const KVertex* vertices, __global const KVertexColor* vertex_colors,
-                            __global const KTriangle* triangles, __global const KBvhNode* blas_nodes,
-                            __global const KBlas* blases, __global const KInstance* instances,
-                            __global const KBvhNode* tlas_nodes, __global const KMaterial* materials,
-                            __global const KTexture* textures, __global const kuint* texels,
-                            __global const KLight* lights, __global const KLightNode* light_nodes,
-                            __global const KEmissiveTriangle* emissive, __global const KFrameParams* params_in,
-                            __global const KCamera* camera_in, __global float* band_rgba, __global uint* row_rays,
-                            __global KPathFirstHit* first_hits, __local uint* group_row_rays) {
+KFN void render_band_pixels(COHORT_BAND_KERNEL_PARAMS, __global KPathFirstHit* first_hits,
+                            __local uint* group_row_rays) {
   /* Rays traced per row of the band (the balancer's per-row work), summed in local memory first so
    * that each work group adds once per row. The host launches 8x8 work groups. */
   KFrameParams params = *params_in;
@@ -44,35 +50,16 @@ KFN void render_band_pixels(__global const KVertex* vertices, __global const KVe
   if (lx == 0u && y < params.row_end && group_row_rays[ly] != 0u) atomic_add(&row_rays[row], group_row_rays[ly]);
 }
 
-__kernel void cohort_render_band(__global const KVertex* vertices, __global const KVertexColor* vertex_colors,
-                                 __global const KTriangle* triangles,
-                                 __global const KBvhNode* blas_nodes, __global const KBlas* blases,
-                                 __global const KInstance* instances, __global const KBvhNode* tlas_nodes,
-                                 __global const KMaterial* materials, __global const KTexture* textures,
-                                 __global const kuint* texels, __global const KLight* lights,
-                                 __global const KLightNode* light_nodes, __global const KEmissiveTriangle* emissive,
-                                 __global const KFrameParams* params_in, __global const KCamera* camera_in,
-                                 __global float* band_rgba, __global uint* row_rays) {
+__kernel void cohort_render_band(COHORT_BAND_KERNEL_PARAMS) {
   __local uint group_row_rays[8];
-  render_band_pixels(vertices, vertex_colors, triangles, blas_nodes, blases, instances, tlas_nodes, materials, textures,
-                     texels, lights, light_nodes, emissive, params_in, camera_in, band_rgba, row_rays, 0, group_row_rays);
+  render_band_pixels(COHORT_BAND_KERNEL_ARGS, 0, group_row_rays);
 }
 
 /* The same, recording each pixel's first sample's first surface for the aux planes (K_AUX_PATH_FIRST_HIT):
  * a kernel of its own, so that the one without it compiles as before. */
-__kernel void cohort_render_band_first_hits(__global const KVertex* vertices, __global const KVertexColor* vertex_colors,
-                                 __global const KTriangle* triangles,
-                                 __global const KBvhNode* blas_nodes, __global const KBlas* blases,
-                                 __global const KInstance* instances, __global const KBvhNode* tlas_nodes,
-                                 __global const KMaterial* materials, __global const KTexture* textures,
-                                 __global const kuint* texels, __global const KLight* lights,
-                                 __global const KLightNode* light_nodes, __global const KEmissiveTriangle* emissive,
-                                 __global const KFrameParams* params_in, __global const KCamera* camera_in,
-                                 __global float* band_rgba, __global uint* row_rays,
-                                 __global KPathFirstHit* first_hits) {
+__kernel void cohort_render_band_first_hits(COHORT_BAND_KERNEL_PARAMS, __global KPathFirstHit* first_hits) {
   __local uint group_row_rays[8];
-  render_band_pixels(vertices, vertex_colors, triangles, blas_nodes, blases, instances, tlas_nodes, materials, textures,
-                     texels, lights, light_nodes, emissive, params_in, camera_in, band_rgba, row_rays, first_hits, group_row_rays);
+  render_band_pixels(COHORT_BAND_KERNEL_ARGS, first_hits, group_row_rays);
 }
 
 /* Auxiliary outputs (aux_outputs.h), launched only for frames that ask for them: one work item per

@@ -107,6 +107,28 @@ KFN void k_aux_miss_motion(const KCamera* prev_cam, KVec3 dir, float sx, float s
   }
 }
 
+/* The planes of an opaque surface sf (of hit) seen at image position (sx, sy). */
+KFN void k_aux_surface(const KSceneView* scene, const KCamera* cam, const KCamera* prev_cam,
+                       const KAuxHistory* history, KHit hit, const KSurface* sf, float sx, float sy, KAux* out) {
+  out->normal[0] = sf->normal.x;
+  out->normal[1] = sf->normal.y;
+  out->normal[2] = sf->normal.z;
+  KVec3 a = v3_add(sf->albedo, sf->emission);
+  out->albedo[0] = k_saturate(a.x);
+  out->albedo[1] = k_saturate(a.y);
+  out->albedo[2] = k_saturate(a.z);
+  out->id = scene->instances[hit.instance].entity + 1u;
+  k_aux_surface_motion(scene, cam, prev_cam, history, hit, sf->position, sx, sy, out);
+}
+
+/* A sky surface: infinitely far, as a miss (depth 0, motion by the camera's rotation), with its colour. */
+KFN void k_aux_sky(const KCamera* prev_cam, KVec3 dir, KVec3 sky, float sx, float sy, KAux* out) {
+  out->albedo[0] = k_saturate(sky.x);
+  out->albedo[1] = k_saturate(sky.y);
+  out->albedo[2] = k_saturate(sky.z);
+  k_aux_miss_motion(prev_cam, dir, sx, sy, out);
+}
+
 KFN void k_aux_clear(KAux* out) {
   out->depth = 0.0f;
   out->prev_depth = 0.0f;
@@ -134,26 +156,14 @@ KFN void k_pixel_aux(KTraceCtx* ctx, const KCamera* cam, const KCamera* prev_cam
     if (!k_trace_closest(ctx, ray_org, dir, K_INF, K_RAY_PRIMARY, &hit)) break;
     KSurface sf = k_surface_eval(scene, hit, ray_org, dir, pixel_spread * hit.t);
     if (sf.blend == K_BLEND_SKY) {
-      /* Infinitely far, as a miss (depth 0, motion by the camera's rotation), but with its colour. */
-      KVec3 sky = k_sky_radiance(scene, hit.instance, sf.material, dir);
-      out->albedo[0] = k_saturate(sky.x);
-      out->albedo[1] = k_saturate(sky.y);
-      out->albedo[2] = k_saturate(sky.z);
-      break;
+      k_aux_sky(prev_cam, dir, k_sky_radiance(scene, hit.instance, sf.material, dir), cx, cy, out);
+      return;
     }
     if (sf.blend != K_BLEND_OPAQUE) {
       ray_org = v3_madd(sf.position, dir, k_ray_epsilon(sf.position));
       continue;
     }
-    out->normal[0] = sf.normal.x;
-    out->normal[1] = sf.normal.y;
-    out->normal[2] = sf.normal.z;
-    KVec3 a = v3_add(sf.albedo, sf.emission);
-    out->albedo[0] = k_saturate(a.x);
-    out->albedo[1] = k_saturate(a.y);
-    out->albedo[2] = k_saturate(a.z);
-    out->id = scene->instances[hit.instance].entity + 1u;
-    k_aux_surface_motion(scene, cam, prev_cam, history, hit, sf.position, cx, cy, out);
+    k_aux_surface(scene, cam, prev_cam, history, hit, &sf, cx, cy, out);
     return;
   }
   k_aux_miss_motion(prev_cam, dir, cx, cy, out);
@@ -201,10 +211,7 @@ KFN void k_aux_from_first_hit(const KSceneView* scene, const KFrameParams* param
   }
   if (record.sky) {
     KVec3 sky = k_sky_radiance(scene, record.instance, k_hit_material(scene, record.instance, record.triangle), dir);
-    out->albedo[0] = k_saturate(sky.x);
-    out->albedo[1] = k_saturate(sky.y);
-    out->albedo[2] = k_saturate(sky.z);
-    k_aux_miss_motion(prev_cam, dir, sx, sy, out);
+    k_aux_sky(prev_cam, dir, sky, sx, sy, out);
     return;
   }
   if (!(hit.t > 0.0f)) {
@@ -212,15 +219,7 @@ KFN void k_aux_from_first_hit(const KSceneView* scene, const KFrameParams* param
     return;
   }
   KSurface sf = k_surface_eval(scene, hit, org, dir, k_pixel_spread(cam) * hit.t);
-  out->normal[0] = sf.normal.x;
-  out->normal[1] = sf.normal.y;
-  out->normal[2] = sf.normal.z;
-  KVec3 a = v3_add(sf.albedo, sf.emission);
-  out->albedo[0] = k_saturate(a.x);
-  out->albedo[1] = k_saturate(a.y);
-  out->albedo[2] = k_saturate(a.z);
-  out->id = inst->entity + 1u;
-  k_aux_surface_motion(scene, cam, prev_cam, history, hit, sf.position, sx, sy, out);
+  k_aux_surface(scene, cam, prev_cam, history, hit, &sf, sx, sy, out);
 }
 
 #endif
