@@ -391,8 +391,9 @@ void add_play_command(CLI::App& app, int& exit_code) {
       cmd->add_option("--spp", a->spp, "samples per pixel per frame")->capture_default_str()->check(CLI::Range(1, 256));
   cmd->add_option("--bounces", a->bounces, "indirect bounces")->capture_default_str()->check(CLI::Range(0, 16));
   cmd->add_option("--light-sampling", a->light_sampling,
-                  "how each hit picks the map's lights: tree (the light tree), all or every (references; see "
-                  "`cohort render --help`)")
+                  "how each hit picks the map's lights: tree (the light tree), gather (the lights in range, "
+                  "found through the tree, each its own shadow ray within a budget of one here; `cohort render "
+                  "--light-samples N` sets a larger one), all or every (references; see `cohort render --help`)")
       ->capture_default_str()
       ->check(CLI::IsMember(core::light_sampling_names()));
   cmd->add_option("--convergence", a->convergence,
