@@ -407,7 +407,7 @@ void add_play_command(CLI::App& app, int& exit_code) {
                   "centre) or first-hit (the first sample's own first surface: no extra ray, about 0.8 ms less a "
                   "1080p frame on an H100, noisier at silhouettes); see `cohort render --help`")
       ->capture_default_str()
-      ->check(CLI::IsMember({"centre", "first-hit"}));
+      ->check(CLI::IsMember(core::aux_rays_names()));
   cmd->add_option("--denoise", a->session.denoise,
                   "the real-time a-trous filter after the reprojection: atrous, none, or auto (atrous where the "
                   "reprojection runs on a CUDA GPU, about 1-3 ms a frame; none on the host's threads, where it "

@@ -182,6 +182,7 @@ int run_render(const RenderArgs& a) {
   std::unique_ptr<core::OidnDenoiser> denoiser;
   core::FrameBuffer denoised;
   const bool atrous = a.denoise == "atrous";
+  const kuint aux_mode = core::aux_rays_mode(a.aux_rays);  // KFrameParams.aux_outputs of frames with planes
   // Reprojection and the a-trous filter run together, on the host or on a GPU (core/frame_post.h).
   std::unique_ptr<core::FramePost> post;
   if (reproject || atrous) {
@@ -362,7 +363,7 @@ int run_render(const RenderArgs& a) {
       p.path_phase = pattern.phase;
     }
     if (reproject || atrous || sparse || a.write_ids) {
-      p.aux_outputs = a.aux_rays == "first-hit" ? K_AUX_PATH_FIRST_HIT : K_AUX_CENTRE_RAY;
+      p.aux_outputs = aux_mode;
       job.previous_camera = previous_camera;
       previous_camera = job.camera;
     }
@@ -465,7 +466,7 @@ void add_render_command(CLI::App& app, int& exit_code) {
                   "do, so silhouettes keep less history; frames with sparse paths keep centre rays; "
                   "docs/denoising.md)")
       ->capture_default_str()
-      ->check(CLI::IsMember({"centre", "first-hit"}));
+      ->check(CLI::IsMember(core::aux_rays_names()));
   cmd->add_option("--denoise", a->denoise,
                   "denoise the shown frame: none, atrous (the real-time edge-aware a-trous filter of the portable "
                   "kernel, every frame), oidn (Intel Open Image Denoise on the CPU) or oidn-cuda (on an NVIDIA GPU); "

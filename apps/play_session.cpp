@@ -120,9 +120,7 @@ PlaySession::PlaySession(const SessionOptions& options) {
   s.pipeline = std::make_unique<core::FramePipeline>(*s.renderer);
   s.post_place = tracers::auto_frame_post_place(started);
   core::FramePostOptions post_options;
-  if (options.aux_rays != "centre" && options.aux_rays != "first-hit")
-    throw std::invalid_argument("--aux-rays '" + options.aux_rays + "': choose centre or first-hit");
-  s.aux_mode = options.aux_rays == "first-hit" ? K_AUX_PATH_FIRST_HIT : K_AUX_CENTRE_RAY;
+  s.aux_mode = core::aux_rays_mode(options.aux_rays);
   if (options.denoise != "auto" && options.denoise != "atrous" && options.denoise != "none")
     throw std::invalid_argument("--denoise '" + options.denoise + "': choose auto, atrous or none");
   post_options.atrous = options.denoise == "atrous" || (options.denoise == "auto" && s.post_place != "host");

@@ -36,4 +36,15 @@ kuint light_sampling_mode(const std::string& name) {
   throw std::invalid_argument("light sampling '" + name + "': choose tree, all, every or gather");
 }
 
+const std::vector<std::string>& aux_rays_names() {
+  static const std::vector<std::string> names = {"centre", "first-hit"};
+  return names;
+}
+
+kuint aux_rays_mode(const std::string& name) {
+  if (name == "centre") return K_AUX_CENTRE_RAY;
+  if (name == "first-hit") return K_AUX_PATH_FIRST_HIT;
+  throw std::invalid_argument("aux rays '" + name + "': choose centre or first-hit");
+}
+
 }  // namespace cohort::core

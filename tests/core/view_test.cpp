@@ -104,5 +104,13 @@ TEST(FrameDefaults, LightSamplingNamesRoundTrip) {
   EXPECT_THROW(light_sampling_mode("bvh"), std::invalid_argument);
 }
 
+TEST(FrameDefaults, AuxRaysNamesRoundTrip) {
+  const std::vector<std::string>& names = aux_rays_names();
+  ASSERT_EQ(names.size(), 2u);
+  EXPECT_EQ(aux_rays_mode(names[0]), K_AUX_CENTRE_RAY);
+  EXPECT_EQ(aux_rays_mode(names[1]), K_AUX_PATH_FIRST_HIT);
+  EXPECT_THROW(aux_rays_mode("center"), std::invalid_argument);
+}
+
 }  // namespace
 }  // namespace cohort::core
