@@ -177,13 +177,18 @@ KFN void k_pixel_aux(KTraceCtx* ctx, const KCamera* cam, const KCamera* prev_cam
 KFN void k_aux_from_first_hit(const KSceneView* scene, const KFrameParams* params, const KCamera* cam,
                               const KCamera* prev_cam, const KAuxHistory* history, kuint x, kuint y,
                               KPathFirstHit record, KAux* out) {
-  KRng jitter = k_rng_seed(x, y, params->frame_index, 0u);
-  float sx = (float)x + k_rng_next(&jitter);
-  float sy = (float)y + k_rng_next(&jitter);
+  KRng rng;
+  float sx, sy;
+  k_camera_sample_position(params, x, y, 0u, &rng, &sx, &sy);
   KVec3 dir = k_camera_direction(cam, sx, sy);
   k_aux_clear(out);
   if (record.instance == K_NONE) {
     k_aux_miss_motion(prev_cam, dir, sx, sy, out);
+    return;
+  }
+  if (record.sky) {
+    KVec3 sky = k_sky_radiance(scene, record.instance, k_hit_material(scene, record.instance, record.triangle), dir);
+    k_aux_sky(prev_cam, dir, sky, sx, sy, out);
     return;
   }
   /* The ray in the instance's object space, as the walk intersected it, against the triangle's plane (no
@@ -208,11 +213,6 @@ KFN void k_aux_from_first_hit(const KSceneView* scene, const KFrameParams* param
     hit.t = v3_dot(e2, q) * inv_det;
     hit.u = v3_dot(s, pv) * inv_det;
     hit.v = v3_dot(d, q) * inv_det;
-  }
-  if (record.sky) {
-    KVec3 sky = k_sky_radiance(scene, record.instance, k_hit_material(scene, record.instance, record.triangle), dir);
-    k_aux_sky(prev_cam, dir, sky, sx, sy, out);
-    return;
   }
   if (!(hit.t > 0.0f)) {
     k_aux_miss_motion(prev_cam, dir, sx, sy, out);

@@ -378,13 +378,23 @@ KFN KVec3 k_trace_path(KTraceCtx* ctx, const KFrameParams* params, KVec3 org, KV
 /* The angle one pixel subtends, for k_trace_path's mip selection. */
 KFN float k_pixel_spread(const KCamera* cam) { return 2.0f * cam->tan_half_fov_x / (float)cam->width; }
 
+/* Where sample s of pixel (x, y) leaves the image (its jittered position, in pixels) and, in *rng, the
+ * sample's random stream after the jitter. */
+KFN void k_camera_sample_position(const KFrameParams* params, kuint x, kuint y, kuint s, KRng* rng, float* sx,
+                                  float* sy) {
+  *rng = k_rng_seed(x, y, params->frame_index, s);
+  float jx = k_rng_next(rng), jy = k_rng_next(rng);
+  *sx = (float)x + jx;
+  *sy = (float)y + jy;
+}
+
 /* Sample s of pixel (x, y): the camera ray's direction (from cam->origin) and, in *rng, the sample's
  * random stream after the jitter, ready for k_trace_path. Tracers that trace camera rays ahead in
  * batches (Embree's packets) start each path from here, so their rays are exactly these. */
 KFN KVec3 k_camera_sample(const KFrameParams* params, const KCamera* cam, kuint x, kuint y, kuint s, KRng* rng) {
-  *rng = k_rng_seed(x, y, params->frame_index, s);
-  float jx = k_rng_next(rng), jy = k_rng_next(rng);
-  return k_camera_direction(cam, (float)x + jx, (float)y + jy);
+  float sx, sy;
+  k_camera_sample_position(params, x, y, s, rng, &sx, &sy);
+  return k_camera_direction(cam, sx, sy);
 }
 
 /* A pixel's colour, its paths traced whatever the sparse path pattern says (k_render_pixel asks it);
