@@ -23,6 +23,11 @@
 #   tools/gpu_run.sh cluster   there, on a two-GPU kind: two ranks with one GPU each against the in-process two GPUs
 #   tools/gpu_run.sh kernels   there: GPU time kernel by kernel (ncu) on the large map at 1080p, cuda:0, Brigade's
 #                              blend / reprojection / reprojection + a-trous, with the same runs' frame times
+#   tools/gpu_run.sh quality   there: bench/quality/bench_quality.py on cuda:0 along the test map's scenario,
+#                              references at COHORT_QUALITY_REF_SPP (default 1,024) spp, at each of
+#                              COHORT_QUALITY_SIZES (default "1280x720 320x180"); FLIP is computed there (the
+#                              flip-evaluator wheel travels in .gpu/wheels: stage with COHORT_GPU_QUALITY=1);
+#                              table, JSON, plot and door crops back in $OUT
 #   tools/gpu_run.sh frametimes  there: only the end-to-end frame times (large map 1080p generated there,
 #                              test map 720p; cuda:0, 1 spp, NEE + 1 bounce; reprojection on the GPU with and
 #                              without the a-trous filter, on the host, and Brigade's blend; per-stage medians;
@@ -59,6 +64,11 @@ case "${1:-}" in
       build/gpu/bin/cohort pack build/gpu/assets/largemap/maps/largemap.map --out "$stage/largemap.cpk"
     fi
     tar -C "$stage" -cJf "$stage/payload.tar.xz" bin lib && rm -rf "$stage/bin" "$stage/lib"
+    if [ "${COHORT_GPU_QUALITY:-0}" = 1 ]; then
+      # NVIDIA's FLIP for `quality`, as a wheel for the GPU machine's Python 3.12 (nothing is fetched there).
+      python3 -m pip download -q --no-deps --only-binary=:all: --python-version 3.12 --implementation cp \
+        --platform manylinux_2_17_x86_64 --platform manylinux2014_x86_64 -d "$stage/wheels" flip-evaluator==1.7
+    fi
     du -sh "$stage"
     ;;
   stage-mpi)
@@ -217,6 +227,34 @@ print(f"  {sum(total.values()) / frames:7.3f} ms  all kernels a frame")'
       "$stage/bin/cohort" render "${args[@]}" --frames 60 --write last --out /tmp/kernels_plain >/dev/null 2>&1
       echo "  without the profiler: $(python3 tools/frame_times.py /tmp/kernels_plain/stats.json --skip 10 | head -n 1)"
     done
+    ;;
+  quality)
+    # There: issue 17's quality figures with references of >= 1,024 spp (a CPU affords 64-128), rendered and
+    # measured on cuda:0. Each size is one bench_quality.py run over the scenario; the frames stay on the
+    # machine, the report comes back.
+    [ -d "$stage/bin" ] || tar -C "$stage" -xJf "$stage/payload.tar.xz"
+    export LD_LIBRARY_PATH="$PWD/$stage/lib${LD_LIBRARY_PATH:+:$LD_LIBRARY_PATH}"
+    ls "$stage"/wheels/flip_evaluator-*.whl >/dev/null 2>&1 || { echo "no FLIP wheel: stage with COHORT_GPU_QUALITY=1"; exit 2; }
+    python3 -m pip install -q --no-index --no-deps --no-compile --no-cache-dir --upgrade --target /tmp/site \
+      "$stage"/wheels/*.whl
+    export PYTHONPATH=/tmp/site${PYTHONPATH:+:$PYTHONPATH} PYTHONUNBUFFERED=1
+    nvidia-smi --query-gpu=index,name --format=csv,noheader
+    out=${OUT:-/tmp/out}; mkdir -p "$out"
+    methods=${COHORT_QUALITY_METHODS:-none,brigade,reproject+atrous,reproject+atrous-first-hit}
+    status=0
+    for size in ${COHORT_QUALITY_SIZES:-1280x720 320x180}; do
+      work=/tmp/quality_$size
+      python3 bench/quality/bench_quality.py --cohort "$stage/bin/cohort" --tracers cuda:0 --scenario \
+        --frames "${COHORT_QUALITY_FRAMES:-48}" --width "${size%x*}" --height "${size#*x}" \
+        --ref-spp "${COHORT_QUALITY_REF_SPP:-1024}" --methods "$methods" --out "$work" \
+        ${COHORT_QUALITY_ARGS:-} 2>&1 | tee "$work.log" || status=1
+      mkdir -p "$out/$size"
+      for f in bench_quality.json bench_quality.png bench_quality_door_main.png; do
+        [ -f "$work/$f" ] && cp "$work/$f" "$out/$size/"
+      done
+      cp "$work.log" "$out/$size/" 2>/dev/null || true
+    done
+    exit $status
     ;;
   frametimes)
     [ -d "$stage/bin" ] || tar -C "$stage" -xJf "$stage/payload.tar.xz"

@@ -173,7 +173,33 @@ def masked_mean(flip_map, mask):
 
 
 def load_ldr(path):
+    """The frame as FLIP's LDR input: float32 sRGB values in [0, 1], height x width x 3. A build without
+    OpenImageIO (the GPU machine's) writes binary PPM, which FLIP's own loader does not read."""
+    if path.endswith(".ppm"):
+        return load_ppm(path)
     return flip_evaluator.load(path)
+
+
+def load_ppm(path):
+    """An 8-bit binary PPM (P6, maxval 255) as `cohort render` writes it, as flip_evaluator.load returns a PNG."""
+    with open(path, "rb") as f:
+        data = f.read()
+    fields, pos = [], 0
+    while len(fields) < 4:  # magic, width, height, maxval; no comments in the files cohort writes
+        while data[pos:pos + 1].isspace():
+            pos += 1
+        end = pos
+        while end < len(data) and not data[end:end + 1].isspace():
+            end += 1
+        fields.append(data[pos:end])
+        pos = end
+    if fields[0] != b"P6" or int(fields[3]) != 255:
+        sys.exit(f"bench_quality: {path} is not an 8-bit binary PPM")
+    width, height = int(fields[1]), int(fields[2])
+    pixels = np.frombuffer(data[pos + 1:pos + 1 + 3 * width * height], dtype=np.uint8)
+    if pixels.size != 3 * width * height:
+        sys.exit(f"bench_quality: {path} is truncated ({pixels.size} of {3 * width * height} bytes)")
+    return pixels.reshape(height, width, 3).astype(np.float32) / np.float32(255.0)
 
 
 def psnr(reference, test):
@@ -386,9 +412,7 @@ def write_object_crops(args, ref_dir, masks, methods, plt):
     for f in frames:
         row = []
         for d in dirs:
-            img = plt.imread(frame_path(d, f))[..., :3].astype(np.float32)
-            if img.max() > 1.0:
-                img /= 255.0
+            img = load_ldr(frame_path(d, f))[..., :3]
             row.append(img[y0:y1, x0:x1])
             row.append(np.ones((y1 - y0, 1, 3), np.float32))
         rows.append(np.concatenate(row[:-1], axis=1))
