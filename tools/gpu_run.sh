@@ -253,6 +253,18 @@ print(f"  {sum(total.values()) / frames:7.3f} ms  all kernels a frame")'
         [ -f "$work/$f" ] && cp "$work/$f" "$out/$size/"
       done
       cp "$work.log" "$out/$size/" 2>/dev/null || true
+      # COHORT_QUALITY_VARIANTS="--anti-lag 0;--atrous-passes 3": the methods again with each set of render
+      # options, against the same references (tables in the log; the other files are the first run's).
+      IFS=';' read -r -a variants <<<"${COHORT_QUALITY_VARIANTS:-}"
+      for variant in "${variants[@]}"; do
+        [ -n "$variant" ] || continue
+        echo "== with: $variant" | tee -a "$work.log"
+        python3 bench/quality/bench_quality.py --cohort "$stage/bin/cohort" --tracers cuda:0 --scenario \
+          --frames "${COHORT_QUALITY_FRAMES:-48}" --width "${size%x*}" --height "${size#*x}" \
+          --ref-spp "${COHORT_QUALITY_REF_SPP:-1024}" --methods "$methods" --out "$work" --reuse-reference \
+          --extra-args="$variant" ${COHORT_QUALITY_ARGS:-} 2>&1 | grep -A12 "^testmap" | tee -a "$work.log" || status=1
+        cp "$work.log" "$out/$size/"
+      done
     done
     exit $status
     ;;
