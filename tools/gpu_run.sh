@@ -27,7 +27,9 @@
 #                              references at COHORT_QUALITY_REF_SPP (default 1,024) spp, at each of
 #                              COHORT_QUALITY_SIZES (default "1280x720 320x180"); FLIP is computed there (the
 #                              flip-evaluator wheel travels in .gpu/wheels: stage with COHORT_GPU_QUALITY=1);
-#                              table, JSON, plot and door crops back in $OUT
+#                              table, JSON, plot and door crops back in $OUT; COHORT_QUALITY_PATH=spin-slow
+#                              follows that camera path instead, COHORT_QUALITY_VARIANTS="opts;opts" reruns the
+#                              methods with other render options against the same references
 #   tools/gpu_run.sh frametimes  there: only the end-to-end frame times (large map 1080p generated there,
 #                              test map 720p; cuda:0, 1 spp, NEE + 1 bounce; reprojection on the GPU with and
 #                              without the a-trous filter, on the host, and Brigade's blend; per-stage medians;
@@ -241,10 +243,12 @@ print(f"  {sum(total.values()) / frames:7.3f} ms  all kernels a frame")'
     nvidia-smi --query-gpu=index,name --format=csv,noheader
     out=${OUT:-/tmp/out}; mkdir -p "$out"
     methods=${COHORT_QUALITY_METHODS:-none,brigade,reproject+atrous,reproject+atrous-first-hit}
+    # COHORT_QUALITY_PATH=spin-slow: along that camera path instead of the scenario.
+    if [ -n "${COHORT_QUALITY_PATH:-}" ]; then source=(--camera-path "$COHORT_QUALITY_PATH"); else source=(--scenario); fi
     status=0
     for size in ${COHORT_QUALITY_SIZES:-1280x720 320x180}; do
       work=/tmp/quality_$size
-      python3 bench/quality/bench_quality.py --cohort "$stage/bin/cohort" --tracers cuda:0 --scenario \
+      python3 bench/quality/bench_quality.py --cohort "$stage/bin/cohort" --tracers cuda:0 "${source[@]}" \
         --frames "${COHORT_QUALITY_FRAMES:-48}" --width "${size%x*}" --height "${size#*x}" \
         --ref-spp "${COHORT_QUALITY_REF_SPP:-1024}" --methods "$methods" --out "$work" \
         ${COHORT_QUALITY_ARGS:-} 2>&1 | tee "$work.log" || status=1
@@ -259,7 +263,7 @@ print(f"  {sum(total.values()) / frames:7.3f} ms  all kernels a frame")'
       for variant in "${variants[@]}"; do
         [ -n "$variant" ] || continue
         echo "== with: $variant" | tee -a "$work.log"
-        python3 bench/quality/bench_quality.py --cohort "$stage/bin/cohort" --tracers cuda:0 --scenario \
+        python3 bench/quality/bench_quality.py --cohort "$stage/bin/cohort" --tracers cuda:0 "${source[@]}" \
           --frames "${COHORT_QUALITY_FRAMES:-48}" --width "${size%x*}" --height "${size#*x}" \
           --ref-spp "${COHORT_QUALITY_REF_SPP:-1024}" --methods "$methods" --out "$work" --reuse-reference \
           --extra-args="$variant" ${COHORT_QUALITY_ARGS:-} 2>&1 | grep -A12 "^testmap" | tee -a "$work.log" || status=1
