@@ -212,6 +212,11 @@ Renderer::Renderer(std::vector<std::unique_ptr<Tracer>> tracers, RendererOptions
     w->completion = completion;
     // The worker owns the tracer, so the hook never outlives what it points at.
     if (w->tracer->takes_commits_ahead()) w->tracer->set_commits_ahead([worker = w.get()] { worker->apply_ahead(); });
+    if (w->tracer->takes_jobs_ahead())
+      w->tracer->set_next_job([announcement = announcement_]() -> std::optional<BandJob> {
+        std::lock_guard lock(announcement->mutex);
+        return announcement->job;
+      });
     workers_.push_back(std::move(w));
   }
   // Each thread shares its worker, so a worker whose tracer never returns can be left behind at
@@ -424,10 +429,21 @@ FrameStats Renderer::render(const BandJob& job, FrameBuffer& out, const std::vec
   return finish_frame();
 }
 
+void Renderer::announce_frame(const BandJob& job) {
+  std::lock_guard lock(announcement_->mutex);
+  announcement_->job = job;
+  announcement_->job->params.row_begin = announcement_->job->params.row_end = 0;
+  announcement_->job->keep_on_device = -1;
+}
+
 void Renderer::begin_frame(const BandJob& job, FrameBuffer& out, const std::vector<float>& row_cost_proxy) {
   if (pending_) throw std::logic_error("Renderer::begin_frame: the previous frame was not waited for");
   if (unmerged_ && unmerged_->slot == next_slot_)
     throw std::logic_error("Renderer::begin_frame: the frame before the previous one was not merged");
+  {
+    std::lock_guard lock(announcement_->mutex);
+    announcement_->job.reset();  // from here on, this frame's jobs say what it is
+  }
   const auto frame_start = Clock::now();
   const int width = static_cast<int>(job.camera.width), rows = static_cast<int>(job.camera.height);
   if (width <= 0 || rows <= 0) throw std::invalid_argument("Renderer::render: camera has no pixels");
