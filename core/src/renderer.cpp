@@ -74,6 +74,7 @@ struct Renderer::Worker {
   std::string error;
   double wall_ms = 0.0;
   double reported_ms = 0.0;
+  double balance_ms = 0.0;  // BandResult::balance_ms of the last job
   double apply_ms = 0.0;
   std::vector<float> row_work;
   DeviceBand device_band;        // the last job's band, when it stayed on a GPU
@@ -109,7 +110,7 @@ struct Renderer::Worker {
       }
       bool success = false;
       std::string what;
-      double wall = 0.0, reported = 0.0, applied = 0.0;
+      double wall = 0.0, reported = 0.0, applied = 0.0, balance = 0.0;
       std::vector<float> work;
       DeviceBand kept;
       std::vector<StageSpan> job_spans;
@@ -135,6 +136,7 @@ struct Renderer::Worker {
           wall = std::chrono::duration<double, std::milli>(Clock::now() - start).count();
           rendering.finish();
           reported = result.device_ms;
+          balance = result.balance_ms;
           if (result.row_work.size() == current.params.row_end - current.params.row_begin) work = result.row_work;
           if (current.keep_on_device >= 0) kept = result.device;
         } else {
@@ -154,6 +156,7 @@ struct Renderer::Worker {
         error = std::move(what);
         wall_ms = wall;
         reported_ms = reported;
+        balance_ms = balance;
         apply_ms = applied;
         row_work = std::move(work);
         device_band = kept;
@@ -314,7 +317,8 @@ void Renderer::reset_balancer() {
 
 double Renderer::measured_ms(const Worker& w) const {
   // Reported times are the tracer's own (kernel time); its commit apply is part of its cost too.
-  return options_.use_reported_time && w.reported_ms > 0.0 ? w.reported_ms + w.apply_ms : w.wall_ms;
+  if (options_.use_reported_time && w.reported_ms > 0.0) return w.reported_ms + w.apply_ms;
+  return w.balance_ms > 0.0 ? w.balance_ms + w.apply_ms : w.wall_ms;
 }
 
 void Renderer::harvest_side_job(Worker& w, std::vector<StageSpan>& stages) {

@@ -35,6 +35,10 @@ struct BandResult {
   std::vector<float> row_work;
   // Set when the tracer kept its band on a GPU (BandJob::keep_on_device): the target's rows are stale.
   DeviceBand device;
+  // When > 0: what the band costs the tracer, for the balancer, in place of the wall time of its job (a
+  // tracer that began the band ahead of its job, Tracer::takes_jobs_ahead: its wall time leaves out the
+  // head start, and the balancer divides rows by speed).
+  double balance_ms = 0.0;
 };
 
 class Tracer {
