@@ -23,8 +23,9 @@ longer a band: each frame's commit is submitted while the band before renders, t
 job and is applied once it is rendered; every frame matches the single-process render), ahead_recovery
 (the same with rank 2 stalled through frame 1: its rows are re-rendered on mpi:1, whose node has already
 applied the next frame's commit; rank 0 says so, and the frame differs from the single-process render at
-most in those rows, the others match), jobs_ahead (the scenario on mpi:1 and mpi:2 alone, the nodes 1
-and 2 ms slower a row, so that the balancer moves rows every frame: each later frame's job goes to the
+most in those rows, the others match), jobs_ahead (the scenario on mpi:1 and mpi:2 alone, the nodes 3
+and 6 ms slower a row (bands far longer than rank 0's own frame work, so that each next job is announced
+while they render), so that the balancer moves rows every frame: each later frame's job goes to the
 node while its band before renders, the node renders it right after that band, and the frame's job
 adopts those rows, rendering only the rows beyond them; every frame matches the single-process render;
 with COHORT_MPI_JOBS_AHEAD=0 nothing is adopted).
@@ -242,7 +243,7 @@ def jobs_ahead(a):
         env["COHORT_MPI_JOBS_AHEAD"] = enabled
         _, output = run([a.mpiexec] + flags + ["-np", "1", a.cohort, "render", "--tracers", "mpi:1,mpi:2", "--out",
                                                cluster] + args +
-                        [":"] + flags + ["-np", "1"] + node + ["1"] + [":"] + flags + ["-np", "1"] + node + ["2"],
+                        [":"] + flags + ["-np", "1"] + node + ["3"] + [":"] + flags + ["-np", "1"] + node + ["6"],
                         env=env)
         compare_frames(single, cluster)
         if any(o.get("mpi:1") != "rendered" or o.get("mpi:2") != "rendered" for o in tracer_outcomes(cluster)):
