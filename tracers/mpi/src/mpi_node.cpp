@@ -284,6 +284,12 @@ class Node {
       fail(fmt::format("band {} adopts the job ahead {}, which this node did not render", sequence, request.adopt));
       return;
     }
+    if (diverged_) {  // a commit after the job ahead was refused: rank 0 would not have adopted it
+      send(mpi, wire::Kind::band_failed, sequence,
+           wire::encode_band_failure({true, "the node's scene is behind: " + divergence_}));
+      ahead_.reset();
+      return;
+    }
     const Ahead& a = *ahead_;
     const KFrameParams& p = request.job.params;
     KFrameParams same_rows = request.job.params;

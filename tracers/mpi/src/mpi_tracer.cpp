@@ -588,7 +588,8 @@ core::BandResult MpiTracer::render_band(const core::BandJob& job, core::BandBuff
                                asked.adopt ? fmt::format(" adopting job {}", asked.adopt) : ""));
     // Every piece matched before band_rows has landed (MpiSession::receive); one that was refused or
     // never came leaves rows unwritten: the band fails and the Renderer re-renders them elsewhere.
-    if (const std::string problem = pieces.problem(header.sequence); !problem.empty()) throw refuse(problem);
+    if (const std::string problem = pieces.problem(header.sequence); !problem.empty())  // counted as it was refused
+      throw std::runtime_error(fmt::format("mpi:{}: refused the band's rows: {}", options_.rank, problem));
     if (of_ahead) {
       ahead_closed = true;
       continue;
