@@ -339,6 +339,9 @@ def bench(a):
         sys.exit(f"mpi:1 alone: the node's render time should lie within its time and the round trip: {link}")
     if not 0 < link["mean_first_piece_ms"] <= link["mean_round_trip_ms"]:
         sys.exit(f"mpi:1 alone: rank 0's wait for the first piece should lie within the round trip: {link}")
+    # Frame by frame (no pipeline, no jobs ahead), the node waits between bands: rank 0's turnaround at least.
+    if not link["mean_node_idle_ms"] > 0:
+        sys.exit(f"mpi:1 alone: the node's idle time between bands is not reported: {link}")
     if len(mix[0]["remote"]) != 2:
         sys.exit("the mix should report both remote tracers")
     print("bench: ok")
