@@ -29,6 +29,7 @@ struct NodeArgs {
   double time = 0.0;
   std::string announced_version;
   int stall_frame = -1, stall_ms = 0, die_frame = -1, short_piece_frame = -1, band_delay_ms = 0;
+  double row_delay_ms = 0.0;
   int idle_timeout_s = 600;
 };
 
@@ -42,6 +43,7 @@ int run_node_command(const NodeArgs& a) {
   options.die_frame = a.die_frame;
   options.short_piece_frame = a.short_piece_frame;
   options.band_delay_ms = a.band_delay_ms;
+  options.row_delay_ms = a.row_delay_ms;
   options.idle_timeout = std::chrono::seconds(a.idle_timeout_s);
   std::vector<std::unique_ptr<core::Tracer>> tracers;
   try {
@@ -95,6 +97,7 @@ void add_node_command(CLI::App& app, int& exit_code) {
   cmd->add_option("--die-frame", a->die_frame, "")->group("");
   cmd->add_option("--short-piece-frame", a->short_piece_frame, "")->group("");
   cmd->add_option("--band-delay-ms", a->band_delay_ms, "")->group("");
+  cmd->add_option("--row-delay-ms", a->row_delay_ms, "")->group("");
   cmd->callback([a, &exit_code] {
 #ifdef COHORT_HAVE_MPI
     exit_code = run_node_command(*a);

@@ -21,6 +21,7 @@
 #                              (e.g. COHORT_BLAS_LAYOUT bvh2 cwbvh): its tracer tests, then ms per frame, three rounds
 #   tools/gpu_run.sh stage-mpi here: the travelling cohort built against PyPI's MPICH, with its libraries (.gpu/mpi.tar.xz)
 #   tools/gpu_run.sh cluster   there, on a two-GPU kind: two ranks with one GPU each against the in-process two GPUs
+#                              (COHORT_CLUSTER_JOBS_AHEAD="1 0": with and without jobs ahead, back to back)
 #   tools/gpu_run.sh kernels   there: GPU time kernel by kernel (ncu) on the large map at 1080p, cuda:0, Brigade's
 #                              blend / reprojection / reprojection + a-trous, with the same runs' frame times
 #   tools/gpu_run.sh quality   there: bench/quality/bench_quality.py on cuda:0 along the test map's scenario,
@@ -105,19 +106,22 @@ case "${1:-}" in
         timeout 120 "$cohort" render "$pack" "${size[@]}" "${common[@]}" --tracers cuda:0,cuda:1 --out /tmp/in_$map >/tmp/in_$map.log 2>&1 ||
           tail -n 3 /tmp/in_$map.log
         echo "round $round, $map map, in-process: $(python3 tools/frame_times.py /tmp/in_$map/stats.json --skip 50 | head -n 1)"
-        # COHORT_CLUSTER_PIECES="1 2 4 8": the two-rank run once per piece count a band's rows travel in.
+        # COHORT_CLUSTER_PIECES="1 2 4 8": the two-rank run once per piece count a band's rows travel in;
+        # COHORT_CLUSTER_JOBS_AHEAD="1 0": with and without jobs ahead (docs/cluster.md), back to back.
+        for ahead in ${COHORT_CLUSTER_JOBS_AHEAD:-1}; do
         for pieces in ${COHORT_CLUSTER_PIECES:-4}; do
           rm -rf /tmp/mpi_$map
-          COHORT_MPI_BAND_PIECES=$pieces timeout 180 mpiexec.hydra -np 1 "$cohort" render "$pack" "${size[@]}" "${common[@]}" \
-            --tracers mpi:1,mpi:2 --out /tmp/mpi_$map : \
+          COHORT_MPI_JOBS_AHEAD=$ahead COHORT_MPI_BAND_PIECES=$pieces timeout 180 mpiexec.hydra -np 1 "$cohort" render \
+            "$pack" "${size[@]}" "${common[@]}" --tracers mpi:1,mpi:2 --out /tmp/mpi_$map : \
             -np 1 "$cohort" node "$pack" --tracers cuda:0 : -np 1 "$cohort" node "$pack" --tracers cuda:1 >/tmp/mpi_$map.log 2>&1 ||
             { echo "two-rank run failed"; tail -n 8 /tmp/mpi_$map.log; }
           [ -f /tmp/mpi_$map/stats.json ] &&
-            echo "round $round, $map map, two ranks, $pieces piece(s) a band: $(python3 tools/frame_times.py /tmp/mpi_$map/stats.json --skip 50 | head -n 1)"
+            echo "round $round, $map map, two ranks, $pieces piece(s) a band, jobs ahead $ahead: $(python3 tools/frame_times.py /tmp/mpi_$map/stats.json --skip 50 | head -n 1)"
           # Rank 0's own stages (medians): with no GPU there, its merge, blend and tone map run on the host
           # while the nodes render the next frame; near the frame interval, they set it.
           [ -f /tmp/mpi_$map/stats.json ] && python3 tools/frame_times.py /tmp/mpi_$map/stats.json --skip 50 | grep " core/" || true
           grep -E "round trip" /tmp/mpi_$map.log | sed 's/^.*\] //' || true
+        done
         done
       done
     done

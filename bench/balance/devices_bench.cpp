@@ -85,6 +85,7 @@ DevicesBenchRun run_mix(const DevicesBenchConfig& config, const std::vector<std:
           (after.total_node_commit_ahead_ms - before[i].total_node_commit_ahead_ms) / double(bands);
       link.commits_ahead = after.commits_ahead - before[i].commits_ahead;
       link.mean_first_piece_ms = (after.total_first_piece_ms - before[i].total_first_piece_ms) / double(bands);
+      link.mean_node_idle_ms = (after.total_node_idle_ms - before[i].total_node_idle_ms) / double(bands);
     }
     run.remote.push_back(link);
   }
@@ -192,7 +193,8 @@ nlohmann::json remote_json(const std::vector<RemoteLinkRun>& links) {
                    {"mean_node_commit_ms", l.mean_node_commit_ms},
                    {"mean_node_commit_ahead_ms", l.mean_node_commit_ahead_ms},
                    {"commits_ahead", l.commits_ahead},
-                   {"mean_first_piece_ms", l.mean_first_piece_ms}});
+                   {"mean_first_piece_ms", l.mean_first_piece_ms},
+                   {"mean_node_idle_ms", l.mean_node_idle_ms}});
   return out;
 }
 }  // namespace

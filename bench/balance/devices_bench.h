@@ -38,6 +38,9 @@ struct RemoteLinkRun {
   double mean_node_commit_ahead_ms = 0.0;
   uint64_t commits_ahead = 0;  // commits sent behind a band's job while it rendered, over the counted frames
   double mean_first_piece_ms = 0.0;
+  // The node waiting for its next job between bands (protocol 7). The bench renders frame by frame,
+  // without the pipeline's announcements, so it sends no jobs ahead: this is the gap they would close.
+  double mean_node_idle_ms = 0.0;
 };
 
 struct DevicesBenchRun {

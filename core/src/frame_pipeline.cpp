@@ -23,7 +23,11 @@ std::optional<FramePipeline::Delivered> FramePipeline::push(const BandJob& job, 
   std::optional<InFlight> previous = std::move(in_flight_);
   in_flight_.reset();
   std::optional<FrameStats> stats;
-  if (previous) stats = renderer_.wait_frame();
+  if (previous) {
+    // Known now, handed out only once the frame in flight is back: tracers that can start on it early may.
+    renderer_.announce_frame(job);
+    stats = renderer_.wait_frame();
+  }
   try {
     renderer_.begin_frame(job, image_);
   } catch (...) {

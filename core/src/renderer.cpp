@@ -74,6 +74,7 @@ struct Renderer::Worker {
   std::string error;
   double wall_ms = 0.0;
   double reported_ms = 0.0;
+  double balance_ms = 0.0;  // BandResult::balance_ms of the last job
   double apply_ms = 0.0;
   std::vector<float> row_work;
   DeviceBand device_band;        // the last job's band, when it stayed on a GPU
@@ -109,7 +110,7 @@ struct Renderer::Worker {
       }
       bool success = false;
       std::string what;
-      double wall = 0.0, reported = 0.0, applied = 0.0;
+      double wall = 0.0, reported = 0.0, applied = 0.0, balance = 0.0;
       std::vector<float> work;
       DeviceBand kept;
       std::vector<StageSpan> job_spans;
@@ -135,6 +136,7 @@ struct Renderer::Worker {
           wall = std::chrono::duration<double, std::milli>(Clock::now() - start).count();
           rendering.finish();
           reported = result.device_ms;
+          balance = result.balance_ms;
           if (result.row_work.size() == current.params.row_end - current.params.row_begin) work = result.row_work;
           if (current.keep_on_device >= 0) kept = result.device;
         } else {
@@ -154,6 +156,7 @@ struct Renderer::Worker {
         error = std::move(what);
         wall_ms = wall;
         reported_ms = reported;
+        balance_ms = balance;
         apply_ms = applied;
         row_work = std::move(work);
         device_band = kept;
@@ -212,6 +215,11 @@ Renderer::Renderer(std::vector<std::unique_ptr<Tracer>> tracers, RendererOptions
     w->completion = completion;
     // The worker owns the tracer, so the hook never outlives what it points at.
     if (w->tracer->takes_commits_ahead()) w->tracer->set_commits_ahead([worker = w.get()] { worker->apply_ahead(); });
+    if (w->tracer->takes_jobs_ahead())
+      w->tracer->set_next_job([announcement = announcement_]() -> std::optional<BandJob> {
+        std::lock_guard lock(announcement->mutex);
+        return announcement->job;
+      });
     workers_.push_back(std::move(w));
   }
   // Each thread shares its worker, so a worker whose tracer never returns can be left behind at
@@ -309,7 +317,8 @@ void Renderer::reset_balancer() {
 
 double Renderer::measured_ms(const Worker& w) const {
   // Reported times are the tracer's own (kernel time); its commit apply is part of its cost too.
-  return options_.use_reported_time && w.reported_ms > 0.0 ? w.reported_ms + w.apply_ms : w.wall_ms;
+  if (options_.use_reported_time && w.reported_ms > 0.0) return w.reported_ms + w.apply_ms;
+  return w.balance_ms > 0.0 ? w.balance_ms + w.apply_ms : w.wall_ms;
 }
 
 void Renderer::harvest_side_job(Worker& w, std::vector<StageSpan>& stages) {
@@ -424,10 +433,21 @@ FrameStats Renderer::render(const BandJob& job, FrameBuffer& out, const std::vec
   return finish_frame();
 }
 
+void Renderer::announce_frame(const BandJob& job) {
+  std::lock_guard lock(announcement_->mutex);
+  announcement_->job = job;
+  announcement_->job->params.row_begin = announcement_->job->params.row_end = 0;
+  announcement_->job->keep_on_device = -1;
+}
+
 void Renderer::begin_frame(const BandJob& job, FrameBuffer& out, const std::vector<float>& row_cost_proxy) {
   if (pending_) throw std::logic_error("Renderer::begin_frame: the previous frame was not waited for");
   if (unmerged_ && unmerged_->slot == next_slot_)
     throw std::logic_error("Renderer::begin_frame: the frame before the previous one was not merged");
+  {
+    std::lock_guard lock(announcement_->mutex);
+    announcement_->job.reset();  // from here on, this frame's jobs say what it is
+  }
   const auto frame_start = Clock::now();
   const int width = static_cast<int>(job.camera.width), rows = static_cast<int>(job.camera.height);
   if (width <= 0 || rows <= 0) throw std::invalid_argument("Renderer::render: camera has no pixels");

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <condition_variable>
+#include <cstring>
 #include <map>
 #include <mutex>
 #include <thread>
@@ -303,4 +304,92 @@ TEST(FramePipeline, ATracerThatTakesCommitsAheadAppliesThemWhileItRendersTheOthe
       if (!e.band) commits.push_back(e.frame);
     EXPECT_EQ(commits, (std::vector<uint64_t>{1, 2, 3, 4, 5, 6}));
   }
+}
+
+namespace {
+
+// Records, for each band, the jobs announced while it rendered (Tracer::next_job_announced). With
+// `ahead` it takes jobs ahead and waits, rendering, until the next frame's job is announced (or its
+// frame's gate opens: the last frame has no next); otherwise it looks once and renders at once.
+class AnnouncementTracer final : public Tracer {
+ public:
+  struct Seen {
+    uint64_t band_frame = 0;
+    std::vector<BandJob> announced;
+  };
+  AnnouncementTracer(bool ahead, std::shared_ptr<FrameGates> gates, std::shared_ptr<std::vector<Seen>> seen)
+      : ahead_(ahead), gates_(std::move(gates)), seen_(std::move(seen)) {}
+  std::string name() const override { return ahead_ ? "jobs-ahead" : "no-jobs-ahead"; }
+  bool takes_jobs_ahead() const override { return ahead_; }
+  void apply(const cohort::commit::CommitBuffer&) override {}
+  using Tracer::render_band;
+  BandResult render_band(const BandJob& job, BandBuffer& target) override {
+    Seen seen{job.params.frame_index, {}};
+    const auto give_up = std::chrono::steady_clock::now() + FrameGates::kPatience;
+    for (;;) {
+      if (std::optional<BandJob> next = next_job_announced()) seen.announced.push_back(*next);
+      if (!ahead_ || !seen.announced.empty()) break;
+      {
+        std::lock_guard lock(gates_->mutex);
+        if (gates_->open_through >= static_cast<int64_t>(job.params.frame_index)) break;
+      }
+      if (std::chrono::steady_clock::now() > give_up) {
+        gates_->gave_up = true;
+        break;
+      }
+      std::this_thread::sleep_for(std::chrono::microseconds(200));
+    }
+    seen_->push_back(std::move(seen));
+    std::vector<float> row(static_cast<size_t>(target.width()) * 4, static_cast<float>(job.params.frame_index));
+    for (kuint y = job.params.row_begin; y < job.params.row_end; ++y)
+      target.store(static_cast<int>(y), 0, row.data(), static_cast<size_t>(target.width()));
+    return {};
+  }
+
+ private:
+  bool ahead_;
+  std::shared_ptr<FrameGates> gates_;
+  std::shared_ptr<std::vector<Seen>> seen_;
+};
+
+}  // namespace
+
+TEST(FramePipeline, ATracerThatTakesJobsAheadSeesTheNextFramesJobWhileItRendersTheFrameBefore) {
+  auto gates = std::make_shared<FrameGates>();
+  auto ahead_seen = std::make_shared<std::vector<AnnouncementTracer::Seen>>();
+  auto other_seen = std::make_shared<std::vector<AnnouncementTracer::Seen>>();
+  std::vector<std::unique_ptr<Tracer>> tracers;
+  tracers.push_back(std::make_unique<AnnouncementTracer>(true, gates, ahead_seen));
+  tracers.push_back(std::make_unique<AnnouncementTracer>(false, gates, other_seen));
+  RendererOptions options;
+  options.balancer = "none";
+  Renderer renderer(std::move(tracers), options);
+  FramePipeline pipeline(renderer);
+  constexpr uint64_t kFrames = 6;
+  for (uint64_t f = 0; f < kFrames; ++f) {
+    if (std::optional<FramePipeline::Delivered> done = pipeline.push(job_for(f))) {
+      for (int y = 0; y < kRows; ++y) ASSERT_EQ(pipeline.image().row(y)[0], static_cast<float>(done->stats.frame));
+    }
+  }
+  gates->open(kFrames - 1);  // nothing is announced after the last frame
+  ASSERT_TRUE(pipeline.drain().has_value());
+  EXPECT_FALSE(gates->gave_up) << "a band of the tracer that takes jobs ahead never saw the next job announced";
+
+  ASSERT_EQ(ahead_seen->size(), kFrames);
+  for (const AnnouncementTracer::Seen& s : *ahead_seen) {
+    if (s.band_frame + 1 == kFrames) {
+      EXPECT_TRUE(s.announced.empty()) << "the last frame has no next";
+      continue;
+    }
+    // Only the next frame's job, whole but for its rows, which are divided when it is handed out.
+    ASSERT_FALSE(s.announced.empty()) << s.band_frame;
+    for (const BandJob& next : s.announced) {
+      const BandJob expected = job_for(s.band_frame + 1);
+      EXPECT_EQ(next.params.frame_index, s.band_frame + 1);
+      EXPECT_EQ(std::memcmp(&next.camera, &expected.camera, sizeof expected.camera), 0);
+      EXPECT_EQ(next.params.row_begin, 0u);
+      EXPECT_EQ(next.params.row_end, 0u);
+    }
+  }
+  for (const AnnouncementTracer::Seen& s : *other_seen) EXPECT_TRUE(s.announced.empty()) << "it did not ask for jobs ahead";
 }

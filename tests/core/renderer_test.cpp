@@ -512,3 +512,44 @@ TEST(Renderer, ABenchedTracerReRendersTheRowsOfATracerThatFailed) {
     }
   }
 }
+
+namespace {
+
+// Renders at once and says its band cost `ms_per_row` a row (BandResult::balance_ms), as a tracer that
+// began its band ahead of its job does: its wall time says nothing of its speed.
+class HeadStartTracer final : public Tracer {
+ public:
+  explicit HeadStartTracer(double ms_per_row) : ms_per_row_(ms_per_row) {}
+  std::string name() const override { return "head-start"; }
+  void apply(const cohort::commit::CommitBuffer&) override {}
+  using Tracer::render_band;
+  BandResult render_band(const BandJob& job, BandBuffer& target) override {
+    std::vector<float> row(static_cast<size_t>(target.width()) * 4, static_cast<float>(job.params.frame_index));
+    for (kuint y = job.params.row_begin; y < job.params.row_end; ++y)
+      target.store(static_cast<int>(y), 0, row.data(), static_cast<size_t>(target.width()));
+    BandResult result;
+    result.balance_ms = ms_per_row_ * static_cast<double>(job.params.row_end - job.params.row_begin);
+    return result;
+  }
+
+ private:
+  double ms_per_row_;
+};
+
+}  // namespace
+
+TEST(Renderer, TheBalancerChargesATracerTheCostItReportsForABandBegunAhead) {
+  std::vector<std::unique_ptr<Tracer>> tracers;
+  tracers.push_back(std::make_unique<HeadStartTracer>(1.0));
+  tracers.push_back(std::make_unique<HeadStartTracer>(3.0));
+  RendererOptions options;
+  options.balancer = "perfect";
+  Renderer renderer(std::move(tracers), options);
+  FrameBuffer fb;
+  FrameStats stats;
+  for (uint64_t f = 0; f < 6; ++f) stats = renderer.render(job_for(f), fb);
+  // A third of the speed, a third of the rows: 72 and 24 of 96 (the balancer's 4-row units).
+  EXPECT_EQ(stats.tracers[0].row_end - stats.tracers[0].row_begin, 72);
+  EXPECT_EQ(stats.tracers[1].row_end - stats.tracers[1].row_begin, 24);
+  EXPECT_NEAR(stats.tracers[0].ms, 72.0, 1.0) << "the cost it reported (and its commit's apply), not its wall time";
+}

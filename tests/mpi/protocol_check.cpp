@@ -6,11 +6,13 @@
 //  - a well-framed commit with a corrupt payload is refused, never applied: the node's next band fails
 //    asking for a full resync, records on top are refused, and a full resync brings it back, its
 //    rows again equal to the local tracer's;
-//  - a band asked of rows outside the frame is refused with the reason.
+//  - a band asked of rows outside the frame is refused with the reason;
+//  - a band that adopts a job ahead the node never rendered (protocol 7) is refused with the reason.
 // Exit status 0 when every check holds.
 #include <cstdio>
 #include <cstring>
 #include <functional>
+#include <optional>
 #include <string>
 
 #include <spdlog/spdlog.h>
@@ -125,6 +127,25 @@ int rank0() {
   check(next_error.empty() && same_rows(next, expected, 4, 12) && remote.link_stats().stale_answers >= 1,
         "a band job outside the frame is refused by the node; its answer is dropped as another job's" +
             (next_error.empty() ? std::string() : ": " + next_error));
+
+  wire::BandRequest adopting;
+  adopting.job = band_job(w, h, 0, 16);
+  adopting.format = core::BandFormat::rgb16f;
+  adopting.adopt = 987654321;
+  adopting.pieces = 0;
+  const uint64_t adopting_id = (1u << 30) + 1;
+  mpi.send(1, wire::frame_message(wire::Kind::band_job, adopting_id, wire::encode_band_request(adopting)));
+  std::string adopt_reason;
+  if (std::optional<std::vector<uint8_t>> answer = mpi.receive(1, tracers::MpiClock::now() + std::chrono::seconds(10))) {
+    const wire::Message m = wire::parse_message(answer->data(), answer->size());
+    if (m.kind == wire::Kind::band_failed && m.sequence == adopting_id) adopt_reason = wire::decode_band_failure(m.payload).reason;
+  }
+  check(adopt_reason.find("which this node did not render") != std::string::npos,
+        "a band adopting a job ahead the node never rendered is refused: " + adopt_reason);
+  core::BandBuffer after_adopt(w, h, core::BandFormat::rgb16f);
+  const std::string after_adopt_error = thrown([&] { remote.render_band(band_job(w, h, 4, 12), after_adopt); });
+  check(after_adopt_error.empty() && same_rows(after_adopt, expected, 4, 12),
+        "and the next band renders" + (after_adopt_error.empty() ? std::string() : ": " + after_adopt_error));
   return failures == 0 ? 0 : 1;
 }
 

@@ -23,7 +23,12 @@ longer a band: each frame's commit is submitted while the band before renders, t
 job and is applied once it is rendered; every frame matches the single-process render), ahead_recovery
 (the same with rank 2 stalled through frame 1: its rows are re-rendered on mpi:1, whose node has already
 applied the next frame's commit; rank 0 says so, and the frame differs from the single-process render at
-most in those rows, the others match).
+most in those rows, the others match), jobs_ahead (the scenario on mpi:1 and mpi:2 alone, the nodes 3
+and 6 ms slower a row (bands far longer than rank 0's own frame work, so that each next job is announced
+while they render), so that the balancer moves rows every frame: each later frame's job goes to the
+node while its band before renders, the node renders it right after that band, and the frame's job
+adopts those rows, rendering only the rows beyond them; every frame matches the single-process render;
+with COHORT_MPI_JOBS_AHEAD=0 nothing is adopted).
 """
 import argparse
 import json
@@ -221,6 +226,47 @@ def ahead(a, stalled=False):
     print("ahead: ok")
 
 
+def jobs_ahead(a):
+    os.makedirs(a.out)
+    stream = os.path.join(a.out, "scenario.cdelta")
+    run([a.cohort, "record-scenario", "testmap", "--base", a.testmap_base, "--frames", str(FRAMES), "--out", stream])
+    args = ["--replay", stream, "--base", a.testmap_base, "--width", "96", "--height", "54", "--spp", "1"]
+    single = os.path.join(a.out, "single")
+    run([a.cohort, "render", "--tracers", "embree", "--out", single] + args)
+    flags = mpiexec_flags(a.mpiexec)
+    node = [a.cohort, "node", "testmap", "--base", a.testmap_base, "--tracers", "embree", "--row-delay-ms"]
+    pattern = (r"mpi:{}: the node idled ([\d.]+) ms a band waiting for a job; jobs ahead: (\d+) sent, (\d+) adopted "
+               r"by their frame's band, (\d+) dropped; (\d+) row\(s\) rendered ahead for nothing, (\d+) rendered after")
+    for enabled in ("1", "0"):
+        cluster = os.path.join(a.out, "cluster_" + enabled)
+        env = dict(os.environ)
+        env["COHORT_MPI_JOBS_AHEAD"] = enabled
+        _, output = run([a.mpiexec] + flags + ["-np", "1", a.cohort, "render", "--tracers", "mpi:1,mpi:2", "--out",
+                                               cluster] + args +
+                        [":"] + flags + ["-np", "1"] + node + ["3"] + [":"] + flags + ["-np", "1"] + node + ["6"],
+                        env=env)
+        compare_frames(single, cluster)
+        if any(o.get("mpi:1") != "rendered" or o.get("mpi:2") != "rendered" for o in tracer_outcomes(cluster)):
+            sys.exit("a remote tracer failed a band of the scenario")
+        moved = 0
+        for rank in (1, 2):
+            found = re.search(pattern.format(rank), output)
+            if not found:
+                sys.exit(f"mpi:{rank}: no jobs-ahead line in the log")
+            idle, sent, adopted, dropped, unused, beyond = found.groups()
+            moved += int(unused) + int(beyond)
+            print(f"jobs ahead {'on' if enabled == '1' else 'off'}, mpi:{rank}: idle {idle} ms a band, {sent} sent, "
+                  f"{adopted} adopted, {dropped} dropped, rows unused {unused}, beyond {beyond}")
+            # Frame 0 has no band before it; every later frame's job went ahead and was adopted.
+            want = FRAMES - 1 if enabled == "1" else 0
+            if int(sent) != want or int(adopted) != want or int(dropped) != 0:
+                sys.exit(f"mpi:{rank}: {sent} job(s) ahead sent, {adopted} adopted, {dropped} dropped; {want} should "
+                         f"have gone ahead and been adopted")
+        if enabled == "1" and moved == 0:
+            sys.exit("the balancer never moved the rows between frames: the rows beyond a job ahead went untested")
+    print("jobs_ahead: ok")
+
+
 def ahead_recovery_check(single, cluster, output):
     with open(os.path.join(cluster, "stats.json")) as f:
         stats = json.load(f)["frames"]
@@ -293,6 +339,9 @@ def bench(a):
         sys.exit(f"mpi:1 alone: the node's render time should lie within its time and the round trip: {link}")
     if not 0 < link["mean_first_piece_ms"] <= link["mean_round_trip_ms"]:
         sys.exit(f"mpi:1 alone: rank 0's wait for the first piece should lie within the round trip: {link}")
+    # Frame by frame (no pipeline, no jobs ahead), the node waits between bands: rank 0's turnaround at least.
+    if not link["mean_node_idle_ms"] > 0:
+        sys.exit(f"mpi:1 alone: the node's idle time between bands is not reported: {link}")
     if len(mix[0]["remote"]) != 2:
         sys.exit("the mix should report both remote tracers")
     print("bench: ok")
@@ -301,7 +350,7 @@ def bench(a):
 def main():
     parser = argparse.ArgumentParser()
     parser.add_argument("case", choices=["match", "mixed", "stall", "killed", "version", "load_error", "bench", "protocol", "replay",
-                                           "play", "bad_piece", "ahead", "ahead_recovery"])
+                                           "play", "bad_piece", "ahead", "ahead_recovery", "jobs_ahead"])
     parser.add_argument("--mpiexec", required=True)
     parser.add_argument("--cohort", required=True)
     parser.add_argument("--map", required=True)
@@ -328,12 +377,15 @@ def main():
     if a.case == "play":
         play(a)
         return
+    if a.case == "jobs_ahead":
+        jobs_ahead(a)
+        return
     if a.case == "bad_piece":
         bad_piece(a)
         return
     if a.case == "protocol":
         _, output = run([a.mpiexec] + mpiexec_flags(a.mpiexec) + ["-np", "2", a.protocol_check])
-        if "FAILED" in output or output.count("ok: ") < 6:
+        if "FAILED" in output or output.count("ok: ") < 8:
             sys.exit("protocol check failed")
         print("protocol: ok")
         return

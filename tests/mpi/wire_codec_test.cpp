@@ -179,10 +179,10 @@ TEST(WireCodec, BandRowsCloseABandAndEveryFieldIsChecked) {
   done.pieces = 3;
   done.aux = true;
   done.device_ms = 2.5;
-  done.timing = {2.5, 2.0, 1.5, 0.25, 0.75, 0.5, 0.125};
+  done.timing = {2.5, 2.0, 1.5, 0.25, 0.75, 0.5, 0.125, 0.375, 1.25};
   done.row_work = {3.0f, 4.0f, 5.0f};
   const std::vector<uint8_t> payload = wire::encode_band_rows(done);
-  EXPECT_EQ(payload.size(), 6 * 4 + 8 + 56 + 8 + 3 * 4) << "no pixels: they went ahead as pieces";
+  EXPECT_EQ(payload.size(), 6 * 4 + 8 + 8 + 72 + 8 + 3 * 4) << "no pixels: they went ahead as pieces";
   const wire::BandRows back = wire::decode_band_rows(payload);
   EXPECT_EQ(back.row_begin, 10u);
   EXPECT_EQ(back.row_end, 13u);
@@ -195,6 +195,9 @@ TEST(WireCodec, BandRowsCloseABandAndEveryFieldIsChecked) {
   EXPECT_EQ(back.timing.first_piece_ms, 0.75);
   EXPECT_EQ(back.timing.commit_ms, 0.5);
   EXPECT_EQ(back.timing.commit_ahead_ms, 0.125);
+  EXPECT_EQ(back.timing.idle_ms, 0.375);
+  EXPECT_EQ(back.timing.ahead_ms, 1.25);
+  EXPECT_EQ(back.adopted, 0u);
   EXPECT_EQ(back.row_work, done.row_work);
   expect_every_prefix_refused(payload, [](const auto& p) { return wire::decode_band_rows(p); });
 
@@ -213,6 +216,18 @@ TEST(WireCodec, BandRowsCloseABandAndEveryFieldIsChecked) {
             std::string::npos);
   EXPECT_NE(changed([](wire::BandRows& b) { b.device_ms = -1.0; }).find("not a duration"), std::string::npos);
   EXPECT_NE(changed([](wire::BandRows& b) { b.timing.commit_ahead_ms = -0.5; }).find("not a duration"),
+            std::string::npos);
+  EXPECT_NE(changed([](wire::BandRows& b) { b.timing.ahead_ms = -0.5; }).find("not a duration"), std::string::npos);
+  // A band that adopted a job ahead sent only the runs of rows beyond it: none to two pieces.
+  wire::BandRows adopted = done;
+  adopted.adopted = 77;
+  for (uint32_t pieces : {0u, 1u, 2u}) {
+    adopted.pieces = pieces;
+    EXPECT_EQ(wire::decode_band_rows(wire::encode_band_rows(adopted)).pieces, pieces);
+  }
+  EXPECT_EQ(wire::decode_band_rows(wire::encode_band_rows(adopted)).adopted, 77u);
+  adopted.pieces = 3;
+  EXPECT_NE(refusal([&] { wire::decode_band_rows(wire::encode_band_rows(adopted)); }).find("3 pieces beyond the adopted rows"),
             std::string::npos);
   std::vector<uint8_t> bad_aux = payload;
   bad_aux[20] = 2;  // the aux flag
@@ -293,6 +308,47 @@ TEST(WireCodec, BandJobsOutsideTheFrameAreRefused) {
   EXPECT_NE(refusal([&] { wire::decode_band_request(wire::encode_band_request(request)); }).find("do not fit"),
             std::string::npos);
   expect_every_prefix_refused(wire::encode_band_request(back), [](const auto& p) { return wire::decode_band_request(p); });
+  EXPECT_EQ(wire::encode_band_request(back).size(), 4 + sizeof(core::BandJob) + 4 * 4 + 8);
+
+  // Jobs ahead: a job ahead, and a band that adopts one with its rows beyond in 0 to 2 pieces.
+  request.job.params.row_end = 16;
+  request.ahead = true;
+  EXPECT_TRUE(wire::decode_band_request(wire::encode_band_request(request)).ahead);
+  request.adopt = 5;
+  EXPECT_NE(refusal([&] { wire::decode_band_request(wire::encode_band_request(request)); }).find("cannot adopt"),
+            std::string::npos);
+  request.ahead = false;
+  for (uint32_t pieces : {0u, 2u}) {
+    request.pieces = pieces;
+    const wire::BandRequest adopting = wire::decode_band_request(wire::encode_band_request(request));
+    EXPECT_EQ(adopting.adopt, 5u);
+    EXPECT_EQ(adopting.pieces, pieces);
+  }
+  request.pieces = 3;
+  EXPECT_NE(refusal([&] { wire::decode_band_request(wire::encode_band_request(request)); }).find("3 pieces beyond"),
+            std::string::npos);
+  std::vector<uint8_t> bad_ahead = wire::encode_band_request(back);
+  bad_ahead[4 + sizeof(core::BandJob) + 12] = 2;  // the ahead flag
+  EXPECT_NE(refusal([&] { wire::decode_band_request(bad_ahead); }).find("ahead flag 2"), std::string::npos);
+}
+
+TEST(WireCodec, RowsBeyondAJobAheadAreTheBandsRowsItDidNotCover) {
+  using R = wire::RowRange;
+  auto beyond = [](R ahead, R band) {
+    std::vector<std::pair<uint32_t, uint32_t>> out;
+    for (const R& r : wire::rows_beyond(ahead, band)) out.emplace_back(r.begin, r.end);
+    return out;
+  };
+  using V = std::vector<std::pair<uint32_t, uint32_t>>;
+  EXPECT_EQ(beyond({10, 20}, {10, 20}), V{}) << "the same rows: nothing left to render";
+  EXPECT_EQ(beyond({10, 20}, {12, 18}), V{}) << "the band shrank: nothing left";
+  EXPECT_EQ(beyond({10, 20}, {8, 20}), (V{{8, 10}}));
+  EXPECT_EQ(beyond({10, 20}, {10, 24}), (V{{20, 24}}));
+  EXPECT_EQ(beyond({10, 20}, {6, 26}), (V{{6, 10}, {20, 26}})) << "below and above";
+  EXPECT_EQ(beyond({10, 20}, {14, 28}), (V{{20, 28}}));
+  EXPECT_TRUE(wire::rows_overlap({10, 20}, {19, 30}));
+  EXPECT_FALSE(wire::rows_overlap({10, 20}, {20, 30}));
+  EXPECT_FALSE(wire::rows_overlap({10, 10}, {0, 30})) << "an empty range overlaps nothing";
 }
 
 TEST(WireCodec, HelloAndFailuresRoundTrip) {

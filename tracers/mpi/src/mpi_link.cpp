@@ -33,6 +33,7 @@ struct MpiSession::Impl {
     int destination;
     std::vector<uint8_t> bytes;  // empty for a send in place
     MPI_Request request;
+    const void* group = nullptr;  // a send in place: the buffer it lies in (MpiSession::flush_group)
   };
   std::list<Outgoing> sends;
   struct Incoming {
@@ -121,12 +122,16 @@ void MpiSession::finalize() {
     }
     std::this_thread::sleep_for(std::chrono::microseconds(100));
   }
-  for (auto& s : impl_->sends) MPI_Request_free(&s.request);
+  // (A request from a rank that was lost may already be null.)
+  auto release = [](MPI_Request& request) {
+    if (request != MPI_REQUEST_NULL) MPI_Request_free(&request);
+  };
+  for (auto& s : impl_->sends) release(s.request);
   impl_->sends.clear();
-  for (auto& [source, r] : impl_->receives) MPI_Request_free(&r.request);
+  for (auto& [source, r] : impl_->receives) release(r.request);
   impl_->receives.clear();
   for (auto& [source, list] : impl_->pieces)
-    for (auto& piece : list) MPI_Request_free(&piece.request);
+    for (auto& piece : list) release(piece.request);
   impl_->pieces.clear();
   MPI_Comm_free(&impl_->comm);
   int mpi_finalized = 0;
@@ -164,12 +169,12 @@ void MpiSession::send(int destination, std::vector<uint8_t> bytes) {
   }
 }
 
-void MpiSession::send_in_place(int destination, int tag, const void* data, size_t size) {
+void MpiSession::send_in_place(int destination, int tag, const void* data, size_t size, const void* group) {
   if (size > size_t(std::numeric_limits<int>::max()))
     throw std::runtime_error("MPI message of " + std::to_string(size) + " bytes is over the 2 GiB a send takes");
   std::lock_guard lock(mutex_);
   if (finalized_) throw std::runtime_error("MPI send after the session was finalized");
-  impl_->sends.push_back({destination, {}, MPI_REQUEST_NULL});
+  impl_->sends.push_back({destination, {}, MPI_REQUEST_NULL, group});
   Impl::Outgoing& out = impl_->sends.back();
   // MPI-3 takes a const buffer; the cast is for MPI-2 headers that still declare void*.
   if (MPI_Isend(const_cast<void*>(data), int(size), MPI_BYTE, destination, tag, impl_->comm, &out.request) !=
@@ -207,6 +212,25 @@ bool MpiSession::flush_sends(int destination, MpiClock::time_point deadline) {
         int done = 0;
         MPI_Test(&it->request, &done, MPI_STATUS_IGNORE);
         if (!done && (destination < 0 || it->destination == destination)) pending = true;
+        it = done ? impl_->sends.erase(it) : std::next(it);
+      }
+    }
+    if (!pending) return true;
+    if (MpiClock::now() >= deadline) return false;
+    std::this_thread::sleep_for(std::chrono::microseconds(50));
+  }
+}
+
+bool MpiSession::flush_group(const void* group, MpiClock::time_point deadline) {
+  for (;;) {
+    bool pending = false;
+    {
+      std::lock_guard lock(mutex_);
+      if (finalized_) return true;
+      for (auto it = impl_->sends.begin(); it != impl_->sends.end();) {
+        int done = 0;
+        MPI_Test(&it->request, &done, MPI_STATUS_IGNORE);
+        if (!done && it->group == group) pending = true;
         it = done ? impl_->sends.erase(it) : std::next(it);
       }
     }

@@ -7,6 +7,7 @@
 #include <condition_variable>
 #include <mutex>
 #include <csignal>
+#include <cstring>
 #include <exception>
 #include <functional>
 #include <optional>
@@ -61,7 +62,9 @@ class Node {
 
   int serve(MpiSession& mpi) {
     for (;;) {
+      const auto wait_start = MpiClock::now();
       std::optional<wire::Message> received = receive_from_rank0(mpi, options_.idle_timeout);
+      idle_ms_ += ms_since(wait_start);  // nothing to do meanwhile: waiting for rank 0
       if (!received) {
         spdlog::error("node {}: rank 0 was silent for {} s; leaving", mpi.rank(), options_.idle_timeout.count());
         return 1;
@@ -72,7 +75,8 @@ class Node {
         case wire::Kind::full_local: timed_commit(mpi, [&] { apply_full_local(m); }); break;
         case wire::Kind::band_job: render(mpi, m); break;
         case wire::Kind::shutdown:
-          spdlog::info("node {}: shutdown from rank 0 after {} band(s)", mpi.rank(), bands_);
+          spdlog::info("node {}: shutdown from rank 0 after {} band(s), {} of them on rows rendered ahead", mpi.rank(),
+                       bands_, adopted_);
           mpi.flush_sends(kRank0, MpiClock::now() + std::chrono::seconds(2));
           return 0;
         default:
@@ -143,7 +147,49 @@ class Node {
     diverged_ = true;
   }
 
+  struct Rendered {
+    std::vector<float> row_work;
+    double tracer_ms = 0.0;  // what the tracers measured themselves (summed over pieces; the slowest part's)
+    double mpi_ms = 0.0;     // in MPI calls moving the pieces sent, meanwhile
+  };
+
+  // A band's buffer: the node renders into one while the pieces of the band before may still be leaving
+  // the other (a job ahead is rendered while rank 0 has not yet taken the band before it). The token names
+  // the buffer's sends (MpiSession::flush_group) and stays with them if the buffer is retired.
+  struct BandSlot {
+    core::BandBuffer buffer;
+    std::unique_ptr<char> token = std::make_unique<char>();
+  };
+
+  // The next buffer, its last band's pieces gone (they have, unless rank 0 stopped reading: then a fresh
+  // buffer takes its place and the old one stays with its sends).
+  size_t take_slot(MpiSession& mpi, double& send_ms) {
+    const size_t index = next_slot_;
+    next_slot_ ^= 1;
+    const auto send_start = MpiClock::now();
+    if (!mpi.flush_group(slots_[index].token.get(), MpiClock::now() + std::chrono::seconds(2))) {
+      spdlog::warn("node {}: a band's rows have not left after 2 s; rendering into a new buffer", mpi.rank());
+      retired_.push_back(std::move(slots_[index]));
+      slots_[index] = BandSlot();
+    }
+    send_ms += ms_since(send_start);
+    return index;
+  }
+
+  // What a job ahead left for the band that adopts it.
+  struct Ahead {
+    uint64_t id = 0;
+    wire::BandRequest request;
+    size_t slot = 0;
+    wire::NodeTiming timing;
+    std::vector<float> row_work;
+    MpiClock::time_point start{};
+    MpiClock::time_point next_seen{};  // when a message from rank 0 (its job, normally) was first waiting
+  };
+
   void render(MpiSession& mpi, const wire::Message& m) {
+    const double idle = idle_ms_;
+    idle_ms_ = 0.0;
     wire::BandRequest request;
     try {
       request = wire::decode_band_request(m.payload);
@@ -152,109 +198,241 @@ class Node {
       send(mpi, wire::Kind::band_failed, m.sequence, wire::encode_band_failure({false, e.what()}));
       return;
     }
+    if (request.adopt != 0) {
+      adopt(mpi, m.sequence, request, idle);
+      return;
+    }
+    ahead_.reset();  // whatever was rendered ahead and not adopted is dropped
     if (diverged_) {
       send(mpi, wire::Kind::band_failed, m.sequence,
            wire::encode_band_failure({true, "the node's scene is behind: " + divergence_}));
       return;
     }
     const KFrameParams& p = request.job.params;
+    // The test faults strike once the band before has left (a job ahead of that frame comes while rank 0
+    // still receives it), so that they hit that frame, not the one before.
     if (int(p.frame_index) == options_.die_frame) {
+      mpi.flush_sends(kRank0, MpiClock::now() + std::chrono::seconds(2));
       spdlog::warn("node {}: killing itself before frame {} (--die-frame)", mpi.rank(), p.frame_index);
       std::raise(SIGKILL);
     }
     if (int(p.frame_index) == options_.stall_frame && !stalled_) {
+      mpi.flush_sends(kRank0, MpiClock::now() + std::chrono::seconds(2));
       stalled_ = true;
       spdlog::warn("node {}: stalling {} ms before frame {} (--stall-frame)", mpi.rank(), options_.stall_ms,
                    p.frame_index);
       std::this_thread::sleep_for(std::chrono::milliseconds(options_.stall_ms));
     }
     const auto start = MpiClock::now();
+    // A job ahead: the first message from rank 0 that waits meanwhile is, normally, the job that adopts it.
+    MpiClock::time_point next_seen{};
+    const std::function<void()> watch = [&] {
+      if (next_seen == MpiClock::time_point{} && mpi.control_waiting(kRank0)) next_seen = MpiClock::now();
+    };
     // A slow node's render, counted in its time.
-    if (options_.band_delay_ms > 0) std::this_thread::sleep_for(std::chrono::milliseconds(options_.band_delay_ms));
+    if (options_.band_delay_ms > 0)
+      run_while_sending(mpi, [&] { std::this_thread::sleep_for(std::chrono::milliseconds(options_.band_delay_ms)); },
+                        request.ahead ? watch : nullptr);
     wire::NodeTiming timing;
     timing.commit_ms = commit_ms_;
     timing.commit_ahead_ms = commit_ahead_ms_;
+    timing.idle_ms = idle;
     commit_ms_ = commit_ahead_ms_ = 0.0;
-    // The pieces of the last band are sent from target_ itself: before its rows are written again,
-    // they must have left (they have, unless rank 0 stopped reading: then this band goes to a fresh
-    // buffer, and the old one stays with its sends).
-    const auto send_start = MpiClock::now();
-    if (!mpi.flush_sends(kRank0, MpiClock::now() + std::chrono::seconds(2))) {
-      spdlog::warn("node {}: the last band's rows have not left after 2 s; rendering into a new buffer", mpi.rank());
-      retired_.push_back(std::move(target_));
-      target_ = core::BandBuffer();
-    }
-    timing.send_ms += ms_since(send_start);
-    target_.resize(int(request.job.camera.width), int(request.job.camera.height), request.format);
-    target_.enable_aux(request.aux);
-    // The band in pieces: each goes out, straight from target_ (page-locked by a CUDA tracer, which
+    const size_t slot = take_slot(mpi, timing.send_ms);
+    core::BandBuffer& target = slots_[slot].buffer;
+    target.resize(int(request.job.camera.width), int(request.job.camera.height), request.format);
+    target.enable_aux(request.aux);
+    // The band in pieces: each goes out, straight from its buffer (page-locked by a CUDA tracer, which
     // downloads into it), as soon as it is rendered, and travels while the next renders.
-    const uint32_t width = request.job.camera.width;
-    std::vector<int> cuts;
-    for (uint32_t i = 0; i < request.pieces; ++i)
-      cuts.push_back(int(wire::piece_rows(p.row_begin, p.row_end, request.pieces, i).begin));
-    cuts.push_back(int(p.row_end));
-    // Called on the rendering thread as each piece lands in target_.
-    auto post_piece = [&](size_t i) {
-      const auto post_start = MpiClock::now();
-      if (i == 0) timing.first_piece_ms = ms_since(start);
-      const uint32_t count = uint32_t(cuts[i + 1] - cuts[i]);
-      uint64_t colour_bytes = wire::piece_bytes(count, width, request.format, wire::Plane::colour);
-      if (i == 0 && int(p.frame_index) == options_.short_piece_frame && colour_bytes > 0) {
-        spdlog::warn("node {}: sending piece 0 of frame {} a byte short (--short-piece-frame)", mpi.rank(),
-                     p.frame_index);
-        --colour_bytes;
-      }
-      mpi.send_in_place(kRank0, wire::piece_tag(m.sequence, uint32_t(i), wire::Plane::colour), target_.row(cuts[i]),
-                        colour_bytes);
-      if (request.aux)
-        mpi.send_in_place(kRank0, wire::piece_tag(m.sequence, uint32_t(i), wire::Plane::aux), target_.aux_row(cuts[i]),
-                          wire::piece_bytes(count, width, request.format, wire::Plane::aux));
-      timing.send_ms += ms_since(post_start);
-    };
-    const auto render_start = MpiClock::now();
+    std::vector<wire::RowRange> pieces;
+    for (uint32_t i = 0; i < request.pieces; ++i) pieces.push_back(wire::piece_rows(p.row_begin, p.row_end, request.pieces, i));
     Rendered rendered;
     try {
-      rendered = render_while_sending(mpi, request.job, cuts, post_piece);
+      rendered = render_pieces(mpi, request, m.sequence, slot, pieces, start, timing, request.ahead ? watch : nullptr);
     } catch (const std::exception& e) {
       // Pieces already sent are this job's: rank 0 takes them, then this failure.
       send(mpi, wire::Kind::band_failed, m.sequence, wire::encode_band_failure({false, e.what()}));
       return;
     }
-    timing.render_ms = ms_since(render_start);
-    timing.send_ms += rendered.mpi_ms;
-    timing.device_ms = rendered.tracer_ms;
     wire::BandRows done;
     done.row_begin = p.row_begin;
     done.row_end = p.row_end;
-    done.width = width;
+    done.width = request.job.camera.width;
     done.format = request.format;
     done.pieces = request.pieces;
     done.aux = request.aux;
-    done.row_work = std::move(rendered.row_work);
+    done.row_work = rendered.row_work;
     timing.total_ms = ms_since(start);
     done.device_ms = timing.total_ms;
     done.timing = timing;
     send(mpi, wire::Kind::band_rows, m.sequence, wire::encode_band_rows(done));
     ++bands_;
+    if (request.ahead) ahead_ = Ahead{m.sequence, request, slot, timing, std::move(rendered.row_work), start, next_seen};
   }
 
-  struct Rendered {
-    std::vector<float> row_work;
-    double tracer_ms = 0.0;  // what the tracers measured themselves (summed over pieces; the slowest part's)
-    double mpi_ms = 0.0;     // in MPI calls moving the pieces sent, meanwhile
-  };
+  // The frame's job for the rows a job ahead rendered: its rows that the job ahead covered are taken as
+  // they are (their pieces went to rank 0 under the job ahead's id), the rest rendered now, in the same
+  // buffer, one piece per run of rows.
+  void adopt(MpiSession& mpi, uint64_t sequence, const wire::BandRequest& request, double idle) {
+    const auto taken = MpiClock::now();
+    auto fail = [&](const std::string& why) {
+      spdlog::warn("node {}: {}", mpi.rank(), why);
+      send(mpi, wire::Kind::band_failed, sequence, wire::encode_band_failure({false, why}));
+      ahead_.reset();
+    };
+    if (!ahead_ || ahead_->id != request.adopt) {
+      fail(fmt::format("band {} adopts the job ahead {}, which this node did not render", sequence, request.adopt));
+      return;
+    }
+    if (diverged_) {  // a commit after the job ahead was refused: rank 0 would not have adopted it
+      send(mpi, wire::Kind::band_failed, sequence,
+           wire::encode_band_failure({true, "the node's scene is behind: " + divergence_}));
+      ahead_.reset();
+      return;
+    }
+    const Ahead& a = *ahead_;
+    const KFrameParams& p = request.job.params;
+    KFrameParams same_rows = request.job.params;
+    same_rows.row_begin = a.request.job.params.row_begin;
+    same_rows.row_end = a.request.job.params.row_end;
+    if (std::memcmp(&same_rows, &a.request.job.params, sizeof same_rows) != 0 ||
+        std::memcmp(&request.job.camera, &a.request.job.camera, sizeof request.job.camera) != 0 ||
+        std::memcmp(&request.job.previous_camera, &a.request.job.previous_camera, sizeof request.job.camera) != 0 ||
+        request.format != a.request.format || request.aux != a.request.aux) {
+      fail(fmt::format("band {} adopts the job ahead {}, which rendered another frame or format", sequence, a.id));
+      return;
+    }
+    const wire::RowRange ahead_rows{a.request.job.params.row_begin, a.request.job.params.row_end};
+    const wire::RowRange band_rows{p.row_begin, p.row_end};
+    const std::vector<wire::RowRange> beyond = wire::rows_beyond(ahead_rows, band_rows);
+    if (!wire::rows_overlap(ahead_rows, band_rows) || request.pieces != beyond.size()) {
+      fail(fmt::format("band {} of rows [{}, {}) in {} piece(s) cannot adopt the job ahead of rows [{}, {})", sequence,
+                       p.row_begin, p.row_end, request.pieces, ahead_rows.begin, ahead_rows.end));
+      return;
+    }
+    wire::NodeTiming timing = a.timing;
+    timing.idle_ms += idle;
+    timing.commit_ms += commit_ms_;
+    timing.commit_ahead_ms += commit_ahead_ms_;
+    commit_ms_ = commit_ahead_ms_ = 0.0;
+    // Rendered before its job came: up to the moment it was seen waiting, else all of the job ahead.
+    timing.ahead_ms = a.next_seen != MpiClock::time_point{}
+                          ? std::chrono::duration<double, std::milli>(a.next_seen - a.start).count()
+                          : a.timing.total_ms;
+    wire::NodeTiming beyond_timing;
+    Rendered rendered;
+    try {
+      rendered = render_pieces(mpi, request, sequence, a.slot, beyond, taken, beyond_timing, nullptr);
+    } catch (const std::exception& e) {
+      fail(e.what());
+      return;
+    }
+    timing.render_ms += beyond_timing.render_ms;
+    timing.device_ms += beyond_timing.device_ms;
+    timing.send_ms += beyond_timing.send_ms;
+    timing.total_ms += ms_since(taken);
+    // The band's row work: the job ahead's where it covered the band, the rows beyond's elsewhere.
+    std::vector<float> work;
+    if (a.row_work.size() == ahead_rows.end - ahead_rows.begin && rendered.row_work.size() == beyond_rows(beyond)) {
+      size_t next_beyond = 0;
+      for (uint32_t y = band_rows.begin; y < band_rows.end; ++y)
+        work.push_back(y >= ahead_rows.begin && y < ahead_rows.end ? a.row_work[y - ahead_rows.begin]
+                                                                   : rendered.row_work[next_beyond++]);
+    }
+    wire::BandRows done;
+    done.row_begin = p.row_begin;
+    done.row_end = p.row_end;
+    done.width = request.job.camera.width;
+    done.format = request.format;
+    done.pieces = request.pieces;
+    done.aux = request.aux;
+    done.adopted = a.id;
+    done.row_work = std::move(work);
+    done.device_ms = timing.total_ms;
+    done.timing = timing;
+    ahead_.reset();
+    send(mpi, wire::Kind::band_rows, sequence, wire::encode_band_rows(done));
+    ++bands_;
+    ++adopted_;
+  }
+
+  static size_t beyond_rows(const std::vector<wire::RowRange>& ranges) {
+    size_t rows = 0;
+    for (const wire::RowRange& r : ranges) rows += r.end - r.begin;
+    return rows;
+  }
+
+  // Renders `pieces` (runs of rows, each sent as soon as it is in the slot's buffer, on job `sequence`'s
+  // tags) and adds where the time went to `timing`. Consecutive pieces render in one call (a GPU
+  // downloads each while the next renders); separate runs one after the other.
+  Rendered render_pieces(MpiSession& mpi, const wire::BandRequest& request, uint64_t sequence, size_t slot,
+                         const std::vector<wire::RowRange>& pieces, MpiClock::time_point start,
+                         wire::NodeTiming& timing, const std::function<void()>& watch) {
+    core::BandBuffer& target = slots_[slot].buffer;
+    const void* group = slots_[slot].token.get();
+    const uint32_t width = request.job.camera.width;
+    const KFrameParams& p = request.job.params;
+    Rendered total;
+    bool complete_work = true;
+    const auto render_start = MpiClock::now();
+    for (size_t first = 0; first < pieces.size();) {
+      size_t last = first + 1;
+      while (last < pieces.size() && pieces[last].begin == pieces[last - 1].end) ++last;
+      std::vector<int> cuts;
+      for (size_t i = first; i < last; ++i) cuts.push_back(int(pieces[i].begin));
+      cuts.push_back(int(pieces[last - 1].end));
+      core::BandJob run = request.job;
+      run.params.row_begin = pieces[first].begin;
+      run.params.row_end = pieces[last - 1].end;
+      // Called on the rendering thread as each piece lands in the buffer.
+      auto post_piece = [&, first](size_t local) {
+        const size_t i = first + local;
+        const auto post_start = MpiClock::now();
+        if (i == 0) timing.first_piece_ms = ms_since(start);
+        const uint32_t count = pieces[i].end - pieces[i].begin;
+        uint64_t colour_bytes = wire::piece_bytes(count, width, request.format, wire::Plane::colour);
+        if (i == 0 && int(p.frame_index) == options_.short_piece_frame && colour_bytes > 0 && !short_piece_sent_) {
+          short_piece_sent_ = true;
+          spdlog::warn("node {}: sending piece 0 of frame {} a byte short (--short-piece-frame)", mpi.rank(),
+                       p.frame_index);
+          --colour_bytes;
+        }
+        mpi.send_in_place(kRank0, wire::piece_tag(sequence, uint32_t(i), wire::Plane::colour),
+                          target.row(int(pieces[i].begin)), colour_bytes, group);
+        if (request.aux)
+          mpi.send_in_place(kRank0, wire::piece_tag(sequence, uint32_t(i), wire::Plane::aux),
+                            target.aux_row(int(pieces[i].begin)),
+                            wire::piece_bytes(count, width, request.format, wire::Plane::aux), group);
+        timing.send_ms += ms_since(post_start);
+      };
+      Rendered part = render_while_sending(mpi, run, target, cuts, post_piece, watch);
+      total.tracer_ms += part.tracer_ms;
+      total.mpi_ms += part.mpi_ms;
+      complete_work = complete_work && part.row_work.size() == size_t(run.params.row_end - run.params.row_begin);
+      if (complete_work) total.row_work.insert(total.row_work.end(), part.row_work.begin(), part.row_work.end());
+      first = last;
+    }
+    if (!complete_work) total.row_work.clear();
+    timing.render_ms += ms_since(render_start);
+    timing.send_ms += total.mpi_ms;
+    timing.device_ms += total.tracer_ms;
+    return total;
+  }
 
   // Renders the band's pieces on a thread of their own, `post_piece(i)` sending each as it lands, while
   // this thread keeps the sends going: a library may move a large message only inside MPI calls (with
   // naps, so as not to take a core from a CPU tracer). One tracer renders the pieces itself (a GPU
   // downloads each while the next renders); several split each piece by their speed.
-  Rendered render_while_sending(MpiSession& mpi, const core::BandJob& job, const std::vector<int>& cuts,
-                                const std::function<void(size_t)>& post_piece) {
+  Rendered render_while_sending(MpiSession& mpi, const core::BandJob& job, core::BandBuffer& target,
+                                const std::vector<int>& cuts, const std::function<void(size_t)>& post_piece,
+                                const std::function<void()>& watch) {
     Rendered rendered;
     rendered.mpi_ms = run_while_sending(mpi, [&] {
+      if (options_.row_delay_ms > 0.0)  // a slower node, in proportion to its rows (tests)
+        std::this_thread::sleep_for(std::chrono::duration<double, std::milli>(
+            options_.row_delay_ms * double(job.params.row_end - job.params.row_begin)));
       if (tracers_.size() == 1) {
-        core::BandResult result = tracers_.front()->render_band_in_pieces(job, target_, cuts, post_piece);
+        core::BandResult result = tracers_.front()->render_band_in_pieces(job, target, cuts, post_piece);
         rendered.tracer_ms = result.device_ms;
         rendered.row_work = std::move(result.row_work);
       } else {
@@ -264,7 +442,7 @@ class Node {
           piece.params.row_begin = uint32_t(cuts[i]);
           piece.params.row_end = uint32_t(cuts[i + 1]);
           double ms = 0.0;
-          std::vector<float> work = render_split(piece, ms);
+          std::vector<float> work = render_split(piece, target, ms);
           rendered.tracer_ms += ms;
           complete_work = complete_work && work.size() == size_t(cuts[i + 1] - cuts[i]);
           if (complete_work) rendered.row_work.insert(rendered.row_work.end(), work.begin(), work.end());
@@ -272,14 +450,16 @@ class Node {
         }
         if (!complete_work) rendered.row_work.clear();
       }
-    });
+    }, watch);
     return rendered;
   }
 
   // Runs `work` on a thread of its own while this thread keeps the sends going (with naps, so as not to
   // take a core from a CPU tracer); rethrows what it threw. Returns the time spent in MPI calls.
   // The work's end wakes this thread at once (band_rows follows it), not at its next nap's end.
-  static double run_while_sending(MpiSession& mpi, const std::function<void()>& work) {
+  // `watch`, when given, runs between the polls (without the session's lock).
+  static double run_while_sending(MpiSession& mpi, const std::function<void()>& work,
+                                  const std::function<void()>& watch = {}) {
     std::mutex mutex;
     std::condition_variable ended;
     bool finished = false;
@@ -300,6 +480,7 @@ class Node {
       lock.unlock();
       const auto call = MpiClock::now();
       const bool sending = mpi.progress_sends() > 0;
+      if (watch) watch();
       mpi_ms += ms_since(call);
       lock.lock();
       ended.wait_for(lock, std::chrono::microseconds(sending ? 30 : 60), [&] { return finished; });
@@ -313,7 +494,7 @@ class Node {
   // The band split among the node's tracers by their last speed, rendered in parallel; a tracer that
   // fails has its rows re-rendered by one that did not. Returns the per-row work when every part
   // reported it.
-  std::vector<float> render_split(const core::BandJob& job, double& tracer_ms) {
+  std::vector<float> render_split(const core::BandJob& job, core::BandBuffer& target, double& tracer_ms) {
     const uint32_t begin = job.params.row_begin, end = job.params.row_end, rows = end - begin;
     const size_t n = tracers_.size();
     // Shares in proportion to speed (the balancer module's Perfect division, in its 4-row units): the
@@ -333,7 +514,7 @@ class Node {
       part.params.row_end = to;
       const auto start = MpiClock::now();
       try {
-        results[i] = tracers_[i]->render_band(part, target_);
+        results[i] = tracers_[i]->render_band(part, target);
         errors[i].clear();
       } catch (const std::exception& e) {
         errors[i] = tracers_[i]->name() + ": " + e.what();
@@ -380,8 +561,13 @@ class Node {
   std::vector<std::unique_ptr<core::Tracer>> tracers_;
   NodeOptions options_;
   std::vector<double> rows_per_ms_;
-  core::BandBuffer target_;
-  std::vector<core::BandBuffer> retired_;  // band buffers whose pieces had not left (rank 0 stopped reading)
+  BandSlot slots_[2];
+  size_t next_slot_ = 0;
+  std::vector<BandSlot> retired_;  // band buffers whose pieces had not left (rank 0 stopped reading)
+  std::optional<Ahead> ahead_;     // the last job ahead, until a band adopts it or another job comes
+  double idle_ms_ = 0.0;           // waiting for rank 0 since the last band
+  bool short_piece_sent_ = false;
+  uint64_t adopted_ = 0;
   bool diverged_ = false;
   std::string divergence_;
   bool stalled_ = false;

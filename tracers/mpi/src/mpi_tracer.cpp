@@ -40,14 +40,19 @@ struct DropPieces : PieceSink {
   uint64_t bytes = 0;
 };
 
-// The pieces of the current band: each one checked against the band (its tag names this job, a piece
-// and plane that exist, its size that of its rows) and received straight into its rows of the target;
-// anything else is dropped, and a piece of this band that does not fit makes the band fail when its
-// band_rows comes.
+// The pieces of the current band: each one checked against the band (its tag names a job of this band,
+// a piece and plane it asked for, its size that of its rows) and received straight into its rows of the
+// target; anything else is dropped, and a piece of this band that does not fit makes the band fail when
+// its band_rows comes. A band that adopts a job ahead takes that job's pieces (its rows, over the
+// target's) and its own beyond them.
 class BandPieces : public PieceSink {
  public:
-  BandPieces(uint64_t job, uint32_t row_begin, uint32_t row_end, uint32_t pieces, core::BandBuffer& target)
-      : job_(job), row_begin_(row_begin), row_end_(row_end), pieces_(pieces), target_(target) {}
+  BandPieces(core::BandBuffer& target) : target_(target) {}
+  // Pieces of job `job` over `rows`, in order, named 0, 1, ... on their tags.
+  void expect(uint64_t job, const std::vector<wire::RowRange>& rows) {
+    for (uint32_t i = 0; i < rows.size(); ++i) expected_.push_back({job, i, uint32_t(rows.size()), rows[i]});
+    landed_.resize(expected_.size() * 2, false);
+  }
 
   void* place(int tag, size_t size) override {
     bytes += size;
@@ -58,43 +63,49 @@ class BandPieces : public PieceSink {
       refuse(fmt::format("a message on tag {}, which is neither the control tag nor a piece's", tag));
       return nullptr;
     }
-    if (!piece.of_job(job_)) {
-      ++stale;  // a piece of an earlier job's late answer
+    const bool ours = std::any_of(expected_.begin(), expected_.end(), [&](const Expected& e) { return piece.of_job(e.job); });
+    if (!ours) {
+      ++stale;  // a piece of an earlier job's late answer, or of a job ahead that was dropped
       return nullptr;
     }
     const bool aux = piece.plane == wire::Plane::aux;
-    if (piece.piece >= pieces_ || (aux && !target_.has_aux())) {
+    const auto found = std::find_if(expected_.begin(), expected_.end(),
+                                    [&](const Expected& e) { return piece.of_job(e.job) && piece.piece == e.piece; });
+    if (found == expected_.end() || (aux && !target_.has_aux())) {
       ++refused;
-      refuse(fmt::format("piece {} of {}{} was not asked for", piece.piece, pieces_, aux ? " (aux planes)" : ""));
+      refuse(fmt::format("piece {}{} was not asked for", piece.piece, aux ? " (aux planes)" : ""));
       return nullptr;
     }
-    const wire::RowRange rows = wire::piece_rows(row_begin_, row_end_, pieces_, piece.piece);
+    const wire::RowRange rows = found->rows;
     const uint64_t expected = wire::piece_bytes(rows.end - rows.begin, uint32_t(target_.width()), target_.format(),
                                                 piece.plane);
     if (size != expected) {
       ++refused;
-      refuse(fmt::format("piece {} of {} ({}rows [{}, {})) has {} bytes; they are {}", piece.piece, pieces_,
+      refuse(fmt::format("piece {} of {} ({}rows [{}, {})) has {} bytes; they are {}", piece.piece, found->of,
                          aux ? "aux texels of " : "", rows.begin, rows.end, size, expected));
       return nullptr;
     }
-    const uint64_t bit = uint64_t(1) << (piece.piece * 2 + uint32_t(piece.plane));
-    if (landed_ & bit) {
+    const size_t bit = size_t(found - expected_.begin()) * 2 + uint32_t(piece.plane);
+    if (landed_[bit]) {
       ++refused;
-      refuse(fmt::format("piece {} of {}{} came twice", piece.piece, pieces_, aux ? " (aux planes)" : ""));
+      refuse(fmt::format("piece {} of {}{} came twice", piece.piece, found->of, aux ? " (aux planes)" : ""));
       return nullptr;
     }
-    landed_ |= bit;
+    landed_[bit] = true;
     if (aux) return target_.aux_row(int(rows.begin));
     return target_.row(int(rows.begin));
   }
 
-  // Why the band's rows cannot be taken (a piece refused or missing), or empty.
-  std::string problem() const {
+  // Why the rows of job `job` cannot be taken (a piece refused, or one of its pieces missing), or empty.
+  std::string problem(uint64_t job) const {
     if (!problem_.empty()) return problem_;
-    for (uint32_t i = 0; i < pieces_; ++i)
+    for (size_t i = 0; i < expected_.size(); ++i) {
+      if (expected_[i].job != job) continue;
       for (uint32_t plane = 0; plane < (target_.has_aux() ? 2u : 1u); ++plane)
-        if (!(landed_ & (uint64_t(1) << (i * 2 + plane))))
-          return fmt::format("piece {} of {}{} never came", i, pieces_, plane == 1 ? " (aux planes)" : "");
+        if (!landed_[i * 2 + plane])
+          return fmt::format("piece {} of {}{} never came", expected_[i].piece, expected_[i].of,
+                             plane == 1 ? " (aux planes)" : "");
+    }
     return {};
   }
 
@@ -102,19 +113,45 @@ class BandPieces : public PieceSink {
   MpiClock::time_point first_matched{};
 
  private:
+  struct Expected {
+    uint64_t job;
+    uint32_t piece, of;
+    wire::RowRange rows;
+  };
   void refuse(std::string why) {
     if (problem_.empty()) problem_ = std::move(why);
   }
-  uint64_t job_;
-  uint32_t row_begin_, row_end_, pieces_;
   core::BandBuffer& target_;
-  uint64_t landed_ = 0;
+  std::vector<Expected> expected_;
+  std::vector<bool> landed_;
   std::string problem_;
 };
+
+std::vector<wire::RowRange> band_piece_rows(uint32_t row_begin, uint32_t row_end, uint32_t pieces) {
+  std::vector<wire::RowRange> rows;
+  for (uint32_t i = 0; i < pieces; ++i) rows.push_back(wire::piece_rows(row_begin, row_end, pieces, i));
+  return rows;
+}
 
 // Band job ids are unique over the run, so that a late answer to an earlier tracer's job is never
 // taken for the current one.
 std::atomic<uint64_t> next_band_job{1};
+
+// A new job id whose piece tags differ from those of `other` (a job ahead whose pieces are still coming).
+uint64_t new_band_job(uint64_t other = 0) {
+  for (;;) {
+    const uint64_t id = next_band_job++;
+    if (other == 0 || id % wire::kPieceJobSlots != other % wire::kPieceJobSlots) return id;
+  }
+}
+
+// Whether two jobs render the same frame: all but their rows (and where the core takes them from).
+bool same_frame(const core::BandJob& a, const core::BandJob& b) {
+  KFrameParams pa = a.params, pb = b.params;
+  pa.row_begin = pb.row_begin = pa.row_end = pb.row_end = 0;
+  return std::memcmp(&pa, &pb, sizeof pa) == 0 && std::memcmp(&a.camera, &b.camera, sizeof a.camera) == 0 &&
+         std::memcmp(&a.previous_camera, &b.previous_camera, sizeof a.previous_camera) == 0;
+}
 }  // namespace
 
 MpiTracer::MpiTracer(MpiTracerOptions options) : options_(options) {
@@ -221,6 +258,15 @@ MpiTracer::~MpiTracer() {
                  s.last_pieces, round_trip, node, s.total_node_render_ms / n, s.total_node_tracer_ms / n,
                  s.total_node_send_ms / n, s.total_node_first_piece_ms / n, s.total_first_piece_ms / n, round_trip - node,
                  s.total_node_commit_ms / n, s.total_node_commit_ahead_ms / n, s.commits_ahead);
+    // Jobs ahead: the node's time includes what it rendered before the band's job came (ahead_ms), so
+    // what lies beyond the node's time is the round trip less the part of it after the job came.
+    spdlog::info("mpi:{}: the node idled {:.2f} ms a band waiting for a job; jobs ahead: {} sent, {} adopted by their "
+                 "frame's band, {} dropped; {} row(s) rendered ahead for nothing, {} rendered after their job came "
+                 "beyond the rows adopted; the node rendered {:.2f} ms a band before the band's job came, so {:.2f} ms "
+                 "of the round trip lie beyond the node's time after it",
+                 options_.rank, s.total_node_idle_ms / n, s.jobs_ahead, s.adopted, s.dropped_ahead,
+                 s.rows_ahead_unused, s.rows_beyond_ahead, s.total_node_ahead_ms / n,
+                 round_trip - (node - s.total_node_ahead_ms / n));
   }
   // The node stays for later tracers of this run; the session's end tells every node to leave.
   try {
@@ -255,6 +301,7 @@ void MpiTracer::apply(const commit::CommitBuffer& commit) {
     if (node_needs_resync_)
       throw std::runtime_error(fmt::format("mpi:{}: {}; it needs a full resync", options_.rank, node_failure_));
     send(int(wire::Kind::commit), commit.frame(), wire::encode_commit(commit));
+    ++commits_sent_;
     return;
   }
   const commit::TracerScene& scene = *commit.full_scene();
@@ -269,6 +316,7 @@ void MpiTracer::apply(const commit::CommitBuffer& commit) {
     spdlog::info("mpi:{}: sending the whole scene (the node's own load differs or is gone)", options_.rank);
     send(int(wire::Kind::commit), commit.frame(), wire::encode_commit(commit));
   }
+  ++commits_sent_;
   node_needs_resync_ = false;
   after_full_resync_ = true;
   ++full_resyncs_sent_;
@@ -311,16 +359,70 @@ void MpiTracer::fail_timed_out(uint64_t id, MpiClock::time_point start, const co
                                        options_.rank, job.params.row_begin, job.params.row_end, ms_since(start)));
 }
 
+std::string MpiTracer::why_not_adopt(const JobAhead& ahead, const core::BandJob& job,
+                                     const core::BandBuffer& target) const {
+  if (ahead.request.job.params.frame_index != job.params.frame_index) return "it was for another frame";
+  if (!same_frame(ahead.request.job, job)) return "the frame's job differs from the one announced";
+  if (ahead.commits_at != commits_sent_) return "a commit went to the node after it";
+  if (ahead.request.format != target.format() || ahead.request.aux != target.has_aux() ||
+      ahead.request.job.camera.width != uint32_t(target.width()))
+    return "the band's format changed";
+  if (!wire::rows_overlap({ahead.request.job.params.row_begin, ahead.request.job.params.row_end},
+                          {job.params.row_begin, job.params.row_end}))
+    return "it has no rows in common with the band";
+  return {};
+}
+
+void MpiTracer::send_job_ahead(const core::BandJob& job, const core::BandBuffer& target) {
+  if (ahead_ || job.params.row_end <= job.params.row_begin) return;
+  const std::optional<core::BandJob> next = next_job_announced();
+  if (!next || next->params.frame_index == job.params.frame_index) return;
+  // What the core published before it announced the job belongs to that frame: it goes first.
+  apply_commits_ahead();
+  if (node_needs_resync_) return;
+  JobAhead ahead;
+  ahead.id = new_band_job();
+  ahead.request.job = *next;
+  ahead.request.job.keep_on_device = -1;
+  ahead.request.job.params.row_begin = job.params.row_begin;  // the balancer's rows come with the frame's job
+  ahead.request.job.params.row_end = job.params.row_end;
+  ahead.request.format = target.format();
+  ahead.request.aux = target.has_aux();
+  ahead.request.pieces = wire::band_pieces(job.params.row_end - job.params.row_begin, options_.pieces);
+  ahead.request.ahead = true;
+  ahead.commits_at = commits_sent_;
+  send(int(wire::Kind::band_job), ahead.id, wire::encode_band_request(ahead.request));
+  ahead_ = std::move(ahead);
+  std::lock_guard lock(stats_mutex_);
+  ++stats_.jobs_ahead;
+}
+
 core::BandResult MpiTracer::render_band(const core::BandJob& job, core::BandBuffer& target) {
   MpiSession& mpi = MpiSession::get();
+  // The job ahead sent during the last band: this band adopts it, or it is dropped (its answer, when it
+  // comes, is a stale one).
+  std::optional<JobAhead> ahead = std::move(ahead_);
+  ahead_.reset();
+  auto drop_ahead = [&](const std::string& why) {
+    if (!ahead) return;
+    spdlog::debug("mpi:{}: dropped the job ahead {} (rows [{}, {}) of frame {}): {}", options_.rank, ahead->id,
+                  ahead->request.job.params.row_begin, ahead->request.job.params.row_end,
+                  ahead->request.job.params.frame_index, why);
+    std::lock_guard lock(stats_mutex_);
+    ++stats_.dropped_ahead;
+    stats_.rows_ahead_unused += ahead->request.job.params.row_end - ahead->request.job.params.row_begin;
+    ahead.reset();
+  };
   if (timed_out_job_ != 0) {
     // A node that has not answered its last band yet (stalled, or gone) is not sent another: its band
     // fails at once, so it costs one late frame, not one per frame, and it is back when it answers.
     take_late_answers();
-    if (timed_out_job_ != 0)
+    if (timed_out_job_ != 0) {
+      drop_ahead("the node has not answered");
       throw std::runtime_error(fmt::format("mpi:{}: the node has not answered the band it was sent {:.0f} ms ago "
                                            "(stalled or gone); its rows go to the others", options_.rank,
                                            ms_since(timed_out_start_)));
+    }
   }
   if (job.params.row_end > uint32_t(target.height()) || job.params.row_begin > job.params.row_end ||
       job.camera.width != uint32_t(target.width()))
@@ -334,25 +436,62 @@ core::BandResult MpiTracer::render_band(const core::BandJob& job, core::BandBuff
                  job.params.frame_index);
   commits_ahead_of_band_ = false;
   band_frame_ = job.params.frame_index;
+  if (ahead) {
+    if (const std::string why = why_not_adopt(*ahead, job, target); !why.empty()) drop_ahead(why);
+  }
   const uint64_t resyncs_before = full_resyncs_sent_;
   const bool first_after_resync = after_full_resync_;
-  const uint64_t id = next_band_job++;
+  const uint64_t id = new_band_job(ahead ? ahead->id : 0);
   wire::BandRequest request;
   request.job = job;
   request.job.keep_on_device = -1;  // rank 0's GPUs are not the node's: the rows travel
   request.format = target.format();
   request.aux = target.has_aux();
-  request.pieces = wire::band_pieces(job.params.row_end - job.params.row_begin, options_.pieces);
+  // The rows travel as pieces, each received straight into its rows of the target. Adopting a job ahead,
+  // its pieces (over its rows) and then one piece per run of the band's rows beyond them.
+  BandPieces pieces(target);
+  if (ahead) {
+    const wire::RowRange ahead_rows{ahead->request.job.params.row_begin, ahead->request.job.params.row_end};
+    const std::vector<wire::RowRange> beyond = wire::rows_beyond(ahead_rows, {job.params.row_begin, job.params.row_end});
+    request.adopt = ahead->id;
+    request.pieces = uint32_t(beyond.size());
+    pieces.expect(ahead->id, band_piece_rows(ahead_rows.begin, ahead_rows.end, ahead->request.pieces));
+    pieces.expect(id, beyond);
+    std::lock_guard lock(stats_mutex_);
+    for (const wire::RowRange& r : beyond) stats_.rows_beyond_ahead += r.end - r.begin;
+    stats_.rows_ahead_unused += (ahead_rows.end - ahead_rows.begin) -
+                                (std::min(ahead_rows.end, job.params.row_end) - std::max(ahead_rows.begin, job.params.row_begin));
+  } else {
+    request.pieces = wire::band_pieces(job.params.row_end - job.params.row_begin, options_.pieces);
+    pieces.expect(id, band_piece_rows(job.params.row_begin, job.params.row_end, request.pieces));
+  }
   const auto start = MpiClock::now();
   send(int(wire::Kind::band_job), id, wire::encode_band_request(request));
   // From here on, what the core submits goes to the node behind this job (Tracer::apply_commits_ahead,
   // between polls): the node applies it once this band is rendered, while rank 0 waits for the frame.
+  // Once the core announces the next frame's job, that goes too (a job ahead, after its commits).
   in_band_ = true;
   struct LeaveBand {
-    bool& in_band;
-    ~LeaveBand() { in_band = false; }
-  } leave_band{in_band_};
-  const std::function<void()> between_polls = [this] { apply_commits_ahead(); };
+    MpiTracer& tracer;
+    uint64_t band;
+    bool done = false;
+    ~LeaveBand() {
+      tracer.in_band_ = false;
+      // A band that fails takes its job ahead with it (the node may have stalled, or failed under it).
+      if (!done && tracer.ahead_ && tracer.ahead_->sent_in_band == band) {
+        std::lock_guard lock(tracer.stats_mutex_);
+        ++tracer.stats_.dropped_ahead;
+        tracer.ahead_.reset();
+      }
+    }
+  } leave_band{*this, id};
+  const std::function<void()> between_polls = [&] {
+    apply_commits_ahead();
+    if (options_.jobs_ahead && !ahead_) {
+      send_job_ahead(job, target);
+      if (ahead_) ahead_->sent_in_band = id;
+    }
+  };
   double expected_ms;
   {
     std::lock_guard lock(stats_mutex_);
@@ -361,9 +500,6 @@ core::BandResult MpiTracer::render_band(const core::BandJob& job, core::BandBuff
   // The first band after a full resync also waits for the node to build its acceleration structures.
   const auto allowance = options_.band_timeout * (after_full_resync_ ? 10 : 1);
   const auto deadline = start + allowance + std::chrono::microseconds(int64_t(4000.0 * expected_ms));
-  // The rows arrive as pieces, each received straight into its rows of the target; band_rows closes
-  // the band once every piece has landed.
-  BandPieces pieces(id, job.params.row_begin, job.params.row_end, request.pieces, target);
   uint64_t counted_piece_bytes = 0;
   auto count_pieces = [&] {
     std::lock_guard lock(stats_mutex_);
@@ -373,6 +509,12 @@ core::BandResult MpiTracer::render_band(const core::BandJob& job, core::BandBuff
     counted_piece_bytes = pieces.bytes;
     pieces.refused = pieces.stale = 0;
   };
+  auto refuse = [&](const std::string& why) {
+    std::lock_guard lock(stats_mutex_);
+    ++stats_.refused_messages;
+    return std::runtime_error(fmt::format("mpi:{}: refused the band's rows: {}", options_.rank, why));
+  };
+  bool ahead_closed = false;  // the adopted job ahead's band_rows has come, its pieces in place
   for (;;) {
     std::optional<std::vector<uint8_t>> bytes = mpi.receive(options_.rank, deadline, &pieces, between_polls);
     count_pieces();
@@ -397,7 +539,8 @@ core::BandResult MpiTracer::render_band(const core::BandJob& job, core::BandBuff
       spdlog::warn("mpi:{}: ignored an unexpected {} message", options_.rank, wire::to_string(kind));
       continue;
     }
-    if (header.sequence != id) {  // the answer to a job that timed out before
+    const bool of_ahead = ahead && header.sequence == ahead->id && !ahead_closed;
+    if (header.sequence != id && !of_ahead) {  // the answer to a job that timed out before, or was dropped
       std::lock_guard lock(stats_mutex_);
       ++stats_.stale_answers;
       // A band that merely took longer than the timeout teaches the next deadline how long bands take.
@@ -420,37 +563,48 @@ core::BandResult MpiTracer::render_band(const core::BandJob& job, core::BandBuff
         node_failure_ = failure.reason;
         node_fingerprint_ = 0;  // whatever it loaded, send the whole scene next time
       }
+      if (of_ahead) {
+        // The node answers this band too (it has nothing to adopt): that answer is dropped when it comes.
+        throw std::runtime_error(fmt::format("mpi:{}: {} (rendering ahead)", options_.rank, failure.reason));
+      }
       throw std::runtime_error(fmt::format("mpi:{}: {}", options_.rank, failure.reason));
     }
     wire::BandRows rows;
     try {
       rows = wire::decode_band_rows(payload, payload_size);
     } catch (const wire::WireError& e) {
-      std::lock_guard lock(stats_mutex_);
-      ++stats_.refused_messages;
-      throw std::runtime_error(fmt::format("mpi:{}: refused the band's rows: {}", options_.rank, e.what()));
+      throw refuse(e.what());
     }
-    if (rows.row_begin != job.params.row_begin || rows.row_end != job.params.row_end ||
-        int(rows.width) != target.width() || rows.format != target.format() || rows.pieces != request.pieces ||
-        rows.aux != target.has_aux())
-      throw std::runtime_error(fmt::format("mpi:{}: refused the band's rows: rows [{}, {}) of {} {} pixels in {} "
-                                           "pieces{}, asked for [{}, {}) of {} {} in {}{}", options_.rank,
-                                           rows.row_begin, rows.row_end, rows.width, core::to_string(rows.format),
-                                           rows.pieces, rows.aux ? " with aux planes" : "", job.params.row_begin,
-                                           job.params.row_end, target.width(), core::to_string(target.format()),
-                                           request.pieces, target.has_aux() ? " with aux planes" : ""));
+    const wire::BandRequest& asked = of_ahead ? ahead->request : request;
+    if (rows.row_begin != asked.job.params.row_begin || rows.row_end != asked.job.params.row_end ||
+        int(rows.width) != target.width() || rows.format != target.format() || rows.pieces != asked.pieces ||
+        rows.aux != target.has_aux() || rows.adopted != asked.adopt)
+      throw refuse(fmt::format("rows [{}, {}) of {} {} pixels in {} pieces{}{}, asked for [{}, {}) of {} {} in {}{}{}",
+                               rows.row_begin, rows.row_end, rows.width, core::to_string(rows.format), rows.pieces,
+                               rows.aux ? " with aux planes" : "",
+                               rows.adopted ? fmt::format(" adopting job {}", rows.adopted) : "",
+                               asked.job.params.row_begin, asked.job.params.row_end, target.width(),
+                               core::to_string(target.format()), asked.pieces, target.has_aux() ? " with aux planes" : "",
+                               asked.adopt ? fmt::format(" adopting job {}", asked.adopt) : ""));
     // Every piece matched before band_rows has landed (MpiSession::receive); one that was refused or
     // never came leaves rows unwritten: the band fails and the Renderer re-renders them elsewhere.
-    if (const std::string problem = pieces.problem(); !problem.empty())
+    if (const std::string problem = pieces.problem(header.sequence); !problem.empty())  // counted as it was refused
       throw std::runtime_error(fmt::format("mpi:{}: refused the band's rows: {}", options_.rank, problem));
+    if (of_ahead) {
+      ahead_closed = true;
+      continue;
+    }
+    if (ahead && !ahead_closed) throw refuse(fmt::format("the band closed before the job ahead {} it adopts", ahead->id));
     const double round_trip = ms_since(start);
     if (full_resyncs_sent_ == resyncs_before) after_full_resync_ = false;  // not when one went ahead of the next band
+    leave_band.done = true;
     {
       std::lock_guard lock(stats_mutex_);
       ++stats_.bands;
+      if (ahead) ++stats_.adopted;
       stats_.last_round_trip_ms = round_trip;
       stats_.last_node_ms = rows.timing.total_ms;
-      stats_.last_pieces = request.pieces;
+      stats_.last_pieces = ahead ? ahead->request.pieces : request.pieces;
       stats_.last_band_bytes_sent = pending_sent_;
       stats_.last_band_bytes_received = pieces.bytes + bytes->size();
       pending_sent_ = 0;
@@ -470,12 +624,17 @@ core::BandResult MpiTracer::render_band(const core::BandJob& job, core::BandBuff
       stats_.total_node_commit_ms += rows.timing.commit_ms;
       stats_.total_node_commit_ahead_ms += rows.timing.commit_ahead_ms;
       stats_.total_node_first_piece_ms += rows.timing.first_piece_ms;
+      stats_.total_node_idle_ms += rows.timing.idle_ms;
+      stats_.total_node_ahead_ms += rows.timing.ahead_ms;
       stats_.total_first_piece_ms +=
           std::chrono::duration<double, std::milli>(pieces.first_matched - start).count();
     }
     core::BandResult result;
     result.device_ms = rows.device_ms;
     result.row_work = std::move(rows.row_work);
+    // Begun ahead of its job, the band cost the node its head start too: the balancer divides rows by the
+    // round trip as if the node had begun at the job, not by the shorter wait rank 0 saw.
+    if (ahead) result.balance_ms = round_trip + rows.timing.ahead_ms;
     return result;
   }
 }

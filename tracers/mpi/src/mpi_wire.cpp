@@ -396,6 +396,19 @@ commit::CommitBuffer decode_full_local(const std::vector<uint8_t>& payload,
   return c;
 }
 
+namespace {
+// A band travels in band_pieces of its rows; one that adopts a job ahead in one piece per run of rows
+// beyond it (none to two).
+void check_pieces(Reader& r, uint32_t pieces, uint32_t rows, bool adopts) {
+  if (adopts) {
+    if (pieces > kMaxBeyondPieces)
+      r.fail(fmt::format("{} pieces beyond the adopted rows (at most {})", pieces, kMaxBeyondPieces));
+  } else if (pieces != band_pieces(rows, pieces)) {
+    r.fail(fmt::format("{} pieces for a band of {} rows (1 to {}, at most one a row)", pieces, rows, kMaxPieces));
+  }
+}
+}  // namespace
+
 std::vector<uint8_t> encode_band_request(const BandRequest& request) {
   Writer w;
   w.scalar(uint32_t(sizeof(core::BandJob)));
@@ -403,6 +416,8 @@ std::vector<uint8_t> encode_band_request(const BandRequest& request) {
   w.scalar(uint32_t(request.format));
   w.scalar(uint32_t(request.aux ? 1 : 0));
   w.scalar(request.pieces);
+  w.scalar(uint32_t(request.ahead ? 1 : 0));
+  w.scalar(request.adopt);
   return std::move(w.out);
 }
 
@@ -419,17 +434,29 @@ BandRequest decode_band_request(const std::vector<uint8_t>& payload) {
   if (aux > 1) r.fail(fmt::format("aux flag {} is neither 0 nor 1", aux));
   q.aux = aux == 1;
   q.pieces = r.scalar<uint32_t>();
+  const uint32_t ahead = r.scalar<uint32_t>();
+  if (ahead > 1) r.fail(fmt::format("ahead flag {} is neither 0 nor 1", ahead));
+  q.ahead = ahead == 1;
+  q.adopt = r.scalar<uint64_t>();
   r.expect_end();
+  if (q.ahead && q.adopt != 0) r.fail(fmt::format("a job ahead cannot adopt another (job {})", q.adopt));
   const KFrameParams& p = q.job.params;
   if (q.job.camera.width == 0 || q.job.camera.height == 0 || q.job.camera.width > 65536 || q.job.camera.height > 65536)
     r.fail(fmt::format("camera size {}x{} is out of range", q.job.camera.width, q.job.camera.height));
   if (p.row_begin > p.row_end || p.row_end > q.job.camera.height)
     r.fail(fmt::format("rows [{}, {}) do not fit a frame of {} rows", p.row_begin, p.row_end, q.job.camera.height));
-  if (q.pieces != band_pieces(p.row_end - p.row_begin, q.pieces))
-    r.fail(fmt::format("{} pieces for a band of {} rows (1 to {}, at most one a row)", q.pieces, p.row_end - p.row_begin,
-                       kMaxPieces));
+  check_pieces(r, q.pieces, p.row_end - p.row_begin, q.adopt != 0);
   return q;
 }
+
+std::vector<RowRange> rows_beyond(RowRange ahead, RowRange band) {
+  std::vector<RowRange> beyond;
+  if (band.begin < std::min(ahead.begin, band.end)) beyond.push_back({band.begin, std::min(ahead.begin, band.end)});
+  if (std::max(ahead.end, band.begin) < band.end) beyond.push_back({std::max(ahead.end, band.begin), band.end});
+  return beyond;
+}
+
+bool rows_overlap(RowRange a, RowRange b) { return std::max(a.begin, b.begin) < std::min(a.end, b.end); }
 
 int piece_tag(uint64_t job, uint32_t piece, Plane plane) {
   return kPieceTagBase + int(((job % kPieceJobSlots) * kMaxPieces + piece % kMaxPieces) * 2 + uint32_t(plane));
@@ -466,6 +493,7 @@ std::vector<uint8_t> encode_band_rows(const BandRows& rows) {
   w.scalar(uint32_t(rows.format));
   w.scalar(rows.pieces);
   w.scalar(uint32_t(rows.aux ? 1 : 0));
+  w.scalar(rows.adopted);
   w.scalar(rows.device_ms);
   w.scalar(rows.timing);
   w.array(rows.row_work);
@@ -485,6 +513,7 @@ BandRows decode_band_rows(const uint8_t* payload, size_t size) {
   const uint32_t aux = r.scalar<uint32_t>();
   if (aux > 1) r.fail(fmt::format("aux flag {} is neither 0 nor 1", aux));
   b.aux = aux == 1;
+  b.adopted = r.scalar<uint64_t>();
   b.device_ms = r.scalar<double>();
   b.timing = r.scalar<NodeTiming>();
   b.row_work = r.array<float>("row work");
@@ -492,12 +521,12 @@ BandRows decode_band_rows(const uint8_t* payload, size_t size) {
   if (b.row_end < b.row_begin) r.fail(fmt::format("rows [{}, {}) end before they begin", b.row_begin, b.row_end));
   if (b.width == 0 || b.width > 65536) r.fail(fmt::format("width {} is out of range", b.width));
   const uint32_t rows = b.row_end - b.row_begin;
-  if (b.pieces != band_pieces(rows, b.pieces))
-    r.fail(fmt::format("{} pieces for a band of {} rows (1 to {}, at most one a row)", b.pieces, rows, kMaxPieces));
+  check_pieces(r, b.pieces, rows, b.adopted != 0);
   if (!b.row_work.empty() && b.row_work.size() != rows)
     r.fail(fmt::format("{} row work values for {} rows", b.row_work.size(), rows));
   const double times[] = {b.device_ms, b.timing.total_ms, b.timing.render_ms, b.timing.device_ms, b.timing.send_ms,
-                          b.timing.first_piece_ms, b.timing.commit_ms, b.timing.commit_ahead_ms};
+                          b.timing.first_piece_ms, b.timing.commit_ms, b.timing.commit_ahead_ms, b.timing.idle_ms,
+                          b.timing.ahead_ms};
   for (double t : times)
     if (!(t >= 0.0 && t < 1e9)) r.fail(fmt::format("time {} ms is not a duration", t));
   return b;

@@ -155,6 +155,8 @@ std::unique_ptr<core::Tracer> make_tracer(const TracerSpec& spec) {
       options.pieces = uint32_t(std::clamp(std::atol(pieces), 1L, long(wire::kMaxPieces)));
     if (const char* ahead = std::getenv("COHORT_MPI_COMMITS_AHEAD"); ahead && *ahead)
       options.commits_ahead = std::string(ahead) != "0";
+    if (const char* ahead = std::getenv("COHORT_MPI_JOBS_AHEAD"); ahead && *ahead)
+      options.jobs_ahead = std::string(ahead) != "0";
     return std::make_unique<MpiTracer>(options);
   }
 #endif

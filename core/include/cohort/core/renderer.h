@@ -23,6 +23,7 @@
 #include <cstdint>
 #include <functional>
 #include <memory>
+#include <mutex>
 #include <optional>
 #include <string>
 #include <vector>
@@ -96,6 +97,10 @@ class Renderer {
   // `out` must stay alive until merge_frame() returns; only merge_frame() writes it. Calls out of order
   // throw std::logic_error.
   void begin_frame(const BandJob& job, FrameBuffer& out, const std::vector<float>& row_cost_proxy = {});
+  // The job the next begin_frame() will hand out, known before the frame in flight is waited for (its
+  // commits submitted): tracers that take jobs ahead (Tracer::takes_jobs_ahead) may start on it while
+  // their band of the frame in flight ends. begin_frame() withdraws it. FramePipeline::push calls it.
+  void announce_frame(const BandJob& job);
   FrameStats wait_frame();
   void merge_frame(FrameStats& stats);
   FrameStats finish_frame();
@@ -179,6 +184,12 @@ class Renderer {
   std::shared_ptr<const commit::TracerScene> full_scene_;    // the latest full commit's scene
   bool records_since_full_ = false;
   uint64_t commit_frame_ = 0;                                // frame of the latest submitted commit
+  // The announced next job (announce_frame), shared with the tracers' hooks.
+  struct Announcement {
+    std::mutex mutex;
+    std::optional<BandJob> job;
+  };
+  std::shared_ptr<Announcement> announcement_ = std::make_shared<Announcement>();
   std::unique_ptr<PendingFrame> pending_;    // begun, not yet waited for
   std::unique_ptr<PendingFrame> unmerged_;   // waited for, bands not yet merged
   int next_slot_ = 0;

@@ -4,6 +4,7 @@
 
 #include <cstddef>
 #include <functional>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -34,6 +35,10 @@ struct BandResult {
   std::vector<float> row_work;
   // Set when the tracer kept its band on a GPU (BandJob::keep_on_device): the target's rows are stale.
   DeviceBand device;
+  // When > 0: what the band costs the tracer, for the balancer, in place of the wall time of its job (a
+  // tracer that began the band ahead of its job, Tracer::takes_jobs_ahead: its wall time leaves out the
+  // head start, and the balancer divides rows by speed).
+  double balance_ms = 0.0;
 };
 
 class Tracer {
@@ -74,13 +79,27 @@ class Tracer {
   // The Renderer's hook (set once, before the first job); without one apply_commits_ahead does nothing.
   void set_commits_ahead(CommitsAhead hook) { commits_ahead_ = std::move(hook); }
 
+  // Jobs ahead. The core knows the next frame's job (camera, parameters) before it waits for the frame
+  // in flight (FramePipeline::push announces it, its commits already submitted), but divides its rows
+  // only once every band is back. A tracer that can start on that frame before its job comes (a remote
+  // tracer: its node would otherwise idle while its band travels back and the core turns the frame
+  // around) says so here and may call next_job_announced() from inside render_band(): the announced
+  // job, with no rows, or nothing. Whatever it renders ahead is its own business and must not touch the
+  // target; the job it is handed next is what counts (its rows, and its commit, which may change the
+  // scene after the announcement).
+  virtual bool takes_jobs_ahead() const { return false; }
+  using NextJob = std::function<std::optional<BandJob>()>;
+  void set_next_job(NextJob hook) { next_job_ = std::move(hook); }
+
  protected:
   void apply_commits_ahead() {
     if (commits_ahead_) commits_ahead_();
   }
+  std::optional<BandJob> next_job_announced() const { return next_job_ ? next_job_() : std::nullopt; }
 
  private:
   CommitsAhead commits_ahead_;
+  NextJob next_job_;
 };
 
 }  // namespace cohort::core

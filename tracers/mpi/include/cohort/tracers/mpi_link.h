@@ -41,8 +41,11 @@ class MpiSession {
   // Queues `bytes` for `destination`; the session keeps them until the send has completed.
   void send(int destination, std::vector<uint8_t> bytes);
   // Sends `size` bytes from where they lie on `tag` (a band's piece, straight from the node's band
-  // buffer): they must stay valid and unchanged until flush_sends(destination) returns true.
-  void send_in_place(int destination, int tag, const void* data, size_t size);
+  // buffer): they must stay valid and unchanged until flush_sends(destination) or, for the sends of
+  // one `group` (the buffer they lie in), flush_group(group) returns true.
+  void send_in_place(int destination, int tag, const void* data, size_t size, const void* group = nullptr);
+  // Waits until every send of `group` has completed, at most until the deadline; false if some had not.
+  bool flush_group(const void* group, MpiClock::time_point deadline);
   // Progresses the queued sends; returns how many are still in flight.
   size_t progress_sends();
   // Waits until every queued send to `destination` (or all, with -1) has completed, at most until the

@@ -32,6 +32,9 @@ struct NodeOptions {
   // Tests: every band takes this much longer, counted in the node's time (a slow node: rank 0's next
   // commits are submitted while it renders, so they travel ahead of their job).
   int band_delay_ms = 0;
+  // Tests: every row rendered takes this much longer (a node whose time grows with its rows, so that
+  // rank 0's balancer moves rows between nodes of different speeds).
+  double row_delay_ms = 0.0;
   // Tests: before rendering the band of this frame index, the process kills itself (a lost node).
   int die_frame = -1;
   // Tests: piece 0 of this frame index's band goes out a byte short (a malformed piece).

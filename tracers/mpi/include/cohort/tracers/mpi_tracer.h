@@ -16,6 +16,7 @@
 #include <cstdint>
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <string>
 
 #include "cohort/core/tracer.h"
@@ -41,6 +42,11 @@ struct MpiTracerOptions {
   // (Tracer::takes_commits_ahead), so that the node applies them once its band is rendered, before the
   // next job comes, instead of with it. COHORT_MPI_COMMITS_AHEAD=0 turns it off (for comparison).
   bool commits_ahead = true;
+  // Send the next frame's job to the node as soon as the core announces it (Tracer::takes_jobs_ahead),
+  // with the rows of the band in flight, so that the node renders it right after that band instead of
+  // idling until the frame's job comes; that job then adopts the rows rendered ahead where they are its
+  // own (docs/cluster.md, "Jobs ahead"). COHORT_MPI_JOBS_AHEAD=0 turns it off (for comparison).
+  bool jobs_ahead = true;
 };
 
 // What crossed the wire for this tracer, for `cohort bench devices` and the logs.
@@ -72,6 +78,15 @@ struct MpiLinkStats {
   uint64_t commits_ahead = 0;  // commits forwarded while a band rendered, after its job
   double total_first_piece_ms = 0.0;
   double total_node_first_piece_ms = 0.0;  // on the node: job taken -> first piece posted
+  // Jobs ahead (protocol 7): sent, adopted by the frame's job, dropped (another frame came, a commit
+  // came between, no rows in common, or the band before failed); rows rendered ahead that the frame's
+  // job did not take; on the node, summed over the steady bands: its idle time waiting for a job, and of
+  // its time the part it rendered before the job came.
+  uint64_t jobs_ahead = 0, adopted = 0, dropped_ahead = 0;
+  uint64_t rows_ahead_unused = 0;
+  uint64_t rows_beyond_ahead = 0;  // rows of adopting bands that the job ahead had not covered (rendered after)
+  double total_node_idle_ms = 0.0;
+  double total_node_ahead_ms = 0.0;
   uint32_t last_pieces = 0;
   uint64_t stale_answers = 0;       // late answers to jobs that had timed out, dropped
   uint64_t refused_messages = 0;    // malformed answers, refused
@@ -89,6 +104,8 @@ class MpiTracer : public core::Tracer {
   bool renders_on_gpu() const override { return gpu_; }
   // Its apply() only sends the commit on; the node applies it after the band it renders.
   bool takes_commits_ahead() const override { return options_.commits_ahead; }
+  // It sends the announced next job to its node while its band renders (MpiTracerOptions::jobs_ahead).
+  bool takes_jobs_ahead() const override { return options_.jobs_ahead; }
   void apply(const commit::CommitBuffer& commit) override;
   using core::Tracer::render_band;
   core::BandResult render_band(const core::BandJob& job, core::BandBuffer& target) override;
@@ -106,6 +123,18 @@ class MpiTracer : public core::Tracer {
   // The answer to the current job has not come: its pieces already matched get a moment to land (they
   // write the target's rows), and the node is sent no band until it answers this one.
   [[noreturn]] void fail_timed_out(uint64_t id, MpiClock::time_point start, const core::BandJob& job);
+  // Between the polls of band `job`: once the core announces the next frame's job, sends it to the node
+  // as a job ahead with this band's rows (the commits published before it go first).
+  void send_job_ahead(const core::BandJob& job, const core::BandBuffer& target);
+  // A job sent ahead, until the next band adopts it or drops it.
+  struct JobAhead {
+    uint64_t id = 0;
+    wire::BandRequest request;
+    uint64_t commits_at = 0;  // commits_sent_ when it left: a commit after it changes the scene it saw
+    uint64_t sent_in_band = 0;
+  };
+  // Whether `job` into `target` may take the rows `ahead` rendered, or why not.
+  std::string why_not_adopt(const JobAhead& ahead, const core::BandJob& job, const core::BandBuffer& target) const;
 
   MpiTracerOptions options_;
   std::string description_;
@@ -119,6 +148,8 @@ class MpiTracer : public core::Tracer {
   bool in_band_ = false;             // inside render_band, its job sent: apply() is a commit ahead
   uint32_t band_frame_ = 0;          // the frame index of the last band sent
   bool commits_ahead_of_band_ = false;  // commits went ahead of the node since the last band's job
+  uint64_t commits_sent_ = 0;         // commits (and full resyncs) sent to the node so far
+  std::optional<JobAhead> ahead_;
   uint64_t timed_out_job_ = 0;
   MpiClock::time_point timed_out_start_{};
   std::string node_failure_;

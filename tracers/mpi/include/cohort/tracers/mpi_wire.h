@@ -21,8 +21,10 @@ constexpr uint32_t kMagic = 0x504d4843u;  // "CHMP" in memory order
 // 2: vertex colours in scenes and BLAS uploads; 3: BandJob::keep_on_device; 4: a band's rows travel in
 // pieces, raw, on tags of their own (band_job names the piece count, band_rows closes the band);
 // 5: KMaterial carries an environment cube (128 bytes); 6: NodeTiming tells commits applied before the
-// job came from those in its way (commits travel ahead of their job, docs/cluster.md).
-constexpr uint16_t kProtocolVersion = 6;
+// job came from those in its way (commits travel ahead of their job, docs/cluster.md); 7: jobs ahead
+// (band_job says whether it is one, or which one it takes the rows of; band_rows too; NodeTiming tells
+// the node's idle time and the time it rendered before the job came).
+constexpr uint16_t kProtocolVersion = 7;
 
 enum class Kind : uint16_t {
   hello = 1,        // node -> 0: versions, what scene it loaded, its tracers
@@ -124,11 +126,26 @@ RowRange piece_rows(uint32_t row_begin, uint32_t row_end, uint32_t pieces, uint3
 // more than its rows.
 uint32_t band_pieces(uint32_t rows, uint32_t wanted);
 
+// Jobs ahead (docs/cluster.md): rank 0 sends the next frame's job as soon as the core announces it,
+// with the rows of the band in flight (`ahead`), so that the node renders it right after that band;
+// the frame's real job then names it (`adopt`): the node takes its rows where they are the band's and
+// renders only the band's rows beyond them, each run of them in one piece (at most two: below and
+// above). No overlap, another frame or a commit in between: rank 0 adopts nothing, and the rows
+// rendered ahead are dropped.
+constexpr uint32_t kMaxBeyondPieces = 2;
+// The rows of `band` outside `ahead`, in order (empty when ahead covers band).
+std::vector<RowRange> rows_beyond(RowRange ahead, RowRange band);
+bool rows_overlap(RowRange a, RowRange b);
+
 struct BandRequest {
   core::BandJob job;
   core::BandFormat format = core::BandFormat::rgb16f;
   bool aux = false;  // send the auxiliary planes too (kernel/aux_outputs.h)
-  uint32_t pieces = 1;  // the rows travel in this many pieces (band_pieces of the band's rows)
+  // The rows travel in this many pieces (band_pieces of the band's rows); when adopting, one piece per
+  // run of rows_beyond (0 to kMaxBeyondPieces).
+  uint32_t pieces = 1;
+  bool ahead = false;  // a job ahead: render it after the band in flight; its rows are rank 0's guess
+  uint64_t adopt = 0;  // the job ahead whose rows this band takes (0: none)
 };
 std::vector<uint8_t> encode_band_request(const BandRequest& request);
 BandRequest decode_band_request(const std::vector<uint8_t>& payload);
@@ -147,16 +164,22 @@ struct NodeTiming {
   // trip's way, at most by their time), and those applied before it came (hidden while rank 0 waited).
   double commit_ms = 0.0;
   double commit_ahead_ms = 0.0;
+  // Protocol 7. The node waited this long with nothing to render before this band (its previous band
+  // was done, and neither this job nor a job ahead had come): what jobs ahead take away.
+  double idle_ms = 0.0;
+  // Of total_ms, the time it rendered the band (as a job ahead) before its job came.
+  double ahead_ms = 0.0;
 };
-static_assert(sizeof(NodeTiming) == 56, "NodeTiming travels as it lies: seven doubles");
+static_assert(sizeof(NodeTiming) == 72, "NodeTiming travels as it lies: nine doubles");
 
 // The band_rows message: the band is done. Its pieces went ahead on their own tags: `pieces` of colour
 // rows in the band format (6 bytes a pixel as rgb16f), and as many of aux texels when `aux`.
 struct BandRows {
   uint32_t row_begin = 0, row_end = 0, width = 0;
   core::BandFormat format = core::BandFormat::rgb16f;
-  uint32_t pieces = 1;
+  uint32_t pieces = 1;  // as in its band_job
   bool aux = false;
+  uint64_t adopted = 0;  // the job ahead whose rows it took (BandRequest::adopt)
   double device_ms = 0.0;  // the node's time for the band, as the balancer takes it
   NodeTiming timing;
   std::vector<float> row_work;
