@@ -36,8 +36,9 @@ struct MpiTracerOptions {
   // A band's rows travel in this many pieces (fewer when it has fewer rows; at most wire::kMaxPieces):
   // the node sends each as soon as it is on its host while it renders the next, and this tracer
   // receives each straight into its target rows, so the round trip is the node's render plus one
-  // piece's way back instead of the whole band's.
-  uint32_t pieces = 4;
+  // piece's way back instead of the whole band's. With jobs ahead (below) that way back is off the node's
+  // path and only the last piece's download is on it: 2 measured best then (docs/cluster.md).
+  uint32_t pieces = 2;
   // Forward the commits the core submits while a band renders right after that band's job
   // (Tracer::takes_commits_ahead), so that the node applies them once its band is rendered, before the
   // next job comes, instead of with it. COHORT_MPI_COMMITS_AHEAD=0 turns it off (for comparison).
