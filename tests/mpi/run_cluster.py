@@ -183,8 +183,13 @@ def replay(a):
     compare_frames(single, cluster)
     outcomes = tracer_outcomes(cluster)
     print("outcomes per frame:", outcomes)
-    if any(o.get("mpi:1") != "rendered" or o.get("mpi:2") != "rendered" for o in outcomes):
+    # A frame may leave a node out ("no_rows": the balancer found the frame faster without it, which a loaded
+    # machine can make so); a failed band may not, and each node must render frames after the first, so that
+    # the scenario's commits reached it.
+    if any(o.get(t) not in ("rendered", "no_rows") for o in outcomes for t in ("mpi:1", "mpi:2")):
         sys.exit("a remote tracer failed a band of the scenario")
+    if any(sum(o.get(t) == "rendered" for o in outcomes[1:]) < 2 for t in ("mpi:1", "mpi:2")):
+        sys.exit("a remote tracer rendered fewer than 2 of the scenario's frames after the first")
     if "sending the whole scene" in output:
         sys.exit("the nodes loaded the same map: the first resync should not have sent the whole scene")
     print("replay: ok")
