@@ -190,6 +190,8 @@ int run_render(const RenderArgs& a) {
     post_options.reproject = reproject;
     post_options.atrous = atrous;
     if (a.anti_lag >= 0.0f) post_options.reprojection.anti_lag_sigma = a.anti_lag;
+    // Sparse-path frames keep centre rays (one fixed ray a pixel), whatever --aux-rays says.
+    post_options.reprojection.jittered_planes = aux_mode == K_AUX_PATH_FIRST_HIT && !sparse;
     post_options.atrous_options.passes =
         a.atrous_passes > 0 ? a.atrous_passes : core::atrous_passes_for_height(render_height);
     core::AtrousOptions& ao = post_options.atrous_options;
