@@ -465,7 +465,8 @@ void add_render_command(CLI::App& app, int& exit_code) {
                   "where the G-buffer for reprojection and denoising comes from: centre (a ray of its own through "
                   "each pixel's centre: steady planes) or first-hit (the first sample's own first surface: no "
                   "extra ray, about 0.8 ms less a 1080p frame on an H100, but the planes jitter as the samples "
-                  "do, so silhouettes keep less history; frames with sparse paths keep centre rays; "
+                  "do; the reprojection then keeps silhouettes' history from the neighbours' surfaces; frames with "
+                  "sparse paths keep centre rays; "
                   "docs/denoising.md)")
       ->capture_default_str()
       ->check(CLI::IsMember(core::aux_rays_names()));
