@@ -172,7 +172,8 @@ KFN int k_reproject_tap_matches(const KReprojectParams* p, const KReprojectHisto
  * surface carry less than K_REPROJECT_FOOTPRINT_SHARE of the bilinear weight: with a moving camera, a pixel wholly
  * on one surface next to an edge has taps of the other surface too, and taking them would blur the edge.
  * Measured on the test map's scenario (docs/denoising.md, "Silhouettes with first hits"): motion 0.1, 0.25,
- * 0.5, 1 px and share 0.25, 0.5, 0.75, 1.01 tried; 0.25 px and 0.5 best on the door and the doorway. */
+ * 0.5, 1 px and shares 0.25, 0.5, 0.75 and any (every failed tap) tried; 0.25 px and 0.5 did best on the door
+ * and the doorway. */
 #define K_REPROJECT_FOOTPRINT_MOTION 0.25f
 #define K_REPROJECT_FOOTPRINT_SHARE 0.5f
 KFN int k_reproject_footprint_tap(const KReprojectParams* p, const KReprojectFresh* fresh,
