@@ -405,7 +405,7 @@ void add_play_command(CLI::App& app, int& exit_code) {
   cmd->add_option("--aux-rays", a->session.aux_rays,
                   "where the G-buffer for reprojection comes from: centre (a ray of its own through each pixel's "
                   "centre) or first-hit (the first sample's own first surface: no extra ray, about 0.8 ms less a "
-                  "1080p frame on an H100, noisier at silhouettes); see `cohort render --help`")
+                  "1080p frame on an H100; the planes jitter at silhouettes); see `cohort render --help`")
       ->capture_default_str()
       ->check(CLI::IsMember(core::aux_rays_names()));
   cmd->add_option("--denoise", a->session.denoise,

@@ -190,6 +190,8 @@ int run_render(const RenderArgs& a) {
     post_options.reproject = reproject;
     post_options.atrous = atrous;
     if (a.anti_lag >= 0.0f) post_options.reprojection.anti_lag_sigma = a.anti_lag;
+    // Sparse-path frames keep centre rays (one fixed ray a pixel), whatever --aux-rays says.
+    post_options.reprojection.jittered_planes = aux_mode == K_AUX_PATH_FIRST_HIT && !sparse;
     post_options.atrous_options.passes =
         a.atrous_passes > 0 ? a.atrous_passes : core::atrous_passes_for_height(render_height);
     core::AtrousOptions& ao = post_options.atrous_options;
@@ -463,7 +465,8 @@ void add_render_command(CLI::App& app, int& exit_code) {
                   "where the G-buffer for reprojection and denoising comes from: centre (a ray of its own through "
                   "each pixel's centre: steady planes) or first-hit (the first sample's own first surface: no "
                   "extra ray, about 0.8 ms less a 1080p frame on an H100, but the planes jitter as the samples "
-                  "do, so silhouettes keep less history; frames with sparse paths keep centre rays; "
+                  "do; the reprojection then keeps silhouettes' history from the neighbours' surfaces; frames with "
+                  "sparse paths keep centre rays; "
                   "docs/denoising.md)")
       ->capture_default_str()
       ->check(CLI::IsMember(core::aux_rays_names()));

@@ -125,6 +125,8 @@ PlaySession::PlaySession(const SessionOptions& options) {
     throw std::invalid_argument("--denoise '" + options.denoise + "': choose auto, atrous or none");
   post_options.atrous = options.denoise == "atrous" || (options.denoise == "auto" && s.post_place != "host");
   post_options.atrous_options.passes = core::atrous_passes_for_height(options.window_height);
+  // (Frames with sparse paths keep centre rays, on which these taps only blur silhouettes a little.)
+  post_options.reprojection.jittered_planes = s.aux_mode == K_AUX_PATH_FIRST_HIT;
   s.denoising = post_options.atrous;
   s.reprojection = tracers::make_frame_post(s.post_place, core::with_history_moments(post_options));
 

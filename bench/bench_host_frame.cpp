@@ -11,6 +11,9 @@
 //
 //   bench_host_frame [--width 1920] [--height 1080] [--frames 40] [--json FILE]   (out/bench_host_frame.json)
 //                    [--anti-lag SIGMA]   (the reprojection's; 0 turns it off, default ReprojectionOptions')
+//                    [--jittered-edges 0|1|2]  (every pixel a silhouette whose surface flips each frame, as
+//                    first-hit planes at an edge: a checkerboard of two surfaces inverted every frame; 1 with
+//                    ReprojectionOptions::jittered_planes off, 2 on: the footprint taps' worst case)
 #include <algorithm>
 #include <cstdio>
 #include <filesystem>
@@ -36,6 +39,7 @@ using namespace cohort::core;
 namespace {
 
 float anti_lag_sigma = -1.0f;  // --anti-lag; < 0: the default of ReprojectionOptions
+int jittered_edges = 0;        // --jittered-edges
 
 double stage_ms(const FrameStats& stats, const std::string& stage) {
   double ms = 0.0;
@@ -61,6 +65,7 @@ nlohmann::json run(BandFormat format, int width, int height, int frames) {
   ToneMapOptions tone_options;
   ReprojectionOptions reprojection_options;
   if (anti_lag_sigma >= 0.0f) reprojection_options.anti_lag_sigma = anti_lag_sigma;
+  reprojection_options.jittered_planes = jittered_edges == 2;
   TemporalReprojection reprojection(reprojection_options);
   ReprojectionOptions moment_options = reprojection_options;
   moment_options.luminance_moments = true;
@@ -82,6 +87,14 @@ nlohmann::json run(BandFormat format, int width, int height, int frames) {
   }
   std::vector<double> merge, blend, tone, reproject, denoise, reproject_moments, guided_ms, spatial_ms;
   auto finish = [&](FramePipeline::Delivered done) {
+    if (jittered_edges > 0)
+      for (int y = 0; y < height; ++y)
+        for (int x = 0; x < width; ++x) {
+          const size_t p = static_cast<size_t>(y) * static_cast<size_t>(width) + static_cast<size_t>(x);
+          const bool near = ((x + y + static_cast<int>(done.stats.frame)) & 1) != 0;
+          moving.id[p] = near ? 1u : 0u;
+          moving.depth[p] = moving.prev_depth[p] = near ? 50.0f : 100.0f;
+        }
     ScopedStage blending(done.stats.stages, kCoreTrack, "convergence");
     convergence.accumulate(done.job.camera, pipeline.image());
     blending.finish();
@@ -142,6 +155,7 @@ int main(int argc, char** argv) {
     else if (arg == "--frames") frames = std::max(6, std::stoi(argv[i + 1]));
     else if (arg == "--json") json_path = argv[i + 1];
     else if (arg == "--anti-lag") anti_lag_sigma = std::stof(argv[i + 1]);
+    else if (arg == "--jittered-edges") jittered_edges = std::clamp(std::stoi(argv[i + 1]), 0, 2);
     else {
       std::fprintf(stderr, "bench_host_frame: unknown option %s\n", arg.c_str());
       return 2;

@@ -59,6 +59,7 @@ void TemporalReprojection::accumulate(const FrameBuffer& fresh, const GBuffer& g
   params.still_motion = o.still_motion;
   params.anti_lag_sigma = o.anti_lag_sigma;
   params.anti_lag_relative = o.anti_lag_relative;
+  params.footprint_taps = o.jittered_planes ? 1 : 0;
 
   ycocgw_.resize(4 * pixels);
   const KReprojectFresh fresh_planes{fresh.rgba.data(), ycocgw_.data(),     gbuffer.depth.data(), gbuffer.prev_depth.data(),

@@ -69,9 +69,11 @@ struct RegionMean {
 TEST(ReprojectionGhosting, TheDoorLeavesNoTrailAndKeepsItsColourAfterFourStillFrames) {
   for (const float behind_depth : {30.0f, 10.5f})
   for (const bool moments : {false, true})
-  for (const bool anti_lag : {false, true}) {
+  for (const bool anti_lag : {false, true})
+  for (const bool jittered_planes : {false, true}) {  // the footprint taps must not let the door into the doorway
     ReprojectionOptions o;
     o.luminance_moments = moments;
+    o.jittered_planes = jittered_planes;
     if (!anti_lag) o.anti_lag_sigma = 0.0f;
     TemporalReprojection r(o);
     std::mt19937 rng(5);
@@ -96,7 +98,8 @@ TEST(ReprojectionGhosting, TheDoorLeavesNoTrailAndKeepsItsColourAfterFourStillFr
           if (s == Surface::wall && (wx < kDoorX0 - 1 || wx > kDoorX1) && x < kW - 1) wall.sum += v, ++wall.count;
         }
       SCOPED_TRACE(testing::Message() << "frame " << frame << ", behind the door at depth " << behind_depth
-                                      << (moments ? ", with moments" : "") << (anti_lag ? ", anti-lag" : ""));
+                                      << (moments ? ", with moments" : "") << (anti_lag ? ", anti-lag" : "")
+                                      << (jittered_planes ? ", jittered planes" : ""));
       if (frame > 0) {
         ASSERT_GT(uncovered.count, 0);
         // A ghost: any share of the door's history (100x brighter) in the far room shows at once.

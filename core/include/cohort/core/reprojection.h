@@ -13,6 +13,9 @@
 // to catch). Blend: C = H + (S - H) / n, n the
 // history length (capped at max_history). Samples that are not finite (NaN, Inf) never enter the
 // history: the pixel keeps its history (or shows its neighbourhood's mean when it has none).
+// With jittered_planes (a G-buffer from each pixel's jittered sample, whose surface flips frame to frame at
+// silhouettes), a tap of another surface also counts where that surface is still in the pixel's 3x3
+// neighbourhood, moved with it, and the pixel's own surface has under half the bilinear weight.
 // With luminance_moments, the history also keeps the first and second moments of the illumination's
 // luminance (colour over albedo), blended like the colour, for the a-trous filter's variance guide.
 // The per-pixel arithmetic is the portable kernel's (kernel/reproject.h); this class runs it on the host's
@@ -39,6 +42,9 @@ struct ReprojectionOptions {
   float anti_lag_sigma = 0.75f;
   float anti_lag_relative = 0.0f;
   bool luminance_moments = false; // also keep M1, M2 of the illumination's luminance (SVGF's variance)
+  // The G-buffer comes from each pixel's jittered sample (--aux-rays first-hit): at a silhouette, history
+  // taps of the other surface the pixel covers count too (kernel/reproject.h's k_reproject_footprint_tap).
+  bool jittered_planes = false;
 };
 
 class TemporalReprojection {

@@ -12,7 +12,14 @@
  * With `moments` set, the history also keeps the first and second moments of the illumination's luminance
  * (kernel/illumination.h; two floats a pixel), fetched through the same taps and blended with the same
  * weight as the colour, so that M2 - M1^2 is the pixel's temporal variance (SVGF, Schied et al. 2017; the
- * a-trous filter's luminance stop, kernel/svgf.h). Non-finite samples never enter them either. */
+ * a-trous filter's luminance stop, kernel/svgf.h). Non-finite samples never enter them either.
+ *
+ * With `footprint_taps` set (planes from each pixel's jittered first hit, K_AUX_PATH_FIRST_HIT), a silhouette
+ * pixel's sample lands on the near surface one frame and on the far one the next, so its id, depth and normal
+ * flip from frame to frame and the same-surface test alone would restart its history at every flip: those
+ * pixels would stay at about one sample. Centre rays do not flip (one fixed ray a pixel), and there every
+ * sample of the pixel, whichever surface it met, enters one history: the pixel converges to the mix of the
+ * surfaces its footprint covers. k_reproject_footprint_tap keeps that: see there. */
 #ifndef COHORT_KERNEL_REPROJECT_H
 #define COHORT_KERNEL_REPROJECT_H
 #include "illumination.h"
@@ -29,7 +36,8 @@ typedef struct KReprojectParams {
   float anti_lag_sigma;   /* moving pixels: history luma off the fresh 5x5 mean by more than this many standard
                              errors (plus anti_lag_relative of the mean) is stale lighting; 0: off */
   float anti_lag_relative;
-  float pad3;
+  kint footprint_taps;    /* 1: the planes come from each pixel's jittered sample (K_AUX_PATH_FIRST_HIT): history
+                             taps of another surface that still lies in the pixel's footprint count too */
 } KReprojectParams;
 
 /* The fresh planes of one frame. */
@@ -146,6 +154,46 @@ KFN float k_reproject_anti_lag(const KReprojectParams* p, const KReprojectFresh*
   return difference > bound ? bound / difference : 1.0f;
 }
 
+/* A history tap saw the surface (id, depth in the previous camera, normal) given: does it match? Misses match
+ * misses by id alone. */
+KFN int k_reproject_tap_matches(const KReprojectParams* p, const KReprojectHistory* history, kint q, kuint id,
+                                float expected_depth, KVec3 n) {
+  if (history->id[q] != id) return 0;
+  if (id == 0xFFFFFFFFu) return 1;
+  if (k_fabs(history->depth[q] - expected_depth) > p->depth_tolerance * k_fmax(expected_depth, 1e-3f)) return 0;
+  return v3_dot(n, v3_load_g(history->normal + 3 * q)) >= p->normal_cos;
+}
+
+/* footprint_taps: a tap may count although it saw another surface than this frame's sample where that surface
+ * is still inside the pixel's footprint: one of the 8 fresh neighbours saw it (same id, the tap's depth at that
+ * neighbour's previous depth, same orientation) and moved with this pixel (motion vectors within
+ * K_REPROJECT_FOOTPRINT_MOTION pixels). The motion test keeps the door's history out of the doorway it uncovers:
+ * there the door's neighbours moved and the uncovered pixel did not. Only where the taps of this sample's own
+ * surface carry less than K_REPROJECT_FOOTPRINT_SHARE of the bilinear weight: with a moving camera, a pixel wholly
+ * on one surface next to an edge has taps of the other surface too, and taking them would blur the edge.
+ * Measured on the test map's scenario (docs/denoising.md, "Silhouettes with first hits"): motion 0.1, 0.25,
+ * 0.5, 1 px and shares 0.25, 0.5, 0.75 and any (every failed tap) tried; 0.25 px and 0.5 did best on the door
+ * and the doorway. */
+#define K_REPROJECT_FOOTPRINT_MOTION 0.25f
+#define K_REPROJECT_FOOTPRINT_SHARE 0.5f
+KFN int k_reproject_footprint_tap(const KReprojectParams* p, const KReprojectFresh* fresh,
+                                  const KReprojectHistory* history, kint q, kint x, kint y, float mx, float my) {
+  for (kint dy = -1; dy <= 1; ++dy) {
+    kint ny = y + dy;
+    if (ny < 0 || ny >= p->height) continue;
+    for (kint dx = -1; dx <= 1; ++dx) {
+      kint nx = x + dx;
+      if ((dx == 0 && dy == 0) || nx < 0 || nx >= p->width) continue;
+      kint f = ny * p->width + nx;
+      float ex = fresh->motion[2 * f] - mx, ey = fresh->motion[2 * f + 1] - my;
+      if (ex * ex + ey * ey > K_REPROJECT_FOOTPRINT_MOTION * K_REPROJECT_FOOTPRINT_MOTION) continue;
+      if (k_reproject_tap_matches(p, history, q, fresh->id[f], fresh->prev_depth[f], v3_load_g(fresh->normal + 3 * f)))
+        return 1;
+    }
+  }
+  return 0;
+}
+
 KFN void k_reproject_pixel(const KReprojectParams* p, const KReprojectFresh* fresh, const KReprojectHistory* history,
                            const KReprojectState* next, kint x, kint y) {
   kint pix = y * p->width + x;
@@ -170,22 +218,31 @@ KFN void k_reproject_pixel(const KReprojectParams* p, const KReprojectFresh* fre
     float expected_depth = fresh->prev_depth[pix];
     KVec3 n = v3_load_g(fresh->normal + 3 * pix);
     float weight_sum = 0.0f, length_sum = 0.0f;
-    for (int t = 0; t < 4; ++t) {
-      kint tx = x0 + (t & 1), ty = y0 + (t >> 1);
-      float w = ((t & 1) ? wx : 1.0f - wx) * ((t >> 1) ? wy : 1.0f - wy);
-      if (w <= 0.0f || tx < 0 || ty < 0 || tx >= p->width || ty >= p->height) continue;
-      kint q = ty * p->width + tx;
-      if (history->id[q] != id || !(history->length[q] > 0.0f)) continue;
-      if (id != 0xFFFFFFFFu) { /* a surface: same depth and orientation as the history's */
-        if (k_fabs(history->depth[q] - expected_depth) > p->depth_tolerance * k_fmax(expected_depth, 1e-3f)) continue;
-        if (v3_dot(n, v3_load_g(history->normal + 3 * q)) < p->normal_cos) continue;
-      }
-      h = v3_madd(h, v3_load_g(history->rgba + 4 * q), w);
-      length_sum += w * history->length[q];
-      weight_sum += w;
-      if (p->moments) {
-        h1 += w * history->moments[2 * q];
-        h2 += w * history->moments[2 * q + 1];
+    int other_surface = 0; /* bit t: tap t holds history of another surface than this sample's */
+    /* Pass 0: the taps that saw this sample's surface; pass 1 (footprint_taps, above): others in its footprint. */
+    for (int pass = 0; pass < 2; ++pass) {
+      if (pass == 1 && !(p->footprint_taps && other_surface && weight_sum < K_REPROJECT_FOOTPRINT_SHARE)) break;
+      for (int t = 0; t < 4; ++t) {
+        kint tx = x0 + (t & 1), ty = y0 + (t >> 1);
+        float w = ((t & 1) ? wx : 1.0f - wx) * ((t >> 1) ? wy : 1.0f - wy);
+        if (w <= 0.0f || tx < 0 || ty < 0 || tx >= p->width || ty >= p->height) continue;
+        kint q = ty * p->width + tx;
+        if (!(history->length[q] > 0.0f)) continue;
+        if (pass == 0) {
+          if (!k_reproject_tap_matches(p, history, q, id, expected_depth, n)) {
+            other_surface |= 1 << t;
+            continue;
+          }
+        } else if (!(other_surface & (1 << t)) || !k_reproject_footprint_tap(p, fresh, history, q, x, y, mx, my)) {
+          continue;
+        }
+        h = v3_madd(h, v3_load_g(history->rgba + 4 * q), w);
+        length_sum += w * history->length[q];
+        weight_sum += w;
+        if (p->moments) {
+          h1 += w * history->moments[2 * q];
+          h2 += w * history->moments[2 * q + 1];
+        }
       }
     }
     if (weight_sum > 1e-3f) {
