@@ -16,6 +16,7 @@
 #include "cohort/core/image_output.h"
 #include "commands.h"
 #include "default_map.h"
+#include "aux_rays_choice.h"
 #include "convergence_choice.h"
 #include "workload_choice.h"
 #include "play_rate.h"
@@ -403,11 +404,12 @@ void add_play_command(CLI::App& app, int& exit_code) {
       ->capture_default_str()
       ->check(CLI::IsMember({"auto", "brigade", "reproject"}));
   cmd->add_option("--aux-rays", a->session.aux_rays,
-                  "where the G-buffer for reprojection comes from: centre (a ray of its own through each pixel's "
+                  "where the G-buffer for reprojection comes from: auto (first-hit where CUDA GPUs render and no "
+                  "OpenCL tracer does, else centre), centre (a ray of its own through each pixel's "
                   "centre) or first-hit (the first sample's own first surface: no extra ray, about 0.8 ms less a "
                   "1080p frame on an H100; the planes jitter at silhouettes); see `cohort render --help`")
       ->capture_default_str()
-      ->check(CLI::IsMember(core::aux_rays_names()));
+      ->check(CLI::IsMember(aux_rays_choices()));
   cmd->add_option("--denoise", a->session.denoise,
                   "the real-time a-trous filter after the reprojection: atrous, none, or auto (atrous where the "
                   "reprojection runs on a CUDA GPU, about 1-3 ms a frame; none on the host's threads, where it "

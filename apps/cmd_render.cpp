@@ -31,6 +31,7 @@
 #include "cohort/core/tonemap.h"
 #include "commands.h"
 #include "camera_path.h"
+#include "aux_rays_choice.h"
 #include "convergence_choice.h"
 #include "default_map.h"
 #include "id_plane_output.h"
@@ -63,7 +64,7 @@ struct RenderArgs {
   std::string replay;
   std::string trace;
   std::string denoise = "none";
-  std::string aux_rays = "centre";
+  std::string aux_rays = "auto";
   std::string denoise_quality = "high";
   int atrous_passes = 0;  // 0: from the image height (core/atrous_filter.h)
   std::string atrous_guide = core::atrous_guide_name(core::AtrousOptions{}.guide);
@@ -182,7 +183,8 @@ int run_render(const RenderArgs& a) {
   std::unique_ptr<core::OidnDenoiser> denoiser;
   core::FrameBuffer denoised;
   const bool atrous = a.denoise == "atrous";
-  const kuint aux_mode = core::aux_rays_mode(a.aux_rays);  // KFrameParams.aux_outputs of frames with planes
+  // KFrameParams.aux_outputs of frames with planes
+  const kuint aux_mode = core::aux_rays_mode(a.aux_rays == "auto" ? tracers::auto_aux_rays(specs) : a.aux_rays);
   // Reprojection and the a-trous filter run together, on the host or on a GPU (core/frame_post.h).
   std::unique_ptr<core::FramePost> post;
   if (reproject || atrous) {
@@ -462,14 +464,15 @@ void add_render_command(CLI::App& app, int& exit_code) {
         }
       });
   cmd->add_option("--aux-rays", a->aux_rays,
-                  "where the G-buffer for reprojection and denoising comes from: centre (a ray of its own through "
+                  "where the G-buffer for reprojection and denoising comes from: auto (first-hit where CUDA GPUs "
+                  "render and no OpenCL or mpi tracer does, else centre), centre (a ray of its own through "
                   "each pixel's centre: steady planes) or first-hit (the first sample's own first surface: no "
                   "extra ray, about 0.8 ms less a 1080p frame on an H100, but the planes jitter as the samples "
                   "do; the reprojection then keeps silhouettes' history from the neighbours' surfaces; frames with "
                   "sparse paths keep centre rays; "
                   "docs/denoising.md)")
       ->capture_default_str()
-      ->check(CLI::IsMember(core::aux_rays_names()));
+      ->check(CLI::IsMember(aux_rays_choices()));
   cmd->add_option("--denoise", a->denoise,
                   "denoise the shown frame: none, atrous (the real-time edge-aware a-trous filter of the portable "
                   "kernel, every frame), oidn (Intel Open Image Denoise on the CPU) or oidn-cuda (on an NVIDIA GPU); "

@@ -120,7 +120,8 @@ PlaySession::PlaySession(const SessionOptions& options) {
   s.pipeline = std::make_unique<core::FramePipeline>(*s.renderer);
   s.post_place = tracers::auto_frame_post_place(started);
   core::FramePostOptions post_options;
-  s.aux_mode = core::aux_rays_mode(options.aux_rays);
+  s.aux_mode =
+      core::aux_rays_mode(options.aux_rays == "auto" ? tracers::auto_aux_rays(started) : options.aux_rays);
   if (options.denoise != "auto" && options.denoise != "atrous" && options.denoise != "none")
     throw std::invalid_argument("--denoise '" + options.denoise + "': choose auto, atrous or none");
   post_options.atrous = options.denoise == "atrous" || (options.denoise == "auto" && s.post_place != "host");

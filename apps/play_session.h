@@ -29,7 +29,7 @@ struct SessionOptions {
   std::string denoise = "auto";
   // Where the G-buffer comes from: "centre" (a ray of its own through each pixel's centre) or "first-hit"
   // (the first sample's own first surface: no extra ray; kernel/aux_outputs.h).
-  std::string aux_rays = "centre";
+  std::string aux_rays = "auto";
   int window_height = 360;
 };
 

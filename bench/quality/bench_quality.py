@@ -52,7 +52,9 @@ METHODS = {
     "atrous-fixed": ["--no-convergence", "--denoise", "atrous", "--atrous-guide", "fixed"],
     "reproject+atrous": ["--convergence", "reproject", "--denoise", "atrous"],
     "reproject+atrous-fixed": ["--convergence", "reproject", "--denoise", "atrous", "--atrous-guide", "fixed"],
-    # The G-buffer from the first sample's own first hit instead of a centre ray of its own (--aux-rays).
+    # The G-buffer from the first sample's own first hit instead of a centre ray of its own (--aux-rays; its
+    # default, auto, takes first hits on CUDA-only runs and centre rays elsewhere: these two name it).
+    "reproject+atrous-centre": ["--convergence", "reproject", "--denoise", "atrous", "--aux-rays", "centre"],
     "reproject-first-hit": ["--convergence", "reproject", "--aux-rays", "first-hit"],
     "reproject+atrous-first-hit": ["--convergence", "reproject", "--denoise", "atrous", "--aux-rays", "first-hit"],
     "reproject+atrous-variance": ["--convergence", "reproject", "--denoise", "atrous", "--atrous-guide", "variance"],

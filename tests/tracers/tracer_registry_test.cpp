@@ -28,3 +28,11 @@ TEST(TracerRegistry, OnlyAListWithCudaLimitsEmbree) {
   EXPECT_EQ(mixed[1].threads, embree_threads_beside_gpus(std::thread::hardware_concurrency()));
   EXPECT_EQ(mixed[0].threads, 0);
 }
+
+TEST(TracerRegistry, AutoAuxRaysTakesFirstHitsWhereCudaRendersWithoutOpenClOrNodes) {
+  EXPECT_EQ(auto_aux_rays(parse_tracer_list("cuda:0")), "first-hit");
+  EXPECT_EQ(auto_aux_rays(parse_tracer_list("cuda:0,cuda:1,embree")), "first-hit");
+  EXPECT_EQ(auto_aux_rays(parse_tracer_list("embree")), "centre") << "Embree's centre packets cost about as much";
+  EXPECT_EQ(auto_aux_rays(parse_tracer_list("cuda:0,opencl:2")), "centre") << "OpenCL reads first hits after its band";
+  EXPECT_EQ(auto_aux_rays(parse_tracer_list("embree,cuda:0,mpi:1")), "centre") << "a node's tracers are unknown here";
+}

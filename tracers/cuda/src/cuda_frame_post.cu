@@ -254,6 +254,7 @@ class CudaFramePost final : public core::FramePost {
       params.still_motion = o.still_motion;
       params.anti_lag_sigma = o.anti_lag_sigma;
       params.anti_lag_relative = o.anti_lag_relative;
+      params.footprint_taps = o.jittered_planes ? 1 : 0;
       params.moments = o.luminance_moments ? 1 : 0;
       float* ycocgw = ycocgw_.scratch(4 * pixels);
       if (!unpacked_with_planes)

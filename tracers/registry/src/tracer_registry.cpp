@@ -244,6 +244,15 @@ std::unique_ptr<core::FramePost> make_frame_post(const std::string& where, const
   throw std::invalid_argument("frame post: unknown place '" + where + "' (host or cuda:N)");
 }
 
+std::string auto_aux_rays(const std::vector<TracerSpec>& tracers) {
+  bool cuda = false;
+  for (const TracerSpec& t : tracers) {
+    if (t.kind == "opencl" || t.kind == "mpi") return "centre";
+    cuda = cuda || t.kind == "cuda";
+  }
+  return cuda ? "first-hit" : "centre";
+}
+
 std::string auto_frame_post_place(const std::vector<TracerSpec>& tracers) {
   for (const TracerSpec& t : tracers)
     if (t.kind == "cuda") return "cuda:" + std::to_string(t.device);
