@@ -7,6 +7,18 @@ namespace cohort::tracers {
 void HostRegistrations::ensure(const void* ptr, size_t bytes, const char* what) {
   for (const Slot& s : slots_)
     if (s.ptr == ptr && s.bytes == bytes) return;
+  // A registered range the new one overlaps was freed by its owner (live buffers never overlap) and its
+  // memory handed out again: its registration must go first. Left in place, the driver refuses the new
+  // range ("already mapped") and a copy that starts in the stale range and runs past it fails.
+  const char* begin = static_cast<const char*>(ptr);
+  for (Slot& s : slots_) {
+    const char* s_begin = static_cast<const char*>(s.ptr);
+    if (s.ptr && s_begin < begin + bytes && begin < s_begin + s.bytes) {
+      cudaHostUnregister(s.ptr);
+      cudaGetLastError();
+      s = {};
+    }
+  }
   Slot& slot = slots_[next_];
   next_ = (next_ + 1) % slots_.size();
   if (slot.ptr) cudaHostUnregister(slot.ptr);

@@ -11,6 +11,8 @@ namespace cohort::tracers {
 // DMA at full bus speed instead of going through the driver's pageable staging. Callers reuse their
 // buffers frame after frame, so the most recent `capacity` ranges stay registered (the oldest is let go).
 // A range the driver will not register is not an error: copies still work from pageable memory, slower.
+// A new range overlapping a registered one means that one was freed and its memory reused: it is
+// unregistered first (a band target resized between frames, or a test's buffers one after another).
 class HostRegistrations {
  public:
   explicit HostRegistrations(size_t capacity) : slots_(capacity) {}
