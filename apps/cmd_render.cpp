@@ -493,7 +493,7 @@ void add_render_command(CLI::App& app, int& exit_code) {
       ->check(CLI::IsMember({"variance", "variance-of-mean", "fixed"}));
   cmd->add_option("--atrous-sigma", a->atrous_sigma,
                   "luminance stop's scale of --denoise atrous: standard deviations with the variance guide "
-                  "(default 2), relative difference with the fixed one (default 2); 0 keeps the default")
+                  "(default 4), relative difference with the fixed one (default 2); 0 keeps the default")
       ->capture_default_str()
       ->check(CLI::Range(0.0f, 1000.0f));
   cmd->add_option("--anti-lag", a->anti_lag,
