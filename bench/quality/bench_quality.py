@@ -103,23 +103,32 @@ def record_scenario(args):
     return path
 
 
-def load_id_plane(path):
-    """A 16-bit binary PGM as `cohort render --write-ids` writes it: 0 the world, entity + 1, 65535 a miss."""
+def read_pnm(path, magic, maxval):
+    """A binary PNM as `cohort render` writes it (no comments): its width, height and pixel bytes, checked
+    against the magic (b"P5", b"P6") and maxval it must have."""
     with open(path, "rb") as f:
         data = f.read()
     fields, pos = [], 0
-    while len(fields) < 4:  # magic, width, height, maxval; no comments in the files cohort writes
+    while len(fields) < 4:  # magic, width, height, maxval
         while data[pos:pos + 1].isspace():
             pos += 1
         end = pos
-        while not data[end:end + 1].isspace():
+        while end < len(data) and not data[end:end + 1].isspace():
             end += 1
         fields.append(data[pos:end])
         pos = end
-    if fields[0] != b"P5" or int(fields[3]) != 65535:
-        sys.exit(f"bench_quality: {path} is not a 16-bit binary PGM")
+    if fields[0] != magic or not fields[3].isdigit() or int(fields[3]) != maxval:
+        sys.exit(f"bench_quality: {path} is not a {magic.decode()} PNM with maxval {maxval}")
     width, height = int(fields[1]), int(fields[2])
-    return np.frombuffer(data[pos + 1:pos + 1 + 2 * width * height], dtype=">u2").reshape(height, width)
+    return width, height, data[pos + 1:]
+
+
+def load_id_plane(path):
+    """A 16-bit binary PGM as `cohort render --write-ids` writes it: 0 the world, entity + 1, 65535 a miss."""
+    width, height, pixels = read_pnm(path, b"P5", 65535)
+    if len(pixels) < 2 * width * height:
+        sys.exit(f"bench_quality: {path} is truncated")
+    return np.frombuffer(pixels[:2 * width * height], dtype=">u2").reshape(height, width)
 
 
 def grow(mask, pixels):
@@ -184,24 +193,11 @@ def load_ldr(path):
 
 def load_ppm(path):
     """An 8-bit binary PPM (P6, maxval 255) as `cohort render` writes it, as flip_evaluator.load returns a PNG."""
-    with open(path, "rb") as f:
-        data = f.read()
-    fields, pos = [], 0
-    while len(fields) < 4:  # magic, width, height, maxval; no comments in the files cohort writes
-        while data[pos:pos + 1].isspace():
-            pos += 1
-        end = pos
-        while end < len(data) and not data[end:end + 1].isspace():
-            end += 1
-        fields.append(data[pos:end])
-        pos = end
-    if fields[0] != b"P6" or int(fields[3]) != 255:
-        sys.exit(f"bench_quality: {path} is not an 8-bit binary PPM")
-    width, height = int(fields[1]), int(fields[2])
-    pixels = np.frombuffer(data[pos + 1:pos + 1 + 3 * width * height], dtype=np.uint8)
-    if pixels.size != 3 * width * height:
-        sys.exit(f"bench_quality: {path} is truncated ({pixels.size} of {3 * width * height} bytes)")
-    return pixels.reshape(height, width, 3).astype(np.float32) / np.float32(255.0)
+    width, height, pixels = read_pnm(path, b"P6", 255)
+    if len(pixels) < 3 * width * height:
+        sys.exit(f"bench_quality: {path} is truncated ({len(pixels)} of {3 * width * height} bytes)")
+    return (np.frombuffer(pixels[:3 * width * height], dtype=np.uint8).reshape(height, width, 3).astype(np.float32) /
+            np.float32(255.0))
 
 
 def psnr(reference, test):

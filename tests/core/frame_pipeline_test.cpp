@@ -49,11 +49,35 @@ struct FrameGates {
     open_through = std::max(open_through, static_cast<int64_t>(frame));
     opened.notify_all();
   }
+  // Until the frame's gate opens or `done()` (called every 200 us, first) says to stop waiting.
+  template <typename Done>
+  void poll(uint64_t frame, Done done) {
+    const auto give_up = std::chrono::steady_clock::now() + kPatience;
+    for (;;) {
+      if (done()) return;
+      {
+        std::lock_guard lock(mutex);
+        if (open_through >= static_cast<int64_t>(frame)) return;
+      }
+      if (std::chrono::steady_clock::now() > give_up) {
+        gave_up = true;
+        return;
+      }
+      std::this_thread::sleep_for(std::chrono::microseconds(200));
+    }
+  }
   void wait(uint64_t frame) {
     std::unique_lock lock(mutex);
     if (!opened.wait_for(lock, kPatience, [&] { return open_through >= static_cast<int64_t>(frame); })) gave_up = true;
   }
 };
+
+// Every pixel of the job's rows holds the frame index (what the pipeline tests read back).
+void fill_band_with_frame_index(const BandJob& job, BandBuffer& target) {
+  std::vector<float> row(static_cast<size_t>(target.width()) * 4, static_cast<float>(job.params.frame_index));
+  for (kuint y = job.params.row_begin; y < job.params.row_end; ++y)
+    target.store(static_cast<int>(y), 0, row.data(), static_cast<size_t>(target.width()));
+}
 
 // Fills its band with the frame index once the frame's gate is open.
 class GatedTracer final : public Tracer {
@@ -64,9 +88,7 @@ class GatedTracer final : public Tracer {
   using Tracer::render_band;
   BandResult render_band(const BandJob& job, BandBuffer& target) override {
     gates_->wait(job.params.frame_index);
-    std::vector<float> row(static_cast<size_t>(target.width()) * 4, static_cast<float>(job.params.frame_index));
-    for (kuint y = job.params.row_begin; y < job.params.row_end; ++y)
-      target.store(static_cast<int>(y), 0, row.data(), static_cast<size_t>(target.width()));
+    fill_band_with_frame_index(job, target);
     return {};
   }
 
@@ -209,23 +231,12 @@ class CommitLoggingTracer final : public Tracer {
   BandResult render_band(const BandJob& job, BandBuffer& target) override {
     log_->add({true, job.params.frame_index, false});
     rendering_ = true;
-    const auto give_up = std::chrono::steady_clock::now() + FrameGates::kPatience;
-    for (;;) {
+    gates_->poll(job.params.frame_index, [&] {
       apply_commits_ahead();
-      {
-        std::lock_guard lock(gates_->mutex);
-        if (gates_->open_through >= static_cast<int64_t>(job.params.frame_index)) break;
-      }
-      if (std::chrono::steady_clock::now() > give_up) {
-        gates_->gave_up = true;
-        break;
-      }
-      std::this_thread::sleep_for(std::chrono::microseconds(200));
-    }
+      return false;
+    });
     rendering_ = false;
-    std::vector<float> row(static_cast<size_t>(target.width()) * 4, static_cast<float>(job.params.frame_index));
-    for (kuint y = job.params.row_begin; y < job.params.row_end; ++y)
-      target.store(static_cast<int>(y), 0, row.data(), static_cast<size_t>(target.width()));
+    fill_band_with_frame_index(job, target);
     return {};
   }
 
@@ -325,24 +336,12 @@ class AnnouncementTracer final : public Tracer {
   using Tracer::render_band;
   BandResult render_band(const BandJob& job, BandBuffer& target) override {
     Seen seen{job.params.frame_index, {}};
-    const auto give_up = std::chrono::steady_clock::now() + FrameGates::kPatience;
-    for (;;) {
+    gates_->poll(job.params.frame_index, [&] {
       if (std::optional<BandJob> next = next_job_announced()) seen.announced.push_back(*next);
-      if (!ahead_ || !seen.announced.empty()) break;
-      {
-        std::lock_guard lock(gates_->mutex);
-        if (gates_->open_through >= static_cast<int64_t>(job.params.frame_index)) break;
-      }
-      if (std::chrono::steady_clock::now() > give_up) {
-        gates_->gave_up = true;
-        break;
-      }
-      std::this_thread::sleep_for(std::chrono::microseconds(200));
-    }
+      return !ahead_ || !seen.announced.empty();
+    });
     seen_->push_back(std::move(seen));
-    std::vector<float> row(static_cast<size_t>(target.width()) * 4, static_cast<float>(job.params.frame_index));
-    for (kuint y = job.params.row_begin; y < job.params.row_end; ++y)
-      target.store(static_cast<int>(y), 0, row.data(), static_cast<size_t>(target.width()));
+    fill_band_with_frame_index(job, target);
     return {};
   }
 

@@ -41,6 +41,19 @@ void send(MpiSession& mpi, wire::Kind kind, uint64_t sequence, const std::vector
   mpi.send(kRank0, wire::frame_message(kind, sequence, payload));
 }
 
+// The closing message of the band `request` asked for: its rows, their format and pieces as the request
+// had them (the caller adds the work, timing and, for a band that adopts a job ahead, its id).
+wire::BandRows band_rows_of(const wire::BandRequest& request) {
+  wire::BandRows done;
+  done.row_begin = request.job.params.row_begin;
+  done.row_end = request.job.params.row_end;
+  done.width = request.job.camera.width;
+  done.format = request.format;
+  done.pieces = request.pieces;
+  done.aux = request.aux;
+  return done;
+}
+
 // The next well-formed message from rank 0 (a malformed one is logged, skipped, and the wait starts
 // again); nothing when rank 0 stays silent for `timeout`.
 std::optional<wire::Message> receive_from_rank0(MpiSession& mpi, std::chrono::seconds timeout) {
@@ -254,13 +267,7 @@ class Node {
       send(mpi, wire::Kind::band_failed, m.sequence, wire::encode_band_failure({false, e.what()}));
       return;
     }
-    wire::BandRows done;
-    done.row_begin = p.row_begin;
-    done.row_end = p.row_end;
-    done.width = request.job.camera.width;
-    done.format = request.format;
-    done.pieces = request.pieces;
-    done.aux = request.aux;
+    wire::BandRows done = band_rows_of(request);
     done.row_work = rendered.row_work;
     timing.total_ms = ms_since(start);
     done.device_ms = timing.total_ms;
@@ -339,13 +346,7 @@ class Node {
         work.push_back(y >= ahead_rows.begin && y < ahead_rows.end ? a.row_work[y - ahead_rows.begin]
                                                                    : rendered.row_work[next_beyond++]);
     }
-    wire::BandRows done;
-    done.row_begin = p.row_begin;
-    done.row_end = p.row_end;
-    done.width = request.job.camera.width;
-    done.format = request.format;
-    done.pieces = request.pieces;
-    done.aux = request.aux;
+    wire::BandRows done = band_rows_of(request);
     done.adopted = a.id;
     done.row_work = std::move(work);
     done.device_ms = timing.total_ms;
