@@ -1,5 +1,7 @@
 #include "host_registrations.h"
 
+#include <algorithm>
+
 #include <spdlog/spdlog.h>
 
 namespace cohort::tracers {
@@ -19,8 +21,11 @@ void HostRegistrations::ensure(const void* ptr, size_t bytes, const char* what) 
       s = {};
     }
   }
-  Slot& slot = slots_[next_];
-  next_ = (next_ + 1) % slots_.size();
+  // A slot left empty (by the stale ranges above, or never used) before the oldest live registration, which
+  // would cost its buffer another registration when it comes back.
+  auto empty = std::find_if(slots_.begin(), slots_.end(), [](const Slot& s) { return !s.ptr; });
+  Slot& slot = empty != slots_.end() ? *empty : slots_[next_];
+  if (empty == slots_.end()) next_ = (next_ + 1) % slots_.size();
   if (slot.ptr) cudaHostUnregister(slot.ptr);
   slot = {};
   const cudaError_t error = cudaHostRegister(const_cast<void*>(ptr), bytes, cudaHostRegisterPortable);

@@ -24,8 +24,9 @@ const std::vector<std::string>& light_sampling_names();
 // Throws std::invalid_argument naming the choices for any other name.
 kuint light_sampling_mode(const std::string& name);
 
-// Where the aux planes come from, by command-line name (--aux-rays): "centre" (K_AUX_CENTRE_RAY, the
-// default) and "first-hit" (K_AUX_PATH_FIRST_HIT), in that order.
+// Where the aux planes come from, by command-line name (--aux-rays): "centre" (K_AUX_CENTRE_RAY) and
+// "first-hit" (K_AUX_PATH_FIRST_HIT), in that order. The command line's default, "auto", is resolved by the
+// tracers first (tracers::auto_aux_rays).
 const std::vector<std::string>& aux_rays_names();
 // KFrameParams.aux_outputs for a frame that wants the planes; throws std::invalid_argument naming the choices.
 kuint aux_rays_mode(const std::string& name);
