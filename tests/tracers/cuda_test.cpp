@@ -161,6 +161,79 @@ TEST(CudaScenePack, PackedSceneMatchesEmbree) {
   }
 }
 
+
+// The wavefront (bounce rays walked by a kernel of their own, the paths in memory between kernels) draws
+// the megakernel's image: same integrator, same random numbers; over several bounces, Russian roulette,
+// several samples a pixel, the first-hit records of the aux planes, and a band that starts mid-frame.
+struct WavefrontCase {
+  uint32_t bounces, spp;
+  bool pack;
+  const char* name;
+};
+class CudaWavefront : public ::testing::TestWithParam<WavefrontCase> {};
+
+TEST_P(CudaWavefront, DrawsTheMegakernelsImage) {
+  REQUIRE_GPU();
+  const WavefrontCase c = GetParam();
+  const char* pack_file = std::getenv("COHORT_PACK");
+  if (c.pack && !pack_file) GTEST_SKIP() << "COHORT_PACK names no packed map (tools/gpu_run.sh sets it)";
+  commit::TracerScene scene;
+  const int w = 96, h = 64;
+  KCamera cam;
+  if (c.pack) {
+    core::PackedScene pack = core::read_scene_pack(pack_file);
+    scene = pack.tracer_scene;
+    glm::vec3 eye(pack.player_start[0], pack.player_start[1], pack.player_start[2] + core::kPlayerEyeHeight);
+    cam = core::make_camera(eye, {pack.player_yaw, 0.0f}, core::kDefaultFovX, w, h);
+  } else {
+    scene = core::compile_scene(test_room()).tracer_scene;
+    cam = test_room_camera(w, h);
+  }
+  KFrameParams params = frame_params(K_MODE_PATH, c.spp, c.bounces, h);
+  params.rr_start = 2.0f;
+  params.frame_index = 5;
+  params.aux_outputs = K_AUX_PATH_FIRST_HIT;
+  core::BandBuffer frames[2];
+  for (int wavefront = 0; wavefront < 2; ++wavefront) {
+    tracers::CudaTracer cuda(0);
+    cuda.set_wavefront(wavefront == 1);
+    cuda.set_ray_counting(true);
+    cuda.apply(commit::CommitBuffer::full(std::make_shared<commit::TracerScene>(scene), 1));
+    frames[wavefront].resize(w, h, core::BandFormat::rgba32f);
+    frames[wavefront].enable_aux(true);
+    for (int band = 0; band < 2; ++band) {  // the second band starts mid-frame
+      core::BandJob job;
+      job.params = params;
+      job.camera = cam;
+      job.params.row_begin = band == 0 ? 0u : 24u;
+      job.params.row_end = band == 0 ? 24u : uint32_t(h);
+      cuda.render_band(job, frames[wavefront]);
+    }
+    const auto counts = cuda.last_ray_counts();
+    EXPECT_GT(counts.closest, 0u) << (wavefront ? "wavefront" : "megakernel") << " counts its rays";
+  }
+  core::FrameBuffer a, b;
+  a.resize(w, h);
+  b.resize(w, h);
+  frames[0].copy_rows_to(a, 0, h);
+  frames[1].copy_rows_to(b, 0, h);
+  for (float v : b.rgba) ASSERT_TRUE(std::isfinite(v));
+  const double error = relative_rmse(a, b, 1.0);
+  std::cout << c.name << ": relative RMSE megakernel/wavefront " << error << "\n";
+  EXPECT_LT(error, 1e-4) << c.name;
+  size_t same_ids = 0;
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) same_ids += frames[0].aux_row(y)[x].id == frames[1].aux_row(y)[x].id;
+  EXPECT_GE(double(same_ids), 0.999 * w * h) << "the first-hit records agree";
+}
+
+INSTANTIATE_TEST_SUITE_P(Paths, CudaWavefront,
+                         ::testing::Values(WavefrontCase{1, 1, false, "room_bounce1"},
+                                           WavefrontCase{3, 2, false, "room_bounce3_spp2"},
+                                           WavefrontCase{1, 1, true, "pack_bounce1"},
+                                           WavefrontCase{2, 4, true, "pack_bounce2_spp4"}),
+                         [](const auto& info) { return std::string(info.param.name); });
+
 }  // namespace
 
 #else

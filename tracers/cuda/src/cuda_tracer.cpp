@@ -3,6 +3,8 @@
 #include <cuda_runtime.h>
 
 #include <algorithm>
+#include <cstdlib>
+#include <cstring>
 #include <vector>
 
 #include "cohort/kernel/aux_mode.h"
@@ -77,6 +79,22 @@ struct CudaTracer::Impl {
   float4* band = nullptr;
   unsigned short* band_rgb16f = nullptr;   // the band as RGB halves, for RGB16F targets
   bool count_rays = false;
+  // The bounce rays' wavefront (render_band.cu) instead of the megakernel, unless COHORT_CUDA_WAVEFRONT=0.
+  bool wavefront = wavefront_by_default();
+  DeviceArray<KPathState> wave_states;
+  DeviceArray<KHit> wave_hits;
+  DeviceArray<kuint> wave_active;
+  WavefrontScratch wave_scratch;
+  // The wavefront's scratch for a band of `pixels`, or null for the megakernel.
+  const WavefrontScratch* wave(size_t pixels) {
+    if (!wavefront) return nullptr;
+    wave_scratch = {wave_states.scratch(pixels), wave_hits.scratch(pixels), wave_active.scratch(pixels)};
+    return &wave_scratch;
+  }
+  static bool wavefront_by_default() {
+    const char* v = std::getenv("COHORT_CUDA_WAVEFRONT");
+    return !(v && std::strcmp(v, "0") == 0);
+  }
   unsigned long long* ray_counts = nullptr;   // device: closest, occlusion
   unsigned* row_rays = nullptr;                // device: rays per band row (the balancer's per-row work)
   size_t row_rays_capacity = 0;                // rows
@@ -314,7 +332,7 @@ core::BandResult CudaTracer::render_band(const core::BandJob& job, core::BandBuf
   }
   KPathFirstHit* first_hits = aux_from_paths ? m.first_hits.scratch(pixels) : nullptr;
   launch_render_band(m.view(params), params, camera, m.band, m.count_rays ? m.ray_counts : nullptr, m.row_rays,
-                     first_hits, m.stream);
+                     first_hits, m.wave(pixels), m.stream);
   if (aux_from_paths) {
     // From the paths' first hits: after the band's kernel, no ray of their own (counted in the band's time).
     launch_aux_from_first_hits(m.view(params), params, camera, previous, history, first_hits, texels, m.stream);
@@ -373,6 +391,7 @@ core::BandResult CudaTracer::render_band_in_pieces(const core::BandJob& job, cor
   // download never races the next piece's kernel: the copy stream takes piece i while `stream` runs
   // piece i + 1.
   const size_t pixel_bytes = core::bytes_per_pixel(target.format());
+  const WavefrontScratch* wave = m.wave(pixels);  // the pieces take turns with it on `stream`
   COHORT_CUDA(cudaEventRecord(m.start, m.stream));
   for (size_t i = 0; i < pieces; ++i) {
     KFrameParams piece = params;
@@ -383,7 +402,7 @@ core::BandResult CudaTracer::render_band_in_pieces(const core::BandJob& job, cor
     float4* band = m.band + first_row * width;
     if (piece_pixels > 0)
       launch_render_band(m.view(piece), piece, camera, band, m.count_rays ? m.ray_counts : nullptr,
-                         m.row_rays + first_row, nullptr, m.stream);
+                         m.row_rays + first_row, nullptr, wave, m.stream);
     const void* source = band;
     if (half) {
       unsigned short* rgb = m.band_rgb16f + first_row * width * 3;
@@ -415,6 +434,8 @@ core::BandResult CudaTracer::render_band_in_pieces(const core::BandJob& job, cor
 }
 
 void CudaTracer::set_ray_counting(bool on) { impl_->count_rays = on; }
+void CudaTracer::set_wavefront(bool on) { impl_->wavefront = on; }
+bool CudaTracer::wavefront() const { return impl_->wavefront; }
 CudaTracer::RayCounts CudaTracer::last_ray_counts() const { return impl_->last_counts; }
 int CudaTracer::device() const { return impl_->device; }
 

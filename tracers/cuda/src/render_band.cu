@@ -23,6 +23,29 @@ namespace cohort::tracers {
 // 128-register kernel even that early exit cost 1.5-2% of a full frame (nvidia-h100-x1, docs/integrator.md).
 // kFirstHit: the first sample's first surface is recorded for the aux planes (K_AUX_PATH_FIRST_HIT), a
 // build of its own so that the kernel without it stays as it was.
+// The rays a thread traced, added up per warp: into ray_counts (closest, occlusion; may be null) and into
+// row_rays, the rays per row of the band (the balancer's per-row work; may be null). Every lane of the warp
+// calls it, inside the image or not; blocks are 16 wide, so a warp holds two rows.
+__device__ void count_rays(const KTraceCtx& ctx, bool inside, kuint row, bool row_inside,
+                           unsigned long long* ray_counts, unsigned* row_rays) {
+  if (ray_counts) {
+    unsigned closest = __reduce_add_sync(0xffffffffu, ctx.closest_rays);
+    unsigned occlusion = __reduce_add_sync(0xffffffffu, ctx.occlusion_rays);
+    if ((threadIdx.x + threadIdx.y * blockDim.x) % 32u == 0u) {
+      atomicAdd(&ray_counts[0], (unsigned long long)closest);
+      atomicAdd(&ray_counts[1], (unsigned long long)occlusion);
+    }
+  }
+  if (row_rays) {
+    const unsigned mine = inside ? ctx.closest_rays + ctx.occlusion_rays : 0u;
+    const unsigned lane = (threadIdx.x + threadIdx.y * blockDim.x) % 32u;
+    const unsigned low = __reduce_add_sync(0xffffffffu, lane < 16u ? mine : 0u);
+    const unsigned high = __reduce_add_sync(0xffffffffu, lane >= 16u ? mine : 0u);
+    const unsigned half = lane < 16u ? low : high;
+    if ((lane == 0u || lane == 16u) && row_inside && half != 0u) atomicAdd(&row_rays[row], half);
+  }
+}
+
 template <bool kSparse, bool kFirstHit>
 __global__ void __launch_bounds__(128, 4) render_band_kernel(KSceneView scene, KFrameParams params, KCamera camera,
                                                           float4* band, unsigned long long* ray_counts,
@@ -41,25 +64,131 @@ __global__ void __launch_bounds__(128, 4) render_band_kernel(KSceneView scene, K
                                              kFirstHit ? first_hits + size_t(row) * camera.width + x : nullptr);
     band[size_t(row) * camera.width + x] = make_float4(c.x, c.y, c.z, 1.0f);
   }
-  if (ray_counts) {
-    // One atomic per warp: the whole warp reaches here, inside the image or not.
-    unsigned closest = __reduce_add_sync(0xffffffffu, ctx.closest_rays);
-    unsigned occlusion = __reduce_add_sync(0xffffffffu, ctx.occlusion_rays);
-    if ((threadIdx.x + threadIdx.y * blockDim.x) % 32u == 0u) {
-      atomicAdd(&ray_counts[0], (unsigned long long)closest);
-      atomicAdd(&ray_counts[1], (unsigned long long)occlusion);
+  count_rays(ctx, inside, row, y < params.row_end, ray_counts, row_rays);
+}
+
+// The bounce rays' wavefront. The megakernel above keeps a whole path in one thread of a 128-register
+// kernel at a quarter occupancy, where an incoherent bounce ray's walk waits on memory with few warps to
+// hide it. Here a path's segments (the camera ray and what it meets up to the first bounce; then, per
+// bounce, what the bounce ray meets up to the next) are shaded by kernels like the megakernel, while each
+// bounce ray is walked by a small kernel of its own, at the occupancy its registers allow. The paths wait
+// in memory (KPathState, kernel/integrator.h) between them: same integrator, same random numbers, the same
+// image as the megakernel. Transparent layers are walked inline by the shading kernels.
+
+// Runs a path from its current ray until it ends (false) or has bounced (true: its next ray in *s).
+// `traced`: the current ray's hit, walked by the bounce kernel (null: walked here).
+__device__ bool path_segment(KTraceCtx* ctx, const KFrameParams* params, KPathState* s, const KHit* traced,
+                             KPathFirstHit* first_hit) {
+  const kuint bounce = s->bounce;
+  for (;;) {
+    KHit hit;
+    bool met;
+    if (traced) {
+      hit = *traced;
+      met = hit.instance != K_NONE;
+      traced = nullptr;
+    } else {
+      hit.cost = 0u;
+      met = k_trace_closest(ctx, s->org, s->dir, K_INF, K_RAY_PRIMARY, &hit);
+    }
+    if (!met) {
+      k_path_miss(K_CTX_SCENE(ctx), params, s, &hit);
+      return false;
+    }
+    if (!k_path_hit(ctx, params, s, hit, first_hit)) return false;
+    if (s->bounce != bounce) return true;
+  }
+}
+
+// A finished path's radiance into its pixel: the mean over the frame's samples, sample by sample.
+__device__ void finish_sample(float4* band, size_t p, KVec3 radiance, kuint sample, float inv_spp) {
+  float4 c = make_float4(radiance.x * inv_spp, radiance.y * inv_spp, radiance.z * inv_spp, 1.0f);
+  if (sample > 0u) {
+    const float4 sum = band[p];
+    c = make_float4(sum.x + c.x, sum.y + c.y, sum.z + c.z, 1.0f);
+  }
+  band[p] = c;
+}
+
+// A sample's camera ray and its path up to the first bounce.
+template <bool kFirstHit>
+__global__ void __launch_bounds__(128, 4) wave_camera_kernel(KSceneView scene, KFrameParams params, KCamera camera,
+                                                          kuint sample, float4* band, WavefrontScratch wave,
+                                                          unsigned long long* ray_counts, unsigned* row_rays,
+                                                          KPathFirstHit* first_hits) {
+  const kuint x = blockIdx.x * blockDim.x + threadIdx.x;
+  const kuint row = blockIdx.y * blockDim.y + threadIdx.y;
+  const kuint y = params.row_begin + row;
+  const bool inside = x < camera.width && y < params.row_end;
+  KTraceCtx ctx;
+  ctx.scene = scene;
+  ctx.closest_rays = 0u;
+  ctx.occlusion_rays = 0u;
+  if (inside) {
+    const size_t p = size_t(row) * camera.width + x;
+    KPathFirstHit* record = kFirstHit && sample == 0u ? first_hits + p : nullptr;
+    if (record) k_record_first_hit(record, K_NONE, 0u, 0u);
+    KRng rng;
+    const KVec3 dir = k_camera_sample(&params, &camera, x, y, sample, &rng);
+    KPathState s;
+    k_path_begin(&s, v3_load(camera.origin), dir, k_pixel_spread(&camera), rng);
+    const bool goes_on = path_segment(&ctx, &params, &s, nullptr, record);
+    wave.active[p] = goes_on ? 1u : 0u;
+    if (goes_on) wave.states[p] = s;
+    else finish_sample(band, p, s.radiance, sample, 1.0f / float(params.spp > 0u ? params.spp : 1u));
+  }
+  count_rays(ctx, inside, row, y < params.row_end, ray_counts, row_rays);
+}
+
+// The live paths' bounce rays, walked: their hits (instance K_NONE: a miss) for the shading kernel.
+// 8 blocks of 128 threads an SM cap it at 64 registers (half occupancy; a few bytes spilled): on one H100 the
+// large map's 1080p frame took 8.90-8.94 ms so, 8.96-9.04 at 80 registers and 9.13-9.17 at its own 96.
+__global__ void __launch_bounds__(128, 8) wave_bounce_kernel(KSceneView scene, KFrameParams params, KCamera camera,
+                                                          WavefrontScratch wave, unsigned long long* ray_counts,
+                                                          unsigned* row_rays) {
+  const kuint x = blockIdx.x * blockDim.x + threadIdx.x;
+  const kuint row = blockIdx.y * blockDim.y + threadIdx.y;
+  const kuint y = params.row_begin + row;
+  const size_t p = size_t(row) * camera.width + x;
+  const bool inside = x < camera.width && y < params.row_end && wave.active[p];
+  KTraceCtx ctx;
+  ctx.scene = scene;
+  ctx.closest_rays = 0u;
+  ctx.occlusion_rays = 0u;
+  if (inside) {
+    const KPathState* s = wave.states + p;
+    KHit hit;
+    hit.cost = 0u;
+    if (!k_trace_closest(&ctx, s->org, s->dir, K_INF, K_RAY_PRIMARY, &hit)) hit.instance = K_NONE;
+    wave.hits[p] = hit;
+  }
+  count_rays(ctx, inside, row, y < params.row_end, ray_counts, row_rays);
+}
+
+// What the live paths' bounce rays met, shaded, and their paths on to the next bounce.
+__global__ void __launch_bounds__(128, 4) wave_shade_kernel(KSceneView scene, KFrameParams params, KCamera camera,
+                                                         kuint sample, float4* band, WavefrontScratch wave,
+                                                         unsigned long long* ray_counts, unsigned* row_rays) {
+  const kuint x = blockIdx.x * blockDim.x + threadIdx.x;
+  const kuint row = blockIdx.y * blockDim.y + threadIdx.y;
+  const kuint y = params.row_begin + row;
+  const size_t p = size_t(row) * camera.width + x;
+  const bool inside = x < camera.width && y < params.row_end && wave.active[p];
+  KTraceCtx ctx;
+  ctx.scene = scene;
+  ctx.closest_rays = 0u;
+  ctx.occlusion_rays = 0u;
+  if (inside) {
+    KPathState s = wave.states[p];
+    const KHit hit = wave.hits[p];
+    const bool goes_on = path_segment(&ctx, &params, &s, &hit, nullptr);
+    if (goes_on) wave.states[p] = s;
+    else {
+      wave.active[p] = 0u;
+      finish_sample(band, p, s.radiance, sample, 1.0f / float(params.spp > 0u ? params.spp : 1u));
     }
   }
-  if (row_rays) {
-    // Rays per row of the band (the balancer's per-row work). With 16-wide blocks a warp holds two
-    // rows: lanes 0-15 one, 16-31 the next; each half adds once.
-    const unsigned mine = inside ? ctx.closest_rays + ctx.occlusion_rays : 0u;
-    const unsigned lane = (threadIdx.x + threadIdx.y * blockDim.x) % 32u;
-    const unsigned low = __reduce_add_sync(0xffffffffu, lane < 16u ? mine : 0u);
-    const unsigned high = __reduce_add_sync(0xffffffffu, lane >= 16u ? mine : 0u);
-    const unsigned half = lane < 16u ? low : high;
-    if ((lane == 0u || lane == 16u) && y < params.row_end && half != 0u) atomicAdd(&row_rays[row], half);
-  }
+  count_rays(ctx, inside, row, y < params.row_end, ray_counts, row_rays);
 }
 
 // The 32-byte texel the host's BandBuffer keeps (halves for normal and albedo).
@@ -135,12 +264,26 @@ void set_texel_texture(cudaTextureObject_t texture) {
 
 void launch_render_band(const KSceneView& scene, const KFrameParams& params, const KCamera& camera, float4* band,
                         unsigned long long* ray_counts, unsigned* row_rays, KPathFirstHit* first_hits,
-                        cudaStream_t stream) {
+                        const WavefrontScratch* wave, cudaStream_t stream) {
   const kuint rows = params.row_end - params.row_begin;
   const dim3 block(16, 8);  // 16 wide: the row ray counts rely on two rows per warp
   const dim3 grid((camera.width + block.x - 1) / block.x, (rows + block.y - 1) / block.y);
   const bool sparse = params.path_pixels != 0u && params.path_pixels < K_PATH_PATTERN_PIXELS;
-  if (sparse)
+  if (wave && wavefront_renders(params)) {
+    const kuint spp = params.spp > 0u ? params.spp : 1u;
+    for (kuint sample = 0u; sample < spp; ++sample) {
+      if (first_hits)
+        wave_camera_kernel<true><<<grid, block, 0, stream>>>(scene, params, camera, sample, band, *wave, ray_counts,
+                                                             row_rays, first_hits);
+      else
+        wave_camera_kernel<false><<<grid, block, 0, stream>>>(scene, params, camera, sample, band, *wave, ray_counts,
+                                                              row_rays, nullptr);
+      for (kuint bounce = 1u; bounce <= params.max_bounces; ++bounce) {
+        wave_bounce_kernel<<<grid, block, 0, stream>>>(scene, params, camera, *wave, ray_counts, row_rays);
+        wave_shade_kernel<<<grid, block, 0, stream>>>(scene, params, camera, sample, band, *wave, ray_counts, row_rays);
+      }
+    }
+  } else if (sparse)
     render_band_kernel<true, false><<<grid, block, 0, stream>>>(scene, params, camera, band, ray_counts, row_rays, nullptr);
   else if (first_hits)
     render_band_kernel<false, true><<<grid, block, 0, stream>>>(scene, params, camera, band, ray_counts, row_rays,

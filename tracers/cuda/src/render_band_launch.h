@@ -4,18 +4,36 @@
 
 #include "cuda_check.h"
 #include "cohort/kernel/aux_history.h"
+#include "cohort/kernel/path_pattern.h"
+#include "cohort/kernel/path_state.h"
 #include "cohort/kernel/scene_view.h"
 
 namespace cohort::tracers {
 
 void set_texel_texture(cudaTextureObject_t texture);
+
+// The bounce rays' wavefront (render_band.cu): where paths wait between its kernels. Device pointers, each
+// for at least the band's pixels.
+struct WavefrontScratch {
+  KPathState* states = nullptr;
+  KHit* hits = nullptr;
+  kuint* active = nullptr;
+};
+// Whether launch_render_band renders this band as a wavefront when given the scratch: lit paths that bounce,
+// every pixel tracing (the sparse pattern of dynamic resolution stays with the megakernel).
+inline bool wavefront_renders(const KFrameParams& params) {
+  const bool lit = params.mode == K_MODE_PATH;
+  const bool sparse = params.path_pixels != 0u && params.path_pixels < K_PATH_PATTERN_PIXELS;
+  return lit && !sparse && params.max_bounces > 0u;
+}
 // The scene view holds device pointers (built on the host with k_scene_view, passed by value).
 // ray_counts (closest, occlusion) and row_rays (one per band row, zeroed by the caller) may be null.
 // first_hits (may be null; only for bands where every pixel traces paths): each pixel's record of its first
-// sample's first surface, for launch_aux_from_first_hits.
+// sample's first surface, for launch_aux_from_first_hits. wave (may be null): scratch for the wavefront,
+// used where wavefront_renders(params).
 void launch_render_band(const KSceneView& scene, const KFrameParams& params, const KCamera& camera, float4* band,
                         unsigned long long* ray_counts, unsigned* row_rays, KPathFirstHit* first_hits,
-                        cudaStream_t stream);
+                        const WavefrontScratch* wave, cudaStream_t stream);
 // The band's auxiliary planes (kernel/aux_outputs.h) as the 32-byte KAuxTexel the host's BandBuffer
 // keeps (halves for normal and albedo); history: the previous frame's transforms and joints (device
 // pointers, kernel/aux_history.h).

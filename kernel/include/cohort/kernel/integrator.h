@@ -16,6 +16,7 @@
 #include "emissive_tree.h"
 #include "emitters.h"
 #include "fog.h"
+#include "path_state.h"
 #include "light_gather.h"
 #include "light_tree.h"
 #include "rng.h"
@@ -252,127 +253,157 @@ KFN void k_record_first_hit(KGLOBAL KPathFirstHit* record, kuint instance, kuint
   record->pad = 0u;
 }
 
+/* A camera ray's path before its first trace; pixel_spread is the angle one pixel subtends (for mip
+ * selection), rng the sample's stream after the camera's jitter. */
+KFN void k_path_begin(KPathState* s, KVec3 org, KVec3 dir, float pixel_spread, KRng rng) {
+  s->radiance = v3s(0.0f);
+  s->throughput = v3s(1.0f);
+  s->org = org;
+  s->dir = dir;
+  s->vertex_position = org;
+  s->cone_width = 0.0f;
+  s->spread = pixel_spread;
+  s->vertex_brdf_pdf = 0.0f;
+  s->bounce = 0u;
+  s->layers = 0u;
+  s->rng = rng;
+  s->pad = 0u;
+}
+
+/* The path's ray met nothing (hit->cost: the steps the walk took, for the BVH view): the path ends. */
+KFN void k_path_miss(const KSceneView* scene, const KFrameParams* params, KPathState* s, const KHit* hit) {
+  int lit_mode = params->mode == K_MODE_PATH || params->mode == K_MODE_DIRECT;
+  if (params->mode == K_MODE_BVH && s->bounce == 0u) s->radiance = k_heat_color((float)hit->cost / 200.0f);
+  if (lit_mode) k_apply_fog(scene, s->org, s->dir, K_INF, &s->radiance, &s->throughput);
+}
+
+/* The path's ray (s->org, s->dir) met `hit`: shades it. 1 when the path goes on, with its next ray in
+ * s->org and s->dir (through a transparent layer, s->bounce unchanged, or a bounce, s->bounce one more);
+ * 0 when it ends. first_hit (may be null): where the ray's first opaque surface is recorded for the aux
+ * planes (recorded before the first bounce only). */
+KFN int k_path_hit(KTraceCtx* ctx, const KFrameParams* params, KPathState* s, KHit hit,
+                   KGLOBAL KPathFirstHit* first_hit) {
+  const KSceneView* scene = K_CTX_SCENE(ctx);
+  int emissive_nee = params->emissive_samples > 0u && scene->emissive_count > 0u;
+  KVec3 org = s->org, dir = s->dir;
+  int lit_mode = params->mode == K_MODE_PATH || params->mode == K_MODE_DIRECT;
+  if (first_hit && s->bounce != 0u) first_hit = 0;
+  if (params->mode == K_MODE_BVH) { s->radiance = k_heat_color((float)hit.cost / 200.0f); return 0; }
+  if (params->mode == K_MODE_TRIANGLES) { s->radiance = k_id_color(hit.triangle); return 0; }
+  if (lit_mode) {
+    k_apply_fog(scene, org, dir, hit.t, &s->radiance, &s->throughput);
+    if (v3_max_component(s->throughput) <= 0.0f) return 0;
+  }
+  kuint hit_material = k_hit_material(scene, hit.instance, hit.triangle);
+  if (scene->materials[hit_material].blend == K_BLEND_SKY) {
+    /* The sky: what its cube shows along the ray, and nothing behind it. */
+    if (first_hit) k_record_first_hit(first_hit, hit.instance, hit.triangle, 1u);
+    if (lit_mode || params->mode == K_MODE_ALBEDO) {
+      KVec3 sky = v3_mul(s->throughput, k_sky_radiance(scene, hit.instance, hit_material, dir));
+      s->radiance = v3_add(s->radiance, s->bounce > 0u ? k_clamp_radiance(sky, params->firefly_clamp) : sky);
+    }
+    return 0;
+  }
+  s->cone_width += s->spread * hit.t;
+  KSurface sf = k_surface_eval(scene, hit, org, dir, s->cone_width);
+  KVec3 wo = v3_neg(dir);
+
+  if (sf.blend != K_BLEND_OPAQUE) {
+    /* Transparent layers: shade the layer, carry on through it without consuming a bounce. An
+     * environment stage (glass) adds its reflection over what the layer does, or, drawn before the
+     * layer's stage, under it: filtered by the layer like what is behind. */
+    KVec3 env = lit_mode ? k_environment_radiance(scene, hit, hit_material, sf.normal, dir) : v3s(0.0f);
+    KVec3 env_throughput = s->throughput;
+    if (sf.blend == K_BLEND_ADDITIVE) {
+      s->radiance = v3_add(s->radiance, v3_mul(s->throughput, v3_add(sf.albedo, sf.emission)));
+    } else if (sf.blend == K_BLEND_MODULATE) {
+      s->throughput = v3_mul(s->throughput, sf.albedo);
+    } else {
+      s->radiance = v3_add(s->radiance, v3_scale(v3_mul(s->throughput, sf.albedo), sf.alpha));
+      s->throughput = v3_scale(s->throughput, 1.0f - sf.alpha);
+    }
+    env = v3_mul((sf.flags & K_MAT_ENV_UNDER_LAYER) ? s->throughput : env_throughput, env);
+    s->radiance = v3_add(s->radiance, s->bounce > 0u ? k_clamp_radiance(env, params->firefly_clamp) : env);
+    if (++s->layers > K_MAX_LAYERS || v3_max_component(s->throughput) <= 0.0f) return 0;
+    s->org = v3_madd(sf.position, dir, k_ray_epsilon(sf.position));
+    return 1;
+  }
+
+  if (first_hit) k_record_first_hit(first_hit, hit.instance, hit.triangle, 0u);
+  if (params->mode == K_MODE_ALBEDO) { s->radiance = v3_add(sf.albedo, sf.emission); return 0; }
+  if (params->mode == K_MODE_NORMALS) { s->radiance = v3_add(v3_scale(sf.normal, 0.5f), v3s(0.5f)); return 0; }
+  if (params->mode == K_MODE_SPECULAR) { s->radiance = sf.specular; return 0; }
+
+  KFrameParams vertex_params = *params;
+  if (s->bounce > 0u) {
+    /* Path regularisation: after a bounce, a sharp highlight lit by next-event estimation is a
+     * caustic path the bounce found by chance (a firefly). Widen it and drop the boost there. */
+    sf.roughness = k_fmax(sf.roughness, K_REGULARIZED_ROUGHNESS);
+    vertex_params.spec_boost = 1.0f;
+  }
+  k_apply_blend_lights(scene, sf.position, &s->radiance, &s->throughput);
+  KVec3 contribution = sf.emission;
+  if (s->bounce > 0u && emissive_nee && v3_max_component(sf.emission) > 0.0f) {
+    KVec3 d = v3_sub(sf.position, s->vertex_position);
+    float light_pdf = k_emissive_pdf(scene, s->vertex_position, hit.instance, hit.triangle, v3_dot(d, d),
+                                     k_fabs(v3_dot(sf.geo_normal, dir)));
+    contribution = v3_scale(contribution, k_power_heuristic(s->vertex_brdf_pdf, light_pdf));
+  }
+  contribution = v3_add(contribution, k_environment_radiance(scene, hit, hit_material, sf.normal, dir));
+  float path_weight = v3_max_component(s->throughput);
+  KRng rng = s->rng;
+  contribution = v3_add(contribution, k_direct_lighting(ctx, &vertex_params, &sf, wo, path_weight, &rng));
+  if (emissive_nee) {
+    int bounce_follows = params->mode != K_MODE_DIRECT && s->bounce < params->max_bounces;
+    contribution = v3_add(contribution,
+                          k_emissive_lighting(ctx, &sf, wo, bounce_follows, params->shadow_rr, path_weight, &rng));
+  }
+  contribution = v3_mul(s->throughput, contribution);
+  if (s->bounce > 0u) contribution = k_clamp_radiance(contribution, params->firefly_clamp);
+  s->radiance = v3_add(s->radiance, contribution);
+
+  if (params->mode == K_MODE_DIRECT || s->bounce >= params->max_bounces) { s->rng = rng; return 0; }
+
+  KVec3 wi;
+  float u_lobe = k_rng_next(&rng), u1 = k_rng_next(&rng), u2 = k_rng_next(&rng);
+  KVec3 weight = k_brdf_sample(&sf, wo, u_lobe, u1, u2, &wi);
+  if (v3_max_component(weight) <= 0.0f || v3_dot(wi, sf.geo_normal) <= 0.0f) { s->rng = rng; return 0; }
+  s->throughput = v3_mul(s->throughput, weight);
+  s->vertex_position = sf.position;
+  s->vertex_brdf_pdf = k_brdf_pdf(&sf, wo, wi);
+  s->spread += K_BOUNCE_SPREAD;
+  ++s->bounce;
+  if ((float)s->bounce >= params->rr_start) {
+    float keep = k_clamp(v3_max_component(s->throughput), 0.05f, 0.95f);
+    if (k_rng_next(&rng) >= keep) { s->rng = rng; return 0; }
+    s->throughput = v3_scale(s->throughput, 1.0f / keep);
+  }
+  s->rng = rng;
+  s->org = v3_madd(sf.position, sf.geo_normal, k_ray_epsilon(sf.position));
+  s->dir = wi;
+  s->layers = 0u;
+  return 1;
+}
+
 /* Radiance along one camera ray; pixel_spread is the angle one pixel subtends (for mip selection).
  * first_hit (may be null): where the ray's first opaque surface is recorded for the aux planes (a miss,
  * or a ray the path gives up on before one, is recorded as a miss). */
 KFN KVec3 k_trace_path(KTraceCtx* ctx, const KFrameParams* params, KVec3 org, KVec3 dir, float pixel_spread,
                        KRng* rng, KGLOBAL KPathFirstHit* first_hit) {
-  const KSceneView* scene = K_CTX_SCENE(ctx);
   if (first_hit) k_record_first_hit(first_hit, K_NONE, 0u, 0u);
-  KVec3 radiance = v3s(0.0f), throughput = v3s(1.0f);
-  float cone_width = 0.0f, spread = pixel_spread;
-  kuint bounce = 0u, layers = 0u;
-  float tmax = K_INF;
-  /* The last opaque vertex, for weighing emission that a bounce from it finds (MIS). */
-  int emissive_nee = params->emissive_samples > 0u && scene->emissive_count > 0u;
-  KVec3 vertex_position = org;
-  float vertex_brdf_pdf = 0.0f;
+  KPathState s;
+  k_path_begin(&s, org, dir, pixel_spread, *rng);
   for (;;) {
     KHit hit;
     hit.cost = 0u;
-    int lit_mode = params->mode == K_MODE_PATH || params->mode == K_MODE_DIRECT;
-    if (!k_trace_closest(ctx, org, dir, tmax, K_RAY_PRIMARY, &hit)) {
-      if (params->mode == K_MODE_BVH && bounce == 0u) radiance = k_heat_color((float)hit.cost / 200.0f);
-      if (lit_mode) k_apply_fog(scene, org, dir, tmax, &radiance, &throughput);
+    if (!k_trace_closest(ctx, s.org, s.dir, K_INF, K_RAY_PRIMARY, &hit)) {
+      k_path_miss(K_CTX_SCENE(ctx), params, &s, &hit);
       break;
     }
-    if (params->mode == K_MODE_BVH) { radiance = k_heat_color((float)hit.cost / 200.0f); break; }
-    if (params->mode == K_MODE_TRIANGLES) { radiance = k_id_color(hit.triangle); break; }
-    if (lit_mode) {
-      k_apply_fog(scene, org, dir, hit.t, &radiance, &throughput);
-      if (v3_max_component(throughput) <= 0.0f) break;
-    }
-    kuint hit_material = k_hit_material(scene, hit.instance, hit.triangle);
-    if (scene->materials[hit_material].blend == K_BLEND_SKY) {
-      /* The sky: what its cube shows along the ray, and nothing behind it. */
-      if (first_hit) k_record_first_hit(first_hit, hit.instance, hit.triangle, 1u);
-      if (lit_mode || params->mode == K_MODE_ALBEDO) {
-        KVec3 sky = v3_mul(throughput, k_sky_radiance(scene, hit.instance, hit_material, dir));
-        radiance = v3_add(radiance, bounce > 0u ? k_clamp_radiance(sky, params->firefly_clamp) : sky);
-      }
-      break;
-    }
-    cone_width += spread * hit.t;
-    KSurface sf = k_surface_eval(scene, hit, org, dir, cone_width);
-    KVec3 wo = v3_neg(dir);
-
-    if (sf.blend != K_BLEND_OPAQUE) {
-      /* Transparent layers: shade the layer, carry on through it without consuming a bounce. An
-       * environment stage (glass) adds its reflection over what the layer does, or, drawn before the
-       * layer's stage, under it: filtered by the layer like what is behind. */
-      KVec3 env = lit_mode ? k_environment_radiance(scene, hit, hit_material, sf.normal, dir) : v3s(0.0f);
-      KVec3 env_throughput = throughput;
-      if (sf.blend == K_BLEND_ADDITIVE) {
-        radiance = v3_add(radiance, v3_mul(throughput, v3_add(sf.albedo, sf.emission)));
-      } else if (sf.blend == K_BLEND_MODULATE) {
-        throughput = v3_mul(throughput, sf.albedo);
-      } else {
-        radiance = v3_add(radiance, v3_scale(v3_mul(throughput, sf.albedo), sf.alpha));
-        throughput = v3_scale(throughput, 1.0f - sf.alpha);
-      }
-      env = v3_mul((sf.flags & K_MAT_ENV_UNDER_LAYER) ? throughput : env_throughput, env);
-      radiance = v3_add(radiance, bounce > 0u ? k_clamp_radiance(env, params->firefly_clamp) : env);
-      if (++layers > K_MAX_LAYERS || v3_max_component(throughput) <= 0.0f) break;
-      org = v3_madd(sf.position, dir, k_ray_epsilon(sf.position));
-      continue;
-    }
-
-    if (first_hit) {
-      k_record_first_hit(first_hit, hit.instance, hit.triangle, 0u);
-      first_hit = 0;
-    }
-    if (params->mode == K_MODE_ALBEDO) { radiance = v3_add(sf.albedo, sf.emission); break; }
-    if (params->mode == K_MODE_NORMALS) { radiance = v3_add(v3_scale(sf.normal, 0.5f), v3s(0.5f)); break; }
-    if (params->mode == K_MODE_SPECULAR) { radiance = sf.specular; break; }
-
-    KFrameParams vertex_params = *params;
-    if (bounce > 0u) {
-      /* Path regularisation: after a bounce, a sharp highlight lit by next-event estimation is a
-       * caustic path the bounce found by chance (a firefly). Widen it and drop the boost there. */
-      sf.roughness = k_fmax(sf.roughness, K_REGULARIZED_ROUGHNESS);
-      vertex_params.spec_boost = 1.0f;
-    }
-    k_apply_blend_lights(scene, sf.position, &radiance, &throughput);
-    KVec3 contribution = sf.emission;
-    if (bounce > 0u && emissive_nee && v3_max_component(sf.emission) > 0.0f) {
-      KVec3 d = v3_sub(sf.position, vertex_position);
-      float light_pdf = k_emissive_pdf(scene, vertex_position, hit.instance, hit.triangle, v3_dot(d, d),
-                                       k_fabs(v3_dot(sf.geo_normal, dir)));
-      contribution = v3_scale(contribution, k_power_heuristic(vertex_brdf_pdf, light_pdf));
-    }
-    contribution = v3_add(contribution, k_environment_radiance(scene, hit, hit_material, sf.normal, dir));
-    float path_weight = v3_max_component(throughput);
-    contribution = v3_add(contribution, k_direct_lighting(ctx, &vertex_params, &sf, wo, path_weight, rng));
-    if (emissive_nee) {
-      int bounce_follows = params->mode != K_MODE_DIRECT && bounce < params->max_bounces;
-      contribution = v3_add(contribution,
-                            k_emissive_lighting(ctx, &sf, wo, bounce_follows, params->shadow_rr, path_weight, rng));
-    }
-    contribution = v3_mul(throughput, contribution);
-    if (bounce > 0u) contribution = k_clamp_radiance(contribution, params->firefly_clamp);
-    radiance = v3_add(radiance, contribution);
-
-    if (params->mode == K_MODE_DIRECT || bounce >= params->max_bounces) break;
-
-    KVec3 wi;
-    float u_lobe = k_rng_next(rng), u1 = k_rng_next(rng), u2 = k_rng_next(rng);
-    KVec3 weight = k_brdf_sample(&sf, wo, u_lobe, u1, u2, &wi);
-    if (v3_max_component(weight) <= 0.0f || v3_dot(wi, sf.geo_normal) <= 0.0f) break;
-    throughput = v3_mul(throughput, weight);
-    vertex_position = sf.position;
-    vertex_brdf_pdf = k_brdf_pdf(&sf, wo, wi);
-    spread += K_BOUNCE_SPREAD;
-    ++bounce;
-    if ((float)bounce >= params->rr_start) {
-      float keep = k_clamp(v3_max_component(throughput), 0.05f, 0.95f);
-      if (k_rng_next(rng) >= keep) break;
-      throughput = v3_scale(throughput, 1.0f / keep);
-    }
-    org = v3_madd(sf.position, sf.geo_normal, k_ray_epsilon(sf.position));
-    dir = wi;
-    layers = 0u;
+    if (!k_path_hit(ctx, params, &s, hit, first_hit)) break;
   }
-  return radiance;
+  *rng = s.rng;
+  return s.radiance;
 }
 
 /* The angle one pixel subtends, for k_trace_path's mip selection. */

@@ -36,6 +36,10 @@ class CudaTracer final : public TracerBase {
     unsigned long long closest = 0, occlusion = 0;
   };
   void set_ray_counting(bool on);
+  // Bounce rays walked by a kernel of their own between shading kernels (the wavefront) instead of the
+  // megakernel; same image, faster (docs/integrator.md). On unless COHORT_CUDA_WAVEFRONT=0.
+  void set_wavefront(bool on);
+  bool wavefront() const;
   RayCounts last_ray_counts() const;
   int device() const;
 

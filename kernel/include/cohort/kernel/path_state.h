@@ -1,0 +1,25 @@
+/* A path between two of its rays: all the integrator (integrator.h's k_path_hit) carries from one surface
+ * to the next. Plain data, so that a wavefront tracer keeps it in memory between the kernel that walks a
+ * path's next ray and the one that shades what it met (tracers/cuda), where the megakernel keeps it in
+ * registers. */
+#ifndef COHORT_KERNEL_PATH_STATE_H
+#define COHORT_KERNEL_PATH_STATE_H
+#include "portable.h"
+#include "rng.h"
+#include "vec.h"
+
+typedef struct KPathState {
+  KVec3 radiance, throughput;
+  KVec3 org, dir;          /* the next ray */
+  KVec3 vertex_position;   /* the last opaque vertex, for weighing emission a bounce from it finds (MIS) */
+  float cone_width, spread, vertex_brdf_pdf;
+  kuint bounce, layers;
+  KRng rng;
+  kuint pad;
+} KPathState;
+
+#if defined(__cplusplus) && !defined(__CUDACC_RTC__)
+static_assert(sizeof(KPathState) == 88, "KPathState layout");
+#endif
+
+#endif
