@@ -4,6 +4,8 @@
 #include <cuda_fp16.h>
 #include <cuda_runtime.h>
 
+#include <cstdlib>
+
 #define K_CUDA_DEVICE_ONLY 1
 #define K_BVH_TRIANGLE_EDGES 1  // leaves read KTriangleEdges (CudaTracer keeps them with the triangles)
 __constant__ cudaTextureObject_t cohort_texel_texture;
@@ -12,6 +14,7 @@ __constant__ cudaTextureObject_t cohort_texel_texture;
 #include "cohort/kernel/trace_bvh.h"
 #include "cohort/kernel/integrator.h"
 #include "cohort/kernel/aux_outputs.h"
+#include "ray_counting.cuh"
 #include "render_band_launch.h"
 
 namespace cohort::tracers {
@@ -23,29 +26,6 @@ namespace cohort::tracers {
 // 128-register kernel even that early exit cost 1.5-2% of a full frame (nvidia-h100-x1, docs/integrator.md).
 // kFirstHit: the first sample's first surface is recorded for the aux planes (K_AUX_PATH_FIRST_HIT), a
 // build of its own so that the kernel without it stays as it was.
-// The rays a thread traced, added up per warp: into ray_counts (closest, occlusion; may be null) and into
-// row_rays, the rays per row of the band (the balancer's per-row work; may be null). Every lane of the warp
-// calls it, inside the image or not; blocks are 16 wide, so a warp holds two rows.
-__device__ void count_rays(const KTraceCtx& ctx, bool inside, kuint row, bool row_inside,
-                           unsigned long long* ray_counts, unsigned* row_rays) {
-  if (ray_counts) {
-    unsigned closest = __reduce_add_sync(0xffffffffu, ctx.closest_rays);
-    unsigned occlusion = __reduce_add_sync(0xffffffffu, ctx.occlusion_rays);
-    if ((threadIdx.x + threadIdx.y * blockDim.x) % 32u == 0u) {
-      atomicAdd(&ray_counts[0], (unsigned long long)closest);
-      atomicAdd(&ray_counts[1], (unsigned long long)occlusion);
-    }
-  }
-  if (row_rays) {
-    const unsigned mine = inside ? ctx.closest_rays + ctx.occlusion_rays : 0u;
-    const unsigned lane = (threadIdx.x + threadIdx.y * blockDim.x) % 32u;
-    const unsigned low = __reduce_add_sync(0xffffffffu, lane < 16u ? mine : 0u);
-    const unsigned high = __reduce_add_sync(0xffffffffu, lane >= 16u ? mine : 0u);
-    const unsigned half = lane < 16u ? low : high;
-    if ((lane == 0u || lane == 16u) && row_inside && half != 0u) atomicAdd(&row_rays[row], half);
-  }
-}
-
 template <bool kSparse, bool kFirstHit>
 __global__ void __launch_bounds__(128, 4) render_band_kernel(KSceneView scene, KFrameParams params, KCamera camera,
                                                           float4* band, unsigned long long* ray_counts,
@@ -140,35 +120,13 @@ __global__ void __launch_bounds__(128, 4) wave_camera_kernel(KSceneView scene, K
   count_rays(ctx, inside, row, y < params.row_end, ray_counts, row_rays);
 }
 
-// The live paths' bounce rays, walked: their hits (instance K_NONE: a miss) for the shading kernel.
-// 8 blocks of 128 threads an SM cap it at 64 registers (half occupancy; a few bytes spilled): on one H100 the
-// large map's 1080p frame took 8.90-8.94 ms so, 8.96-9.04 at 80 registers and 9.13-9.17 at its own 96.
-__global__ void __launch_bounds__(128, 8) wave_bounce_kernel(KSceneView scene, KFrameParams params, KCamera camera,
-                                                          WavefrontScratch wave, unsigned long long* ray_counts,
-                                                          unsigned* row_rays) {
-  const kuint x = blockIdx.x * blockDim.x + threadIdx.x;
-  const kuint row = blockIdx.y * blockDim.y + threadIdx.y;
-  const kuint y = params.row_begin + row;
-  const size_t p = size_t(row) * camera.width + x;
-  const bool inside = x < camera.width && y < params.row_end && wave.active[p];
-  KTraceCtx ctx;
-  ctx.scene = scene;
-  ctx.closest_rays = 0u;
-  ctx.occlusion_rays = 0u;
-  if (inside) {
-    const KPathState* s = wave.states + p;
-    KHit hit;
-    hit.cost = 0u;
-    if (!k_trace_closest(&ctx, s->org, s->dir, K_INF, K_RAY_PRIMARY, &hit)) hit.instance = K_NONE;
-    wave.hits[p] = hit;
-  }
-  count_rays(ctx, inside, row, y < params.row_end, ray_counts, row_rays);
-}
-
-// What the live paths' bounce rays met, shaded, and their paths on to the next bounce.
+// What the live paths' rays (walked by wavefront_walk.cu's kernels) met, shaded, and the paths on to their
+// next bounce. kFirstHit: the camera rays' segment of the frame's first sample, which records first hits.
+template <bool kFirstHit>
 __global__ void __launch_bounds__(128, 4) wave_shade_kernel(KSceneView scene, KFrameParams params, KCamera camera,
                                                          kuint sample, float4* band, WavefrontScratch wave,
-                                                         unsigned long long* ray_counts, unsigned* row_rays) {
+                                                         unsigned long long* ray_counts, unsigned* row_rays,
+                                                         KPathFirstHit* first_hits) {
   const kuint x = blockIdx.x * blockDim.x + threadIdx.x;
   const kuint row = blockIdx.y * blockDim.y + threadIdx.y;
   const kuint y = params.row_begin + row;
@@ -181,7 +139,7 @@ __global__ void __launch_bounds__(128, 4) wave_shade_kernel(KSceneView scene, KF
   if (inside) {
     KPathState s = wave.states[p];
     const KHit hit = wave.hits[p];
-    const bool goes_on = path_segment(&ctx, &params, &s, &hit, nullptr);
+    const bool goes_on = path_segment(&ctx, &params, &s, &hit, kFirstHit ? first_hits + p : nullptr);
     if (goes_on) wave.states[p] = s;
     else {
       wave.active[p] = 0u;
@@ -260,6 +218,7 @@ void launch_aux_from_first_hits(const KSceneView& scene, const KFrameParams& par
 
 void set_texel_texture(cudaTextureObject_t texture) {
   COHORT_CUDA(cudaMemcpyToSymbol(cohort_texel_texture, &texture, sizeof texture));
+  set_walk_texel_texture(texture);
 }
 
 void launch_render_band(const KSceneView& scene, const KFrameParams& params, const KCamera& camera, float4* band,
@@ -271,16 +230,28 @@ void launch_render_band(const KSceneView& scene, const KFrameParams& params, con
   const bool sparse = params.path_pixels != 0u && params.path_pixels < K_PATH_PATTERN_PIXELS;
   if (wave && wavefront_renders(params)) {
     const kuint spp = params.spp > 0u ? params.spp : 1u;
+    static const bool camera_walk = !std::getenv("COHORT_EXP_CAMERA_WALK") || std::atoi(std::getenv("COHORT_EXP_CAMERA_WALK"));
     for (kuint sample = 0u; sample < spp; ++sample) {
-      if (first_hits)
+      KPathFirstHit* records = sample == 0u ? first_hits : nullptr;
+      if (camera_walk) {
+        launch_wave_camera_walk(grid, block, scene, params, camera, sample, *wave, records, ray_counts, row_rays, stream);
+        if (records)
+          wave_shade_kernel<true><<<grid, block, 0, stream>>>(scene, params, camera, sample, band, *wave, ray_counts,
+                                                              row_rays, records);
+        else
+          wave_shade_kernel<false><<<grid, block, 0, stream>>>(scene, params, camera, sample, band, *wave, ray_counts,
+                                                               row_rays, nullptr);
+      } else if (first_hits) {
         wave_camera_kernel<true><<<grid, block, 0, stream>>>(scene, params, camera, sample, band, *wave, ray_counts,
                                                              row_rays, first_hits);
-      else
+      } else {
         wave_camera_kernel<false><<<grid, block, 0, stream>>>(scene, params, camera, sample, band, *wave, ray_counts,
                                                               row_rays, nullptr);
+      }
       for (kuint bounce = 1u; bounce <= params.max_bounces; ++bounce) {
-        wave_bounce_kernel<<<grid, block, 0, stream>>>(scene, params, camera, *wave, ray_counts, row_rays);
-        wave_shade_kernel<<<grid, block, 0, stream>>>(scene, params, camera, sample, band, *wave, ray_counts, row_rays);
+        launch_wave_bounce_walk(grid, block, scene, params, camera, *wave, ray_counts, row_rays, stream);
+        wave_shade_kernel<false><<<grid, block, 0, stream>>>(scene, params, camera, sample, band, *wave, ray_counts,
+                                                             row_rays, nullptr);
       }
     }
   } else if (sparse)

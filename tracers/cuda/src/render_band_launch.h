@@ -19,6 +19,16 @@ struct WavefrontScratch {
   KHit* hits = nullptr;
   kuint* active = nullptr;
 };
+// The wavefront's walks (wavefront_walk.cu): the camera rays of a sample, their paths begun (records: the
+// first-hit records to clear, or null), and the live paths' bounce rays; each ray's hit into wave.hits.
+void launch_wave_camera_walk(dim3 grid, dim3 block, const KSceneView& scene, const KFrameParams& params,
+                             const KCamera& camera, kuint sample, const WavefrontScratch& wave, KPathFirstHit* records,
+                             unsigned long long* ray_counts, unsigned* row_rays, cudaStream_t stream);
+void launch_wave_bounce_walk(dim3 grid, dim3 block, const KSceneView& scene, const KFrameParams& params,
+                             const KCamera& camera, const WavefrontScratch& wave, unsigned long long* ray_counts,
+                             unsigned* row_rays, cudaStream_t stream);
+// That translation unit's copy of the texel texture (its alpha-tested surfaces read it).
+void set_walk_texel_texture(cudaTextureObject_t texture);
 // Whether launch_render_band renders this band as a wavefront when given the scratch: lit paths that bounce,
 // every pixel tracing (the sparse pattern of dynamic resolution stays with the megakernel).
 inline bool wavefront_renders(const KFrameParams& params) {

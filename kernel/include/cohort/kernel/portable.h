@@ -37,7 +37,9 @@
    * four copies of it; as one called function the test map frame went from 6.2 to 4.2 ms on one H100
    * (docs/integrator.md, "CUDA kernel shape"). Outlining the surface and lighting functions as well was
    * slower (4.6 ms). */
-  #if defined(__CUDACC__) && defined(K_CUDA_DEVICE_ONLY)
+  #if defined(KFN_OUTLINED)
+    /* the includer's choice (a kernel of one walk inlines it) */
+  #elif defined(__CUDACC__) && defined(K_CUDA_DEVICE_ONLY)
     #define KFN_OUTLINED static __device__ __noinline__
   #elif defined(__CUDACC__)
     #define KFN_OUTLINED static __host__ __device__ __noinline__

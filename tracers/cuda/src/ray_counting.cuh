@@ -1,0 +1,33 @@
+// Ray counting shared by the CUDA tracer's kernels (render_band.cu, wavefront_walk.cu).
+#pragma once
+
+#include <cuda_runtime.h>
+
+#include "cohort/kernel/trace_bvh.h"
+
+namespace cohort::tracers {
+
+// The rays a thread traced, added up per warp: into ray_counts (closest, occlusion; may be null) and into
+// row_rays, the rays per row of the band (the balancer's per-row work; may be null). Every lane of the warp
+// calls it, inside the image or not; blocks are 16 wide, so a warp holds two rows.
+__device__ inline void count_rays(const KTraceCtx& ctx, bool inside, kuint row, bool row_inside,
+                           unsigned long long* ray_counts, unsigned* row_rays) {
+  if (ray_counts) {
+    unsigned closest = __reduce_add_sync(0xffffffffu, ctx.closest_rays);
+    unsigned occlusion = __reduce_add_sync(0xffffffffu, ctx.occlusion_rays);
+    if ((threadIdx.x + threadIdx.y * blockDim.x) % 32u == 0u) {
+      atomicAdd(&ray_counts[0], (unsigned long long)closest);
+      atomicAdd(&ray_counts[1], (unsigned long long)occlusion);
+    }
+  }
+  if (row_rays) {
+    const unsigned mine = inside ? ctx.closest_rays + ctx.occlusion_rays : 0u;
+    const unsigned lane = (threadIdx.x + threadIdx.y * blockDim.x) % 32u;
+    const unsigned low = __reduce_add_sync(0xffffffffu, lane < 16u ? mine : 0u);
+    const unsigned high = __reduce_add_sync(0xffffffffu, lane >= 16u ? mine : 0u);
+    const unsigned half = lane < 16u ? low : high;
+    if ((lane == 0u || lane == 16u) && row_inside && half != 0u) atomicAdd(&row_rays[row], half);
+  }
+}
+
+}  // namespace cohort::tracers

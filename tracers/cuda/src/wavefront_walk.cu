@@ -1,0 +1,95 @@
+// The wavefront's walks (render_band.cu has the shading): kernels that only walk rays through the BVH, with
+// the walk inlined (one call site each) and at most 64 registers, so that twice the megakernel's warps hide
+// the memory latency of incoherent bounce rays. Measured on one H100 (docs/integrator.md): the bounce walk
+// outlined at its own 96 registers, 80 and 64: 9.13-9.17, 8.96-9.04 and 8.86-8.93 ms a 1080p frame of the
+// large map; inlined at 64 registers 8.61; inlined at 72 and 79, 8.77-8.82.
+#include <cuda_runtime.h>
+
+#define K_CUDA_DEVICE_ONLY 1
+#define K_BVH_TRIANGLE_EDGES 1
+#define KFN_OUTLINED static __device__ __forceinline__
+// This translation unit's own copy of the texel texture: alpha-tested surfaces are looked up mid-walk.
+static __constant__ cudaTextureObject_t cohort_walk_texel_texture;
+#define K_TEXEL_LOAD(texels, index) tex1Dfetch<unsigned int>(cohort_walk_texel_texture, (int)(index))
+
+#include "cohort/kernel/trace_bvh.h"
+#include "cohort/kernel/integrator.h"
+#include "ray_counting.cuh"
+#include "render_band_launch.h"
+
+namespace cohort::tracers {
+
+namespace {
+
+// A sample's camera rays: each pixel's path begun in wave.states, its first hit in wave.hits.
+__global__ void __launch_bounds__(128, 8) camera_walk_kernel(KSceneView scene, KFrameParams params, KCamera camera,
+                                                             kuint sample, WavefrontScratch wave,
+                                                             KPathFirstHit* records, unsigned long long* ray_counts,
+                                                             unsigned* row_rays) {
+  const kuint x = blockIdx.x * blockDim.x + threadIdx.x;
+  const kuint row = blockIdx.y * blockDim.y + threadIdx.y;
+  const kuint y = params.row_begin + row;
+  const bool inside = x < camera.width && y < params.row_end;
+  KTraceCtx ctx;
+  ctx.scene = scene;
+  ctx.closest_rays = 0u;
+  ctx.occlusion_rays = 0u;
+  if (inside) {
+    const size_t p = size_t(row) * camera.width + x;
+    if (records) k_record_first_hit(records + p, K_NONE, 0u, 0u);
+    KRng rng;
+    const KVec3 dir = k_camera_sample(&params, &camera, x, y, sample, &rng);
+    KPathState s;
+    k_path_begin(&s, v3_load(camera.origin), dir, k_pixel_spread(&camera), rng);
+    KHit hit;
+    hit.cost = 0u;
+    if (!k_trace_closest(&ctx, s.org, s.dir, K_INF, K_RAY_PRIMARY, &hit)) hit.instance = K_NONE;
+    wave.states[p] = s;
+    wave.hits[p] = hit;
+    wave.active[p] = 1u;
+  }
+  count_rays(ctx, inside, row, y < params.row_end, ray_counts, row_rays);
+}
+
+// The live paths' bounce rays: their hits (instance K_NONE: a miss) for the shading kernel.
+__global__ void __launch_bounds__(128, 8) bounce_walk_kernel(KSceneView scene, KFrameParams params, KCamera camera,
+                                                             WavefrontScratch wave, unsigned long long* ray_counts,
+                                                             unsigned* row_rays) {
+  const kuint x = blockIdx.x * blockDim.x + threadIdx.x;
+  const kuint row = blockIdx.y * blockDim.y + threadIdx.y;
+  const kuint y = params.row_begin + row;
+  const size_t p = size_t(row) * camera.width + x;
+  const bool inside = x < camera.width && y < params.row_end && wave.active[p];
+  KTraceCtx ctx;
+  ctx.scene = scene;
+  ctx.closest_rays = 0u;
+  ctx.occlusion_rays = 0u;
+  if (inside) {
+    const KPathState* s = wave.states + p;
+    KHit hit;
+    hit.cost = 0u;
+    if (!k_trace_closest(&ctx, s->org, s->dir, K_INF, K_RAY_PRIMARY, &hit)) hit.instance = K_NONE;
+    wave.hits[p] = hit;
+  }
+  count_rays(ctx, inside, row, y < params.row_end, ray_counts, row_rays);
+}
+
+}  // namespace
+
+void set_walk_texel_texture(cudaTextureObject_t texture) {
+  COHORT_CUDA(cudaMemcpyToSymbol(cohort_walk_texel_texture, &texture, sizeof texture));
+}
+
+void launch_wave_camera_walk(dim3 grid, dim3 block, const KSceneView& scene, const KFrameParams& params,
+                             const KCamera& camera, kuint sample, const WavefrontScratch& wave, KPathFirstHit* records,
+                             unsigned long long* ray_counts, unsigned* row_rays, cudaStream_t stream) {
+  camera_walk_kernel<<<grid, block, 0, stream>>>(scene, params, camera, sample, wave, records, ray_counts, row_rays);
+}
+
+void launch_wave_bounce_walk(dim3 grid, dim3 block, const KSceneView& scene, const KFrameParams& params,
+                             const KCamera& camera, const WavefrontScratch& wave, unsigned long long* ray_counts,
+                             unsigned* row_rays, cudaStream_t stream) {
+  bounce_walk_kernel<<<grid, block, 0, stream>>>(scene, params, camera, wave, ray_counts, row_rays);
+}
+
+}  // namespace cohort::tracers
