@@ -1,6 +1,7 @@
 #include "cohort/tracers/tracer_registry.h"
 
 #include <algorithm>
+#include <cstdlib>
 #include <stdexcept>
 #include <thread>
 
@@ -139,6 +140,15 @@ std::unique_ptr<core::Tracer> make_tracer(const TracerSpec& spec) {
   if (spec.kind == "opencl") {
     OpenCLTracer::Options options;
     options.device = spec.device;
+    // For A/B runs of the first-hit pieces (1: the whole band, then its aux work) without a rebuild.
+    if (const char* pieces = std::getenv("COHORT_OPENCL_FIRST_HIT_PIECES"); pieces && *pieces) {
+      char* end = nullptr;
+      const long count = std::strtol(pieces, &end, 10);
+      if (*end != '\0' || count < 1 || count > OpenCLTracer::kMaxFirstHitPieces)
+        throw std::invalid_argument("COHORT_OPENCL_FIRST_HIT_PIECES='" + std::string(pieces) + "': expected a count from 1 to " +
+                                    std::to_string(OpenCLTracer::kMaxFirstHitPieces));
+      options.first_hit_pieces = static_cast<int>(count);
+    }
     return std::make_unique<OpenCLTracer>(options);
   }
 #endif
