@@ -61,6 +61,22 @@ TEST(OpenCLFirstHitPieces, TheTracerRefusesAPieceCountOutOfRange) {
   }
 }
 
+// COHORT_OPENCL_FIRST_HIT_PIECES (A/B runs) is read before any device is asked: a bad value is named.
+TEST(OpenCLFirstHitPieces, ABadPieceCountInTheEnvironmentIsNamed) {
+  for (const char* bad : {"0", "9", "four", "2x"}) {
+    ::setenv("COHORT_OPENCL_FIRST_HIT_PIECES", bad, 1);
+    std::string message;
+    try {
+      tracers::make_tracer(tracers::parse_tracer_list("opencl:0").front());
+    } catch (const std::invalid_argument& e) {
+      message = e.what();
+    }
+    ::unsetenv("COHORT_OPENCL_FIRST_HIT_PIECES");
+    EXPECT_NE(message.find(std::string("COHORT_OPENCL_FIRST_HIT_PIECES='") + bad + "'"), std::string::npos)
+        << bad << ": " << message;
+  }
+}
+
 std::unique_ptr<tracers::OpenCLTracer> opencl_in_pieces(int pieces) {
   tracers::OpenCLTracer::Options options;
   if (const char* device = std::getenv("COHORT_TEST_OPENCL_DEVICE")) options.device = std::atoi(device);
