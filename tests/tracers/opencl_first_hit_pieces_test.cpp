@@ -10,6 +10,7 @@
 #include <cstring>
 #include <memory>
 #include <string>
+#include <utility>
 
 #include "test_scenes.h"
 #include "test_tracers.h"
@@ -61,26 +62,32 @@ TEST(OpenCLFirstHitPieces, TheTracerRefusesAPieceCountOutOfRange) {
   }
 }
 
-// COHORT_OPENCL_FIRST_HIT_PIECES (A/B runs) is read before any device is asked: a bad value is named.
-TEST(OpenCLFirstHitPieces, ABadPieceCountInTheEnvironmentIsNamed) {
-  for (const char* bad : {"0", "9", "four", "2x"}) {
-    ::setenv("COHORT_OPENCL_FIRST_HIT_PIECES", bad, 1);
+// COHORT_OPENCL_FIRST_HIT_PIECES and COHORT_OPENCL_AUX_INTO_TARGET (A/B runs) are read before any device
+// is asked: a bad value is named.
+TEST(OpenCLFirstHitPieces, ABadValueInTheEnvironmentIsNamed) {
+  const std::pair<const char*, const char*> bad_values[] = {{"COHORT_OPENCL_FIRST_HIT_PIECES", "0"},
+                                                            {"COHORT_OPENCL_FIRST_HIT_PIECES", "9"},
+                                                            {"COHORT_OPENCL_FIRST_HIT_PIECES", "four"},
+                                                            {"COHORT_OPENCL_FIRST_HIT_PIECES", "2x"},
+                                                            {"COHORT_OPENCL_AUX_INTO_TARGET", "yes"}};
+  for (const auto& [variable, bad] : bad_values) {
+    ::setenv(variable, bad, 1);
     std::string message;
     try {
       tracers::make_tracer(tracers::parse_tracer_list("opencl:0").front());
     } catch (const std::invalid_argument& e) {
       message = e.what();
     }
-    ::unsetenv("COHORT_OPENCL_FIRST_HIT_PIECES");
-    EXPECT_NE(message.find(std::string("COHORT_OPENCL_FIRST_HIT_PIECES='") + bad + "'"), std::string::npos)
-        << bad << ": " << message;
+    ::unsetenv(variable);
+    EXPECT_NE(message.find(std::string(variable) + "='" + bad + "'"), std::string::npos) << bad << ": " << message;
   }
 }
 
-std::unique_ptr<tracers::OpenCLTracer> opencl_in_pieces(int pieces) {
+std::unique_ptr<tracers::OpenCLTracer> opencl_in_pieces(int pieces, bool aux_into_target = false) {
   tracers::OpenCLTracer::Options options;
   if (const char* device = std::getenv("COHORT_TEST_OPENCL_DEVICE")) options.device = std::atoi(device);
   options.first_hit_pieces = pieces;
+  options.aux_into_target = aux_into_target;
   return std::make_unique<tracers::OpenCLTracer>(options);
 }
 
@@ -128,33 +135,36 @@ TEST(OpenCLFirstHitPieces, PiecedBandsEqualTheBandInOnePiece) {
   if (!tracer_runs_here("opencl")) GTEST_SKIP() << "no OpenCL device here";
   auto room = std::make_shared<commit::TracerScene>(core::compile_scene(test_room()).tracer_scene);
   auto whole = opencl_in_pieces(1);
-  auto pieced = opencl_in_pieces(4);
   whole->apply(commit::CommitBuffer::full(room, 1));
-  pieced->apply(commit::CommitBuffer::full(room, 1));
-  for (const Band& band : kBands)
-    for (core::BandFormat format : {core::BandFormat::rgb16f, core::BandFormat::rgba32f}) {
-      SCOPED_TRACE(std::string(band.what) + (format == core::BandFormat::rgb16f ? ", half floats" : ", floats"));
-      const Rendered a = render_band(*whole, band, format);
-      const Rendered b = render_band(*pieced, band, format);
-      ASSERT_EQ(std::memcmp(a.buffer->data(), b.buffer->data(), a.buffer->bytes()), 0) << "the colours differ";
-      ASSERT_EQ(std::memcmp(a.buffer->aux_data(), b.buffer->aux_data(), a.buffer->aux_bytes()), 0) << "the planes differ";
-      EXPECT_EQ(b.result.row_work, a.result.row_work);
-      ASSERT_EQ(b.result.row_work.size(), size_t(band.end - band.begin));
-      for (float rays : b.result.row_work) EXPECT_GE(rays, float(kW)) << "every pixel traces its camera ray";
-      EXPECT_GT(b.result.device_ms, 0.0);
-      // The band's rows hold a picture and planes; the rows outside it are untouched (zero).
-      const core::GBuffer g = planes_of(*b.buffer, band);
-      size_t hits = 0, outside = 0;
-      for (int y = 0; y < kH; ++y)
-        for (int x = 0; x < band.target_width; ++x) {
-          const bool inside = y >= band.begin && y < band.end && x < kW;
-          const float depth = g.depth[size_t(y) * size_t(band.target_width) + size_t(x)];
-          hits += inside && depth > 0.0f ? 1u : 0u;
-          outside += !inside && depth != 0.0f ? 1u : 0u;
-        }
-      EXPECT_GT(hits, size_t(band.end - band.begin) * kW / 2) << "the planes are mostly empty";
-      EXPECT_EQ(outside, 0u) << "planes written outside the band";
-    }
+  for (bool aux_into_target : {false, true}) {
+    auto pieced = opencl_in_pieces(4, aux_into_target);
+    pieced->apply(commit::CommitBuffer::full(room, 1));
+    for (const Band& band : kBands)
+      for (core::BandFormat format : {core::BandFormat::rgb16f, core::BandFormat::rgba32f}) {
+        SCOPED_TRACE(std::string(band.what) + (format == core::BandFormat::rgb16f ? ", half floats" : ", floats") +
+                     (aux_into_target ? ", aux read into the target" : ", aux through page-locked staging"));
+        const Rendered a = render_band(*whole, band, format);
+        const Rendered b = render_band(*pieced, band, format);
+        ASSERT_EQ(std::memcmp(a.buffer->data(), b.buffer->data(), a.buffer->bytes()), 0) << "the colours differ";
+        ASSERT_EQ(std::memcmp(a.buffer->aux_data(), b.buffer->aux_data(), a.buffer->aux_bytes()), 0) << "the planes differ";
+        EXPECT_EQ(b.result.row_work, a.result.row_work);
+        ASSERT_EQ(b.result.row_work.size(), size_t(band.end - band.begin));
+        for (float rays : b.result.row_work) EXPECT_GE(rays, float(kW)) << "every pixel traces its camera ray";
+        EXPECT_GT(b.result.device_ms, 0.0);
+        // The band's rows hold a picture and planes; the rows outside it are untouched (zero).
+        const core::GBuffer g = planes_of(*b.buffer, band);
+        size_t hits = 0, outside = 0;
+        for (int y = 0; y < kH; ++y)
+          for (int x = 0; x < band.target_width; ++x) {
+            const bool inside = y >= band.begin && y < band.end && x < kW;
+            const float depth = g.depth[size_t(y) * size_t(band.target_width) + size_t(x)];
+            hits += inside && depth > 0.0f ? 1u : 0u;
+            outside += !inside && depth != 0.0f ? 1u : 0u;
+          }
+        EXPECT_GT(hits, size_t(band.end - band.begin) * kW / 2) << "the planes are mostly empty";
+        EXPECT_EQ(outside, 0u) << "planes written outside the band";
+      }
+  }
 }
 
 // Agreement with Embree's first-hit planes (the tolerance of AgreementAux): the pieces' rows land where

@@ -223,6 +223,7 @@ struct OpenCLTracer::Impl {
   // the core's merge and tone map hold while this band renders.
   core::HostThreads aux_copy_threads{3};
   int first_hit_pieces = 1;  // Options::first_hit_pieces
+  bool aux_into_target = false;  // Options::aux_into_target
   DeviceBuffer previous_transforms, previous_joints;
   DeviceBuffer vertices, vertex_colors, triangles, blas_nodes, blases, instances, tlas_nodes, materials, textures, texels, lights, light_nodes,
       emissive;
@@ -372,6 +373,7 @@ OpenCLTracer::OpenCLTracer(const Options& options) : impl_(std::make_unique<Impl
     throw std::invalid_argument("OpenCLTracer: first_hit_pieces " + std::to_string(options.first_hit_pieces) +
                                 " is outside 1-" + std::to_string(kMaxFirstHitPieces));
   impl_->first_hit_pieces = options.first_hit_pieces;
+  impl_->aux_into_target = options.aux_into_target;
   std::vector<DeviceEntry> devices = all_devices();
   if (devices.empty()) throw std::runtime_error("OpenCLTracer: no OpenCL platform/device found");
   if (options.device < 0 || static_cast<size_t>(options.device) >= devices.size())
@@ -635,8 +637,10 @@ core::BandResult OpenCLTracer::render_first_hits_in_pieces(const core::BandJob& 
   const size_t colour_bytes = half ? 6 : 4 * sizeof(float);
   cl_mem colour = half ? m.grow(m.packed, m.packed_bytes, pixels * 6, "clCreateBuffer(half band)") : m.output;
   const size_t aux_bytes = straight ? sizeof(KAuxTexel) : sizeof(KAux);
-  char* staging = static_cast<char*>(
-      m.aux_staging.reserve(m.context, m.aux_queue, pixels * aux_bytes, "allocating page-locked aux memory"));
+  const bool aux_into_target = straight && m.aux_into_target;
+  char* staging = aux_into_target ? nullptr
+                                  : static_cast<char*>(m.aux_staging.reserve(m.context, m.aux_queue, pixels * aux_bytes,
+                                                                             "allocating page-locked aux memory"));
   // The whole band's texels before the first piece: growing them later would lose the earlier pieces'.
   if (straight) m.grow(m.packed_aux, m.packed_aux_bytes, pixels * sizeof(KAuxTexel), "clCreateBuffer(aux texels)");
   prepare_aux(job, camera, rows);
@@ -661,15 +665,17 @@ core::BandResult OpenCLTracer::render_first_hits_in_pieces(const core::BandJob& 
   for (size_t i = 0; i < pieces; ++i) {
     const size_t first = starts[i], count = starts[i + 1] - first;
     const cl_event ready = piece_ready[i].get();
+    void* aux_destination =
+        aux_into_target ? static_cast<void*>(target.aux_row(int(params.row_begin + first))) : staging + first * width * aux_bytes;
     check(clEnqueueReadBuffer(m.aux_queue, straight ? m.packed_aux : m.aux, CL_FALSE, first * width * aux_bytes,
-                              count * width * aux_bytes, staging + first * width * aux_bytes, 1, &ready,
-                              aux_read[i].out()),
+                              count * width * aux_bytes, aux_destination, 1, &ready, aux_read[i].out()),
           "reading the aux band");
     void* colour_destination = straight ? target.row(int(params.row_begin + first)) : band.data() + first * width * 4;
     check(clEnqueueReadBuffer(m.aux_queue, colour, CL_FALSE, first * width * colour_bytes, count * width * colour_bytes,
                               colour_destination, 1, &ready, colour_read[i].out()),
           "reading the band");
     check(clFlush(m.aux_queue), "clFlush(aux)");
+    if (aux_into_target) continue;  // both reads land in place: the queue is finished below
     m.copy_aux_rows_into(target, int(params.row_begin + first), width, count, staging + first * width * aux_bytes,
                          straight, aux_read[i].get());
     if (straight) continue;

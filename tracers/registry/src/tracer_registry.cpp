@@ -149,6 +149,11 @@ std::unique_ptr<core::Tracer> make_tracer(const TracerSpec& spec) {
                                     std::to_string(OpenCLTracer::kMaxFirstHitPieces));
       options.first_hit_pieces = static_cast<int>(count);
     }
+    if (const char* into = std::getenv("COHORT_OPENCL_AUX_INTO_TARGET"); into && *into) {
+      if (std::string(into) != "0" && std::string(into) != "1")
+        throw std::invalid_argument("COHORT_OPENCL_AUX_INTO_TARGET='" + std::string(into) + "': expected 0 or 1");
+      options.aux_into_target = std::string(into) == "1";
+    }
     return std::make_unique<OpenCLTracer>(options);
   }
 #endif

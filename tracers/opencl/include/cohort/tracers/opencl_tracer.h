@@ -20,6 +20,10 @@ class OpenCLTracer : public TracerBase {
     // each one's aux finishing, read and host copy overlap the next one's rendering (1: one range, the
     // whole band, then its aux work after it). At most kMaxFirstHitPieces.
     int first_hit_pieces = 4;
+    // Pieces spanning the target's width read their aux texels straight into its rows (pageable memory)
+    // instead of into page-locked staging and then copying them on the host: for measuring one against
+    // the other on a GPU driver.
+    bool aux_into_target = false;
   };
   static constexpr int kMaxFirstHitPieces = 8;
   // The pieces' first rows, relative to the band, and `rows` last: up to `pieces` ranges of whole work
