@@ -3,6 +3,7 @@
 #include <CL/cl.h>
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cstring>
 #include <stdexcept>
@@ -221,6 +222,8 @@ struct OpenCLTracer::Impl {
   // threads of its own (1.35 ms median on nvidia-h100-x2, docs/balancing.md), not the shared pool, which
   // the core's merge and tone map hold while this band renders.
   core::HostThreads aux_copy_threads{3};
+  int first_hit_pieces = 1;  // Options::first_hit_pieces
+  bool aux_into_target = false;  // Options::aux_into_target
   DeviceBuffer previous_transforms, previous_joints;
   DeviceBuffer vertices, vertex_colors, triangles, blas_nodes, blases, instances, tlas_nodes, materials, textures, texels, lights, light_nodes,
       emissive;
@@ -297,14 +300,37 @@ struct OpenCLTracer::Impl {
     }
     return mem;
   }
-  // Runs a 1-D packing kernel (source, destination, pixel count) over `pixels`.
-  void pack(cl_kernel k, cl_mem from, cl_mem to, size_t pixels, const char* what, cl_event* done = nullptr) {
-    const cl_uint n = static_cast<cl_uint>(pixels);
+  // Runs a 1-D packing kernel (source, destination, end pixel) over the pixels [first, first + pixels):
+  // the kernel stops at the end pixel, so a piece's last work group leaves the next piece's pixels alone.
+  void pack(cl_kernel k, cl_mem from, cl_mem to, size_t first, size_t pixels, const char* what,
+            cl_event* done = nullptr) {
+    const cl_uint end = static_cast<cl_uint>(first + pixels);
     check(clSetKernelArg(k, 0, sizeof(cl_mem), &from), what);
     check(clSetKernelArg(k, 1, sizeof(cl_mem), &to), what);
-    check(clSetKernelArg(k, 2, sizeof n, &n), what);
+    check(clSetKernelArg(k, 2, sizeof end, &end), what);
     const size_t local = 64, global = (pixels + local - 1) / local * local;
-    check(clEnqueueNDRangeKernel(queue, k, 1, nullptr, &global, &local, 0, nullptr, done), what);
+    check(clEnqueueNDRangeKernel(queue, k, 1, &first, &global, &local, 0, nullptr, done), what);
+  }
+  // Once `read` is done, the aux planes of `rows` band rows from page-locked staging into the target from
+  // `first_row` on: packed texels copied on the aux copy threads (`straight`), else full records
+  // converted row by row.
+  void copy_aux_rows_into(core::BandBuffer& target, int first_row, size_t width, size_t rows, const void* staging,
+                          bool straight, cl_event read) {
+    check(clWaitForEvents(1, &read), "waiting for the aux band");
+    const size_t pixels = rows * width;
+    if (straight) {
+      const auto started = std::chrono::steady_clock::now();
+      char* to = reinterpret_cast<char*>(target.aux_row(first_row));
+      const char* from = static_cast<const char*>(staging);
+      aux_copy_threads.for_ranges(pixels, 16384, [&](size_t begin, size_t end) {
+        std::memcpy(to + begin * sizeof(KAuxTexel), from + begin * sizeof(KAuxTexel), (end - begin) * sizeof(KAuxTexel));
+      });
+      const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - started).count();
+      spdlog::debug("opencl ({}): aux texels of {} pixels copied in {:.2f} ms", label, pixels, ms);
+      return;
+    }
+    const KAux* aux = static_cast<const KAux*>(staging);
+    for (size_t r = 0; r < rows; ++r) target.store_aux(first_row + static_cast<int>(r), 0, aux + r * width, width);
   }
 
   ~Impl() {
@@ -343,6 +369,11 @@ std::vector<OpenCLTracer::DeviceDescription> OpenCLTracer::describe_devices() {
 }
 
 OpenCLTracer::OpenCLTracer(const Options& options) : impl_(std::make_unique<Impl>()) {
+  if (options.first_hit_pieces < 1 || options.first_hit_pieces > kMaxFirstHitPieces)
+    throw std::invalid_argument("OpenCLTracer: first_hit_pieces " + std::to_string(options.first_hit_pieces) +
+                                " is outside 1-" + std::to_string(kMaxFirstHitPieces));
+  impl_->first_hit_pieces = options.first_hit_pieces;
+  impl_->aux_into_target = options.aux_into_target;
   std::vector<DeviceEntry> devices = all_devices();
   if (devices.empty()) throw std::runtime_error("OpenCLTracer: no OpenCL platform/device found");
   if (options.device < 0 || static_cast<size_t>(options.device) >= devices.size())
@@ -461,6 +492,34 @@ void OpenCLTracer::upload(const commit::ChangeSet& changes) {
   }
 }
 
+namespace {
+
+// The band kernels' work groups are 8x8 pixels (render_band.cl sums a group's rays per row in local memory).
+constexpr size_t kGroupRows = 8;
+
+// Waits for both queues however the function that declares it leaves (a failed check throws): declared
+// after the host memory the queues read into, it runs before that memory goes.
+struct FinishQueues {
+  cl_command_queue a, b;
+  ~FinishQueues() {
+    clFinish(a);
+    clFinish(b);
+  }
+};
+
+}  // namespace
+
+std::vector<size_t> OpenCLTracer::piece_starts(size_t rows, int pieces, size_t group_rows) {
+  std::vector<size_t> starts{0};
+  if (rows == 0) return starts;
+  const size_t count = static_cast<size_t>(std::clamp(pieces, 1, kMaxFirstHitPieces));
+  const size_t groups = std::max<size_t>(group_rows, 1);
+  const size_t per_piece = ((rows + count - 1) / count + groups - 1) / groups * groups;
+  for (size_t start = per_piece; start < rows; start += per_piece) starts.push_back(start);
+  starts.push_back(rows);
+  return starts;
+}
+
 core::BandResult OpenCLTracer::render_band(const core::BandJob& job, core::BandBuffer& target) {
   Impl& m = *impl_;
   if (!has_scene()) throw std::runtime_error("OpenCLTracer: render_band before any commit was applied");
@@ -487,14 +546,8 @@ core::BandResult OpenCLTracer::render_band(const core::BandJob& job, core::BandB
   std::vector<float> band;  // a band narrower than the target, read before it is stored row by row
   std::vector<cl_uint> row_rays(rows);
   // The reads and writes below run from and into this function's locals without blocking: whatever way
-  // it leaves (a failed check throws), both queues are done first (the guard goes before those locals).
-  struct FinishQueues {
-    cl_command_queue a, b;
-    ~FinishQueues() {
-      clFinish(a);
-      clFinish(b);
-    }
-  } finish_queues{m.queue, m.aux_queue};
+  // it leaves, both queues are done first (the guard goes after those locals).
+  FinishQueues finish_queues{m.queue, m.aux_queue};
   const cl_uint zero = 0;
   check(clEnqueueFillBuffer(m.queue, m.row_rays, &zero, sizeof zero, 0, rows * sizeof(cl_uint), 0, nullptr, nullptr),
         "clearing the row ray counts");
@@ -504,11 +557,11 @@ core::BandResult OpenCLTracer::render_band(const core::BandJob& job, core::BandB
         "writing the camera");
   // Only frames that ask pay for the aux planes. From centre rays: a short kernel before the band's, whose
   // texels go down on the second queue while the band's kernel runs (the CUDA tracer's order); from the
-  // paths' first hits: the band's kernel records them and the aux kernel finishes them after it.
+  // paths' first hits: the band's kernel records them and the aux kernel finishes them after it, piece by
+  // piece (render_first_hits_in_pieces).
   const bool write_aux = params.aux_outputs != 0u && target.has_aux();
   const bool aux_from_paths = write_aux && k_aux_from_paths(&params);
   const bool straight = target.width() == static_cast<int>(camera.width);
-  if (write_aux && !aux_from_paths) enqueue_aux(job, camera, rows, straight);
   cl_mem args[] = {m.vertices.mem(),  m.vertex_colors.mem(), m.triangles.mem(), m.blas_nodes.mem(), m.blases.mem(),
                    m.instances.mem(), m.tlas_nodes.mem(), m.materials.mem(), m.textures.mem(),
                    m.texels.mem(),    m.lights.mem(),     m.light_nodes.mem(), m.emissive.mem(),
@@ -521,13 +574,14 @@ core::BandResult OpenCLTracer::render_band(const core::BandJob& job, core::BandB
     cl_mem records = m.grow(m.first_hits, m.first_hits_bytes, rows * camera.width * sizeof(KPathFirstHit),
                             "clCreateBuffer(first hits)");
     check(clSetKernelArg(band_kernel, arg_count, sizeof(cl_mem), &records), "clSetKernelArg(first hits)");
+    return render_first_hits_in_pieces(job, target, params, camera, straight);
   }
+  if (write_aux) enqueue_aux(job, camera, rows, straight);
   const size_t local[2] = {8, 8};
   const size_t global[2] = {(camera.width + 7) / 8 * 8, (rows + 7) / 8 * 8};
   Event band_done;
   check(clEnqueueNDRangeKernel(m.queue, band_kernel, 2, nullptr, global, local, 0, nullptr, band_done.out()),
         "launching the kernel");
-  if (aux_from_paths) enqueue_aux(job, camera, rows, straight);  // the in-order queue runs it after the band
   // The band goes straight into its rows of the target, converted on the device to the target's format.
   const size_t pixels = rows * camera.width;
   size_t band_bytes = bytes;
@@ -536,7 +590,7 @@ core::BandResult OpenCLTracer::render_band(const core::BandJob& job, core::BandB
     band.resize(pixels * 4);
   } else if (target.format() == core::BandFormat::rgb16f) {
     band_mem = m.grow(m.packed, m.packed_bytes, pixels * 6, "clCreateBuffer(half band)");
-    m.pack(m.to_rgb16f, m.output, band_mem, pixels, "converting the band to half floats");
+    m.pack(m.to_rgb16f, m.output, band_mem, 0, pixels, "converting the band to half floats");
     band_bytes = pixels * 6;
   }
   // Both kernels are on the device before any read is enqueued: a driver that copies into pageable
@@ -555,10 +609,88 @@ core::BandResult OpenCLTracer::render_band(const core::BandJob& job, core::BandB
   for (size_t r = 0; r < rows && !straight; ++r)
     target.store(static_cast<int>(params.row_begin + r), 0, band.data() + r * camera.width * 4, camera.width);
   // Device time from the first kernel (the aux one when it ran first, as the CUDA tracer times it) to the
-  // last (the aux one when it finished the paths' first hits).
-  const cl_ulong start =
-      (write_aux && !aux_from_paths ? m.aux_kernel_done : band_done).time(CL_PROFILING_COMMAND_START);
-  const cl_ulong end = (aux_from_paths ? m.aux_kernel_done : band_done).time(CL_PROFILING_COMMAND_END);
+  // band's kernel.
+  const cl_ulong start = (write_aux ? m.aux_kernel_done : band_done).time(CL_PROFILING_COMMAND_START);
+  const cl_ulong end = band_done.time(CL_PROFILING_COMMAND_END);
+  core::BandResult result;
+  result.device_ms = end > start && start != 0 ? double(end - start) * 1e-6 : 0.0;
+  if (params.row_end == frame_params(job).row_end) result.row_work.assign(row_rays.begin(), row_rays.end());
+  return result;
+}
+
+core::BandResult OpenCLTracer::render_first_hits_in_pieces(const core::BandJob& job, core::BandBuffer& target,
+                                                           const KFrameParams& params, const KCamera& camera,
+                                                           bool straight) {
+  Impl& m = *impl_;
+  const size_t width = camera.width;
+  const size_t rows = params.row_end - params.row_begin;
+  const size_t pixels = rows * width;
+  const std::vector<size_t> starts = piece_starts(rows, m.first_hit_pieces, kGroupRows);
+  const size_t pieces = starts.size() - 1;
+  // A band narrower than the target comes down as float pixels and full aux records, stored row by row.
+  std::vector<float> band(straight ? 0 : pixels * 4);
+  std::vector<cl_uint> row_rays(rows);
+  Event band_started;
+  std::array<Event, kMaxFirstHitPieces> piece_ready, aux_read, colour_read;
+  FinishQueues finish_queues{m.queue, m.aux_queue};
+  const bool half = straight && target.format() == core::BandFormat::rgb16f;
+  const size_t colour_bytes = half ? 6 : 4 * sizeof(float);
+  cl_mem colour = half ? m.grow(m.packed, m.packed_bytes, pixels * 6, "clCreateBuffer(half band)") : m.output;
+  const size_t aux_bytes = straight ? sizeof(KAuxTexel) : sizeof(KAux);
+  const bool aux_into_target = straight && m.aux_into_target;
+  char* staging = aux_into_target ? nullptr
+                                  : static_cast<char*>(m.aux_staging.reserve(m.context, m.aux_queue, pixels * aux_bytes,
+                                                                             "allocating page-locked aux memory"));
+  // The whole band's texels before the first piece: growing them later would lose the earlier pieces'.
+  if (straight) m.grow(m.packed_aux, m.packed_aux_bytes, pixels * sizeof(KAuxTexel), "clCreateBuffer(aux texels)");
+  prepare_aux(job, camera, rows);
+  // Each piece renders, finishes its first hits and packs into its own rows of the band's device buffers,
+  // so the second queue reads piece i while the main one runs piece i + 1.
+  const size_t local[2] = {8, 8};
+  for (size_t i = 0; i < pieces; ++i) {
+    const size_t first = starts[i], count = starts[i + 1] - first;
+    const size_t offset[2] = {0, first};
+    const size_t global[2] = {(width + 7) / 8 * 8, (count + kGroupRows - 1) / kGroupRows * kGroupRows};
+    check(clEnqueueNDRangeKernel(m.queue, m.first_hits_kernel, 2, offset, global, local, 0, nullptr,
+                                 i == 0 ? band_started.out() : nullptr),
+          "launching the kernel");
+    enqueue_aux_rows(camera, first, count, straight);
+    if (half) m.pack(m.to_rgb16f, m.output, colour, first * width, count * width, "converting the band to half floats");
+    check(clEnqueueMarkerWithWaitList(m.queue, 0, nullptr, piece_ready[i].out()), "marking a piece's end");
+    check(clFlush(m.queue), "clFlush");
+  }
+  // Piece by piece: its reads behind its marker (the page-locked aux read never blocks; a driver may hold
+  // the colour read into pageable memory until it is done, by when the aux read is too), then the host's
+  // copy of its aux rows while the later pieces render.
+  for (size_t i = 0; i < pieces; ++i) {
+    const size_t first = starts[i], count = starts[i + 1] - first;
+    const cl_event ready = piece_ready[i].get();
+    void* aux_destination =
+        aux_into_target ? static_cast<void*>(target.aux_row(int(params.row_begin + first))) : staging + first * width * aux_bytes;
+    check(clEnqueueReadBuffer(m.aux_queue, straight ? m.packed_aux : m.aux, CL_FALSE, first * width * aux_bytes,
+                              count * width * aux_bytes, aux_destination, 1, &ready, aux_read[i].out()),
+          "reading the aux band");
+    void* colour_destination = straight ? target.row(int(params.row_begin + first)) : band.data() + first * width * 4;
+    check(clEnqueueReadBuffer(m.aux_queue, colour, CL_FALSE, first * width * colour_bytes, count * width * colour_bytes,
+                              colour_destination, 1, &ready, colour_read[i].out()),
+          "reading the band");
+    check(clFlush(m.aux_queue), "clFlush(aux)");
+    if (aux_into_target) continue;  // both reads land in place: the queue is finished below
+    m.copy_aux_rows_into(target, int(params.row_begin + first), width, count, staging + first * width * aux_bytes,
+                         straight, aux_read[i].get());
+    if (straight) continue;
+    const cl_event read = colour_read[i].get();
+    check(clWaitForEvents(1, &read), "waiting for the band");
+    for (size_t r = first; r < first + count; ++r)
+      target.store(static_cast<int>(params.row_begin + r), 0, band.data() + r * width * 4, width);
+  }
+  // Blocking, and only now: a read into pageable memory may return only once the whole queue got there.
+  check(clEnqueueReadBuffer(m.queue, m.row_rays, CL_TRUE, 0, rows * sizeof(cl_uint), row_rays.data(), 0, nullptr, nullptr),
+        "reading the row ray counts");
+  check(clFinish(m.aux_queue), "waiting for the band's reads");
+  // Device time from the first piece's band kernel to the last piece's aux kernel.
+  const cl_ulong start = band_started.time(CL_PROFILING_COMMAND_START);
+  const cl_ulong end = m.aux_kernel_done.time(CL_PROFILING_COMMAND_END);
   core::BandResult result;
   result.device_ms = end > start && start != 0 ? double(end - start) * 1e-6 : 0.0;
   if (params.row_end == frame_params(job).row_end) result.row_work.assign(row_rays.begin(), row_rays.end());
@@ -566,6 +698,11 @@ core::BandResult OpenCLTracer::render_band(const core::BandJob& job, core::BandB
 }
 
 void OpenCLTracer::enqueue_aux(const core::BandJob& job, const KCamera& camera, size_t rows, bool straight) {
+  prepare_aux(job, camera, rows);
+  enqueue_aux_rows(camera, 0, rows, straight);
+}
+
+void OpenCLTracer::prepare_aux(const core::BandJob& job, const KCamera& camera, size_t rows) {
   Impl& m = *impl_;
   const size_t bytes = rows * camera.width * sizeof(KAux);
   cl_int err = CL_SUCCESS;
@@ -603,14 +740,21 @@ void OpenCLTracer::enqueue_aux(const core::BandJob& job, const KCamera& camera, 
   cl_mem records = m.first_hits ? m.first_hits : m.previous_transforms.mem();
   check(clSetKernelArg(m.aux_kernel, arg++, sizeof(cl_mem), &records), "clSetKernelArg(aux first hits)");
   check(clSetKernelArg(m.aux_kernel, arg, sizeof(cl_mem), &m.aux), "clSetKernelArg(aux output)");
+}
+
+void OpenCLTracer::enqueue_aux_rows(const KCamera& camera, size_t first_row, size_t rows, bool straight) {
+  Impl& m = *impl_;
   const size_t local[2] = {8, 8};
-  const size_t global[2] = {(camera.width + 7) / 8 * 8, (rows + 7) / 8 * 8};
-  check(clEnqueueNDRangeKernel(m.queue, m.aux_kernel, 2, nullptr, global, local, 0, nullptr, m.aux_kernel_done.out()),
+  const size_t offset[2] = {0, first_row};
+  const size_t global[2] = {(camera.width + 7) / 8 * 8, (rows + kGroupRows - 1) / kGroupRows * kGroupRows};
+  check(clEnqueueNDRangeKernel(m.queue, m.aux_kernel, 2, offset, global, local, 0, nullptr, m.aux_kernel_done.out()),
         "launching the aux kernel");
-  const size_t pixels = rows * camera.width;
+  const size_t first = first_row * camera.width, pixels = rows * camera.width;
   if (straight) {
-    cl_mem packed = m.grow(m.packed_aux, m.packed_aux_bytes, pixels * sizeof(KAuxTexel), "clCreateBuffer(aux texels)");
-    m.pack(m.to_texels, m.aux, packed, pixels, "packing the aux records", m.aux_packed.out());
+    // Sized for the band's rows above this range too: the packing indexes from the band's first pixel.
+    cl_mem packed =
+        m.grow(m.packed_aux, m.packed_aux_bytes, (first + pixels) * sizeof(KAuxTexel), "clCreateBuffer(aux texels)");
+    m.pack(m.to_texels, m.aux, packed, first, pixels, "packing the aux records", m.aux_packed.out());
   } else {
     // A narrower band keeps the full records (the target converts them row by row): the read waits on
     // the aux kernel itself.
@@ -633,24 +777,8 @@ void OpenCLTracer::read_aux_when_packed(size_t pixels, bool straight) {
 void OpenCLTracer::copy_aux_into(core::BandBuffer& target, const KFrameParams& params, const KCamera& camera,
                                  size_t rows, bool straight) {
   Impl& m = *impl_;
-  const cl_event read = m.aux_read.get();
-  check(clWaitForEvents(1, &read), "waiting for the aux band");
-  const size_t pixels = rows * camera.width;
-  const void* staging = m.aux_staging.host();
-  if (straight) {
-    const auto started = std::chrono::steady_clock::now();
-    char* to = reinterpret_cast<char*>(target.aux_row(int(params.row_begin)));
-    const char* from = static_cast<const char*>(staging);
-    m.aux_copy_threads.for_ranges(pixels, 16384, [&](size_t begin, size_t end) {
-      std::memcpy(to + begin * sizeof(KAuxTexel), from + begin * sizeof(KAuxTexel), (end - begin) * sizeof(KAuxTexel));
-    });
-    const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - started).count();
-    spdlog::debug("{}: aux texels of {} pixels copied in {:.2f} ms", name(), pixels, ms);
-    return;
-  }
-  const KAux* aux = static_cast<const KAux*>(staging);
-  for (size_t r = 0; r < rows; ++r)
-    target.store_aux(static_cast<int>(params.row_begin + r), 0, aux + r * camera.width, camera.width);
+  m.copy_aux_rows_into(target, int(params.row_begin), camera.width, rows, m.aux_staging.host(), straight,
+                       m.aux_read.get());
 }
 
 }  // namespace cohort::tracers

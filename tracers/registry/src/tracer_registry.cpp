@@ -1,6 +1,7 @@
 #include "cohort/tracers/tracer_registry.h"
 
 #include <algorithm>
+#include <cstdlib>
 #include <stdexcept>
 #include <thread>
 
@@ -139,6 +140,20 @@ std::unique_ptr<core::Tracer> make_tracer(const TracerSpec& spec) {
   if (spec.kind == "opencl") {
     OpenCLTracer::Options options;
     options.device = spec.device;
+    // For A/B runs of the first-hit pieces (1: the whole band, then its aux work) without a rebuild.
+    if (const char* pieces = std::getenv("COHORT_OPENCL_FIRST_HIT_PIECES"); pieces && *pieces) {
+      char* end = nullptr;
+      const long count = std::strtol(pieces, &end, 10);
+      if (*end != '\0' || count < 1 || count > OpenCLTracer::kMaxFirstHitPieces)
+        throw std::invalid_argument("COHORT_OPENCL_FIRST_HIT_PIECES='" + std::string(pieces) + "': expected a count from 1 to " +
+                                    std::to_string(OpenCLTracer::kMaxFirstHitPieces));
+      options.first_hit_pieces = static_cast<int>(count);
+    }
+    if (const char* into = std::getenv("COHORT_OPENCL_AUX_INTO_TARGET"); into && *into) {
+      if (std::string(into) != "0" && std::string(into) != "1")
+        throw std::invalid_argument("COHORT_OPENCL_AUX_INTO_TARGET='" + std::string(into) + "': expected 0 or 1");
+      options.aux_into_target = std::string(into) == "1";
+    }
     return std::make_unique<OpenCLTracer>(options);
   }
 #endif
@@ -245,12 +260,12 @@ std::unique_ptr<core::FramePost> make_frame_post(const std::string& where, const
 }
 
 std::string auto_aux_rays(const std::vector<TracerSpec>& tracers) {
-  bool cuda = false;
+  bool gpu = false;
   for (const TracerSpec& t : tracers) {
-    if (t.kind == "opencl" || t.kind == "mpi") return "centre";
-    cuda = cuda || t.kind == "cuda";
+    if (t.kind == "mpi") return "centre";
+    gpu = gpu || t.kind == "cuda" || t.kind == "opencl";
   }
-  return cuda ? "first-hit" : "centre";
+  return gpu ? "first-hit" : "centre";
 }
 
 std::string auto_frame_post_place(const std::vector<TracerSpec>& tracers) {

@@ -16,9 +16,23 @@ class OpenCLTracer : public TracerBase {
   struct Options {
     int device = 0;         // index into list_devices(): every device of every platform, in order
     std::string build_options;  // extra OpenCL compiler options
+    // With the aux planes from the paths' first hits, the band renders in this many row ranges so that
+    // each one's aux finishing, read and host copy overlap the next one's rendering (1: one range, the
+    // whole band, then its aux work after it). At most kMaxFirstHitPieces.
+    int first_hit_pieces = 4;
+    // Pieces spanning the target's width read their aux texels straight into its rows (pageable memory)
+    // instead of into page-locked staging and then copying them on the host: for measuring one against
+    // the other on a GPU driver.
+    bool aux_into_target = false;
   };
+  static constexpr int kMaxFirstHitPieces = 8;
+  // The pieces' first rows, relative to the band, and `rows` last: up to `pieces` ranges of whole work
+  // groups (multiples of `group_rows`, the last one the remainder), none empty. Every kernel of a piece
+  // runs over whole work groups from its first row, so a piece that ended inside a group would render
+  // the next piece's first rows too.
+  static std::vector<size_t> piece_starts(size_t rows, int pieces, size_t group_rows);
   // Throws std::runtime_error when there is no such device or the kernel does not compile (the
-  // message carries the build log).
+  // message carries the build log), std::invalid_argument for a piece count outside 1-kMaxFirstHitPieces.
   explicit OpenCLTracer(const Options& options);
   ~OpenCLTracer() override;
   OpenCLTracer(const OpenCLTracer&) = delete;
@@ -44,14 +58,23 @@ class OpenCLTracer : public TracerBase {
  private:
   void upload(const commit::ChangeSet& changes) override;
   bool skins_on_device() const override { return true; }
-  // The band's auxiliary planes (kernel/aux_outputs.h), in three steps around the band's kernel: the aux
-  // kernel (and the packing to texels when the band spans the target's width, `straight`) enqueued before
-  // it; the read into page-locked memory on the second queue, overlapping it; the copy into the target
-  // once that read is done.
+  // The band's auxiliary planes from centre rays (kernel/aux_outputs.h), in three steps around the band's
+  // kernel: the aux kernel (and the packing to texels when the band spans the target's width,
+  // `straight`) enqueued before it; the read into page-locked memory on the second queue, overlapping it;
+  // the copy into the target once that read is done.
   void enqueue_aux(const core::BandJob& job, const KCamera& camera, size_t rows, bool straight);
   void read_aux_when_packed(size_t pixels, bool straight);
   void copy_aux_into(core::BandBuffer& target, const KFrameParams& params, const KCamera& camera, size_t rows,
                      bool straight);
+  // The aux kernel's arguments for this band (and the previous camera, transforms and joints it reads),
+  // then its launch (and packing) over the band's rows [first_row, first_row + rows).
+  void prepare_aux(const core::BandJob& job, const KCamera& camera, size_t rows);
+  void enqueue_aux_rows(const KCamera& camera, size_t first_row, size_t rows, bool straight);
+  // The band with its aux planes from the paths' first hits, in pieces (Options::first_hit_pieces):
+  // per piece, on the main queue, the band's kernel, the aux kernel, the packings; on the second queue
+  // the piece's aux and colour reads behind them; on the host its aux copy, while later pieces render.
+  core::BandResult render_first_hits_in_pieces(const core::BandJob& job, core::BandBuffer& target,
+                                               const KFrameParams& params, const KCamera& camera, bool straight);
 
   struct Impl;
   std::unique_ptr<Impl> impl_;
