@@ -464,8 +464,8 @@ void add_render_command(CLI::App& app, int& exit_code) {
         }
       });
   cmd->add_option("--aux-rays", a->aux_rays,
-                  "where the G-buffer for reprojection and denoising comes from: auto (first-hit where CUDA or "
-                  "OpenCL tracers render and no mpi tracer does, else centre), centre (a ray of its own through "
+                  "where the G-buffer for reprojection and denoising comes from: auto (first-hit where CUDA GPUs "
+                  "render and no OpenCL or mpi tracer does, else centre), centre (a ray of its own through "
                   "each pixel's centre: steady planes) or first-hit (the first sample's own first surface: no "
                   "extra ray, about 0.8 ms less a 1080p frame on an H100, but the planes jitter as the samples "
                   "do; the reprojection then keeps silhouettes' history from the neighbours' surfaces; frames with "

@@ -260,12 +260,12 @@ std::unique_ptr<core::FramePost> make_frame_post(const std::string& where, const
 }
 
 std::string auto_aux_rays(const std::vector<TracerSpec>& tracers) {
-  bool gpu = false;
+  bool cuda = false;
   for (const TracerSpec& t : tracers) {
-    if (t.kind == "mpi") return "centre";
-    gpu = gpu || t.kind == "cuda" || t.kind == "opencl";
+    if (t.kind == "opencl" || t.kind == "mpi") return "centre";
+    cuda = cuda || t.kind == "cuda";
   }
-  return gpu ? "first-hit" : "centre";
+  return cuda ? "first-hit" : "centre";
 }
 
 std::string auto_frame_post_place(const std::vector<TracerSpec>& tracers) {

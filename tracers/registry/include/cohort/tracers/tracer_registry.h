@@ -58,11 +58,11 @@ std::unique_ptr<core::FramePost> make_frame_post(const std::string& where, const
 // and the bus to it), else the host.
 std::string auto_frame_post_place(const std::vector<TracerSpec>& tracers);
 
-// What `--aux-rays auto` picks (core::aux_rays_mode's names): "first-hit" where a CUDA or OpenCL tracer
-// renders and no remote (mpi) tracer does, "centre" otherwise. First hits spare a GPU the second camera ray
-// (about 0.8 ms a 1080p frame on an H100 through CUDA) at equal quality (docs/denoising.md); the OpenCL
-// tracer finishes and reads them in pieces behind its band (docs/balancing.md); a node's tracers are not
-// known here, and on the CPU alone Embree's centre-ray packets cost about as little as the finisher.
+// What `--aux-rays auto` picks (core::aux_rays_mode's names): "first-hit" where a CUDA tracer renders and no
+// OpenCL or remote (mpi) tracer does, "centre" otherwise. First hits spare a CUDA GPU the second camera ray
+// (about 0.8 ms a 1080p frame on an H100) at equal quality (docs/denoising.md); an OpenCL tracer finishes
+// and reads them only after its band (slower in a mix), a node's tracers are not known here, and on the
+// CPU alone Embree's centre-ray packets cost about as little as the finisher.
 std::string auto_aux_rays(const std::vector<TracerSpec>& tracers);
 
 }  // namespace cohort::tracers
