@@ -18,8 +18,9 @@ class OpenCLTracer : public TracerBase {
     std::string build_options;  // extra OpenCL compiler options
     // With the aux planes from the paths' first hits, the band renders in this many row ranges so that
     // each one's aux finishing, read and host copy overlap the next one's rendering (1: one range, the
-    // whole band, then its aux work after it). At most kMaxFirstHitPieces.
-    int first_hit_pieces = 4;
+    // whole band, then its aux work after it). At most kMaxFirstHitPieces. 2: on two H100s (design card's
+    // mix, 1080p) 1 / 2 / 4 pieces took 7.48-7.62 / 7.15-7.32 / 7.34-7.52 ms a frame (docs/balancing.md).
+    int first_hit_pieces = 2;
     // Pieces spanning the target's width read their aux texels straight into its rows (pageable memory)
     // instead of into page-locked staging and then copying them on the host: for measuring one against
     // the other on a GPU driver.
