@@ -217,8 +217,10 @@ rows = [r for r in csv.reader(l for l in sys.stdin if l.startswith("\""))]
 head, rows = rows[0], rows[1:]
 name, value, ident = head.index("Kernel Name"), head.index("Metric Value"), head.index("ID")
 launches = sorted({int(r[ident]) for r in rows})
-# The render kernel marks frames: keep the launches from its 21st up to its 29th.
-render = [int(r[ident]) for r in rows if r[name].startswith("render_band_kernel")]
+# The first kernel of a band marks frames (the megakernel, or the camera kernel of the wavefront): keep
+# the launches from its 21st up to its 29th.
+firsts = ("render_band_kernel", "wave_camera_kernel", "camera_walk_kernel")
+render = [int(r[ident]) for r in rows if r[name].split("(")[0].replace("void ", "").split("::")[-1].startswith(firsts)]
 lo, hi = (render[20], render[28]) if len(render) >= 29 else (launches[0], launches[-1] + 1)
 total = collections.defaultdict(float); count = collections.Counter()
 for r in rows:

@@ -28,13 +28,16 @@ __global__ void prepare_kernel(const float* rgba, float* ycocgw, int pixels) {
   if (p < pixels) k_reproject_prepare(rgba, ycocgw, p);
 }
 
+// With `demodulated` (the a-trous filter follows), the pixel's new history is also divided by its albedo
+// into the filter's input while it is at hand, instead of a pass of its own.
 __global__ void reproject_kernel(KReprojectParams params, KReprojectFresh fresh, KReprojectHistory history,
-                                 KReprojectState next, double* length_sum) {
+                                 KReprojectState next, double* length_sum, const float* albedo, float* demodulated) {
   const int p = blockIdx.x * blockDim.x + threadIdx.x;
   float length = 0.0f;
   if (p < params.width * params.height) {
     k_reproject_pixel(&params, &fresh, &history, &next, p % params.width, p / params.width);
     length = next.length[p];
+    if (demodulated) k_atrous_modulate(next.rgba, albedo, demodulated, p, 0);
   }
   // The mean history length for stats, summed per warp then once per warp into one double.
   for (int offset = 16; offset > 0; offset /= 2) length += __shfl_down_sync(0xffffffffu, length, offset);
@@ -101,9 +104,14 @@ __global__ void svgf_variance_kernel(float* illumination, const float* moments, 
         k_svgf_variance_estimate(illumination, moments, length, geometry, &params, x, y);
 }
 
-__global__ void svgf_atrous_kernel(const float* in, float* out, const float* geometry, KAtrousParams params) {
+// With `modulated` (the last pass), the filtered pixel is also multiplied by its albedo into the shown image.
+__global__ void svgf_atrous_kernel(const float* in, float* out, const float* geometry, KAtrousParams params,
+                                   const float* albedo, float* modulated) {
   const int x = blockIdx.x * blockDim.x + threadIdx.x, y = blockIdx.y * blockDim.y + threadIdx.y;
-  if (x < params.width && y < params.height) k_svgf_atrous_pixel(in, out, geometry, &params, x, y);
+  if (x < params.width && y < params.height) {
+    k_svgf_atrous_pixel(in, out, geometry, &params, x, y);
+    if (modulated) k_atrous_modulate(out, albedo, modulated, y * params.width + x, 1);
+  }
 }
 
 class CudaFramePost final : public core::FramePost {
@@ -267,7 +275,10 @@ class CudaFramePost final : public core::FramePost {
                                  to.moments.data()};
       double* sum = length_sum_.scratch(1);
       COHORT_CUDA(cudaMemsetAsync(sum, 0, sizeof(double), stream_));
-      reproject_kernel<<<blocks_for(pixels), kThreads, 0, stream_>>>(params, planes, history, next, sum);
+      // The a-trous filter's demodulated input comes out of the reprojection kernel.
+      float* demodulated = options_.atrous ? ping_.scratch(4 * pixels) : nullptr;
+      reproject_kernel<<<blocks_for(pixels), kThreads, 0, stream_>>>(params, planes, history, next, sum, albedo_.data(),
+                                                                     demodulated);
       COHORT_CUDA(cudaGetLastError());
       COHORT_CUDA(cudaMemcpyAsync(length_sum_host_, sum, sizeof(double), cudaMemcpyDeviceToHost, stream_));
       parity_ ^= 1;
@@ -277,8 +288,9 @@ class CudaFramePost final : public core::FramePost {
     if (options_.atrous) {
       float* ping = ping_.scratch(4 * pixels);
       float* pong = pong_.scratch(4 * pixels);
-      modulate_kernel<<<blocks_for(pixels), kThreads, 0, stream_>>>(current, albedo_.data(), ping,
-                                                                       static_cast<int>(pixels), 0);
+      if (!options_.reproject)
+        modulate_kernel<<<blocks_for(pixels), kThreads, 0, stream_>>>(current, albedo_.data(), ping,
+                                                                         static_cast<int>(pixels), 0);
       const core::AtrousOptions& ao = options_.atrous_options;
       const bool variance = core::atrous_guide_uses_variance(ao.guide);
       KAtrousParams params{};
@@ -302,17 +314,24 @@ class CudaFramePost final : public core::FramePost {
             ping, options_.reproject ? history.moments.data() : nullptr,
             options_.reproject ? history.length.data() : nullptr, geometry, v);
       }
-      for (int pass = 0; pass < std::max(ao.passes, 0); ++pass) {
+      float* shown = shown_device_.scratch(4 * pixels);
+      const int passes = std::max(ao.passes, 0);
+      bool modulated = false;  // the last SVGF pass multiplies by the albedo itself
+      for (int pass = 0; pass < passes; ++pass) {
         params.step = 1 << pass;
-        if (variance)
-          svgf_atrous_kernel<<<tile_grid(width, height), kTile, 0, stream_>>>(ping, pong, geometry, params);
-        else
+        const bool last = pass + 1 == passes;
+        if (variance) {
+          svgf_atrous_kernel<<<tile_grid(width, height), kTile, 0, stream_>>>(ping, pong, geometry, params, albedo_.data(),
+                                                                              last ? shown : nullptr);
+          modulated = last;
+        } else {
           atrous_kernel<<<tile_grid(width, height), kTile, 0, stream_>>>(ping, pong, geometry, params);
+        }
         std::swap(ping, pong);
       }
-      float* shown = shown_device_.scratch(4 * pixels);
-      modulate_kernel<<<blocks_for(pixels), kThreads, 0, stream_>>>(ping, albedo_.data(), shown,
-                                                                       static_cast<int>(pixels), 1);
+      if (!modulated)
+        modulate_kernel<<<blocks_for(pixels), kThreads, 0, stream_>>>(ping, albedo_.data(), shown,
+                                                                         static_cast<int>(pixels), 1);
       COHORT_CUDA(cudaGetLastError());
       current = shown;
     }

@@ -4,8 +4,6 @@
 #include <cuda_fp16.h>
 #include <cuda_runtime.h>
 
-#include <cstdlib>
-
 #define K_CUDA_DEVICE_ONLY 1
 #define K_BVH_TRIANGLE_EDGES 1  // leaves read KTriangleEdges (CudaTracer keeps them with the triangles)
 __constant__ cudaTextureObject_t cohort_texel_texture;
@@ -47,13 +45,13 @@ __global__ void __launch_bounds__(128, 4) render_band_kernel(KSceneView scene, K
   count_rays(ctx, inside, row, y < params.row_end, ray_counts, row_rays);
 }
 
-// The bounce rays' wavefront. The megakernel above keeps a whole path in one thread of a 128-register
-// kernel at a quarter occupancy, where an incoherent bounce ray's walk waits on memory with few warps to
-// hide it. Here a path's segments (the camera ray and what it meets up to the first bounce; then, per
-// bounce, what the bounce ray meets up to the next) are shaded by kernels like the megakernel, while each
-// bounce ray is walked by a small kernel of its own, at the occupancy its registers allow. The paths wait
-// in memory (KPathState, kernel/integrator.h) between them: same integrator, same random numbers, the same
-// image as the megakernel. Transparent layers are walked inline by the shading kernels.
+// The wavefront. The megakernel above keeps a whole path in one thread of a 128-register kernel at a
+// quarter occupancy, where an incoherent bounce ray's walk waits on memory with few warps to hide it. Here
+// the camera rays and each bounce's rays are walked by small kernels of their own (wavefront_walk.cu, at
+// twice the occupancy), and a path's segments (what its camera ray meets up to the first bounce; then, per
+// bounce, what the bounce ray meets up to the next) are shaded by kernels like the megakernel. The paths
+// wait in memory between them (KPathState, kernel/path_state.h): same integrator, same random numbers, the
+// megakernel's image. Transparent layers and shadow rays are still walked inline by the shading kernels.
 
 // Runs a path from its current ray until it ends (false) or has bounced (true: its next ray in *s).
 // `traced`: the current ray's hit, walked by the bounce kernel (null: walked here).
@@ -90,39 +88,11 @@ __device__ void finish_sample(float4* band, size_t p, KVec3 radiance, kuint samp
   band[p] = c;
 }
 
-// A sample's camera ray and its path up to the first bounce.
-template <bool kFirstHit>
-__global__ void __launch_bounds__(128, 4) wave_camera_kernel(KSceneView scene, KFrameParams params, KCamera camera,
-                                                          kuint sample, float4* band, WavefrontScratch wave,
-                                                          unsigned long long* ray_counts, unsigned* row_rays,
-                                                          KPathFirstHit* first_hits) {
-  const kuint x = blockIdx.x * blockDim.x + threadIdx.x;
-  const kuint row = blockIdx.y * blockDim.y + threadIdx.y;
-  const kuint y = params.row_begin + row;
-  const bool inside = x < camera.width && y < params.row_end;
-  KTraceCtx ctx;
-  ctx.scene = scene;
-  ctx.closest_rays = 0u;
-  ctx.occlusion_rays = 0u;
-  if (inside) {
-    const size_t p = size_t(row) * camera.width + x;
-    KPathFirstHit* record = kFirstHit && sample == 0u ? first_hits + p : nullptr;
-    if (record) k_record_first_hit(record, K_NONE, 0u, 0u);
-    KRng rng;
-    const KVec3 dir = k_camera_sample(&params, &camera, x, y, sample, &rng);
-    KPathState s;
-    k_path_begin(&s, v3_load(camera.origin), dir, k_pixel_spread(&camera), rng);
-    const bool goes_on = path_segment(&ctx, &params, &s, nullptr, record);
-    wave.active[p] = goes_on ? 1u : 0u;
-    if (goes_on) wave.states[p] = s;
-    else finish_sample(band, p, s.radiance, sample, 1.0f / float(params.spp > 0u ? params.spp : 1u));
-  }
-  count_rays(ctx, inside, row, y < params.row_end, ray_counts, row_rays);
-}
-
 // What the live paths' rays (walked by wavefront_walk.cu's kernels) met, shaded, and the paths on to their
-// next bounce. kFirstHit: the camera rays' segment of the frame's first sample, which records first hits.
-template <bool kFirstHit>
+// next bounce. kCameraRays: the camera rays' segment, whose paths begin here from the pixel (the walk kept
+// only the hits: 88 bytes a pixel less each way); kFirstHit: that segment of the frame's first sample,
+// which records first hits.
+template <bool kCameraRays, bool kFirstHit>
 __global__ void __launch_bounds__(128, 4) wave_shade_kernel(KSceneView scene, KFrameParams params, KCamera camera,
                                                          kuint sample, float4* band, WavefrontScratch wave,
                                                          unsigned long long* ray_counts, unsigned* row_rays,
@@ -131,20 +101,25 @@ __global__ void __launch_bounds__(128, 4) wave_shade_kernel(KSceneView scene, KF
   const kuint row = blockIdx.y * blockDim.y + threadIdx.y;
   const kuint y = params.row_begin + row;
   const size_t p = size_t(row) * camera.width + x;
-  const bool inside = x < camera.width && y < params.row_end && wave.active[p];
+  const bool inside = x < camera.width && y < params.row_end && (kCameraRays || wave.active[p]);
   KTraceCtx ctx;
   ctx.scene = scene;
   ctx.closest_rays = 0u;
   ctx.occlusion_rays = 0u;
   if (inside) {
-    KPathState s = wave.states[p];
+    KPathState s;
+    if (kCameraRays) {
+      KRng rng;
+      const KVec3 dir = k_camera_sample(&params, &camera, x, y, sample, &rng);
+      k_path_begin(&s, v3_load(camera.origin), dir, k_pixel_spread(&camera), rng);
+    } else {
+      s = wave.states[p];
+    }
     const KHit hit = wave.hits[p];
     const bool goes_on = path_segment(&ctx, &params, &s, &hit, kFirstHit ? first_hits + p : nullptr);
     if (goes_on) wave.states[p] = s;
-    else {
-      wave.active[p] = 0u;
-      finish_sample(band, p, s.radiance, sample, 1.0f / float(params.spp > 0u ? params.spp : 1u));
-    }
+    if (kCameraRays || !goes_on) wave.active[p] = goes_on ? 1u : 0u;
+    if (!goes_on) finish_sample(band, p, s.radiance, sample, 1.0f / float(params.spp > 0u ? params.spp : 1u));
   }
   count_rays(ctx, inside, row, y < params.row_end, ray_counts, row_rays);
 }
@@ -230,27 +205,18 @@ void launch_render_band(const KSceneView& scene, const KFrameParams& params, con
   const bool sparse = params.path_pixels != 0u && params.path_pixels < K_PATH_PATTERN_PIXELS;
   if (wave && wavefront_renders(params)) {
     const kuint spp = params.spp > 0u ? params.spp : 1u;
-    static const bool camera_walk = !std::getenv("COHORT_EXP_CAMERA_WALK") || std::atoi(std::getenv("COHORT_EXP_CAMERA_WALK"));
     for (kuint sample = 0u; sample < spp; ++sample) {
       KPathFirstHit* records = sample == 0u ? first_hits : nullptr;
-      if (camera_walk) {
-        launch_wave_camera_walk(grid, block, scene, params, camera, sample, *wave, records, ray_counts, row_rays, stream);
-        if (records)
-          wave_shade_kernel<true><<<grid, block, 0, stream>>>(scene, params, camera, sample, band, *wave, ray_counts,
-                                                              row_rays, records);
-        else
-          wave_shade_kernel<false><<<grid, block, 0, stream>>>(scene, params, camera, sample, band, *wave, ray_counts,
-                                                               row_rays, nullptr);
-      } else if (first_hits) {
-        wave_camera_kernel<true><<<grid, block, 0, stream>>>(scene, params, camera, sample, band, *wave, ray_counts,
-                                                             row_rays, first_hits);
-      } else {
-        wave_camera_kernel<false><<<grid, block, 0, stream>>>(scene, params, camera, sample, band, *wave, ray_counts,
-                                                              row_rays, nullptr);
-      }
+      launch_wave_camera_walk(grid, block, scene, params, camera, sample, *wave, records, ray_counts, row_rays, stream);
+      if (records)
+        wave_shade_kernel<true, true><<<grid, block, 0, stream>>>(scene, params, camera, sample, band, *wave, ray_counts,
+                                                                  row_rays, records);
+      else
+        wave_shade_kernel<true, false><<<grid, block, 0, stream>>>(scene, params, camera, sample, band, *wave,
+                                                                   ray_counts, row_rays, nullptr);
       for (kuint bounce = 1u; bounce <= params.max_bounces; ++bounce) {
         launch_wave_bounce_walk(grid, block, scene, params, camera, *wave, ray_counts, row_rays, stream);
-        wave_shade_kernel<false><<<grid, block, 0, stream>>>(scene, params, camera, sample, band, *wave, ray_counts,
+        wave_shade_kernel<false, false><<<grid, block, 0, stream>>>(scene, params, camera, sample, band, *wave, ray_counts,
                                                              row_rays, nullptr);
       }
     }

@@ -19,7 +19,7 @@ struct WavefrontScratch {
   KHit* hits = nullptr;
   kuint* active = nullptr;
 };
-// The wavefront's walks (wavefront_walk.cu): the camera rays of a sample, their paths begun (records: the
+// The wavefront's walks (wavefront_walk.cu): the camera rays of a sample (records: the
 // first-hit records to clear, or null), and the live paths' bounce rays; each ray's hit into wave.hits.
 void launch_wave_camera_walk(dim3 grid, dim3 block, const KSceneView& scene, const KFrameParams& params,
                              const KCamera& camera, kuint sample, const WavefrontScratch& wave, KPathFirstHit* records,

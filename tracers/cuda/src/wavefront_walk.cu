@@ -21,7 +21,7 @@ namespace cohort::tracers {
 
 namespace {
 
-// A sample's camera rays: each pixel's path begun in wave.states, its first hit in wave.hits.
+// A sample's camera rays: each pixel's first hit in wave.hits (the shading kernel begins the paths).
 __global__ void __launch_bounds__(128, 8) camera_walk_kernel(KSceneView scene, KFrameParams params, KCamera camera,
                                                              kuint sample, WavefrontScratch wave,
                                                              KPathFirstHit* records, unsigned long long* ray_counts,
@@ -39,14 +39,10 @@ __global__ void __launch_bounds__(128, 8) camera_walk_kernel(KSceneView scene, K
     if (records) k_record_first_hit(records + p, K_NONE, 0u, 0u);
     KRng rng;
     const KVec3 dir = k_camera_sample(&params, &camera, x, y, sample, &rng);
-    KPathState s;
-    k_path_begin(&s, v3_load(camera.origin), dir, k_pixel_spread(&camera), rng);
     KHit hit;
     hit.cost = 0u;
-    if (!k_trace_closest(&ctx, s.org, s.dir, K_INF, K_RAY_PRIMARY, &hit)) hit.instance = K_NONE;
-    wave.states[p] = s;
+    if (!k_trace_closest(&ctx, v3_load(camera.origin), dir, K_INF, K_RAY_PRIMARY, &hit)) hit.instance = K_NONE;
     wave.hits[p] = hit;
-    wave.active[p] = 1u;
   }
   count_rays(ctx, inside, row, y < params.row_end, ray_counts, row_rays);
 }
