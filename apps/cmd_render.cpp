@@ -69,6 +69,7 @@ struct RenderArgs {
   int atrous_passes = 0;  // 0: from the image height (core/atrous_filter.h)
   std::string atrous_guide = core::atrous_guide_name(core::AtrousOptions{}.guide);
   float atrous_sigma = 0.0f;  // 0: the guide's default
+  float atrous_short_history = core::AtrousOptions{}.short_history;
   float anti_lag = -1.0f;     // < 0: ReprojectionOptions' default
   std::string post_on = "auto";
   std::string band_format = "rgb16f";
@@ -200,6 +201,7 @@ int run_render(const RenderArgs& a) {
     ao.guide = core::parse_atrous_guide(a.atrous_guide);
     if (a.atrous_sigma > 0.0f)
       (core::atrous_guide_uses_variance(ao.guide) ? ao.variance_sigma : ao.color_sigma) = a.atrous_sigma;
+    ao.short_history = a.atrous_short_history;
     post = tracers::make_frame_post(post_place, post_options);
     spdlog::info("{}{}{} on {}", reproject ? "reprojection" : "", reproject && atrous ? " and " : "",
                  atrous ? "the a-trous filter (" + std::to_string(ao.passes) + " passes, " + a.atrous_guide + " guide)"
@@ -494,6 +496,11 @@ void add_render_command(CLI::App& app, int& exit_code) {
   cmd->add_option("--atrous-sigma", a->atrous_sigma,
                   "luminance stop's scale of --denoise atrous: standard deviations with the variance guide "
                   "(default 4), relative difference with the fixed one (default 2); 0 keeps the default")
+      ->capture_default_str()
+      ->check(CLI::Range(0.0f, 1000.0f));
+  cmd->add_option("--atrous-short-history", a->atrous_short_history,
+                  "variance guides of --denoise atrous: a history shorter than this many frames has its variance "
+                  "estimated from its 7x7 neighbourhood instead of its own temporal moments (SVGF: 4; cheaper: 2)")
       ->capture_default_str()
       ->check(CLI::Range(0.0f, 1000.0f));
   cmd->add_option("--anti-lag", a->anti_lag,
