@@ -44,6 +44,26 @@ core::FrameBuffer render_scene(core::Tracer& tracer, const commit::TracerScene& 
   return render_frame(tracer, cam, params);
 }
 
+// The packed map named by COHORT_PACK (eye height above its player start, along its yaw, as `cohort render`
+// looks) or, with none, the test room; w x h pixels.
+struct TestView {
+  commit::TracerScene scene;
+  KCamera camera;
+};
+TestView pack_or_room(const char* pack_file, int w, int h) {
+  TestView v;
+  if (pack_file) {
+    core::PackedScene pack = core::read_scene_pack(pack_file);
+    v.scene = pack.tracer_scene;
+    glm::vec3 eye(pack.player_start[0], pack.player_start[1], pack.player_start[2] + core::kPlayerEyeHeight);
+    v.camera = core::make_camera(eye, {pack.player_yaw, 0.0f}, core::kDefaultFovX, w, h);
+  } else {
+    v.scene = core::compile_scene(test_room()).tracer_scene;
+    v.camera = test_room_camera(w, h);
+  }
+  return v;
+}
+
 #define REQUIRE_GPU()                                                                                   \
   if (tracers::cuda_device_count() == 0) GTEST_SKIP() << "no CUDA device on this machine (run tools/gpu_run.sh)"
 
@@ -128,19 +148,10 @@ TEST(CudaMultiGpu, BandsMergeIntoTheSingleGpuFrame) {
 TEST(CudaScenePack, PackedSceneMatchesEmbree) {
   REQUIRE_GPU();
   const char* pack_file = std::getenv("COHORT_PACK");
-  commit::TracerScene scene;
-  KCamera cam;
   const int w = 128, h = 72;
-  if (pack_file) {
-    core::PackedScene pack = core::read_scene_pack(pack_file);
-    scene = pack.tracer_scene;
-    // Eye height above the player start, looking along its yaw, as `cohort render` does.
-    glm::vec3 eye(pack.player_start[0], pack.player_start[1], pack.player_start[2] + core::kPlayerEyeHeight);
-    cam = core::make_camera(eye, {pack.player_yaw, 0.0f}, core::kDefaultFovX, w, h);
-  } else {
-    scene = core::compile_scene(test_room()).tracer_scene;
-    cam = test_room_camera(w, h);
-  }
+  const TestView view = pack_or_room(pack_file, w, h);
+  const commit::TracerScene& scene = view.scene;
+  const KCamera& cam = view.camera;
   // 64 spp: on the full map (8 lights, textures, glass) a few samples per thousand take another path
   // on the GPU (fused multiply-adds shift a light pick or a Russian roulette decision); at 16 spp those
   // alone came to 0.5% RMSE, at 64 they average down below the bound.
@@ -177,18 +188,10 @@ TEST_P(CudaWavefront, DrawsTheMegakernelsImage) {
   const WavefrontCase c = GetParam();
   const char* pack_file = std::getenv("COHORT_PACK");
   if (c.pack && !pack_file) GTEST_SKIP() << "COHORT_PACK names no packed map (tools/gpu_run.sh sets it)";
-  commit::TracerScene scene;
   const int w = 96, h = 64;
-  KCamera cam;
-  if (c.pack) {
-    core::PackedScene pack = core::read_scene_pack(pack_file);
-    scene = pack.tracer_scene;
-    glm::vec3 eye(pack.player_start[0], pack.player_start[1], pack.player_start[2] + core::kPlayerEyeHeight);
-    cam = core::make_camera(eye, {pack.player_yaw, 0.0f}, core::kDefaultFovX, w, h);
-  } else {
-    scene = core::compile_scene(test_room()).tracer_scene;
-    cam = test_room_camera(w, h);
-  }
+  const TestView view = pack_or_room(c.pack ? pack_file : nullptr, w, h);
+  const commit::TracerScene& scene = view.scene;
+  const KCamera& cam = view.camera;
   KFrameParams params = frame_params(K_MODE_PATH, c.spp, c.bounces, h);
   params.rr_start = 2.0f;
   params.frame_index = 5;

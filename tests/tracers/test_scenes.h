@@ -91,6 +91,27 @@ inline KFrameParams testmap_agreement_params(int height) {
 
 // The auxiliary planes (kernel/aux_outputs.h) of one whole-frame band from the tracer's current scene.
 // aux_mode: K_AUX_CENTRE_RAY or K_AUX_PATH_FIRST_HIT (kernel/layout.h).
+// Pixel p of two tracers' aux planes (same surface id) agree within the tracer agreement tolerance: depth
+// relative, motion, normal and albedo absolute.
+inline ::testing::AssertionResult aux_planes_agree(const core::GBuffer& a, const core::GBuffer& b, size_t p) {
+  auto near = [](float u, float v, float tolerance) { return std::fabs(u - v) <= tolerance; };
+  if (!near(a.depth[p], b.depth[p], 1e-2f * std::max(1.0f, a.depth[p])))
+    return ::testing::AssertionFailure() << "depth " << a.depth[p] << " against " << b.depth[p];
+  for (int k = 0; k < 2; ++k)
+    if (!near(a.motion[2 * p + k], b.motion[2 * p + k], 1e-2f))
+      return ::testing::AssertionFailure() << "motion[" << k << "] " << a.motion[2 * p + k] << " against "
+                                           << b.motion[2 * p + k];
+  for (int k = 0; k < 3; ++k) {
+    if (!near(a.normal[3 * p + k], b.normal[3 * p + k], 1e-2f))
+      return ::testing::AssertionFailure() << "normal[" << k << "] " << a.normal[3 * p + k] << " against "
+                                           << b.normal[3 * p + k];
+    if (!near(a.albedo[3 * p + k], b.albedo[3 * p + k], 1e-2f))
+      return ::testing::AssertionFailure() << "albedo[" << k << "] " << a.albedo[3 * p + k] << " against "
+                                           << b.albedo[3 * p + k];
+  }
+  return ::testing::AssertionSuccess();
+}
+
 inline core::GBuffer render_aux_band(core::Tracer& tracer, const KCamera& camera, const KCamera& previous,
                                      kuint aux_mode = K_AUX_CENTRE_RAY) {
   core::BandBuffer band(static_cast<int>(camera.width), static_cast<int>(camera.height), core::BandFormat::rgba32f);

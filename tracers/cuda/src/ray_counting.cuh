@@ -1,4 +1,5 @@
-// Ray counting shared by the CUDA tracer's kernels (render_band.cu, wavefront_walk.cu).
+// What the CUDA tracer's band kernels share (render_band.cu, wavefront_walk.cu): where a thread's pixel lies
+// in the band, a fresh trace context, and the ray counts.
 #pragma once
 
 #include <cuda_runtime.h>
@@ -6,6 +7,28 @@
 #include "cohort/kernel/trace_bvh.h"
 
 namespace cohort::tracers {
+
+// A thread's pixel: blocks tile the band (row: within it; y: in the frame); `inside` where the band has it.
+struct BandPixel {
+  kuint x, row, y;
+  bool inside;
+  __device__ size_t index(const KCamera& camera) const { return size_t(row) * camera.width + x; }
+};
+__device__ inline BandPixel band_pixel(const KFrameParams& params, const KCamera& camera) {
+  BandPixel p;
+  p.x = blockIdx.x * blockDim.x + threadIdx.x;
+  p.row = blockIdx.y * blockDim.y + threadIdx.y;
+  p.y = params.row_begin + p.row;
+  p.inside = p.x < camera.width && p.y < params.row_end;
+  return p;
+}
+__device__ inline KTraceCtx fresh_trace_ctx(const KSceneView& scene) {
+  KTraceCtx ctx;
+  ctx.scene = scene;
+  ctx.closest_rays = 0u;
+  ctx.occlusion_rays = 0u;
+  return ctx;
+}
 
 // The rays a thread traced, added up per warp: into ray_counts (closest, occlusion; may be null) and into
 // row_rays, the rays per row of the band (the balancer's per-row work; may be null). Every lane of the warp

@@ -28,21 +28,15 @@ template <bool kSparse, bool kFirstHit>
 __global__ void __launch_bounds__(128, 4) render_band_kernel(KSceneView scene, KFrameParams params, KCamera camera,
                                                           float4* band, unsigned long long* ray_counts,
                                                           unsigned* row_rays, KPathFirstHit* first_hits) {
-  const kuint x = blockIdx.x * blockDim.x + threadIdx.x;
-  const kuint row = blockIdx.y * blockDim.y + threadIdx.y;
-  const kuint y = params.row_begin + row;
-  const bool inside = x < camera.width && y < params.row_end;
-  KTraceCtx ctx;
-  ctx.scene = scene;
-  ctx.closest_rays = 0u;
-  ctx.occlusion_rays = 0u;
-  if (inside) {
-    KVec3 c = kSparse ? k_render_pixel(&ctx, &params, &camera, x, y)
-                      : k_render_pixel_paths(&ctx, &params, &camera, x, y,
-                                             kFirstHit ? first_hits + size_t(row) * camera.width + x : nullptr);
-    band[size_t(row) * camera.width + x] = make_float4(c.x, c.y, c.z, 1.0f);
+  const BandPixel px = band_pixel(params, camera);
+  KTraceCtx ctx = fresh_trace_ctx(scene);
+  if (px.inside) {
+    const size_t p = px.index(camera);
+    KVec3 c = kSparse ? k_render_pixel(&ctx, &params, &camera, px.x, px.y)
+                      : k_render_pixel_paths(&ctx, &params, &camera, px.x, px.y, kFirstHit ? first_hits + p : nullptr);
+    band[p] = make_float4(c.x, c.y, c.z, 1.0f);
   }
-  count_rays(ctx, inside, row, y < params.row_end, ray_counts, row_rays);
+  count_rays(ctx, px.inside, px.row, px.y < params.row_end, ray_counts, row_rays);
 }
 
 // The wavefront. The megakernel above keeps a whole path in one thread of a 128-register kernel at a
@@ -97,20 +91,15 @@ __global__ void __launch_bounds__(128, 4) wave_shade_kernel(KSceneView scene, KF
                                                          kuint sample, float4* band, WavefrontScratch wave,
                                                          unsigned long long* ray_counts, unsigned* row_rays,
                                                          KPathFirstHit* first_hits) {
-  const kuint x = blockIdx.x * blockDim.x + threadIdx.x;
-  const kuint row = blockIdx.y * blockDim.y + threadIdx.y;
-  const kuint y = params.row_begin + row;
-  const size_t p = size_t(row) * camera.width + x;
-  const bool inside = x < camera.width && y < params.row_end && (kCameraRays || wave.active[p]);
-  KTraceCtx ctx;
-  ctx.scene = scene;
-  ctx.closest_rays = 0u;
-  ctx.occlusion_rays = 0u;
+  const BandPixel px = band_pixel(params, camera);
+  const size_t p = px.index(camera);
+  const bool inside = px.inside && (kCameraRays || wave.active[p]);
+  KTraceCtx ctx = fresh_trace_ctx(scene);
   if (inside) {
     KPathState s;
     if (kCameraRays) {
       KRng rng;
-      const KVec3 dir = k_camera_sample(&params, &camera, x, y, sample, &rng);
+      const KVec3 dir = k_camera_sample(&params, &camera, px.x, px.y, sample, &rng);
       k_path_begin(&s, v3_load(camera.origin), dir, k_pixel_spread(&camera), rng);
     } else {
       s = wave.states[p];
@@ -121,7 +110,7 @@ __global__ void __launch_bounds__(128, 4) wave_shade_kernel(KSceneView scene, KF
     if (kCameraRays || !goes_on) wave.active[p] = goes_on ? 1u : 0u;
     if (!goes_on) finish_sample(band, p, s.radiance, sample, 1.0f / float(params.spp > 0u ? params.spp : 1u));
   }
-  count_rays(ctx, inside, row, y < params.row_end, ray_counts, row_rays);
+  count_rays(ctx, inside, px.row, px.y < params.row_end, ray_counts, row_rays);
 }
 
 // The 32-byte texel the host's BandBuffer keeps (halves for normal and albedo).

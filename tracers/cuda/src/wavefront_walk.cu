@@ -26,40 +26,29 @@ __global__ void __launch_bounds__(128, 8) camera_walk_kernel(KSceneView scene, K
                                                              kuint sample, WavefrontScratch wave,
                                                              KPathFirstHit* records, unsigned long long* ray_counts,
                                                              unsigned* row_rays) {
-  const kuint x = blockIdx.x * blockDim.x + threadIdx.x;
-  const kuint row = blockIdx.y * blockDim.y + threadIdx.y;
-  const kuint y = params.row_begin + row;
-  const bool inside = x < camera.width && y < params.row_end;
-  KTraceCtx ctx;
-  ctx.scene = scene;
-  ctx.closest_rays = 0u;
-  ctx.occlusion_rays = 0u;
-  if (inside) {
-    const size_t p = size_t(row) * camera.width + x;
+  const BandPixel px = band_pixel(params, camera);
+  KTraceCtx ctx = fresh_trace_ctx(scene);
+  if (px.inside) {
+    const size_t p = px.index(camera);
     if (records) k_record_first_hit(records + p, K_NONE, 0u, 0u);
     KRng rng;
-    const KVec3 dir = k_camera_sample(&params, &camera, x, y, sample, &rng);
+    const KVec3 dir = k_camera_sample(&params, &camera, px.x, px.y, sample, &rng);
     KHit hit;
     hit.cost = 0u;
     if (!k_trace_closest(&ctx, v3_load(camera.origin), dir, K_INF, K_RAY_PRIMARY, &hit)) hit.instance = K_NONE;
     wave.hits[p] = hit;
   }
-  count_rays(ctx, inside, row, y < params.row_end, ray_counts, row_rays);
+  count_rays(ctx, px.inside, px.row, px.y < params.row_end, ray_counts, row_rays);
 }
 
 // The live paths' bounce rays: their hits (instance K_NONE: a miss) for the shading kernel.
 __global__ void __launch_bounds__(128, 8) bounce_walk_kernel(KSceneView scene, KFrameParams params, KCamera camera,
                                                              WavefrontScratch wave, unsigned long long* ray_counts,
                                                              unsigned* row_rays) {
-  const kuint x = blockIdx.x * blockDim.x + threadIdx.x;
-  const kuint row = blockIdx.y * blockDim.y + threadIdx.y;
-  const kuint y = params.row_begin + row;
-  const size_t p = size_t(row) * camera.width + x;
-  const bool inside = x < camera.width && y < params.row_end && wave.active[p];
-  KTraceCtx ctx;
-  ctx.scene = scene;
-  ctx.closest_rays = 0u;
-  ctx.occlusion_rays = 0u;
+  const BandPixel px = band_pixel(params, camera);
+  const size_t p = px.index(camera);
+  const bool inside = px.inside && wave.active[p];
+  KTraceCtx ctx = fresh_trace_ctx(scene);
   if (inside) {
     const KPathState* s = wave.states + p;
     KHit hit;
@@ -67,7 +56,7 @@ __global__ void __launch_bounds__(128, 8) bounce_walk_kernel(KSceneView scene, K
     if (!k_trace_closest(&ctx, s->org, s->dir, K_INF, K_RAY_PRIMARY, &hit)) hit.instance = K_NONE;
     wave.hits[p] = hit;
   }
-  count_rays(ctx, inside, row, y < params.row_end, ray_counts, row_rays);
+  count_rays(ctx, inside, px.row, px.y < params.row_end, ray_counts, row_rays);
 }
 
 }  // namespace
