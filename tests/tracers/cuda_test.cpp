@@ -237,6 +237,88 @@ INSTANTIATE_TEST_SUITE_P(Paths, CudaWavefront,
                                            WavefrontCase{2, 4, true, "pack_bounce2_spp4"}),
                          [](const auto& info) { return std::string(info.param.name); });
 
+// Next-event estimation's shadow rays walked by a kernel of their own (CudaTracer::set_shadow_walk): the
+// image of the wavefront that walks them in its shading kernels bit for bit, the megakernel's, and the same
+// rays counted. On a floor of 96 lights (or 6) and an emissive panel, two samples, two bounces, soft
+// shadows: gather chooses among more lights than its budget, two light samples average with the shadow
+// roulette on, `every` with 6 lights leaves 7 rays a vertex, with 96 more than a vertex's slots (then the
+// shading kernels walk them), and the firefly clamp works on the vertex's sum.
+struct ShadowWalkCase {
+  uint32_t light_sampling, light_samples;
+  float shadow_rr;
+  int point_lights, projected_lights;
+  const char* name;
+};
+class CudaShadowWalk : public ::testing::TestWithParam<ShadowWalkCase> {};
+
+TEST_P(CudaShadowWalk, DrawsTheImageOfShadowsWalkedInTheShadingKernels) {
+  REQUIRE_GPU();
+  const ShadowWalkCase c = GetParam();
+  const int w = 64, h = 48;
+  const KCamera cam = camera_looking_down({0, 0, 1400}, 0.7f, w, h);
+  KFrameParams params = frame_params(K_MODE_PATH, 2, 2, h);
+  params.soft_shadow_scale = 1.0f;
+  params.firefly_clamp = 4.0f;
+  params.frame_index = 3;
+  params.light_sampling = c.light_sampling;
+  params.light_samples = c.light_samples;
+  params.shadow_rr = c.shadow_rr;
+  scene::Scene floor = many_lights_floor(c.point_lights, c.projected_lights);
+  scene::Material panel;
+  panel.name = "panel";
+  panel.diffuse_color = glm::vec4(0.0f, 0.0f, 0.0f, 1.0f);
+  panel.emitter = true;
+  panel.emissive_color = glm::vec4(4.0f, 3.5f, 3.0f, 1.0f);
+  floor.materials.push_back(panel);
+  scene::Mesh lamp;
+  lamp.name = "_area1";
+  add_quad(lamp, int(floor.materials.size() - 1), {-60, -60, 150}, {-60, 60, 150}, {60, 60, 150}, {60, -60, 150},
+           {0, 0, -1});
+  add_world_mesh(floor, std::move(lamp));
+  auto scene = std::make_shared<commit::TracerScene>(core::compile_scene(floor).tracer_scene);
+  ASSERT_EQ(scene->emissive_triangles.size(), 2u) << "the panel's triangles are emitters to sample";
+  struct Variant {
+    bool wavefront, shadow_walk;
+    const char* name;
+  };
+  const Variant variants[3] = {
+      {false, false, "megakernel"}, {true, false, "shadows in the shading kernels"}, {true, true, "shadow walk"}};
+  core::FrameBuffer frames[3];
+  tracers::CudaTracer::RayCounts counts[3];
+  for (int v = 0; v < 3; ++v) {
+    tracers::CudaTracer cuda(0);
+    cuda.set_wavefront(variants[v].wavefront);
+    cuda.set_shadow_walk(variants[v].shadow_walk);
+    cuda.set_ray_counting(true);
+    cuda.apply(commit::CommitBuffer::full(scene, 1));
+    frames[v] = render_frame(cuda, cam, params);
+    counts[v] = cuda.last_ray_counts();
+    for (float x : frames[v].rgba) ASSERT_TRUE(std::isfinite(x)) << variants[v].name;
+  }
+  size_t differing = 0;
+  for (size_t i = 0; i < frames[1].rgba.size(); ++i) differing += frames[1].rgba[i] != frames[2].rgba[i];
+  EXPECT_EQ(differing, 0u) << c.name << ": floats that differ between the shadow walk and the shading kernels'";
+  double mean = 0.0;
+  const double error = rgb_rmse(frames[0], frames[2], &mean);
+  std::cout << c.name << ": mean " << mean << ", RMSE megakernel/shadow walk " << error << ", floats differing from "
+            << "the shading kernels' shadows " << differing << ", occlusion rays " << counts[2].occlusion << "\n";
+  EXPECT_GT(mean, 0.0) << c.name << ": the floor is lit";
+  EXPECT_LE(error, 1e-4 * mean) << c.name;
+  EXPECT_GT(counts[2].occlusion, 0u) << c.name;
+  for (int v = 0; v < 2; ++v) {
+    EXPECT_EQ(counts[v].closest, counts[2].closest) << c.name << ": " << variants[v].name;
+    EXPECT_EQ(counts[v].occlusion, counts[2].occlusion) << c.name << ": " << variants[v].name;
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(LightSampling, CudaShadowWalk,
+                         ::testing::Values(ShadowWalkCase{K_LIGHTS_TREE, 1, 0.0f, 88, 8, "tree1"},
+                                           ShadowWalkCase{K_LIGHTS_TREE, 2, 0.03f, 88, 8, "tree2_roulette"},
+                                           ShadowWalkCase{K_LIGHTS_GATHER, 4, 0.03f, 88, 8, "gather4_roulette"},
+                                           ShadowWalkCase{K_LIGHTS_EVERY, 0, 0.03f, 4, 2, "every_6_lights"},
+                                           ShadowWalkCase{K_LIGHTS_EVERY, 0, 0.03f, 88, 8, "every_past_the_slots"}),
+                         [](const auto& info) { return std::string(info.param.name); });
+
 }  // namespace
 
 #else

@@ -84,17 +84,33 @@ struct CudaTracer::Impl {
   DeviceArray<KPathState> wave_states;
   DeviceArray<KHit> wave_hits;
   DeviceArray<kuint> wave_active;
+  // Its shadow rays walked by a kernel of their own, unless COHORT_CUDA_SHADOW_WALK=0 (the shading kernels
+  // walk them as they come).
+  bool shadow_walk = enabled_unless_zero("COHORT_CUDA_SHADOW_WALK");
+  DeviceArray<KVertexLight> wave_vertices;
+  DeviceArray<KShadowRay> wave_shadow_rays;
   WavefrontScratch wave_scratch;
-  // The wavefront's scratch for a band of `pixels`, or null for the megakernel.
-  const WavefrontScratch* wave(size_t pixels) {
+  // The wavefront's scratch for a band of `pixels` rendered with `params`, or null for the megakernel.
+  const WavefrontScratch* wave(size_t pixels, const KFrameParams& params) {
     if (!wavefront) return nullptr;
-    wave_scratch = {wave_states.scratch(pixels), wave_hits.scratch(pixels), wave_active.scratch(pixels)};
+    wave_scratch = {};
+    wave_scratch.states = wave_states.scratch(pixels);
+    wave_scratch.hits = wave_hits.scratch(pixels);
+    wave_scratch.active = wave_active.scratch(pixels);
+    const KSceneView scene = view(params);
+    const kuint slots = shadow_walk ? k_shadow_queue_slots(&params, scene.light_count, scene.emissive_count) : 0u;
+    if (slots > 0u) {
+      wave_scratch.vertices = wave_vertices.scratch(pixels);
+      wave_scratch.shadow_rays = wave_shadow_rays.scratch(pixels * slots);
+      wave_scratch.shadow_slots = slots;
+    }
     return &wave_scratch;
   }
-  static bool wavefront_by_default() {
-    const char* v = std::getenv("COHORT_CUDA_WAVEFRONT");
+  static bool enabled_unless_zero(const char* variable) {
+    const char* v = std::getenv(variable);
     return !(v && std::strcmp(v, "0") == 0);
   }
+  static bool wavefront_by_default() { return enabled_unless_zero("COHORT_CUDA_WAVEFRONT"); }
   unsigned long long* ray_counts = nullptr;   // device: closest, occlusion
   unsigned* row_rays = nullptr;                // device: rays per band row (the balancer's per-row work)
   size_t row_rays_capacity = 0;                // rows
@@ -332,7 +348,7 @@ core::BandResult CudaTracer::render_band(const core::BandJob& job, core::BandBuf
   }
   KPathFirstHit* first_hits = aux_from_paths ? m.first_hits.scratch(pixels) : nullptr;
   launch_render_band(m.view(params), params, camera, m.band, m.count_rays ? m.ray_counts : nullptr, m.row_rays,
-                     first_hits, m.wave(pixels), m.stream);
+                     first_hits, m.wave(pixels, params), m.stream);
   if (aux_from_paths) {
     // From the paths' first hits: after the band's kernel, no ray of their own (counted in the band's time).
     launch_aux_from_first_hits(m.view(params), params, camera, previous, history, first_hits, texels, m.stream);
@@ -391,7 +407,7 @@ core::BandResult CudaTracer::render_band_in_pieces(const core::BandJob& job, cor
   // download never races the next piece's kernel: the copy stream takes piece i while `stream` runs
   // piece i + 1.
   const size_t pixel_bytes = core::bytes_per_pixel(target.format());
-  const WavefrontScratch* wave = m.wave(pixels);  // the pieces take turns with it on `stream`
+  const WavefrontScratch* wave = m.wave(pixels, params);  // the pieces take turns with it on `stream`
   COHORT_CUDA(cudaEventRecord(m.start, m.stream));
   for (size_t i = 0; i < pieces; ++i) {
     KFrameParams piece = params;
@@ -435,6 +451,8 @@ core::BandResult CudaTracer::render_band_in_pieces(const core::BandJob& job, cor
 
 void CudaTracer::set_ray_counting(bool on) { impl_->count_rays = on; }
 void CudaTracer::set_wavefront(bool on) { impl_->wavefront = on; }
+void CudaTracer::set_shadow_walk(bool on) { impl_->shadow_walk = on; }
+bool CudaTracer::shadow_walk() const { return impl_->shadow_walk; }
 bool CudaTracer::wavefront() const { return impl_->wavefront; }
 CudaTracer::RayCounts CudaTracer::last_ray_counts() const { return impl_->last_counts; }
 int CudaTracer::device() const { return impl_->device; }

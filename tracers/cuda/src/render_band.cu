@@ -12,6 +12,7 @@ __constant__ cudaTextureObject_t cohort_texel_texture;
 #include "cohort/kernel/trace_bvh.h"
 #include "cohort/kernel/integrator.h"
 #include "cohort/kernel/aux_outputs.h"
+#include "band_samples.cuh"
 #include "ray_counting.cuh"
 #include "render_band_launch.h"
 
@@ -45,12 +46,15 @@ __global__ void __launch_bounds__(128, 4) render_band_kernel(KSceneView scene, K
 // twice the occupancy), and a path's segments (what its camera ray meets up to the first bounce; then, per
 // bounce, what the bounce ray meets up to the next) are shaded by kernels like the megakernel. The paths
 // wait in memory between them (KPathState, kernel/path_state.h): same integrator, same random numbers, the
-// megakernel's image. Transparent layers and shadow rays are still walked inline by the shading kernels.
+// megakernel's image. Transparent layers are walked inline by the shading kernels; next-event estimation's
+// shadow rays are left in memory for a walk of their own (wavefront_walk.cu's shadow_walk_kernel), unless a
+// vertex may emit more than its slots or COHORT_CUDA_SHADOW_WALK=0 (then walked inline too).
 
 // Runs a path from its current ray until it ends (false) or has bounced (true: its next ray in *s).
-// `traced`: the current ray's hit, walked by the bounce kernel (null: walked here).
+// `traced`: the current ray's hit, walked by the bounce kernel (null: walked here). shadows: where the last
+// vertex's shadow rays go; with some left there (shadows->count > 0) its light waits in *vertex.
 __device__ bool path_segment(KTraceCtx* ctx, const KFrameParams* params, KPathState* s, const KHit* traced,
-                             KPathFirstHit* first_hit) {
+                             KPathFirstHit* first_hit, KShadowQueue* shadows, KVertexLight* vertex) {
   const kuint bounce = s->bounce;
   for (;;) {
     KHit hit;
@@ -67,33 +71,38 @@ __device__ bool path_segment(KTraceCtx* ctx, const KFrameParams* params, KPathSt
       k_path_miss(K_CTX_SCENE(ctx), params, s, &hit);
       return false;
     }
-    if (!k_path_hit(ctx, params, s, hit, first_hit)) return false;
+    if (!k_path_hit_queued(ctx, params, s, hit, first_hit, shadows, vertex)) return false;
     if (s->bounce != bounce) return true;
   }
 }
 
-// A finished path's radiance into its pixel: the mean over the frame's samples, sample by sample.
-__device__ void finish_sample(float4* band, size_t p, KVec3 radiance, kuint sample, float inv_spp) {
-  float4 c = make_float4(radiance.x * inv_spp, radiance.y * inv_spp, radiance.z * inv_spp, 1.0f);
-  if (sample > 0u) {
-    const float4 sum = band[p];
-    c = make_float4(sum.x + c.x, sum.y + c.y, sum.z + c.z, 1.0f);
+// Pixel p's slots for its vertex's shadow rays (kShadowWalk; else none: walked as they come). The
+// capacity is a constant, so that each build keeps one way (the launch gives a vertex all the slots it
+// needs, k_shadow_queue_slots).
+template <bool kShadowWalk>
+__device__ KShadowQueue shadow_slots(const WavefrontScratch& wave, size_t p) {
+  KShadowQueue q = k_shadow_queue_inline();
+  if (kShadowWalk) {
+    q.rays = wave.shadow_rays + p;
+    q.stride = wave.shadow_stride;
+    q.capacity = K_SHADOW_QUEUE_MAX;
   }
-  band[p] = c;
+  return q;
 }
 
 // What the live paths' rays (walked by wavefront_walk.cu's kernels) met, shaded, and the paths on to their
 // next bounce. kCameraRays: the camera rays' segment, whose paths begin here from the pixel (the walk kept
 // only the hits: 88 bytes a pixel less each way); kFirstHit: that segment of the frame's first sample,
-// which records first hits.
-template <bool kCameraRays, bool kFirstHit>
+// which records first hits. kShadowWalk: the shadow rays left in their slots for the shadow walk (else
+// walked here).
+template <bool kCameraRays, bool kFirstHit, bool kShadowWalk>
 __global__ void __launch_bounds__(128, 4) wave_shade_kernel(KSceneView scene, KFrameParams params, KCamera camera,
                                                          kuint sample, float4* band, WavefrontScratch wave,
                                                          unsigned long long* ray_counts, unsigned* row_rays,
                                                          KPathFirstHit* first_hits) {
   const BandPixel px = band_pixel(params, camera);
   const size_t p = px.index(camera);
-  const bool inside = px.inside && (kCameraRays || wave.active[p]);
+  const bool inside = px.inside && (kCameraRays || (wave.active[p] & kWaveLive));
   KTraceCtx ctx = fresh_trace_ctx(scene);
   if (inside) {
     KPathState s;
@@ -105,10 +114,19 @@ __global__ void __launch_bounds__(128, 4) wave_shade_kernel(KSceneView scene, KF
       s = wave.states[p];
     }
     const KHit hit = wave.hits[p];
-    const bool goes_on = path_segment(&ctx, &params, &s, &hit, kFirstHit ? first_hits + p : nullptr);
-    if (goes_on) wave.states[p] = s;
-    if (kCameraRays || !goes_on) wave.active[p] = goes_on ? 1u : 0u;
-    if (!goes_on) finish_sample(band, p, s.radiance, sample, 1.0f / float(params.spp > 0u ? params.spp : 1u));
+    KShadowQueue shadows = shadow_slots<kShadowWalk>(wave, p);
+    KVertexLight vertex;
+    const bool goes_on =
+        path_segment(&ctx, &params, &s, &hit, kFirstHit ? first_hits + p : nullptr, &shadows, &vertex);
+    // A vertex whose shadow rays are out waits for the shadow walk, which adds its light and finishes the
+    // sample of a path that ended there.
+    const bool shadows_out = shadows.count > 0u;
+    if (goes_on || shadows_out) wave.states[p] = s;
+    if (shadows_out) wave.vertices[p] = vertex;
+    if (kCameraRays || !goes_on || shadows_out)
+      wave.active[p] = (goes_on ? kWaveLive : 0u) | (shadows_out ? kWaveShadowsOut : 0u);
+    if (!goes_on && !shadows_out)
+      finish_sample(band, p, s.radiance, sample, 1.0f / float(params.spp > 0u ? params.spp : 1u));
   }
   count_rays(ctx, inside, px.row, px.y < params.row_end, ray_counts, row_rays);
 }
@@ -193,20 +211,34 @@ void launch_render_band(const KSceneView& scene, const KFrameParams& params, con
   const dim3 grid((camera.width + block.x - 1) / block.x, (rows + block.y - 1) / block.y);
   const bool sparse = params.path_pixels != 0u && params.path_pixels < K_PATH_PATTERN_PIXELS;
   if (wave && wavefront_renders(params)) {
+    WavefrontScratch scratch = *wave;
+    scratch.shadow_stride = camera.width * rows;
     const kuint spp = params.spp > 0u ? params.spp : 1u;
+    const bool shadow_walk = scratch.shadow_slots > 0u;
+    // A shading kernel and, after it, the shadow rays it left, before the next one shades the paths further.
+    auto shade = [&](kuint sample, bool camera_rays, KPathFirstHit* records) {
+      auto launch = [&](auto kernel) {
+        kernel<<<grid, block, 0, stream>>>(scene, params, camera, sample, band, scratch, ray_counts, row_rays,
+                                           records);
+      };
+      if (!camera_rays)
+        shadow_walk ? launch(wave_shade_kernel<false, false, true>) : launch(wave_shade_kernel<false, false, false>);
+      else if (records)
+        shadow_walk ? launch(wave_shade_kernel<true, true, true>) : launch(wave_shade_kernel<true, true, false>);
+      else
+        shadow_walk ? launch(wave_shade_kernel<true, false, true>) : launch(wave_shade_kernel<true, false, false>);
+      if (shadow_walk)
+        launch_wave_shadow_walk(grid, block, scene, params, camera, sample, band, scratch, ray_counts, row_rays,
+                                stream);
+    };
     for (kuint sample = 0u; sample < spp; ++sample) {
       KPathFirstHit* records = sample == 0u ? first_hits : nullptr;
-      launch_wave_camera_walk(grid, block, scene, params, camera, sample, *wave, records, ray_counts, row_rays, stream);
-      if (records)
-        wave_shade_kernel<true, true><<<grid, block, 0, stream>>>(scene, params, camera, sample, band, *wave, ray_counts,
-                                                                  row_rays, records);
-      else
-        wave_shade_kernel<true, false><<<grid, block, 0, stream>>>(scene, params, camera, sample, band, *wave,
-                                                                   ray_counts, row_rays, nullptr);
+      launch_wave_camera_walk(grid, block, scene, params, camera, sample, scratch, records, ray_counts, row_rays,
+                              stream);
+      shade(sample, true, records);
       for (kuint bounce = 1u; bounce <= params.max_bounces; ++bounce) {
-        launch_wave_bounce_walk(grid, block, scene, params, camera, *wave, ray_counts, row_rays, stream);
-        wave_shade_kernel<false, false><<<grid, block, 0, stream>>>(scene, params, camera, sample, band, *wave, ray_counts,
-                                                             row_rays, nullptr);
+        launch_wave_bounce_walk(grid, block, scene, params, camera, scratch, ray_counts, row_rays, stream);
+        shade(sample, false, nullptr);
       }
     }
   } else if (sparse)

@@ -7,18 +7,27 @@
 #include "cohort/kernel/path_pattern.h"
 #include "cohort/kernel/path_state.h"
 #include "cohort/kernel/scene_view.h"
+#include "cohort/kernel/shadow_ray.h"
 
 namespace cohort::tracers {
 
 void set_texel_texture(cudaTextureObject_t texture);
 
 // The bounce rays' wavefront (render_band.cu): where paths wait between its kernels. Device pointers, each
-// for at least the band's pixels.
+// for at least the band's pixels (shadow_rays: shadow_slots times that).
 struct WavefrontScratch {
   KPathState* states = nullptr;
   KHit* hits = nullptr;
-  kuint* active = nullptr;
+  kuint* active = nullptr;  // kWaveLive | kWaveShadowsOut
+  // Next-event estimation's shadow rays, walked by a kernel of their own (wavefront_walk.cu) when
+  // shadow_slots > 0; 0: the shading kernels walk them as they come. The shading kernel leaves a pixel's
+  // vertex in vertices and its rays in slots k * shadow_stride + pixel (launch_render_band sets the stride).
+  KVertexLight* vertices = nullptr;
+  KShadowRay* shadow_rays = nullptr;
+  kuint shadow_slots = 0u, shadow_stride = 0u;
 };
+// A pixel's wavefront flags: its path goes on; its last vertex waits for its shadow rays.
+constexpr kuint kWaveLive = 1u, kWaveShadowsOut = 2u;
 // The wavefront's walks (wavefront_walk.cu): the camera rays of a sample (records: the
 // first-hit records to clear, or null), and the live paths' bounce rays; each ray's hit into wave.hits.
 void launch_wave_camera_walk(dim3 grid, dim3 block, const KSceneView& scene, const KFrameParams& params,
@@ -27,6 +36,11 @@ void launch_wave_camera_walk(dim3 grid, dim3 block, const KSceneView& scene, con
 void launch_wave_bounce_walk(dim3 grid, dim3 block, const KSceneView& scene, const KFrameParams& params,
                              const KCamera& camera, const WavefrontScratch& wave, unsigned long long* ray_counts,
                              unsigned* row_rays, cudaStream_t stream);
+// The shadow rays the shading kernel left (pixels flagged kWaveShadowsOut): each walked, its vertex's light
+// added to its path's radiance, and a path that ended there finished into the band.
+void launch_wave_shadow_walk(dim3 grid, dim3 block, const KSceneView& scene, const KFrameParams& params,
+                             const KCamera& camera, kuint sample, float4* band, const WavefrontScratch& wave,
+                             unsigned long long* ray_counts, unsigned* row_rays, cudaStream_t stream);
 // That translation unit's copy of the texel texture (its alpha-tested surfaces read it).
 void set_walk_texel_texture(cudaTextureObject_t texture);
 // Whether launch_render_band renders this band as a wavefront when given the scratch: lit paths that bounce,

@@ -14,6 +14,7 @@ static __constant__ cudaTextureObject_t cohort_walk_texel_texture;
 
 #include "cohort/kernel/trace_bvh.h"
 #include "cohort/kernel/integrator.h"
+#include "band_samples.cuh"
 #include "ray_counting.cuh"
 #include "render_band_launch.h"
 
@@ -47,7 +48,7 @@ __global__ void __launch_bounds__(128, 8) bounce_walk_kernel(KSceneView scene, K
                                                              unsigned* row_rays) {
   const BandPixel px = band_pixel(params, camera);
   const size_t p = px.index(camera);
-  const bool inside = px.inside && wave.active[p];
+  const bool inside = px.inside && (wave.active[p] & kWaveLive);
   KTraceCtx ctx = fresh_trace_ctx(scene);
   if (inside) {
     const KPathState* s = wave.states + p;
@@ -55,6 +56,44 @@ __global__ void __launch_bounds__(128, 8) bounce_walk_kernel(KSceneView scene, K
     hit.cost = 0u;
     if (!k_trace_closest(&ctx, s->org, s->dir, K_INF, K_RAY_PRIMARY, &hit)) hit.instance = K_NONE;
     wave.hits[p] = hit;
+  }
+  count_rays(ctx, inside, px.row, px.y < params.row_end, ray_counts, row_rays);
+}
+
+// The shadow rays a shading kernel left: each vertex's rays walked, then the visible ones' values added in
+// their order and the vertex's light to its path's radiance (k_vertex_light_sum, the integrator's order of
+// additions), a path that ended there finished. Only a bit per ray is carried through the walks, and the
+// vertex is read after them, to keep its sums out of the walk's registers (spills otherwise).
+__global__ void __launch_bounds__(128, 8) shadow_walk_kernel(KSceneView scene, KFrameParams params, KCamera camera,
+                                                             kuint sample, float4* band, WavefrontScratch wave,
+                                                             unsigned long long* ray_counts, unsigned* row_rays) {
+  const BandPixel px = band_pixel(params, camera);
+  const size_t p = px.index(camera);
+  const kuint flags = px.inside ? wave.active[p] : 0u;
+  const bool inside = (flags & kWaveShadowsOut) != 0u;
+  KTraceCtx ctx = fresh_trace_ctx(scene);
+  if (inside) {
+    const KShadowRay* rays = wave.shadow_rays + p;
+    const kuint count = wave.vertices[p].ray_count;  // at most K_SHADOW_QUEUE_MAX
+    kuint visible = 0u;
+    for (kuint k = 0u; k < count; ++k) {
+      const KShadowRay ray = rays[size_t(k) * wave.shadow_stride];
+      if (k_shadow_ray_visible(&ctx, &ray)) visible |= 1u << k;
+    }
+    KVertexLight v = wave.vertices[p];
+    for (kuint k = 0u; k < count; ++k)
+      if (visible & (1u << k)) {
+        const KShadowRay ray = rays[size_t(k) * wave.shadow_stride];
+        k_shadow_ray_add(&v, &ray);
+      }
+    const KVec3 radiance = v3_add(wave.states[p].radiance, k_vertex_light_sum(&v));
+    if (flags & kWaveLive) {
+      wave.states[p].radiance = radiance;
+      wave.active[p] = kWaveLive;
+    } else {
+      wave.active[p] = 0u;
+      finish_sample(band, p, radiance, sample, 1.0f / float(params.spp > 0u ? params.spp : 1u));
+    }
   }
   count_rays(ctx, inside, px.row, px.y < params.row_end, ray_counts, row_rays);
 }
@@ -75,6 +114,12 @@ void launch_wave_bounce_walk(dim3 grid, dim3 block, const KSceneView& scene, con
                              const KCamera& camera, const WavefrontScratch& wave, unsigned long long* ray_counts,
                              unsigned* row_rays, cudaStream_t stream) {
   bounce_walk_kernel<<<grid, block, 0, stream>>>(scene, params, camera, wave, ray_counts, row_rays);
+}
+
+void launch_wave_shadow_walk(dim3 grid, dim3 block, const KSceneView& scene, const KFrameParams& params,
+                             const KCamera& camera, kuint sample, float4* band, const WavefrontScratch& wave,
+                             unsigned long long* ray_counts, unsigned* row_rays, cudaStream_t stream) {
+  shadow_walk_kernel<<<grid, block, 0, stream>>>(scene, params, camera, sample, band, wave, ray_counts, row_rays);
 }
 
 }  // namespace cohort::tracers

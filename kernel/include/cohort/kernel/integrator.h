@@ -18,6 +18,7 @@
 #include "fog.h"
 #include "path_state.h"
 #include "light_gather.h"
+#include "shadow_queue.h"
 #include "light_tree.h"
 #include "rng.h"
 #include "path_pattern.h"
@@ -56,28 +57,45 @@ KFN float k_shadow_roulette(float threshold, float pixel_value, KRng* rng) {
   return k_rng_next(rng) < keep ? 1.0f / keep : 0.0f;
 }
 
-/* One shadow ray toward a point jittered over the light's extent: 1 when the light is visible. */
-KFN int k_light_visible(KTraceCtx* ctx, const KFrameParams* params, const KSurface* sf, KGLOBAL const KLight* light,
-                        float u1, float u2) {
+/* The shadow ray toward a point jittered over the light's extent, into *ray (its value left to the caller);
+ * 0 when the light cannot be seen from the point (it lies behind the surface). */
+KFN int k_light_shadow_ray(const KFrameParams* params, const KSurface* sf, KGLOBAL const KLight* light, float u1,
+                           float u2, KShadowRay* ray) {
+  ray->tmax = 0.0f;
+  ray->mask = 0u;
   if (light->flags & K_LIGHT_NO_SHADOWS) return 1;
   float dist;
   KVec3 dir = k_light_jittered_direction(light, sf->position, params->soft_shadow_scale, u1, u2, &dist);
   if (v3_dot(dir, sf->geo_normal) <= 0.0f) return 0;
   float eps = k_ray_epsilon(sf->position);
-  KVec3 org = v3_madd(sf->position, sf->geo_normal, eps);
-  float tmax = dist < K_INF ? dist - 2.0f * eps : K_INF;
-  return tmax <= 0.0f || !k_trace_occluded(ctx, org, dir, tmax, k_shadow_ray_mask(sf->flags));
+  ray->org = v3_madd(sf->position, sf->geo_normal, eps);
+  ray->dir = dir;
+  ray->tmax = dist < K_INF ? dist - 2.0f * eps : K_INF;
+  ray->mask = k_shadow_ray_mask(sf->flags);
+  return 1;
 }
 
-/* One light sample traced as K_LIGHTS_EVERY traces each light: `value` (its unshadowed contribution,
- * over its probability of being sampled) when its shadow ray, and the shadow roulette, let it through.
- * Every light sample draws its random numbers in this order. */
-KFN KVec3 k_light_sample_traced(KTraceCtx* ctx, const KFrameParams* params, const KSurface* sf,
-                                KGLOBAL const KLight* light, KVec3 value, float path_weight, KRng* rng) {
+/* One light sample as K_LIGHTS_EVERY takes each light: `value` (its unshadowed contribution, over its
+ * probability of being sampled) queued behind its shadow ray when the shadow roulette keeps it. Every
+ * light sample draws its random numbers in this order. */
+KFN void k_light_sample_emit(KTraceCtx* ctx, const KFrameParams* params, const KSurface* sf,
+                             KGLOBAL const KLight* light, KVec3 value, float path_weight, KRng* rng,
+                             KShadowQueue* queue, KVertexLight* vertex) {
   float u1 = k_rng_next(rng), u2 = k_rng_next(rng);
   float kept = k_shadow_roulette(params->shadow_rr, v3_max_component(value) * path_weight, rng);
-  if (kept > 0.0f && k_light_visible(ctx, params, sf, light, u1, u2)) return v3_scale(value, kept);
-  return v3s(0.0f);
+  KShadowRay ray;
+  if (kept > 0.0f && k_light_shadow_ray(params, sf, light, u1, u2, &ray)) {
+    ray.value = v3_scale(value, kept);
+    ray.kept = 1.0f;
+    k_shadow_queue_push(ctx, queue, vertex, ray);
+  }
+}
+
+/* Whether k_direct_lighting traces each light it takes once (`every`, gather) rather than light_samples
+ * samples of one light each, which it averages. */
+KFN int k_lights_one_ray_each(const KFrameParams* params) {
+  return (params->light_sampling == K_LIGHTS_GATHER && params->light_samples > 0u) || params->light_samples == 0u ||
+         params->light_sampling == K_LIGHTS_EVERY;
 }
 
 /* Next-event estimation toward the Doom 3 lights, four ways (KFrameParams.light_sampling):
@@ -89,13 +107,14 @@ KFN KVec3 k_light_sample_traced(KTraceCtx* ctx, const KFrameParams* params, cons
  *   unshadowed contribution (the reference for the tree: same pick, cost grows with the map).
  * - K_LIGHTS_GATHER: `every` among the lights whose volume holds the point, found through the tree, while
  *   there are at most light_samples of them; beyond that at most light_samples shadow rays, each light
- *   with a known probability (light_gather.h). */
-KFN KVec3 k_direct_lighting(KTraceCtx* ctx, const KFrameParams* params, const KSurface* sf, KVec3 wo, float path_weight,
-                            KRng* rng) {
+ *   with a known probability (light_gather.h).
+ * Each sample's shadow ray goes to the queue with its value (shadow_queue.h), which adds the values of the
+ * visible ones, in order, to the vertex's direct sum. */
+KFN void k_direct_lighting(KTraceCtx* ctx, const KFrameParams* params, const KSurface* sf, KVec3 wo, float path_weight,
+                           KRng* rng, KShadowQueue* queue, KVertexLight* vertex) {
   const KSceneView* scene = K_CTX_SCENE(ctx);
-  KVec3 sum = v3s(0.0f);
   int gather = params->light_sampling == K_LIGHTS_GATHER && params->light_samples > 0u;
-  if (gather || params->light_samples == 0u || params->light_sampling == K_LIGHTS_EVERY) {
+  if (k_lights_one_ray_each(params)) {
     /* `every` walks the whole light array; gather, the lights k_light_gather chose (outlined, on values,
      * so that the kernel's other paths keep ctx and sf in registers). One loop traces both. */
     KLightGather gathered;
@@ -109,9 +128,9 @@ KFN KVec3 k_direct_lighting(KTraceCtx* ctx, const KFrameParams* params, const KS
       KGLOBAL const KLight* light = &scene->lights[i];
       KVec3 c = gather ? gathered.value[k] : k_light_unshadowed(scene, light, sf, wo, params->spec_boost);
       if (v3_max_component(c) <= 0.0f) continue;
-      sum = v3_add(sum, k_light_sample_traced(ctx, params, sf, light, c, path_weight, rng));
+      k_light_sample_emit(ctx, params, sf, light, c, path_weight, rng, queue, vertex);
     }
-    return sum;
+    return;
   }
   kuint samples = params->light_samples;
   for (kuint k = 0u; k < samples; ++k) {
@@ -145,10 +164,12 @@ KFN KVec3 k_direct_lighting(KTraceCtx* ctx, const KFrameParams* params, const KS
     if (chosen == K_NONE || !(pdf > 0.0f)) continue;
     KVec3 value = v3_scale(chosen_contrib, 1.0f / pdf);
     float kept = k_shadow_roulette(params->shadow_rr, v3_max_component(value) * path_weight / (float)samples, rng);
-    if (kept <= 0.0f || !k_light_visible(ctx, params, sf, &scene->lights[chosen], u1, u2)) continue;
-    sum = v3_add(sum, v3_scale(value, kept));
+    KShadowRay ray;
+    if (kept <= 0.0f || !k_light_shadow_ray(params, sf, &scene->lights[chosen], u1, u2, &ray)) continue;
+    ray.value = value;
+    ray.kept = kept;
+    k_shadow_queue_push(ctx, queue, vertex, ray);
   }
-  return v3_scale(sum, 1.0f / (float)samples);
 }
 
 /* Power-heuristic weight (exponent 2) of a sample drawn with pdf `own` against the other strategy's pdf. */
@@ -172,16 +193,17 @@ KFN float k_emissive_pdf(const KSceneView* scene, KVec3 p, kuint instance, kuint
 }
 
 /* One emissive-triangle sample for next-event estimation: a triangle picked through the emissive tree
- * (near and bright ones first), a uniform point on it, its emission there, one shadow ray. With a bounce
- * to follow from this vertex the result is weighted by the power heuristic against BRDF sampling, which
- * weighs the emission it finds the same way (k_trace_path); without one it stands alone (weight 1). */
-KFN KVec3 k_emissive_lighting(KTraceCtx* ctx, const KSurface* sf, KVec3 wo, int bounce_follows, float shadow_rr,
-                              float path_weight, KRng* rng) {
+ * (near and bright ones first), a uniform point on it, its emission there, one shadow ray (to the queue,
+ * which sets the vertex's emissive term when the point is visible). With a bounce to follow from this
+ * vertex the value is weighted by the power heuristic against BRDF sampling, which weighs the emission it
+ * finds the same way (k_path_hit); without one it stands alone (weight 1). */
+KFN void k_emissive_lighting(KTraceCtx* ctx, const KSurface* sf, KVec3 wo, int bounce_follows, float shadow_rr,
+                             float path_weight, KRng* rng, KShadowQueue* queue, KVertexLight* vertex) {
   const KSceneView* scene = K_CTX_SCENE(ctx);
   float u_pick = k_rng_next(rng), u1 = k_rng_next(rng), u2 = k_rng_next(rng);
   float pick = 0.0f;
   kuint index = k_emissive_tree_pick(scene, sf->position, u_pick, &pick);
-  if (index == K_NONE || !(pick > 0.0f)) return v3s(0.0f);
+  if (index == K_NONE || !(pick > 0.0f)) return;
   KGLOBAL const KEmissiveTriangle* e = &scene->emissive[index];
 
   float su = k_sqrt(u1);
@@ -190,16 +212,16 @@ KFN KVec3 k_emissive_lighting(KTraceCtx* ctx, const KSurface* sf, KVec3 wo, int 
   KVec3 x = v3_add(v3_scale(p0, 1.0f - bu - bv), v3_add(v3_scale(p1, bu), v3_scale(p2, bv)));
   KVec3 cr = v3_cross(v3_sub(p1, p0), v3_sub(p2, p0));
   float double_area = v3_length(cr);
-  if (!(double_area > 0.0f)) return v3s(0.0f);
+  if (!(double_area > 0.0f)) return;
   KVec3 to_light = v3_sub(x, sf->position);
   float dist2 = v3_dot(to_light, to_light);
-  if (!(dist2 > 0.0f)) return v3s(0.0f);
+  if (!(dist2 > 0.0f)) return;
   float dist = k_sqrt(dist2);
   KVec3 wi = v3_scale(to_light, 1.0f / dist);
   float cos_light = k_fabs(v3_dot(cr, wi)) / double_area;   /* emitters shine from both faces */
-  if (cos_light <= 1e-6f) return v3s(0.0f);
+  if (cos_light <= 1e-6f) return;
   KVec3 f = k_brdf_eval_cos(sf, wo, wi, 1.0f);
-  if (v3_max_component(f) <= 0.0f) return v3s(0.0f);
+  if (v3_max_component(f) <= 0.0f) return;
 
   KGLOBAL const KMaterial* m = &scene->materials[k_hit_material(scene, e->instance, e->triangle)];
   KVec3 le = v3(m->emissive_color[0], m->emissive_color[1], m->emissive_color[2]);
@@ -209,7 +231,7 @@ KFN KVec3 k_emissive_lighting(KTraceCtx* ctx, const KSurface* sf, KVec3 wo, int 
     le = v3_mul(le, v4_rgb(k_texture_sample(scene, m->emissive_tex, s, t)));
   }
   le = v3_mul(le, v4_rgb(k_hit_vertex_color(scene, e->triangle, bu, bv, m->flags)));
-  if (v3_max_component(le) <= 0.0f) return v3s(0.0f);
+  if (v3_max_component(le) <= 0.0f) return;
 
   float pdf = pick * 2.0f / double_area * dist2 / cos_light;
   float weight = 1.0f;
@@ -217,22 +239,36 @@ KFN KVec3 k_emissive_lighting(KTraceCtx* ctx, const KSurface* sf, KVec3 wo, int 
     weight = k_power_heuristic(pdf, k_brdf_pdf(sf, wo, wi));
   KVec3 value = v3_scale(v3_mul(le, f), weight / pdf);
   float kept = k_shadow_roulette(shadow_rr, v3_max_component(value) * path_weight, rng);
-  if (kept <= 0.0f) return v3s(0.0f);
+  if (kept <= 0.0f) return;
 
   float eps = k_ray_epsilon(sf->position);
-  KVec3 org = v3_madd(sf->position, sf->geo_normal, eps);
-  KVec3 seg = v3_sub(x, org);
+  KShadowRay ray;
+  ray.org = v3_madd(sf->position, sf->geo_normal, eps);
+  KVec3 seg = v3_sub(x, ray.org);
   float seg_len = v3_length(seg);
-  float tmax = seg_len - 2.0f * k_ray_epsilon(x);
-  if (tmax > 0.0f && k_trace_occluded(ctx, org, v3_scale(seg, 1.0f / seg_len), tmax, k_shadow_ray_mask(sf->flags)))
-    return v3s(0.0f);
-  return v3_scale(value, kept);
+  ray.dir = v3_scale(seg, 1.0f / seg_len);
+  ray.tmax = seg_len - 2.0f * k_ray_epsilon(x);
+  if (!(ray.tmax > 0.0f)) ray.tmax = 0.0f;   /* no room for an occluder (NaN included): visible */
+  ray.mask = k_shadow_ray_mask(sf->flags) | K_SHADOW_RAY_EMISSIVE;
+  ray.value = v3_scale(value, kept);
+  ray.kept = 1.0f;
+  k_shadow_queue_push(ctx, queue, vertex, ray);
 }
 
 KFN KVec3 k_clamp_radiance(KVec3 c, float limit) {
   if (limit <= 0.0f) return c;
   float m = v3_max_component(c);
   return m > limit ? v3_scale(c, limit / m) : c;
+}
+
+/* What an opaque vertex adds to its path's radiance once its shadow rays are in:
+ * throughput * (emission + environment + direct + emissive), clamped after a bounce, in that order of
+ * additions whether the rays were walked as they came or by a wavefront's shadow kernel. */
+KFN KVec3 k_vertex_light_sum(const KVertexLight* v) {
+  KVec3 direct = v->direct_scale > 0.0f ? v3_scale(v->direct, v->direct_scale) : v->direct;
+  KVec3 c = v3_add(v->base, direct);
+  if (v->has_emissive) c = v3_add(c, v->emissive);
+  return k_clamp_radiance(v3_mul(v->throughput, c), v->clamp);
 }
 
 KFN KVec3 k_heat_color(float x) {
@@ -280,9 +316,12 @@ KFN void k_path_miss(const KSceneView* scene, const KFrameParams* params, KPathS
 /* The path's ray (s->org, s->dir) met `hit`: shades it. 1 when the path goes on, with its next ray in
  * s->org and s->dir (through a transparent layer, s->bounce unchanged, or a bounce, s->bounce one more);
  * 0 when it ends. first_hit (may be null): where the ray's first opaque surface is recorded for the aux
- * planes (recorded before the first bounce only). */
-KFN int k_path_hit(KTraceCtx* ctx, const KFrameParams* params, KPathState* s, KHit hit,
-                   KGLOBAL KPathFirstHit* first_hit) {
+ * planes (recorded before the first bounce only). shadows (empty on entry): where an opaque vertex's
+ * shadow rays go; when some are left in its slots (shadows->count > 0) the vertex's light waits in
+ * *vertex, for the caller to add k_vertex_light_sum to s->radiance once they are walked, before the
+ * path's next segment; otherwise it is in s->radiance already. */
+KFN int k_path_hit_queued(KTraceCtx* ctx, const KFrameParams* params, KPathState* s, KHit hit,
+                          KGLOBAL KPathFirstHit* first_hit, KShadowQueue* shadows, KVertexLight* vertex) {
   const KSceneView* scene = K_CTX_SCENE(ctx);
   int emissive_nee = params->emissive_samples > 0u && scene->emissive_count > 0u;
   KVec3 org = s->org, dir = s->dir;
@@ -350,17 +389,24 @@ KFN int k_path_hit(KTraceCtx* ctx, const KFrameParams* params, KPathState* s, KH
     contribution = v3_scale(contribution, k_power_heuristic(s->vertex_brdf_pdf, light_pdf));
   }
   contribution = v3_add(contribution, k_environment_radiance(scene, hit, hit_material, sf.normal, dir));
+  /* The vertex's sums are filled in as its shadow rays come back (now, or after a wavefront's shadow
+   * kernel); the rest of it is written after the samples, so as not to be carried through their walks. */
+  vertex->direct = v3s(0.0f);
+  vertex->emissive = v3s(0.0f);
+  vertex->ray_count = 0u;
   float path_weight = v3_max_component(s->throughput);
   KRng rng = s->rng;
-  contribution = v3_add(contribution, k_direct_lighting(ctx, &vertex_params, &sf, wo, path_weight, &rng));
+  k_direct_lighting(ctx, &vertex_params, &sf, wo, path_weight, &rng, shadows, vertex);
   if (emissive_nee) {
     int bounce_follows = params->mode != K_MODE_DIRECT && s->bounce < params->max_bounces;
-    contribution = v3_add(contribution,
-                          k_emissive_lighting(ctx, &sf, wo, bounce_follows, params->shadow_rr, path_weight, &rng));
+    k_emissive_lighting(ctx, &sf, wo, bounce_follows, params->shadow_rr, path_weight, &rng, shadows, vertex);
   }
-  contribution = v3_mul(s->throughput, contribution);
-  if (s->bounce > 0u) contribution = k_clamp_radiance(contribution, params->firefly_clamp);
-  s->radiance = v3_add(s->radiance, contribution);
+  vertex->throughput = s->throughput;
+  vertex->clamp = s->bounce > 0u ? params->firefly_clamp : 0.0f;
+  vertex->base = contribution;
+  vertex->direct_scale = k_lights_one_ray_each(params) ? 0.0f : 1.0f / (float)params->light_samples;
+  vertex->has_emissive = (kuint)emissive_nee;
+  if (shadows->count == 0u) s->radiance = v3_add(s->radiance, k_vertex_light_sum(vertex));
 
   if (params->mode == K_MODE_DIRECT || s->bounce >= params->max_bounces) { s->rng = rng; return 0; }
 
@@ -383,6 +429,14 @@ KFN int k_path_hit(KTraceCtx* ctx, const KFrameParams* params, KPathState* s, KH
   s->dir = wi;
   s->layers = 0u;
   return 1;
+}
+
+/* k_path_hit_queued with each shadow ray walked as it comes. */
+KFN int k_path_hit(KTraceCtx* ctx, const KFrameParams* params, KPathState* s, KHit hit,
+                   KGLOBAL KPathFirstHit* first_hit) {
+  KShadowQueue shadows = k_shadow_queue_inline();
+  KVertexLight vertex;
+  return k_path_hit_queued(ctx, params, s, hit, first_hit, &shadows, &vertex);
 }
 
 /* Radiance along one camera ray; pixel_spread is the angle one pixel subtends (for mip selection).

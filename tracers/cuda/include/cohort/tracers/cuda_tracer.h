@@ -40,6 +40,10 @@ class CudaTracer final : public TracerBase {
   // megakernel; same image, faster (docs/integrator.md). On unless COHORT_CUDA_WAVEFRONT=0.
   void set_wavefront(bool on);
   bool wavefront() const;
+  // In the wavefront, next-event estimation's shadow rays walked by a kernel of their own instead of by the
+  // shading kernels; same image (docs/integrator.md). On unless COHORT_CUDA_SHADOW_WALK=0.
+  void set_shadow_walk(bool on);
+  bool shadow_walk() const;
   RayCounts last_ray_counts() const;
   int device() const;
 
