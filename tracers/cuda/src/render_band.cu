@@ -94,10 +94,10 @@ __device__ KShadowQueue shadow_slots(const WavefrontScratch& wave, size_t p) {
 // next bounce. kCameraRays: the camera rays' segment, whose paths begin here from the pixel (the walk kept
 // only the hits: 88 bytes a pixel less each way); kFirstHit: that segment of the frame's first sample,
 // which records first hits. kShadowWalk: the shadow rays left in their slots for the shadow walk (else
-// walked here). Five blocks an SM (102 registers): with the shadow rays out, 7.12-7.17 ms a 1080p frame of the
-// large map on one H100 against 7.33-7.35 at four (docs/integrator.md).
+// walked here). Six blocks an SM (80 registers): with the shadow rays out, 6.94-7.02 ms a 1080p frame of the
+// large map on one H100 against 7.12-7.16 at five and 7.33-7.35 at four (docs/integrator.md).
 template <bool kCameraRays, bool kFirstHit, bool kShadowWalk>
-__global__ void __launch_bounds__(128, 5) wave_shade_kernel(KSceneView scene, KFrameParams params, KCamera camera,
+__global__ void __launch_bounds__(128, 6) wave_shade_kernel(KSceneView scene, KFrameParams params, KCamera camera,
                                                          kuint sample, float4* band, WavefrontScratch wave,
                                                          unsigned long long* ray_counts, unsigned* row_rays,
                                                          KPathFirstHit* first_hits) {
