@@ -180,6 +180,7 @@ struct WavefrontCase {
   uint32_t bounces, spp;
   bool pack;
   const char* name;
+  uint32_t path_pixels = 0;  // dynamic resolution's sparse pattern: paths at this many of each 16 pixels
 };
 class CudaWavefront : public ::testing::TestWithParam<WavefrontCase> {};
 
@@ -195,7 +196,9 @@ TEST_P(CudaWavefront, DrawsTheMegakernelsImage) {
   KFrameParams params = frame_params(K_MODE_PATH, c.spp, c.bounces, h);
   params.rr_start = 2.0f;
   params.frame_index = 5;
-  params.aux_outputs = K_AUX_PATH_FIRST_HIT;
+  params.aux_outputs = K_AUX_PATH_FIRST_HIT;  // centre rays under the sparse pattern, in both
+  params.path_pixels = c.path_pixels;
+  params.path_phase = 3;
   core::BandBuffer frames[2];
   for (int wavefront = 0; wavefront < 2; ++wavefront) {
     tracers::CudaTracer cuda(0);
@@ -234,7 +237,9 @@ INSTANTIATE_TEST_SUITE_P(Paths, CudaWavefront,
                          ::testing::Values(WavefrontCase{1, 1, false, "room_bounce1"},
                                            WavefrontCase{3, 2, false, "room_bounce3_spp2"},
                                            WavefrontCase{1, 1, true, "pack_bounce1"},
-                                           WavefrontCase{2, 4, true, "pack_bounce2_spp4"}),
+                                           WavefrontCase{2, 4, true, "pack_bounce2_spp4"},
+                                           WavefrontCase{1, 1, true, "pack_sparse4", 4},
+                                           WavefrontCase{2, 2, false, "room_sparse8_spp2", 8}),
                          [](const auto& info) { return std::string(info.param.name); });
 
 // Next-event estimation's shadow rays walked by a kernel of their own (CudaTracer::set_shadow_walk): the

@@ -94,17 +94,24 @@ __device__ KShadowQueue shadow_slots(const WavefrontScratch& wave, size_t p) {
 // next bounce. kCameraRays: the camera rays' segment, whose paths begin here from the pixel (the walk kept
 // only the hits: 88 bytes a pixel less each way); kFirstHit: that segment of the frame's first sample,
 // which records first hits. kShadowWalk: the shadow rays left in their slots for the shadow walk (else
-// walked here). Six blocks an SM (80 registers): with the shadow rays out, 6.94-7.02 ms a 1080p frame of the
-// large map on one H100 against 7.12-7.16 at five and 7.33-7.35 at four (docs/integrator.md).
+// walked here). With the shadow rays out, six blocks an SM (80 registers): 6.94-7.02 ms a 1080p frame of the
+// large map on one H100 against 7.12-7.16 at five and 7.33-7.35 at four (docs/integrator.md); with them in
+// (`every` past the slots, COHORT_CUDA_SHADOW_WALK=0) four, as the megakernel (at six that build spills 2.5 KB).
 template <bool kCameraRays, bool kFirstHit, bool kShadowWalk>
-__global__ void __launch_bounds__(128, 6) wave_shade_kernel(KSceneView scene, KFrameParams params, KCamera camera,
+__global__ void __launch_bounds__(128, kShadowWalk ? 6 : 4) wave_shade_kernel(KSceneView scene, KFrameParams params, KCamera camera,
                                                          kuint sample, float4* band, WavefrontScratch wave,
                                                          unsigned long long* ray_counts, unsigned* row_rays,
                                                          KPathFirstHit* first_hits) {
   const BandPixel px = band_pixel(params, camera);
   const size_t p = px.index(camera);
-  const bool inside = px.inside && (kCameraRays || (wave.active[p] & kWaveLive));
+  bool inside = px.inside && (kCameraRays || (wave.active[p] & kWaveLive));
   KTraceCtx ctx = fresh_trace_ctx(scene);
+  if (kCameraRays && inside && !k_pixel_traces_path(params.path_pixels, params.path_phase, px.x, px.y)) {
+    // Dynamic resolution's sparse pattern leaves this pixel out: black, at no cost (k_render_pixel's way).
+    wave.active[p] = 0u;
+    finish_sample(band, p, v3s(0.0f), sample, 1.0f);
+    inside = false;
+  }
   if (inside) {
     KPathState s;
     if (kCameraRays) {

@@ -43,12 +43,11 @@ void launch_wave_shadow_walk(dim3 grid, dim3 block, const KSceneView& scene, con
                              unsigned long long* ray_counts, unsigned* row_rays, cudaStream_t stream);
 // That translation unit's copy of the texel texture (its alpha-tested surfaces read it).
 void set_walk_texel_texture(cudaTextureObject_t texture);
-// Whether launch_render_band renders this band as a wavefront when given the scratch: lit paths that bounce,
-// every pixel tracing (the sparse pattern of dynamic resolution stays with the megakernel).
+// Whether launch_render_band renders this band as a wavefront when given the scratch: lit paths that bounce
+// (dynamic resolution's sparse pattern too: the pixels it leaves out are painted black by the first shading
+// kernel); the other modes take the megakernel.
 inline bool wavefront_renders(const KFrameParams& params) {
-  const bool lit = params.mode == K_MODE_PATH;
-  const bool sparse = params.path_pixels != 0u && params.path_pixels < K_PATH_PATTERN_PIXELS;
-  return lit && !sparse && params.max_bounces > 0u;
+  return params.mode == K_MODE_PATH && params.max_bounces > 0u;
 }
 // The scene view holds device pointers (built on the host with k_scene_view, passed by value).
 // ray_counts (closest, occlusion) and row_rays (one per band row, zeroed by the caller) may be null.

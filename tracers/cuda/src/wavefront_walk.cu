@@ -29,7 +29,9 @@ __global__ void __launch_bounds__(128, 8) camera_walk_kernel(KSceneView scene, K
                                                              unsigned* row_rays) {
   const BandPixel px = band_pixel(params, camera);
   KTraceCtx ctx = fresh_trace_ctx(scene);
-  if (px.inside) {
+  // Pixels the sparse pattern of dynamic resolution leaves out trace nothing (the shading kernel paints them).
+  const bool traces = px.inside && k_pixel_traces_path(params.path_pixels, params.path_phase, px.x, px.y);
+  if (traces) {
     const size_t p = px.index(camera);
     if (records) k_record_first_hit(records + p, K_NONE, 0u, 0u);
     KRng rng;
@@ -39,7 +41,7 @@ __global__ void __launch_bounds__(128, 8) camera_walk_kernel(KSceneView scene, K
     if (!k_trace_closest(&ctx, v3_load(camera.origin), dir, K_INF, K_RAY_PRIMARY, &hit)) hit.instance = K_NONE;
     wave.hits[p] = hit;
   }
-  count_rays(ctx, px.inside, px.row, px.y < params.row_end, ray_counts, row_rays);
+  count_rays(ctx, traces, px.row, px.y < params.row_end, ray_counts, row_rays);
 }
 
 // The live paths' bounce rays: their hits (instance K_NONE: a miss) for the shading kernel.
