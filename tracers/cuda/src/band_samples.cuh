@@ -4,12 +4,15 @@
 
 #include <cuda_runtime.h>
 
+#include "cohort/kernel/layout.h"
+#include "cohort/kernel/path_pattern.h"
 #include "cohort/kernel/vec.h"
 
 namespace cohort::tracers {
 
 // A finished path's radiance into its pixel: the mean over the frame's samples, sample by sample.
-__device__ inline void finish_sample(float4* band, size_t p, KVec3 radiance, kuint sample, float inv_spp) {
+__device__ inline void finish_sample(float4* band, size_t p, KVec3 radiance, kuint sample, const KFrameParams& params) {
+  const float inv_spp = 1.0f / float(k_paths_per_pixel(params.spp));
   float4 c = make_float4(radiance.x * inv_spp, radiance.y * inv_spp, radiance.z * inv_spp, 1.0f);
   if (sample > 0u) {
     const float4 sum = band[p];

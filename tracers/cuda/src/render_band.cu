@@ -109,7 +109,7 @@ __global__ void __launch_bounds__(128, kShadowWalk ? 6 : 4) wave_shade_kernel(KS
   if (kCameraRays && inside && !k_pixel_traces_path(params.path_pixels, params.path_phase, px.x, px.y)) {
     // Dynamic resolution's sparse pattern leaves this pixel out: black, at no cost (k_render_pixel's way).
     wave.active[p] = 0u;
-    finish_sample(band, p, v3s(0.0f), sample, 1.0f);
+    finish_sample(band, p, v3s(0.0f), sample, params);
     inside = false;
   }
   if (inside) {
@@ -134,7 +134,7 @@ __global__ void __launch_bounds__(128, kShadowWalk ? 6 : 4) wave_shade_kernel(KS
     if (kCameraRays || !goes_on || shadows_out)
       wave.active[p] = (goes_on ? kWaveLive : 0u) | (shadows_out ? kWaveShadowsOut : 0u);
     if (!goes_on && !shadows_out)
-      finish_sample(band, p, s.radiance, sample, 1.0f / float(params.spp > 0u ? params.spp : 1u));
+      finish_sample(band, p, s.radiance, sample, params);
   }
   count_rays(ctx, inside, px.row, px.y < params.row_end, ray_counts, row_rays);
 }
@@ -221,7 +221,7 @@ void launch_render_band(const KSceneView& scene, const KFrameParams& params, con
   if (wave && wavefront_renders(params)) {
     WavefrontScratch scratch = *wave;
     scratch.shadow_stride = camera.width * rows;
-    const kuint spp = params.spp > 0u ? params.spp : 1u;
+    const kuint spp = params.spp > 0u ? params.spp : 1u;  // k_paths_per_pixel (device-only in this translation unit)
     const bool shadow_walk = scratch.shadow_slots > 0u;
     // A shading kernel and, after it, the shadow rays it left, before the next one shades the paths further.
     auto shade = [&](kuint sample, bool camera_rays, KPathFirstHit* records) {

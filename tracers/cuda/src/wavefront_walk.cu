@@ -94,7 +94,7 @@ __global__ void __launch_bounds__(128, 8) shadow_walk_kernel(KSceneView scene, K
       wave.active[p] = kWaveLive;
     } else {
       wave.active[p] = 0u;
-      finish_sample(band, p, radiance, sample, 1.0f / float(params.spp > 0u ? params.spp : 1u));
+      finish_sample(band, p, radiance, sample, params);
     }
   }
   count_rays(ctx, inside, px.row, px.y < params.row_end, ray_counts, row_rays);

@@ -131,7 +131,7 @@ void COHORT_RENDER_TILE(const Frame& frame, const Tile& tile, Arena& a, embree_k
     return;
   }
 
-  const kuint spp = params->spp > 0u ? params->spp : 1u;
+  const kuint spp = k_paths_per_pixel(params->spp);
   const KVec3 org = v3_load(camera->origin);
   const float pixel_spread = k_pixel_spread(camera);
   // Sparse paths (dynamic resolution): only the pattern's pixels trace, packed so packets stay full;

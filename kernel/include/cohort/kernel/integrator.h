@@ -486,7 +486,7 @@ KFN KVec3 k_camera_sample(const KFrameParams* params, const KCamera* cam, kuint 
  * first_hit (may be null): the first sample's first surface, for the aux planes. */
 KFN KVec3 k_render_pixel_paths(KTraceCtx* ctx, const KFrameParams* params, const KCamera* cam, kuint x, kuint y,
                                KGLOBAL KPathFirstHit* first_hit) {
-  kuint spp = params->spp > 0u ? params->spp : 1u;
+  kuint spp = k_paths_per_pixel(params->spp);
   KVec3 sum = v3s(0.0f);
   KVec3 org = v3_load(cam->origin);
   float pixel_spread = k_pixel_spread(cam);

@@ -22,6 +22,9 @@ KFN kuint k_bayer4_rank(kuint x, kuint y) {
   return 4u * (2u * (x0 ^ y0) + y0) + 2u * (x1 ^ y1) + y1;
 }
 
+/* Paths each traced pixel takes a frame: KFrameParams.spp, at least one. */
+KFN kuint k_paths_per_pixel(kuint spp) { return spp > 0u ? spp : 1u; }
+
 /* Whether pixel (x, y) traces paths this frame. */
 KFN int k_pixel_traces_path(kuint path_pixels, kuint path_phase, kuint x, kuint y) {
   if (path_pixels == 0u || path_pixels >= K_PATH_PATTERN_PIXELS) return 1;
