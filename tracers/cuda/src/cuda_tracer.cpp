@@ -80,7 +80,7 @@ struct CudaTracer::Impl {
   unsigned short* band_rgb16f = nullptr;   // the band as RGB halves, for RGB16F targets
   bool count_rays = false;
   // The bounce rays' wavefront (render_band.cu) instead of the megakernel, unless COHORT_CUDA_WAVEFRONT=0.
-  bool wavefront = wavefront_by_default();
+  bool wavefront = enabled_unless_zero("COHORT_CUDA_WAVEFRONT");
   DeviceArray<KPathState> wave_states;
   DeviceArray<KHit> wave_hits;
   DeviceArray<kuint> wave_active;
@@ -90,9 +90,10 @@ struct CudaTracer::Impl {
   DeviceArray<KVertexLight> wave_vertices;
   DeviceArray<KShadowRay> wave_shadow_rays;
   WavefrontScratch wave_scratch;
-  // The wavefront's scratch for a band of `pixels` rendered with `params`, or null for the megakernel.
+  // The wavefront's scratch for a band of `pixels` rendered with `params`, or null for the megakernel (also
+  // for frames the wavefront does not render: no scratch allocated for them).
   const WavefrontScratch* wave(size_t pixels, const KFrameParams& params) {
-    if (!wavefront) return nullptr;
+    if (!wavefront || !wavefront_renders(params)) return nullptr;
     wave_scratch = {};
     wave_scratch.states = wave_states.scratch(pixels);
     wave_scratch.hits = wave_hits.scratch(pixels);
@@ -110,7 +111,6 @@ struct CudaTracer::Impl {
     const char* v = std::getenv(variable);
     return !(v && std::strcmp(v, "0") == 0);
   }
-  static bool wavefront_by_default() { return enabled_unless_zero("COHORT_CUDA_WAVEFRONT"); }
   unsigned long long* ray_counts = nullptr;   // device: closest, occlusion
   unsigned* row_rays = nullptr;                // device: rays per band row (the balancer's per-row work)
   size_t row_rays_capacity = 0;                // rows
