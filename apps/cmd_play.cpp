@@ -46,10 +46,10 @@ struct PlayArgs {
   std::string screenshot;    // written from the last frame
   std::string window_shot;   // the last frame as the window showed it, HUD included
   std::string trace;         // Chrome trace event file of every frame's timeline
-  // How a scale below 1 reaches the window (core/upsample.h). Bilinear by default: the joint-bilateral
-  // reconstruction traces a G-buffer ray at every window pixel and runs on the host, which costs more
-  // than it gives at play's frame rates (docs/denoising.md, "Dynamic resolution").
-  std::string upsample = "bilinear";
+  // How a scale below 1 reaches the window (core/upsample.h). auto: joint-bilateral where the reprojection
+  // runs on a GPU (it reconstructs there, about 1 ms at 1080p), else bilinear: on the host the reconstruction
+  // costs more than it gives at play's frame rates (docs/denoising.md, "Dynamic resolution").
+  std::string upsample = "auto";
 };
 
 std::string key_help() {
@@ -139,8 +139,10 @@ int run_play(PlayArgs a) {
   settings.light_sampling = core::light_sampling_mode(a.light_sampling);
   settings.mode = debug_mode_from_name(a.mode).value_or(K_MODE_PATH);
   settings.tone_curve = a.tone;
-  settings.upsample = core::parse_upsample_method(a.upsample);
   settings.reproject = resolve_convergence(a.convergence, session->any_gpu_tracer(), session->frame_post_place()) == "reproject";
+  const bool reconstructs_on_gpu = settings.reproject && session->frame_post_place() != "host";
+  settings.upsample = core::parse_upsample_method(
+      a.upsample != "auto" ? a.upsample : reconstructs_on_gpu ? "joint-bilateral" : "bilinear");
   if (session->denoising())
     spdlog::info("{}reprojection and the a-trous filter on {}", settings.reproject ? "" : "(not used: Brigade's blend) ",
                  session->frame_post_place());
@@ -426,11 +428,12 @@ void add_play_command(CLI::App& app, int& exit_code) {
                   "how a --scale below 1 reaches the window: joint-bilateral (paths for about scale^2 of the "
                   "window's pixels, a moving pattern, the rest reconstructed with weights from the full-resolution "
                   "depth, normal, object id and albedo, textures from the full-resolution albedo), nearest (the nearest "
-                  "traced pixel) or bilinear (a smaller frame stretched by the GPU, the default: the other two trace a "
-                  "G-buffer ray at every window pixel and reconstruct on the host); the frame-rate target's scale "
-                  "drives it too. docs/denoising.md")
+                  "traced pixel), bilinear (a smaller frame stretched by the GPU) or auto: joint-bilateral where the "
+                  "reprojection runs on a CUDA GPU (the reconstruction runs there too), else bilinear (the other two "
+                  "trace a G-buffer ray at every window pixel, and the host's reconstruction costs more than it gives "
+                  "at play's frame rates); the frame-rate target's scale drives it too. docs/denoising.md")
       ->capture_default_str()
-      ->check(CLI::IsMember({"joint-bilateral", "nearest", "bilinear"}));
+      ->check(CLI::IsMember({"auto", "joint-bilateral", "nearest", "bilinear"}));
   cmd->add_option("--mode", a->mode, "debug mode at start")
       ->capture_default_str()
       ->check(CLI::IsMember(debug_mode_names()));

@@ -195,6 +195,7 @@ int run_render(const RenderArgs& a) {
     if (a.anti_lag >= 0.0f) post_options.reprojection.anti_lag_sigma = a.anti_lag;
     // Sparse-path frames keep centre rays (one fixed ray a pixel), whatever --aux-rays says.
     post_options.reprojection.jittered_planes = aux_mode == K_AUX_PATH_FIRST_HIT && !sparse;
+    post_options.upsample = upsample;
     post_options.atrous_options.passes =
         a.atrous_passes > 0 ? a.atrous_passes : core::atrous_passes_for_height(render_height);
     core::AtrousOptions& ao = post_options.atrous_options;
@@ -209,9 +210,20 @@ int run_render(const RenderArgs& a) {
                  post->where());
   }
   // A GPU post-processing reprojection takes the bands as the tracers packed them: half the bytes cross
-  // the bus and the host skips its conversions (the float frame and G-buffer are not made).
+  // the bus and the host skips its conversions (the float frame and G-buffer are not made). A reprojecting
+  // post also reconstructs sparse frames, where it runs; Brigade's blend takes them reconstructed on the host.
   const bool packed = post && reproject && post->where() != "host" && a.denoise != "oidn" &&
-                      a.denoise != "oidn-cuda" && !a.write_ids && !sparse;  // the reconstruction runs on the host's frame
+                      a.denoise != "oidn-cuda" && !a.write_ids;
+  // Sparse frames are filled where the post runs: inside the reprojecting post, or for Brigade's blend (which
+  // takes full frames) by a post of its own with neither step, on the same place.
+  std::unique_ptr<core::FramePost> reconstruction;
+  if (sparse && !reproject) {
+    core::FramePostOptions only_reconstruct;
+    only_reconstruct.reproject = false;
+    only_reconstruct.upsample = upsample;
+    reconstruction = tracers::make_frame_post(post_place, only_reconstruct);
+  }
+  if (sparse) spdlog::info("sparse frames reconstructed on {}", (reconstruction ? reconstruction : post)->where());
   renderer.set_packed_merge(packed);
   if (packed && !a.bands_through_host) renderer.set_device_bands(post->cuda_device());
   if (a.denoise != "none" && !atrous) {
@@ -234,12 +246,11 @@ int run_render(const RenderArgs& a) {
     core::FrameStats& stats = done.stats;
     const int f = static_cast<int>(stats.frame);
     const core::FrameBuffer* merged = &pipeline.image();
-    if (sparse && !pipeline.gbuffer().empty()) {
+    const core::PathPattern traced{done.job.params.path_pixels, done.job.params.path_phase};
+    if (reconstruction && !pipeline.gbuffer().empty()) {
       core::ScopedStage upsampling(stats.stages, core::kCoreTrack, "upsample");
-      core::upsample_sparse(*merged, pipeline.gbuffer(),
-                            core::PathPattern{done.job.params.path_pixels, done.job.params.path_phase}, upsample,
-                            upsampled);
-      merged = &upsampled;
+      reconstruction->process(*merged, pipeline.gbuffer(), traced);
+      merged = &reconstruction->image();
     }
     const core::FrameBuffer& frame = *merged;
     // Adaptive convergence: a still camera accumulates every frame; motion raises f (see convergence.h).
@@ -255,8 +266,8 @@ int run_render(const RenderArgs& a) {
       // One stage: on a GPU the two steps share one upload and one download.
       core::ScopedStage posting(stats.stages, core::kCoreTrack,
                                 !atrous ? "convergence" : reproject ? "convergence+denoise" : "denoise");
-      if (packed) post->process_packed(renderer.packed_frame(), renderer.packed_device_rows());
-      else post->process(reproject ? frame : *shown_image, gbuffer);
+      if (packed) post->process_packed(renderer.packed_frame(), renderer.packed_device_rows(), traced);
+      else post->process(reproject ? frame : *shown_image, gbuffer, reproject ? traced : core::kEveryPixel);
       // On a GPU its own clock tells the bus from the passes (a track of its own in the timeline).
       if (const core::FramePostDeviceTimes t = post->device_times(); t.measured) {
         const std::string track = "post on " + post->where();

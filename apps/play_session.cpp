@@ -213,7 +213,11 @@ SessionFrame PlaySession::frame(const viewer::FlyCamera& camera, double seconds,
   const core::FrameBuffer* merged = &s.pipeline->image();
   const core::GBuffer& gbuffer = s.pipeline->gbuffer();
   const core::PathPattern pattern{done->job.params.path_pixels, done->job.params.path_phase};
-  if (pattern.sparse() && !gbuffer.empty()) {
+  // The reprojection reconstructs a sparse frame itself (joint-bilateral, FramePostOptions' default), where
+  // it runs; the other methods (baselines picked in the HUD) run here first.
+  const bool reprojects = settings.reproject && done->job.params.aux_outputs != 0u && !gbuffer.empty();
+  const bool post_reconstructs = reprojects && settings.upsample == core::UpsampleMethod::joint_bilateral;
+  if (pattern.sparse() && !post_reconstructs && !gbuffer.empty()) {
     core::ScopedStage upsampling(out.stats.stages, core::kCoreTrack, "upsample");
     core::upsample_sparse(*merged, gbuffer, pattern, settings.upsample, s.upsampled);
     merged = &s.upsampled;
@@ -226,10 +230,10 @@ SessionFrame PlaySession::frame(const viewer::FlyCamera& camera, double seconds,
     s.reprojection->reset();
   }
   s.last_mode = mode;
-  if (settings.reproject && done->job.params.aux_outputs != 0u && !gbuffer.empty()) {
+  if (reprojects) {
     // Per-pixel history: moving objects carry their own motion, so no mask is needed.
     core::ScopedStage blending(out.stats.stages, core::kCoreTrack, "convergence");
-    s.reprojection->process(hdr, gbuffer);
+    s.reprojection->process(hdr, gbuffer, post_reconstructs ? pattern : core::kEveryPixel);
     out.stats.convergence_f = 1.0 / std::max(s.reprojection->mean_history_length(), 1.0);
     blending.finish();
     core::ToneMapOptions tm;

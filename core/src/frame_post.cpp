@@ -1,10 +1,12 @@
 #include "cohort/core/frame_post.h"
 
 #include <stdexcept>
+#include <string>
 
 namespace cohort::core {
 
-void FramePost::process_packed(const BandBuffer& packed, const std::vector<DeviceBandRows>& on_device) {
+void FramePost::process_packed(const BandBuffer& packed, const std::vector<DeviceBandRows>& on_device,
+                               const PathPattern& traced) {
   if (!on_device.empty())
     throw std::invalid_argument("FramePost::process_packed: bands on a GPU reached the post-processing on " + where());
   if (!packed.has_aux())
@@ -14,7 +16,7 @@ void FramePost::process_packed(const BandBuffer& packed, const std::vector<Devic
   packed.copy_rows_to(unpacked_frame_, 0, height);
   if (unpacked_gbuffer_.width != width || unpacked_gbuffer_.height != height) unpacked_gbuffer_.resize(width, height);
   packed.copy_aux_rows_to(unpacked_gbuffer_, 0, height);
-  process(unpacked_frame_, unpacked_gbuffer_);
+  process(unpacked_frame_, unpacked_gbuffer_, traced);
 }
 
 FramePostOptions with_history_moments(FramePostOptions options) {
@@ -23,13 +25,27 @@ FramePostOptions with_history_moments(FramePostOptions options) {
   return options;
 }
 
+void check_traced_pattern(const FramePostOptions& options, const PathPattern& traced) {
+  if (traced.sparse() && options.atrous && !options.reproject)
+    throw std::invalid_argument("frame post: a sparse frame (" + std::to_string(traced.pixels) +
+                                " of 16 pixels traced) reached a filter without history, which takes blended frames; "
+                                "reconstruct it first");
+  if (traced.sparse() && options.upsample == UpsampleMethod::bilinear)
+    throw std::invalid_argument("frame post: bilinear upsampling stretches a small frame, not a sparse one");
+}
+
 HostFramePost::HostFramePost(FramePostOptions options)
     : options_(with_history_moments(options)), reprojection_(options_.reprojection), atrous_(options_.atrous_options) {}
 
-void HostFramePost::process(const FrameBuffer& fresh, const GBuffer& gbuffer) {
+void HostFramePost::process(const FrameBuffer& fresh, const GBuffer& gbuffer, const PathPattern& traced) {
+  check_traced_pattern(options_, traced);
   const FrameBuffer* current = &fresh;
+  if (traced.sparse()) {
+    upsampler_.upsample(fresh, gbuffer, traced, options_.upsample, reconstructed_);
+    current = &reconstructed_;
+  }
   if (options_.reproject) {
-    reprojection_.accumulate(fresh, gbuffer);
+    reprojection_.accumulate(*current, gbuffer);
     current = &reprojection_.image();
   }
   if (options_.atrous) {

@@ -177,7 +177,7 @@ TEST(SvgfVariance, NonFiniteSamplesNeverEnterTheMoments) {
       ++good[p];
     }
     r.accumulate(f, g);
-    post.process(f, g);
+    post.process(f, g, kEveryPixel);
     for (float v : r.luminance_moments()) ASSERT_TRUE(std::isfinite(v)) << "frame " << n;
     for (float v : post.image().rgba) ASSERT_TRUE(std::isfinite(v)) << "frame " << n;
   }

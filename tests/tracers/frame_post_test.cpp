@@ -11,6 +11,8 @@
 #include "cohort/core/frame_post.h"
 #include "cohort/core/reprojection.h"
 #include "cohort/core/renderer.h"
+#include "cohort/core/upsample.h"
+#include "cohort/kernel/path_pattern.h"
 #include "cohort/core/gpu_scene.h"
 #include "cohort/tracers/tracer_registry.h"
 #include "test_scenes.h"
@@ -67,6 +69,17 @@ core::BandJob aux_room_job(int w, int h) {
   return job;
 }
 
+// Dynamic resolution's frame f: the pixels outside the pattern traced nothing (black, as the tracers leave them).
+core::PathPattern sparse_frame(int f, core::FrameBuffer& frame, core::GBuffer& g) {
+  make_frame(f, frame, g);
+  const core::PathPattern pattern = core::path_pattern_for_scale(0.5, uint64_t(f));
+  for (int y = 0; y < kH; ++y)
+    for (int x = 0; x < kW; ++x)
+      if (!k_pixel_traces_path(pattern.pixels, pattern.phase, kuint(x), kuint(y)))
+        for (int k = 0; k < 3; ++k) frame.rgba[4 * (size_t(y) * kW + x) + k] = 0.0f;
+  return pattern;
+}
+
 double max_relative_difference(const core::FrameBuffer& a, const core::FrameBuffer& b) {
   double worst = 0.0;
   for (size_t i = 0; i < a.rgba.size(); ++i)
@@ -92,7 +105,7 @@ TEST(FramePost, HostRunsReprojectionThenTheFilter) {
     core::GBuffer g;
     for (int f = 0; f < 5; ++f) {
       make_frame(f, frame, g);
-      post.process(frame, g);
+      post.process(frame, g, core::kEveryPixel);
       reprojection.accumulate(frame, g);
       core::AtrousHistory history;
       if (reprojection_options.luminance_moments)
@@ -112,10 +125,52 @@ TEST(FramePost, HostWithNeitherStepShowsTheFrame) {
   core::FrameBuffer frame;
   core::GBuffer g;
   make_frame(1, frame, g);
-  post.process(frame, g);
+  post.process(frame, g, core::kEveryPixel);
   EXPECT_EQ(post.image().rgba.size(), frame.rgba.size());
   EXPECT_DOUBLE_EQ(post.mean_history_length(), 1.0);
   EXPECT_EQ(post.where(), "host");
+}
+
+// A sparse frame is reconstructed where the post runs, before the reprojection: the same picture as the
+// reconstruction on the host followed by the post on the full frame.
+TEST(FramePost, HostReconstructsSparseFramesBeforeReprojecting) {
+  for (core::UpsampleMethod method : {core::UpsampleMethod::joint_bilateral, core::UpsampleMethod::nearest}) {
+    core::FramePostOptions options = both();
+    options.upsample = method;
+    core::HostFramePost post(options), after_host_reconstruction(options);
+    core::FrameBuffer frame, full;
+    core::GBuffer g;
+    for (int f = 0; f < 4; ++f) {
+      const core::PathPattern pattern = sparse_frame(f, frame, g);
+      ASSERT_TRUE(pattern.sparse());
+      post.process(frame, g, pattern);
+      core::upsample_sparse(frame, g, pattern, method, full);
+      after_host_reconstruction.process(full, g, core::kEveryPixel);
+      ASSERT_EQ(post.image().rgba, after_host_reconstruction.image().rgba)
+          << "frame " << f << " " << core::upsample_method_name(method);
+    }
+  }
+}
+
+// A post with neither step only reconstructs (Brigade's blend follows it); a filter without history takes
+// blended frames, so it refuses a sparse one, and bilinear stretches a small frame, it does not fill a sparse one.
+TEST(FramePost, SparseFramesAreReconstructedOrRefused) {
+  core::FrameBuffer frame, full;
+  core::GBuffer g;
+  const core::PathPattern pattern = sparse_frame(1, frame, g);
+  core::FramePostOptions neither;
+  neither.reproject = false;
+  core::HostFramePost reconstruction(neither);
+  reconstruction.process(frame, g, pattern);
+  core::upsample_sparse(frame, g, pattern, core::UpsampleMethod::joint_bilateral, full);
+  EXPECT_EQ(reconstruction.image().rgba, full.rgba);
+  core::FramePostOptions filter_only = both();
+  filter_only.reproject = false;
+  EXPECT_THROW(core::HostFramePost(filter_only).process(frame, g, pattern), std::invalid_argument);
+  core::FramePostOptions bilinear = both();
+  bilinear.upsample = core::UpsampleMethod::bilinear;
+  EXPECT_THROW(core::HostFramePost(bilinear).process(frame, g, pattern), std::invalid_argument);
+  EXPECT_NO_THROW(core::HostFramePost(filter_only).process(frame, g, core::kEveryPixel));
 }
 
 TEST(FramePost, PlacesAreNamedOrRefused) {
@@ -126,7 +181,7 @@ TEST(FramePost, PlacesAreNamedOrRefused) {
   EXPECT_EQ(tracers::auto_frame_post_place(tracers::parse_tracer_list("embree")), "host");
   core::FramePostOptions odd = both();
   odd.atrous_options.normal_power = 48;
-  EXPECT_THROW(tracers::make_frame_post("host", odd)->process(core::FrameBuffer{}, core::GBuffer{}),
+  EXPECT_THROW(tracers::make_frame_post("host", odd)->process(core::FrameBuffer{}, core::GBuffer{}, core::kEveryPixel),
                std::invalid_argument);
 }
 
@@ -152,8 +207,8 @@ TEST(FramePost, CudaMatchesTheHostOverAMovingSequence) {
     core::GBuffer g;
     for (int f = 0; f < 6; ++f) {
       make_frame(f, frame, g);
-      host.process(frame, g);
-      gpu->process(frame, g);
+      host.process(frame, g, core::kEveryPixel);
+      gpu->process(frame, g, core::kEveryPixel);
       ASSERT_EQ(gpu->image().width, kW);
       // Same arithmetic; only the device's exp/sqrt/FMA contraction differ.
       EXPECT_LT(max_relative_difference(gpu->image(), host.image()), 2e-3) << "frame " << f << " variant " << variant;
@@ -165,10 +220,34 @@ TEST(FramePost, CudaMatchesTheHostOverAMovingSequence) {
     gpu->reset();
     host.reset();
     make_frame(7, frame, g);
-    host.process(frame, g);
-    gpu->process(frame, g);
+    host.process(frame, g, core::kEveryPixel);
+    gpu->process(frame, g, core::kEveryPixel);
     EXPECT_NEAR(gpu->mean_history_length(), 1.0, 1e-3) << "reset drops the history";
     EXPECT_NEAR(host.mean_history_length(), 1.0, 1e-3);
+  }
+}
+
+// The reconstruction on the GPU (kernel/upsample.h in CUDA) gives the host's picture, from float planes and
+// from the packed frame, whose YCoCg planes are then made after the reconstruction.
+TEST(FramePost, CudaReconstructsSparseFramesAsTheHost) {
+  if (tracers::device_count("cuda") == 0) GTEST_SKIP() << "no CUDA device (or a build without CUDA)";
+  for (int variant = 0; variant < 3; ++variant) {
+    const core::UpsampleMethod method =
+        variant == 1 ? core::UpsampleMethod::nearest : core::UpsampleMethod::joint_bilateral;
+    core::FramePostOptions options = both();
+    options.upsample = method;
+    if (variant == 2) options.reproject = options.atrous = false;  // the reconstruction alone
+    core::HostFramePost host(options);
+    std::unique_ptr<core::FramePost> gpu = tracers::make_frame_post("cuda:0", options);
+    core::FrameBuffer frame;
+    core::GBuffer g;
+    for (int f = 0; f < 5; ++f) {
+      const core::PathPattern pattern = sparse_frame(f, frame, g);
+      host.process(frame, g, pattern);
+      gpu->process(frame, g, pattern);
+      EXPECT_LT(max_relative_difference(gpu->image(), host.image()), 2e-3) << "frame " << f << " variant " << variant;
+      EXPECT_NEAR(gpu->mean_history_length(), host.mean_history_length(), 1e-3) << "frame " << f;
+    }
   }
 }
 
@@ -210,13 +289,33 @@ TEST(FramePost, PackedMergeUnpacksToTheFloatMergeEverywhere) {
   EXPECT_EQ(unpacked_g.motion, g.motion);
 
   core::HostFramePost from_floats(both()), from_packed(both());
-  from_floats.process(floats, g);
-  from_packed.process_packed(packed);
+  from_floats.process(floats, g, core::kEveryPixel);
+  from_packed.process_packed(packed, {}, core::kEveryPixel);
   EXPECT_EQ(from_packed.image().rgba, from_floats.image().rgba);
+  std::unique_ptr<core::FramePost> gpu;
   if (tracers::device_count("cuda") > 0) {
-    std::unique_ptr<core::FramePost> gpu = tracers::make_frame_post("cuda:0", both());
-    gpu->process_packed(packed);
+    gpu = tracers::make_frame_post("cuda:0", both());
+    gpu->process_packed(packed, {}, core::kEveryPixel);
     EXPECT_LT(max_relative_difference(gpu->image(), from_floats.image()), 2e-3) << "packed frame on cuda:0";
+  }
+
+  // The next frame traced sparsely (dynamic resolution at scale 0.5): reconstructed inside each post.
+  core::BandJob sparse_job = job;
+  const core::PathPattern pattern = core::path_pattern_for_scale(0.5, 1);
+  sparse_job.params.frame_index = 2;
+  sparse_job.params.path_pixels = pattern.pixels;
+  sparse_job.params.path_phase = pattern.phase;
+  renderer.set_packed_merge(false);
+  renderer.render(sparse_job, floats);
+  const core::GBuffer sparse_g = renderer.gbuffer();
+  renderer.set_packed_merge(true);
+  renderer.render(sparse_job, untouched);
+  from_floats.process(floats, sparse_g, pattern);
+  from_packed.process_packed(renderer.packed_frame(), {}, pattern);
+  EXPECT_EQ(from_packed.image().rgba, from_floats.image().rgba) << "sparse frame";
+  if (gpu) {
+    gpu->process_packed(renderer.packed_frame(), {}, pattern);
+    EXPECT_LT(max_relative_difference(gpu->image(), from_floats.image()), 2e-3) << "sparse packed frame on cuda:0";
   }
 }
 
@@ -252,12 +351,12 @@ TEST(FramePost, CudaBandsStayingOnTheGpusGiveTheHostRoundTripsPicture) {
       const std::vector<core::DeviceBandRows>& rows = renderer.packed_device_rows();
       EXPECT_EQ(rows.size(), on_device ? kinds.size() - 1 : 0u) << "every CUDA band, and only those";
       for (const core::DeviceBandRows& r : rows) EXPECT_LT(r.row_begin, r.row_end);
-      post->process_packed(renderer.packed_frame(), rows);
+      post->process_packed(renderer.packed_frame(), rows, core::kEveryPixel);
       shown[on_device].push_back(post->image());
     }
     core::HostFramePost host(both());
     if (on_device) {
-      EXPECT_THROW(host.process_packed(renderer.packed_frame(), renderer.packed_device_rows()), std::invalid_argument);
+      EXPECT_THROW(host.process_packed(renderer.packed_frame(), renderer.packed_device_rows(), core::kEveryPixel), std::invalid_argument);
     }
   }
   for (size_t f = 0; f < shown[0].size(); ++f)

@@ -11,6 +11,7 @@
 #include "cohort/kernel/atrous.h"
 #include "cohort/kernel/reproject.h"
 #include "cohort/kernel/svgf.h"
+#include "cohort/kernel/upsample.h"
 #include "cuda_check.h"
 #include "device_array.h"
 #include "host_registrations.h"
@@ -84,6 +85,21 @@ __global__ void modulate_kernel(const float* rgba, const float* albedo, float* o
 dim3 tile_grid(int width, int height) { return dim3((width + 15) / 16, (height + 15) / 16); }
 const dim3 kTile(16, 16);
 
+// Dynamic resolution's reconstruction (kernel/upsample.h): the traced pixels' illumination, then every
+// pixel's joint-bilateral mean of its traced neighbours, on tiles as the a-trous passes (a window of taps).
+__global__ void upsample_demodulate_kernel(const float* rgba, const float* albedo, float* illumination,
+                                           KUpsampleParams params) {
+  const int x = blockIdx.x * blockDim.x + threadIdx.x, y = blockIdx.y * blockDim.y + threadIdx.y;
+  if (x < params.width && y < params.height) k_upsample_demodulate_pixel(rgba, albedo, illumination, &params, x, y);
+}
+
+__global__ void upsample_kernel(const float* rgba, const float* illumination, const float* depth, const float* normal,
+                                const float* albedo, const kuint* id, float* out, KUpsampleParams params, int method) {
+  const int x = blockIdx.x * blockDim.x + threadIdx.x, y = blockIdx.y * blockDim.y + threadIdx.y;
+  if (x < params.width && y < params.height)
+    k_upsample_pixel(rgba, illumination, depth, normal, albedo, id, out, &params, method, x, y);
+}
+
 __global__ void pack_geometry_kernel(const float* depth, const float* normal, float* geometry, int pixels) {
   const int p = blockIdx.x * blockDim.x + threadIdx.x;
   if (p < pixels) k_atrous_pack_geometry(depth, normal, geometry, p);
@@ -143,9 +159,10 @@ class CudaFramePost final : public core::FramePost {
     cudaStreamDestroy(stream_);
   }
 
-  void process(const core::FrameBuffer& fresh, const core::GBuffer& g) override {
+  void process(const core::FrameBuffer& fresh, const core::GBuffer& g, const core::PathPattern& traced) override {
     if (g.width != fresh.width || g.height != fresh.height)
       throw std::invalid_argument("CudaFramePost: the G-buffer's size differs from the frame's");
+    core::check_traced_pattern(options_, traced);
     if (!begin(fresh.width, fresh.height)) return;
     COHORT_CUDA(cudaEventRecord(events_[0], stream_));
     upload(fresh.rgba, frame_);
@@ -154,19 +171,22 @@ class CudaFramePost final : public core::FramePost {
     if (options_.reproject) {
       upload(g.prev_depth, prev_depth_);
       upload(g.motion, motion_);
-      upload(g.id, id_);
     }
-    if (options_.atrous) upload(g.albedo, albedo_);  // the history's moments read it too (only with atrous)
+    if (options_.reproject || traced.sparse()) upload(g.id, id_);
+    // The history's moments read the albedo too (only with atrous); the reconstruction's weights read it.
+    if (options_.atrous || traced.sparse()) upload(g.albedo, albedo_);
     COHORT_CUDA(cudaEventRecord(events_[1], stream_));
-    run(fresh.width, fresh.height);
+    run(fresh.width, fresh.height, traced, /*ycocgw_ready=*/false, /*geometry_ready=*/false);
   }
 
   // About 38 bytes a pixel cross the bus (RGB halves and 32-byte aux texels) instead of 76 in floats;
   // none for rows a CUDA tracer left on its GPU (`on_device`): those are copied device to device, or from
   // a peer GPU (over NVLink where the GPUs have it).
-  void process_packed(const core::BandBuffer& packed, const std::vector<core::DeviceBandRows>& on_device) override {
+  void process_packed(const core::BandBuffer& packed, const std::vector<core::DeviceBandRows>& on_device,
+                      const core::PathPattern& traced) override {
     if (!packed.has_aux())
       throw std::invalid_argument("CudaFramePost: the packed frame has no aux planes (render with aux outputs)");
+    core::check_traced_pattern(options_, traced);
     const int width = packed.width(), height = packed.height();
     if (!begin(width, height)) return;
     const size_t pixels = size_t(width) * size_t(height);
@@ -200,14 +220,15 @@ class CudaFramePost final : public core::FramePost {
     }
     upload_rows(row, height);
     COHORT_CUDA(cudaEventRecord(events_[1], stream_));
-    float* ycocgw = options_.reproject ? ycocgw_.scratch(4 * pixels) : nullptr;
+    // A sparse frame's YCoCg planes are those of its reconstruction, made after the unpack.
+    float* ycocgw = options_.reproject && !traced.sparse() ? ycocgw_.scratch(4 * pixels) : nullptr;
     float* geometry = options_.atrous ? geometry_.scratch(4 * pixels) : nullptr;
     unpack_kernel<<<blocks_for(pixels), kThreads, 0, stream_>>>(
         colour, packed.format() == core::BandFormat::rgb16f ? 1 : 0, texels, frame_.scratch(4 * pixels),
         depth_.scratch(pixels), prev_depth_.scratch(pixels), motion_.scratch(2 * pixels), normal_.scratch(3 * pixels),
         albedo_.scratch(3 * pixels), id_.scratch(pixels), ycocgw, geometry, static_cast<int>(pixels));
     COHORT_CUDA(cudaGetLastError());
-    run(width, height, /*unpacked_with_planes=*/true);
+    run(width, height, traced, /*ycocgw_ready=*/ycocgw != nullptr, /*geometry_ready=*/true);
   }
 
   int cuda_device() const override { return device_; }
@@ -242,11 +263,13 @@ class CudaFramePost final : public core::FramePost {
     return width > 0 && height > 0;
   }
 
-  // The passes over the device planes, then the shown image back to the host. `unpacked_with_planes`: the
-  // unpack kernel already wrote the YCoCg frame and the packed geometry.
-  void run(int width, int height, bool unpacked_with_planes = false) {
+  // The passes over the device planes, then the shown image back to the host. `ycocgw_ready`,
+  // `geometry_ready`: the unpack kernel already wrote the YCoCg frame and the packed geometry.
+  void run(int width, int height, const core::PathPattern& traced, bool ycocgw_ready, bool geometry_ready) {
     const size_t pixels = static_cast<size_t>(width) * static_cast<size_t>(height);
-    float* current = frame_.data();
+    float* fresh = frame_.data();
+    if (traced.sparse()) fresh = reconstruct(width, height, traced);
+    float* current = fresh;
     mean_length_ = 1.0;
     if (options_.reproject) {
       State& from = state_[parity_];
@@ -265,9 +288,9 @@ class CudaFramePost final : public core::FramePost {
       params.footprint_taps = o.jittered_planes ? 1 : 0;
       params.moments = o.luminance_moments ? 1 : 0;
       float* ycocgw = ycocgw_.scratch(4 * pixels);
-      if (!unpacked_with_planes)
-        prepare_kernel<<<blocks_for(pixels), kThreads, 0, stream_>>>(frame_.data(), ycocgw, static_cast<int>(pixels));
-      const KReprojectFresh planes{frame_.data(), ycocgw,      depth_.data(), prev_depth_.data(),
+      if (!ycocgw_ready)
+        prepare_kernel<<<blocks_for(pixels), kThreads, 0, stream_>>>(fresh, ycocgw, static_cast<int>(pixels));
+      const KReprojectFresh planes{fresh, ycocgw,      depth_.data(), prev_depth_.data(),
                                    motion_.data(), normal_.data(), id_.data(),    albedo_.data()};
       const KReprojectHistory history{from.rgba.data(), from.length.data(), from.depth.data(), from.normal.data(),
                                       from.id.data(),   from.moments.data()};
@@ -299,7 +322,7 @@ class CudaFramePost final : public core::FramePost {
       params.depth_sigma = ao.depth_sigma;
       params.color_sigma = variance ? ao.variance_sigma : ao.color_sigma;
       float* geometry = geometry_.scratch(4 * pixels);
-      if (!unpacked_with_planes)
+      if (!geometry_ready)
         pack_geometry_kernel<<<blocks_for(pixels), kThreads, 0, stream_>>>(depth_.data(), normal_.data(), geometry,
                                                                             static_cast<int>(pixels));
       if (variance) {
@@ -356,6 +379,26 @@ class CudaFramePost final : public core::FramePost {
     if (options_.reproject) mean_length_ = *length_sum_host_ / static_cast<double>(pixels);
   }
 
+  // The sparse frame in frame_ filled from its traced pixels (kernel/upsample.h); returns the full frame.
+  float* reconstruct(int width, int height, const core::PathPattern& traced) {
+    const size_t pixels = static_cast<size_t>(width) * static_cast<size_t>(height);
+    const KUpsampleParams params = k_upsample_params(width, height, traced.pixels, traced.phase);
+    float* full = reconstructed_.scratch(4 * pixels);
+    const float* illumination = frame_.data();  // nearest reads the colour only
+    if (options_.upsample == core::UpsampleMethod::joint_bilateral) {
+      float* demodulated = illumination_.scratch(4 * pixels);
+      upsample_demodulate_kernel<<<tile_grid(width, height), kTile, 0, stream_>>>(frame_.data(), albedo_.data(),
+                                                                                  demodulated, params);
+      illumination = demodulated;
+    }
+    const int method = options_.upsample == core::UpsampleMethod::nearest ? K_UPSAMPLE_NEAREST : K_UPSAMPLE_JOINT_BILATERAL;
+    upsample_kernel<<<tile_grid(width, height), kTile, 0, stream_>>>(frame_.data(), illumination, depth_.data(),
+                                                                     normal_.data(), albedo_.data(), id_.data(), full,
+                                                                     params, method);
+    COHORT_CUDA(cudaGetLastError());
+    return full;
+  }
+
  public:
   const core::FrameBuffer& image() const override { return shown_; }
   double mean_history_length() const override { return mean_length_; }
@@ -395,6 +438,7 @@ class CudaFramePost final : public core::FramePost {
   int normal_squarings_ = 0;
   State state_[2];
   DeviceArray<float> frame_, depth_, prev_depth_, motion_, normal_, albedo_, ycocgw_, ping_, pong_, shown_device_;
+  DeviceArray<float> reconstructed_, illumination_;  // a sparse frame filled, and its traced pixels' illumination
   DeviceArray<float> geometry_;  // normal and depth packed for the a-trous passes (kernel/atrous.h)
   DeviceArray<kuint> id_;
   DeviceArray<unsigned char> packed_colour_;

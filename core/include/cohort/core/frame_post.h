@@ -1,7 +1,8 @@
-// What happens to a merged frame before it is shown: temporal reprojection (core/reprojection.h) and the
-// a-trous spatial filter (core/atrous_filter.h), on the host's threads or on a GPU (tracers/cuda's
-// CudaFramePost, made by name in tracers/registry). Both run the portable kernel's per-pixel code
-// (kernel/reproject.h, kernel/atrous.h), so where they run changes the cost, not the picture.
+// What happens to a merged frame before it is shown: dynamic resolution's reconstruction of a sparse frame
+// (core/upsample.h), temporal reprojection (core/reprojection.h) and the a-trous spatial filter
+// (core/atrous_filter.h), on the host's threads or on a GPU (tracers/cuda's CudaFramePost, made by name in
+// tracers/registry). Both run the portable kernel's per-pixel code (kernel/upsample.h, kernel/reproject.h,
+// kernel/atrous.h), so where they run changes the cost, not the picture.
 #pragma once
 
 #include <memory>
@@ -12,6 +13,7 @@
 #include "cohort/core/frame_buffer.h"
 #include "cohort/core/gbuffer.h"
 #include "cohort/core/reprojection.h"
+#include "cohort/core/upsample.h"
 
 namespace cohort::core {
 
@@ -20,11 +22,17 @@ struct FramePostOptions {
   ReprojectionOptions reprojection;
   bool atrous = false;
   AtrousOptions atrous_options;
+  // How a sparse frame (a render scale below 1) is filled before the reprojection: joint_bilateral or nearest.
+  UpsampleMethod upsample = UpsampleMethod::joint_bilateral;
 };
 
 // The options with the reprojection's luminance moments switched on exactly when the variance-guided
 // a-trous filter reads them (every place calls this, so they agree).
 FramePostOptions with_history_moments(FramePostOptions options);
+
+// Throws std::invalid_argument unless a post with these options can take frames traced as `traced`: a
+// filter without reprojection takes blended frames, so it refuses sparse ones.
+void check_traced_pattern(const FramePostOptions& options, const PathPattern& traced);
 
 // A GPU place's own clock for the last frame (CUDA events), to tell the bus from the passes.
 struct FramePostDeviceTimes {
@@ -35,13 +43,16 @@ struct FramePostDeviceTimes {
 class FramePost {
  public:
   virtual ~FramePost() = default;
-  // Takes the merged frame and its G-buffer (same size); a size change restarts the history.
-  virtual void process(const FrameBuffer& fresh, const GBuffer& gbuffer) = 0;
+  // Takes the merged frame and its G-buffer (same size); a size change restarts the history. `traced`: the
+  // pixels that traced paths (kEveryPixel, or dynamic resolution's sparse pattern, which the post
+  // reconstructs from the G-buffer first, where it runs). A post with neither step only reconstructs.
+  virtual void process(const FrameBuffer& fresh, const GBuffer& gbuffer, const PathPattern& traced) = 0;
   // The same from the Renderer's packed merge (Renderer::set_packed_merge): the frame in its band format
   // with its aux texels. Here: unpacked on the host, then process(); a GPU place unpacks on the device.
   // `on_device` lists rows that GPU tracers left on their devices (Renderer::packed_device_rows): their
   // rows in `packed` are stale. Only a place on a CUDA device (cuda_device() >= 0) takes them.
-  virtual void process_packed(const BandBuffer& packed, const std::vector<DeviceBandRows>& on_device = {});
+  virtual void process_packed(const BandBuffer& packed, const std::vector<DeviceBandRows>& on_device,
+                              const PathPattern& traced);
   // The CUDA device the passes run on, -1 on the host.
   virtual int cuda_device() const { return -1; }
   // The frame to show: reprojected, then filtered, as the options ask.
@@ -61,7 +72,7 @@ class FramePost {
 class HostFramePost final : public FramePost {
  public:
   explicit HostFramePost(FramePostOptions options);
-  void process(const FrameBuffer& fresh, const GBuffer& gbuffer) override;
+  void process(const FrameBuffer& fresh, const GBuffer& gbuffer, const PathPattern& traced) override;
   const FrameBuffer& image() const override { return *shown_; }
   double mean_history_length() const override;
   void reset() override;
@@ -71,7 +82,8 @@ class HostFramePost final : public FramePost {
   FramePostOptions options_;
   TemporalReprojection reprojection_;
   AtrousFilter atrous_;
-  FrameBuffer filtered_, copy_;
+  SparseUpsampler upsampler_;
+  FrameBuffer reconstructed_, filtered_, copy_;
   const FrameBuffer* shown_ = &copy_;
 };
 

@@ -28,6 +28,7 @@ struct PathPattern {
   uint32_t phase = 0;
   bool sparse() const { return pixels != 0 && pixels < 16; }
 };
+inline constexpr PathPattern kEveryPixel{};
 
 // The pattern for a render scale (traces about scale^2 of the pixels, at least 1 of 16) at frame
 // `frame`: the phase advances by `pixels` a frame, so consecutive frames trace different pixels.
