@@ -129,3 +129,45 @@ TEST(FrameTimeline, ChromeTraceWriterNamesAFileItCannotWrite) {
     EXPECT_NE(std::string(e.what()).find("/nonexistent-folder/trace.json"), std::string::npos);
   }
 }
+
+namespace {
+
+// A tracer that reports its own clock as a GPU does: 1 ms of kernels and 0.5 ms of transfer in a band
+// whose wall time is longer (the host's launches and waits around them).
+class DeviceTimedTracer final : public Tracer {
+ public:
+  std::string name() const override { return "timed"; }
+  void apply(const cohort::commit::CommitBuffer&) override {}
+  BandResult render_band(const BandJob&, BandBuffer&) override {
+    std::this_thread::sleep_for(std::chrono::milliseconds(4));
+    BandResult result;
+    result.device_ms = 1.0;
+    result.transfer_ms = 0.5;
+    return result;
+  }
+  using Tracer::render_band;
+};
+
+}  // namespace
+
+TEST(FrameTimeline, AGpusOwnClockShowsItsKernelsAndTransferAtTheEndOfItsRender) {
+  std::vector<std::unique_ptr<Tracer>> tracers;
+  tracers.push_back(std::make_unique<DeviceTimedTracer>());
+  tracers.push_back(sim(1));
+  Renderer renderer(std::move(tracers), RendererOptions{});
+  renderer.submit_commit(cohort::commit::CommitBuffer::full(std::make_shared<cohort::commit::TracerScene>(), 0));
+  FrameBuffer fb;
+  const FrameStats stats = renderer.render(job_for(0), fb);
+  const std::string timed = tracer_track(0, "timed");
+  const StageSpan* render = find(stats.stages, timed, "render");
+  const StageSpan* kernels = find(stats.stages, timed, "kernels");
+  const StageSpan* transfer = find(stats.stages, timed, "transfer");
+  ASSERT_NE(render, nullptr);
+  ASSERT_NE(kernels, nullptr);
+  ASSERT_NE(transfer, nullptr);
+  EXPECT_NEAR(kernels->ms, 1.0, 1e-9);
+  EXPECT_NEAR(transfer->ms, 0.5, 1e-9);
+  EXPECT_NEAR(transfer->start_ms + transfer->ms, render->start_ms + render->ms, 1e-9) << "the transfer ends the band";
+  EXPECT_NEAR(kernels->start_ms + kernels->ms, transfer->start_ms, 1e-9) << "the kernels end where it begins";
+  EXPECT_EQ(find(stats.stages, tracer_track(1, "sim1"), "kernels"), nullptr) << "a tracer that cannot tell has none";
+}

@@ -4,7 +4,10 @@
 
 #include <cmath>
 #include <cstdlib>
+#include <cstring>
 #include <iostream>
+#include <stdexcept>
+#include <vector>
 
 #include "cohort/core/gpu_scene.h"
 #include "cohort/core/scene_pack.h"
@@ -241,6 +244,53 @@ INSTANTIATE_TEST_SUITE_P(Paths, CudaWavefront,
                                            WavefrontCase{1, 1, true, "pack_sparse4", 4},
                                            WavefrontCase{2, 2, false, "room_sparse8_spp2", 8}),
                          [](const auto& info) { return std::string(info.param.name); });
+
+// The wavefront's lanes (CudaTracer::set_wave_lanes: a band's rows split over streams) change only where
+// kernels run: the image, the first-hit planes, the ray counts and the per-row work are those of one lane,
+// exactly, for bands that start mid-frame and split unevenly.
+TEST(CudaWaveLanes, DrawTheImageOfOneLane) {
+  REQUIRE_GPU();
+  const char* pack_file = std::getenv("COHORT_PACK");
+  const int w = 64, h = 200;
+  const TestView view = pack_or_room(pack_file, w, h);
+  KFrameParams params = frame_params(K_MODE_PATH, 2, 2, h);
+  params.frame_index = 7;
+  params.aux_outputs = K_AUX_PATH_FIRST_HIT;
+  core::BandBuffer frames[4];
+  std::vector<float> work[4];
+  tracers::CudaTracer::RayCounts counts[4];
+  for (int lanes = 1; lanes <= 4; ++lanes) {
+    tracers::CudaTracer cuda(0);
+    cuda.set_wave_lanes(lanes);
+    cuda.set_ray_counting(true);
+    cuda.apply(commit::CommitBuffer::full(std::make_shared<commit::TracerScene>(view.scene), 1));
+    core::BandBuffer& frame = frames[lanes - 1];
+    frame.resize(w, h, core::BandFormat::rgba32f);
+    frame.enable_aux(true);
+    for (int band = 0; band < 2; ++band) {  // 75 rows (two lanes at most), then 125 from mid-frame (three)
+      core::BandJob job;
+      job.params = params;
+      job.camera = view.camera;
+      job.params.row_begin = band == 0 ? 0u : 75u;
+      job.params.row_end = band == 0 ? 75u : uint32_t(h);
+      const core::BandResult result = cuda.render_band(job, frame);
+      work[lanes - 1].insert(work[lanes - 1].end(), result.row_work.begin(), result.row_work.end());
+    }
+    counts[lanes - 1] = cuda.last_ray_counts();
+  }
+  EXPECT_THROW(tracers::CudaTracer(0).set_wave_lanes(5), std::invalid_argument);
+  for (int lanes = 2; lanes <= 4; ++lanes) {
+    for (int y = 0; y < h; ++y) {
+      ASSERT_EQ(std::memcmp(frames[lanes - 1].row(y), frames[0].row(y), frames[0].row_bytes()), 0)
+          << lanes << " lanes, row " << y;
+      ASSERT_EQ(std::memcmp(frames[lanes - 1].aux_row(y), frames[0].aux_row(y), sizeof(KAuxTexel) * w), 0)
+          << lanes << " lanes, aux row " << y;
+    }
+    EXPECT_EQ(work[lanes - 1], work[0]) << lanes << " lanes";
+    EXPECT_EQ(counts[lanes - 1].closest, counts[0].closest) << lanes << " lanes";
+    EXPECT_EQ(counts[lanes - 1].occlusion, counts[0].occlusion) << lanes << " lanes";
+  }
+}
 
 // Next-event estimation's shadow rays walked by a kernel of their own (CudaTracer::set_shadow_walk): the
 // image of the wavefront that walks them in its shading kernels bit for bit, the megakernel's, and the same

@@ -5,6 +5,8 @@
 #include <algorithm>
 #include <cstdlib>
 #include <cstring>
+#include <stdexcept>
+#include <string>
 #include <vector>
 
 #include "cohort/kernel/aux_mode.h"
@@ -45,7 +47,7 @@ struct CudaTracer::Impl {
   cudaStream_t stream = nullptr;
   // The aux planes' download runs here, on the copy engine, while the band's kernel runs on `stream`.
   cudaStream_t aux_copy_stream = nullptr;
-  cudaEvent_t start = nullptr, stop = nullptr, aux_ready = nullptr;
+  cudaEvent_t start = nullptr, stop = nullptr, finished = nullptr, aux_ready = nullptr;
   // render_band_in_pieces: per piece, its rows rendered (the copy stream waits for it) and downloaded.
   std::vector<cudaEvent_t> piece_rendered, piece_downloaded;
   DeviceArray<KVertex> vertices;
@@ -90,6 +92,8 @@ struct CudaTracer::Impl {
   DeviceArray<KVertexLight> wave_vertices;
   DeviceArray<KShadowRay> wave_shadow_rays;
   WavefrontScratch wave_scratch;
+  // Its lanes (render_band_launch.h, CudaTracer::set_wave_lanes).
+  WaveLanes wave_lanes;
   // The wavefront's scratch for a band of `pixels` rendered with `params`, or null for the megakernel (also
   // for frames the wavefront does not render: no scratch allocated for them).
   const WavefrontScratch* wave(size_t pixels, const KFrameParams& params) {
@@ -98,6 +102,7 @@ struct CudaTracer::Impl {
     wave_scratch.states = wave_states.scratch(pixels);
     wave_scratch.hits = wave_hits.scratch(pixels);
     wave_scratch.active = wave_active.scratch(pixels);
+    wave_scratch.lanes = &wave_lanes;
     const KSceneView scene = view(params);
     const kuint slots = shadow_walk ? k_shadow_queue_slots(&params, scene.light_count, scene.emissive_count) : 0u;
     if (slots > 0u) {
@@ -158,6 +163,7 @@ struct CudaTracer::Impl {
   // stream too), the ray totals kept, and the kernels' device time and per-row work in the result.
   core::BandResult finish_band(size_t rows, bool wait_aux_copy) {
     host_row_rays.resize(rows);
+    COHORT_CUDA(cudaEventRecord(finished, stream));  // the band's way back (after `stop`) is queued before this
     COHORT_CUDA(cudaMemcpyAsync(host_row_rays.data(), row_rays, rows * sizeof(unsigned), cudaMemcpyDeviceToHost, stream));
     unsigned long long counts[2] = {0, 0};
     if (count_rays) COHORT_CUDA(cudaMemcpyAsync(counts, ray_counts, sizeof counts, cudaMemcpyDeviceToHost, stream));
@@ -166,8 +172,11 @@ struct CudaTracer::Impl {
     last_counts = RayCounts{counts[0], counts[1]};
     float kernel_ms = 0.0f;
     COHORT_CUDA(cudaEventElapsedTime(&kernel_ms, start, stop));
+    float transfer_ms = 0.0f;
+    COHORT_CUDA(cudaEventElapsedTime(&transfer_ms, stop, finished));
     core::BandResult result;
     result.device_ms = kernel_ms;
+    result.transfer_ms = transfer_ms;
     result.row_work.assign(host_row_rays.begin(), host_row_rays.end());
     return result;
   }
@@ -199,6 +208,22 @@ struct CudaTracer::Impl {
   }
 };
 
+namespace {
+
+// COHORT_CUDA_WAVE_LANES: how many lanes of rows the wavefront runs a band in (1 to kMaxWaveLanes; default 2).
+int wave_lanes_from_environment() {
+  const char* v = std::getenv("COHORT_CUDA_WAVE_LANES");
+  if (!v || !*v) return 2;
+  char* end = nullptr;
+  const long lanes = std::strtol(v, &end, 10);
+  if (*end != '\0' || lanes < 1 || lanes > kMaxWaveLanes)
+    throw std::invalid_argument(std::string("COHORT_CUDA_WAVE_LANES=") + v + ": expected 1 to " +
+                                std::to_string(kMaxWaveLanes));
+  return static_cast<int>(lanes);
+}
+
+}  // namespace
+
 CudaTracer::CudaTracer(int device) : impl_(std::make_unique<Impl>()) {
   const int count = cuda_device_count();
   if (device < 0 || device >= count)
@@ -211,7 +236,10 @@ CudaTracer::CudaTracer(int device) : impl_(std::make_unique<Impl>()) {
   COHORT_CUDA(cudaStreamCreateWithFlags(&impl_->aux_copy_stream, cudaStreamNonBlocking));
   COHORT_CUDA(cudaEventCreate(&impl_->start));
   COHORT_CUDA(cudaEventCreate(&impl_->stop));
+  COHORT_CUDA(cudaEventCreate(&impl_->finished));
   COHORT_CUDA(cudaEventCreateWithFlags(&impl_->aux_ready, cudaEventDisableTiming));
+  COHORT_CUDA(cudaEventCreateWithFlags(&impl_->wave_lanes.forked, cudaEventDisableTiming));
+  set_wave_lanes(wave_lanes_from_environment());
 }
 
 CudaTracer::~CudaTracer() {
@@ -223,9 +251,16 @@ CudaTracer::~CudaTracer() {
   if (impl_->row_rays) cudaFree(impl_->row_rays);
   if (impl_->start) cudaEventDestroy(impl_->start);
   if (impl_->stop) cudaEventDestroy(impl_->stop);
+  if (impl_->finished) cudaEventDestroy(impl_->finished);
   if (impl_->aux_ready) cudaEventDestroy(impl_->aux_ready);
   for (cudaEvent_t e : impl_->piece_rendered) cudaEventDestroy(e);
   for (cudaEvent_t e : impl_->piece_downloaded) cudaEventDestroy(e);
+  const WaveLanes& lanes = impl_->wave_lanes;
+  if (lanes.forked) cudaEventDestroy(lanes.forked);
+  for (int lane = 1; lane < kMaxWaveLanes; ++lane) {
+    if (lanes.streams[lane]) cudaStreamDestroy(lanes.streams[lane]);
+    if (lanes.joined[lane]) cudaEventDestroy(lanes.joined[lane]);
+  }
   if (impl_->stream) cudaStreamDestroy(impl_->stream);
   if (impl_->aux_copy_stream) cudaStreamDestroy(impl_->aux_copy_stream);
 }
@@ -452,6 +487,18 @@ core::BandResult CudaTracer::render_band_in_pieces(const core::BandJob& job, cor
 void CudaTracer::set_ray_counting(bool on) { impl_->count_rays = on; }
 void CudaTracer::set_wavefront(bool on) { impl_->wavefront = on; }
 void CudaTracer::set_shadow_walk(bool on) { impl_->shadow_walk = on; }
+void CudaTracer::set_wave_lanes(int lanes) {
+  if (lanes < 1 || lanes > kMaxWaveLanes)
+    throw std::invalid_argument(impl_->name + ": wave lanes " + std::to_string(lanes) + " (expected 1 to " +
+                                std::to_string(kMaxWaveLanes) + ")");
+  WaveLanes& w = impl_->wave_lanes;
+  COHORT_CUDA(cudaSetDevice(impl_->device));
+  for (int lane = 1; lane < lanes; ++lane) {  // made once, kept for later counts
+    if (!w.streams[lane]) COHORT_CUDA(cudaStreamCreateWithFlags(&w.streams[lane], cudaStreamNonBlocking));
+    if (!w.joined[lane]) COHORT_CUDA(cudaEventCreateWithFlags(&w.joined[lane], cudaEventDisableTiming));
+  }
+  w.count = lanes;
+}
 bool CudaTracer::shadow_walk() const { return impl_->shadow_walk; }
 bool CudaTracer::wavefront() const { return impl_->wavefront; }
 CudaTracer::RayCounts CudaTracer::last_ray_counts() const { return impl_->last_counts; }

@@ -211,43 +211,83 @@ void set_texel_texture(cudaTextureObject_t texture) {
   set_walk_texel_texture(texture);
 }
 
+namespace {
+
+// One lane of a band (all of it, or launch_render_band's rows of it) as a wavefront on `stream`: per sample
+// the camera walk, then per bounce a shading kernel, its shadow walk and the next bounce's walk.
+void render_wavefront(const KSceneView& scene, const KFrameParams& params, const KCamera& camera, float4* band,
+                      unsigned long long* ray_counts, unsigned* row_rays, KPathFirstHit* first_hits,
+                      const WavefrontScratch& scratch, cudaStream_t stream) {
+  const kuint rows = params.row_end - params.row_begin;
+  const dim3 block(16, 8);  // 16 wide: the row ray counts rely on two rows per warp
+  const dim3 grid((camera.width + block.x - 1) / block.x, (rows + block.y - 1) / block.y);
+  const kuint spp = params.spp > 0u ? params.spp : 1u;  // k_paths_per_pixel (device-only in this translation unit)
+  const bool shadow_walk = scratch.shadow_slots > 0u;
+  // A shading kernel and, after it, the shadow rays it left, before the next one shades the paths further.
+  auto shade = [&](kuint sample, bool camera_rays, KPathFirstHit* records) {
+    auto launch = [&](auto kernel) {
+      kernel<<<grid, block, 0, stream>>>(scene, params, camera, sample, band, scratch, ray_counts, row_rays, records);
+    };
+    if (!camera_rays)
+      shadow_walk ? launch(wave_shade_kernel<false, false, true>) : launch(wave_shade_kernel<false, false, false>);
+    else if (records)
+      shadow_walk ? launch(wave_shade_kernel<true, true, true>) : launch(wave_shade_kernel<true, true, false>);
+    else
+      shadow_walk ? launch(wave_shade_kernel<true, false, true>) : launch(wave_shade_kernel<true, false, false>);
+    if (shadow_walk)
+      launch_wave_shadow_walk(grid, block, scene, params, camera, sample, band, scratch, ray_counts, row_rays, stream);
+  };
+  for (kuint sample = 0u; sample < spp; ++sample) {
+    KPathFirstHit* records = sample == 0u ? first_hits : nullptr;
+    launch_wave_camera_walk(grid, block, scene, params, camera, sample, scratch, records, ray_counts, row_rays, stream);
+    shade(sample, true, records);
+    for (kuint bounce = 1u; bounce <= params.max_bounces; ++bounce) {
+      launch_wave_bounce_walk(grid, block, scene, params, camera, scratch, ray_counts, row_rays, stream);
+      shade(sample, false, nullptr);
+    }
+  }
+}
+
+}  // namespace
+
 void launch_render_band(const KSceneView& scene, const KFrameParams& params, const KCamera& camera, float4* band,
                         unsigned long long* ray_counts, unsigned* row_rays, KPathFirstHit* first_hits,
                         const WavefrontScratch* wave, cudaStream_t stream) {
   const kuint rows = params.row_end - params.row_begin;
-  const dim3 block(16, 8);  // 16 wide: the row ray counts rely on two rows per warp
+  const dim3 block(16, 8);
   const dim3 grid((camera.width + block.x - 1) / block.x, (rows + block.y - 1) / block.y);
   const bool sparse = params.path_pixels != 0u && params.path_pixels < K_PATH_PATTERN_PIXELS;
   if (wave && wavefront_renders(params)) {
-    WavefrontScratch scratch = *wave;
-    scratch.shadow_stride = camera.width * rows;
-    const kuint spp = params.spp > 0u ? params.spp : 1u;  // k_paths_per_pixel (device-only in this translation unit)
-    const bool shadow_walk = scratch.shadow_slots > 0u;
-    // A shading kernel and, after it, the shadow rays it left, before the next one shades the paths further.
-    auto shade = [&](kuint sample, bool camera_rays, KPathFirstHit* records) {
-      auto launch = [&](auto kernel) {
-        kernel<<<grid, block, 0, stream>>>(scene, params, camera, sample, band, scratch, ray_counts, row_rays,
-                                           records);
-      };
-      if (!camera_rays)
-        shadow_walk ? launch(wave_shade_kernel<false, false, true>) : launch(wave_shade_kernel<false, false, false>);
-      else if (records)
-        shadow_walk ? launch(wave_shade_kernel<true, true, true>) : launch(wave_shade_kernel<true, true, false>);
-      else
-        shadow_walk ? launch(wave_shade_kernel<true, false, true>) : launch(wave_shade_kernel<true, false, false>);
-      if (shadow_walk)
-        launch_wave_shadow_walk(grid, block, scene, params, camera, sample, band, scratch, ray_counts, row_rays,
-                                stream);
-    };
-    for (kuint sample = 0u; sample < spp; ++sample) {
-      KPathFirstHit* records = sample == 0u ? first_hits : nullptr;
-      launch_wave_camera_walk(grid, block, scene, params, camera, sample, scratch, records, ray_counts, row_rays,
-                              stream);
-      shade(sample, true, records);
-      for (kuint bounce = 1u; bounce <= params.max_bounces; ++bounce) {
-        launch_wave_bounce_walk(grid, block, scene, params, camera, scratch, ray_counts, row_rays, stream);
-        shade(sample, false, nullptr);
-      }
+    // Every kernel indexes its lane's pixels from the lane's first row: each lane gets the band's buffers
+    // from its first pixel on (shadow slots keep the whole band's stride, so lanes never share one).
+    WavefrontScratch whole = *wave;
+    whole.shadow_stride = camera.width * rows;
+    const int lanes = wave_lane_count(wave->lanes, rows);
+    if (lanes > 1) {
+      COHORT_CUDA(cudaEventRecord(wave->lanes->forked, stream));
+      for (int lane = 1; lane < lanes; ++lane)
+        COHORT_CUDA(cudaStreamWaitEvent(wave->lanes->streams[lane], wave->lanes->forked, 0));
+    }
+    for (int lane = 0; lane < lanes; ++lane) {
+      // Lanes of whole 8-row blocks, the last one taking the rest.
+      const kuint first = (rows * kuint(lane) / kuint(lanes)) / 8u * 8u;
+      const kuint last = lane + 1 == lanes ? rows : (rows * kuint(lane + 1) / kuint(lanes)) / 8u * 8u;
+      KFrameParams lane_params = params;
+      lane_params.row_begin = params.row_begin + first;
+      lane_params.row_end = params.row_begin + last;
+      const size_t offset = size_t(first) * camera.width;
+      WavefrontScratch s = whole;
+      s.states += offset;
+      s.hits += offset;
+      s.active += offset;
+      if (s.vertices) s.vertices += offset;
+      if (s.shadow_rays) s.shadow_rays += offset;
+      render_wavefront(scene, lane_params, camera, band + offset, ray_counts, row_rays ? row_rays + first : nullptr,
+                       first_hits ? first_hits + offset : nullptr, s, lane == 0 ? stream : wave->lanes->streams[lane]);
+    }
+    for (int lane = 1; lane < lanes; ++lane) {
+      COHORT_CUDA(cudaEventRecord(wave->lanes->joined[lane], wave->lanes->streams[lane]));
+      COHORT_CUDA(cudaStreamWaitEvent(stream, wave->lanes->joined[lane], 0));
     }
   } else if (sparse)
     render_band_kernel<true, false><<<grid, block, 0, stream>>>(scene, params, camera, band, ray_counts, row_rays, nullptr);

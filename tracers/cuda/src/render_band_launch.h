@@ -13,6 +13,25 @@ namespace cohort::tracers {
 
 void set_texel_texture(cudaTextureObject_t texture);
 
+// The wavefront may run a band as lanes of rows, each lane's kernels on a stream of its own, so that one
+// lane's kernels fill the GPU while another's drain: a kernel's last wave leaves SMs idle, and a GPU's share
+// of a four-GPU frame is only about four waves a kernel (nvidia-h100-x4, large map 1080p: the four bands'
+// kernels took 16 % more GPU time than one GPU's whole frame). The band's own stream runs lane 0;
+// streams[i] lane i, forked from it and joined back with the events.
+constexpr int kMaxWaveLanes = 4;
+struct WaveLanes {
+  int count = 1;
+  cudaStream_t streams[kMaxWaveLanes] = {};
+  cudaEvent_t forked = nullptr;
+  cudaEvent_t joined[kMaxWaveLanes] = {};
+};
+// The lanes a band of `rows` runs in: at most lanes->count, each at least 32 rows.
+inline int wave_lane_count(const WaveLanes* lanes, unsigned rows) {
+  if (!lanes) return 1;
+  const int most = static_cast<int>(rows / 32u);
+  return lanes->count < most ? lanes->count : (most > 1 ? most : 1);
+}
+
 // The bounce rays' wavefront (render_band.cu): where paths wait between its kernels. Device pointers, each
 // for at least the band's pixels (shadow_rays: shadow_slots times that).
 struct WavefrontScratch {
@@ -25,6 +44,7 @@ struct WavefrontScratch {
   KVertexLight* vertices = nullptr;
   KShadowRay* shadow_rays = nullptr;
   kuint shadow_slots = 0u, shadow_stride = 0u;
+  const WaveLanes* lanes = nullptr;  // null: one lane
 };
 // A pixel's wavefront flags: its path goes on; its last vertex waits for its shadow rays.
 constexpr kuint kWaveLive = 1u, kWaveShadowsOut = 2u;

@@ -30,6 +30,10 @@ struct BandJob {
 
 struct BandResult {
   double device_ms = 0.0;  // time the tracer measured itself (kernel time for GPUs); 0 if it cannot
+  // A GPU's own clock for the band's way back after its kernels (format conversion and download, or the
+  // copy it keeps for the post); 0 if it cannot tell. With device_ms, the timeline shows them inside the
+  // render span (the rest of it is the host's: launches, waits, wake-ups).
+  double transfer_ms = 0.0;
   // Optional: a work count per row of the band, row_begin first (e.g. rays traced in that row). The
   // core hands it to the balancer as an image-space cost map for the next frame. Empty if not counted.
   std::vector<float> row_work;

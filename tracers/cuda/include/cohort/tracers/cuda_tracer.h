@@ -43,6 +43,10 @@ class CudaTracer final : public TracerBase {
   // In the wavefront, next-event estimation's shadow rays walked by a kernel of their own instead of by the
   // shading kernels; same image (docs/integrator.md). On unless COHORT_CUDA_SHADOW_WALK=0.
   void set_shadow_walk(bool on);
+  // The wavefront runs a band as up to `lanes` lanes of rows (1 to 4), each on a stream of its own, so one
+  // lane's kernels fill the GPU while another's drain (default: COHORT_CUDA_WAVE_LANES, else 2). The image
+  // is the same for any count.
+  void set_wave_lanes(int lanes);
   bool shadow_walk() const;
   RayCounts last_ray_counts() const;
   int device() const;
