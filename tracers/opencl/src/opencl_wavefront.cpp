@@ -88,14 +88,20 @@ void OpenCLWavefront::enqueue(cl_command_queue queue, const KFrameParams& params
   const size_t local[2] = {8, 8};
   const size_t offset[2] = {0, first_row};
   const size_t global[2] = {(width + 7) / 8 * 8, (rows + 7) / 8 * 8};
-  cl_event last = nullptr;
+  // The latest kernel's event, released however this leaves unless handed out as `done`.
+  struct LastEvent {
+    cl_event event = nullptr;
+    ~LastEvent() {
+      if (event) clReleaseEvent(event);
+    }
+  } last;
   // Each kernel behind the one before (one in-order queue); the first's event kept, the last's handed out.
   auto run = [&](cl_kernel k) {
     cl_event event = nullptr;
     const cl_int err = clEnqueueNDRangeKernel(queue, k, 2, offset, global, local, 0, nullptr, &event);
     if (err == CL_SUCCESS && started && !*started && clRetainEvent(event) == CL_SUCCESS) *started = event;
-    if (last) clReleaseEvent(last);
-    last = event;
+    if (last.event) clReleaseEvent(last.event);
+    last.event = event;
     check(err, "launching a wavefront kernel");
   };
   const int walk = slots_ > 0u ? 1 : 0;
@@ -116,10 +122,10 @@ void OpenCLWavefront::enqueue(cl_command_queue queue, const KFrameParams& params
       shade(shade_[walk][2], sample);
     }
   }
-  if (done)
-    *done = last;
-  else if (last)
-    clReleaseEvent(last);
+  if (done) {
+    *done = last.event;
+    last.event = nullptr;
+  }
 }
 
 }  // namespace cohort::tracers
