@@ -169,6 +169,9 @@ case "${1:-}" in
     variable=$2; shift 2
     [ -d "$stage/bin" ] || tar -C "$stage" -xJf "$stage/payload.tar.xz"
     export LD_LIBRARY_PATH="$PWD/$stage/lib${LD_LIBRARY_PATH:+:$LD_LIBRARY_PATH}"
+    # NVIDIA's OpenCL only, so that opencl:0 is the first GPU (COHORT_GPU_TRACERS=opencl:0, the OpenCL tests).
+    mkdir -p /tmp/icd && echo libnvidia-opencl.so.1 > /tmp/icd/nvidia.icd
+    export OCL_ICD_VENDORS=/tmp/icd
     nvidia-smi --query-gpu=index,name --format=csv,noheader
     [ -f /tmp/largemap.cpk ] || { [ -f "$stage/largemap.cpk" ] && cp "$stage/largemap.cpk" /tmp/largemap.cpk; } ||
       { python3 tools/gen_testmap.py --large --out /tmp/largemap >/dev/null &&

@@ -1,7 +1,8 @@
 # Build step: inlines the quoted #includes of the OpenCL entry file (resolved against the including
 # file's folder, then INCLUDE_ROOT), each file once, and writes the result as a C++ string so the
 # tracer has no run-time dependence on the source tree.
-#   cmake -DENTRY=... -DINCLUDE_ROOT=... -DOUTPUT=... -P embed_kernel.cmake
+# NAME: the string's name in cohort::tracers::opencl_source (default kRenderBand).
+#   cmake -DENTRY=... -DINCLUDE_ROOT=... -DOUTPUT=... [-DNAME=...] -P embed_kernel.cmake
 cmake_minimum_required(VERSION 3.25)
 set(_seen "")
 function(_inline file out_var)
@@ -30,9 +31,12 @@ function(_inline file out_var)
   set(${out_var} "${text}" PARENT_SCOPE)
 endfunction()
 
+if(NOT NAME)
+  set(NAME kRenderBand)
+endif()
 get_filename_component(entry ${ENTRY} REALPATH)
 _inline(${entry} source)
 file(WRITE ${OUTPUT}.tmp "// Generated from ${ENTRY} by embed_kernel.cmake; do not edit.\n"
-     "namespace cohort::tracers::opencl_source {\nextern const char* const kRenderBand;\n"
-     "const char* const kRenderBand = R\"COHORTCL(\n${source})COHORTCL\";\n}\n")
+     "namespace cohort::tracers::opencl_source {\nextern const char* const ${NAME};\n"
+     "const char* const ${NAME} = R\"COHORTCL(\n${source})COHORTCL\";\n}\n")
 execute_process(COMMAND ${CMAKE_COMMAND} -E copy_if_different ${OUTPUT}.tmp ${OUTPUT})

@@ -50,30 +50,11 @@ __global__ void __launch_bounds__(128, 4) render_band_kernel(KSceneView scene, K
 // shadow rays are left in memory for a walk of their own (wavefront_walk.cu's shadow_walk_kernel), unless a
 // vertex may emit more than its slots or COHORT_CUDA_SHADOW_WALK=0 (then walked inline too).
 
-// Runs a path from its current ray until it ends (false) or has bounced (true: its next ray in *s).
-// `traced`: the current ray's hit, walked by the bounce kernel (null: walked here). shadows: where the last
-// vertex's shadow rays go; with some left there (shadows->count > 0) its light waits in *vertex.
+// k_path_segment (kernel/path_segment.h) behind a call of default inlining: forced inline into the shading
+// kernels, their spill stores moved by -48 to +24 bytes (ptxas, sm_90); through this they are as they were.
 __device__ bool path_segment(KTraceCtx* ctx, const KFrameParams* params, KPathState* s, const KHit* traced,
                              KPathFirstHit* first_hit, KShadowQueue* shadows, KVertexLight* vertex) {
-  const kuint bounce = s->bounce;
-  for (;;) {
-    KHit hit;
-    bool met;
-    if (traced) {
-      hit = *traced;
-      met = hit.instance != K_NONE;
-      traced = nullptr;
-    } else {
-      hit.cost = 0u;
-      met = k_trace_closest(ctx, s->org, s->dir, K_INF, K_RAY_PRIMARY, &hit);
-    }
-    if (!met) {
-      k_path_miss(K_CTX_SCENE(ctx), params, s, &hit);
-      return false;
-    }
-    if (!k_path_hit_queued(ctx, params, s, hit, first_hit, shadows, vertex)) return false;
-    if (s->bounce != bounce) return true;
-  }
+  return k_path_segment(ctx, params, s, traced, first_hit, shadows, vertex) != 0;
 }
 
 // Pixel p's slots for its vertex's shadow rays (kShadowWalk; else none: walked as they come). The

@@ -66,6 +66,7 @@ void set_walk_texel_texture(cudaTextureObject_t texture);
 // Whether launch_render_band renders this band as a wavefront when given the scratch: lit paths that bounce
 // (dynamic resolution's sparse pattern too: the pixels it leaves out are painted black by the first shading
 // kernel); the other modes take the megakernel.
+// k_wavefront_renders' rule (path_state.h), spelled out: that helper is device-only in render_band.cu.
 inline bool wavefront_renders(const KFrameParams& params) {
   return params.mode == K_MODE_PATH && params.max_bounces > 0u;
 }

@@ -4,18 +4,7 @@
 #include "cohort/kernel/integrator.h"
 #include "cohort/kernel/aux_outputs.h"
 
-/* The band kernels' parameters (the scene, the frame, the band and its row ray counts), for both entries. */
-#define COHORT_BAND_KERNEL_PARAMS                                                                               \
-      __global const KVertex* vertices, __global const KVertexColor* vertex_colors,                      \
-      __global const KTriangle* triangles, __global const KBvhNode* blas_nodes, __global const KBlas* blases,          \
-      __global const KInstance* instances, __global const KBvhNode* tlas_nodes, __global const KMaterial* materials,   \
-      __global const KTexture* textures, __global const kuint* texels, __global const KLight* lights,                \
-      __global const KLightNode* light_nodes, __global const KEmissiveTriangle* emissive,                             \
-      __global const KFrameParams* params_in, __global const KCamera* camera_in, __global float* band_rgba,           \
-      __global uint* row_rays
-#define COHORT_BAND_KERNEL_ARGS                                                                                 \
-  vertices, vertex_colors, triangles, blas_nodes, blases, instances, tlas_nodes, materials, textures, texels,     \
-      lights, light_nodes, emissive, params_in, camera_in, band_rgba, row_rays
+#include "band_params.cl"
 
 /* The band's pixels, recording first hits where first_hits is not null (the kernels below). */
 KFN void render_band_pixels(COHORT_BAND_KERNEL_PARAMS, __global KPathFirstHit* first_hits,
@@ -134,6 +123,9 @@ __kernel void cohort_aux_to_texels(__global const KAux* aux, __global KAuxTexel*
   }
   t->id = a.id;
 }
+
+/* The wavefront's shading kernels (its walks are a program of their own: wavefront_walk.cl). */
+#include "wavefront_shade.cl"
 
 /* Skinned characters: the skinning kernels share the program. */
 #include "skinning.cl"

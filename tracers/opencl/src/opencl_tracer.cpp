@@ -14,6 +14,10 @@
 
 #include "cohort/core/host_threads.h"
 #include "cohort/kernel/aux_mode.h"
+#include "cohort/kernel/path_state.h"
+#include "cohort/kernel/shadow_ray.h"
+#include "opencl_support.h"
+#include "opencl_wavefront.h"
 
 namespace cohort::tracers {
 
@@ -22,10 +26,6 @@ extern const char* const kRenderBand;
 }
 
 namespace {
-
-void check(cl_int err, const char* what) {
-  if (err != CL_SUCCESS) throw std::runtime_error(std::string("OpenCLTracer: ") + what + " failed (error " + std::to_string(err) + ")");
-}
 
 // A string property of a platform or device: OpenCL's query-the-size-then-fill pattern.
 template <typename Object, typename Info>
@@ -211,6 +211,7 @@ class PinnedStaging {
 struct OpenCLTracer::Impl {
   std::string label;
   bool gpu = false;
+  cl_device_id device = nullptr;
   cl_context context = nullptr;
   cl_command_queue queue = nullptr;
   // The aux texels' read runs on this second in-order queue, behind the aux kernel's event, while the
@@ -291,14 +292,48 @@ struct OpenCLTracer::Impl {
 
   // A device buffer of at least `bytes`, reallocated (contents lost) when it is smaller.
   cl_mem& grow(cl_mem& mem, size_t& capacity, size_t bytes, const char* what) {
-    if (bytes > capacity) {
-      if (mem) clReleaseMemObject(mem);
-      cl_int err = CL_SUCCESS;
-      mem = clCreateBuffer(context, CL_MEM_READ_WRITE, bytes, nullptr, &err);
-      check(err, what);
-      capacity = bytes;
+    return grow_buffer(context, mem, capacity, bytes, what);
+  }
+
+  // The wavefront (Options::wavefront, shadow_walk), its walk program built with walk_options the first
+  // time a frame renders as one.
+  bool wavefront_on = true, shadow_walk = true;
+  std::string walk_options, main_options;
+  std::unique_ptr<OpenCLWavefront> wavefront;
+  // The wavefront, its kernels' arguments set for this band, where it renders the frame (k_wavefront_renders);
+  // null: the megakernel renders it.
+  OpenCLWavefront* wavefront_for(const KFrameParams& params, const OpenCLWavefront::BandArgs& band, size_t pixels,
+                                 cl_mem first_hit_records) {
+    if (!wavefront_on || !k_wavefront_renders(&params)) return nullptr;
+    if (!wavefront) {
+      wavefront = std::make_unique<OpenCLWavefront>(context, device, program, walk_options, label);
+      spdlog::info("opencl ({}): frames that bounce render as a wavefront (walks built with '{}', the rest with '{}')",
+                   label, walk_options, main_options);
     }
-    return mem;
+    const kuint slots = shadow_walk ? k_shadow_queue_slots(&params, params.light_count, params.emissive_count) : 0u;
+    wavefront->prepare(band, pixels, slots, first_hit_records);
+    return wavefront.get();
+  }
+  // The band's rows [first_row, first_row + rows): the wavefront's kernels where `wave`, else the
+  // megakernel `kernel`, in 8x8 work groups from first_row; started / done: the first and last kernel's events.
+  void enqueue_band_rows(cl_kernel kernel, OpenCLWavefront* wave, const KFrameParams& params, size_t width,
+                         size_t first_row, size_t rows, Event* started, Event* done) {
+    if (wave) {
+      wave->enqueue(queue, params, width, first_row, rows, started ? started->out() : nullptr,
+                    done ? done->out() : nullptr);
+      return;
+    }
+    const size_t local[2] = {8, 8};
+    const size_t offset[2] = {0, first_row};
+    const size_t global[2] = {(width + 7) / 8 * 8, (rows + 7) / 8 * 8};
+    // One kernel: its event is both.
+    Event* event = done ? done : started;
+    check(clEnqueueNDRangeKernel(queue, kernel, 2, offset, global, local, 0, nullptr, event ? event->out() : nullptr),
+          "launching the kernel");
+    if (started && done) {
+      check(clRetainEvent(done->get()), "clRetainEvent");
+      *started->out() = done->get();
+    }
   }
   // Runs a 1-D packing kernel (source, destination, end pixel) over the pixels [first, first + pixels):
   // the kernel stops at the end pixel, so a piece's last work group leaves the next piece's pixels alone.
@@ -335,6 +370,7 @@ struct OpenCLTracer::Impl {
 
   ~Impl() {
     if (aux_queue) clFinish(aux_queue);
+    wavefront.reset();
     aux_staging.reset();
     for (cl_mem m : {params, camera, previous_camera, output, row_rays, aux, packed, packed_aux, first_hits})
       if (m) clReleaseMemObject(m);
@@ -399,20 +435,23 @@ OpenCLTracer::OpenCLTracer(const Options& options) : impl_(std::make_unique<Impl
 #if defined(__GNUC__)
 #pragma GCC diagnostic pop
 #endif
-  const char* source = opencl_source::kRenderBand;
-  impl_->program = clCreateProgramWithSource(impl_->context, 1, &source, nullptr, &err);
-  check(err, "clCreateProgramWithSource");
-  std::string build_options = "-cl-std=CL1.2 " + options.build_options;
-  err = clBuildProgram(impl_->program, 1, &dev.device, build_options.c_str(), nullptr, nullptr);
-  if (err != CL_SUCCESS) {
-    size_t n = 0;
-    clGetProgramBuildInfo(impl_->program, dev.device, CL_PROGRAM_BUILD_LOG, 0, nullptr, &n);
-    std::string log(n, '\0');
-    clGetProgramBuildInfo(impl_->program, dev.device, CL_PROGRAM_BUILD_LOG, n, log.data(), nullptr);
-    spdlog::error("OpenCLTracer: kernel build log for {}:\n{}", dev.label, log);
-    throw std::runtime_error("OpenCLTracer: kernel build failed on " + dev.label + " (error " + std::to_string(err) +
-                             "):\n" + log);
-  }
+  // NVIDIA's compiler takes a register cap per program (cl_nv_compiler_options): the walks'
+  // (Options::walk_registers) and the main program's (Options::shade_registers: shading kernels and
+  // megakernels); other platforms know no such option.
+  const bool nvidia = lists_extension(device_info(dev.device, CL_DEVICE_EXTENSIONS), "cl_nv_compiler_options") ||
+                      device_info(dev.device, CL_DEVICE_VENDOR).find("NVIDIA") != std::string::npos;
+  auto with_registers = [&](int registers) {
+    std::string o = "-cl-std=CL1.2 " + options.build_options;
+    if (nvidia && registers > 0) o += " -cl-nv-maxrregcount=" + std::to_string(registers);
+    return o;
+  };
+  impl_->device = dev.device;
+  impl_->wavefront_on = options.wavefront == Options::Wavefront::always ||
+                        (options.wavefront == Options::Wavefront::on_gpus && impl_->gpu);
+  impl_->shadow_walk = options.shadow_walk;
+  impl_->walk_options = with_registers(options.walk_registers);
+  impl_->main_options = with_registers(options.shade_registers);
+  impl_->program = build_program(impl_->context, dev.device, opencl_source::kRenderBand, impl_->main_options, dev.label);
   impl_->kernel = clCreateKernel(impl_->program, "cohort_render_band", &err);
   check(err, "clCreateKernel");
   impl_->skin_positions = clCreateKernel(impl_->program, "cohort_skin_positions", &err);
@@ -446,6 +485,8 @@ OpenCLTracer::~OpenCLTracer() = default;
 std::string OpenCLTracer::name() const { return "opencl (" + impl_->label + ")"; }
 
 bool OpenCLTracer::renders_on_gpu() const { return impl_->gpu; }
+bool OpenCLTracer::wavefront() const { return impl_->wavefront_on; }
+bool OpenCLTracer::shadow_walk() const { return impl_->shadow_walk; }
 
 void OpenCLTracer::upload(const commit::ChangeSet& changes) {
   Impl& m = *impl_;
@@ -570,18 +611,19 @@ core::BandResult OpenCLTracer::render_band(const core::BandJob& job, core::BandB
   cl_uint arg_count = sizeof(args) / sizeof(args[0]);
   for (cl_uint i = 0; i < arg_count; ++i)
     check(clSetKernelArg(band_kernel, i, sizeof(cl_mem), &args[i]), "clSetKernelArg");
+  cl_mem records = nullptr;
   if (aux_from_paths) {
-    cl_mem records = m.grow(m.first_hits, m.first_hits_bytes, rows * camera.width * sizeof(KPathFirstHit),
-                            "clCreateBuffer(first hits)");
+    records = m.grow(m.first_hits, m.first_hits_bytes, rows * camera.width * sizeof(KPathFirstHit),
+                     "clCreateBuffer(first hits)");
     check(clSetKernelArg(band_kernel, arg_count, sizeof(cl_mem), &records), "clSetKernelArg(first hits)");
-    return render_first_hits_in_pieces(job, target, params, camera, straight);
   }
+  OpenCLWavefront::BandArgs band_args;
+  std::copy(std::begin(args), std::end(args), band_args.begin());
+  OpenCLWavefront* wave = m.wavefront_for(params, band_args, rows * camera.width, records);
+  if (aux_from_paths) return render_first_hits_in_pieces(job, target, params, camera, straight, wave);
   if (write_aux) enqueue_aux(job, camera, rows, straight);
-  const size_t local[2] = {8, 8};
-  const size_t global[2] = {(camera.width + 7) / 8 * 8, (rows + 7) / 8 * 8};
-  Event band_done;
-  check(clEnqueueNDRangeKernel(m.queue, band_kernel, 2, nullptr, global, local, 0, nullptr, band_done.out()),
-        "launching the kernel");
+  Event band_started, band_done;
+  m.enqueue_band_rows(band_kernel, wave, params, camera.width, 0, rows, &band_started, &band_done);
   // The band goes straight into its rows of the target, converted on the device to the target's format.
   const size_t pixels = rows * camera.width;
   size_t band_bytes = bytes;
@@ -609,8 +651,8 @@ core::BandResult OpenCLTracer::render_band(const core::BandJob& job, core::BandB
   for (size_t r = 0; r < rows && !straight; ++r)
     target.store(static_cast<int>(params.row_begin + r), 0, band.data() + r * camera.width * 4, camera.width);
   // Device time from the first kernel (the aux one when it ran first, as the CUDA tracer times it) to the
-  // band's kernel.
-  const cl_ulong start = (write_aux ? m.aux_kernel_done : band_done).time(CL_PROFILING_COMMAND_START);
+  // band's last kernel.
+  const cl_ulong start = (write_aux ? m.aux_kernel_done : band_started).time(CL_PROFILING_COMMAND_START);
   const cl_ulong end = band_done.time(CL_PROFILING_COMMAND_END);
   core::BandResult result;
   result.device_ms = end > start && start != 0 ? double(end - start) * 1e-6 : 0.0;
@@ -620,7 +662,7 @@ core::BandResult OpenCLTracer::render_band(const core::BandJob& job, core::BandB
 
 core::BandResult OpenCLTracer::render_first_hits_in_pieces(const core::BandJob& job, core::BandBuffer& target,
                                                            const KFrameParams& params, const KCamera& camera,
-                                                           bool straight) {
+                                                           bool straight, OpenCLWavefront* wave) {
   Impl& m = *impl_;
   const size_t width = camera.width;
   const size_t rows = params.row_end - params.row_begin;
@@ -646,14 +688,10 @@ core::BandResult OpenCLTracer::render_first_hits_in_pieces(const core::BandJob& 
   prepare_aux(job, camera, rows);
   // Each piece renders, finishes its first hits and packs into its own rows of the band's device buffers,
   // so the second queue reads piece i while the main one runs piece i + 1.
-  const size_t local[2] = {8, 8};
   for (size_t i = 0; i < pieces; ++i) {
     const size_t first = starts[i], count = starts[i + 1] - first;
-    const size_t offset[2] = {0, first};
-    const size_t global[2] = {(width + 7) / 8 * 8, (count + kGroupRows - 1) / kGroupRows * kGroupRows};
-    check(clEnqueueNDRangeKernel(m.queue, m.first_hits_kernel, 2, offset, global, local, 0, nullptr,
-                                 i == 0 ? band_started.out() : nullptr),
-          "launching the kernel");
+    m.enqueue_band_rows(m.first_hits_kernel, wave, params, width, first, count, i == 0 ? &band_started : nullptr,
+                        nullptr);
     enqueue_aux_rows(camera, first, count, straight);
     if (half) m.pack(m.to_rgb16f, m.output, colour, first * width, count * width, "converting the band to half floats");
     check(clEnqueueMarkerWithWaitList(m.queue, 0, nullptr, piece_ready[i].out()), "marking a piece's end");

@@ -132,6 +132,30 @@ int embree_threads_beside_gpus(unsigned hardware_threads) {
   return std::max(1, all - std::max(2, all / 4));
 }
 
+namespace {
+
+// An on/off environment switch: 0 or 1, `otherwise` when unset or empty; anything else is named.
+[[maybe_unused]] bool env_switch(const char* variable, bool otherwise) {
+  const char* value = std::getenv(variable);
+  if (!value || !*value) return otherwise;
+  if (std::string(value) != "0" && std::string(value) != "1")
+    throw std::invalid_argument(std::string(variable) + "='" + value + "': expected 0 or 1");
+  return std::string(value) == "1";
+}
+
+// A register cap for an OpenCL program: 0 (none) to 255, `otherwise` when unset or empty.
+[[maybe_unused]] int env_registers(const char* variable, int otherwise) {
+  const char* value = std::getenv(variable);
+  if (!value || !*value) return otherwise;
+  char* end = nullptr;
+  const long count = std::strtol(value, &end, 10);
+  if (*end != '\0' || count < 0 || count > 255)
+    throw std::invalid_argument(std::string(variable) + "='" + value + "': expected a register count from 0 (no cap) to 255");
+  return static_cast<int>(count);
+}
+
+}  // namespace
+
 std::unique_ptr<core::Tracer> make_tracer(const TracerSpec& spec) {
 #ifdef COHORT_HAVE_EMBREE
   if (spec.kind == "embree") return std::make_unique<EmbreeTracer>(spec.threads);
@@ -154,6 +178,13 @@ std::unique_ptr<core::Tracer> make_tracer(const TracerSpec& spec) {
         throw std::invalid_argument("COHORT_OPENCL_AUX_INTO_TARGET='" + std::string(into) + "': expected 0 or 1");
       options.aux_into_target = std::string(into) == "1";
     }
+    // The wavefront against the megakernel, and its register caps on NVIDIA, for A/B runs without a rebuild.
+    if (const char* wave = std::getenv("COHORT_OPENCL_WAVEFRONT"); wave && *wave)
+      options.wavefront = env_switch("COHORT_OPENCL_WAVEFRONT", true) ? OpenCLTracer::Options::Wavefront::always
+                                                                       : OpenCLTracer::Options::Wavefront::never;
+    options.shadow_walk = env_switch("COHORT_OPENCL_SHADOW_WALK", options.shadow_walk);
+    options.walk_registers = env_registers("COHORT_OPENCL_WALK_REGISTERS", options.walk_registers);
+    options.shade_registers = env_registers("COHORT_OPENCL_SHADE_REGISTERS", options.shade_registers);
     return std::make_unique<OpenCLTracer>(options);
   }
 #endif

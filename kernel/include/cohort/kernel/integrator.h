@@ -196,7 +196,7 @@ KFN float k_emissive_pdf(const KSceneView* scene, KVec3 p, kuint instance, kuint
  * (near and bright ones first), a uniform point on it, its emission there, one shadow ray (to the queue,
  * which sets the vertex's emissive term when the point is visible). With a bounce to follow from this
  * vertex the value is weighted by the power heuristic against BRDF sampling, which weighs the emission it
- * finds the same way (k_path_hit); without one it stands alone (weight 1). */
+ * finds the same way (k_path_hit_queued); without one it stands alone (weight 1). */
 KFN void k_emissive_lighting(KTraceCtx* ctx, const KSurface* sf, KVec3 wo, int bounce_follows, float shadow_rr,
                              float path_weight, KRng* rng, KShadowQueue* queue, KVertexLight* vertex) {
   const KSceneView* scene = K_CTX_SCENE(ctx);
@@ -431,30 +431,20 @@ KFN int k_path_hit_queued(KTraceCtx* ctx, const KFrameParams* params, KPathState
   return 1;
 }
 
-/* k_path_hit_queued with each shadow ray walked as it comes. */
-KFN int k_path_hit(KTraceCtx* ctx, const KFrameParams* params, KPathState* s, KHit hit,
-                   KGLOBAL KPathFirstHit* first_hit) {
-  KShadowQueue shadows = k_shadow_queue_inline();
-  KVertexLight vertex;
-  return k_path_hit_queued(ctx, params, s, hit, first_hit, &shadows, &vertex);
-}
+#include "path_segment.h"
 
 /* Radiance along one camera ray; pixel_spread is the angle one pixel subtends (for mip selection).
  * first_hit (may be null): where the ray's first opaque surface is recorded for the aux planes (a miss,
- * or a ray the path gives up on before one, is recorded as a miss). */
+ * or a ray the path gives up on before one, is recorded as a miss). The path runs segment after segment,
+ * each vertex's shadow rays walked as they come. */
 KFN KVec3 k_trace_path(KTraceCtx* ctx, const KFrameParams* params, KVec3 org, KVec3 dir, float pixel_spread,
                        KRng* rng, KGLOBAL KPathFirstHit* first_hit) {
   if (first_hit) k_record_first_hit(first_hit, K_NONE, 0u, 0u);
   KPathState s;
   k_path_begin(&s, org, dir, pixel_spread, *rng);
-  for (;;) {
-    KHit hit;
-    hit.cost = 0u;
-    if (!k_trace_closest(ctx, s.org, s.dir, K_INF, K_RAY_PRIMARY, &hit)) {
-      k_path_miss(K_CTX_SCENE(ctx), params, &s, &hit);
-      break;
-    }
-    if (!k_path_hit(ctx, params, &s, hit, first_hit)) break;
+  KShadowQueue shadows = k_shadow_queue_inline();
+  KVertexLight vertex;
+  while (k_path_segment(ctx, params, &s, 0, first_hit, &shadows, &vertex)) {
   }
   *rng = s.rng;
   return s.radiance;

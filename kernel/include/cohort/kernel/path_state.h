@@ -1,9 +1,10 @@
-/* A path between two of its rays: all the integrator (integrator.h's k_path_hit) carries from one surface
+/* A path between two of its rays: all the integrator (integrator.h's k_path_hit_queued) carries from one surface
  * to the next. Plain data, so that a wavefront tracer keeps it in memory between the kernel that walks a
- * path's next ray and the one that shades what it met (tracers/cuda), where the megakernel keeps it in
+ * path's next ray and the one that shades what it met (tracers/cuda, tracers/opencl), where the megakernel keeps it in
  * registers. */
 #ifndef COHORT_KERNEL_PATH_STATE_H
 #define COHORT_KERNEL_PATH_STATE_H
+#include "layout.h"
 #include "portable.h"
 #include "rng.h"
 #include "vec.h"
@@ -17,6 +18,13 @@ typedef struct KPathState {
   KRng rng;
   kuint pad;
 } KPathState;
+
+/* Whether a wavefront tracer renders a frame with these parameters as a wavefront: lit paths that bounce
+ * (dynamic resolution's sparse pattern too); the debug views and frames without a bounce take its
+ * megakernel. */
+KFN int k_wavefront_renders(const KFrameParams* params) {
+  return params->mode == K_MODE_PATH && params->max_bounces > 0u;
+}
 
 #if defined(__cplusplus) && !defined(__CUDACC_RTC__)
 static_assert(sizeof(KPathState) == 88, "KPathState layout");

@@ -11,6 +11,8 @@
 
 namespace cohort::tracers {
 
+class OpenCLWavefront;
+
 class OpenCLTracer : public TracerBase {
  public:
   struct Options {
@@ -25,6 +27,23 @@ class OpenCLTracer : public TracerBase {
     // instead of into page-locked staging and then copying them on the host: for measuring one against
     // the other on a GPU driver.
     bool aux_into_target = false;
+    // Where lit frames that bounce (k_wavefront_renders) render as a wavefront (kernel/wavefront.cl: the
+    // rays walked by kernels of their own between shading kernels, the paths in device memory between
+    // them; the megakernel's image bit for bit) instead of the megakernel: on GPU devices (the CUDA
+    // wavefront's gain), or always, or never. A CPU device keeps the megakernel by default: on PoCL (2-core
+    // VM) the wavefront took 60-61 ms a frame against 53-54 (docs/integrator.md). COHORT_OPENCL_WAVEFRONT
+    // (the registry): 1 always, 0 never.
+    enum class Wavefront { on_gpus, always, never };
+    Wavefront wavefront = Wavefront::on_gpus;
+    // In the wavefront, next-event estimation's shadow rays left in memory for a walk of their own (where a
+    // vertex's rays fit its slots, k_shadow_queue_slots) instead of walked by the shading kernels as they
+    // come. COHORT_OPENCL_SHADOW_WALK=0 keeps them in the shading kernels.
+    bool shadow_walk = true;
+    // On NVIDIA's OpenCL only, -cl-nv-maxrregcount for the wavefront's walk program (the CUDA walks run at
+    // 64) and for the main program (the shading kernels and the megakernels); 0: no cap.
+    // COHORT_OPENCL_WALK_REGISTERS, COHORT_OPENCL_SHADE_REGISTERS.
+    int walk_registers = 64;
+    int shade_registers = 0;
   };
   static constexpr int kMaxFirstHitPieces = 8;
   // The pieces' first rows, relative to the band, and `rows` last: up to `pieces` ranges of whole work
@@ -41,6 +60,10 @@ class OpenCLTracer : public TracerBase {
 
   std::string name() const override;
   bool renders_on_gpu() const override;
+  // Whether this tracer renders lit frames that bounce as a wavefront (Options::wavefront on its device),
+  // and whether the wavefront's shadow rays have their own walk (Options::shadow_walk).
+  bool wavefront() const;
+  bool shadow_walk() const;
   using core::Tracer::render_band;
   core::BandResult render_band(const core::BandJob& job, core::BandBuffer& target) override;
 
@@ -74,8 +97,10 @@ class OpenCLTracer : public TracerBase {
   // The band with its aux planes from the paths' first hits, in pieces (Options::first_hit_pieces):
   // per piece, on the main queue, the band's kernel, the aux kernel, the packings; on the second queue
   // the piece's aux and colour reads behind them; on the host its aux copy, while later pieces render.
+  // wave: the wavefront that renders each piece's rows, or null for the megakernel.
   core::BandResult render_first_hits_in_pieces(const core::BandJob& job, core::BandBuffer& target,
-                                               const KFrameParams& params, const KCamera& camera, bool straight);
+                                               const KFrameParams& params, const KCamera& camera, bool straight,
+                                               OpenCLWavefront* wave);
 
   struct Impl;
   std::unique_ptr<Impl> impl_;

@@ -1,0 +1,319 @@
+// The OpenCL tracer's wavefront (OpenCLTracer::Options::wavefront: walks and shading in kernels of their own,
+// the paths in device memory between them) draws the megakernel's image bit for bit: same integrator, same
+// random numbers, same order of float operations. Every float of the band, every aux texel, and the rays
+// counted per row must be the megakernel's, on the test room and the test map, over several bounces,
+// Russian roulette, 2, 3 and 4 samples a pixel, bands that start mid-frame, the first-hit records of the aux
+// planes (in pieces), the sparse pattern of dynamic resolution, and a floor of many lights, whose shadow rays
+// go to the shadow walk where they fit a vertex's slots and stay in the shading kernels where they do not.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdlib>
+#include <cstring>
+#include <memory>
+#include <ostream>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "cohort/core/view.h"
+#include "cohort/scene/map_loader.h"
+#include "test_scenes.h"
+#include "test_tracers.h"
+
+#ifdef COHORT_HAVE_OPENCL
+#include "cohort/tracers/opencl_tracer.h"
+#endif
+
+using namespace cohort;
+using namespace cohort::test;
+
+#ifdef COHORT_HAVE_OPENCL
+
+namespace {
+
+struct Variant {
+  bool wavefront, shadow_walk;
+  int pieces;  // the first-hit pieces (Options::first_hit_pieces)
+  const char* name;
+};
+const Variant kMegakernel{false, true, 1, "megakernel"};
+const Variant kWavefront{true, true, 4, "wavefront"};
+const Variant kShadowsInTheShadingKernels{true, false, 2, "wavefront, shadow rays in the shading kernels"};
+
+std::unique_ptr<tracers::OpenCLTracer> opencl(const Variant& v) {
+  tracers::OpenCLTracer::Options options;
+  if (const char* device = std::getenv("COHORT_TEST_OPENCL_DEVICE")) options.device = std::atoi(device);
+  options.wavefront = v.wavefront ? tracers::OpenCLTracer::Options::Wavefront::always
+                                  : tracers::OpenCLTracer::Options::Wavefront::never;
+  options.shadow_walk = v.shadow_walk;
+  options.first_hit_pieces = v.pieces;
+  return std::make_unique<tracers::OpenCLTracer>(options);
+}
+
+struct View {
+  std::shared_ptr<commit::TracerScene> scene;
+  KCamera camera;
+};
+
+View room_view(int w, int h) {
+  static const auto room = std::make_shared<commit::TracerScene>(core::compile_scene(test_room()).tracer_scene);
+  return {room, test_room_camera(w, h)};
+}
+
+// The generated test map (what its scene pack holds), from the player start at eye height.
+View map_view(int w, int h) {
+  struct Map {
+    std::shared_ptr<commit::TracerScene> scene;
+    glm::vec3 eye;
+    float yaw;
+  };
+  static const Map map = [] {
+    scene::Vfs vfs;
+    const scene::Scene m = scene::load_map(vfs, std::string(COHORT_SOURCE_DIR) + "/assets/testmap/maps/testmap.map");
+    return Map{std::make_shared<commit::TracerScene>(core::compile_scene(m).tracer_scene), core::player_eye(m),
+               m.player_yaw};
+  }();
+  return {map.scene, core::make_camera(map.eye, {map.yaw, 0.0f}, core::kDefaultFovX, w, h)};
+}
+
+// A floor of point and projected lights under an emissive panel (two emissive triangles), seen from above.
+View many_lights_view(int point_lights, int projected_lights, int w, int h) {
+  scene::Scene floor = many_lights_floor(point_lights, projected_lights);
+  scene::Material panel;
+  panel.name = "panel";
+  panel.diffuse_color = glm::vec4(0.0f, 0.0f, 0.0f, 1.0f);
+  panel.emitter = true;
+  panel.emissive_color = glm::vec4(4.0f, 3.5f, 3.0f, 1.0f);
+  floor.materials.push_back(panel);
+  scene::Mesh lamp;
+  lamp.name = "_area1";
+  add_quad(lamp, int(floor.materials.size() - 1), {-60, -60, 150}, {-60, 60, 150}, {60, 60, 150}, {60, -60, 150},
+           {0, 0, -1});
+  add_world_mesh(floor, std::move(lamp));
+  return {std::make_shared<commit::TracerScene>(core::compile_scene(floor).tracer_scene),
+          camera_looking_down({0, 0, 1400}, 0.7f, w, h)};
+}
+
+struct Rendered {
+  core::BandBuffer frame;
+  std::vector<float> row_work;  // the bands' rays per row, band after band
+  double device_ms = 0.0;
+};
+
+// The frame rendered band by band (cuts: the bands' first rows, then the height), with its aux planes
+// when params.aux_outputs asks for them.
+Rendered render_bands(const Variant& v, const View& view, const KFrameParams& params, const std::vector<int>& cuts) {
+  auto tracer = opencl(v);
+  tracer->apply(commit::CommitBuffer::full(view.scene, 1));
+  Rendered out;
+  out.frame.resize(int(view.camera.width), int(view.camera.height), core::BandFormat::rgba32f);
+  out.frame.enable_aux(params.aux_outputs != 0u);
+  for (size_t i = 0; i + 1 < cuts.size(); ++i) {
+    core::BandJob job;
+    job.params = params;
+    job.params.row_begin = kuint(cuts[i]);
+    job.params.row_end = kuint(cuts[i + 1]);
+    job.camera = view.camera;
+    const core::BandResult result = tracer->render_band(job, out.frame);
+    out.row_work.insert(out.row_work.end(), result.row_work.begin(), result.row_work.end());
+    out.device_ms += result.device_ms;
+  }
+  return out;
+}
+
+size_t differing_floats(core::BandBuffer& a, core::BandBuffer& b) {
+  const float* fa = static_cast<const float*>(a.data());
+  const float* fb = static_cast<const float*>(b.data());
+  size_t n = 0;
+  for (size_t i = 0; i < a.bytes() / sizeof(float); ++i) n += std::memcmp(fa + i, fb + i, sizeof(float)) != 0;
+  return n;
+}
+
+// The wavefront's frame against the megakernel's: every float, aux texel and row count the same.
+void expect_the_megakernels_frame(const Variant& v, const View& view, const KFrameParams& params,
+                                  const std::vector<int>& cuts, const std::string& what) {
+  SCOPED_TRACE(what + ", " + v.name);
+  Rendered mega = render_bands(kMegakernel, view, params, cuts);
+  Rendered wave = render_bands(v, view, params, cuts);
+  double sum = 0.0;
+  const float* f = static_cast<const float*>(wave.frame.data());
+  for (size_t i = 0; i < wave.frame.bytes() / sizeof(float); ++i) {
+    ASSERT_TRUE(std::isfinite(f[i])) << "float " << i;
+    sum += f[i];
+  }
+  EXPECT_GT(sum, 0.0) << "the frame shows something";
+  EXPECT_EQ(differing_floats(mega.frame, wave.frame), 0u) << "floats that differ from the megakernel's";
+  if (params.aux_outputs != 0u) {
+    ASSERT_EQ(mega.frame.aux_bytes(), wave.frame.aux_bytes());
+    EXPECT_EQ(std::memcmp(mega.frame.aux_data(), wave.frame.aux_data(), mega.frame.aux_bytes()), 0)
+        << "the aux planes differ";
+  }
+  ASSERT_EQ(wave.row_work.size(), size_t(view.camera.height)) << "every band reports its row ray counts";
+  EXPECT_EQ(wave.row_work, mega.row_work) << "rays counted per row";
+  EXPECT_GT(wave.device_ms, 0.0);
+}
+
+struct SceneCase {
+  bool map;
+  uint32_t bounces, spp;
+  const char* name;
+  float rr_start = 2.0f;
+  kuint aux = 0u;              // K_AUX_PATH_FIRST_HIT: the first-hit records (centre rays under the sparse pattern)
+  uint32_t path_pixels = 0u;   // dynamic resolution's sparse pattern: paths at this many of each 16 pixels
+  uint32_t light_sampling = K_LIGHTS_TREE;
+  std::vector<int> cuts = {};  // the bands (default: two, the second from row 13)
+};
+void PrintTo(const SceneCase& c, std::ostream* os) { *os << c.name; }
+class OpenCLWavefront : public ::testing::TestWithParam<SceneCase> {};
+
+TEST_P(OpenCLWavefront, DrawsTheMegakernelsImage) {
+  if (!tracer_runs_here("opencl")) GTEST_SKIP() << "no OpenCL device here";
+  const SceneCase c = GetParam();
+  const int w = 40, h = 32;
+  const View view = c.map ? map_view(w, h) : room_view(w, h);
+  KFrameParams params = frame_params(K_MODE_PATH, c.spp, c.bounces, h);
+  params.rr_start = c.rr_start;
+  params.frame_index = 5;
+  params.firefly_clamp = 5.0f;
+  params.soft_shadow_scale = 0.2f;
+  params.shadow_rr = 0.03f;
+  params.aux_outputs = c.aux;
+  params.path_pixels = c.path_pixels;
+  params.path_phase = 3;
+  params.light_sampling = c.light_sampling;
+  params.light_samples = c.light_sampling == K_LIGHTS_EVERY ? 0u : 1u;
+  const std::vector<int> cuts = c.cuts.empty() ? std::vector<int>{0, 13, h} : c.cuts;
+  expect_the_megakernels_frame(kWavefront, view, params, cuts, c.name);
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    Paths, OpenCLWavefront,
+    ::testing::Values(SceneCase{false, 1, 1, "room_bounce1"},
+                      SceneCase{false, 3, 2, "room_bounce3_spp2_roulette", 1.0f},
+                      SceneCase{false, 2, 3, "room_bounce2_spp3"},
+                      SceneCase{false, 2, 2, "room_first_hits_bands_mid_frame", 2.0f, K_AUX_PATH_FIRST_HIT, 0u,
+                                K_LIGHTS_TREE, {0, 5, 21, 32}},
+                      SceneCase{false, 2, 2, "room_sparse8_spp2", 2.0f, K_AUX_PATH_FIRST_HIT, 8u},
+                      SceneCase{true, 1, 1, "map_bounce1"},
+                      SceneCase{true, 2, 4, "map_bounce2_spp4_first_hits", 1.0f, K_AUX_PATH_FIRST_HIT},
+                      SceneCase{true, 1, 1, "map_sparse4", 2.0f, K_AUX_PATH_FIRST_HIT, 4u},
+                      SceneCase{true, 1, 2, "map_every_light", 2.0f, 0u, 0u, K_LIGHTS_EVERY}),
+    [](const auto& info) { return std::string(info.param.name); });
+
+// Next-event estimation's shadow rays on a floor of 96 (or 6) lights and an emissive panel, two samples,
+// two bounces, soft shadows, the firefly clamp: gather choosing among more lights than its budget, two light
+// samples averaged with the shadow roulette, `every` with 6 lights (7 rays a vertex: the shadow walk) and
+// with 96 (more than a vertex's slots: the shading kernels walk them); with the shadow walk and without.
+struct LightCase {
+  uint32_t light_sampling, light_samples;
+  float shadow_rr;
+  int point_lights, projected_lights;
+  const char* name;
+};
+void PrintTo(const LightCase& c, std::ostream* os) { *os << c.name; }
+class OpenCLWavefrontShadows : public ::testing::TestWithParam<LightCase> {};
+
+TEST_P(OpenCLWavefrontShadows, DrawTheMegakernelsImage) {
+  if (!tracer_runs_here("opencl")) GTEST_SKIP() << "no OpenCL device here";
+  const LightCase c = GetParam();
+  const int w = 32, h = 24;
+  const View view = many_lights_view(c.point_lights, c.projected_lights, w, h);
+  ASSERT_EQ(view.scene->emissive_triangles.size(), 2u) << "the panel's triangles are emitters to sample";
+  KFrameParams params = frame_params(K_MODE_PATH, 2, 2, h);
+  params.soft_shadow_scale = 1.0f;
+  params.firefly_clamp = 4.0f;
+  params.frame_index = 3;
+  params.light_sampling = c.light_sampling;
+  params.light_samples = c.light_samples;
+  params.shadow_rr = c.shadow_rr;
+  for (const Variant& v : {kWavefront, kShadowsInTheShadingKernels})
+    expect_the_megakernels_frame(v, view, params, {0, 11, h}, c.name);
+}
+
+INSTANTIATE_TEST_SUITE_P(LightSampling, OpenCLWavefrontShadows,
+                         ::testing::Values(LightCase{K_LIGHTS_TREE, 1, 0.0f, 88, 8, "tree1"},
+                                           LightCase{K_LIGHTS_TREE, 2, 0.03f, 88, 8, "tree2_roulette"},
+                                           LightCase{K_LIGHTS_GATHER, 4, 0.03f, 88, 8, "gather4_roulette"},
+                                           LightCase{K_LIGHTS_EVERY, 0, 0.03f, 4, 2, "every_6_lights"},
+                                           LightCase{K_LIGHTS_EVERY, 0, 0.03f, 88, 8, "every_past_the_slots"}),
+                         [](const auto& info) { return std::string(info.param.name); });
+
+// A band that grows between frames grows the wavefront's scratch (a second, taller band on the same
+// tracer), and frames the wavefront does not render (no bounce, a debug view) take the megakernel.
+TEST(OpenCLWavefrontScratch, GrowsWithTheBandAndSitsOutFramesWithoutABounce) {
+  if (!tracer_runs_here("opencl")) GTEST_SKIP() << "no OpenCL device here";
+  const int w = 24, h = 40;
+  const View view = room_view(w, h);
+  auto mega = opencl(kMegakernel);
+  auto wave = opencl(kWavefront);
+  mega->apply(commit::CommitBuffer::full(view.scene, 1));
+  wave->apply(commit::CommitBuffer::full(view.scene, 1));
+  struct Frame {
+    uint32_t mode, bounces;
+    int begin, end;
+  };
+  for (const Frame& f : {Frame{K_MODE_PATH, 1, 30, 38}, Frame{K_MODE_PATH, 2, 3, 40}, Frame{K_MODE_PATH, 0, 0, 40},
+                         Frame{K_MODE_ALBEDO, 1, 0, 40}, Frame{K_MODE_PATH, 1, 0, 24}}) {
+    SCOPED_TRACE("mode " + std::to_string(f.mode) + ", " + std::to_string(f.bounces) + " bounces, rows " +
+                 std::to_string(f.begin) + "-" + std::to_string(f.end));
+    KFrameParams params = frame_params(f.mode, 1, f.bounces, h);
+    params.row_begin = kuint(f.begin);
+    params.row_end = kuint(f.end);
+    core::BandBuffer a(w, h, core::BandFormat::rgba32f), b(w, h, core::BandFormat::rgba32f);
+    core::BandJob job;
+    job.params = params;
+    job.camera = view.camera;
+    const core::BandResult ra = mega->render_band(job, a);
+    const core::BandResult rb = wave->render_band(job, b);
+    EXPECT_EQ(differing_floats(a, b), 0u);
+    EXPECT_EQ(ra.row_work, rb.row_work);
+  }
+}
+
+// The switches read from the environment (tracer registry): the wavefront on GPU devices unless
+// COHORT_OPENCL_WAVEFRONT says 1 (always) or 0 (never), its shadow walk unless COHORT_OPENCL_SHADOW_WALK=0;
+// the register caps counts; a bad value is named.
+TEST(OpenCLWavefrontSwitches, TheEnvironmentSetsThemAndABadValueIsNamed) {
+  if (!tracer_runs_here("opencl")) GTEST_SKIP() << "no OpenCL device here";
+  auto made = [] {
+    auto tracer = make_test_tracer("opencl");
+    auto* cl = dynamic_cast<tracers::OpenCLTracer*>(tracer.get());
+    EXPECT_NE(cl, nullptr);
+    return std::make_pair(cl && cl->wavefront(), cl && cl->shadow_walk());
+  };
+  const auto on_its_own = made();
+  EXPECT_EQ(on_its_own.first, make_test_tracer("opencl")->renders_on_gpu()) << "the wavefront on GPUs only";
+  EXPECT_TRUE(on_its_own.second);
+  ::setenv("COHORT_OPENCL_WAVEFRONT", "1", 1);
+  EXPECT_EQ(made(), std::make_pair(true, true));
+  ::setenv("COHORT_OPENCL_WAVEFRONT", "0", 1);
+  ::setenv("COHORT_OPENCL_SHADOW_WALK", "0", 1);
+  EXPECT_EQ(made(), std::make_pair(false, false));
+  ::unsetenv("COHORT_OPENCL_WAVEFRONT");
+  ::unsetenv("COHORT_OPENCL_SHADOW_WALK");
+  const std::pair<const char*, const char*> bad_values[] = {{"COHORT_OPENCL_WAVEFRONT", "no"},
+                                                            {"COHORT_OPENCL_SHADOW_WALK", "2"},
+                                                            {"COHORT_OPENCL_WALK_REGISTERS", "64k"},
+                                                            {"COHORT_OPENCL_WALK_REGISTERS", "-1"},
+                                                            {"COHORT_OPENCL_SHADE_REGISTERS", "256"}};
+  for (const auto& [variable, bad] : bad_values) {
+    ::setenv(variable, bad, 1);
+    std::string message;
+    try {
+      tracers::make_tracer(tracers::parse_tracer_list("opencl:0").front());
+    } catch (const std::invalid_argument& e) {
+      message = e.what();
+    }
+    ::unsetenv(variable);
+    EXPECT_NE(message.find(std::string(variable) + "='" + bad + "'"), std::string::npos) << bad << ": " << message;
+  }
+}
+
+}  // namespace
+
+#else
+
+TEST(OpenCLWavefront, NeedsOpenCL) { GTEST_SKIP() << "built without OpenCL (COHORT_WITH_OPENCL=OFF)"; }
+
+#endif
