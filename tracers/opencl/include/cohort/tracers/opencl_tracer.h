@@ -41,9 +41,10 @@ class OpenCLTracer : public TracerBase {
     bool shadow_walk = true;
     // On NVIDIA's OpenCL only, -cl-nv-maxrregcount for the wavefront's walk program (the CUDA walks run at
     // 64) and for the main program (the shading kernels and the megakernels); 0: no cap.
-    // COHORT_OPENCL_WALK_REGISTERS, COHORT_OPENCL_SHADE_REGISTERS.
+    // COHORT_OPENCL_WALK_REGISTERS, COHORT_OPENCL_SHADE_REGISTERS. Shading at 96: large map 1080p on an H100
+    // 8.74-8.89 ms uncapped, 8.53-8.61 at 128, 8.34-8.49 at 96 (docs/integrator.md, "The OpenCL wavefront").
     int walk_registers = 64;
-    int shade_registers = 0;
+    int shade_registers = 96;
   };
   static constexpr int kMaxFirstHitPieces = 8;
   // The pieces' first rows, relative to the band, and `rows` last: up to `pieces` ranges of whole work
