@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "cohort/core/view.h"
+#include "cohort/tracers/device_listing.h"
 #include "cohort/scene/map_loader.h"
 #include "test_scenes.h"
 #include "test_tracers.h"
@@ -36,6 +37,7 @@ struct Variant {
   bool wavefront, shadow_walk;
   int pieces;  // the first-hit pieces (Options::first_hit_pieces)
   const char* name;
+  bool lanes = true;  // Options::wave_lanes
 };
 const Variant kMegakernel{false, true, 1, "megakernel"};
 const Variant kWavefront{true, true, 4, "wavefront"};
@@ -48,6 +50,7 @@ std::unique_ptr<tracers::OpenCLTracer> opencl(const Variant& v) {
                                   : tracers::OpenCLTracer::Options::Wavefront::never;
   options.shadow_walk = v.shadow_walk;
   options.first_hit_pieces = v.pieces;
+  options.wave_lanes = v.lanes;
   return std::make_unique<tracers::OpenCLTracer>(options);
 }
 
@@ -185,6 +188,39 @@ TEST_P(OpenCLWavefront, DrawsTheMegakernelsImage) {
   params.light_samples = c.light_sampling == K_LIGHTS_EVERY ? 0u : 1u;
   const std::vector<int> cuts = c.cuts.empty() ? std::vector<int>{0, 13, h} : c.cuts;
   expect_the_megakernels_frame(kWavefront, view, params, cuts, c.name);
+}
+
+// The wavefront's two lanes (Options::wave_lanes: on a GPU device, a band of 64 rows or more split over two
+// queues) change only where kernels run: against one lane every float, aux texel and row count is the same,
+// for bands that start mid-frame and split off the middle, with and without the first-hit records.
+TEST(OpenCLWaveLanes, DrawTheImageOfOneLane) {
+  int gpu = -1;  // the first OpenCL GPU device (lanes are for GPUs only)
+  const std::vector<tracers::TracerDevice> devices = tracers::list_tracer_devices();
+  for (const tracers::TracerDevice& d : devices)
+    if (gpu < 0 && d.tracer.rfind("opencl:", 0) == 0 && d.kind == tracers::DeviceKind::gpu)
+      gpu = std::atoi(d.tracer.c_str() + 7);
+  if (gpu < 0) GTEST_SKIP() << "no OpenCL GPU device here (lanes run on GPUs only)";
+  ::setenv("COHORT_TEST_OPENCL_DEVICE", std::to_string(gpu).c_str(), 1);
+  const int w = 24, h = 150;
+  const View view = room_view(w, h);
+  for (kuint aux : {0u, kuint(K_AUX_PATH_FIRST_HIT)}) {
+    KFrameParams params = frame_params(K_MODE_PATH, 2, 2, h);
+    params.frame_index = 9;
+    params.aux_outputs = aux;
+    const Variant one_lane{true, true, 1, "one lane", false};
+    const Variant two_lanes{true, true, 1, "two lanes", true};
+    const std::vector<int> cuts = {0, 5, 85, h};  // 80 rows (lanes of 40), 65 (32 and 33)
+    Rendered one = render_bands(one_lane, view, params, cuts);
+    Rendered two = render_bands(two_lanes, view, params, cuts);
+    SCOPED_TRACE(aux ? "first-hit records" : "no aux planes");
+    EXPECT_EQ(differing_floats(one.frame, two.frame), 0u);
+    if (aux) {
+      EXPECT_EQ(std::memcmp(one.frame.aux_data(), two.frame.aux_data(), one.frame.aux_bytes()), 0) << "aux planes";
+    }
+    EXPECT_EQ(two.row_work, one.row_work);
+    EXPECT_GT(two.device_ms, 0.0) << "the join is timed";
+  }
+  ::unsetenv("COHORT_TEST_OPENCL_DEVICE");
 }
 
 INSTANTIATE_TEST_SUITE_P(

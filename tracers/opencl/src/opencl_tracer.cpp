@@ -314,10 +314,29 @@ struct OpenCLTracer::Impl {
     wavefront->prepare(band, pixels, slots, first_hit_records);
     return wavefront.get();
   }
+  // The wavefront's second lane (Options::wave_lanes; null: one lane): an in-order queue of its own.
+  cl_command_queue lane_queue = nullptr;
   // The band's rows [first_row, first_row + rows): the wavefront's kernels where `wave`, else the
-  // megakernel `kernel`, in 8x8 work groups from first_row; started / done: the first and last kernel's events.
+  // megakernel `kernel`, in 8x8 work groups from first_row; started / done: the first and last kernel's events
+  // (with lanes, `done` is the join: both lanes' kernels are before it).
   void enqueue_band_rows(cl_kernel kernel, OpenCLWavefront* wave, const KFrameParams& params, size_t width,
                          size_t first_row, size_t rows, Event* started, Event* done) {
+    if (wave && lane_queue && rows >= 64) {
+      // Two lanes of whole 8-row work groups (a lane's last group must not reach into the other's rows), the
+      // second on lane_queue behind everything queued so far, joined back before what follows the band; as
+      // the CUDA tracer's lanes: one lane's kernels fill the GPU while the other's last wave drains.
+      const size_t split = rows / 2 / 8 * 8;
+      Event forked, second_done;
+      check(clEnqueueMarkerWithWaitList(queue, 0, nullptr, forked.out()), "forking the wavefront's lanes");
+      cl_event fork = forked.get();
+      check(clEnqueueMarkerWithWaitList(lane_queue, 1, &fork, nullptr), "forking the wavefront's lanes");
+      wave->enqueue(queue, params, width, first_row, split, started ? started->out() : nullptr, nullptr);
+      wave->enqueue(lane_queue, params, width, first_row + split, rows - split, nullptr, second_done.out());
+      check(clFlush(lane_queue), "clFlush(lane)");
+      cl_event join = second_done.get();
+      check(clEnqueueMarkerWithWaitList(queue, 1, &join, done ? done->out() : nullptr), "joining the wavefront's lanes");
+      return;
+    }
     if (wave) {
       wave->enqueue(queue, params, width, first_row, rows, started ? started->out() : nullptr,
                     done ? done->out() : nullptr);
@@ -370,6 +389,7 @@ struct OpenCLTracer::Impl {
 
   ~Impl() {
     if (aux_queue) clFinish(aux_queue);
+    if (lane_queue) clFinish(lane_queue);
     wavefront.reset();
     aux_staging.reset();
     for (cl_mem m : {params, camera, previous_camera, output, row_rays, aux, packed, packed_aux, first_hits})
@@ -379,6 +399,7 @@ struct OpenCLTracer::Impl {
       if (k) clReleaseKernel(k);
     if (program) clReleaseProgram(program);
     if (aux_queue) clReleaseCommandQueue(aux_queue);
+    if (lane_queue) clReleaseCommandQueue(lane_queue);
     if (queue) clReleaseCommandQueue(queue);
     if (context) clReleaseContext(context);
   }
@@ -432,6 +453,7 @@ OpenCLTracer::OpenCLTracer(const Options& options) : impl_(std::make_unique<Impl
   check(err, "clCreateCommandQueue");
   impl_->aux_queue = clCreateCommandQueue(impl_->context, dev.device, 0, &err);
   check(err, "clCreateCommandQueue(aux)");
+
 #if defined(__GNUC__)
 #pragma GCC diagnostic pop
 #endif
@@ -449,6 +471,17 @@ OpenCLTracer::OpenCLTracer(const Options& options) : impl_(std::make_unique<Impl
   impl_->wavefront_on = options.wavefront == Options::Wavefront::always ||
                         (options.wavefront == Options::Wavefront::on_gpus && impl_->gpu);
   impl_->shadow_walk = options.shadow_walk;
+  if (options.wave_lanes && impl_->gpu) {
+#if defined(__GNUC__)
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wdeprecated-declarations"
+#endif
+    impl_->lane_queue = clCreateCommandQueue(impl_->context, dev.device, 0, &err);
+#if defined(__GNUC__)
+#pragma GCC diagnostic pop
+#endif
+    check(err, "clCreateCommandQueue(lane)");
+  }
   impl_->walk_options = with_registers(options.walk_registers);
   impl_->main_options = with_registers(options.shade_registers);
   impl_->program = build_program(impl_->context, dev.device, opencl_source::kRenderBand, impl_->main_options, dev.label);
@@ -540,11 +573,12 @@ constexpr size_t kGroupRows = 8;
 
 // Waits for both queues however the function that declares it leaves (a failed check throws): declared
 // after the host memory the queues read into, it runs before that memory goes.
+// Every queue of a band drained however it leaves (a throw included): nothing may still write its buffers.
 struct FinishQueues {
-  cl_command_queue a, b;
+  cl_command_queue a, b, c;
   ~FinishQueues() {
-    clFinish(a);
-    clFinish(b);
+    for (cl_command_queue q : {a, b, c})
+      if (q) clFinish(q);
   }
 };
 
@@ -588,7 +622,7 @@ core::BandResult OpenCLTracer::render_band(const core::BandJob& job, core::BandB
   std::vector<cl_uint> row_rays(rows);
   // The reads and writes below run from and into this function's locals without blocking: whatever way
   // it leaves, both queues are done first (the guard goes after those locals).
-  FinishQueues finish_queues{m.queue, m.aux_queue};
+  FinishQueues finish_queues{m.queue, m.aux_queue, m.lane_queue};
   const cl_uint zero = 0;
   check(clEnqueueFillBuffer(m.queue, m.row_rays, &zero, sizeof zero, 0, rows * sizeof(cl_uint), 0, nullptr, nullptr),
         "clearing the row ray counts");
@@ -674,7 +708,7 @@ core::BandResult OpenCLTracer::render_first_hits_in_pieces(const core::BandJob& 
   std::vector<cl_uint> row_rays(rows);
   Event band_started;
   std::array<Event, kMaxFirstHitPieces> piece_ready, aux_read, colour_read;
-  FinishQueues finish_queues{m.queue, m.aux_queue};
+  FinishQueues finish_queues{m.queue, m.aux_queue, m.lane_queue};
   const bool half = straight && target.format() == core::BandFormat::rgb16f;
   const size_t colour_bytes = half ? 6 : 4 * sizeof(float);
   cl_mem colour = half ? m.grow(m.packed, m.packed_bytes, pixels * 6, "clCreateBuffer(half band)") : m.output;

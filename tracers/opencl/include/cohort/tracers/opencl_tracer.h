@@ -45,6 +45,11 @@ class OpenCLTracer : public TracerBase {
     // 8.74-8.89 ms uncapped, 8.53-8.61 at 128, 8.34-8.49 at 96 (docs/integrator.md, "The OpenCL wavefront").
     int walk_registers = 64;
     int shade_registers = 96;
+    // On a GPU device, the wavefront runs a band of 64 rows or more as two lanes of rows on two queues, so one
+    // lane's kernels fill the GPU while the other's drain (CudaTracer::set_wave_lanes' two). Never on a CPU
+    // device: nothing to fill there, and the PoCL 5 of Ubuntu 24.04 aborts on the same kernels in two queues
+    // (a reference count in its kernel cache). COHORT_OPENCL_WAVE_LANES=0: one lane.
+    bool wave_lanes = true;
   };
   static constexpr int kMaxFirstHitPieces = 8;
   // The pieces' first rows, relative to the band, and `rows` last: up to `pieces` ranges of whole work
