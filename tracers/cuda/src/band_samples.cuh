@@ -6,19 +6,15 @@
 
 #include "cohort/kernel/layout.h"
 #include "cohort/kernel/path_pattern.h"
+#include "cohort/kernel/path_state.h"
 #include "cohort/kernel/vec.h"
 
 namespace cohort::tracers {
 
-// A finished path's radiance into its pixel: the mean over the frame's samples, sample by sample.
+// A finished path's radiance into its pixel (kernel/path_state.h: summed, scaled at the last sample, as the
+// megakernel and the OpenCL wavefront do).
 __device__ inline void finish_sample(float4* band, size_t p, KVec3 radiance, kuint sample, const KFrameParams& params) {
-  const float inv_spp = 1.0f / float(k_paths_per_pixel(params.spp));
-  float4 c = make_float4(radiance.x * inv_spp, radiance.y * inv_spp, radiance.z * inv_spp, 1.0f);
-  if (sample > 0u) {
-    const float4 sum = band[p];
-    c = make_float4(sum.x + c.x, sum.y + c.y, sum.z + c.z, 1.0f);
-  }
-  band[p] = c;
+  k_wave_finish_sample(reinterpret_cast<float*>(band), p, radiance, sample, &params);
 }
 
 }  // namespace cohort::tracers

@@ -68,17 +68,3 @@ KFN void k_wave_count_rays(__local uint* group_rows, __global uint* row_rays, co
   if (lx == 0u && px->y < params->row_end && group_rows[ly] != 0u) atomic_add(&row_rays[px->row], group_rows[ly]);
 }
 
-/* A finished path's radiance into its pixel. The band holds the sum of the pixel's samples so far, scaled
- * by 1 / spp when the last one is in: the megakernel's order of float operations (k_render_pixel_paths),
- * so the pixel is its value bit for bit whatever the sample count. */
-KFN void k_wave_finish_sample(__global float* band, size_t p, KVec3 radiance, kuint sample, const KFrameParams* params) {
-  kuint spp = k_paths_per_pixel(params->spp);
-  __global float* out = band + p * 4u;
-  KVec3 sum = sample > 0u ? v3(out[0], out[1], out[2]) : v3s(0.0f);
-  sum = v3_add(sum, radiance);
-  if (sample + 1u == spp) sum = v3_scale(sum, 1.0f / (float)spp);
-  out[0] = sum.x;
-  out[1] = sum.y;
-  out[2] = sum.z;
-  out[3] = 1.0f;
-}

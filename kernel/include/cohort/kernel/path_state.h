@@ -5,6 +5,7 @@
 #ifndef COHORT_KERNEL_PATH_STATE_H
 #define COHORT_KERNEL_PATH_STATE_H
 #include "layout.h"
+#include "path_pattern.h"
 #include "portable.h"
 #include "rng.h"
 #include "vec.h"
@@ -24,6 +25,21 @@ typedef struct KPathState {
  * megakernel. */
 KFN int k_wavefront_renders(const KFrameParams* params) {
   return params->mode == K_MODE_PATH && params->max_bounces > 0u;
+}
+
+/* A finished path's radiance into its pixel of a wavefront's band (RGBA floats). The band holds the sum of
+ * the pixel's samples so far, scaled by 1 / spp when the last one is in: the megakernel's order of float
+ * operations (k_render_pixel_paths), so the pixel is its value bit for bit whatever the sample count. */
+KFN void k_wave_finish_sample(KGLOBAL float* band, size_t p, KVec3 radiance, kuint sample, const KFrameParams* params) {
+  kuint spp = k_paths_per_pixel(params->spp);
+  KGLOBAL float* out = band + p * 4u;
+  KVec3 sum = sample > 0u ? v3(out[0], out[1], out[2]) : v3s(0.0f);
+  sum = v3_add(sum, radiance);
+  if (sample + 1u == spp) sum = v3_scale(sum, 1.0f / (float)spp);
+  out[0] = sum.x;
+  out[1] = sum.y;
+  out[2] = sum.z;
+  out[3] = 1.0f;
 }
 
 #if defined(__cplusplus) && !defined(__CUDACC_RTC__)
