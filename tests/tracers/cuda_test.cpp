@@ -319,18 +319,7 @@ TEST_P(CudaShadowWalk, DrawsTheImageOfShadowsWalkedInTheShadingKernels) {
   params.light_sampling = c.light_sampling;
   params.light_samples = c.light_samples;
   params.shadow_rr = c.shadow_rr;
-  scene::Scene floor = many_lights_floor(c.point_lights, c.projected_lights);
-  scene::Material panel;
-  panel.name = "panel";
-  panel.diffuse_color = glm::vec4(0.0f, 0.0f, 0.0f, 1.0f);
-  panel.emitter = true;
-  panel.emissive_color = glm::vec4(4.0f, 3.5f, 3.0f, 1.0f);
-  floor.materials.push_back(panel);
-  scene::Mesh lamp;
-  lamp.name = "_area1";
-  add_quad(lamp, int(floor.materials.size() - 1), {-60, -60, 150}, {-60, 60, 150}, {60, 60, 150}, {60, -60, 150},
-           {0, 0, -1});
-  add_world_mesh(floor, std::move(lamp));
+  scene::Scene floor = many_lights_floor_under_a_panel(c.point_lights, c.projected_lights);
   auto scene = std::make_shared<commit::TracerScene>(core::compile_scene(floor).tracer_scene);
   ASSERT_EQ(scene->emissive_triangles.size(), 2u) << "the panel's triangles are emitters to sample";
   struct Variant {

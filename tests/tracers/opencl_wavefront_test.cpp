@@ -82,18 +82,7 @@ View map_view(int w, int h) {
 
 // A floor of point and projected lights under an emissive panel (two emissive triangles), seen from above.
 View many_lights_view(int point_lights, int projected_lights, int w, int h) {
-  scene::Scene floor = many_lights_floor(point_lights, projected_lights);
-  scene::Material panel;
-  panel.name = "panel";
-  panel.diffuse_color = glm::vec4(0.0f, 0.0f, 0.0f, 1.0f);
-  panel.emitter = true;
-  panel.emissive_color = glm::vec4(4.0f, 3.5f, 3.0f, 1.0f);
-  floor.materials.push_back(panel);
-  scene::Mesh lamp;
-  lamp.name = "_area1";
-  add_quad(lamp, int(floor.materials.size() - 1), {-60, -60, 150}, {-60, 60, 150}, {60, 60, 150}, {60, -60, 150},
-           {0, 0, -1});
-  add_world_mesh(floor, std::move(lamp));
+  scene::Scene floor = many_lights_floor_under_a_panel(point_lights, projected_lights);
   return {std::make_shared<commit::TracerScene>(core::compile_scene(floor).tracer_scene),
           camera_looking_down({0, 0, 1400}, 0.7f, w, h)};
 }
