@@ -189,17 +189,19 @@ TEST(FramePost, CudaMatchesTheHostOverAMovingSequence) {
   if (tracers::device_count("cuda") == 0) GTEST_SKIP() << "no CUDA device (or a build without CUDA)";
   EXPECT_EQ(tracers::auto_frame_post_place(tracers::parse_tracer_list("embree,cuda:0")), "cuda:0");
   // No filter, the fixed guide, the variance guide over the history's moments, the variance guide alone
-  // (spatial estimate only), the variance of the mean, and that with first-hit planes' footprint taps.
-  for (int variant = 0; variant < 6; ++variant) {
+  // (spatial estimate only), the variance of the mean, that with first-hit planes' footprint taps, and the
+  // history fix before the variance-of-mean and the fixed guides' passes.
+  for (int variant = 0; variant < 8; ++variant) {
     const bool atrous = variant > 0;
     core::FramePostOptions options = both();
     options.atrous = atrous;
     options.reproject = variant != 3;
-    options.atrous_options.guide = variant == 1   ? core::AtrousGuide::fixed
+    options.atrous_options.guide = variant == 1 || variant == 7 ? core::AtrousGuide::fixed
                                    : variant >= 4 ? core::AtrousGuide::variance_of_mean
                                                   : core::AtrousGuide::variance;
     // First-hit planes: history taps of another surface in the pixel's footprint (the sliding box's edges).
     options.reprojection.jittered_planes = variant == 5;
+    if (variant >= 6) options.atrous_options.history_fix_frames = 4.0f;  // lengths 1-6 along the sequence
     core::HostFramePost host(options);
     std::unique_ptr<core::FramePost> gpu = tracers::make_frame_post("cuda:0", options);
     EXPECT_EQ(gpu->where(), "cuda:0");
