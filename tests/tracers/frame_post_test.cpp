@@ -107,9 +107,9 @@ TEST(FramePost, HostRunsReprojectionThenTheFilter) {
       make_frame(f, frame, g);
       post.process(frame, g, core::kEveryPixel);
       reprojection.accumulate(frame, g);
-      core::AtrousHistory history;
-      if (reprojection_options.luminance_moments)
-        history = {reprojection.luminance_moments().data(), reprojection.history_length().data()};
+      // The history lengths always (the history fix reads them), the moments with the variance guides.
+      core::AtrousHistory history{nullptr, reprojection.history_length().data()};
+      if (reprojection_options.luminance_moments) history.moments = reprojection.luminance_moments().data();
       filter.apply(reprojection.image(), g, filtered, history);
       ASSERT_EQ(post.image().rgba, filtered.rgba) << "frame " << f << " " << core::atrous_guide_name(guide);
       EXPECT_DOUBLE_EQ(post.mean_history_length(), reprojection.mean_history_length());
