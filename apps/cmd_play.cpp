@@ -418,6 +418,11 @@ void add_play_command(CLI::App& app, int& exit_code) {
                   "would set the frame rate); see docs/denoising.md")
       ->capture_default_str()
       ->check(CLI::IsMember({"auto", "atrous", "none"}));
+  cmd->add_option("--history-fix", a->session.history_fix,
+                  "with the a-trous filter: a pixel whose history is shorter than this many frames gets a wider "
+                  "edge-aware blur first (NRD's HistoryFix; 0: off); see `cohort render --help`")
+      ->capture_default_str()
+      ->check(CLI::Range(0.0f, 64.0f));
   cmd->add_option("--target-fps", a->target_fps,
                   "hold this frame rate by choosing spp and render scale from the measured frame time (0: off; "
                   "default: 30 when only CPU tracers render and neither --spp nor --scale is given, off with a GPU); "

@@ -70,6 +70,9 @@ struct RenderArgs {
   std::string atrous_guide = core::atrous_guide_name(core::AtrousOptions{}.guide);
   float atrous_sigma = 0.0f;  // 0: the guide's default
   float atrous_short_history = core::AtrousOptions{}.short_history;
+  float history_fix = core::AtrousOptions{}.history_fix_frames;
+  float history_fix_stride = core::AtrousOptions{}.history_fix_stride;
+  float history_fix_sigma = core::AtrousOptions{}.history_fix_sigma_scale;
   float anti_lag = -1.0f;     // < 0: ReprojectionOptions' default
   std::string post_on = "auto";
   std::string band_format = "rgb16f";
@@ -203,6 +206,9 @@ int run_render(const RenderArgs& a) {
     if (a.atrous_sigma > 0.0f)
       (core::atrous_guide_uses_variance(ao.guide) ? ao.variance_sigma : ao.color_sigma) = a.atrous_sigma;
     ao.short_history = a.atrous_short_history;
+    ao.history_fix_frames = a.history_fix;
+    ao.history_fix_stride = a.history_fix_stride;
+    ao.history_fix_sigma_scale = a.history_fix_sigma;
     post = tracers::make_frame_post(post_place, post_options);
     spdlog::info("{}{}{} on {}", reproject ? "reprojection" : "", reproject && atrous ? " and " : "",
                  atrous ? "the a-trous filter (" + std::to_string(ao.passes) + " passes, " + a.atrous_guide + " guide)"
@@ -512,6 +518,19 @@ void add_render_command(CLI::App& app, int& exit_code) {
   cmd->add_option("--atrous-short-history", a->atrous_short_history,
                   "variance guides of --denoise atrous: a history shorter than this many frames has its variance "
                   "estimated from its 7x7 neighbourhood instead of its own temporal moments (SVGF: 4; cheaper: 2)")
+      ->capture_default_str()
+      ->check(CLI::Range(0.0f, 1000.0f));
+  cmd->add_option("--history-fix", a->history_fix,
+                  "--denoise atrous after the reprojection: a pixel whose history is shorter than this many frames "
+                  "gets a wider edge-aware blur before the passes (NRD's HistoryFix; 0: off)")
+      ->capture_default_str()
+      ->check(CLI::Range(0.0f, 64.0f));
+  cmd->add_option("--history-fix-stride", a->history_fix_stride,
+                  "pixels between the history fix's taps at a one-frame history (fewer as the history grows)")
+      ->capture_default_str()
+      ->check(CLI::Range(1.0f, 32.0f));
+  cmd->add_option("--history-fix-sigma", a->history_fix_sigma,
+                  "the history fix's luminance stop as a multiple of the passes' (--atrous-sigma)")
       ->capture_default_str()
       ->check(CLI::Range(0.0f, 1000.0f));
   cmd->add_option("--anti-lag", a->anti_lag,

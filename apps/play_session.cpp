@@ -126,6 +126,7 @@ PlaySession::PlaySession(const SessionOptions& options) {
     throw std::invalid_argument("--denoise '" + options.denoise + "': choose auto, atrous or none");
   post_options.atrous = options.denoise == "atrous" || (options.denoise == "auto" && s.post_place != "host");
   post_options.atrous_options.passes = core::atrous_passes_for_height(options.window_height);
+  post_options.atrous_options.history_fix_frames = options.history_fix;
   // (Frames with sparse paths keep centre rays, on which these taps only blur silhouettes a little.)
   post_options.reprojection.jittered_planes = s.aux_mode == K_AUX_PATH_FIRST_HIT;
   s.denoising = post_options.atrous;

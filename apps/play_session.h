@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "cohort/core/atrous_filter.h"
 #include "cohort/core/frame_buffer.h"
 #include "cohort/core/frame_stats.h"
 #include "cohort/core/upsample.h"
@@ -27,6 +28,8 @@ struct SessionOptions {
   // post-processing runs on a CUDA GPU, where it costs 1-3 ms; none on the host, where it would set the
   // frame rate). Passes as `cohort render` picks them for the window's height.
   std::string denoise = "auto";
+  // Frames of history below which the a-trous filter's history fix blurs a pixel wider (0: off).
+  float history_fix = core::AtrousOptions{}.history_fix_frames;
   // Where the G-buffer comes from: "centre" (a ray of its own through each pixel's centre) or "first-hit"
   // (the first sample's own first surface: no extra ray; kernel/aux_outputs.h).
   std::string aux_rays = "auto";

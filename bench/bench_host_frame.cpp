@@ -7,7 +7,8 @@
 // result with the passes `--denoise atrous` picks for the height: with the fixed luminance stop, and
 // with the variance guide (core/atrous_filter.h) over a reprojection that keeps the luminance moments
 // (its own "reproject+moments" column): from the history's temporal variance (every pixel's history is
-// long after 4 frames) and, the worst case of a frame with no history, from the 7x7 spatial estimate.
+// long after 4 frames) and, the worst case of a frame with no history, from the 7x7 spatial estimate,
+// without and with the history fix (every pixel's history one frame long: every pixel is fixed).
 //
 //   bench_host_frame [--width 1920] [--height 1080] [--frames 40] [--json FILE]   (out/bench_host_frame.json)
 //                    [--anti-lag SIGMA]   (the reprojection's; 0 turns it off, default ReprojectionOptions')
@@ -74,7 +75,12 @@ nlohmann::json run(BandFormat format, int width, int height, int frames) {
   fixed_options.passes = variance_options.passes = atrous_passes_for_height(height);
   fixed_options.guide = AtrousGuide::fixed;
   variance_options.guide = AtrousGuide::variance_of_mean;  // the default; SVGF's "variance" costs the same
-  AtrousFilter atrous(fixed_options), guided(variance_options);
+  AtrousOptions fix_options = variance_options, no_fix_options = variance_options;
+  no_fix_options.history_fix_frames = 0.0f;
+  if (fix_options.history_fix_frames <= 0.0f) fix_options.history_fix_frames = 6.0f;
+  AtrousFilter atrous(fixed_options), guided(variance_options), guided_no_fix(no_fix_options), guided_fix(fix_options);
+  // The history fix's worst case: every pixel's history one frame long, so every pixel is fixed.
+  const std::vector<float> one_frame(static_cast<size_t>(width) * static_cast<size_t>(height), 1.0f);
   FrameBuffer filtered;
   GBuffer moving;
   moving.resize(width, height);
@@ -85,7 +91,7 @@ nlohmann::json run(BandFormat format, int width, int height, int frames) {
     moving.motion[2 * p] = 0.3f;
     for (int k = 0; k < 3; ++k) moving.albedo[3 * p + k] = 0.5f;
   }
-  std::vector<double> merge, blend, tone, reproject, denoise, reproject_moments, guided_ms, spatial_ms;
+  std::vector<double> merge, blend, tone, reproject, denoise, reproject_moments, guided_ms, spatial_ms, fix_ms;
   auto finish = [&](FramePipeline::Delivered done) {
     if (jittered_edges > 0)
       for (int y = 0; y < height; ++y)
@@ -113,8 +119,11 @@ nlohmann::json run(BandFormat format, int width, int height, int frames) {
                                reprojection_with_moments.history_length().data()});
     guiding.finish();
     ScopedStage spatial(done.stats.stages, kCoreTrack, "atrous variance spatial");
-    guided.apply(reprojection_with_moments.image(), moving, filtered);
+    guided_no_fix.apply(reprojection_with_moments.image(), moving, filtered, AtrousHistory{nullptr, one_frame.data()});
     spatial.finish();
+    ScopedStage fixing(done.stats.stages, kCoreTrack, "atrous variance spatial+fix");
+    guided_fix.apply(reprojection_with_moments.image(), moving, filtered, AtrousHistory{nullptr, one_frame.data()});
+    fixing.finish();
     ScopedStage mapping(done.stats.stages, kCoreTrack, "tone map");
     const std::vector<uint8_t> display = tone_map(convergence.image(), tone_options);
     mapping.finish();
@@ -127,6 +136,7 @@ nlohmann::json run(BandFormat format, int width, int height, int frames) {
     reproject_moments.push_back(stage_ms(done.stats, "reproject+moments"));
     guided_ms.push_back(stage_ms(done.stats, "atrous variance"));
     spatial_ms.push_back(stage_ms(done.stats, "atrous variance spatial"));
+    fix_ms.push_back(stage_ms(done.stats, "atrous variance spatial+fix"));
   };
   for (int f = 0; f < frames; ++f) {
     BandJob job;
@@ -140,7 +150,8 @@ nlohmann::json run(BandFormat format, int width, int height, int frames) {
           {"merge_ms", m}, {"convergence_ms", c}, {"tone_map_ms", t}, {"host_ms", m + c + t},
           {"reproject_ms", median(reproject)}, {"atrous_passes", atrous_passes_for_height(height)},
           {"atrous_ms", median(denoise)}, {"reproject_moments_ms", median(reproject_moments)},
-          {"atrous_variance_ms", median(guided_ms)}, {"atrous_variance_spatial_ms", median(spatial_ms)}};
+          {"atrous_variance_ms", median(guided_ms)}, {"atrous_variance_spatial_ms", median(spatial_ms)},
+          {"atrous_variance_spatial_history_fix_ms", median(fix_ms)}};
 }
 
 }  // namespace
@@ -163,17 +174,18 @@ int main(int argc, char** argv) {
   }
   std::printf("host work per frame at %dx%d, %u host threads, median of %d frames\n", width, height,
               HostThreads::shared().threads(), frames - 5);
-  std::printf("%-8s %10s %10s %14s %12s %10s %13s %10s %15s %13s %13s\n", "band", "bytes/px", "merge ms",
+  std::printf("%-8s %10s %10s %14s %12s %10s %13s %10s %15s %13s %13s %13s\n", "band", "bytes/px", "merge ms",
               "convergence ms", "tone map ms", "host ms", "reproject ms", "atrous ms", "+moments ms", "variance ms",
-              "spatial ms");
+              "spatial ms", "+fix ms");
   nlohmann::json results = nlohmann::json::array();
   for (BandFormat format : {BandFormat::rgba32f, BandFormat::rgb16f}) {
     const nlohmann::json r = run(format, width, height, frames);
-    std::printf("%-8s %10zu %10.2f %14.2f %12.2f %10.2f %13.2f %10.2f %15.2f %13.2f %13.2f\n", to_string(format),
+    std::printf("%-8s %10zu %10.2f %14.2f %12.2f %10.2f %13.2f %10.2f %15.2f %13.2f %13.2f %13.2f\n", to_string(format),
                 bytes_per_pixel(format), r["merge_ms"].get<double>(), r["convergence_ms"].get<double>(),
                 r["tone_map_ms"].get<double>(), r["host_ms"].get<double>(), r["reproject_ms"].get<double>(),
                 r["atrous_ms"].get<double>(), r["reproject_moments_ms"].get<double>(),
-                r["atrous_variance_ms"].get<double>(), r["atrous_variance_spatial_ms"].get<double>());
+                r["atrous_variance_ms"].get<double>(), r["atrous_variance_spatial_ms"].get<double>(),
+                r["atrous_variance_spatial_history_fix_ms"].get<double>());
     results.push_back(r);
   }
   const std::filesystem::path path(json_path);

@@ -38,6 +38,19 @@ const char* atrous_guide_name(AtrousGuide guide) {
 
 bool atrous_guide_uses_variance(AtrousGuide guide) { return guide != AtrousGuide::fixed; }
 
+KHistoryFixParams history_fix_params(const AtrousOptions& options, int width, int height, bool guided) {
+  KHistoryFixParams p{};
+  p.width = width;
+  p.height = height;
+  p.normal_squarings = atrous_normal_squarings(options.normal_power);
+  p.guided = guided ? 1 : 0;
+  p.frames = options.history_fix_frames;
+  p.stride = std::max(options.history_fix_stride, 1.0f);
+  p.depth_sigma = options.depth_sigma;
+  p.color_sigma = (guided ? options.variance_sigma : options.color_sigma) * options.history_fix_sigma_scale;
+  return p;
+}
+
 int atrous_passes_for_height(int height) {
   int passes = 1;
   for (int rows = 360; rows < height && passes < 5; rows *= 2) ++passes;
@@ -96,6 +109,14 @@ void AtrousFilter::apply(const FrameBuffer& frame, const GBuffer& gbuffer, Frame
   }
   FrameBuffer* from = &ping_;
   FrameBuffer* to = &pong_;
+  if (options_.history_fix_frames > 0.0f && history.length) {
+    const KHistoryFixParams fix = history_fix_params(options_, width, height, variance);
+    rows([&](int x, int y) {
+      k_svgf_history_fix_pixel(from->rgba.data(), to->rgba.data(), geometry_.data(), gbuffer.id.data(), history.length,
+                               &fix, x, y);
+    });
+    std::swap(from, to);
+  }
   for (int pass = 0; pass < std::max(options_.passes, 0); ++pass) {
     params.step = 1 << pass;
     if (variance)

@@ -50,10 +50,8 @@ void HostFramePost::process(const FrameBuffer& fresh, const GBuffer& gbuffer, co
   }
   if (options_.atrous) {
     AtrousHistory history;
-    if (options_.reprojection.luminance_moments) {
-      history.moments = reprojection_.luminance_moments().data();
-      history.length = reprojection_.history_length().data();
-    }
+    if (options_.reproject) history.length = reprojection_.history_length().data();
+    if (options_.reprojection.luminance_moments) history.moments = reprojection_.luminance_moments().data();
     atrous_.apply(*current, gbuffer, filtered_, history);
     current = &filtered_;
   }

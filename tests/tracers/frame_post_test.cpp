@@ -107,9 +107,9 @@ TEST(FramePost, HostRunsReprojectionThenTheFilter) {
       make_frame(f, frame, g);
       post.process(frame, g, core::kEveryPixel);
       reprojection.accumulate(frame, g);
-      core::AtrousHistory history;
-      if (reprojection_options.luminance_moments)
-        history = {reprojection.luminance_moments().data(), reprojection.history_length().data()};
+      // The history lengths always (the history fix reads them), the moments with the variance guides.
+      core::AtrousHistory history{nullptr, reprojection.history_length().data()};
+      if (reprojection_options.luminance_moments) history.moments = reprojection.luminance_moments().data();
       filter.apply(reprojection.image(), g, filtered, history);
       ASSERT_EQ(post.image().rgba, filtered.rgba) << "frame " << f << " " << core::atrous_guide_name(guide);
       EXPECT_DOUBLE_EQ(post.mean_history_length(), reprojection.mean_history_length());
@@ -189,17 +189,19 @@ TEST(FramePost, CudaMatchesTheHostOverAMovingSequence) {
   if (tracers::device_count("cuda") == 0) GTEST_SKIP() << "no CUDA device (or a build without CUDA)";
   EXPECT_EQ(tracers::auto_frame_post_place(tracers::parse_tracer_list("embree,cuda:0")), "cuda:0");
   // No filter, the fixed guide, the variance guide over the history's moments, the variance guide alone
-  // (spatial estimate only), the variance of the mean, and that with first-hit planes' footprint taps.
-  for (int variant = 0; variant < 6; ++variant) {
+  // (spatial estimate only), the variance of the mean, that with first-hit planes' footprint taps, and the
+  // history fix before the variance-of-mean and the fixed guides' passes.
+  for (int variant = 0; variant < 8; ++variant) {
     const bool atrous = variant > 0;
     core::FramePostOptions options = both();
     options.atrous = atrous;
     options.reproject = variant != 3;
-    options.atrous_options.guide = variant == 1   ? core::AtrousGuide::fixed
+    options.atrous_options.guide = variant == 1 || variant == 7 ? core::AtrousGuide::fixed
                                    : variant >= 4 ? core::AtrousGuide::variance_of_mean
                                                   : core::AtrousGuide::variance;
     // First-hit planes: history taps of another surface in the pixel's footprint (the sliding box's edges).
     options.reprojection.jittered_planes = variant == 5;
+    if (variant >= 6) options.atrous_options.history_fix_frames = 4.0f;  // lengths 1-6 along the sequence
     core::HostFramePost host(options);
     std::unique_ptr<core::FramePost> gpu = tracers::make_frame_post("cuda:0", options);
     EXPECT_EQ(gpu->where(), "cuda:0");

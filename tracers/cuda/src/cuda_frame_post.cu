@@ -120,6 +120,12 @@ __global__ void svgf_variance_kernel(float* illumination, const float* moments, 
         k_svgf_variance_estimate(illumination, moments, length, geometry, &params, x, y);
 }
 
+__global__ void history_fix_kernel(const float* in, float* out, const float* geometry, const kuint* id,
+                                   const float* length, KHistoryFixParams params) {
+  const int x = blockIdx.x * blockDim.x + threadIdx.x, y = blockIdx.y * blockDim.y + threadIdx.y;
+  if (x < params.width && y < params.height) k_svgf_history_fix_pixel(in, out, geometry, id, length, &params, x, y);
+}
+
 // With `modulated` (the last pass), the filtered pixel is also multiplied by its albedo into the shown image.
 __global__ void svgf_atrous_kernel(const float* in, float* out, const float* geometry, KAtrousParams params,
                                    const float* albedo, float* modulated) {
@@ -336,6 +342,12 @@ class CudaFramePost final : public core::FramePost {
         svgf_variance_kernel<<<tile_grid(width, height), kTile, 0, stream_>>>(
             ping, options_.reproject ? history.moments.data() : nullptr,
             options_.reproject ? history.length.data() : nullptr, geometry, v);
+      }
+      if (options_.reproject && ao.history_fix_frames > 0.0f) {
+        const KHistoryFixParams fix = core::history_fix_params(ao, width, height, variance);
+        history_fix_kernel<<<tile_grid(width, height), kTile, 0, stream_>>>(
+            ping, pong, geometry, id_.data(), state_[parity_].length.data(), fix);
+        std::swap(ping, pong);
       }
       float* shown = shown_device_.scratch(4 * pixels);
       const int passes = std::max(ao.passes, 0);

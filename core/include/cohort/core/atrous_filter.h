@@ -17,6 +17,8 @@
 #include "cohort/core/frame_buffer.h"
 #include "cohort/core/gbuffer.h"
 
+struct KHistoryFixParams;  // kernel/svgf.h
+
 namespace cohort::core {
 
 // variance: SVGF's, the luminance variance of one frame's sample; variance_of_mean: that over the history
@@ -35,6 +37,15 @@ struct AtrousOptions {
   // the 1080p post 0.1 ms cheaper (the 7x7 estimate was most of a frame's pixels, whose history averages
   // ~4 frames) for 1.5 % more mean FLIP at 720p (docs/denoising.md).
   float short_history = 2.0f;
+  // History fix (kernel/svgf.h's k_svgf_history_fix_pixel, NRD's HistoryFix): before the passes, a pixel whose
+  // reprojected history is shorter than this many frames gets an extra edge-aware blur, taps
+  // `history_fix_stride` pixels apart at a one-frame history and closer as it grows; 0: off. Needs the history
+  // (AtrousHistory::length). 6 frames, stride 1, 4x the passes' sigma: measured best on the test map's
+  // scenario at 320x180 (door 4 frames after it stops 0.118 -> 0.099, mean FLIP 0.1176 -> 0.1155; wider
+  // strides were worse there; docs/denoising.md).
+  float history_fix_frames = 6.0f;
+  float history_fix_stride = 1.0f;
+  float history_fix_sigma_scale = 4.0f;  // the fix's luminance stop: the passes' sigma times this
 };
 
 // "variance", "variance-of-mean" or "fixed" (std::invalid_argument otherwise, naming the word).
@@ -43,8 +54,9 @@ const char* atrous_guide_name(AtrousGuide guide);
 // Whether the guide reads a variance (and the history's luminance moments when reprojecting).
 bool atrous_guide_uses_variance(AtrousGuide guide);
 
-// The reprojected history the variance guide reads (TemporalReprojection with luminance moments, two
-// floats a pixel, and its history lengths); null: no history, the variance is estimated spatially.
+// The reprojected history: the variance guide reads its luminance moments (TemporalReprojection with
+// luminance moments, two floats a pixel) and lengths, the history fix its lengths; null moments: the
+// variance is estimated spatially; null length: no history (and no history fix).
 struct AtrousHistory {
   const float* moments = nullptr;
   const float* length = nullptr;
@@ -54,6 +66,9 @@ struct AtrousHistory {
 // per doubling (3 at 1080). Measured on the test map at 192x108 (docs/denoising.md): more passes than
 // that blur lighting detail that FLIP sees, and reprojected frames need little spatial help.
 int atrous_passes_for_height(int height);
+
+// The history fix's parameters for a frame of this size (guided: the variance guide's planes, variance in alpha).
+KHistoryFixParams history_fix_params(const AtrousOptions& options, int width, int height, bool guided);
 
 // log2 of the normal stop's power, which must be a power of two (std::invalid_argument otherwise).
 int atrous_normal_squarings(int power);

@@ -15,6 +15,18 @@
  *                          with the colour (weights squared: the variance of the weighted mean), so later
  *                          passes see the noise that is left.
  *
+ *   k_svgf_history_fix_pixel  before the passes (ReLAX's and ReBLUR's HistoryFix, NVIDIA NRD): a pixel
+ *                          whose history is shorter than `frames` gets a wider blur of its illumination, a
+ *                          5x5 B3 spline whose taps lie `stride` pixels apart at a one-frame history and
+ *                          fewer as the history grows, with the a-trous filter's normal stop, its depth
+ *                          stop relative to the nearer depth (symmetric, and per pixel of distance), an
+ *                          id stop (another entity is another surface) and a loose luminance stop (the
+ *                          passes' times a scale: it keeps a lamp's light off the wall around it, while a
+ *                          short history's noise passes); the variance in alpha follows the colour, weights
+ *                          squared, so the passes see the noise the blur left. Taps are not weighted by
+ *                          their own history length (inverse variance): that pulled stale light from long
+ *                          histories into pixels the anti-lag had just shortened (docs/denoising.md).
+ *
  * Planes: illumination RGBA floats (the passes keep the variance in alpha), moments two floats a pixel,
  * history length one; normal and depth packed (k_atrous_pack_geometry) for the estimate and the passes:
  * one 16-byte load a tap, where the 7x7 estimate's four loads a tap set its cost on GPUs. */
@@ -99,6 +111,92 @@ KFN void k_svgf_variance_pixel(KGLOBAL const float* illumination, KGLOBAL const 
                                KGLOBAL const float* length, KGLOBAL const float* geometry, KGLOBAL float* variance,
                                const KSvgfVarianceParams* p, kint x, kint y) {
   variance[y * p->width + x] = k_svgf_variance_estimate(illumination, moments, length, geometry, p, x, y);
+}
+
+typedef struct KHistoryFixParams {
+  kint width; kint height; kint normal_squarings;
+  kint guided;          /* 1: alpha carries the variance (kernel/atrous.h's guided passes); 0: alpha is 1 */
+  float frames;         /* a history shorter than this many frames is fixed; 0: off */
+  float stride;         /* pixels between taps at a one-frame history */
+  float depth_sigma;    /* relative depth difference per pixel of tap distance (the a-trous filter's) */
+  float color_sigma;    /* the luminance stop: standard deviations guided, relative difference unguided */
+} KHistoryFixParams;
+
+/* The taps' spacing for a history of `length` frames: `stride` at one frame, down to 1 pixel just short of
+ * `frames`; 0 where the pixel is left alone (history long enough, or none at all: no reprojection, or
+ * non-finite samples that never entered it). */
+KFN kint k_svgf_history_fix_stride(const KHistoryFixParams* p, float length) {
+  if (!(length > 0.0f) || !(length < p->frames)) return 0;
+  float shortness = p->frames > 1.0f ? (p->frames - k_fmax(length, 1.0f)) / (p->frames - 1.0f) : 1.0f;
+  kint stride = (kint)(1.0f + (p->stride - 1.0f) * shortness + 0.5f);
+  return stride < 1 ? 1 : stride;
+}
+
+/* One pixel from `in` into `out` (both RGBA illumination; unchanged pixels are copied). */
+KFN void k_svgf_history_fix_pixel(KGLOBAL const float* in_rgba, KGLOBAL float* out_rgba, KGLOBAL const float* geometry,
+                                  KGLOBAL const kuint* id, KGLOBAL const float* length, const KHistoryFixParams* p,
+                                  kint x, kint y) {
+  const float spline[3] = {0.375f, 0.25f, 0.0625f};
+  kint centre = y * p->width + x;
+  KFloat4 c = k_load4(in_rgba + 4 * centre);
+  KGLOBAL float* out = out_rgba + 4 * centre;
+  kint stride = k_svgf_history_fix_stride(p, length[centre]);
+  if (stride == 0 || !k_finite3(c.x, c.y, c.z)) {
+    out[0] = c.x, out[1] = c.y, out[2] = c.z, out[3] = c.w;
+    return;
+  }
+  KFloat4 gp = k_load4(geometry + 4 * centre);
+  float zp = gp.w;
+  KVec3 np = v3(gp.x, gp.y, gp.z);
+  kuint idp = id[centre];
+  float lp = k_luminance3(c.x, c.y, c.z);
+  float inv_luminance_scale = p->guided ? 1.0f / (p->color_sigma * k_sqrt(k_fmax(c.w, 0.0f)) + K_SVGF_LUMINANCE_EPSILON)
+                                        : 0.0f;
+  float sum[3] = {0.0f, 0.0f, 0.0f};
+  float weight_sum = 0.0f, variance_sum = 0.0f;
+  for (kint dy = -2; dy <= 2; ++dy) {
+    kint qy = y + dy * stride;
+    if (qy < 0 || qy >= p->height) continue;
+    for (kint dx = -2; dx <= 2; ++dx) {
+      kint qx = x + dx * stride;
+      if (qx < 0 || qx >= p->width) continue;
+      kint q = qy * p->width + qx;
+      KFloat4 cq = k_load4(in_rgba + 4 * q);
+      if (!k_finite3(cq.x, cq.y, cq.z)) continue;
+      float w = spline[dx < 0 ? -dx : dx] * spline[dy < 0 ? -dy : dy];
+      if (q != centre) {
+        if (id[q] != idp || !(length[q] > 0.0f)) continue;
+        float exponent = 0.0f; /* |zp - zq| */
+        KFloat4 gq = k_load4(geometry + 4 * q);
+        float stop = k_atrous_geometry_stop(zp, np, gq.w, v3(gq.x, gq.y, gq.z), 1.0f, p->normal_squarings, &exponent);
+        if (!(stop > 0.0f)) continue;
+        /* Relative to the nearer of the two depths, per pixel of (Chebyshev) distance: the wide taps reach
+         * across silhouettes, and a far pixel must not take a near surface's light any more than the
+         * other way round. */
+        if (zp > 0.0f) {
+          kint ax = dx < 0 ? -dx : dx, ay = dy < 0 ? -dy : dy;
+          float distance = (float)((ax > ay ? ax : ay) * stride);
+          exponent /= p->depth_sigma * k_fmin(zp, gq.w) * distance + 1e-6f;
+        }
+        float lq = k_luminance3(cq.x, cq.y, cq.z);
+        exponent += p->guided ? k_fabs(lp - lq) * inv_luminance_scale
+                              : k_fabs(lp - lq) / (p->color_sigma * 0.5f * (k_fabs(lp) + k_fabs(lq)) + 1e-4f);
+        if (exponent > 12.0f) continue;
+        w *= stop * k_exp(-exponent);
+      }
+      if (!(w > 0.0f)) continue;
+      sum[0] += w * cq.x;
+      sum[1] += w * cq.y;
+      sum[2] += w * cq.z;
+      weight_sum += w;
+      if (p->guided) variance_sum += w * w * cq.w;
+    }
+  }
+  float inv = 1.0f / weight_sum; /* the centre always counts */
+  out[0] = sum[0] * inv;
+  out[1] = sum[1] * inv;
+  out[2] = sum[2] * inv;
+  out[3] = p->guided ? variance_sum * inv * inv : c.w;
 }
 
 /* The pixel's variance (the alpha of the passes' RGBA planes) seen through a 3x3 Gaussian (1/4 centre, 1/8
