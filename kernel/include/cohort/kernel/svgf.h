@@ -18,7 +18,7 @@
  *   k_svgf_history_fix_pixel  before the passes (ReLAX's and ReBLUR's HistoryFix, NVIDIA NRD): a pixel
  *                          whose history is shorter than `frames` gets a wider blur of its illumination, a
  *                          5x5 B3 spline whose taps lie `stride` pixels apart at a one-frame history and
- *                          fewer as the history grows, with the a-trous filter's normal stop, its depth
+ *                          closer together as the history grows, with the a-trous filter's normal stop, its depth
  *                          stop relative to the nearer depth (symmetric, and per pixel of distance), an
  *                          id stop (another entity is another surface) and a loose luminance stop (the
  *                          passes' times a scale: it keeps a lamp's light off the wall around it, while a
@@ -150,6 +150,7 @@ KFN void k_svgf_history_fix_pixel(KGLOBAL const float* in_rgba, KGLOBAL float* o
   KVec3 np = v3(gp.x, gp.y, gp.z);
   kuint idp = id[centre];
   float lp = k_luminance3(c.x, c.y, c.z);
+  /* The pixel's own variance, not the passes' 3x3 blur of it: the fix's stop is loose anyway. */
   float inv_luminance_scale = p->guided ? 1.0f / (p->color_sigma * k_sqrt(k_fmax(c.w, 0.0f)) + K_SVGF_LUMINANCE_EPSILON)
                                         : 0.0f;
   float sum[3] = {0.0f, 0.0f, 0.0f};
