@@ -40,11 +40,12 @@ struct AtrousOptions {
   // History fix (kernel/svgf.h's k_svgf_history_fix_pixel, NRD's HistoryFix): before the passes, a pixel whose
   // reprojected history is shorter than this many frames gets an extra edge-aware blur, taps
   // `history_fix_stride` pixels apart at a one-frame history and closer as it grows; 0: off. Needs the history
-  // (AtrousHistory::length). 6 frames, stride 1, 4x the passes' sigma: measured best on the test map's
-  // scenario at 320x180 (door 4 frames after it stops 0.118 -> 0.099, mean FLIP 0.1176 -> 0.1155; wider
-  // strides were worse there). At 640x360: door 0.115 -> 0.111, mean FLIP -3 %; stride 3 reaches 0.0999 on
-  // the still door but blurs the moving one (docs/denoising.md).
-  float history_fix_frames = 6.0f;
+  // (AtrousHistory::length). Off by default. `--history-fix 6` (stride 1, 4x the passes' sigma) was best on
+  // the test map's scenario at 320x180 (door 4 frames after it stops 0.118 -> 0.099, mean FLIP 0.1176 ->
+  // 0.1155); at 640x360 it leaves the door at 0.111 (mean FLIP -3 %), and it costs 0.33-0.35 ms of a 1080p
+  // frame on an H100 (issue 17's budget is 1.5 ms) and about half again of the host's filter where histories
+  // are short. Not yet measured against 1,024-spp references at 720p (docs/denoising.md).
+  float history_fix_frames = 0.0f;
   float history_fix_stride = 1.0f;
   float history_fix_sigma_scale = 4.0f;  // the fix's luminance stop: the passes' sigma times this
 };
