@@ -217,7 +217,7 @@ int run_render(const RenderArgs& a) {
   }
   // A GPU post-processing reprojection takes the bands as the tracers packed them: half the bytes cross
   // the bus and the host skips its conversions (the float frame and G-buffer are not made). A reprojecting
-  // post also reconstructs sparse frames, where it runs; Brigade's blend takes them reconstructed on the host.
+  // post also reconstructs sparse frames, where it runs.
   const bool packed = post && reproject && post->where() != "host" && a.denoise != "oidn" &&
                       a.denoise != "oidn-cuda" && !a.write_ids;
   // Sparse frames are filled where the post runs: inside the reprojecting post, or for Brigade's blend (which
