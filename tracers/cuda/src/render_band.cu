@@ -12,6 +12,7 @@ __constant__ cudaTextureObject_t cohort_texel_texture;
 #include "cohort/kernel/trace_bvh.h"
 #include "cohort/kernel/integrator.h"
 #include "cohort/kernel/aux_outputs.h"
+#include "cohort/tracers/wave_lanes.h"
 #include "band_samples.cuh"
 #include "ray_counting.cuh"
 #include "render_band_launch.h"
@@ -243,16 +244,14 @@ void launch_render_band(const KSceneView& scene, const KFrameParams& params, con
     // from its first pixel on (shadow slots keep the whole band's stride, so lanes never share one).
     WavefrontScratch whole = *wave;
     whole.shadow_stride = camera.width * rows;
-    const int lanes = wave_lane_count(wave->lanes, rows);
+    const int lanes = wave->lanes ? wave_lane_count(wave->lanes->count, rows) : 1;
     if (lanes > 1) {
       COHORT_CUDA(cudaEventRecord(wave->lanes->forked, stream));
       for (int lane = 1; lane < lanes; ++lane)
         COHORT_CUDA(cudaStreamWaitEvent(wave->lanes->streams[lane], wave->lanes->forked, 0));
     }
     for (int lane = 0; lane < lanes; ++lane) {
-      // Lanes of whole 8-row blocks, the last one taking the rest.
-      const kuint first = (rows * kuint(lane) / kuint(lanes)) / 8u * 8u;
-      const kuint last = lane + 1 == lanes ? rows : (rows * kuint(lane + 1) / kuint(lanes)) / 8u * 8u;
+      const kuint first = wave_lane_first_row(rows, lanes, lane), last = wave_lane_first_row(rows, lanes, lane + 1);
       KFrameParams lane_params = params;
       lane_params.row_begin = params.row_begin + first;
       lane_params.row_end = params.row_begin + last;

@@ -25,12 +25,6 @@ struct WaveLanes {
   cudaEvent_t forked = nullptr;
   cudaEvent_t joined[kMaxWaveLanes] = {};
 };
-// The lanes a band of `rows` runs in: at most lanes->count, each at least 32 rows.
-inline int wave_lane_count(const WaveLanes* lanes, unsigned rows) {
-  if (!lanes) return 1;
-  const int most = static_cast<int>(rows / 32u);
-  return lanes->count < most ? lanes->count : (most > 1 ? most : 1);
-}
 
 // The bounce rays' wavefront (render_band.cu): where paths wait between its kernels. Device pointers, each
 // for at least the band's pixels (shadow_rays: shadow_slots times that).

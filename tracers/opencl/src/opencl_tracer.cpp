@@ -16,6 +16,7 @@
 #include "cohort/kernel/aux_mode.h"
 #include "cohort/kernel/path_state.h"
 #include "cohort/kernel/shadow_ray.h"
+#include "cohort/tracers/wave_lanes.h"
 #include "opencl_support.h"
 #include "opencl_wavefront.h"
 
@@ -321,11 +322,10 @@ struct OpenCLTracer::Impl {
   // (with lanes, `done` is the join: both lanes' kernels are before it).
   void enqueue_band_rows(cl_kernel kernel, OpenCLWavefront* wave, const KFrameParams& params, size_t width,
                          size_t first_row, size_t rows, Event* started, Event* done) {
-    if (wave && lane_queue && rows >= 64) {
-      // Two lanes of whole 8-row work groups (a lane's last group must not reach into the other's rows), the
-      // second on lane_queue behind everything queued so far, joined back before what follows the band; as
-      // the CUDA tracer's lanes: one lane's kernels fill the GPU while the other's last wave drains.
-      const size_t split = rows / 2 / 8 * 8;
+    if (wave && lane_queue && wave_lane_count(2, static_cast<unsigned>(rows)) == 2) {
+      // Two lanes (cohort/tracers/wave_lanes.h, the CUDA tracer's rule), the second on lane_queue behind
+      // everything queued so far, joined back before what follows the band.
+      const size_t split = wave_lane_first_row(static_cast<unsigned>(rows), 2, 1);
       Event forked, second_done;
       check(clEnqueueMarkerWithWaitList(queue, 0, nullptr, forked.out()), "forking the wavefront's lanes");
       cl_event fork = forked.get();
