@@ -276,12 +276,8 @@ int run_render(const RenderArgs& a) {
       else post->process(reproject ? frame : *shown_image, gbuffer, reproject ? traced : core::kEveryPixel);
       // On a GPU its own clock tells the bus from the passes (a track of its own in the timeline).
       if (const core::FramePostDeviceTimes t = post->device_times(); t.measured) {
-        const std::string track = "post on " + post->where();
-        const double download_at = core::timeline_now_ms() - t.download_ms;  // back to back, ending now
-        const double passes_at = download_at - t.passes_ms;
-        stats.stages.push_back({track, "upload", passes_at - t.upload_ms, t.upload_ms});
-        stats.stages.push_back({track, "passes", passes_at, t.passes_ms});
-        stats.stages.push_back({track, "download", download_at, t.download_ms});
+        core::append_spans_ending_at(stats.stages, "post on " + post->where(), core::timeline_now_ms(),
+                                     {{"upload", t.upload_ms}, {"passes", t.passes_ms}, {"download", t.download_ms}});
       }
       if (reproject) stats.convergence_f = 1.0 / std::max(post->mean_history_length(), 1.0);
     }

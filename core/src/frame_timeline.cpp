@@ -1,5 +1,7 @@
 #include "cohort/core/frame_timeline.h"
 
+#include <algorithm>
+
 #include <stdexcept>
 
 #include <nlohmann/json.hpp>
@@ -17,6 +19,15 @@ std::string tracer_track(int tracer_id, const std::string& tracer_name) {
 
 void to_json(nlohmann::json& j, const StageSpan& s) {
   j = nlohmann::json{{"track", s.track}, {"stage", s.stage}, {"start_ms", s.start_ms}, {"ms", s.ms}};
+}
+
+void append_spans_ending_at(std::vector<StageSpan>& spans, const std::string& track, double end_ms,
+                            const std::vector<ClockedStage>& stages, double not_before_ms) {
+  std::vector<double> starts(stages.size());
+  double at = end_ms;
+  for (size_t i = stages.size(); i-- > 0;) starts[i] = at = std::max(not_before_ms, at - stages[i].ms);
+  for (size_t i = 0; i < stages.size(); ++i)
+    spans.push_back({track, stages[i].stage, starts[i], (i + 1 < stages.size() ? starts[i + 1] : end_ms) - starts[i]});
 }
 
 ScopedStage::ScopedStage(std::vector<StageSpan>& spans, std::string track, std::string stage)

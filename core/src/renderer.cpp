@@ -135,7 +135,12 @@ struct Renderer::Worker {
           end_ahead(job_spans);
           wall = std::chrono::duration<double, std::milli>(Clock::now() - start).count();
           rendering.finish();
-          if (result.transfer_ms > 0.0) add_device_spans(job_spans, track, result);
+          if (result.transfer_ms > 0.0) {
+            // The tracer's own clock inside its render span: kernels then transfer, ending with the span.
+            const StageSpan render = job_spans.back();
+            append_spans_ending_at(job_spans, track, render.start_ms + render.ms,
+                                   {{"kernels", result.device_ms}, {"transfer", result.transfer_ms}}, render.start_ms);
+          }
           reported = result.device_ms;
           balance = result.balance_ms;
           if (result.row_work.size() == current.params.row_end - current.params.row_begin) work = result.row_work;
@@ -165,17 +170,6 @@ struct Renderer::Worker {
       }
       completion->cv.notify_all();
     }
-  }
-
-  // The tracer's own clock inside its render span: kernels then transfer, back to back and ending with the
-  // span (the device's clock cannot be placed on the host's, so where the span ends is the best guess).
-  static void add_device_spans(std::vector<StageSpan>& spans, const std::string& track, const BandResult& result) {
-    const StageSpan& render = spans.back();
-    const double end = render.start_ms + render.ms;
-    const double transfer_at = end - std::min(result.transfer_ms, render.ms);
-    const double kernels_at = std::max(render.start_ms, transfer_at - result.device_ms);
-    spans.push_back({track, "kernels", kernels_at, transfer_at - kernels_at});
-    spans.push_back({track, "transfer", transfer_at, end - transfer_at});
   }
 
   // Tracer::apply_commits_ahead, on this worker's thread inside render_band: what the core published

@@ -171,3 +171,21 @@ TEST(FrameTimeline, AGpusOwnClockShowsItsKernelsAndTransferAtTheEndOfItsRender) 
   EXPECT_NEAR(kernels->start_ms + kernels->ms, transfer->start_ms, 1e-9) << "the kernels end where it begins";
   EXPECT_EQ(find(stats.stages, tracer_track(1, "sim1"), "kernels"), nullptr) << "a tracer that cannot tell has none";
 }
+
+TEST(FrameTimeline, StagesOnAnotherClockEndAtTheGivenTimeBackToBackAndNeverBeforeTheBound) {
+  std::vector<StageSpan> spans;
+  append_spans_ending_at(spans, "gpu", 100.0, {{"upload", 1.0}, {"passes", 2.0}, {"download", 0.5}});
+  ASSERT_EQ(spans.size(), 3u);
+  EXPECT_EQ(spans[0].stage, "upload");
+  EXPECT_DOUBLE_EQ(spans[0].start_ms, 96.5);
+  EXPECT_DOUBLE_EQ(spans[1].start_ms, 97.5);
+  EXPECT_DOUBLE_EQ(spans[2].start_ms, 99.5);
+  EXPECT_DOUBLE_EQ(spans[2].start_ms + spans[2].ms, 100.0);
+  EXPECT_DOUBLE_EQ(spans[0].ms + spans[1].ms + spans[2].ms, 3.5);
+  spans.clear();
+  append_spans_ending_at(spans, "gpu", 10.0, {{"kernels", 5.0}, {"transfer", 1.0}}, 7.0);
+  EXPECT_DOUBLE_EQ(spans[0].start_ms, 7.0) << "clipped to the bound";
+  EXPECT_DOUBLE_EQ(spans[0].ms, 2.0);
+  EXPECT_DOUBLE_EQ(spans[1].start_ms, 9.0);
+  EXPECT_DOUBLE_EQ(spans[1].ms, 1.0);
+}

@@ -35,6 +35,16 @@ struct StageSpan {
 
 void to_json(nlohmann::json& j, const StageSpan& s);
 
+// Stages timed on another clock (a GPU's events), in the order they ran: appended back to back so that the
+// last ends at end_ms on the timeline's clock (only where they end is known there), none starting before
+// not_before_ms (each clipped to it).
+struct ClockedStage {
+  const char* stage;
+  double ms;
+};
+void append_spans_ending_at(std::vector<StageSpan>& spans, const std::string& track, double end_ms,
+                            const std::vector<ClockedStage>& stages, double not_before_ms = -1e300);
+
 // Times a stage from construction to destruction (or finish()) and appends it to `spans`.
 class ScopedStage {
  public:
