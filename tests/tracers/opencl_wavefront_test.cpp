@@ -321,16 +321,10 @@ TEST(OpenCLWavefrontSwitches, TheEnvironmentSetsThemAndABadValueIsNamed) {
                                                             {"COHORT_OPENCL_SHADOW_WALK", "2"},
                                                             {"COHORT_OPENCL_WALK_REGISTERS", "64k"},
                                                             {"COHORT_OPENCL_WALK_REGISTERS", "-1"},
-                                                            {"COHORT_OPENCL_SHADE_REGISTERS", "256"}};
+                                                            {"COHORT_OPENCL_SHADE_REGISTERS", "256"},
+                                                            {"COHORT_OPENCL_WAVE_LANES", "2"}};
   for (const auto& [variable, bad] : bad_values) {
-    ::setenv(variable, bad, 1);
-    std::string message;
-    try {
-      tracers::make_tracer(tracers::parse_tracer_list("opencl:0").front());
-    } catch (const std::invalid_argument& e) {
-      message = e.what();
-    }
-    ::unsetenv(variable);
+    const std::string message = registry_error_with(variable, bad, "opencl:0");
     EXPECT_NE(message.find(std::string(variable) + "='" + bad + "'"), std::string::npos) << bad << ": " << message;
   }
 }

@@ -5,6 +5,7 @@
 
 #include <cstdlib>
 #include <memory>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -24,6 +25,20 @@ inline std::unique_ptr<core::Tracer> make_test_tracer(const std::string& name) {
   if (name == "opencl")
     if (const char* device = std::getenv("COHORT_TEST_OPENCL_DEVICE")) spec.device = std::atoi(device);
   return tracers::make_tracer(spec);
+}
+
+// The message the registry gives when `variable` holds `value` while it makes `name`'s tracer ("" if none:
+// it made the tracer); the variable is unset afterwards.
+inline std::string registry_error_with(const char* variable, const char* value, const std::string& name) {
+  ::setenv(variable, value, 1);
+  std::string message;
+  try {
+    tracers::make_tracer(tracers::parse_tracer_list(name).front());
+  } catch (const std::invalid_argument& e) {
+    message = e.what();
+  }
+  ::unsetenv(variable);
+  return message;
 }
 
 }  // namespace cohort::test
