@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "cohort/kernel/aux_mode.h"
+#include "cohort/kernel/path_state.h"
 #include "device_array.h"
 #include "host_registrations.h"
 #include "render_band_launch.h"
@@ -97,7 +98,7 @@ struct CudaTracer::Impl {
   // The wavefront's scratch for a band of `pixels` rendered with `params`, or null for the megakernel (also
   // for frames the wavefront does not render: no scratch allocated for them).
   const WavefrontScratch* wave(size_t pixels, const KFrameParams& params) {
-    if (!wavefront || !wavefront_renders(params)) return nullptr;
+    if (!wavefront || !k_wavefront_renders(&params)) return nullptr;
     wave_scratch = {};
     wave_scratch.states = wave_states.scratch(pixels);
     wave_scratch.hits = wave_hits.scratch(pixels);

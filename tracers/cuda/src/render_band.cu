@@ -239,7 +239,7 @@ void launch_render_band(const KSceneView& scene, const KFrameParams& params, con
   const dim3 block(16, 8);
   const dim3 grid((camera.width + block.x - 1) / block.x, (rows + block.y - 1) / block.y);
   const bool sparse = params.path_pixels != 0u && params.path_pixels < K_PATH_PATTERN_PIXELS;
-  if (wave && wavefront_renders(params)) {
+  if (wave) {
     // Every kernel indexes its lane's pixels from the lane's first row: each lane gets the band's buffers
     // from its first pixel on (shadow slots keep the whole band's stride, so lanes never share one).
     WavefrontScratch whole = *wave;

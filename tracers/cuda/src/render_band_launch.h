@@ -57,18 +57,12 @@ void launch_wave_shadow_walk(dim3 grid, dim3 block, const KSceneView& scene, con
                              unsigned long long* ray_counts, unsigned* row_rays, cudaStream_t stream);
 // That translation unit's copy of the texel texture (its alpha-tested surfaces read it).
 void set_walk_texel_texture(cudaTextureObject_t texture);
-// Whether launch_render_band renders this band as a wavefront when given the scratch: lit paths that bounce
-// (dynamic resolution's sparse pattern too: the pixels it leaves out are painted black by the first shading
-// kernel); the other modes take the megakernel.
-// k_wavefront_renders' rule (path_state.h), spelled out: that helper is device-only in render_band.cu.
-inline bool wavefront_renders(const KFrameParams& params) {
-  return params.mode == K_MODE_PATH && params.max_bounces > 0u;
-}
 // The scene view holds device pointers (built on the host with k_scene_view, passed by value).
 // ray_counts (closest, occlusion) and row_rays (one per band row, zeroed by the caller) may be null.
 // first_hits (may be null; only for bands where every pixel traces paths): each pixel's record of its first
-// sample's first surface, for launch_aux_from_first_hits. wave (may be null): scratch for the wavefront,
-// used where wavefront_renders(params).
+// sample's first surface, for launch_aux_from_first_hits. wave (may be null): scratch for the wavefront;
+// given, the band renders as one, so the caller gives it only where k_wavefront_renders (path_state.h: lit
+// paths that bounce, the sparse pattern too), and the megakernel renders the rest.
 void launch_render_band(const KSceneView& scene, const KFrameParams& params, const KCamera& camera, float4* band,
                         unsigned long long* ray_counts, unsigned* row_rays, KPathFirstHit* first_hits,
                         const WavefrontScratch* wave, cudaStream_t stream);
