@@ -111,13 +111,37 @@ __global__ void atrous_kernel(const float* in, float* out, const float* geometry
 }
 
 // The estimate goes into the illumination's alpha, where the passes read it: each pixel writes only its
-// own alpha and reads only its neighbours' RGB.
+// own alpha and reads only its neighbours' RGB. A pixel with a long history reads its own moments; the
+// warp's pixels with short ones (a few along edges and disocclusions) then take their 7x7 neighbourhood
+// estimates one after the other, each spread over the warp's 32 lanes (a tap or two a lane, the sums
+// added across the warp), where a thread of its own would walk all 49 taps while the rest of its warp
+// waited (the kernel's cost before: docs/denoising.md). Same taps, summed in another order.
 __global__ void svgf_variance_kernel(float* illumination, const float* moments, const float* length,
                                      const float* geometry, KSvgfVarianceParams params) {
   const int x = blockIdx.x * blockDim.x + threadIdx.x, y = blockIdx.y * blockDim.y + threadIdx.y;
-  if (x < params.width && y < params.height)
+  const bool inside = x < params.width && y < params.height;
+  const bool spatial = inside && k_svgf_variance_is_spatial(length, &params, x, y);
+  if (inside && !spatial)
     illumination[4 * (y * params.width + x) + 3] =
         k_svgf_variance_estimate(illumination, moments, length, geometry, &params, x, y);
+  constexpr unsigned kWarp = 0xffffffffu;
+  constexpr int kSide = 2 * K_SVGF_SPATIAL_RADIUS + 1;
+  const int lane = int(threadIdx.y * blockDim.x + threadIdx.x) & 31;
+  for (unsigned pending = __ballot_sync(kWarp, spatial); pending != 0u; pending &= pending - 1u) {
+    const int owner = __ffs(pending) - 1;
+    const int px = __shfl_sync(kWarp, x, owner), py = __shfl_sync(kWarp, y, owner);
+    KSvgfNeighbourhood n = k_svgf_neighbourhood_begin(geometry, &params, px, py);
+    for (int tap = lane; tap < kSide * kSide; tap += 32)
+      k_svgf_neighbourhood_tap(&n, illumination, moments, length, geometry, &params, tap % kSide - K_SVGF_SPATIAL_RADIUS,
+                               tap / kSide - K_SVGF_SPATIAL_RADIUS);
+    for (int offset = 16; offset > 0; offset /= 2) {
+      n.s1 += __shfl_xor_sync(kWarp, n.s1, offset);
+      n.s2 += __shfl_xor_sync(kWarp, n.s2, offset);
+      n.weight_sum += __shfl_xor_sync(kWarp, n.weight_sum, offset);
+    }
+    if (lane == owner)
+      illumination[4 * (py * params.width + px) + 3] = k_svgf_neighbourhood_variance(&n, length, &params);
+  }
 }
 
 __global__ void history_fix_kernel(const float* in, float* out, const float* geometry, const kuint* id,

@@ -48,62 +48,97 @@ typedef struct KSvgfVarianceParams {
 #define K_SVGF_LUMINANCE_EPSILON 1e-4f
 #define K_SVGF_SPATIAL_RADIUS 3
 
+/* The 7x7 neighbourhood estimate of a pixel (x, y) in pieces, so that a GPU can spread its taps over the
+ * lanes of a warp (cuda_frame_post.cu) where one thread would walk all 49 while its neighbours with long
+ * histories wait: begin, every tap (dx, dy) in any order, then sums combined by addition, then finish. */
+typedef struct KSvgfNeighbourhood {
+  KVec3 np; float zp;
+  float inv_depth_scale; kint x; kint y;
+  float s1; float s2; float weight_sum;  /* the taps' weighted moments and weights */
+} KSvgfNeighbourhood;
+
+KFN KSvgfNeighbourhood k_svgf_neighbourhood_begin(KGLOBAL const float* geometry, const KSvgfVarianceParams* p,
+                                                  kint x, kint y) {
+  KSvgfNeighbourhood n;
+  KFloat4 gp = k_load4(geometry + 4 * (y * p->width + x));
+  n.np = v3(gp.x, gp.y, gp.z);
+  n.zp = gp.w;
+  n.inv_depth_scale = k_atrous_inv_depth_scale(p->depth_sigma, gp.w, 1);
+  n.x = x, n.y = y;
+  n.s1 = 0.0f, n.s2 = 0.0f, n.weight_sum = 0.0f;
+  return n;
+}
+
+/* Tap (dx, dy), each within +-K_SVGF_SPATIAL_RADIUS, into the sums: its moments (or its sample's luminance
+ * where it has no history), weighted by the normal stop and the depth stop per pixel of distance. */
+KFN void k_svgf_neighbourhood_tap(KSvgfNeighbourhood* n, KGLOBAL const float* illumination, KGLOBAL const float* moments,
+                                  KGLOBAL const float* length, KGLOBAL const float* geometry,
+                                  const KSvgfVarianceParams* p, kint dx, kint dy) {
+  kint qx = n->x + dx, qy = n->y + dy;
+  if (qy < 0 || qy >= p->height || qx < 0 || qx >= p->width) return;
+  kint q = qy * p->width + qx;
+  float m1, m2;
+  if (p->have_history && length[q] > 0.0f) {
+    m1 = moments[2 * q];
+    m2 = moments[2 * q + 1];
+  } else {
+    KGLOBAL const float* c = illumination + 4 * q;
+    if (!k_finite3(c[0], c[1], c[2])) return;
+    m1 = k_atrous_luminance(c);
+    m2 = m1 * m1;
+  }
+  if (!(k_fabs(m1) < 1e18f) || !(m2 < 3e38f)) return;
+  float w = 1.0f;
+  if (dx != 0 || dy != 0) {
+    float exponent = 0.0f;
+    KFloat4 gq = k_load4(geometry + 4 * q);
+    w = k_atrous_geometry_stop(n->zp, n->np, gq.w, v3(gq.x, gq.y, gq.z), n->inv_depth_scale, p->normal_squarings,
+                               &exponent);
+    if (!(w > 0.0f)) return;
+    kint ax = dx < 0 ? -dx : dx, ay = dy < 0 ? -dy : dy;
+    exponent /= (float)(ax > ay ? ax : ay); /* relative depth per pixel of (Chebyshev) distance */
+    if (exponent > 12.0f) return;
+    w *= k_exp(-exponent);
+  }
+  n->s1 += w * m1;
+  n->s2 += w * m2;
+  n->weight_sum += w;
+}
+
+/* The neighbourhood's variance, boosted by short_history / length as SVGF does (few frames underestimate it). */
+KFN float k_svgf_neighbourhood_variance(const KSvgfNeighbourhood* n, KGLOBAL const float* length,
+                                        const KSvgfVarianceParams* p) {
+  float history = p->have_history ? length[n->y * p->width + n->x] : 0.0f;
+  float of_mean = p->of_mean ? 1.0f / k_fmax(history, 1.0f) : 1.0f;
+  float v = 0.0f;
+  if (n->weight_sum > 0.0f) {
+    float mean = n->s1 / n->weight_sum;
+    v = k_fmax(n->s2 / n->weight_sum - mean * mean, 0.0f);
+  }
+  return v * (p->short_history / k_fmax(history, 1.0f)) * of_mean;
+}
+
+/* 1 where the estimate reads the neighbourhood (the history is shorter than short_history, or there is
+ * none), 0 where it reads the pixel's own temporal moments. */
+KFN int k_svgf_variance_is_spatial(KGLOBAL const float* length, const KSvgfVarianceParams* p, kint x, kint y) {
+  return !(p->have_history && length[y * p->width + x] >= p->short_history);
+}
+
 /* The pixel's variance. `illumination` is the demodulated frame the passes filter (only its RGB is read);
  * moments and length are the reprojected history's (read only with have_history). */
 KFN float k_svgf_variance_estimate(KGLOBAL const float* illumination, KGLOBAL const float* moments,
                                    KGLOBAL const float* length, KGLOBAL const float* geometry,
                                    const KSvgfVarianceParams* p, kint x, kint y) {
-  kint centre = y * p->width + x;
-  float history = p->have_history ? length[centre] : 0.0f;
-  float of_mean = p->of_mean ? 1.0f / k_fmax(history, 1.0f) : 1.0f;
-  if (history >= p->short_history)
+  if (!k_svgf_variance_is_spatial(length, p, x, y)) {
+    kint centre = y * p->width + x;
+    float of_mean = p->of_mean ? 1.0f / k_fmax(length[centre], 1.0f) : 1.0f;
     return k_fmax(moments[2 * centre + 1] - moments[2 * centre] * moments[2 * centre], 0.0f) * of_mean;
-  KFloat4 gp = k_load4(geometry + 4 * centre);
-  float zp = gp.w;
-  KVec3 np = v3(gp.x, gp.y, gp.z);
-  float inv_depth_scale = k_atrous_inv_depth_scale(p->depth_sigma, zp, 1);
-  float s1 = 0.0f, s2 = 0.0f, weight_sum = 0.0f;
-  for (kint dy = -K_SVGF_SPATIAL_RADIUS; dy <= K_SVGF_SPATIAL_RADIUS; ++dy) {
-    kint qy = y + dy;
-    if (qy < 0 || qy >= p->height) continue;
-    for (kint dx = -K_SVGF_SPATIAL_RADIUS; dx <= K_SVGF_SPATIAL_RADIUS; ++dx) {
-      kint qx = x + dx;
-      if (qx < 0 || qx >= p->width) continue;
-      kint q = qy * p->width + qx;
-      float m1, m2;
-      if (p->have_history && length[q] > 0.0f) {
-        m1 = moments[2 * q];
-        m2 = moments[2 * q + 1];
-      } else {
-        KGLOBAL const float* c = illumination + 4 * q;
-        if (!k_finite3(c[0], c[1], c[2])) continue;
-        m1 = k_atrous_luminance(c);
-        m2 = m1 * m1;
-      }
-      if (!(k_fabs(m1) < 1e18f) || !(m2 < 3e38f)) continue;
-      float w = 1.0f;
-      if (q != centre) {
-        float exponent = 0.0f;
-        KFloat4 gq = k_load4(geometry + 4 * q);
-        w = k_atrous_geometry_stop(zp, np, gq.w, v3(gq.x, gq.y, gq.z), inv_depth_scale, p->normal_squarings,
-                                   &exponent);
-        if (!(w > 0.0f)) continue;
-        kint ax = dx < 0 ? -dx : dx, ay = dy < 0 ? -dy : dy;
-        exponent /= (float)(ax > ay ? ax : ay); /* relative depth per pixel of (Chebyshev) distance */
-        if (exponent > 12.0f) continue;
-        w *= k_exp(-exponent);
-      }
-      s1 += w * m1;
-      s2 += w * m2;
-      weight_sum += w;
-    }
   }
-  float v = 0.0f;
-  if (weight_sum > 0.0f) {
-    float mean = s1 / weight_sum;
-    v = k_fmax(s2 / weight_sum - mean * mean, 0.0f);
-  }
-  return v * (p->short_history / k_fmax(history, 1.0f)) * of_mean;
+  KSvgfNeighbourhood n = k_svgf_neighbourhood_begin(geometry, p, x, y);
+  for (kint dy = -K_SVGF_SPATIAL_RADIUS; dy <= K_SVGF_SPATIAL_RADIUS; ++dy)
+    for (kint dx = -K_SVGF_SPATIAL_RADIUS; dx <= K_SVGF_SPATIAL_RADIUS; ++dx)
+      k_svgf_neighbourhood_tap(&n, illumination, moments, length, geometry, p, dx, dy);
+  return k_svgf_neighbourhood_variance(&n, length, p);
 }
 
 /* The estimate into a plane of one float a pixel. */
