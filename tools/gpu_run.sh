@@ -22,6 +22,8 @@
 #   tools/gpu_run.sh stage-mpi here: the travelling cohort built against PyPI's MPICH, with its libraries (.gpu/mpi.tar.xz)
 #   tools/gpu_run.sh cluster   there, on a two-GPU kind: two ranks with one GPU each against the in-process two GPUs
 #                              (COHORT_CLUSTER_JOBS_AHEAD="1 0": with and without jobs ahead, back to back)
+#   tools/gpu_run.sh links     there, on a two-GPU kind: remote tracers behind emulated links (COHORT_LINKS, default
+#                              "none 10gbit,0.5ms 1gbit,1ms"): alone, two ranks together, and beside rank 0's cuda:0
 #   tools/gpu_run.sh kernels   there: GPU time kernel by kernel (ncu) on the large map at 1080p, cuda:0, Brigade's
 #                              blend / reprojection / reprojection + a-trous, with the same runs' frame times
 #   tools/gpu_run.sh quality   there: bench/quality/bench_quality.py on cuda:0 along the test map's scenario,
@@ -124,6 +126,44 @@ case "${1:-}" in
         done
         done
       done
+    done
+    ;;
+  links)
+    # There, on a two-GPU kind: issue 19's emulated links (COHORT_MPI_LINK on every rank, docs/cluster.md),
+    # large map 1080p, Brigade's blend, 200 frames (medians of 50-199): each remote tracer alone and together
+    # (two ranks with one GPU each), and rank 0's own cuda:0 beside mpi:1, on loopback and under each link of
+    # COHORT_LINKS; scaling efficiency = (1 / T_mix) / sum(1 / T_alone), the alone runs over the same link.
+    mkdir -p "$stage/mpi" && tar -C "$stage/mpi" -xJf "$stage/mpi.tar.xz"
+    export PATH="$PWD/$stage/mpi/bin:$PATH"
+    cohort="$PWD/$stage/mpi/bin/cohort"
+    [ -f /tmp/largemap.cpk ] || { python3 tools/gen_testmap.py --large --out /tmp/largemap >/dev/null &&
+      "$cohort" pack /tmp/largemap/maps/largemap.map --out /tmp/largemap.cpk | tail -n 1; }
+    common=(/tmp/largemap.cpk --width 1920 --height 1080 --camera 1690 300 80 5 -12 --spp 1 --light-samples 1 --bounces 1
+            --convergence brigade --frames 200 --camera-path spin-slow --write last)
+    median() { python3 tools/frame_times.py "$1/stats.json" --skip 50 | head -n 1 | sed -E 's/.*median ([0-9.]+) ms.*/\1/'; }
+    "$cohort" render "${common[@]}" --tracers cuda:0 --out /tmp/l_cuda0 >/dev/null 2>&1
+    "$cohort" render "${common[@]}" --tracers cuda:0,cuda:1 --out /tmp/l_cuda01 >/dev/null 2>&1
+    echo "in process: cuda:0 $(median /tmp/l_cuda0) ms, cuda:0,cuda:1 $(median /tmp/l_cuda01) ms"
+    for link in ${COHORT_LINKS:-none 10gbit,0.5ms 1gbit,1ms}; do
+      [ "$link" = none ] && export COHORT_MPI_LINK= || export COHORT_MPI_LINK=$link
+      runs() {  # NAME TRACERS NODE-TRACERS... : rank 0 renders TRACERS, one node per NODE-TRACERS
+        local name=$1 tracers=$2; shift 2
+        local nodes=() ; for t in "$@"; do nodes+=(: -np 1 "$cohort" node /tmp/largemap.cpk --tracers "$t"); done
+        rm -rf /tmp/l_$name
+        timeout 180 mpiexec.hydra -np 1 "$cohort" render "${common[@]}" --tracers "$tracers" --out /tmp/l_$name \
+          "${nodes[@]}" >/tmp/l_$name.log 2>&1 || { echo "$name failed"; tail -n 5 /tmp/l_$name.log; }
+      }
+      runs m1 mpi:1 cuda:0; runs m2 mpi:2 cuda:0 cuda:1; runs m12 mpi:1,mpi:2 cuda:0 cuda:1
+      runs c0m1 cuda:0,mpi:1 cuda:1
+      python3 - "$link" "$(median /tmp/l_m1)" "$(median /tmp/l_m2)" "$(median /tmp/l_m12)" "$(median /tmp/l_cuda0)" \
+        "$(median /tmp/l_c0m1)" <<'PY'
+import sys
+link, m1, m2, m12, c0, c0m1 = sys.argv[1], *map(float, sys.argv[2:])
+print(f"link {link}: mpi:1 alone {m1:.2f} ms, mpi:2 alone {m2:.2f}, mpi:1,mpi:2 {m12:.2f} "
+      f"(efficiency {100 / m12 / (1 / m1 + 1 / m2):.1f} %); cuda:0 + mpi:1 {c0m1:.2f} "
+      f"(efficiency {100 / c0m1 / (1 / c0 + 1 / m1):.1f} %)")
+PY
+      grep -h "round trip" /tmp/l_m12.log | sed 's/^.*\] //' | tail -n 2 || true
     done
     ;;
   compare)

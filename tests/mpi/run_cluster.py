@@ -28,7 +28,9 @@ and 6 ms slower a row (bands far longer than rank 0's own frame work, so that ea
 while they render), so that the balancer moves rows every frame: each later frame's job goes to the
 node while its band before renders, the node renders it right after that band, and the frame's job
 adopts those rows, rendering only the rows beyond them; every frame matches the single-process render;
-with COHORT_MPI_JOBS_AHEAD=0 nothing is adopted).
+with COHORT_MPI_JOBS_AHEAD=0 nothing is adopted), link (`cohort bench devices` with mpi:1 behind an emulated
+link, COHORT_MPI_LINK=0.1gbit,20ms on every rank: the band's round trip holds the link's latency both ways and
+its bytes at the link's rate).
 """
 import argparse
 import json
@@ -352,10 +354,44 @@ def bench(a):
     print("bench: ok")
 
 
+def link(a):
+    """`cohort bench devices` with mpi:1 alone, every rank's sends through an emulated link of 0.1 Gbit/s and
+    20 ms one way (COHORT_MPI_LINK): each band's round trip holds the job's way there and the rows' way
+    back (2 x 20 ms) and the rows' bytes at the link's rate, on top of what the node and rank 0 spend."""
+    os.makedirs(a.out)
+    pack = os.path.join(a.out, "scene.cpk")
+    run([a.cohort, "pack", a.map, "--out", pack])
+    flags = mpiexec_flags(a.mpiexec)
+    # Open MPI's launcher passes only the variables it is told of; MPICH's passes them all.
+    if flags:
+        flags = flags + ["-x", "COHORT_MPI_LINK"]
+    env = dict(os.environ, COHORT_MPI_LINK="0.1gbit,20ms")
+    report = os.path.join(a.out, "bench.json")
+    _, output = run([a.mpiexec] + flags + ["-np", "1", a.cohort, "bench", "devices", "--scene", pack, "--width", "64",
+                                           "--height", "48", "--frames", "4", "--warmup", "1", "--mix", "mpi:1",
+                                           "--json", report, ":"] + flags + ["-np", "1", a.cohort, "node", pack,
+                                                                             "--tracers", "embree"], env=env)
+    if "emulated link of 0.1 Gbit/s and 20 ms one way" not in output:
+        sys.exit("no rank said it emulates the link")
+    with open(report) as f:
+        runs = json.load(f)["runs"]
+    alone = [r for r in runs if r["tracers"] == ["mpi:1"]]
+    if not alone or len(alone[0]["remote"]) != 1:
+        sys.exit("mpi:1's run is missing from the report")
+    remote = alone[0]["remote"][0]
+    print("mpi:1 over the link:", remote)
+    rows_ms = remote["received_bytes_per_frame"] * 8 / 0.1e9 * 1e3
+    wire_ms = remote["mean_round_trip_ms"] - remote["mean_node_ms"]
+    if wire_ms < 40 + rows_ms * 0.9:
+        sys.exit(f"the round trip beyond the node's time is {wire_ms:.1f} ms; the link alone should take "
+                 f"{40 + rows_ms:.1f} ms (2 x 20 ms and {remote['received_bytes_per_frame']} bytes at 0.1 Gbit/s)")
+    print(f"link: ok ({wire_ms:.1f} ms on the wire, {40 + rows_ms:.1f} ms emulated)")
+
+
 def main():
     parser = argparse.ArgumentParser()
     parser.add_argument("case", choices=["match", "mixed", "stall", "killed", "version", "load_error", "bench", "protocol", "replay",
-                                           "play", "bad_piece", "ahead", "ahead_recovery", "jobs_ahead"])
+                                           "play", "link", "bad_piece", "ahead", "ahead_recovery", "jobs_ahead"])
     parser.add_argument("--mpiexec", required=True)
     parser.add_argument("--cohort", required=True)
     parser.add_argument("--map", required=True)
@@ -372,6 +408,9 @@ def main():
         return
     if a.case == "bench":
         bench(a)
+        return
+    if a.case == "link":
+        link(a)
         return
     if a.case == "replay":
         replay(a)

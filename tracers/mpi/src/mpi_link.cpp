@@ -1,5 +1,6 @@
 #include "cohort/tracers/mpi_link.h"
 
+#include <algorithm>
 #include <atomic>
 #include <cstdio>
 #include <cstdlib>
@@ -11,7 +12,9 @@
 #include <thread>
 
 #include <mpi.h>
+#include <spdlog/spdlog.h>
 
+#include "cohort/tracers/mpi_link_emulation.h"
 #include "cohort/tracers/mpi_wire.h"
 
 namespace cohort::tracers {
@@ -34,8 +37,52 @@ struct MpiSession::Impl {
     std::vector<uint8_t> bytes;  // empty for a send in place
     MPI_Request request;
     const void* group = nullptr;  // a send in place: the buffer it lies in (MpiSession::flush_group)
+    // Under an emulated link, a send waits here until `release` (its arrival) before MPI gets it.
+    bool held = false;
+    MpiClock::time_point release{};
+    int tag = 0;
+    const void* data = nullptr;
+    int size = 0;
   };
   std::list<Outgoing> sends;
+  std::optional<LinkSchedule> link;  // COHORT_MPI_LINK
+  std::thread link_pump;             // hands held sends to MPI when they are due
+  std::atomic<bool> link_pump_stop{false};
+
+  bool isend(Outgoing& out) {
+    out.held = false;
+    // MPI-3 takes a const buffer; the cast is for MPI-2 headers that still declare void*.
+    return MPI_Isend(const_cast<void*>(out.data), out.size, MPI_BYTE, out.destination, out.tag, comm, &out.request) ==
+           MPI_SUCCESS;
+  }
+  // Queues a send: to MPI now, or held until the emulated link would deliver it. False if MPI refused it.
+  bool start(Outgoing& out) {
+    if (link) {
+      out.release = link->arrival(out.destination, size_t(out.size), MpiClock::now());
+      if (out.release > MpiClock::now()) {
+        out.held = true;
+        return true;
+      }
+    }
+    return isend(out);
+  }
+  // Hands the held sends that are due to MPI, in order per destination.
+  void release_due(MpiClock::time_point now) {
+    std::vector<int> waiting;  // destinations whose first held send is not due: later ones wait behind it
+    for (Outgoing& out : sends) {
+      if (!out.held) continue;
+      if (std::find(waiting.begin(), waiting.end(), out.destination) != waiting.end()) continue;
+      if (out.release <= now) isend(out);
+      else waiting.push_back(out.destination);
+    }
+  }
+  // Whether a send has completed (a held one has not started).
+  bool completed(Outgoing& out) {
+    if (out.held) return false;
+    int done = 0;
+    MPI_Test(&out.request, &done, MPI_STATUS_IGNORE);
+    return done != 0;
+  }
   struct Incoming {
     std::vector<uint8_t> bytes;
     MPI_Request request;
@@ -59,11 +106,8 @@ struct MpiSession::Impl {
     return found->second.empty();
   }
   void test_sends() {
-    for (auto it = sends.begin(); it != sends.end();) {
-      int done = 0;
-      MPI_Test(&it->request, &done, MPI_STATUS_IGNORE);
-      it = done ? sends.erase(it) : std::next(it);
-    }
+    if (link) release_due(MpiClock::now());
+    for (auto it = sends.begin(); it != sends.end();) it = completed(*it) ? sends.erase(it) : std::next(it);
   }
   std::vector<uint8_t> farewell;
   std::vector<bool> released;
@@ -92,6 +136,23 @@ MpiSession::MpiSession() : impl_(new Impl) {
   MPI_Comm_set_errhandler(impl_->comm, MPI_ERRORS_RETURN);
   MPI_Comm_rank(impl_->comm, &rank_);
   MPI_Comm_size(impl_->comm, &size_);
+  if (std::optional<LinkSpec> link = link_spec_from_environment()) {
+    impl_->link.emplace(*link);
+    const LinkSpec& spec = impl_->link->spec();
+    spdlog::info("rank {}: this rank's sends go through an emulated link of {:.3g} Gbit/s and {:.3g} ms one way "
+                 "(COHORT_MPI_LINK={})", rank_, spec.bytes_per_second * 8e-9, spec.latency_seconds * 1e3, spec.text);
+    // A held send is due at its arrival time, whether or not the rank is calling into the session then.
+    impl_->link_pump = std::thread([this] {
+      while (!impl_->link_pump_stop.load()) {
+        {
+          std::lock_guard lock(mutex_);
+          if (finalized_) return;
+          impl_->release_due(MpiClock::now());
+        }
+        std::this_thread::sleep_for(std::chrono::microseconds(50));
+      }
+    });
+  }
 }
 
 MpiSession::~MpiSession() {
@@ -100,9 +161,14 @@ MpiSession::~MpiSession() {
 }
 
 void MpiSession::finalize() {
+  impl_->link_pump_stop.store(true);
+  if (impl_->link_pump.joinable()) impl_->link_pump.join();
   std::lock_guard lock(mutex_);
   if (finalized_) return;
   finalized_ = true;
+  // Sends an emulated link still holds leave now.
+  for (Impl::Outgoing& out : impl_->sends)
+    if (out.held) impl_->isend(out);
   if (rank_ == 0 && !impl_->farewell.empty()) {
     impl_->released.resize(size_t(size_), false);
     for (int r = 1; r < size_; ++r) {
@@ -115,11 +181,8 @@ void MpiSession::finalize() {
   // Sends still queued get a second; then they are freed (the library completes or drops them).
   const auto deadline = MpiClock::now() + std::chrono::seconds(1);
   while (!impl_->sends.empty() && MpiClock::now() < deadline) {
-    for (auto it = impl_->sends.begin(); it != impl_->sends.end();) {
-      int done = 0;
-      MPI_Test(&it->request, &done, MPI_STATUS_IGNORE);
-      it = done ? impl_->sends.erase(it) : std::next(it);
-    }
+    for (auto it = impl_->sends.begin(); it != impl_->sends.end();)
+      it = impl_->completed(*it) ? impl_->sends.erase(it) : std::next(it);
     std::this_thread::sleep_for(std::chrono::microseconds(100));
   }
   // (A request from a rank that was lost may already be null.)
@@ -162,8 +225,8 @@ void MpiSession::send(int destination, std::vector<uint8_t> bytes) {
   if (finalized_) throw std::runtime_error("MPI send after the session was finalized");
   impl_->sends.push_back({destination, std::move(bytes), MPI_REQUEST_NULL});
   Impl::Outgoing& out = impl_->sends.back();
-  if (MPI_Isend(out.bytes.data(), int(out.bytes.size()), MPI_BYTE, destination, kTag, impl_->comm, &out.request) !=
-      MPI_SUCCESS) {
+  out.tag = kTag, out.data = out.bytes.data(), out.size = int(out.bytes.size());
+  if (!impl_->start(out)) {
     impl_->sends.pop_back();
     throw std::runtime_error("MPI_Isend to rank " + std::to_string(destination) + " failed");
   }
@@ -176,9 +239,8 @@ void MpiSession::send_in_place(int destination, int tag, const void* data, size_
   if (finalized_) throw std::runtime_error("MPI send after the session was finalized");
   impl_->sends.push_back({destination, {}, MPI_REQUEST_NULL, group});
   Impl::Outgoing& out = impl_->sends.back();
-  // MPI-3 takes a const buffer; the cast is for MPI-2 headers that still declare void*.
-  if (MPI_Isend(const_cast<void*>(data), int(size), MPI_BYTE, destination, tag, impl_->comm, &out.request) !=
-      MPI_SUCCESS) {
+  out.tag = tag, out.data = data, out.size = int(size);
+  if (!impl_->start(out)) {
     impl_->sends.pop_back();
     throw std::runtime_error("MPI_Isend to rank " + std::to_string(destination) + " failed");
   }
@@ -208,9 +270,9 @@ bool MpiSession::flush_sends(int destination, MpiClock::time_point deadline) {
     {
       std::lock_guard lock(mutex_);
       if (finalized_) return impl_->sends.empty();
+      if (impl_->link) impl_->release_due(MpiClock::now());
       for (auto it = impl_->sends.begin(); it != impl_->sends.end();) {
-        int done = 0;
-        MPI_Test(&it->request, &done, MPI_STATUS_IGNORE);
+        const bool done = impl_->completed(*it);
         if (!done && (destination < 0 || it->destination == destination)) pending = true;
         it = done ? impl_->sends.erase(it) : std::next(it);
       }
@@ -227,9 +289,9 @@ bool MpiSession::flush_group(const void* group, MpiClock::time_point deadline) {
     {
       std::lock_guard lock(mutex_);
       if (finalized_) return true;
+      if (impl_->link) impl_->release_due(MpiClock::now());
       for (auto it = impl_->sends.begin(); it != impl_->sends.end();) {
-        int done = 0;
-        MPI_Test(&it->request, &done, MPI_STATUS_IGNORE);
+        const bool done = impl_->completed(*it);
         if (!done && it->group == group) pending = true;
         it = done ? impl_->sends.erase(it) : std::next(it);
       }
