@@ -140,7 +140,7 @@ case "${1:-}" in
       "$cohort" pack /tmp/largemap/maps/largemap.map --out /tmp/largemap.cpk | tail -n 1; }
     common=(/tmp/largemap.cpk --width 1920 --height 1080 --camera 1690 300 80 5 -12 --spp 1 --light-samples 1 --bounces 1
             --convergence brigade --frames 200 --camera-path spin-slow --write last)
-    median() { python3 tools/frame_times.py "$1/stats.json" --skip 50 | head -n 1 | sed -E 's/.*median ([0-9.]+) ms.*/\1/'; }
+    median() { python3 tools/frame_times.py "$1/stats.json" --skip 50 | head -n 1 | sed -E 's/.*per frame median ([0-9.]+) ms.*/\1/'; }
     "$cohort" render "${common[@]}" --tracers cuda:0 --out /tmp/l_cuda0 >/dev/null 2>&1
     "$cohort" render "${common[@]}" --tracers cuda:0,cuda:1 --out /tmp/l_cuda01 >/dev/null 2>&1
     echo "in process: cuda:0 $(median /tmp/l_cuda0) ms, cuda:0,cuda:1 $(median /tmp/l_cuda01) ms"

@@ -196,6 +196,18 @@ void MpiSession::finalize() {
   for (auto& [source, list] : impl_->pieces)
     for (auto& piece : list) release(piece.request);
   impl_->pieces.clear();
+  // Messages that came and that nobody received (a node's hello to a rank 0 that never named it): MPICH
+  // refuses to free a communicator that holds any (it aborts the process), so they are received and dropped.
+  for (;;) {
+    int found = 0;
+    MPI_Message message;
+    MPI_Status status;
+    if (MPI_Improbe(MPI_ANY_SOURCE, MPI_ANY_TAG, impl_->comm, &found, &message, &status) != MPI_SUCCESS || !found) break;
+    int count = 0;
+    MPI_Get_count(&status, MPI_BYTE, &count);
+    std::vector<uint8_t> dropped(size_t(std::max(count, 1)));
+    MPI_Mrecv(dropped.data(), count, MPI_BYTE, &message, MPI_STATUS_IGNORE);
+  }
   MPI_Comm_free(&impl_->comm);
   int mpi_finalized = 0;
   MPI_Finalized(&mpi_finalized);
