@@ -215,15 +215,27 @@ int run_render(const RenderArgs& a) {
                         : std::string(),
                  post->where());
   }
-  // A GPU post-processing reprojection takes the bands as the tracers packed them: half the bytes cross
-  // the bus and the host skips its conversions (the float frame and G-buffer are not made). A reprojecting
-  // post also reconstructs sparse frames, where it runs.
-  const bool packed = post && reproject && post->where() != "host" && a.denoise != "oidn" &&
+  // Brigade's blend where a GPU's post would run (the host still picks f from the camera, core/convergence.h):
+  // the bands then stay on the GPUs or cross packed, and the host neither merges nor blends them.
+  const bool blend_on_gpu = !reproject && !atrous && !a.no_convergence && post_place != "host" &&
+                            a.denoise == "none" && !a.write_ids;
+  if (blend_on_gpu) {
+    core::FramePostOptions blend_options;
+    blend_options.reproject = false;
+    blend_options.blend = true;
+    blend_options.upsample = upsample;
+    post = tracers::make_frame_post(post_place, blend_options);
+    spdlog::info("Brigade's blend on {}", post->where());
+  }
+  // A GPU post-processing reprojection (or blend) takes the bands as the tracers packed them: half the bytes
+  // cross the bus and the host skips its conversions (the float frame and G-buffer are not made). A
+  // reprojecting or blending post also reconstructs sparse frames, where it runs.
+  const bool packed = post && (reproject || blend_on_gpu) && post->where() != "host" && a.denoise != "oidn" &&
                       a.denoise != "oidn-cuda" && !a.write_ids;
-  // Sparse frames are filled where the post runs: inside the reprojecting post, or for Brigade's blend (which
-  // takes full frames) by a post of its own with neither step, on the same place.
+  // Sparse frames are filled where the post runs: inside the reprojecting or blending post, or for Brigade's
+  // blend on the host (which takes full frames) by a post of its own with neither step, on the same place.
   std::unique_ptr<core::FramePost> reconstruction;
-  if (sparse && !reproject) {
+  if (sparse && !reproject && !blend_on_gpu) {
     core::FramePostOptions only_reconstruct;
     only_reconstruct.reproject = false;
     only_reconstruct.upsample = upsample;
@@ -262,18 +274,22 @@ int run_render(const RenderArgs& a) {
     // Adaptive convergence: a still camera accumulates every frame; motion raises f (see convergence.h).
     // Reprojection (--convergence reproject): per-pixel history through the frame's motion vectors.
     const core::GBuffer& gbuffer = pipeline.gbuffer();
-    if (!reproject && !a.no_convergence) {
+    if (blend_on_gpu) {
+      stats.convergence_f = convergence.next_factor(done.job.camera);
+      post->set_blend_factor(stats.convergence_f);
+    } else if (!reproject && !a.no_convergence) {
       core::ScopedStage blending(stats.stages, core::kCoreTrack, "convergence");
       stats.convergence_f = convergence.accumulate(done.job.camera, frame);
     }
     const core::FrameBuffer* shown_image = a.no_convergence ? &frame : &convergence.image();
-    const bool post_runs = post && (packed || !gbuffer.empty());
+    const bool post_runs = post && (packed || !gbuffer.empty() || blend_on_gpu);
     if (post_runs) {
       // One stage: on a GPU the two steps share one upload and one download.
       core::ScopedStage posting(stats.stages, core::kCoreTrack,
                                 !atrous ? "convergence" : reproject ? "convergence+denoise" : "denoise");
       if (packed) post->process_packed(renderer.packed_frame(), renderer.packed_device_rows(), traced);
-      else post->process(reproject ? frame : *shown_image, gbuffer, reproject ? traced : core::kEveryPixel);
+      else post->process(reproject || blend_on_gpu ? frame : *shown_image, gbuffer,
+                         reproject || blend_on_gpu ? traced : core::kEveryPixel);
       // On a GPU its own clock tells the bus from the passes (a track of its own in the timeline).
       if (const core::FramePostDeviceTimes t = post->device_times(); t.measured) {
         core::append_spans_ending_at(stats.stages, "post on " + post->where(), core::timeline_now_ms(),

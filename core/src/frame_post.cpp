@@ -3,19 +3,24 @@
 #include <stdexcept>
 #include <string>
 
+#include "cohort/core/host_threads.h"
+#include "cohort/kernel/brigade_blend.h"
+
 namespace cohort::core {
 
 void FramePost::process_packed(const BandBuffer& packed, const std::vector<DeviceBandRows>& on_device,
                                const PathPattern& traced) {
   if (!on_device.empty())
     throw std::invalid_argument("FramePost::process_packed: bands on a GPU reached the post-processing on " + where());
-  if (!packed.has_aux())
-    throw std::invalid_argument("FramePost::process_packed: the packed frame has no aux planes (render with aux outputs)");
   const int width = packed.width(), height = packed.height();
   if (unpacked_frame_.width != width || unpacked_frame_.height != height) unpacked_frame_.resize(width, height);
   packed.copy_rows_to(unpacked_frame_, 0, height);
-  if (unpacked_gbuffer_.width != width || unpacked_gbuffer_.height != height) unpacked_gbuffer_.resize(width, height);
-  packed.copy_aux_rows_to(unpacked_gbuffer_, 0, height);
+  if (packed.has_aux()) {
+    if (unpacked_gbuffer_.width != width || unpacked_gbuffer_.height != height) unpacked_gbuffer_.resize(width, height);
+    packed.copy_aux_rows_to(unpacked_gbuffer_, 0, height);
+  } else {
+    unpacked_gbuffer_ = GBuffer{};  // the blend alone reads none; the other steps refuse an empty one
+  }
   process(unpacked_frame_, unpacked_gbuffer_, traced);
 }
 
@@ -23,6 +28,12 @@ FramePostOptions with_history_moments(FramePostOptions options) {
   options.reprojection.luminance_moments =
       options.reproject && options.atrous && atrous_guide_uses_variance(options.atrous_options.guide);
   return options;
+}
+
+void check_post_options(const FramePostOptions& options) {
+  if (options.blend && (options.reproject || options.atrous))
+    throw std::invalid_argument("frame post: Brigade's blend takes the place of the reprojection and comes without "
+                                "the a-trous filter; ask for one of them");
 }
 
 void check_traced_pattern(const FramePostOptions& options, const PathPattern& traced) {
@@ -35,7 +46,9 @@ void check_traced_pattern(const FramePostOptions& options, const PathPattern& tr
 }
 
 HostFramePost::HostFramePost(FramePostOptions options)
-    : options_(with_history_moments(options)), reprojection_(options_.reprojection), atrous_(options_.atrous_options) {}
+    : options_(with_history_moments(options)), reprojection_(options_.reprojection), atrous_(options_.atrous_options) {
+  check_post_options(options_);
+}
 
 void HostFramePost::process(const FrameBuffer& fresh, const GBuffer& gbuffer, const PathPattern& traced) {
   check_traced_pattern(options_, traced);
@@ -47,6 +60,20 @@ void HostFramePost::process(const FrameBuffer& fresh, const GBuffer& gbuffer, co
   if (options_.reproject) {
     reprojection_.accumulate(*current, gbuffer);
     current = &reprojection_.image();
+  }
+  if (options_.blend) {
+    const FrameBuffer& fresh_frame = *current;
+    if (blend_factor_ >= 1.0 || blended_.width != fresh_frame.width || blended_.height != fresh_frame.height) {
+      blended_ = fresh_frame;
+    } else {
+      float* accumulated = blended_.rgba.data();
+      const float* incoming = fresh_frame.rgba.data();
+      const float f = static_cast<float>(blend_factor_);
+      HostThreads::shared().for_ranges(blended_.rgba.size() / 4, 16384, [=](size_t begin, size_t end) {
+        for (size_t p = begin; p < end; ++p) k_brigade_blend_pixel(accumulated, incoming, f, static_cast<kint>(p));
+      });
+    }
+    current = &blended_;
   }
   if (options_.atrous) {
     AtrousHistory history;
@@ -66,6 +93,9 @@ double HostFramePost::mean_history_length() const {
   return options_.reproject ? reprojection_.mean_history_length() : 1.0;
 }
 
-void HostFramePost::reset() { reprojection_.reset(); }
+void HostFramePost::reset() {
+  reprojection_.reset();
+  blended_ = FrameBuffer{};
+}
 
 }  // namespace cohort::core

@@ -4,10 +4,12 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstring>
 #include <random>
 #include <stdexcept>
 
 #include "cohort/core/atrous_filter.h"
+#include "cohort/core/convergence.h"
 #include "cohort/core/frame_post.h"
 #include "cohort/core/reprojection.h"
 #include "cohort/core/renderer.h"
@@ -363,4 +365,126 @@ TEST(FramePost, CudaBandsStayingOnTheGpusGiveTheHostRoundTripsPicture) {
   }
   for (size_t f = 0; f < shown[0].size(); ++f)
     EXPECT_EQ(shown[1][f].rgba, shown[0][f].rgba) << "frame " << f;
+}
+
+// Brigade's blend as a step of the post (FramePostOptions::blend): the host's gives AdaptiveConvergence's
+// image bit for bit, a GPU's the same picture from float frames and from a packed merge without aux planes
+// whose CUDA bands stayed on their GPUs; it refuses to come with the reprojection or the filter.
+namespace {
+
+// A short walk: still for three frames (f = 1, 1/2, 1/3), two steps of 4 units, a cut, still again.
+KCamera walk_camera(int f) {
+  KCamera c = test::test_room_camera(kW, kH);
+  c.origin[0] += f < 3 ? 0.0f : f < 5 ? 4.0f * float(f - 2) : 400.0f;
+  return c;
+}
+
+bool same_bits(const core::FrameBuffer& a, const core::FrameBuffer& b) {
+  return a.rgba.size() == b.rgba.size() &&
+         std::memcmp(a.rgba.data(), b.rgba.data(), a.rgba.size() * sizeof(float)) == 0;  // NaN samples too
+}
+
+core::FramePostOptions blend_only() {
+  core::FramePostOptions o;
+  o.reproject = false;
+  o.blend = true;
+  return o;
+}
+
+}  // namespace
+
+TEST(FramePost, HostBlendIsBrigadesConvergence) {
+  core::HostFramePost post(blend_only());
+  core::AdaptiveConvergence reference, factors;
+  core::FrameBuffer frame;
+  core::GBuffer g;
+  std::vector<double> seen;
+  for (int f = 0; f < 7; ++f) {
+    make_frame(f, frame, g);
+    const KCamera camera = walk_camera(f);
+    seen.push_back(factors.next_factor(camera));
+    post.set_blend_factor(seen.back());
+    post.process(frame, core::GBuffer{}, core::kEveryPixel);  // the blend reads no G-buffer
+    EXPECT_DOUBLE_EQ(reference.accumulate(camera, frame), seen.back());
+    EXPECT_TRUE(same_bits(post.image(), reference.image())) << "frame " << f;
+  }
+  EXPECT_DOUBLE_EQ(seen[0], 1.0);
+  EXPECT_DOUBLE_EQ(seen[2], 1.0 / 3.0);
+  EXPECT_DOUBLE_EQ(seen[5], 1.0) << "the cut starts over";
+  EXPECT_DOUBLE_EQ(post.mean_history_length(), 1.0);
+  post.reset();
+  post.set_blend_factor(0.5);
+  make_frame(1, frame, g);
+  post.process(frame, core::GBuffer{}, core::kEveryPixel);
+  EXPECT_TRUE(same_bits(post.image(), frame)) << "after a reset the next frame starts the image";
+}
+
+TEST(FramePost, TheBlendComesWithoutReprojectionOrFilter) {
+  core::FramePostOptions with_reprojection = blend_only();
+  with_reprojection.reproject = true;
+  core::FramePostOptions with_filter = blend_only();
+  with_filter.atrous = true;
+  for (const core::FramePostOptions& o : {with_reprojection, with_filter}) {
+    EXPECT_THROW(core::HostFramePost{o}, std::invalid_argument);
+    EXPECT_THROW(tracers::make_frame_post("host", o), std::invalid_argument);
+    if (tracers::device_count("cuda") > 0) EXPECT_THROW(tracers::make_frame_post("cuda:0", o), std::invalid_argument);
+  }
+}
+
+TEST(FramePost, CudaBlendsAsTheHost) {
+  using namespace cohort::test;
+  const int gpus = tracers::device_count("cuda");
+  if (gpus == 0) GTEST_SKIP() << "no CUDA device (or a build without CUDA)";
+  {
+    core::HostFramePost host(blend_only());
+    std::unique_ptr<core::FramePost> gpu = tracers::make_frame_post("cuda:0", blend_only());
+    core::AdaptiveConvergence factors;
+    core::FrameBuffer frame;
+    core::GBuffer g;
+    for (int f = 0; f < 7; ++f) {
+      make_frame(f, frame, g);
+      const double factor = factors.next_factor(walk_camera(f));
+      host.set_blend_factor(factor);
+      gpu->set_blend_factor(factor);
+      host.process(frame, core::GBuffer{}, core::kEveryPixel);
+      gpu->process(frame, core::GBuffer{}, core::kEveryPixel);
+      EXPECT_LT(max_relative_difference(gpu->image(), host.image()), 1e-5) << "frame " << f;
+    }
+  }
+  // Path-traced frames without aux planes through the packed merge, the CUDA bands left on their GPUs.
+  auto room = std::make_shared<commit::TracerScene>(core::compile_scene(test_room()).tracer_scene);
+  const int w = 64, h = 48;
+  core::BandJob job;
+  job.camera = test::test_room_camera(w, h);
+  job.previous_camera = job.camera;
+  job.params = test::frame_params(K_MODE_PATH, 1, 1, h);
+  std::vector<std::unique_ptr<core::Tracer>> list;
+  list.push_back(make_test_tracer("cuda:0"));
+  list.push_back(make_test_tracer("embree"));
+  if (gpus > 1) list.push_back(make_test_tracer("cuda:1"));
+  core::RendererOptions options;
+  options.balancer = "none";
+  options.band_format = core::BandFormat::rgb16f;
+  core::Renderer renderer(std::move(list), options);
+  renderer.submit_commit(commit::CommitBuffer::full(room, 1));
+  std::unique_ptr<core::FramePost> gpu = tracers::make_frame_post("cuda:0", blend_only());
+  core::HostFramePost host(blend_only());
+  renderer.set_device_bands(gpu->cuda_device());
+  core::FrameBuffer floats, untouched;
+  for (int f = 0; f < 4; ++f) {
+    job.params.frame_index = static_cast<kuint>(f + 1);
+    const double factor = 1.0 / (f + 1);
+    renderer.set_packed_merge(false);
+    renderer.render(job, floats);
+    ASSERT_TRUE(renderer.gbuffer().empty());
+    host.set_blend_factor(factor);
+    host.process(floats, core::GBuffer{}, core::kEveryPixel);
+    renderer.set_packed_merge(true);
+    renderer.render(job, untouched);
+    ASSERT_FALSE(renderer.packed_frame().has_aux());
+    EXPECT_EQ(renderer.packed_device_rows().size(), gpus > 1 ? 2u : 1u) << "the CUDA bands stayed on their GPUs";
+    gpu->set_blend_factor(factor);
+    gpu->process_packed(renderer.packed_frame(), renderer.packed_device_rows(), core::kEveryPixel);
+    EXPECT_LT(max_relative_difference(gpu->image(), host.image()), 1e-5) << "frame " << f;
+  }
 }

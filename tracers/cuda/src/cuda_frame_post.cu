@@ -9,6 +9,7 @@
 #include <cuda_runtime.h>
 
 #include "cohort/kernel/atrous.h"
+#include "cohort/kernel/brigade_blend.h"
 #include "cohort/kernel/reproject.h"
 #include "cohort/kernel/svgf.h"
 #include "cohort/kernel/upsample.h"
@@ -61,6 +62,7 @@ __global__ void unpack_kernel(const unsigned char* colour, int half_colour, cons
   } else {
     reinterpret_cast<float4*>(rgba)[p] = reinterpret_cast<const float4*>(colour)[p];
   }
+  if (!texels) return;  // Brigade's blend alone: the colour is all it reads
   const KAuxTexel t = texels[p];
   depth[p] = t.depth;
   prev_depth[p] = t.prev_depth;
@@ -73,6 +75,11 @@ __global__ void unpack_kernel(const unsigned char* colour, int half_colour, cons
   id[p] = t.id;
   if (ycocgw) k_reproject_prepare(rgba, ycocgw, p);
   if (geometry) k_atrous_pack_geometry(depth, normal, geometry, p);
+}
+
+__global__ void brigade_blend_kernel(float* accumulated, const float* fresh, float f, int pixels) {
+  const int p = blockIdx.x * blockDim.x + threadIdx.x;
+  if (p < pixels) k_brigade_blend_pixel(accumulated, fresh, f, p);
 }
 
 __global__ void modulate_kernel(const float* rgba, const float* albedo, float* out, int pixels, int multiply) {
@@ -170,6 +177,7 @@ class CudaFramePost final : public core::FramePost {
       throw std::runtime_error("frame post on cuda:" + std::to_string(device) + ": no such CUDA device (" +
                                std::to_string(count) + " found)");
     }
+    core::check_post_options(options_);
     COHORT_CUDA(cudaSetDevice(device_));
     // The highest stream priority: the passes run while the same GPU renders the next frame, and would
     // otherwise wait behind the render kernel's blocks (measured: 9.6 ms of passes at 1080p on an H100).
@@ -190,14 +198,17 @@ class CudaFramePost final : public core::FramePost {
   }
 
   void process(const core::FrameBuffer& fresh, const core::GBuffer& g, const core::PathPattern& traced) override {
-    if (g.width != fresh.width || g.height != fresh.height)
+    const bool needs_gbuffer = options_.reproject || options_.atrous || traced.sparse();
+    if (needs_gbuffer && (g.width != fresh.width || g.height != fresh.height))
       throw std::invalid_argument("CudaFramePost: the G-buffer's size differs from the frame's");
     core::check_traced_pattern(options_, traced);
     if (!begin(fresh.width, fresh.height)) return;
     COHORT_CUDA(cudaEventRecord(events_[0], stream_));
     upload(fresh.rgba, frame_);
-    upload(g.depth, depth_);
-    upload(g.normal, normal_);
+    if (options_.reproject || options_.atrous || traced.sparse()) {
+      upload(g.depth, depth_);
+      upload(g.normal, normal_);
+    }
     if (options_.reproject) {
       upload(g.prev_depth, prev_depth_);
       upload(g.motion, motion_);
@@ -214,7 +225,8 @@ class CudaFramePost final : public core::FramePost {
   // a peer GPU (over NVLink where the GPUs have it).
   void process_packed(const core::BandBuffer& packed, const std::vector<core::DeviceBandRows>& on_device,
                       const core::PathPattern& traced) override {
-    if (!packed.has_aux())
+    const bool needs_aux = options_.reproject || options_.atrous || traced.sparse();
+    if (needs_aux && !packed.has_aux())
       throw std::invalid_argument("CudaFramePost: the packed frame has no aux planes (render with aux outputs)");
     core::check_traced_pattern(options_, traced);
     const int width = packed.width(), height = packed.height();
@@ -223,10 +235,11 @@ class CudaFramePost final : public core::FramePost {
     const size_t row_bytes = packed.row_bytes(), aux_row_bytes = size_t(width) * sizeof(KAuxTexel);
     COHORT_CUDA(cudaEventRecord(events_[0], stream_));
     unsigned char* colour = packed_colour_.scratch(packed.bytes());
-    KAuxTexel* texels = packed_aux_.scratch(pixels);
+    const bool aux = packed.has_aux();
+    KAuxTexel* texels = aux ? packed_aux_.scratch(pixels) : nullptr;
     auto& host = const_cast<core::BandBuffer&>(packed);
     registered_.ensure(packed.row(0), packed.bytes(), "the packed frame's colour");
-    registered_.ensure(host.aux_row(0), packed.aux_bytes(), "the packed frame's aux texels");
+    if (aux) registered_.ensure(host.aux_row(0), packed.aux_bytes(), "the packed frame's aux texels");
     // Rows from the host: every range no device band covers.
     std::vector<core::DeviceBandRows> bands = on_device;
     std::sort(bands.begin(), bands.end(), [](const auto& a, const auto& b) { return a.row_begin < b.row_begin; });
@@ -235,30 +248,31 @@ class CudaFramePost final : public core::FramePost {
       const size_t rows = size_t(to - from);
       COHORT_CUDA(cudaMemcpyAsync(colour + size_t(from) * row_bytes, packed.row(from), rows * row_bytes,
                                   cudaMemcpyHostToDevice, stream_));
-      COHORT_CUDA(cudaMemcpyAsync(texels + size_t(from) * width, host.aux_row(from), rows * aux_row_bytes,
-                                  cudaMemcpyHostToDevice, stream_));
+      if (aux)
+        COHORT_CUDA(cudaMemcpyAsync(texels + size_t(from) * width, host.aux_row(from), rows * aux_row_bytes,
+                                    cudaMemcpyHostToDevice, stream_));
     };
     int row = 0;
     for (const core::DeviceBandRows& b : bands) {
-      if (b.row_begin < row || b.row_end > height || b.row_end < b.row_begin || !b.band.colour || !b.band.aux)
+      if (b.row_begin < row || b.row_end > height || b.row_end < b.row_begin || !b.band.colour || (aux && !b.band.aux))
         throw std::invalid_argument("CudaFramePost: a band on a GPU overlaps another, lies outside the frame or has no aux texels");
       upload_rows(row, b.row_begin);
       const size_t rows = size_t(b.row_end - b.row_begin);
       copy_from_device(colour + size_t(b.row_begin) * row_bytes, b.band.colour, rows * row_bytes, b.band.cuda_device);
-      copy_from_device(texels + size_t(b.row_begin) * width, b.band.aux, rows * aux_row_bytes, b.band.cuda_device);
+      if (aux) copy_from_device(texels + size_t(b.row_begin) * width, b.band.aux, rows * aux_row_bytes, b.band.cuda_device);
       row = b.row_end;
     }
     upload_rows(row, height);
     COHORT_CUDA(cudaEventRecord(events_[1], stream_));
     // A sparse frame's YCoCg planes are those of its reconstruction, made after the unpack.
-    float* ycocgw = options_.reproject && !traced.sparse() ? ycocgw_.scratch(4 * pixels) : nullptr;
-    float* geometry = options_.atrous ? geometry_.scratch(4 * pixels) : nullptr;
+    float* ycocgw = options_.reproject && !traced.sparse() && aux ? ycocgw_.scratch(4 * pixels) : nullptr;
+    float* geometry = options_.atrous && aux ? geometry_.scratch(4 * pixels) : nullptr;
     unpack_kernel<<<blocks_for(pixels), kThreads, 0, stream_>>>(
         colour, packed.format() == core::BandFormat::rgb16f ? 1 : 0, texels, frame_.scratch(4 * pixels),
         depth_.scratch(pixels), prev_depth_.scratch(pixels), motion_.scratch(2 * pixels), normal_.scratch(3 * pixels),
         albedo_.scratch(3 * pixels), id_.scratch(pixels), ycocgw, geometry, static_cast<int>(pixels));
     COHORT_CUDA(cudaGetLastError());
-    run(width, height, traced, /*ycocgw_ready=*/ycocgw != nullptr, /*geometry_ready=*/true);
+    run(width, height, traced, /*ycocgw_ready=*/ycocgw != nullptr, /*geometry_ready=*/geometry != nullptr);
   }
 
   int cuda_device() const override { return device_; }
@@ -289,6 +303,7 @@ class CudaFramePost final : public core::FramePost {
     if (width != width_ || height != height_) {
       width_ = width, height_ = height;
       have_history_ = false;
+      have_blend_ = false;
     }
     return width > 0 && height > 0;
   }
@@ -337,6 +352,17 @@ class CudaFramePost final : public core::FramePost {
       parity_ ^= 1;
       have_history_ = true;
       current = to.rgba.data();
+    }
+    if (options_.blend) {
+      float* accumulated = blended_.scratch(4 * pixels);
+      if (!have_blend_ || blend_factor_ >= 1.0)
+        COHORT_CUDA(cudaMemcpyAsync(accumulated, current, 4 * pixels * sizeof(float), cudaMemcpyDeviceToDevice, stream_));
+      else
+        brigade_blend_kernel<<<blocks_for(pixels), kThreads, 0, stream_>>>(
+            accumulated, current, static_cast<float>(blend_factor_), static_cast<int>(pixels));
+      COHORT_CUDA(cudaGetLastError());
+      have_blend_ = true;
+      current = accumulated;
     }
     if (options_.atrous) {
       float* ping = ping_.scratch(4 * pixels);
@@ -438,7 +464,7 @@ class CudaFramePost final : public core::FramePost {
  public:
   const core::FrameBuffer& image() const override { return shown_; }
   double mean_history_length() const override { return mean_length_; }
-  void reset() override { have_history_ = false; }
+  void reset() override { have_history_ = false, have_blend_ = false; }
   std::string where() const override { return "cuda:" + std::to_string(device_); }
   core::FramePostDeviceTimes device_times() const override { return times_; }
 
@@ -470,12 +496,14 @@ class CudaFramePost final : public core::FramePost {
   cudaStream_t stream_ = nullptr;
   int width_ = 0, height_ = 0;
   bool have_history_ = false;
+  bool have_blend_ = false;  // blended_ holds an accumulated image of this size
   int parity_ = 0;
   int normal_squarings_ = 0;
   State state_[2];
   DeviceArray<float> frame_, depth_, prev_depth_, motion_, normal_, albedo_, ycocgw_, ping_, pong_, shown_device_;
   DeviceArray<float> reconstructed_, illumination_;  // a sparse frame filled, and its traced pixels' illumination
   DeviceArray<float> geometry_;  // normal and depth packed for the a-trous passes (kernel/atrous.h)
+  DeviceArray<float> blended_;   // Brigade's accumulated image (options.blend)
   DeviceArray<kuint> id_;
   DeviceArray<unsigned char> packed_colour_;
   DeviceArray<KAuxTexel> packed_aux_;

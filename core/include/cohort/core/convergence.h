@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "cohort/core/frame_buffer.h"
+#include "cohort/kernel/brigade_blend.h"
 #include "cohort/kernel/layout.h"
 
 namespace cohort::core {
@@ -52,7 +53,8 @@ class AdaptiveConvergence {
   double effective_frames_ = 0.0;
 };
 
-// Per-pixel blend, exposed for tests: returns (1 - f) * previous + f * fresh.
-inline float converge(float previous, float fresh, float f) { return previous + f * (fresh - previous); }
+// Per-pixel blend, exposed for tests: returns (1 - f) * previous + f * fresh (kernel/brigade_blend.h, which
+// a GPU's post runs too).
+inline float converge(float previous, float fresh, float f) { return k_brigade_blend(previous, fresh, f); }
 
 }  // namespace cohort::core

@@ -24,6 +24,10 @@ struct FramePostOptions {
   AtrousOptions atrous_options;
   // How a sparse frame (a render scale below 1) is filled before the reprojection: joint_bilateral or nearest.
   UpsampleMethod upsample = UpsampleMethod::joint_bilateral;
+  // Brigade's blend of whole frames (core/convergence.h) instead of the reprojection, with the factor the
+  // caller sets each frame (FramePost::set_blend_factor): where the post runs on a GPU, the bands then need
+  // not be merged nor blended on the host. Not with reproject or atrous.
+  bool blend = false;
 };
 
 // The options with the reprojection's luminance moments switched on exactly when the variance-guided
@@ -33,6 +37,9 @@ FramePostOptions with_history_moments(FramePostOptions options);
 // Throws std::invalid_argument unless a post with these options can take frames traced as `traced`: a
 // filter without reprojection takes blended frames, so it refuses sparse ones.
 void check_traced_pattern(const FramePostOptions& options, const PathPattern& traced);
+
+// Throws std::invalid_argument for options no post takes (the blend with the reprojection or the filter).
+void check_post_options(const FramePostOptions& options);
 
 // A GPU place's own clock for the last frame (CUDA events), to tell the bus from the passes.
 struct FramePostDeviceTimes {
@@ -63,6 +70,12 @@ class FramePost {
   // Where it runs, for logs and stats: "host", "cuda:0".
   virtual std::string where() const = 0;
   virtual FramePostDeviceTimes device_times() const { return {}; }
+  // The blend's factor for the next frame (options.blend): f from AdaptiveConvergence::next_factor; 1 (or
+  // more) starts the accumulation over from that frame.
+  void set_blend_factor(double f) { blend_factor_ = f; }
+
+ protected:
+  double blend_factor_ = 1.0;
 
  private:
   FrameBuffer unpacked_frame_;
@@ -83,7 +96,7 @@ class HostFramePost final : public FramePost {
   TemporalReprojection reprojection_;
   AtrousFilter atrous_;
   SparseUpsampler upsampler_;
-  FrameBuffer reconstructed_, filtered_, copy_;
+  FrameBuffer reconstructed_, filtered_, copy_, blended_;
   const FrameBuffer* shown_ = &copy_;
 };
 
