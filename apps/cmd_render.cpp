@@ -73,6 +73,7 @@ struct RenderArgs {
   float history_fix = core::AtrousOptions{}.history_fix_frames;
   float history_fix_stride = core::AtrousOptions{}.history_fix_stride;
   float history_fix_sigma = core::AtrousOptions{}.history_fix_sigma_scale;
+  float history_fix_min = core::AtrousOptions{}.history_fix_min_length;
   float anti_lag = -1.0f;     // < 0: ReprojectionOptions' default
   std::string post_on = "auto";
   std::string band_format = "rgb16f";
@@ -209,6 +210,7 @@ int run_render(const RenderArgs& a) {
     ao.history_fix_frames = a.history_fix;
     ao.history_fix_stride = a.history_fix_stride;
     ao.history_fix_sigma_scale = a.history_fix_sigma;
+    ao.history_fix_min_length = a.history_fix_min;
     post = tracers::make_frame_post(post_place, post_options);
     spdlog::info("{}{}{} on {}", reproject ? "reprojection" : "", reproject && atrous ? " and " : "",
                  atrous ? "the a-trous filter (" + std::to_string(ao.passes) + " passes, " + a.atrous_guide + " guide)"
@@ -538,9 +540,15 @@ void add_render_command(CLI::App& app, int& exit_code) {
       ->capture_default_str()
       ->check(CLI::Range(0.0f, 64.0f));
   cmd->add_option("--history-fix-stride", a->history_fix_stride,
-                  "pixels between the history fix's taps at a one-frame history (fewer as the history grows)")
+                  "pixels between the history fix's taps at a one-frame history (fewer as the history grows); 0: "
+                  "from the image height (1 at 180 rows, 2 at 360, 4 at 720)")
       ->capture_default_str()
-      ->check(CLI::Range(1.0f, 32.0f));
+      ->check(CLI::Range(0.0f, 32.0f));
+  cmd->add_option("--history-fix-min", a->history_fix_min,
+                  "the history fix leaves histories shorter than this many frames to the passes (1: a fresh "
+                  "sample; 1.5 also those the anti-lag cut to under half a frame; 0: fixes every short history)")
+      ->capture_default_str()
+      ->check(CLI::Range(0.0f, 64.0f));
   cmd->add_option("--history-fix-sigma", a->history_fix_sigma,
                   "the history fix's luminance stop as a multiple of the passes' (--atrous-sigma)")
       ->capture_default_str()

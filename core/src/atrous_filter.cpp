@@ -45,11 +45,15 @@ KHistoryFixParams history_fix_params(const AtrousOptions& options, int width, in
   p.normal_squarings = atrous_normal_squarings(options.normal_power);
   p.guided = guided ? 1 : 0;
   p.frames = options.history_fix_frames;
-  p.stride = std::max(options.history_fix_stride, 1.0f);
+  p.stride = options.history_fix_stride > 0.0f ? std::max(options.history_fix_stride, 1.0f)
+                                               : static_cast<float>(history_fix_stride_for_height(height));
   p.depth_sigma = options.depth_sigma;
+  p.min_length = options.history_fix_min_length;
   p.color_sigma = (guided ? options.variance_sigma : options.color_sigma) * options.history_fix_sigma_scale;
   return p;
 }
+
+int history_fix_stride_for_height(int height) { return std::max(1, (height + 90) / 180); }
 
 int atrous_passes_for_height(int height) {
   int passes = 1;

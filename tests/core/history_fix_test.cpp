@@ -124,6 +124,62 @@ TEST(HistoryFix, StrideShrinksAsTheHistoryGrows) {
   }
 }
 
+// With a least length, fresh samples (1 frame: disoccluded, or the anti-lag dropped the history) are left to
+// the passes exactly as they were, while the short histories above it are still smoothed.
+TEST(HistoryFix, FreshSamplesBelowTheLeastLengthAreLeftAlone) {
+  KHistoryFixParams p{};
+  p.frames = 6.0f;
+  p.stride = 2.0f;
+  p.min_length = 1.5f;
+  EXPECT_EQ(k_svgf_history_fix_stride(&p, 1.0f), 0);
+  EXPECT_EQ(k_svgf_history_fix_stride(&p, 1.4f), 0);
+  EXPECT_EQ(k_svgf_history_fix_stride(&p, 1.5f), 2);
+  EXPECT_EQ(k_svgf_history_fix_stride(&p, 5.0f), 1);
+  p.min_length = 0.0f;
+  EXPECT_EQ(k_svgf_history_fix_stride(&p, 1.0f), 2);
+
+  const GBuffer g = wall();
+  const FrameBuffer frame = lit(g, 0.5f, [](int, int) { return 1.0f; });
+  std::vector<float> length(g.pixels());
+  for (int y = 0; y < kH; ++y)
+    for (int x = 0; x < kW; ++x) length[size_t(y) * kW + x] = x < kW / 2 ? 1.0f : 3.0f;
+  AtrousOptions o = fix_only(8.0f);
+  o.history_fix_min_length = 1.5f;
+  AtrousFilter filter(o);
+  FrameBuffer fixed;
+  filter.apply(frame, g, fixed, AtrousHistory{nullptr, length.data()});
+  const FrameBuffer off = filtered(frame, g, length, 0.0f);
+  for (int y = 0; y < kH; ++y)
+    for (int x = 0; x < kW / 2; ++x)
+      for (int k = 0; k < 4; ++k) {
+        const size_t i = 4 * (size_t(y) * kW + x) + k;
+        ASSERT_EQ(fixed.rgba[i], off.rgba[i]) << x << "," << y;
+      }
+  const double before = mean_square_error(off, 0.5f, kW / 2 + 8, kW - 2, 2, kH - 2);
+  const double after = mean_square_error(fixed, 0.5f, kW / 2 + 8, kW - 2, 2, kH - 2);
+  EXPECT_LT(after, before / 4.0) << "before " << before << " after " << after;
+}
+
+// Stride 0 takes the stride from the image height, one pixel per 180 rows (the door's lip grows with the
+// image); a stride given is kept.
+TEST(HistoryFix, StrideFromTheImageHeight) {
+  EXPECT_EQ(history_fix_stride_for_height(108), 1);
+  EXPECT_EQ(history_fix_stride_for_height(180), 1);
+  EXPECT_EQ(history_fix_stride_for_height(269), 1);
+  EXPECT_EQ(history_fix_stride_for_height(270), 2);
+  EXPECT_EQ(history_fix_stride_for_height(360), 2);
+  EXPECT_EQ(history_fix_stride_for_height(720), 4);
+  EXPECT_EQ(history_fix_stride_for_height(1080), 6);
+  EXPECT_EQ(history_fix_stride_for_height(1), 1);
+  AtrousOptions o;
+  o.history_fix_frames = 6.0f;
+  EXPECT_EQ(o.history_fix_stride, 0.0f) << "the default is the height's";
+  EXPECT_EQ(history_fix_params(o, 640, 360, true).stride, 2.0f);
+  EXPECT_EQ(history_fix_params(o, 320, 180, true).stride, 1.0f);
+  o.history_fix_stride = 3.0f;
+  EXPECT_EQ(history_fix_params(o, 320, 180, true).stride, 3.0f);
+}
+
 // A short history everywhere, no noise, light 1 on one side of an edge and 5 on the other: each side keeps
 // its own light exactly, whether the edge is a depth step, a fold (normals at right angles) or another entity
 // at the same depth and normal.

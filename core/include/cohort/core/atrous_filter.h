@@ -40,14 +40,18 @@ struct AtrousOptions {
   // History fix (kernel/svgf.h's k_svgf_history_fix_pixel, NRD's HistoryFix): before the passes, a pixel whose
   // reprojected history is shorter than this many frames gets an extra edge-aware blur, taps
   // `history_fix_stride` pixels apart at a one-frame history and closer as it grows; 0: off. Needs the history
-  // (AtrousHistory::length). Off by default. `--history-fix 6` (stride 1, 4x the passes' sigma) was best on
-  // the test map's scenario at 320x180 (door 4 frames after it stops 0.118 -> 0.099, mean FLIP 0.1176 ->
-  // 0.1155); at 640x360 it leaves the door at 0.111 (mean FLIP -3 %), and it costs 0.33-0.35 ms of a 1080p
-  // frame on an H100 (issue 17's budget is 1.5 ms) and about half again of the host's filter where histories
-  // are short. Not yet measured against 1,024-spp references at 720p (docs/denoising.md).
+  // (AtrousHistory::length). Off by default (docs/denoising.md): `--history-fix 6` brings the test map's door 4
+  // frames after it stops to 0.098 at 320x180 (0.118 without; issue 17 asks <= 0.1) and the frame's mean FLIP
+  // down 1.8-3.9 %, but at 640x360 no setting reaches 0.1 without the moving door's FLIP 12 % worse, the
+  // camera path's mean FLIP gets 0.8-2.2 % worse at 192x108, and on an H100 it costs 0.33-0.35 ms at 1080p.
   float history_fix_frames = 0.0f;
-  float history_fix_stride = 1.0f;
+  // 0: history_fix_stride_for_height (1 at 180 rows, 2 at 360, 4 at 720, 6 at 1080).
+  float history_fix_stride = 0.0f;
   float history_fix_sigma_scale = 4.0f;  // the fix's luminance stop: the passes' sigma times this
+  // Histories shorter than this are left to the passes (a length is the kept history plus the new frame: 1 is a
+  // fresh sample, just above 1 one whose history the anti-lag nearly dropped). 1.5 spared the moving door at 320x180 (every figure better than without the fix) but cost the door after
+  // it stops at 640x360 (0.1024 -> 0.1045) and the camera path (docs/denoising.md); 0: every short history.
+  float history_fix_min_length = 0.0f;
 };
 
 // "variance", "variance-of-mean" or "fixed" (std::invalid_argument otherwise, naming the word).
@@ -68,6 +72,11 @@ struct AtrousHistory {
 // per doubling (3 at 1080). Measured on the test map at 192x108 (docs/denoising.md): more passes than
 // that blur lighting detail that FLIP sees, and reprojected frames need little spatial help.
 int atrous_passes_for_height(int height);
+
+// The history fix's stride at a one-frame history for a frame of this height (history_fix_stride 0): one pixel
+// per 180 rows, rounded. The door after it stops was best at stride 1 at 180 rows and 2-3 at 360 (its lip
+// grows with the image); 720 and 1080 rows follow the rule unmeasured.
+int history_fix_stride_for_height(int height);
 
 // The history fix's parameters for a frame of this size (guided: the variance guide's planes, variance in alpha).
 KHistoryFixParams history_fix_params(const AtrousOptions& options, int width, int height, bool guided);

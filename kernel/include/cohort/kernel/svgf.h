@@ -26,6 +26,9 @@
  *                          squared, so the passes see the noise the blur left. Taps are not weighted by
  *                          their own history length (inverse variance): that pulled stale light from long
  *                          histories into pixels the anti-lag had just shortened (docs/denoising.md).
+ *                          With `min_length`, histories shorter than that (a fresh sample: disoccluded, or
+ *                          the anti-lag dropped the history) are left to the passes, whose spatial variance
+ *                          estimate already lets them blur such pixels hard.
  *
  * Planes: illumination RGBA floats (the passes keep the variance in alpha), moments two floats a pixel,
  * history length one; normal and depth packed (k_atrous_pack_geometry) for the estimate and the passes:
@@ -155,13 +158,15 @@ typedef struct KHistoryFixParams {
   float stride;         /* pixels between taps at a one-frame history */
   float depth_sigma;    /* relative depth difference per pixel of tap distance (the a-trous filter's) */
   float color_sigma;    /* the luminance stop: standard deviations guided, relative difference unguided */
+  float min_length;     /* a history shorter than this is left alone too; 0: none (a fresh sample is 1 frame) */
+  float pad0;
 } KHistoryFixParams;
 
 /* The taps' spacing for a history of `length` frames: `stride` at one frame, down to 1 pixel just short of
- * `frames`; 0 where the pixel is left alone (history long enough, or none at all: no reprojection, or
- * non-finite samples that never entered it). */
+ * `frames`; 0 where the pixel is left alone (history long enough, shorter than `min_length`, or none at all:
+ * no reprojection, or non-finite samples that never entered it). */
 KFN kint k_svgf_history_fix_stride(const KHistoryFixParams* p, float length) {
-  if (!(length > 0.0f) || !(length < p->frames)) return 0;
+  if (!(length > 0.0f) || !(length < p->frames) || length < p->min_length) return 0;
   float shortness = p->frames > 1.0f ? (p->frames - k_fmax(length, 1.0f)) / (p->frames - 1.0f) : 1.0f;
   kint stride = (kint)(1.0f + (p->stride - 1.0f) * shortness + 0.5f);
   return stride < 1 ? 1 : stride;
