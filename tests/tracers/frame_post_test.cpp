@@ -323,6 +323,27 @@ TEST(FramePost, PackedMergeUnpacksToTheFloatMergeEverywhere) {
   }
 }
 
+namespace {
+
+// cuda:0, Embree and cuda:1 where there is one, the rows split evenly, bands as RGB halves, the test room
+// committed.
+std::unique_ptr<core::Renderer> gpu_room_renderer(int gpus) {
+  using namespace cohort::test;
+  auto room = std::make_shared<commit::TracerScene>(core::compile_scene(test_room()).tracer_scene);
+  std::vector<std::unique_ptr<core::Tracer>> list;
+  list.push_back(make_test_tracer("cuda:0"));
+  list.push_back(make_test_tracer("embree"));
+  if (gpus > 1) list.push_back(make_test_tracer("cuda:1"));
+  core::RendererOptions options;
+  options.balancer = "none";
+  options.band_format = core::BandFormat::rgb16f;
+  auto renderer = std::make_unique<core::Renderer>(std::move(list), options);
+  renderer->submit_commit(commit::CommitBuffer::full(room, 1));
+  return renderer;
+}
+
+}  // namespace
+
 // CUDA tracers' bands can stay on their GPUs (Renderer::set_device_bands): the post-processing on cuda:0
 // copies them device to device or from the peer GPU, host bands (Embree's rows) come up between them,
 // and the picture is the one the bands give through the host.
@@ -330,20 +351,13 @@ TEST(FramePost, CudaBandsStayingOnTheGpusGiveTheHostRoundTripsPicture) {
   using namespace cohort::test;
   const int gpus = tracers::device_count("cuda");
   if (gpus == 0) GTEST_SKIP() << "no CUDA device (or a build without CUDA)";
-  auto room = std::make_shared<commit::TracerScene>(core::compile_scene(test_room()).tracer_scene);
   const int w = 64, h = 48;
   core::BandJob job = aux_room_job(w, h);
-  std::vector<std::string> kinds = {"cuda:0", "embree"};
-  if (gpus > 1) kinds.push_back("cuda:1");
+  const size_t cuda_bands = gpus > 1 ? 2 : 1;
   std::vector<core::FrameBuffer> shown[2];
   for (int on_device = 0; on_device < 2; ++on_device) {
-    std::vector<std::unique_ptr<core::Tracer>> list;
-    for (const std::string& k : kinds) list.push_back(make_test_tracer(k));
-    core::RendererOptions options;
-    options.balancer = "none";
-    options.band_format = core::BandFormat::rgb16f;
-    core::Renderer renderer(std::move(list), options);
-    renderer.submit_commit(commit::CommitBuffer::full(room, 1));
+    std::unique_ptr<core::Renderer> room_renderer = gpu_room_renderer(gpus);
+    core::Renderer& renderer = *room_renderer;
     std::unique_ptr<core::FramePost> post = tracers::make_frame_post("cuda:0", both());
     ASSERT_EQ(post->cuda_device(), 0);
     renderer.set_packed_merge(true);
@@ -353,7 +367,7 @@ TEST(FramePost, CudaBandsStayingOnTheGpusGiveTheHostRoundTripsPicture) {
       job.params.frame_index = static_cast<kuint>(f + 1);
       renderer.render(job, untouched);
       const std::vector<core::DeviceBandRows>& rows = renderer.packed_device_rows();
-      EXPECT_EQ(rows.size(), on_device ? kinds.size() - 1 : 0u) << "every CUDA band, and only those";
+      EXPECT_EQ(rows.size(), on_device ? cuda_bands : 0u) << "every CUDA band, and only those";
       for (const core::DeviceBandRows& r : rows) EXPECT_LT(r.row_begin, r.row_end);
       post->process_packed(renderer.packed_frame(), rows, core::kEveryPixel);
       shown[on_device].push_back(post->image());
@@ -427,7 +441,9 @@ TEST(FramePost, TheBlendComesWithoutReprojectionOrFilter) {
   for (const core::FramePostOptions& o : {with_reprojection, with_filter}) {
     EXPECT_THROW(core::HostFramePost{o}, std::invalid_argument);
     EXPECT_THROW(tracers::make_frame_post("host", o), std::invalid_argument);
-    if (tracers::device_count("cuda") > 0) EXPECT_THROW(tracers::make_frame_post("cuda:0", o), std::invalid_argument);
+    if (tracers::device_count("cuda") > 0) {
+      EXPECT_THROW(tracers::make_frame_post("cuda:0", o), std::invalid_argument);
+    }
   }
 }
 
@@ -452,21 +468,13 @@ TEST(FramePost, CudaBlendsAsTheHost) {
     }
   }
   // Path-traced frames without aux planes through the packed merge, the CUDA bands left on their GPUs.
-  auto room = std::make_shared<commit::TracerScene>(core::compile_scene(test_room()).tracer_scene);
   const int w = 64, h = 48;
   core::BandJob job;
   job.camera = test::test_room_camera(w, h);
   job.previous_camera = job.camera;
   job.params = test::frame_params(K_MODE_PATH, 1, 1, h);
-  std::vector<std::unique_ptr<core::Tracer>> list;
-  list.push_back(make_test_tracer("cuda:0"));
-  list.push_back(make_test_tracer("embree"));
-  if (gpus > 1) list.push_back(make_test_tracer("cuda:1"));
-  core::RendererOptions options;
-  options.balancer = "none";
-  options.band_format = core::BandFormat::rgb16f;
-  core::Renderer renderer(std::move(list), options);
-  renderer.submit_commit(commit::CommitBuffer::full(room, 1));
+  std::unique_ptr<core::Renderer> room_renderer = gpu_room_renderer(gpus);
+  core::Renderer& renderer = *room_renderer;
   std::unique_ptr<core::FramePost> gpu = tracers::make_frame_post("cuda:0", blend_only());
   core::HostFramePost host(blend_only());
   renderer.set_device_bands(gpu->cuda_device());
