@@ -86,6 +86,7 @@ INSTANTIATE_TEST_SUITE_P(Modes, Agreement,
                                            Case{K_MODE_PATH, 1, "path_all_pick", 1, K_LIGHTS_ALL},
                                            Case{K_MODE_PATH, 1, "path_no_emissive_nee", 1, K_LIGHTS_TREE, 0},
                                            Case{K_MODE_PATH, 1, "path_gather", 2, K_LIGHTS_GATHER},
+                                           Case{K_MODE_PATH, 2, "path_gather_first", 2, K_LIGHTS_GATHER_FIRST},
                                            Case{K_MODE_DIRECT, 0, "direct"}, Case{K_MODE_ALBEDO, 0, "albedo"},
                                            Case{K_MODE_NORMALS, 0, "normals"},
                                            // Embree draws its heat map on Cohort's own BVH, as OpenCL does.

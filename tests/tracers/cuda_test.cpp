@@ -110,7 +110,8 @@ TEST_P(CudaAgreement, MatchesEmbree) {
 INSTANTIATE_TEST_SUITE_P(Modes, CudaAgreement,
                          ::testing::Values(ModeCase{K_MODE_PATH, 1, "path"}, ModeCase{K_MODE_PATH, 3, "path3"},
                                            ModeCase{K_MODE_DIRECT, 0, "direct"}, ModeCase{K_MODE_ALBEDO, 0, "albedo"},
-                                           ModeCase{K_MODE_PATH, 1, "path_gather", 2, K_LIGHTS_GATHER}),
+                                           ModeCase{K_MODE_PATH, 1, "path_gather", 2, K_LIGHTS_GATHER},
+                                           ModeCase{K_MODE_PATH, 1, "path_gather_first", 2, K_LIGHTS_GATHER_FIRST}),
                          [](const auto& info) { return std::string(info.param.name); });
 
 // Several GPUs render different bands of one frame; the merged frame equals one GPU's whole frame.
@@ -360,6 +361,8 @@ INSTANTIATE_TEST_SUITE_P(LightSampling, CudaShadowWalk,
                          ::testing::Values(ShadowWalkCase{K_LIGHTS_TREE, 1, 0.0f, 88, 8, "tree1"},
                                            ShadowWalkCase{K_LIGHTS_TREE, 2, 0.03f, 88, 8, "tree2_roulette"},
                                            ShadowWalkCase{K_LIGHTS_GATHER, 4, 0.03f, 88, 8, "gather4_roulette"},
+                                           ShadowWalkCase{K_LIGHTS_GATHER_FIRST, 4, 0.03f, 88, 8,
+                                                          "gather_first4_roulette"},
                                            ShadowWalkCase{K_LIGHTS_EVERY, 0, 0.03f, 4, 2, "every_6_lights"},
                                            ShadowWalkCase{K_LIGHTS_EVERY, 0, 0.03f, 88, 8, "every_past_the_slots"}),
                          [](const auto& info) { return std::string(info.param.name); });

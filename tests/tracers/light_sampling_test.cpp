@@ -1,7 +1,8 @@
 // Light sampling at a cost that does not grow with the light count, checked for bias against the
 // references: the light tree (the default), the all-lights pick and gather converge to the every-light
 // image on a floor under 96 overlapping lights; gather is the every-light image where no point has more
-// lights in range than its budget; emissive triangles sampled with MIS converge to the
+// lights in range than its budget; gather-first (gather at the camera ray's hit, the tree after a bounce)
+// converges to it with bounces; emissive triangles sampled with MIS converge to the
 // bounce-only estimate with less noise; lights with defects are skipped and no pixel goes NaN.
 #include <gtest/gtest.h>
 
@@ -11,6 +12,9 @@
 #include <random>
 
 #include "cohort/kernel/light_tree.h"
+#ifdef COHORT_HAVE_EMBREE
+#include "cohort/tracers/embree_tracer.h"
+#endif
 #include "test_scenes.h"
 #include "test_tracers.h"
 
@@ -171,6 +175,78 @@ TEST(LightSampling, GatherIsEveryLightWithinItsBudget) {
   EXPECT_GT(pixel_rmse(one, every), 0.0) << "with one ray per hit, points under two lights must be sampled";
 }
 
+// Gather-first (K_LIGHTS_GATHER_FIRST): gather at the camera ray's hit, one tree sample at the vertices
+// after a bounce. In the test room (three lights, a budget of two: points under all three are sampled) with
+// two bounces, its block means must match the every-light image's as closely as the two images' own noise
+// allows (a 1 / light_samples scale left on the gathered vertex, or a gathered sample counted at the tree's
+// scale, is off by a factor there). Direct light alone is gather's image, float for float (the camera ray's
+// hit is the only vertex); with bounces it is neither gather's nor the tree's, and it traces fewer shadow
+// rays than gather and more than the tree.
+TEST(LightSampling, GatherFirstGathersAtTheCameraHitAndMatchesEveryLight) {
+  if (!tracer_runs_here("embree")) GTEST_SKIP();
+  scene::Scene room = test_room();
+  ASSERT_EQ(room.lights.size(), 3u);
+  const int w = 64, h = 48;
+  const KCamera cam = test_room_camera(w, h);
+  auto tracer = make_test_tracer("embree");
+  auto render_with = [&](kuint mode, kuint sampling, kuint samples, kuint frame, kuint spp) {
+    KFrameParams p = frame_params(mode, spp, 2, h);
+    p.soft_shadow_scale = 1.0f;
+    p.shadow_rr = 0.03f;
+    p.light_sampling = sampling;
+    p.light_samples = samples;
+    p.frame_index = frame;
+    return render(*tracer, room, cam, p);
+  };
+  const core::FrameBuffer direct_gather = render_with(K_MODE_DIRECT, K_LIGHTS_GATHER, 2, 1, 4);
+  const core::FrameBuffer direct_first = render_with(K_MODE_DIRECT, K_LIGHTS_GATHER_FIRST, 2, 1, 4);
+  for (size_t i = 0; i < direct_gather.rgba.size(); ++i)
+    ASSERT_EQ(direct_first.rgba[i], direct_gather.rgba[i])
+        << "direct light: pixel " << (i / 4) % size_t(w) << "," << (i / 4) / size_t(w);
+
+  const core::FrameBuffer every_a = render_with(K_MODE_PATH, K_LIGHTS_EVERY, 1, 1, 64);
+  const core::FrameBuffer every_b = render_with(K_MODE_PATH, K_LIGHTS_EVERY, 1, 2, 64);
+  const core::FrameBuffer first_a = render_with(K_MODE_PATH, K_LIGHTS_GATHER_FIRST, 2, 3, 64);
+  const core::FrameBuffer first_b = render_with(K_MODE_PATH, K_LIGHTS_GATHER_FIRST, 2, 4, 64);
+  expect_finite(first_a, "gather-first");
+  const double mean = mean_luminance(every_a);
+  ASSERT_GT(mean, 0.01) << "the room should be lit";
+  const double noise_every = rms_difference(block_means(every_a, 4), block_means(every_b, 4));
+  const double noise_first = rms_difference(block_means(first_a, 4), block_means(first_b, 4));
+  const double bias = rms_difference(block_means(first_a, 4), block_means(every_b, 4));
+  const double mean_error = std::fabs(mean_luminance(first_a) - mean) / mean;
+  std::cout << "gather-first 2: block RMS vs every light " << bias << ", seeds: every " << noise_every
+            << ", gather-first " << noise_first << ", mean error " << 100.0 * mean_error << "%\n";
+  // Independent renders of one expectation: their block difference is about
+  // sqrt((noise_first^2 + noise_every^2) / 2).
+  EXPECT_LT(bias, 1.25 * std::sqrt(0.5 * (noise_first * noise_first + noise_every * noise_every)) + 1e-4 * mean);
+  EXPECT_LT(mean_error, 0.01);
+
+  const core::FrameBuffer gather_a = render_with(K_MODE_PATH, K_LIGHTS_GATHER, 2, 3, 64);
+  const core::FrameBuffer tree_a = render_with(K_MODE_PATH, K_LIGHTS_TREE, 1, 3, 64);
+  EXPECT_GT(pixel_rmse(first_a, gather_a), 0.0) << "the bounces' vertices must take the tree, not gather";
+  EXPECT_GT(pixel_rmse(first_a, tree_a), 0.0) << "the camera ray's hit must gather";
+#ifdef COHORT_HAVE_EMBREE
+  tracers::EmbreeTracer embree;
+  embree.apply(commit::CommitBuffer::full(
+      std::make_shared<commit::TracerScene>(core::compile_scene(room).tracer_scene), 1));
+  auto shadow_rays = [&](kuint sampling, kuint samples) {
+    core::BandJob job;
+    job.camera = cam;
+    job.params = frame_params(K_MODE_PATH, 4, 2, h);
+    job.params.light_sampling = sampling;
+    job.params.light_samples = samples;
+    return embree.record_rays(job).shadow.size();
+  };
+  const size_t tree_rays = shadow_rays(K_LIGHTS_TREE, 1), first_rays = shadow_rays(K_LIGHTS_GATHER_FIRST, 2),
+               gather_rays = shadow_rays(K_LIGHTS_GATHER, 2);
+  std::cout << "shadow rays, 4 spp: tree 1 " << tree_rays << ", gather-first 2 " << first_rays << ", gather 2 "
+            << gather_rays << "\n";
+  EXPECT_LT(tree_rays, first_rays);
+  EXPECT_LT(first_rays, gather_rays);
+#endif
+}
+
 // An emissive panel over a floor, no lights: one bounce finds the panel by chance, NEE with MIS aims at
 // it. Both estimate the same radiance; MIS with far less noise.
 TEST(LightSampling, EmissiveTrianglesWithMisMatchBounceOnly) {
@@ -246,7 +322,7 @@ TEST(LightSampling, LightsWithDefectsAreSkippedAndNoPixelIsNaN) {
   for (const std::string& kind : built_tracers()) {
     if (!tracer_runs_here(kind)) continue;
     auto tracer = make_test_tracer(kind);
-    for (kuint sampling : {K_LIGHTS_TREE, K_LIGHTS_ALL, K_LIGHTS_EVERY, K_LIGHTS_GATHER}) {
+    for (kuint sampling : {K_LIGHTS_TREE, K_LIGHTS_ALL, K_LIGHTS_EVERY, K_LIGHTS_GATHER, K_LIGHTS_GATHER_FIRST}) {
       for (kuint frame = 0; frame < 3; ++frame) {
         KFrameParams p = frame_params(K_MODE_PATH, 2, 2, h);
         p.light_sampling = sampling;

@@ -98,6 +98,23 @@ KFN int k_lights_one_ray_each(const KFrameParams* params) {
          params->light_sampling == K_LIGHTS_EVERY;
 }
 
+/* The light sampling of one vertex of a path (what k_direct_lighting reads from its params): the frame's,
+ * except with K_LIGHTS_GATHER_FIRST, which gathers (K_LIGHTS_GATHER, light_samples shadow rays at most) at
+ * the camera ray's hit and takes one tree sample at every vertex after a bounce. Why: most of the tree's
+ * noise on a map where several lights reach a point but walls and pillars hide some of them (the large
+ * map) is in the direct light the eye sees; a bounce vertex's light is already spread by the bounce's own
+ * sampling, so a ray per light in range buys less there for the same rays. Each vertex is unbiased on its
+ * own, so the path is. light_samples 0 stays `every` at every vertex. */
+KFN void k_vertex_light_sampling(KFrameParams* vertex_params, kuint bounce) {
+  if (vertex_params->light_sampling != K_LIGHTS_GATHER_FIRST || vertex_params->light_samples == 0u) return;
+  if (bounce == 0u) {
+    vertex_params->light_sampling = K_LIGHTS_GATHER;
+  } else {
+    vertex_params->light_sampling = K_LIGHTS_TREE;
+    vertex_params->light_samples = 1u;
+  }
+}
+
 /* Next-event estimation toward the Doom 3 lights, four ways (KFrameParams.light_sampling):
  * - K_LIGHTS_EVERY (or light_samples == 0): every light that reaches the point, one shadow ray each
  *   (as Doom 3 draws every interaction; lowest noise where few lights overlap, cost grows with them).
@@ -108,6 +125,7 @@ KFN int k_lights_one_ray_each(const KFrameParams* params) {
  * - K_LIGHTS_GATHER: `every` among the lights whose volume holds the point, found through the tree, while
  *   there are at most light_samples of them; beyond that at most light_samples shadow rays, each light
  *   with a known probability (light_gather.h).
+ * (K_LIGHTS_GATHER_FIRST reaches here as one of these, per vertex: k_vertex_light_sampling.)
  * Each sample's shadow ray goes to the queue with its value (shadow_queue.h), which adds the values of the
  * visible ones, in order, to the vertex's direct sum. */
 KFN void k_direct_lighting(KTraceCtx* ctx, const KFrameParams* params, const KSurface* sf, KVec3 wo, float path_weight,
@@ -380,6 +398,7 @@ KFN int k_path_hit_queued(KTraceCtx* ctx, const KFrameParams* params, KPathState
     sf.roughness = k_fmax(sf.roughness, K_REGULARIZED_ROUGHNESS);
     vertex_params.spec_boost = 1.0f;
   }
+  k_vertex_light_sampling(&vertex_params, s->bounce);
   k_apply_blend_lights(scene, sf.position, &s->radiance, &s->throughput);
   KVec3 contribution = sf.emission;
   if (s->bounce > 0u && emissive_nee && v3_max_component(sf.emission) > 0.0f) {
@@ -404,7 +423,8 @@ KFN int k_path_hit_queued(KTraceCtx* ctx, const KFrameParams* params, KPathState
   vertex->throughput = s->throughput;
   vertex->clamp = s->bounce > 0u ? params->firefly_clamp : 0.0f;
   vertex->base = contribution;
-  vertex->direct_scale = k_lights_one_ray_each(params) ? 0.0f : 1.0f / (float)params->light_samples;
+  vertex->direct_scale =
+      k_lights_one_ray_each(&vertex_params) ? 0.0f : 1.0f / (float)vertex_params.light_samples;
   vertex->has_emissive = (kuint)emissive_nee;
   if (shadows->count == 0u) s->radiance = v3_add(s->radiance, k_vertex_light_sum(vertex));
 
