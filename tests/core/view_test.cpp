@@ -101,8 +101,8 @@ TEST(FrameDefaults, LightSamplingNamesRoundTrip) {
   EXPECT_EQ(light_sampling_mode("all"), K_LIGHTS_ALL);
   EXPECT_EQ(light_sampling_mode("every"), K_LIGHTS_EVERY);
   EXPECT_EQ(light_sampling_mode("gather"), K_LIGHTS_GATHER);
-  EXPECT_EQ(light_sampling_mode(names[4]), K_LIGHTS_GATHER_FIRST);
-  EXPECT_EQ(names[4], "gather-first");
+  EXPECT_EQ(light_sampling_mode(names[4]), K_LIGHTS_IN_RANGE);
+  EXPECT_EQ(names[4], "in-range");
   EXPECT_THROW(light_sampling_mode("bvh"), std::invalid_argument);
 }
 

@@ -86,7 +86,6 @@ INSTANTIATE_TEST_SUITE_P(Modes, Agreement,
                                            Case{K_MODE_PATH, 1, "path_all_pick", 1, K_LIGHTS_ALL},
                                            Case{K_MODE_PATH, 1, "path_no_emissive_nee", 1, K_LIGHTS_TREE, 0},
                                            Case{K_MODE_PATH, 1, "path_gather", 2, K_LIGHTS_GATHER},
-                                           Case{K_MODE_PATH, 2, "path_gather_first", 2, K_LIGHTS_GATHER_FIRST},
                                            Case{K_MODE_DIRECT, 0, "direct"}, Case{K_MODE_ALBEDO, 0, "albedo"},
                                            Case{K_MODE_NORMALS, 0, "normals"},
                                            // Embree draws its heat map on Cohort's own BVH, as OpenCL does.
@@ -94,7 +93,8 @@ INSTANTIATE_TEST_SUITE_P(Modes, Agreement,
                          [](const auto& info) { return std::string(info.param.name); });
 
 // The light tree's descent (more lights than K_LIGHT_TREE_GATHER overlap), the emissive-triangle
-// sampling and gather's choice among more lights than its budget give the same image on both tracers.
+// sampling, gather's choice among more lights than its budget and the pick among every light in range
+// give the same image on both tracers.
 TEST(AgreementManyLights, EmbreeAndOpenCLImagesMatch) {
   std::vector<std::string> names = built_tracers();
   if (names.size() < 2 || !tracer_runs_here("opencl")) GTEST_SKIP() << "needs both the Embree and the OpenCL tracer";
@@ -119,6 +119,15 @@ TEST(AgreementManyLights, EmbreeAndOpenCLImagesMatch) {
   b = render(*opencl, s, cam, params);
   error = rgb_rmse(a, b, &mean);
   std::cout << "many lights, gather 4: RMSE embree/opencl " << error << ", mean " << mean << "\n";
+  EXPECT_GT(mean, 0.05);
+  EXPECT_LT(error, 0.005 * mean);
+  // One light among every light in range of the point, without the tree's descent.
+  params.light_sampling = K_LIGHTS_IN_RANGE;
+  params.light_samples = 1;
+  a = render(*embree, s, cam, params);
+  b = render(*opencl, s, cam, params);
+  error = rgb_rmse(a, b, &mean);
+  std::cout << "many lights, in range: RMSE embree/opencl " << error << ", mean " << mean << "\n";
   EXPECT_GT(mean, 0.05);
   EXPECT_LT(error, 0.005 * mean);
 }

@@ -98,34 +98,19 @@ KFN int k_lights_one_ray_each(const KFrameParams* params) {
          params->light_sampling == K_LIGHTS_EVERY;
 }
 
-/* The light sampling of one vertex of a path (what k_direct_lighting reads from its params): the frame's,
- * except with K_LIGHTS_GATHER_FIRST, which gathers (K_LIGHTS_GATHER, light_samples shadow rays at most) at
- * the camera ray's hit and takes one tree sample at every vertex after a bounce. Why: most of the tree's
- * noise on a map where several lights reach a point but walls and pillars hide some of them (the large
- * map) is in the direct light the eye sees; a bounce vertex's light is already spread by the bounce's own
- * sampling, so a ray per light in range buys less there for the same rays. Each vertex is unbiased on its
- * own, so the path is. light_samples 0 stays `every` at every vertex. */
-KFN void k_vertex_light_sampling(KFrameParams* vertex_params, kuint bounce) {
-  if (vertex_params->light_sampling != K_LIGHTS_GATHER_FIRST || vertex_params->light_samples == 0u) return;
-  if (bounce == 0u) {
-    vertex_params->light_sampling = K_LIGHTS_GATHER;
-  } else {
-    vertex_params->light_sampling = K_LIGHTS_TREE;
-    vertex_params->light_samples = 1u;
-  }
-}
-
-/* Next-event estimation toward the Doom 3 lights, four ways (KFrameParams.light_sampling):
+/* Next-event estimation toward the Doom 3 lights, five ways (KFrameParams.light_sampling):
  * - K_LIGHTS_EVERY (or light_samples == 0): every light that reaches the point, one shadow ray each
  *   (as Doom 3 draws every interaction; lowest noise where few lights overlap, cost grows with them).
  * - K_LIGHTS_TREE (default): per light sample, one light picked through the light tree among those
  *   whose volume holds the point (light_tree.h has the pdf), one shadow ray toward it.
+ * - K_LIGHTS_IN_RANGE: the same without the tree's descent: one light per sample picked in proportion to
+ *   its unshadowed contribution among every light whose volume holds the point (cost grows with those, not
+ *   with the map's lights).
  * - K_LIGHTS_ALL: per light sample, one light picked over every light of the map in proportion to its
  *   unshadowed contribution (the reference for the tree: same pick, cost grows with the map).
  * - K_LIGHTS_GATHER: `every` among the lights whose volume holds the point, found through the tree, while
  *   there are at most light_samples of them; beyond that at most light_samples shadow rays, each light
  *   with a known probability (light_gather.h).
- * (K_LIGHTS_GATHER_FIRST reaches here as one of these, per vertex: k_vertex_light_sampling.)
  * Each sample's shadow ray goes to the queue with its value (shadow_queue.h), which adds the values of the
  * visible ones, in order, to the vertex's direct sum. */
 KFN void k_direct_lighting(KTraceCtx* ctx, const KFrameParams* params, const KSurface* sf, KVec3 wo, float path_weight,
@@ -156,9 +141,11 @@ KFN void k_direct_lighting(KTraceCtx* ctx, const KFrameParams* params, const KSu
     KVec3 chosen_contrib = v3s(0.0f);
     float pdf = 0.0f;
     float u_pick = k_rng_next(rng);
-    if (params->light_sampling == K_LIGHTS_TREE) {
+    if (params->light_sampling == K_LIGHTS_TREE || params->light_sampling == K_LIGHTS_IN_RANGE) {
       float u_descend = k_rng_next(rng);
-      chosen = k_light_tree_pick(scene, sf, wo, params->spec_boost, u_descend, u_pick, &chosen_contrib, &pdf);
+      kuint descend_above = params->light_sampling == K_LIGHTS_TREE ? K_LIGHT_TREE_GATHER : K_NONE;
+      chosen = k_light_tree_pick(scene, sf, wo, params->spec_boost, descend_above, u_descend, u_pick,
+                                 &chosen_contrib, &pdf);
     } else {
       float total = 0.0f, chosen_weight = 0.0f;
       for (kuint i = 0u; i < scene->light_count; ++i) {
@@ -398,7 +385,6 @@ KFN int k_path_hit_queued(KTraceCtx* ctx, const KFrameParams* params, KPathState
     sf.roughness = k_fmax(sf.roughness, K_REGULARIZED_ROUGHNESS);
     vertex_params.spec_boost = 1.0f;
   }
-  k_vertex_light_sampling(&vertex_params, s->bounce);
   k_apply_blend_lights(scene, sf.position, &s->radiance, &s->throughput);
   KVec3 contribution = sf.emission;
   if (s->bounce > 0u && emissive_nee && v3_max_component(sf.emission) > 0.0f) {
@@ -423,8 +409,7 @@ KFN int k_path_hit_queued(KTraceCtx* ctx, const KFrameParams* params, KPathState
   vertex->throughput = s->throughput;
   vertex->clamp = s->bounce > 0u ? params->firefly_clamp : 0.0f;
   vertex->base = contribution;
-  vertex->direct_scale =
-      k_lights_one_ray_each(&vertex_params) ? 0.0f : 1.0f / (float)vertex_params.light_samples;
+  vertex->direct_scale = k_lights_one_ray_each(params) ? 0.0f : 1.0f / (float)params->light_samples;
   vertex->has_emissive = (kuint)emissive_nee;
   if (shadows->count == 0u) s->radiance = v3_add(s->radiance, k_vertex_light_sum(vertex));
 
