@@ -468,12 +468,14 @@ void add_render_command(CLI::App& app, int& exit_code) {
                   "contribution over every light), every (reference: every light, one shadow ray each), gather (a "
                   "shadow ray for each light whose volume holds the point, found through the light tree, while "
                   "there are at most --light-samples of them; beyond that at most --light-samples rays (16 at "
-                  "most), the brightest lights first, unbiased)")
+                  "most), the brightest lights first, unbiased) or in-range (one light per sample, picked by its "
+                  "unshadowed contribution among every light whose volume holds the point, found through the tree "
+                  "without its descent: cost grows with the lights in range, not the map's)")
       ->capture_default_str()
       ->check(CLI::IsMember(core::light_sampling_names()));
   cmd->add_option("--light-samples", a->light_samples,
-                  "lights sampled per hit with --light-sampling tree or all, most shadow rays per hit with gather "
-                  "(0: every light, as --light-sampling every)")
+                  "lights sampled per hit with --light-sampling tree, in-range or all, most shadow rays per hit with "
+                  "gather (0: every light, as --light-sampling every)")
       ->capture_default_str()
       ->check(CLI::NonNegativeNumber);
   cmd->add_option("--emissive-samples", a->emissive_samples,

@@ -39,6 +39,7 @@ struct Config {
   std::string tracer = "embree";
   int width = 640, height = 360, spp = 1, bounces = 1, frames = 3;
   int light_samples = -1;   // -1: the renderer's default (core::default_frame_params)
+  std::string light_sampling;   // empty: the renderer's default
   std::vector<int> lights = {8, 64, 256, 1024};
   std::vector<int> triangles = {3000, 300000, 1000000};
   std::string json = "out/bench_scaling.json", plot = "out/bench_scaling.png";
@@ -54,6 +55,9 @@ Config parse(int argc, char** argv) {
   app.add_option("--height", c.height, "image height")->check(CLI::PositiveNumber)->capture_default_str();
   app.add_option("--spp", c.spp, "samples per pixel")->check(CLI::PositiveNumber)->capture_default_str();
   app.add_option("--bounces", c.bounces, "indirect bounces")->check(CLI::NonNegativeNumber)->capture_default_str();
+  app.add_option("--light-sampling", c.light_sampling,
+                 "how each hit picks lights, as `cohort render --light-sampling` (default: the renderer's)")
+      ->check(CLI::IsMember(core::light_sampling_names()));
   app.add_option("--light-samples", c.light_samples, "lights sampled per hit (default: the renderer's)")
       ->check(CLI::NonNegativeNumber);
   app.add_option("--frames", c.frames, "timed frames per case")->check(CLI::PositiveNumber)->capture_default_str();
@@ -201,6 +205,7 @@ Result run_one(const Config& cfg, int triangles, int lights) {
   job.params.spp = uint32_t(cfg.spp);
   job.params.max_bounces = uint32_t(cfg.bounces);
   if (cfg.light_samples >= 0) job.params.light_samples = uint32_t(cfg.light_samples);
+  if (!cfg.light_sampling.empty()) job.params.light_sampling = core::light_sampling_mode(cfg.light_sampling);
   job.params.row_begin = 0;
   job.params.row_end = uint32_t(cfg.height);
   core::FrameBuffer fb;
@@ -238,8 +243,11 @@ int main(int argc, char** argv) {
   }
   const KFrameParams defaults = core::default_frame_params();
   const int light_samples = cfg.light_samples >= 0 ? cfg.light_samples : int(defaults.light_samples);
-  std::printf("bench_scaling: tracer %s, %dx%d, %d spp, %d bounce(s), light samples %d%s, best of %d frames\n",
-              cfg.tracer.c_str(), cfg.width, cfg.height, cfg.spp, cfg.bounces, light_samples,
+  const std::string light_sampling =
+      cfg.light_sampling.empty() ? core::light_sampling_names().at(defaults.light_sampling) : cfg.light_sampling;
+  std::printf("bench_scaling: tracer %s, %dx%d, %d spp, %d bounce(s), light sampling %s, light samples %d%s, best of "
+              "%d frames\n",
+              cfg.tracer.c_str(), cfg.width, cfg.height, cfg.spp, cfg.bounces, light_sampling.c_str(), light_samples,
               light_samples == 0 ? " (every light)" : "", cfg.frames);
   std::printf("%10s %7s %11s %10s %10s %10s %10s %10s\n", "triangles", "lights", "scene tris", "compile ms",
               "apply ms", "ms/frame", "Mpaths/s", "Mrays/s");
@@ -254,7 +262,8 @@ int main(int argc, char** argv) {
     }
 
   nlohmann::json report = {{"tracer", cfg.tracer}, {"width", cfg.width}, {"height", cfg.height}, {"spp", cfg.spp},
-                           {"bounces", cfg.bounces}, {"light_samples", light_samples}, {"frames", cfg.frames}};
+                           {"bounces", cfg.bounces}, {"light_samples", light_samples},
+                           {"light_sampling", light_sampling}, {"frames", cfg.frames}};
   std::vector<bench::ScalingSeries> series;
   for (int t : cfg.triangles) {
     bench::ScalingSeries s;

@@ -24,7 +24,7 @@ KFrameParams default_frame_params() {
 }
 
 const std::vector<std::string>& light_sampling_names() {
-  static const std::vector<std::string> names = {"tree", "all", "every", "gather"};
+  static const std::vector<std::string> names = {"tree", "all", "every", "gather", "in-range"};
   return names;
 }
 
@@ -33,7 +33,8 @@ kuint light_sampling_mode(const std::string& name) {
   if (name == "all") return K_LIGHTS_ALL;
   if (name == "every") return K_LIGHTS_EVERY;
   if (name == "gather") return K_LIGHTS_GATHER;
-  throw std::invalid_argument("light sampling '" + name + "': choose tree, all, every or gather");
+  if (name == "in-range") return K_LIGHTS_IN_RANGE;
+  throw std::invalid_argument("light sampling '" + name + "': choose tree, all, every, gather or in-range");
 }
 
 const std::vector<std::string>& aux_rays_names() {

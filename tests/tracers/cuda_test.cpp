@@ -113,6 +113,29 @@ INSTANTIATE_TEST_SUITE_P(Modes, CudaAgreement,
                                            ModeCase{K_MODE_PATH, 1, "path_gather", 2, K_LIGHTS_GATHER}),
                          [](const auto& info) { return std::string(info.param.name); });
 
+// Under 96 overlapping lights (the tree descends, gather has more lights in range than its budget, the pick
+// in range weighs them all), CUDA draws Embree's image, as AgreementManyLights checks for OpenCL.
+TEST(CudaAgreementManyLights, MatchesEmbree) {
+  REQUIRE_GPU();
+  scene::Scene s = many_lights_floor(88, 8);
+  const int w = 48, h = 36;
+  const KCamera cam = camera_looking_down({0, 0, 1400}, 0.7f, w, h);
+  auto embree = make_test_tracer("embree");
+  auto cuda = make_test_tracer("cuda");
+  for (kuint sampling : {K_LIGHTS_TREE, K_LIGHTS_GATHER, K_LIGHTS_IN_RANGE}) {
+    KFrameParams params = frame_params(K_MODE_PATH, 8, 1, h);
+    params.soft_shadow_scale = 1.0f;
+    params.light_sampling = sampling;
+    params.light_samples = sampling == K_LIGHTS_GATHER ? 4u : 1u;
+    core::FrameBuffer a = render(*embree, s, cam, params);
+    core::FrameBuffer b = render(*cuda, s, cam, params);
+    for (float v : b.rgba) ASSERT_TRUE(std::isfinite(v));
+    double error = relative_rmse(a, b);
+    std::cout << "many lights, sampling " << sampling << ": relative RMSE embree/cuda " << error << "\n";
+    EXPECT_LT(error, 0.005) << "sampling " << sampling;
+  }
+}
+
 // Several GPUs render different bands of one frame; the merged frame equals one GPU's whole frame.
 TEST(CudaMultiGpu, BandsMergeIntoTheSingleGpuFrame) {
   const int gpus = tracers::cuda_device_count();
@@ -360,6 +383,7 @@ INSTANTIATE_TEST_SUITE_P(LightSampling, CudaShadowWalk,
                          ::testing::Values(ShadowWalkCase{K_LIGHTS_TREE, 1, 0.0f, 88, 8, "tree1"},
                                            ShadowWalkCase{K_LIGHTS_TREE, 2, 0.03f, 88, 8, "tree2_roulette"},
                                            ShadowWalkCase{K_LIGHTS_GATHER, 4, 0.03f, 88, 8, "gather4_roulette"},
+                                           ShadowWalkCase{K_LIGHTS_IN_RANGE, 1, 0.03f, 88, 8, "in_range1_roulette"},
                                            ShadowWalkCase{K_LIGHTS_EVERY, 0, 0.03f, 4, 2, "every_6_lights"},
                                            ShadowWalkCase{K_LIGHTS_EVERY, 0, 0.03f, 88, 8, "every_past_the_slots"}),
                          [](const auto& info) { return std::string(info.param.name); });

@@ -1,7 +1,8 @@
 // Light sampling at a cost that does not grow with the light count, checked for bias against the
 // references: the light tree (the default), the all-lights pick and gather converge to the every-light
 // image on a floor under 96 overlapping lights; gather is the every-light image where no point has more
-// lights in range than its budget; emissive triangles sampled with MIS converge to the
+// lights in range than its budget; the pick among the lights in range is the tree's without its descent and
+// less noisy than it; emissive triangles sampled with MIS converge to the
 // bounce-only estimate with less noise; lights with defects are skipped and no pixel goes NaN.
 #include <gtest/gtest.h>
 
@@ -171,6 +172,59 @@ TEST(LightSampling, GatherIsEveryLightWithinItsBudget) {
   EXPECT_GT(pixel_rmse(one, every), 0.0) << "with one ray per hit, points under two lights must be sampled";
 }
 
+// In range (K_LIGHTS_IN_RANGE): the tree's pick without its descent, one light per sample in proportion to
+// its unshadowed contribution among every light whose box holds the point. Where no node holds more than
+// K_LIGHT_TREE_GATHER lights (the test room's three) the tree does not descend either: the same image,
+// float for float, with bounces, soft shadows and the shadow roulette (the same random numbers in the same
+// order). On the 96-light floor, where the tree descends, its block means must match the every-light
+// image's as closely as its own noise allows, and its pixel noise must be below the tree's: the descent
+// weighs a subtree by its lights' power wherever its box holds the point, the pick by what reaches it.
+TEST(LightSampling, InRangeIsTheTreeWithoutItsDescent) {
+  if (!tracer_runs_here("embree")) GTEST_SKIP();
+  auto tracer = make_test_tracer("embree");
+  {
+    scene::Scene room = test_room();
+    ASSERT_EQ(room.lights.size(), 3u);
+    const int w = 64, h = 48;
+    const KCamera cam = test_room_camera(w, h);
+    auto render_with = [&](kuint sampling) {
+      KFrameParams p = frame_params(K_MODE_PATH, 4, 2, h);
+      p.soft_shadow_scale = 1.0f;
+      p.shadow_rr = 0.03f;
+      p.light_sampling = sampling;
+      return render(*tracer, room, cam, p);
+    };
+    const core::FrameBuffer tree = render_with(K_LIGHTS_TREE), in_range = render_with(K_LIGHTS_IN_RANGE);
+    EXPECT_GT(mean_luminance(tree), 0.01) << "the room should be lit";
+    for (size_t i = 0; i < tree.rgba.size(); ++i)
+      ASSERT_EQ(in_range.rgba[i], tree.rgba[i]) << "pixel " << (i / 4) % size_t(w) << "," << (i / 4) / size_t(w);
+  }
+  scene::Scene s = many_lights_floor(88, 8);
+  const int w = 64, h = 48;
+  const KCamera cam = camera_looking_down({0, 0, 1400}, 0.7f, w, h);
+  auto render_with = [&](kuint sampling, kuint frame) {
+    KFrameParams p = frame_params(K_MODE_DIRECT, 16, 0, h);
+    p.light_sampling = sampling;
+    p.frame_index = frame;
+    return render(*tracer, s, cam, p);
+  };
+  const core::FrameBuffer every = render_with(K_LIGHTS_EVERY, 1);
+  const double mean = mean_luminance(every);
+  ASSERT_GT(mean, 0.05) << "the floor should be lit";
+  const core::FrameBuffer a = render_with(K_LIGHTS_IN_RANGE, 1), b = render_with(K_LIGHTS_IN_RANGE, 2);
+  const core::FrameBuffer tree_a = render_with(K_LIGHTS_TREE, 1), tree_b = render_with(K_LIGHTS_TREE, 2);
+  expect_finite(a, "in range");
+  const double bias = rms_difference(block_means(a, 8), block_means(every, 8));
+  const double noise = rms_difference(block_means(a, 8), block_means(b, 8));
+  const double mean_error = std::fabs(mean_luminance(a) - mean) / mean;
+  const double pixel_noise = pixel_rmse(a, b), tree_pixel_noise = pixel_rmse(tree_a, tree_b);
+  std::cout << "in range: block RMS vs every light " << bias << ", between two seeds " << noise << ", mean error "
+            << 100.0 * mean_error << "%, pixel noise " << pixel_noise << " (tree " << tree_pixel_noise << ")\n";
+  EXPECT_LT(bias, 0.95 * noise + 1e-4 * mean);
+  EXPECT_LT(mean_error, 0.01);
+  EXPECT_LT(pixel_noise, 0.9 * tree_pixel_noise);
+}
+
 // An emissive panel over a floor, no lights: one bounce finds the panel by chance, NEE with MIS aims at
 // it. Both estimate the same radiance; MIS with far less noise.
 TEST(LightSampling, EmissiveTrianglesWithMisMatchBounceOnly) {
@@ -246,7 +300,7 @@ TEST(LightSampling, LightsWithDefectsAreSkippedAndNoPixelIsNaN) {
   for (const std::string& kind : built_tracers()) {
     if (!tracer_runs_here(kind)) continue;
     auto tracer = make_test_tracer(kind);
-    for (kuint sampling : {K_LIGHTS_TREE, K_LIGHTS_ALL, K_LIGHTS_EVERY, K_LIGHTS_GATHER}) {
+    for (kuint sampling : {K_LIGHTS_TREE, K_LIGHTS_ALL, K_LIGHTS_EVERY, K_LIGHTS_GATHER, K_LIGHTS_IN_RANGE}) {
       for (kuint frame = 0; frame < 3; ++frame) {
         KFrameParams p = frame_params(K_MODE_PATH, 2, 2, h);
         p.light_sampling = sampling;

@@ -260,6 +260,7 @@ INSTANTIATE_TEST_SUITE_P(LightSampling, OpenCLWavefrontShadows,
                          ::testing::Values(LightCase{K_LIGHTS_TREE, 1, 0.0f, 88, 8, "tree1"},
                                            LightCase{K_LIGHTS_TREE, 2, 0.03f, 88, 8, "tree2_roulette"},
                                            LightCase{K_LIGHTS_GATHER, 4, 0.03f, 88, 8, "gather4_roulette"},
+                                           LightCase{K_LIGHTS_IN_RANGE, 1, 0.03f, 88, 8, "in_range1_roulette"},
                                            LightCase{K_LIGHTS_EVERY, 0, 0.03f, 4, 2, "every_6_lights"},
                                            LightCase{K_LIGHTS_EVERY, 0, 0.03f, 88, 8, "every_past_the_slots"}),
                          [](const auto& info) { return std::string(info.param.name); });

@@ -98,11 +98,14 @@ KFN int k_lights_one_ray_each(const KFrameParams* params) {
          params->light_sampling == K_LIGHTS_EVERY;
 }
 
-/* Next-event estimation toward the Doom 3 lights, four ways (KFrameParams.light_sampling):
+/* Next-event estimation toward the Doom 3 lights, five ways (KFrameParams.light_sampling):
  * - K_LIGHTS_EVERY (or light_samples == 0): every light that reaches the point, one shadow ray each
  *   (as Doom 3 draws every interaction; lowest noise where few lights overlap, cost grows with them).
  * - K_LIGHTS_TREE (default): per light sample, one light picked through the light tree among those
  *   whose volume holds the point (light_tree.h has the pdf), one shadow ray toward it.
+ * - K_LIGHTS_IN_RANGE: the same without the tree's descent: one light per sample picked in proportion to
+ *   its unshadowed contribution among every light whose volume holds the point (cost grows with those, not
+ *   with the map's lights).
  * - K_LIGHTS_ALL: per light sample, one light picked over every light of the map in proportion to its
  *   unshadowed contribution (the reference for the tree: same pick, cost grows with the map).
  * - K_LIGHTS_GATHER: `every` among the lights whose volume holds the point, found through the tree, while
@@ -138,9 +141,11 @@ KFN void k_direct_lighting(KTraceCtx* ctx, const KFrameParams* params, const KSu
     KVec3 chosen_contrib = v3s(0.0f);
     float pdf = 0.0f;
     float u_pick = k_rng_next(rng);
-    if (params->light_sampling == K_LIGHTS_TREE) {
+    if (params->light_sampling == K_LIGHTS_TREE || params->light_sampling == K_LIGHTS_IN_RANGE) {
       float u_descend = k_rng_next(rng);
-      chosen = k_light_tree_pick(scene, sf, wo, params->spec_boost, u_descend, u_pick, &chosen_contrib, &pdf);
+      kuint descend_above = params->light_sampling == K_LIGHTS_TREE ? K_LIGHT_TREE_GATHER : K_NONE;
+      chosen = k_light_tree_pick(scene, sf, wo, params->spec_boost, descend_above, u_descend, u_pick,
+                                 &chosen_contrib, &pdf);
     } else {
       float total = 0.0f, chosen_weight = 0.0f;
       for (kuint i = 0u; i < scene->light_count; ++i) {

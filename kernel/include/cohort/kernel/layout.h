@@ -207,6 +207,9 @@ typedef struct KCamera {
 #define K_LIGHTS_EVERY 2u   /* reference: every light, one shadow ray each */
 #define K_LIGHTS_GATHER 3u  /* `every` among the lights whose volume holds the point, at most about
                                light_samples shadow rays (integrator.h, light_gather.h) */
+#define K_LIGHTS_IN_RANGE 4u  /* per light sample, one light picked by its unshadowed contribution among
+                                 every light whose volume holds the point: the tree walked without its
+                                 descent (light_tree.h) */
 
 /* light_count, instance_count, tlas_node_count, light_node_count and emissive_count are the lengths of
  * the scene's arrays, set by the host from the tracer's scene copy and read only by k_scene_view
