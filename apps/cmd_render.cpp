@@ -50,7 +50,7 @@ struct RenderArgs {
   std::string out = "render_out";
   int width = core::kDefaultWidth, height = core::kDefaultHeight, spp = 4, frames = 1, bounces = 1, light_samples = 1,
       emissive_samples = 1;
-  std::string light_sampling = "tree";
+  std::string light_sampling = "in-range";
   float fov = core::kDefaultFovX, exposure = 1.0f, firefly_clamp = 5.0f, spec_boost = 2.0f, soft_shadow_scale = 0.2f,
         shadow_rr = core::default_frame_params().shadow_rr;
   float yaw_step = 0.0f;

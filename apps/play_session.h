@@ -41,7 +41,7 @@ struct FrameSettings {
   int spp = 1;
   kuint mode = K_MODE_PATH;
   int max_bounces = 1;
-  kuint light_sampling = K_LIGHTS_TREE;
+  kuint light_sampling = K_LIGHTS_IN_RANGE;
   std::string tone_curve = "aces";
   bool reproject = false;           // per-pixel reprojection (core/reprojection.h) instead of Brigade's blend
   // Dynamic resolution (core/upsample.h): below 1 with joint_bilateral or nearest, width x height is the
