@@ -47,6 +47,16 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 stage=.gpu
 
+# There: the MPI build's cohort from .gpu/mpi.tar.xz (as $cohort, mpiexec.hydra on PATH), and the large map
+# generated and packed with it at /tmp/largemap.cpk (kept between calls on a warm machine).
+mpi_cohort_and_large_map() {
+  mkdir -p "$stage/mpi" && tar -C "$stage/mpi" -xJf "$stage/mpi.tar.xz"
+  export PATH="$PWD/$stage/mpi/bin:$PATH"
+  cohort="$PWD/$stage/mpi/bin/cohort"
+  [ -f /tmp/largemap.cpk ] || { python3 tools/gen_testmap.py --large --out /tmp/largemap >/dev/null &&
+    "$cohort" pack /tmp/largemap/maps/largemap.map --out /tmp/largemap.cpk | tail -n 1; }
+}
+
 case "${1:-}" in
   stage)
     cmake --preset gpu-travel
@@ -95,11 +105,7 @@ case "${1:-}" in
   cluster)
     # There, on a two-GPU kind: issue 19's first target, two ranks with one GPU each (cohort node) against
     # the in-process two-GPU frame, both maps, Brigade's blend (rank 0 then has no GPU of its own), two rounds.
-    mkdir -p "$stage/mpi" && tar -C "$stage/mpi" -xJf "$stage/mpi.tar.xz"
-    export PATH="$PWD/$stage/mpi/bin:$PATH"
-    cohort="$PWD/$stage/mpi/bin/cohort"
-    [ -f /tmp/largemap.cpk ] || { python3 tools/gen_testmap.py --large --out /tmp/largemap >/dev/null &&
-      "$cohort" pack /tmp/largemap/maps/largemap.map --out /tmp/largemap.cpk | tail -n 1; }
+    mpi_cohort_and_large_map
     for round in 1 2; do
       for map in large test; do
         if [ $map = large ]; then pack=/tmp/largemap.cpk; size=(--width 1920 --height 1080 --camera 1690 300 80 5 -12)
@@ -133,11 +139,7 @@ case "${1:-}" in
     # large map 1080p, Brigade's blend, 200 frames (medians of 50-199): each remote tracer alone and together
     # (two ranks with one GPU each), and rank 0's own cuda:0 beside mpi:1, on loopback and under each link of
     # COHORT_LINKS; scaling efficiency = (1 / T_mix) / sum(1 / T_alone), the alone runs over the same link.
-    mkdir -p "$stage/mpi" && tar -C "$stage/mpi" -xJf "$stage/mpi.tar.xz"
-    export PATH="$PWD/$stage/mpi/bin:$PATH"
-    cohort="$PWD/$stage/mpi/bin/cohort"
-    [ -f /tmp/largemap.cpk ] || { python3 tools/gen_testmap.py --large --out /tmp/largemap >/dev/null &&
-      "$cohort" pack /tmp/largemap/maps/largemap.map --out /tmp/largemap.cpk | tail -n 1; }
+    mpi_cohort_and_large_map
     common=(/tmp/largemap.cpk --width 1920 --height 1080 --camera 1690 300 80 5 -12 --spp 1 --light-samples 1 --bounces 1
             --convergence brigade --frames 200 --camera-path spin-slow --write last)
     median() { python3 tools/frame_times.py "$1/stats.json" --skip 50 | head -n 1 | sed -E 's/.*per frame median ([0-9.]+) ms.*/\1/'; }
