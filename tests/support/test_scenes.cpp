@@ -247,19 +247,23 @@ scene::Scene many_lights_floor(int point_lights, int projected_lights, unsigned 
   return s;
 }
 
-scene::Scene many_lights_floor_under_a_panel(int point_lights, int projected_lights) {
-  scene::Scene floor = many_lights_floor(point_lights, projected_lights);
+void add_emissive_panel(scene::Scene& s) {
   scene::Material panel;
   panel.name = "panel";
   panel.diffuse_color = glm::vec4(0.0f, 0.0f, 0.0f, 1.0f);
   panel.emitter = true;
   panel.emissive_color = glm::vec4(4.0f, 3.5f, 3.0f, 1.0f);
-  floor.materials.push_back(panel);
+  s.materials.push_back(panel);
   scene::Mesh lamp;
   lamp.name = "_area1";
-  add_quad(lamp, int(floor.materials.size() - 1), {-60, -60, 150}, {-60, 60, 150}, {60, 60, 150}, {60, -60, 150},
+  add_quad(lamp, int(s.materials.size() - 1), {-60, -60, 150}, {-60, 60, 150}, {60, 60, 150}, {60, -60, 150},
            {0, 0, -1});
-  add_world_mesh(floor, std::move(lamp));
+  add_world_mesh(s, std::move(lamp));
+}
+
+scene::Scene many_lights_floor_under_a_panel(int point_lights, int projected_lights) {
+  scene::Scene floor = many_lights_floor(point_lights, projected_lights);
+  add_emissive_panel(floor);
   return floor;
 }
 

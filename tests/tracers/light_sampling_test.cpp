@@ -230,17 +230,7 @@ TEST(LightSampling, InRangeIsTheTreeWithoutItsDescent) {
 TEST(LightSampling, EmissiveTrianglesWithMisMatchBounceOnly) {
   if (!tracer_runs_here("embree")) GTEST_SKIP();
   scene::Scene s = floor_scene(600.0f, {0.8f, 0.8f, 0.8f});
-  scene::Material panel;
-  panel.name = "panel";
-  panel.diffuse_color = glm::vec4(0.0f, 0.0f, 0.0f, 1.0f);
-  panel.emitter = true;
-  panel.emissive_color = glm::vec4(4.0f, 3.5f, 3.0f, 1.0f);
-  s.materials.push_back(panel);
-  const int panel_material = int(s.materials.size() - 1);
-  scene::Mesh lamp;
-  lamp.name = "_area1";
-  add_quad(lamp, panel_material, {-60, -60, 150}, {-60, 60, 150}, {60, 60, 150}, {60, -60, 150}, {0, 0, -1});
-  add_world_mesh(s, std::move(lamp));
+  add_emissive_panel(s);
   auto compiled = core::compile_scene(s);
   ASSERT_EQ(compiled.tracer_scene.emissive_triangles.size(), 2u);
 

@@ -28,8 +28,11 @@ scene::Scene furnace_box(float half, float albedo, float emission);
 // units up) and projected lights shining down from 300 units, of random colours, overlapping a few deep
 // everywhere: for light-sampling tests and benchmarks.
 scene::Scene many_lights_floor(int point_lights, int projected_lights, unsigned seed = 11);
-// The same under a 120 x 120 emissive panel 150 units up (two emissive triangles, facing down): lights and
-// emitters for next-event estimation at once (the wavefronts' shadow-walk tests).
+// A 120 x 120 emissive panel 150 units up over the origin (two emissive triangles, facing down, radiance
+// 4, 3.5, 3): its material and a world mesh of its own added to the scene.
+void add_emissive_panel(scene::Scene& s);
+// many_lights_floor under that panel: lights and emitters for next-event estimation at once (the
+// wavefronts' shadow-walk tests).
 scene::Scene many_lights_floor_under_a_panel(int point_lights, int projected_lights);
 
 }  // namespace cohort::test
