@@ -36,7 +36,7 @@ struct PlayArgs {
   float scale = 0.5f;
   int spp = 1;
   int bounces = 1;
-  std::string light_sampling = "in-range";
+  std::string light_sampling = core::light_sampling_name(core::default_frame_params().light_sampling);
   std::string convergence = "auto";  // convergence_choice.h
   int target_fps = -1;       // -1: 30 when only CPU tracers render, else off (workload_choice.h)
   bool workload_given = false;  // --scale or --spp on the command line: they stand unless --target-fps

@@ -50,7 +50,7 @@ struct RenderArgs {
   std::string out = "render_out";
   int width = core::kDefaultWidth, height = core::kDefaultHeight, spp = 4, frames = 1, bounces = 1, light_samples = 1,
       emissive_samples = 1;
-  std::string light_sampling = "in-range";
+  std::string light_sampling = core::light_sampling_name(core::default_frame_params().light_sampling);
   float fov = core::kDefaultFovX, exposure = 1.0f, firefly_clamp = 5.0f, spec_boost = 2.0f, soft_shadow_scale = 0.2f,
         shadow_rr = core::default_frame_params().shadow_rr;
   float yaw_step = 0.0f;
@@ -229,10 +229,12 @@ int run_render(const RenderArgs& a) {
     post = tracers::make_frame_post(post_place, blend_options);
     spdlog::info("Brigade's blend on {}", post->where());
   }
-  // A GPU post-processing reprojection (or blend) takes the bands as the tracers packed them: half the bytes
-  // cross the bus and the host skips its conversions (the float frame and G-buffer are not made). A
-  // reprojecting or blending post also reconstructs sparse frames, where it runs.
-  const bool packed = post && (reproject || blend_on_gpu) && post->where() != "host" && a.denoise != "oidn" &&
+  // A reprojecting or blending post takes the fresh frame (and reconstructs sparse ones, where it runs); a
+  // filter alone takes the frame Brigade's blend on the host shows.
+  const bool post_takes_fresh = reproject || blend_on_gpu;
+  // On a GPU it takes the bands as the tracers packed them: half the bytes cross the bus and the host skips
+  // its conversions (the float frame and G-buffer are not made).
+  const bool packed = post && post_takes_fresh && post->where() != "host" && a.denoise != "oidn" &&
                       a.denoise != "oidn-cuda" && !a.write_ids;
   // Sparse frames are filled where the post runs: inside the reprojecting or blending post, or for Brigade's
   // blend on the host (which takes full frames) by a post of its own with neither step, on the same place.
@@ -290,8 +292,7 @@ int run_render(const RenderArgs& a) {
       core::ScopedStage posting(stats.stages, core::kCoreTrack,
                                 !atrous ? "convergence" : reproject ? "convergence+denoise" : "denoise");
       if (packed) post->process_packed(renderer.packed_frame(), renderer.packed_device_rows(), traced);
-      else post->process(reproject || blend_on_gpu ? frame : *shown_image, gbuffer,
-                         reproject || blend_on_gpu ? traced : core::kEveryPixel);
+      else post->process(post_takes_fresh ? frame : *shown_image, gbuffer, post_takes_fresh ? traced : core::kEveryPixel);
       // On a GPU its own clock tells the bus from the passes (a track of its own in the timeline).
       if (const core::FramePostDeviceTimes t = post->device_times(); t.measured) {
         core::append_spans_ending_at(stats.stages, "post on " + post->where(), core::timeline_now_ms(),

@@ -11,6 +11,7 @@
 
 #include "cohort/core/atrous_filter.h"
 #include "cohort/core/frame_buffer.h"
+#include "cohort/core/frame_defaults.h"
 #include "cohort/core/frame_stats.h"
 #include "cohort/core/upsample.h"
 #include "cohort/kernel/layout.h"
@@ -41,7 +42,7 @@ struct FrameSettings {
   int spp = 1;
   kuint mode = K_MODE_PATH;
   int max_bounces = 1;
-  kuint light_sampling = K_LIGHTS_IN_RANGE;
+  kuint light_sampling = core::default_frame_params().light_sampling;
   std::string tone_curve = "aces";
   bool reproject = false;           // per-pixel reprojection (core/reprojection.h) instead of Brigade's blend
   // Dynamic resolution (core/upsample.h): below 1 with joint_bilateral or nearest, width x height is the

@@ -50,7 +50,7 @@ struct Config {
   std::string scene = std::string(COHORT_SOURCE_DIR) + "/assets/testmap/maps/testmap.map";
   std::string large = std::string(COHORT_SOURCE_DIR) + "/build/default/assets/largemap/maps/largemap.map";
   int width = 640, height = 360, spp = 1, light_samples = 1, bounces = 1, threads = 1, repeats = 3;
-  std::string light_sampling = "in-range";  // the renderer's default
+  std::string light_sampling = core::light_sampling_name(core::default_frame_params().light_sampling);
   std::vector<float> camera;   // x y z yaw pitch for every scene; empty: each scene's player start
   std::string json;
   bool others = false;

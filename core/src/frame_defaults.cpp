@@ -39,6 +39,12 @@ kuint light_sampling_mode(const std::string& name) {
   throw std::invalid_argument("light sampling '" + name + "': choose tree, all, every, gather or in-range");
 }
 
+const std::string& light_sampling_name(kuint mode) {
+  const std::vector<std::string>& names = light_sampling_names();
+  if (mode >= names.size()) throw std::invalid_argument("light sampling mode " + std::to_string(mode) + " has no name");
+  return names[mode];
+}
+
 const std::vector<std::string>& aux_rays_names() {
   static const std::vector<std::string> names = {"centre", "first-hit"};
   return names;

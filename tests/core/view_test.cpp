@@ -104,6 +104,8 @@ TEST(FrameDefaults, LightSamplingNamesRoundTrip) {
   EXPECT_EQ(light_sampling_mode(names[4]), K_LIGHTS_IN_RANGE);
   EXPECT_EQ(names[4], "in-range");
   EXPECT_THROW(light_sampling_mode("bvh"), std::invalid_argument);
+  for (const std::string& name : names) EXPECT_EQ(light_sampling_name(light_sampling_mode(name)), name);
+  EXPECT_THROW(light_sampling_name(5u), std::invalid_argument);
 }
 
 TEST(FrameDefaults, AuxRaysNamesRoundTrip) {

@@ -23,6 +23,9 @@ KFrameParams default_frame_params();
 const std::vector<std::string>& light_sampling_names();
 // Throws std::invalid_argument naming the choices for any other name.
 kuint light_sampling_mode(const std::string& name);
+// The command-line name of a mode (the command lines' defaults: default_frame_params()'s); throws
+// std::invalid_argument for a mode with no name.
+const std::string& light_sampling_name(kuint mode);
 
 // Where the aux planes come from, by command-line name (--aux-rays): "centre" (K_AUX_CENTRE_RAY) and
 // "first-hit" (K_AUX_PATH_FIRST_HIT), in that order. The command line's default, "auto", is resolved by the

@@ -202,14 +202,14 @@ typedef struct KCamera {
 
 /* How next-event estimation picks Doom 3 lights (KFrameParams.light_sampling). light_samples == 0
  * means K_LIGHTS_EVERY whatever this says. */
-#define K_LIGHTS_TREE  0u   /* the light tree: only lights whose volume holds the point (default) */
+#define K_LIGHTS_TREE  0u   /* the light tree: only lights whose volume holds the point */
 #define K_LIGHTS_ALL   1u   /* reference: a pick by contribution over every light of the map */
 #define K_LIGHTS_EVERY 2u   /* reference: every light, one shadow ray each */
 #define K_LIGHTS_GATHER 3u  /* `every` among the lights whose volume holds the point, at most about
                                light_samples shadow rays (integrator.h, light_gather.h) */
 #define K_LIGHTS_IN_RANGE 4u  /* per light sample, one light picked by its unshadowed contribution among
                                  every light whose volume holds the point: the tree walked without its
-                                 descent (light_tree.h) */
+                                 descent (light_tree.h); the default (core::default_frame_params) */
 
 /* light_count, instance_count, tlas_node_count, light_node_count and emissive_count are the lengths of
  * the scene's arrays, set by the host from the tracer's scene copy and read only by k_scene_view
