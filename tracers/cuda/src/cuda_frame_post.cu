@@ -129,8 +129,7 @@ __global__ void svgf_variance_kernel(float* illumination, const float* moments, 
   const bool inside = x < params.width && y < params.height;
   const bool spatial = inside && k_svgf_variance_is_spatial(length, &params, x, y);
   if (inside && !spatial)
-    illumination[4 * (y * params.width + x) + 3] =
-        k_svgf_variance_estimate(illumination, moments, length, geometry, &params, x, y);
+    illumination[4 * (y * params.width + x) + 3] = k_svgf_temporal_variance(moments, length, &params, x, y);
   constexpr unsigned kWarp = 0xffffffffu;
   constexpr int kSide = 2 * K_SVGF_SPATIAL_RADIUS + 1;
   const int lane = int(threadIdx.y * blockDim.x + threadIdx.x) & 31;

@@ -127,16 +127,20 @@ KFN int k_svgf_variance_is_spatial(KGLOBAL const float* length, const KSvgfVaria
   return !(p->have_history && length[y * p->width + x] >= p->short_history);
 }
 
+/* The pixel's variance from its own temporal moments (where it is not spatial: a long enough history). */
+KFN float k_svgf_temporal_variance(KGLOBAL const float* moments, KGLOBAL const float* length,
+                                   const KSvgfVarianceParams* p, kint x, kint y) {
+  kint centre = y * p->width + x;
+  float of_mean = p->of_mean ? 1.0f / k_fmax(length[centre], 1.0f) : 1.0f;
+  return k_fmax(moments[2 * centre + 1] - moments[2 * centre] * moments[2 * centre], 0.0f) * of_mean;
+}
+
 /* The pixel's variance. `illumination` is the demodulated frame the passes filter (only its RGB is read);
  * moments and length are the reprojected history's (read only with have_history). */
 KFN float k_svgf_variance_estimate(KGLOBAL const float* illumination, KGLOBAL const float* moments,
                                    KGLOBAL const float* length, KGLOBAL const float* geometry,
                                    const KSvgfVarianceParams* p, kint x, kint y) {
-  if (!k_svgf_variance_is_spatial(length, p, x, y)) {
-    kint centre = y * p->width + x;
-    float of_mean = p->of_mean ? 1.0f / k_fmax(length[centre], 1.0f) : 1.0f;
-    return k_fmax(moments[2 * centre + 1] - moments[2 * centre] * moments[2 * centre], 0.0f) * of_mean;
-  }
+  if (!k_svgf_variance_is_spatial(length, p, x, y)) return k_svgf_temporal_variance(moments, length, p, x, y);
   KSvgfNeighbourhood n = k_svgf_neighbourhood_begin(geometry, p, x, y);
   for (kint dy = -K_SVGF_SPATIAL_RADIUS; dy <= K_SVGF_SPATIAL_RADIUS; ++dy)
     for (kint dx = -K_SVGF_SPATIAL_RADIUS; dx <= K_SVGF_SPATIAL_RADIUS; ++dx)
