@@ -55,17 +55,33 @@ double AdaptiveConvergence::next_factor(const KCamera& camera) {
   return f;
 }
 
-double AdaptiveConvergence::accumulate(const KCamera& camera, const FrameBuffer& fresh, const std::vector<float>* motion_mask) {
+namespace {
+
+// Throws std::invalid_argument unless the frame's plane and the mask fit its size; returns its pixels.
+size_t checked_pixels(const FrameBuffer& fresh, const std::vector<float>* motion_mask) {
   const size_t pixels = static_cast<size_t>(fresh.width) * fresh.height;
   if (fresh.rgba.size() != pixels * 4) throw std::invalid_argument("AdaptiveConvergence: frame buffer size mismatch");
   if (motion_mask && motion_mask->size() != pixels)
     throw std::invalid_argument("AdaptiveConvergence: motion mask has " + std::to_string(motion_mask->size()) +
                                 " values for " + std::to_string(pixels) + " pixels");
+  return pixels;
+}
+
+}  // namespace
+
+double AdaptiveConvergence::accumulate(const KCamera& camera, const FrameBuffer& fresh, const std::vector<float>* motion_mask) {
+  checked_pixels(fresh, motion_mask);
   if (fresh.width != accumulated_.width || fresh.height != accumulated_.height) reset();
   const double f = next_factor(camera);
-  if (f >= 1.0) {
+  blend(fresh, f, motion_mask);
+  return f;
+}
+
+void AdaptiveConvergence::blend(const FrameBuffer& fresh, double f, const std::vector<float>* motion_mask) {
+  const size_t pixels = checked_pixels(fresh, motion_mask);
+  if (f >= 1.0 || fresh.width != accumulated_.width || fresh.height != accumulated_.height) {
     accumulated_ = fresh;
-    return f;
+    return;
   }
   const float global = static_cast<float>(f);
   const float object_f = static_cast<float>(options_.moving_object_f);
@@ -84,7 +100,6 @@ double AdaptiveConvergence::accumulate(const KCamera& camera, const FrameBuffer&
       for (size_t k = 4 * p; k < 4 * p + 4; ++k) accumulated[k] = converge(accumulated[k], incoming[k], fp);
     }
   });
-  return f;
 }
 
 }  // namespace cohort::core

@@ -3,9 +3,6 @@
 #include <stdexcept>
 #include <string>
 
-#include "cohort/core/host_threads.h"
-#include "cohort/kernel/brigade_blend.h"
-
 namespace cohort::core {
 
 void FramePost::process_packed(const BandBuffer& packed, const std::vector<DeviceBandRows>& on_device,
@@ -62,18 +59,8 @@ void HostFramePost::process(const FrameBuffer& fresh, const GBuffer& gbuffer, co
     current = &reprojection_.image();
   }
   if (options_.blend) {
-    const FrameBuffer& fresh_frame = *current;
-    if (blend_factor_ >= 1.0 || blended_.width != fresh_frame.width || blended_.height != fresh_frame.height) {
-      blended_ = fresh_frame;
-    } else {
-      float* accumulated = blended_.rgba.data();
-      const float* incoming = fresh_frame.rgba.data();
-      const float f = static_cast<float>(blend_factor_);
-      HostThreads::shared().for_ranges(blended_.rgba.size() / 4, 16384, [=](size_t begin, size_t end) {
-        for (size_t p = begin; p < end; ++p) k_brigade_blend_pixel(accumulated, incoming, f, static_cast<kint>(p));
-      });
-    }
-    current = &blended_;
+    blended_.blend(*current, blend_factor_);
+    current = &blended_.image();
   }
   if (options_.atrous) {
     AtrousHistory history;
@@ -95,7 +82,7 @@ double HostFramePost::mean_history_length() const {
 
 void HostFramePost::reset() {
   reprojection_.reset();
-  blended_ = FrameBuffer{};
+  blended_ = AdaptiveConvergence{};  // its image too: the next frame starts it over
 }
 
 }  // namespace cohort::core

@@ -40,6 +40,9 @@ class AdaptiveConvergence {
   // motion_mask (optional): one value in [0, 1] per pixel, 1 = a moving object covers it.
   // Returns the global f used.
   double accumulate(const KCamera& camera, const FrameBuffer& fresh, const std::vector<float>* motion_mask = nullptr);
+  // The blend alone, with a factor chosen elsewhere (a post that blends, core/frame_post.h): f >= 1, or a
+  // frame of another size, starts the image over from `fresh`.
+  void blend(const FrameBuffer& fresh, double f, const std::vector<float>* motion_mask = nullptr);
   const FrameBuffer& image() const { return accumulated_; }
   // Frames the accumulated image is worth (1/f of the last blend).
   double effective_frames() const { return effective_frames_; }

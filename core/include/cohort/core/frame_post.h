@@ -10,6 +10,7 @@
 
 #include "cohort/core/atrous_filter.h"
 #include "cohort/core/band_buffer.h"
+#include "cohort/core/convergence.h"
 #include "cohort/core/frame_buffer.h"
 #include "cohort/core/gbuffer.h"
 #include "cohort/core/reprojection.h"
@@ -96,7 +97,8 @@ class HostFramePost final : public FramePost {
   TemporalReprojection reprojection_;
   AtrousFilter atrous_;
   SparseUpsampler upsampler_;
-  FrameBuffer reconstructed_, filtered_, copy_, blended_;
+  FrameBuffer reconstructed_, filtered_, copy_;
+  AdaptiveConvergence blended_;  // Brigade's blend, with the factor the caller sets
   const FrameBuffer* shown_ = &copy_;
 };
 

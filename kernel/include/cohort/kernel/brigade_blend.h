@@ -1,6 +1,7 @@
 /* Brigade's adaptive convergence (Bikker & van Schijndel 2013, section 4.7; core/convergence.h picks f from
  * the camera's motion): the accumulated image C = (1 - f) C_prev + f C_new, one value at a time, written once
- * for the host's threads (core::AdaptiveConvergence, core::HostFramePost) and a GPU's post (CudaFramePost). */
+ * for the host's threads (core::AdaptiveConvergence, whose blend HostFramePost runs too) and a GPU's post
+ * (CudaFramePost). */
 #ifndef COHORT_KERNEL_BRIGADE_BLEND_H
 #define COHORT_KERNEL_BRIGADE_BLEND_H
 #include "portable.h"
