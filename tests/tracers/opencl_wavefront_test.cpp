@@ -7,6 +7,7 @@
 // go to the shadow walk where they fit a vertex's slots and stay in the shading kernels where they do not.
 #include <gtest/gtest.h>
 
+#include <chrono>
 #include <cmath>
 #include <cstdlib>
 #include <cstring>
@@ -294,6 +295,32 @@ TEST(OpenCLWavefrontScratch, GrowsWithTheBandAndSitsOutFramesWithoutABounce) {
     const core::BandResult rb = wave->render_band(job, b);
     EXPECT_EQ(differing_floats(a, b), 0u);
     EXPECT_EQ(ra.row_work, rb.row_work);
+  }
+}
+
+// A band tells its own clock, as a CUDA band does (the frame timeline's kernels and transfer spans): the
+// device time of its kernels, and its way back (packing to half floats where the target takes them, the
+// read), from the queue's profiling; both within the band's wall time.
+TEST(OpenCLBandClock, ReportsItsKernelsAndItsWayBack) {
+  if (!tracer_runs_here("opencl")) GTEST_SKIP() << "no OpenCL device here";
+  const int w = 32, h = 24;
+  const View view = room_view(w, h);
+  for (const Variant& v : {kMegakernel, kWavefront}) {
+    auto tracer = opencl(v);
+    tracer->apply(commit::CommitBuffer::full(view.scene, 1));
+    for (const core::BandFormat format : {core::BandFormat::rgb16f, core::BandFormat::rgba32f}) {
+      SCOPED_TRACE(std::string(v.name) + (format == core::BandFormat::rgb16f ? ", half floats" : ", floats"));
+      core::BandBuffer target(w, h, format);
+      core::BandJob job;
+      job.params = frame_params(K_MODE_PATH, 1, 1, h);
+      job.camera = view.camera;
+      const auto start = std::chrono::steady_clock::now();
+      const core::BandResult result = tracer->render_band(job, target);
+      const double wall = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+      EXPECT_GT(result.device_ms, 0.0);
+      EXPECT_GT(result.transfer_ms, 0.0);
+      EXPECT_LE(result.device_ms + result.transfer_ms, wall);
+    }
   }
 }
 

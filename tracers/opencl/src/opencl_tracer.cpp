@@ -674,7 +674,8 @@ core::BandResult OpenCLTracer::render_band(const core::BandJob& job, core::BandB
   check(clFlush(m.queue), "clFlush");
   if (write_aux) read_aux_when_packed(rows * camera.width, straight);
   void* band_destination = straight ? target.row(int(params.row_begin)) : band.data();
-  check(clEnqueueReadBuffer(m.queue, band_mem, CL_FALSE, 0, band_bytes, band_destination, 0, nullptr, nullptr),
+  Event band_read;
+  check(clEnqueueReadBuffer(m.queue, band_mem, CL_FALSE, 0, band_bytes, band_destination, 0, nullptr, band_read.out()),
         "reading the band");
   check(clEnqueueReadBuffer(m.queue, m.row_rays, CL_FALSE, 0, rows * sizeof(cl_uint), row_rays.data(), 0, nullptr, nullptr),
         "reading the row ray counts");
@@ -690,6 +691,9 @@ core::BandResult OpenCLTracer::render_band(const core::BandJob& job, core::BandB
   const cl_ulong end = band_done.time(CL_PROFILING_COMMAND_END);
   core::BandResult result;
   result.device_ms = end > start && start != 0 ? double(end - start) * 1e-6 : 0.0;
+  // The band's way back (the half-float packing, then the read), as the CUDA tracer reports it.
+  const cl_ulong read_end = band_read.time(CL_PROFILING_COMMAND_END);
+  if (result.device_ms > 0.0 && read_end > end) result.transfer_ms = double(read_end - end) * 1e-6;
   if (params.row_end == frame_params(job).row_end) result.row_work.assign(row_rays.begin(), row_rays.end());
   return result;
 }
