@@ -1,8 +1,9 @@
 #include "cohort/core/renderer.h"
 
 #include <algorithm>
-#include <functional>
+#include <atomic>
 #include <condition_variable>
+#include <functional>
 #include <cstring>
 #include <mutex>
 #include <stdexcept>
@@ -10,6 +11,7 @@
 
 #include <spdlog/spdlog.h>
 
+#include "cohort/core/brief_spin.h"
 #include "cohort/core/host_threads.h"
 
 namespace cohort::core {
@@ -24,6 +26,7 @@ constexpr size_t kRowsPerCopy = 16;  // a band's rows are merged into the frame 
 struct Completion {
   std::mutex mutex;
   std::condition_variable cv;
+  std::atomic<uint64_t> count{0};  // jobs ended so far: what the core polls before it blocks
 };
 
 }  // namespace
@@ -39,6 +42,10 @@ struct Renderer::Worker {
   std::condition_variable inbox_cv;
   bool quit = false;
   bool has_job = false;
+  std::atomic<bool> job_posted{false};  // has_job, for polling without the lock
+  std::chrono::microseconds handoff_spin{0};  // RendererOptions::handoff_spin
+  // Core thread only: when this worker's job should end (handed out + its last job's wall time).
+  Clock::time_point expected_end{};
   uint64_t job_id = 0;
   BandJob job;
   bool job_is_recovery = false;    // re-rendering rows a dropped tracer did not deliver
@@ -94,6 +101,8 @@ struct Renderer::Worker {
       int slot = 0;
       const commit::CommitBuffer* to_apply = nullptr;
       commit::CommitChannel* channel_of_job = nullptr;
+      if (handoff_spin.count() > 0)
+        spin_until(Clock::now() + handoff_spin, [&] { return job_posted.load(std::memory_order_acquire); });
       {
         std::unique_lock lock(inbox_mutex);
         inbox_cv.wait(lock, [&] { return quit || has_job; });
@@ -104,6 +113,7 @@ struct Renderer::Worker {
         slot = job_slot;
         probe = job_is_probe;
         has_job = false;
+        job_posted.store(false, std::memory_order_relaxed);
         to_apply = job_commit;
         job_commit = nullptr;
         channel_of_job = job_channel;
@@ -167,6 +177,7 @@ struct Renderer::Worker {
         row_work = std::move(work);
         device_band = kept;
         spans = std::move(job_spans);
+        completion->count.fetch_add(1, std::memory_order_release);
       }
       completion->cv.notify_all();
     }
@@ -219,6 +230,7 @@ Renderer::Renderer(std::vector<std::unique_ptr<Tracer>> tracers, RendererOptions
     w->tracer = std::move(tracers[i]);
     w->name = w->tracer->name();
     w->completion = completion;
+    w->handoff_spin = options_.handoff_spin;
     // The worker owns the tracer, so the hook never outlives what it points at.
     if (w->tracer->takes_commits_ahead()) w->tracer->set_commits_ahead([worker = w.get()] { worker->apply_ahead(); });
     if (w->tracer->takes_jobs_ahead())
@@ -355,6 +367,8 @@ std::vector<uint64_t> Renderer::assign(const std::vector<Assignment>& assignment
     {
       std::lock_guard lock(w.completion->mutex);
       w.busy = true;
+      w.expected_end = Clock::now() + std::chrono::duration_cast<Clock::duration>(
+                                          std::chrono::duration<double, std::milli>(w.wall_ms));
     }
     std::lock_guard lock(w.inbox_mutex);
     w.job = job;
@@ -368,6 +382,7 @@ std::vector<uint64_t> Renderer::assign(const std::vector<Assignment>& assignment
     // Only a frame's own bands may stay on a GPU: re-rendered rows and probes come through the host.
     w.job.keep_on_device = with_commits && !assignments[i].probe && packed_merge_ ? device_bands_for_ : -1;
     w.has_job = true;
+    w.job_posted.store(true, std::memory_order_release);
     // What was published so far belongs to this frame; commits submitted from now on wait for the
     // next. Re-rendering a dropped tracer's rows happens within the same frame, so it takes none.
     if (with_commits && w.channel) {
@@ -395,6 +410,22 @@ Renderer::RoundResult Renderer::collect(const std::vector<Assignment>& assignmen
     }
     return true;
   };
+  if (options_.handoff_spin.count() > 0 && !all_done()) {
+    // Asleep until shortly before the slowest band is due, then polling the count of ended jobs.
+    Clock::time_point due{};
+    for (const Assignment& a : assignments) due = std::max(due, workers_[static_cast<size_t>(a.worker)]->expected_end);
+    const auto spin = std::chrono::duration_cast<Clock::duration>(options_.handoff_spin);
+    completion.cv.wait_until(lock, std::min(due - spin, deadline), all_done);
+    uint64_t seen = completion.count.load(std::memory_order_acquire);
+    const auto spin_end = std::min(std::max(due, Clock::now()) + spin, deadline);
+    while (!all_done()) {
+      lock.unlock();
+      const bool ended = spin_until(spin_end, [&] { return completion.count.load(std::memory_order_acquire) != seen; });
+      lock.lock();
+      if (!ended) break;
+      seen = completion.count.load(std::memory_order_acquire);
+    }
+  }
   completion.cv.wait_until(lock, deadline, all_done);
   for (size_t i = 0; i < assignments.size(); ++i) {
     Worker& w = *workers_[static_cast<size_t>(assignments[i].worker)];

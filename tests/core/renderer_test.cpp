@@ -8,6 +8,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "cohort/core/brief_spin.h"
 #include "cohort/core/renderer.h"
 #include "cohort/core/simulated_tracer.h"
 
@@ -73,6 +74,46 @@ TEST(Renderer, DeliversEveryRowAndBalancesUnequalTracers) {
   EXPECT_EQ(j["tracers"].size(), 2u);
   EXPECT_EQ(j["tracers"][0]["outcome"], "rendered");
   EXPECT_DOUBLE_EQ(j["idle_percent"].get<double>(), stats.idle_percent);
+}
+
+// The hand-over spin (RendererOptions::handoff_spin) changes when threads wake, nothing else: without it,
+// and with one longer than a whole frame (every wait ends while polling), the same bands and complete frames.
+TEST(Renderer, TheHandOffSpinChangesOnlyWhenThreadsWake) {
+  auto run = [](std::chrono::microseconds spin) {
+    std::vector<std::unique_ptr<Tracer>> tracers;
+    tracers.push_back(std::make_unique<SimulatedTracer>(model(), sim(1, 2.0)));
+    tracers.push_back(std::make_unique<SimulatedTracer>(model(), sim(2, 1.0)));
+    RendererOptions options;
+    options.balancer = "perfect";
+    options.use_reported_time = true;
+    options.handoff_spin = spin;
+    Renderer renderer(std::move(tracers), options);
+    FrameBuffer fb;
+    std::vector<std::pair<int, int>> bands;
+    for (uint64_t f = 0; f < 12; ++f) {
+      const FrameStats stats = renderer.render(job_for(f), fb);
+      expect_complete(fb, f, stats, {1, 2});
+      EXPECT_EQ(stats.dropped, 0);
+      for (const TracerFrameStats& t : stats.tracers) bands.emplace_back(t.row_begin, t.row_end);
+    }
+    return bands;
+  };
+  EXPECT_EQ(run(std::chrono::microseconds(0)), run(std::chrono::microseconds(20000)));
+}
+
+TEST(BriefSpin, HoldsAsSoonAsReadyAndGivesUpAtItsDeadline) {
+  using Clock = std::chrono::steady_clock;
+  EXPECT_TRUE(spin_until(Clock::now() - std::chrono::seconds(1), [] { return true; }));
+  const auto start = Clock::now();
+  EXPECT_FALSE(spin_until(start + std::chrono::milliseconds(2), [] { return false; }));
+  EXPECT_GE(Clock::now() - start, std::chrono::milliseconds(2));
+  std::atomic<bool> flag{false};
+  std::thread setter([&] {
+    std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    flag.store(true);
+  });
+  EXPECT_TRUE(spin_until(Clock::now() + std::chrono::seconds(10), [&] { return flag.load(); }));
+  setter.join();
 }
 
 TEST(Renderer, ATracerThatThrowsIsDroppedItsRowsReRenderedAndItRejoins) {

@@ -60,6 +60,10 @@ struct RendererOptions {
   // tracer's apply (skinning, refits, its TLAS on every core) slows the host's part of the frame. 1: every
   // frame. Whatever it skipped is applied before it renders again.
   int benched_commit_every = 1;
+  // How long a thread polls before it blocks where the other side is about to answer (cohort/core/brief_spin.h):
+  // a worker after its band, for its next job; the core from shortly before the frame's bands are due
+  // (the slowest one's last time) to this long after. 0: block at once.
+  std::chrono::microseconds handoff_spin{150};
 };
 
 class Renderer {
