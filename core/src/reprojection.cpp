@@ -30,6 +30,23 @@ double TemporalReprojection::mean_history_length() const {
   return sum / static_cast<double>(length_.size());
 }
 
+KReprojectParams reproject_params(const ReprojectionOptions& o, int width, int height, bool have_history) {
+  KReprojectParams params{};
+  params.width = width;
+  params.height = height;
+  params.have_history = have_history ? 1 : 0;
+  params.moments = o.luminance_moments ? 1 : 0;
+  params.max_history = static_cast<float>(std::max(o.max_history, 1));
+  params.depth_tolerance = o.depth_tolerance;
+  params.normal_cos = o.normal_cos;
+  params.clamp_sigma = o.clamp_sigma;
+  params.still_motion = o.still_motion;
+  params.anti_lag_sigma = o.anti_lag_sigma;
+  params.anti_lag_relative = o.anti_lag_relative;
+  params.footprint_taps = o.jittered_planes ? 1 : 0;
+  return params;
+}
+
 void TemporalReprojection::accumulate(const FrameBuffer& fresh, const GBuffer& gbuffer) {
   if (gbuffer.width != fresh.width || gbuffer.height != fresh.height)
     throw std::invalid_argument("TemporalReprojection: the G-buffer's size differs from the frame's");
@@ -46,20 +63,7 @@ void TemporalReprojection::accumulate(const FrameBuffer& fresh, const GBuffer& g
     next_moments_.resize(2 * pixels);
     if (moments_.size() != 2 * pixels) moments_.assign(2 * pixels, 0.0f);
   }
-  const ReprojectionOptions& o = options_;
-  KReprojectParams params{};
-  params.width = width;
-  params.height = height;
-  params.have_history = have_history ? 1 : 0;
-  params.moments = moments ? 1 : 0;
-  params.max_history = static_cast<float>(std::max(o.max_history, 1));
-  params.depth_tolerance = o.depth_tolerance;
-  params.normal_cos = o.normal_cos;
-  params.clamp_sigma = o.clamp_sigma;
-  params.still_motion = o.still_motion;
-  params.anti_lag_sigma = o.anti_lag_sigma;
-  params.anti_lag_relative = o.anti_lag_relative;
-  params.footprint_taps = o.jittered_planes ? 1 : 0;
+  const KReprojectParams params = reproject_params(options_, width, height, have_history);
 
   ycocgw_.resize(4 * pixels);
   const KReprojectFresh fresh_planes{fresh.rgba.data(), ycocgw_.data(),     gbuffer.depth.data(), gbuffer.prev_depth.data(),

@@ -154,7 +154,16 @@ uint32_t WorldSync::build_mesh_blas(int mesh_index, commit::CommitBuffer& out, c
   });
   if (triangles.empty()) return K_NONE;
   BlasBuild build = build_blas(vertices, triangles);
+  commit::BlasUpload up = append_blas(mesh, std::move(vertices), std::move(build), 0);
+  uint32_t index = up.blas_index;
+  out.add_blas(std::move(up));
+  return index;
+}
 
+// A BLAS built on the mesh's own vertices, appended to the master pools (shared by every BLAS: its
+// triangles are moved to its vertices' place there), with room for at least node_room nodes.
+commit::BlasUpload WorldSync::append_blas(const scene::Mesh& mesh, std::vector<KVertex> vertices, BlasBuild build,
+                                          size_t node_room) {
   commit::BlasUpload up;
   up.blas_index = uint32_t(master_.blases.size());
   up.vertex_offset = uint32_t(master_.vertices.size());
@@ -163,22 +172,21 @@ uint32_t WorldSync::build_mesh_blas(int mesh_index, commit::CommitBuffer& out, c
   up.vertices = std::move(vertices);
   up.vertex_colors = mesh.colors;
   up.triangles = std::move(build.triangles);
-  for (KTriangle& t : up.triangles) {  // built on the mesh's own vertices; the pool is shared
+  for (KTriangle& t : up.triangles) {
     t.v0 += up.vertex_offset;
     t.v1 += up.vertex_offset;
     t.v2 += up.vertex_offset;
   }
+  up.blas = {up.node_offset, uint32_t(build.nodes.size()), up.triangle_offset, uint32_t(up.triangles.size())};
   up.nodes = std::move(build.nodes);
-  up.blas = {up.node_offset, uint32_t(up.nodes.size()), up.triangle_offset, uint32_t(up.triangles.size())};
+  up.nodes.resize(std::max(up.nodes.size(), node_room), KBvhNode{});
   append_vertex_colors(master_.vertex_colors, mesh);   // first: it throws for a mesh with colours missing
   master_.vertices.insert(master_.vertices.end(), up.vertices.begin(), up.vertices.end());
   master_.triangles.insert(master_.triangles.end(), up.triangles.begin(), up.triangles.end());
   master_.blas_nodes.insert(master_.blas_nodes.end(), up.nodes.begin(), up.nodes.end());
   master_.blases.push_back(up.blas);
   ++stats_.blas_builds;
-  uint32_t index = up.blas_index;
-  out.add_blas(std::move(up));
-  return index;
+  return up;
 }
 
 // New or redefined images: their texels (with mips, exactly as compile_scene makes them) are appended
@@ -369,30 +377,9 @@ WorldSync::SkinnedEntity WorldSync::add_skinned_blas(int mesh_index, commit::Com
 
   BlasBuild build = build_blas(vertices, triangles);
   entity.built_sah = build.sah_cost;
-  commit::BlasUpload up;
-  up.blas_index = uint32_t(master_.blases.size());
-  up.vertex_offset = uint32_t(master_.vertices.size());
-  up.triangle_offset = uint32_t(master_.triangles.size());
-  up.node_offset = uint32_t(master_.blas_nodes.size());
-  up.vertices = std::move(vertices);
-  up.vertex_colors = mesh.colors;
-  up.triangles = std::move(build.triangles);
-  for (KTriangle& t : up.triangles) {
-    t.v0 += up.vertex_offset;
-    t.v1 += up.vertex_offset;
-    t.v2 += up.vertex_offset;
-  }
-  up.blas = {up.node_offset, uint32_t(build.nodes.size()), up.triangle_offset, uint32_t(up.triangles.size())};
   // Room for any binary tree over these triangles, so a rebuild after the refit decays stays in place.
-  up.nodes = std::move(build.nodes);
-  up.nodes.resize(std::max<size_t>(up.nodes.size(), 2 * up.triangles.size() - 1), KBvhNode{});
-  append_vertex_colors(master_.vertex_colors, mesh);   // first: it throws for a mesh with colours missing
-  master_.vertices.insert(master_.vertices.end(), up.vertices.begin(), up.vertices.end());
-  master_.triangles.insert(master_.triangles.end(), up.triangles.begin(), up.triangles.end());
-  master_.blas_nodes.insert(master_.blas_nodes.end(), up.nodes.begin(), up.nodes.end());
-  master_.blases.push_back(up.blas);
+  commit::BlasUpload up = append_blas(mesh, std::move(vertices), std::move(build), 2 * triangles.size() - 1);
   entity.blas = up.blas_index;
-  ++stats_.blas_builds;
 
   skin_up.skin_index = uint32_t(master_.skins.size());
   const SharedSkin& shared_skin = shared->second;

@@ -319,18 +319,7 @@ class CudaFramePost final : public core::FramePost {
       State& from = state_[parity_];
       State& to = state_[parity_ ^ 1];
       for (State* s : {&from, &to}) s->resize(pixels, options_.reprojection.luminance_moments);
-      KReprojectParams params{};
-      params.width = width, params.height = height, params.have_history = have_history_ ? 1 : 0;
-      const core::ReprojectionOptions& o = options_.reprojection;
-      params.max_history = static_cast<float>(std::max(o.max_history, 1));
-      params.depth_tolerance = o.depth_tolerance;
-      params.normal_cos = o.normal_cos;
-      params.clamp_sigma = o.clamp_sigma;
-      params.still_motion = o.still_motion;
-      params.anti_lag_sigma = o.anti_lag_sigma;
-      params.anti_lag_relative = o.anti_lag_relative;
-      params.footprint_taps = o.jittered_planes ? 1 : 0;
-      params.moments = o.luminance_moments ? 1 : 0;
+      const KReprojectParams params = core::reproject_params(options_.reprojection, width, height, have_history_);
       float* ycocgw = ycocgw_.scratch(4 * pixels);
       if (!ycocgw_ready)
         prepare_kernel<<<blocks_for(pixels), kThreads, 0, stream_>>>(fresh, ycocgw, static_cast<int>(pixels));

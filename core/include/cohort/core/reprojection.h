@@ -27,6 +27,7 @@
 
 #include "cohort/core/frame_buffer.h"
 #include "cohort/core/gbuffer.h"
+#include "cohort/kernel/reproject.h"
 
 namespace cohort::core {
 
@@ -46,6 +47,10 @@ struct ReprojectionOptions {
   // taps of the other surface the pixel covers count too (kernel/reproject.h's k_reproject_footprint_tap).
   bool jittered_planes = false;
 };
+
+// The portable kernel's parameters (kernel/reproject.h) for a width x height frame, from the options:
+// one translation for the host's reprojection and the GPU post-processing's.
+KReprojectParams reproject_params(const ReprojectionOptions& options, int width, int height, bool have_history);
 
 class TemporalReprojection {
  public:

@@ -40,6 +40,7 @@
 #include <vector>
 
 #include "cohort/commit/commit_buffer.h"
+#include "cohort/core/bvh.h"
 #include "cohort/core/frame_defaults.h"
 #include "cohort/core/gpu_scene.h"
 #include "cohort/scene/material_registers.h"
@@ -96,6 +97,7 @@ class WorldSync {
   // the refit tree has decayed past the rebuild threshold.
   bool refit_moved_instances(const std::vector<int>& moved, commit::CommitBuffer& out);
   uint32_t build_mesh_blas(int mesh, commit::CommitBuffer& out, const std::map<int, uint32_t>* instance_slots = nullptr);
+  commit::BlasUpload append_blas(const scene::Mesh& mesh, std::vector<KVertex> vertices, BlasBuild build, size_t node_room);
   // A character drawn with a skinned mesh and joints: its own BLAS (its own vertices), posed by its
   // joints. Returns the BLAS, or K_NONE when the joints do not fit the skin (not drawn, as in the engine).
   uint32_t pose_skinned_entity(int handle, const scene::RenderEntity& def, commit::CommitBuffer& out);
