@@ -88,6 +88,12 @@ struct MpiLinkStats {
   uint64_t rows_beyond_ahead = 0;  // rows of adopting bands that the job ahead had not covered (rendered after)
   double total_node_idle_ms = 0.0;
   double total_node_ahead_ms = 0.0;
+  // On rank 0: how long after its band's job each job ahead left (the core's announcement of the next
+  // frame: its turnaround of the frame before, e.g. merge and blend on the host, comes first), summed over
+  // the jobs ahead; and the bands that came back before the next frame was announced, so that no job went
+  // ahead of that frame (its node then waits for the frame's job).
+  double total_ahead_sent_after_ms = 0.0;
+  uint64_t bands_back_before_announcement = 0;
   uint32_t last_pieces = 0;
   uint64_t stale_answers = 0;       // late answers to jobs that had timed out, dropped
   uint64_t refused_messages = 0;    // malformed answers, refused
@@ -126,7 +132,7 @@ class MpiTracer : public core::Tracer {
   [[noreturn]] void fail_timed_out(uint64_t id, MpiClock::time_point start, const core::BandJob& job);
   // Between the polls of band `job`: once the core announces the next frame's job, sends it to the node
   // as a job ahead with this band's rows (the commits published before it go first).
-  void send_job_ahead(const core::BandJob& job, const core::BandBuffer& target);
+  void send_job_ahead(const core::BandJob& job, const core::BandBuffer& target, MpiClock::time_point band_start);
   // A job sent ahead, until the next band adopts it or drops it.
   struct JobAhead {
     uint64_t id = 0;
