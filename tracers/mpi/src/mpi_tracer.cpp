@@ -269,7 +269,7 @@ MpiTracer::~MpiTracer() {
                  round_trip - (node - s.total_node_ahead_ms / n));
     if (options_.jobs_ahead)
       spdlog::info("mpi:{}: a job ahead left {:.2f} ms a band after its band's job (when the core announced the next "
-                   "frame); {} band(s) came back before the next frame was announced, so no job went ahead of it",
+                   "frame); {} band(s) came back before the next frame was announced, so that frame's job did not go ahead",
                    options_.rank, s.jobs_ahead ? s.total_ahead_sent_after_ms / double(s.jobs_ahead) : 0.0,
                    s.bands_back_before_announcement);
   }
@@ -441,6 +441,11 @@ core::BandResult MpiTracer::render_band(const core::BandJob& job, core::BandBuff
                  "already applied the commits that came after its band of that frame: they show the next frame's "
                  "world (the camera is this frame's)", options_.rank, job.params.row_begin, job.params.row_end,
                  job.params.frame_index);
+  if (back_unannounced_ && job.params.frame_index > band_frame_) {
+    std::lock_guard lock(stats_mutex_);
+    ++stats_.bands_back_before_announcement;
+  }
+  back_unannounced_ = false;
   commits_ahead_of_band_ = false;
   band_frame_ = job.params.frame_index;
   if (ahead) {
@@ -638,7 +643,7 @@ core::BandResult MpiTracer::render_band(const core::BandJob& job, core::BandBuff
       stats_.total_node_first_piece_ms += rows.timing.first_piece_ms;
       stats_.total_node_idle_ms += rows.timing.idle_ms;
       stats_.total_node_ahead_ms += rows.timing.ahead_ms;
-      if (options_.jobs_ahead && !ahead_) ++stats_.bands_back_before_announcement;
+      back_unannounced_ = options_.jobs_ahead && !ahead_;  // counted when a later frame's band comes
       stats_.total_first_piece_ms +=
           std::chrono::duration<double, std::milli>(pieces.first_matched - start).count();
     }

@@ -89,9 +89,10 @@ struct MpiLinkStats {
   double total_node_idle_ms = 0.0;
   double total_node_ahead_ms = 0.0;
   // On rank 0: how long after its band's job each job ahead left (the core's announcement of the next
-  // frame: its turnaround of the frame before, e.g. merge and blend on the host, comes first), summed over
-  // the jobs ahead; and the bands that came back before the next frame was announced, so that no job went
-  // ahead of that frame (its node then waits for the frame's job).
+  // frame: its turnaround of the frame before, e.g. merge and blend on the host, came first before
+  // FramePipeline's prepare_next), summed over the jobs ahead; and the bands that came back before the
+  // next frame was announced, so that no job went ahead of the next frame (its node then waited for the
+  // frame's job; counted when that frame's band comes, so the run's last band is not).
   double total_ahead_sent_after_ms = 0.0;
   uint64_t bands_back_before_announcement = 0;
   uint32_t last_pieces = 0;
@@ -155,6 +156,7 @@ class MpiTracer : public core::Tracer {
   bool in_band_ = false;             // inside render_band, its job sent: apply() is a commit ahead
   uint32_t band_frame_ = 0;          // the frame index of the last band sent
   bool commits_ahead_of_band_ = false;  // commits went ahead of the node since the last band's job
+  bool back_unannounced_ = false;       // the last band came back with no job ahead sent (none announced)
   uint64_t commits_sent_ = 0;         // commits (and full resyncs) sent to the node so far
   std::optional<JobAhead> ahead_;
   uint64_t timed_out_job_ = 0;
