@@ -143,7 +143,7 @@ case "${1:-}" in
     mpi_cohort_and_large_map
     common=(/tmp/largemap.cpk --width 1920 --height 1080 --camera 1690 300 80 5 -12 --spp 1 --light-samples 1 --bounces 1
             --convergence brigade --frames 200 --camera-path spin-slow --write last)
-    median() { python3 tools/frame_times.py "$1/stats.json" --skip 50 | head -n 1 | sed -E 's/.*per frame median ([0-9.]+) ms.*/\1/'; }
+    median() { python3 tools/frame_times.py "$1/stats.json" --skip 50 | sed -nE '1s/.*per frame median ([0-9.]+) ms.*/\1/p'; }
     "$cohort" render "${common[@]}" --tracers cuda:0 --out /tmp/l_cuda0 >/dev/null 2>&1
     "$cohort" render "${common[@]}" --tracers cuda:0,cuda:1 --out /tmp/l_cuda01 >/dev/null 2>&1
     echo "in process: cuda:0 $(median /tmp/l_cuda0) ms, cuda:0,cuda:1 $(median /tmp/l_cuda01) ms"
@@ -172,6 +172,12 @@ print(f"link {link}: mpi:1 alone {m1:.2f} ms, mpi:2 alone {m2:.2f}, mpi:1,mpi:2 
 PY
       grep -hE "round trip|a job ahead left" /tmp/l_m12.log | sed "s/^.*\] //" || true
       python3 tools/frame_times.py /tmp/l_m12/stats.json --skip 50 | grep " core/" || true
+      # Every run's log, and the mix's stats (~0.5 MB), come back, so that a figure can be read again later.
+      if [ -n "${OUT:-}" ]; then
+        keep="$OUT/links/${link//[^a-z0-9.]/_}_early$early" && mkdir -p "$keep"
+        for run in m1 m2 m12 c0m1; do cp /tmp/l_$run.log "$keep/" 2>/dev/null || true; done
+        cp /tmp/l_m12/stats.json "$keep/m12.stats.json" 2>/dev/null || true
+      fi
     done
     done
     ;;
