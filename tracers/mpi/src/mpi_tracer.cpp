@@ -267,10 +267,10 @@ MpiTracer::~MpiTracer() {
                  options_.rank, s.total_node_idle_ms / n, s.jobs_ahead, s.adopted, s.dropped_ahead,
                  s.rows_ahead_unused, s.rows_beyond_ahead, s.total_node_ahead_ms / n,
                  round_trip - (node - s.total_node_ahead_ms / n));
-    if (options_.jobs_ahead)
+    if (s.jobs_ahead > 0)  // not where nothing is announced (`bench devices` renders without the pipeline)
       spdlog::info("mpi:{}: a job ahead left {:.2f} ms a band after its band's job (when the core announced the next "
                    "frame); {} band(s) came back before the next frame was announced, so that frame's job did not go ahead",
-                   options_.rank, s.jobs_ahead ? s.total_ahead_sent_after_ms / double(s.jobs_ahead) : 0.0,
+                   options_.rank, s.total_ahead_sent_after_ms / double(s.jobs_ahead),
                    s.bands_back_before_announcement);
   }
   // The node stays for later tracers of this run; the session's end tells every node to leave.
