@@ -30,7 +30,7 @@ node while its band before renders, the node renders it right after that band, a
 adopts those rows, rendering only the rows beyond them; every frame matches the single-process render;
 with COHORT_MPI_JOBS_AHEAD=0 nothing is adopted), early_announce (rank 0 writes every frame, which takes
 longer than a node's band: announced after that work, COHORT_EARLY_ANNOUNCE=0, bands come back before the
-next frame is announced, about every other one; announced at hand-out, none does; every frame matches), link (`cohort bench devices` with mpi:1 behind an emulated
+next frame is announced (5-9 of 11 here); announced at hand-out, none does; every frame matches), link (`cohort bench devices` with mpi:1 behind an emulated
 link, COHORT_MPI_LINK=0.1gbit,20ms on every rank: the band's round trip holds the link's latency both ways and
 its bytes at the link's rate).
 """
@@ -359,7 +359,7 @@ def bench(a):
 def early_announce(a):
     """Rank 0's own frame work (every frame written) far longer than a node's band: announced after that work
     (COHORT_EARLY_ANNOUNCE=0, the order before), bands come back before the next frame is announced and its
-    job cannot go ahead (every other band, about); announced at hand-out (the default), none does. Every
+    job cannot go ahead (5-9 of 11 bands in five runs here); announced at hand-out (the default), none does. Every
     frame matches the single-process render either way."""
     os.makedirs(a.out)
     frames = 12
