@@ -1,6 +1,7 @@
 // `cohort render`: headless frames on one or more tracers (rows split by the balancer), written as
 // tone-mapped LDR and linear HDR images plus a JSON of per-frame stats.
 #include <cmath>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
@@ -357,12 +358,17 @@ int run_render(const RenderArgs& a) {
       if (moved != moved_by_frame.end()) moved_by_frame.erase(moved);
     }
   };
-  for (int f = 0; f < frames; ++f) {
+  // Frame f's preparation: its world sync (commits submitted) and its job; nothing when a replay has ended.
+  struct Prepared {
+    core::BandJob job;
+    std::vector<core::StageSpan> stages;  // the core's stages before the Renderer's own
+  };
+  auto prepare = [&](int f) -> std::optional<Prepared> {
     const auto frame_start = core::TimelineClock::now();
     std::vector<core::StageSpan> stages;  // the core's stages before the Renderer's own
     core::BandJob job;
     if (player) {
-      if (!player->play_frame(*world)) break;
+      if (!player->play_frame(*world)) return std::nullopt;
       if (a.write_ids) moved_by_frame[uint64_t(f)] = moved_entities.update(*world);
       core::ScopedStage syncing(stages, core::kCoreTrack, "world sync");
       renderer.submit_commit(sync->sync(world->TakeChanges(), uint64_t(f) + 1), [&] { return sync->snapshot(); });
@@ -406,7 +412,26 @@ int run_render(const RenderArgs& a) {
       previous_camera = job.camera;
     }
     started[uint64_t(f)] = frame_start;
-    if (std::optional<core::FramePipeline::Delivered> done = pipeline.push(job, std::move(stages))) finish(std::move(*done));
+    return Prepared{job, std::move(stages)};
+  };
+  // The next frame is prepared, and announced, as soon as a frame is handed out, before the frame before
+  // it is merged, blended and written (FramePipeline::push with prepare_next): a remote tracer's node
+  // starts on it then (docs/cluster.md). COHORT_EARLY_ANNOUNCE=0 prepares it after, as before (for
+  // comparison).
+  const char* early_text = std::getenv("COHORT_EARLY_ANNOUNCE");
+  const bool early_announce = !(early_text && std::string(early_text) == "0");
+  std::optional<Prepared> next = frames > 0 ? prepare(0) : std::nullopt;
+  for (int f = 0; next; ++f) {
+    Prepared current = std::move(*next);
+    next.reset();
+    const core::FramePipeline::PrepareNext prepare_next = [&, f]() -> std::optional<core::BandJob> {
+      if (f + 1 < frames) next = prepare(f + 1);
+      return next ? std::optional<core::BandJob>(next->job) : std::nullopt;
+    };
+    std::optional<core::FramePipeline::Delivered> done =
+        pipeline.push(current.job, std::move(current.stages), early_announce ? prepare_next : nullptr);
+    if (done) finish(std::move(*done));
+    if (!early_announce) prepare_next();
   }
   if (std::optional<core::FramePipeline::Delivered> done = pipeline.drain()) finish(std::move(*done));
   progress.finish();

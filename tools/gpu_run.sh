@@ -24,6 +24,7 @@
 #                              (COHORT_CLUSTER_JOBS_AHEAD="1 0": with and without jobs ahead, back to back)
 #   tools/gpu_run.sh links     there, on a two-GPU kind: remote tracers behind emulated links (COHORT_LINKS, default
 #                              "none 10gbit,0.5ms 1gbit,1ms"): alone, two ranks together, and beside rank 0's cuda:0
+#                              (COHORT_LINKS_EARLY="1 0": with the next frame announced at hand-out and after, back to back)
 #   tools/gpu_run.sh kernels   there: GPU time kernel by kernel (ncu) on the large map at 1080p, cuda:0, Brigade's
 #                              blend / reprojection / reprojection + a-trous, with the same runs' frame times
 #   tools/gpu_run.sh quality   there: bench/quality/bench_quality.py on cuda:0 along the test map's scenario,
@@ -142,11 +143,15 @@ case "${1:-}" in
     mpi_cohort_and_large_map
     common=(/tmp/largemap.cpk --width 1920 --height 1080 --camera 1690 300 80 5 -12 --spp 1 --light-samples 1 --bounces 1
             --convergence brigade --frames 200 --camera-path spin-slow --write last)
-    median() { python3 tools/frame_times.py "$1/stats.json" --skip 50 | head -n 1 | sed -E 's/.*per frame median ([0-9.]+) ms.*/\1/'; }
+    median() { python3 tools/frame_times.py "$1/stats.json" --skip 50 | sed -nE '1s/.*per frame median ([0-9.]+) ms.*/\1/p'; }
     "$cohort" render "${common[@]}" --tracers cuda:0 --out /tmp/l_cuda0 >/dev/null 2>&1
     "$cohort" render "${common[@]}" --tracers cuda:0,cuda:1 --out /tmp/l_cuda01 >/dev/null 2>&1
     echo "in process: cuda:0 $(median /tmp/l_cuda0) ms, cuda:0,cuda:1 $(median /tmp/l_cuda01) ms"
+    # COHORT_LINKS_EARLY="1 0": each link with the next frame announced at hand-out (the default) and after
+    # rank 0's post of the frame before (COHORT_EARLY_ANNOUNCE=0, the order before), back to back.
     for link in ${COHORT_LINKS:-none 10gbit,0.5ms 1gbit,1ms}; do
+    for early in ${COHORT_LINKS_EARLY:-1}; do
+      export COHORT_EARLY_ANNOUNCE=$early
       [ "$link" = none ] && export COHORT_MPI_LINK= || export COHORT_MPI_LINK=$link
       runs() {  # NAME TRACERS NODE-TRACERS... : rank 0 renders TRACERS, one node per NODE-TRACERS
         local name=$1 tracers=$2; shift 2
@@ -157,7 +162,7 @@ case "${1:-}" in
       }
       runs m1 mpi:1 cuda:0; runs m2 mpi:2 cuda:0 cuda:1; runs m12 mpi:1,mpi:2 cuda:0 cuda:1
       runs c0m1 cuda:0,mpi:1 cuda:1
-      python3 - "$link" "$(median /tmp/l_m1)" "$(median /tmp/l_m2)" "$(median /tmp/l_m12)" "$(median /tmp/l_cuda0)" \
+      python3 - "$link (next frame announced at hand-out: $early)" "$(median /tmp/l_m1)" "$(median /tmp/l_m2)" "$(median /tmp/l_m12)" "$(median /tmp/l_cuda0)" \
         "$(median /tmp/l_c0m1)" <<'PY'
 import sys
 link, m1, m2, m12, c0, c0m1 = sys.argv[1], *map(float, sys.argv[2:])
@@ -165,7 +170,15 @@ print(f"link {link}: mpi:1 alone {m1:.2f} ms, mpi:2 alone {m2:.2f}, mpi:1,mpi:2 
       f"(efficiency {100 / m12 / (1 / m1 + 1 / m2):.1f} %); cuda:0 + mpi:1 {c0m1:.2f} "
       f"(efficiency {100 / c0m1 / (1 / c0 + 1 / m1):.1f} %)")
 PY
-      grep -h "round trip" /tmp/l_m12.log | sed 's/^.*\] //' | tail -n 2 || true
+      grep -hE "round trip|a job ahead left" /tmp/l_m12.log | sed "s/^.*\] //" || true
+      python3 tools/frame_times.py /tmp/l_m12/stats.json --skip 50 | grep " core/" || true
+      # Every run's log, and the mix's stats (~0.5 MB), come back, so that a figure can be read again later.
+      if [ -n "${OUT:-}" ]; then
+        keep="$OUT/links/${link//[^a-z0-9.]/_}_early$early" && mkdir -p "$keep"
+        for run in m1 m2 m12 c0m1; do cp /tmp/l_$run.log "$keep/" 2>/dev/null || true; done
+        cp /tmp/l_m12/stats.json "$keep/m12.stats.json" 2>/dev/null || true
+      fi
+    done
     done
     ;;
   compare)

@@ -20,6 +20,11 @@ FramePipeline::Delivered FramePipeline::delivered(InFlight frame, FrameStats sta
 }
 
 std::optional<FramePipeline::Delivered> FramePipeline::push(const BandJob& job, std::vector<StageSpan> preparation) {
+  return push(job, std::move(preparation), PrepareNext());
+}
+
+std::optional<FramePipeline::Delivered> FramePipeline::push(const BandJob& job, std::vector<StageSpan> preparation,
+                                                            const PrepareNext& prepare_next) {
   std::optional<InFlight> previous = std::move(in_flight_);
   in_flight_.reset();
   std::optional<FrameStats> stats;
@@ -35,6 +40,16 @@ std::optional<FramePipeline::Delivered> FramePipeline::push(const BandJob& job, 
     throw;
   }
   in_flight_ = InFlight{job, std::move(preparation)};
+  if (prepare_next) {
+    std::optional<BandJob> next;
+    try {
+      next = prepare_next();
+    } catch (...) {
+      if (previous) renderer_.merge_frame(*stats);
+      throw;
+    }
+    if (next) renderer_.announce_frame(*next);
+  }
   if (!previous) return std::nullopt;
   renderer_.merge_frame(*stats);
   return delivered(std::move(*previous), std::move(*stats));

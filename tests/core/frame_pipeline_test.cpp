@@ -67,8 +67,12 @@ struct FrameGates {
     }
   }
   void wait(uint64_t frame) {
+    if (!wait_for(frame, kPatience)) gave_up = true;
+  }
+  // Whether the frame's gate opened within `patience`.
+  bool wait_for(uint64_t frame, std::chrono::milliseconds patience) {
     std::unique_lock lock(mutex);
-    if (!opened.wait_for(lock, kPatience, [&] { return open_through >= static_cast<int64_t>(frame); })) gave_up = true;
+    return opened.wait_for(lock, patience, [&] { return open_through >= static_cast<int64_t>(frame); });
   }
 };
 
@@ -391,4 +395,102 @@ TEST(FramePipeline, ATracerThatTakesJobsAheadSeesTheNextFramesJobWhileItRendersT
     }
   }
   for (const AnnouncementTracer::Seen& s : *other_seen) EXPECT_TRUE(s.announced.empty()) << "it did not ask for jobs ahead";
+}
+
+namespace {
+
+// Takes jobs ahead; each band renders until the next frame's job is announced (or its frame's gate
+// opens: the last frame has no next), then opens `saw_next`'s gate of its frame and keeps the job it saw.
+class AheadWatcher final : public Tracer {
+ public:
+  AheadWatcher(std::shared_ptr<FrameGates> gates, std::shared_ptr<FrameGates> saw_next,
+               std::shared_ptr<std::map<uint64_t, BandJob>> announced)
+      : gates_(std::move(gates)), saw_next_(std::move(saw_next)), announced_(std::move(announced)) {}
+  std::string name() const override { return "ahead-watcher"; }
+  bool takes_jobs_ahead() const override { return true; }
+  void apply(const cohort::commit::CommitBuffer&) override {}
+  using Tracer::render_band;
+  BandResult render_band(const BandJob& job, BandBuffer& target) override {
+    std::optional<BandJob> next;
+    gates_->poll(job.params.frame_index, [&] { return (next = next_job_announced()).has_value(); });
+    if (next) {
+      (*announced_)[job.params.frame_index] = *next;
+      saw_next_->open(job.params.frame_index);
+    }
+    fill_band_with_frame_index(job, target);
+    return {};
+  }
+
+ private:
+  std::shared_ptr<FrameGates> gates_, saw_next_;
+  std::shared_ptr<std::map<uint64_t, BandJob>> announced_;
+};
+
+}  // namespace
+
+// push() with prepare_next announces the next frame as soon as this one is handed out: the band of frame
+// f+1 sees f+2's job before push() returns frame f, so before the caller post-processes f (which here
+// waits for exactly that; without prepare_next it would wait in vain, the announcement coming only with
+// the next push, after the post).
+TEST(FramePipeline, PrepareNextAnnouncesTheNextFrameBeforeTheFrameBeforeIsPostProcessed) {
+  auto gates = std::make_shared<FrameGates>();
+  auto saw_next = std::make_shared<FrameGates>();
+  auto announced = std::make_shared<std::map<uint64_t, BandJob>>();
+  std::vector<std::unique_ptr<Tracer>> tracers;
+  tracers.push_back(std::make_unique<AheadWatcher>(gates, saw_next, announced));
+  RendererOptions options;
+  options.balancer = "none";
+  Renderer renderer(std::move(tracers), options);
+  FramePipeline pipeline(renderer);
+  constexpr uint64_t kFrames = 6;
+  std::vector<uint64_t> prepared;
+  uint64_t f = 0;
+  std::optional<BandJob> next = job_for(0);
+  while (next) {
+    const BandJob job = *next;
+    next.reset();
+    std::optional<FramePipeline::Delivered> done = pipeline.push(job, {}, [&]() -> std::optional<BandJob> {
+      if (f + 1 < kFrames) {
+        prepared.push_back(f + 1);
+        next = job_for(f + 1);
+      }
+      return next;
+    });
+    if (done) {
+      ASSERT_EQ(done->stats.frame, f - 1);
+      for (int y = 0; y < kRows; ++y) ASSERT_EQ(pipeline.image().row(y)[0], static_cast<float>(f - 1));
+      // The post of frame f-1: frame f renders meanwhile and has seen f+1's job already.
+      if (f + 1 < kFrames)
+        EXPECT_TRUE(saw_next->wait_for(f, std::chrono::milliseconds(5000)))
+            << "the band of frame " << f << " did not see frame " << f + 1 << "'s job during the post of frame " << f - 1;
+    }
+    ++f;
+  }
+  gates->open(kFrames - 1);  // nothing is announced after the last frame
+  ASSERT_TRUE(pipeline.drain().has_value());
+  EXPECT_FALSE(gates->gave_up);
+  EXPECT_EQ(f, kFrames);
+  EXPECT_EQ(prepared, (std::vector<uint64_t>{1, 2, 3, 4, 5}));
+  ASSERT_EQ(announced->size(), kFrames - 1);
+  for (const auto& [band_frame, job] : *announced) {
+    const BandJob expected = job_for(band_frame + 1);
+    EXPECT_EQ(job.params.frame_index, band_frame + 1);
+    EXPECT_EQ(std::memcmp(&job.camera, &expected.camera, sizeof expected.camera), 0);
+  }
+
+  // The contrast: without prepare_next, frame 1's band has not seen frame 2's job when push() returns
+  // frame 0, nor while the caller post-processes it; the next push announces it.
+  auto gates_serial = std::make_shared<FrameGates>();
+  auto saw_serial = std::make_shared<FrameGates>();
+  std::vector<std::unique_ptr<Tracer>> serial_tracers;
+  serial_tracers.push_back(std::make_unique<AheadWatcher>(gates_serial, saw_serial, announced));
+  Renderer serial_renderer(std::move(serial_tracers), options);
+  FramePipeline serial(serial_renderer);
+  ASSERT_FALSE(serial.push(job_for(0)).has_value());
+  ASSERT_TRUE(serial.push(job_for(1)).has_value());
+  EXPECT_FALSE(saw_serial->wait_for(1, std::chrono::milliseconds(200)));
+  ASSERT_TRUE(serial.push(job_for(2)).has_value());
+  EXPECT_TRUE(saw_serial->wait_for(1, std::chrono::milliseconds(5000)));
+  gates_serial->open(2);
+  ASSERT_TRUE(serial.drain().has_value());
 }

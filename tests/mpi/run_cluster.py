@@ -28,7 +28,9 @@ and 6 ms slower a row (bands far longer than rank 0's own frame work, so that ea
 while they render), so that the balancer moves rows every frame: each later frame's job goes to the
 node while its band before renders, the node renders it right after that band, and the frame's job
 adopts those rows, rendering only the rows beyond them; every frame matches the single-process render;
-with COHORT_MPI_JOBS_AHEAD=0 nothing is adopted), link (`cohort bench devices` with mpi:1 behind an emulated
+with COHORT_MPI_JOBS_AHEAD=0 nothing is adopted), early_announce (rank 0 writes every frame, which takes
+longer than a node's band: announced after that work, COHORT_EARLY_ANNOUNCE=0, bands come back before the
+next frame is announced (5-9 of 11 here); announced at hand-out, none does; every frame matches), link (`cohort bench devices` with mpi:1 behind an emulated
 link, COHORT_MPI_LINK=0.1gbit,20ms on every rank: the band's round trip holds the link's latency both ways and
 its bytes at the link's rate).
 """
@@ -63,9 +65,9 @@ def run(command, env=None, expect_ok=True):
     return result.returncode, output
 
 
-def compare_frames(a_dir, b_dir, tolerant=False):
+def compare_frames(a_dir, b_dir, tolerant=False, frames=FRAMES):
     """Byte for byte; tolerant (other tracer kinds): at most 0.5% of pixels differ, by at most 3 levels."""
-    for f in range(FRAMES):
+    for f in range(frames):
         name = f"frame_{f:04d}.png"
         a, b = os.path.join(a_dir, name), os.path.join(b_dir, name)
         if not os.path.exists(b):
@@ -354,6 +356,48 @@ def bench(a):
     print("bench: ok")
 
 
+def early_announce(a):
+    """Rank 0's own frame work (every frame written) far longer than a node's band: announced after that work
+    (COHORT_EARLY_ANNOUNCE=0, the order before), bands come back before the next frame is announced and its
+    job cannot go ahead (5-9 of 11 bands in five runs here); announced at hand-out (the default), none does. Every
+    frame matches the single-process render either way."""
+    os.makedirs(a.out)
+    frames = 12
+    args = [a.map, "--width", "320", "--height", "180", "--spp", "1", "--mode", "albedo", "--frames", str(frames), "--write", "all"]
+    single = os.path.join(a.out, "single")
+    run([a.cohort, "render", "--tracers", "embree", "--out", single] + args)
+    flags = mpiexec_flags(a.mpiexec)
+    node = [a.cohort, "node", a.map, "--tracers", "embree"]
+    pattern = (r"mpi:{}: a job ahead left ([\d.]+) ms a band after its band's job .*?; (\d+) band\(s\) came back "
+               r"before the next frame was announced")
+    for early in ("1", "0"):
+        cluster = os.path.join(a.out, "cluster_" + early)
+        env = dict(os.environ, COHORT_EARLY_ANNOUNCE=early)
+        if flags:
+            flags_env = flags + ["-x", "COHORT_EARLY_ANNOUNCE"]
+        else:
+            flags_env = flags
+        _, output = run([a.mpiexec] + flags_env + ["-np", "1", a.cohort, "render", "--tracers", "mpi:1,mpi:2", "--out",
+                                                   cluster] + args + [":"] + flags + ["-np", "1"] + node + [":"] +
+                        flags + ["-np", "1"] + node, env=env)
+        compare_frames(single, cluster, frames=frames)
+        for rank in (1, 2):
+            found = re.search(pattern.format(rank), output)
+            if not found:
+                sys.exit(f"mpi:{rank}: no line on when its jobs ahead left")
+            after_ms, back = float(found.group(1)), int(found.group(2))
+            print(f"announced at hand-out {early}, mpi:{rank}: a job ahead left {after_ms} ms after its band's job; "
+                  f"{back} of {frames - 1} band(s) back before the next frame was announced")
+            if early == "1" and back > 1:
+                sys.exit(f"mpi:{rank}: {back} band(s) came back before the next frame was announced at hand-out")
+            # (At most about half: a band that sent no job ahead is an ordinary one, long enough for the next
+            # announcement to come while it renders; the band after adopts that job and is short again.)
+            if early == "0" and back < frames // 4:
+                sys.exit(f"mpi:{rank}: only {back} band(s) came back before the announcement after rank 0's frame "
+                         f"work: the case no longer shows what the early announcement changes")
+    print("early_announce: ok")
+
+
 def link(a):
     """`cohort bench devices` with mpi:1 alone, every rank's sends through an emulated link of 0.1 Gbit/s and
     20 ms one way (COHORT_MPI_LINK): each band's round trip holds the job's way there and the rows' way
@@ -391,7 +435,8 @@ def link(a):
 def main():
     parser = argparse.ArgumentParser()
     parser.add_argument("case", choices=["match", "mixed", "stall", "killed", "version", "load_error", "bench", "protocol", "replay",
-                                           "play", "link", "bad_piece", "ahead", "ahead_recovery", "jobs_ahead"])
+                                           "play", "link", "bad_piece", "ahead", "ahead_recovery", "jobs_ahead",
+                                           "early_announce"])
     parser.add_argument("--mpiexec", required=True)
     parser.add_argument("--cohort", required=True)
     parser.add_argument("--map", required=True)
@@ -423,6 +468,9 @@ def main():
         return
     if a.case == "jobs_ahead":
         jobs_ahead(a)
+        return
+    if a.case == "early_announce":
+        early_announce(a)
         return
     if a.case == "bad_piece":
         bad_piece(a)

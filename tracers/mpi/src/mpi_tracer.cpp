@@ -267,6 +267,11 @@ MpiTracer::~MpiTracer() {
                  options_.rank, s.total_node_idle_ms / n, s.jobs_ahead, s.adopted, s.dropped_ahead,
                  s.rows_ahead_unused, s.rows_beyond_ahead, s.total_node_ahead_ms / n,
                  round_trip - (node - s.total_node_ahead_ms / n));
+    if (s.jobs_ahead > 0)  // not where nothing is announced (`bench devices` renders without the pipeline)
+      spdlog::info("mpi:{}: a job ahead left {:.2f} ms a band after its band's job (when the core announced the next "
+                   "frame); {} band(s) came back before the next frame was announced, so that frame's job did not go ahead",
+                   options_.rank, s.total_ahead_sent_after_ms / double(s.jobs_ahead),
+                   s.bands_back_before_announcement);
   }
   // The node stays for later tracers of this run; the session's end tells every node to leave.
   try {
@@ -373,7 +378,8 @@ std::string MpiTracer::why_not_adopt(const JobAhead& ahead, const core::BandJob&
   return {};
 }
 
-void MpiTracer::send_job_ahead(const core::BandJob& job, const core::BandBuffer& target) {
+void MpiTracer::send_job_ahead(const core::BandJob& job, const core::BandBuffer& target,
+                               MpiClock::time_point band_start) {
   if (ahead_ || job.params.row_end <= job.params.row_begin) return;
   const std::optional<core::BandJob> next = next_job_announced();
   if (!next || next->params.frame_index == job.params.frame_index) return;
@@ -395,6 +401,7 @@ void MpiTracer::send_job_ahead(const core::BandJob& job, const core::BandBuffer&
   ahead_ = std::move(ahead);
   std::lock_guard lock(stats_mutex_);
   ++stats_.jobs_ahead;
+  stats_.total_ahead_sent_after_ms += ms_since(band_start);
 }
 
 core::BandResult MpiTracer::render_band(const core::BandJob& job, core::BandBuffer& target) {
@@ -434,6 +441,11 @@ core::BandResult MpiTracer::render_band(const core::BandJob& job, core::BandBuff
                  "already applied the commits that came after its band of that frame: they show the next frame's "
                  "world (the camera is this frame's)", options_.rank, job.params.row_begin, job.params.row_end,
                  job.params.frame_index);
+  if (back_unannounced_ && job.params.frame_index > band_frame_) {
+    std::lock_guard lock(stats_mutex_);
+    ++stats_.bands_back_before_announcement;
+  }
+  back_unannounced_ = false;
   commits_ahead_of_band_ = false;
   band_frame_ = job.params.frame_index;
   if (ahead) {
@@ -488,7 +500,7 @@ core::BandResult MpiTracer::render_band(const core::BandJob& job, core::BandBuff
   const std::function<void()> between_polls = [&] {
     apply_commits_ahead();
     if (options_.jobs_ahead && !ahead_) {
-      send_job_ahead(job, target);
+      send_job_ahead(job, target, start);
       if (ahead_) ahead_->sent_in_band = id;
     }
   };
@@ -609,6 +621,11 @@ core::BandResult MpiTracer::render_band(const core::BandJob& job, core::BandBuff
       stats_.last_band_bytes_received = pieces.bytes + bytes->size();
       pending_sent_ = 0;
     }
+    // The band is back: the next frame's job, when announced by now, still goes ahead of it.
+    if (options_.jobs_ahead && !ahead_) {
+      send_job_ahead(job, target, start);
+      if (ahead_) ahead_->sent_in_band = id;
+    }
     if (first_after_resync) {
       std::lock_guard lock(stats_mutex_);
       ++stats_.resync_bands;
@@ -626,6 +643,7 @@ core::BandResult MpiTracer::render_band(const core::BandJob& job, core::BandBuff
       stats_.total_node_first_piece_ms += rows.timing.first_piece_ms;
       stats_.total_node_idle_ms += rows.timing.idle_ms;
       stats_.total_node_ahead_ms += rows.timing.ahead_ms;
+      back_unannounced_ = options_.jobs_ahead && !ahead_;  // counted when a later frame's band comes
       stats_.total_first_piece_ms +=
           std::chrono::duration<double, std::milli>(pieces.first_matched - start).count();
     }

@@ -7,6 +7,7 @@
 //   at the end:      pipeline.drain()                  ->  post-process what came back
 #pragma once
 
+#include <functional>
 #include <optional>
 #include <vector>
 
@@ -36,6 +37,15 @@ class FramePipeline {
   // (Renderer::wait_frame throws), `job` is not handed out and the exception propagates; the next push
   // starts afresh.
   std::optional<Delivered> push(const BandJob& job, std::vector<StageSpan> preparation = {});
+  // The same, and as soon as `job` is handed out, before the frame before it is merged, `prepare_next`
+  // prepares the next frame (submits its commits) and returns its job (or nothing, at the end), which is
+  // announced at once (Renderer::announce_frame) instead of by the next push(), after the caller has
+  // post-processed the frame returned here. Tracers that take jobs ahead (remote tracers: their nodes)
+  // then start on it while this frame renders, without waiting for the core's merge, blend and output of
+  // the frame before (docs/cluster.md, "The next frame announced at hand-out"). The returned job is the
+  // one to push next.
+  using PrepareNext = std::function<std::optional<BandJob>()>;
+  std::optional<Delivered> push(const BandJob& job, std::vector<StageSpan> preparation, const PrepareNext& prepare_next);
   // Waits for the frame in flight and returns it merged into image(); nothing when none is.
   std::optional<Delivered> drain();
 

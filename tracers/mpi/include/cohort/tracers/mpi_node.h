@@ -33,7 +33,8 @@ struct NodeOptions {
   // commits are submitted while it renders, so they travel ahead of their job).
   int band_delay_ms = 0;
   // Tests: every row rendered takes this much longer (a node whose time grows with its rows, so that
-  // rank 0's balancer moves rows between nodes of different speeds).
+  // rank 0's balancer moves rows between nodes of different speeds; or a CPU node timed like a GPU one),
+  // each piece before it is rendered, so that the pieces still leave one by one.
   double row_delay_ms = 0.0;
   // Tests: before rendering the band of this frame index, the process kills itself (a lost node).
   int die_frame = -1;

@@ -88,6 +88,13 @@ struct MpiLinkStats {
   uint64_t rows_beyond_ahead = 0;  // rows of adopting bands that the job ahead had not covered (rendered after)
   double total_node_idle_ms = 0.0;
   double total_node_ahead_ms = 0.0;
+  // On rank 0: how long after its band's job each job ahead left (the core's announcement of the next
+  // frame: its turnaround of the frame before, e.g. merge and blend on the host, came first before
+  // FramePipeline's prepare_next), summed over the jobs ahead; and the bands that came back before the
+  // next frame was announced, so that no job went ahead of the next frame (its node then waited for the
+  // frame's job; counted when that frame's band comes, so the run's last band is not).
+  double total_ahead_sent_after_ms = 0.0;
+  uint64_t bands_back_before_announcement = 0;
   uint32_t last_pieces = 0;
   uint64_t stale_answers = 0;       // late answers to jobs that had timed out, dropped
   uint64_t refused_messages = 0;    // malformed answers, refused
@@ -126,7 +133,7 @@ class MpiTracer : public core::Tracer {
   [[noreturn]] void fail_timed_out(uint64_t id, MpiClock::time_point start, const core::BandJob& job);
   // Between the polls of band `job`: once the core announces the next frame's job, sends it to the node
   // as a job ahead with this band's rows (the commits published before it go first).
-  void send_job_ahead(const core::BandJob& job, const core::BandBuffer& target);
+  void send_job_ahead(const core::BandJob& job, const core::BandBuffer& target, MpiClock::time_point band_start);
   // A job sent ahead, until the next band adopts it or drops it.
   struct JobAhead {
     uint64_t id = 0;
@@ -149,6 +156,7 @@ class MpiTracer : public core::Tracer {
   bool in_band_ = false;             // inside render_band, its job sent: apply() is a commit ahead
   uint32_t band_frame_ = 0;          // the frame index of the last band sent
   bool commits_ahead_of_band_ = false;  // commits went ahead of the node since the last band's job
+  bool back_unannounced_ = false;       // the last band came back with no job ahead sent (none announced)
   uint64_t commits_sent_ = 0;         // commits (and full resyncs) sent to the node so far
   std::optional<JobAhead> ahead_;
   uint64_t timed_out_job_ = 0;
