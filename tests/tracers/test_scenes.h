@@ -42,6 +42,25 @@ inline KCamera camera_looking_down(glm::vec3 origin, float tan_half_fov, int wid
   return c;
 }
 
+// A pinhole camera at `origin` looking at `target`, image up toward +Z.
+inline KCamera camera_looking_at(glm::vec3 origin, glm::vec3 target, float tan_half_fov, int width, int height) {
+  KCamera c{};
+  const glm::vec3 forward = glm::normalize(target - origin);
+  const glm::vec3 right = glm::normalize(glm::cross(forward, glm::vec3(0, 0, 1)));
+  const glm::vec3 up = glm::cross(right, forward);
+  for (int i = 0; i < 3; ++i) {
+    c.origin[i] = origin[i];
+    c.forward[i] = forward[i];
+    c.right[i] = right[i];
+    c.up[i] = up[i];
+  }
+  c.width = static_cast<uint32_t>(width);
+  c.height = static_cast<uint32_t>(height);
+  c.tan_half_fov_x = tan_half_fov;
+  c.tan_half_fov_y = tan_half_fov * float(height) / float(width);
+  return c;
+}
+
 inline KFrameParams frame_params(uint32_t mode, uint32_t spp, uint32_t max_bounces, int height) {
   KFrameParams p = core::default_frame_params();
   p.spp = spp;
