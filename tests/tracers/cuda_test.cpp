@@ -87,11 +87,7 @@ TEST_P(CudaAgreement, MatchesEmbree) {
   scene::Scene room = test_room();
   const int w = 64, h = 48;
   KCamera cam = test_room_camera(w, h);
-  KFrameParams params = frame_params(c.mode, 16, c.bounces, h);
-  params.firefly_clamp = 10.0f;
-  params.soft_shadow_scale = 1.0f;
-  params.rr_start = 2.0f;
-  params.frame_index = 7;
+  KFrameParams params = agreement_params(c.mode, c.bounces, h);
   params.light_samples = c.light_samples;
   params.light_sampling = c.light_sampling;
   auto embree = make_test_tracer("embree");

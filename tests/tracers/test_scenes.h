@@ -78,6 +78,17 @@ inline KFrameParams frame_params(uint32_t mode, uint32_t spp, uint32_t max_bounc
   return p;
 }
 
+// The settings the tracers' agreement tests (agreement_test.cpp, cuda_test.cpp) compare images at: 16 spp
+// with the firefly clamp, soft shadows and Russian roulette from bounce 2 on, at one frame index.
+inline KFrameParams agreement_params(uint32_t mode, uint32_t bounces, int height) {
+  KFrameParams p = frame_params(mode, 16, bounces, height);
+  p.firefly_clamp = 10.0f;
+  p.soft_shadow_scale = 1.0f;
+  p.rr_start = 2.0f;
+  p.frame_index = 7;
+  return p;
+}
+
 // One whole-frame band from the scene the tracer holds now.
 inline core::FrameBuffer render_frame(core::Tracer& tracer, const KCamera& camera, const KFrameParams& params) {
   core::FrameBuffer fb;
