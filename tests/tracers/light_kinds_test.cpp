@@ -13,14 +13,7 @@ using namespace cohort::test;
 
 namespace {
 
-class LightKinds : public ::testing::TestWithParam<std::string> {
- protected:
-  void SetUp() override {
-    if (!tracer_runs_here(GetParam())) GTEST_SKIP() << GetParam() << ": no device on this machine";
-    tracer_ = make_test_tracer(GetParam());
-  }
-  std::unique_ptr<core::Tracer> tracer_;
-};
+class LightKinds : public EachTracer {};
 
 int add_light_material(scene::Scene& s, const std::string& name, scene::LightKind kind) {
   scene::Material m;

@@ -12,14 +12,7 @@ using namespace cohort::test;
 
 namespace {
 
-class Lighting : public ::testing::TestWithParam<std::string> {
- protected:
-  void SetUp() override {
-    if (!tracer_runs_here(GetParam())) GTEST_SKIP() << GetParam() << ": no device on this machine";
-    tracer_ = make_test_tracer(GetParam());
-  }
-  std::unique_ptr<core::Tracer> tracer_;
-};
+class Lighting : public EachTracer {};
 
 scene::Light point_light(glm::vec3 origin, float radius) {
   scene::Light l;
