@@ -167,8 +167,7 @@ TEST(ScenePack, RendersLikeTheCompiledScene) {
 TEST(AgreementOnTestMap, EmbreeAndOpenCLImagesMatch) {
   std::vector<std::string> names = built_tracers();
   if (names.size() < 2 || !tracer_runs_here("opencl")) GTEST_SKIP() << "needs both the Embree and the OpenCL tracer";
-  scene::Vfs vfs;
-  scene::Scene map = scene::load_map(vfs, std::string(COHORT_SOURCE_DIR) + "/assets/testmap/maps/testmap.map");
+  scene::Scene map = load_test_map();
   const int w = 64, h = 36;
   const KCamera cameras[2] = {
       core::make_camera(core::player_eye(map), {map.player_yaw, 0.0f}, core::kDefaultFovX, w, h),

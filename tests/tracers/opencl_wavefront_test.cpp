@@ -74,8 +74,7 @@ View map_view(int w, int h) {
     float yaw;
   };
   static const Map map = [] {
-    scene::Vfs vfs;
-    const scene::Scene m = scene::load_map(vfs, std::string(COHORT_SOURCE_DIR) + "/assets/testmap/maps/testmap.map");
+    const scene::Scene m = load_test_map();
     return Map{std::make_shared<commit::TracerScene>(core::compile_scene(m).tracer_scene), core::player_eye(m),
                m.player_yaw};
   }();

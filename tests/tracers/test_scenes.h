@@ -21,7 +21,9 @@
 #include "cohort/core/tracer.h"
 #include "cohort/core/frame_defaults.h"
 #include "cohort/core/view.h"
+#include "cohort/scene/map_loader.h"
 #include "cohort/scene/scene.h"
+#include "cohort/scene/vfs.h"
 #include "cohort/test_support/scene_builders.h"
 #include "cohort/test_support/test_scenes.h"
 #include "test_tracers.h"
@@ -106,6 +108,12 @@ inline core::FrameBuffer render(core::Tracer& tracer, const scene::Scene& scene,
   auto compiled = std::make_shared<commit::TracerScene>(core::compile_scene(scene).tracer_scene);
   tracer.apply(commit::CommitBuffer::full(compiled, 1));
   return render_frame(tracer, camera, params);
+}
+
+// The test map on disk (assets/testmap, made by tools/gen_testmap.py), loaded as `cohort` loads a map.
+inline scene::Scene load_test_map() {
+  scene::Vfs vfs;
+  return scene::load_map(vfs, std::string(COHORT_SOURCE_DIR) + "/assets/testmap/maps/testmap.map");
 }
 
 // The test map agreements' settings (8 spp, 1 bounce, a shadow ray per light, soft shadows, a firefly
