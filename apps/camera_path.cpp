@@ -25,6 +25,15 @@ CameraPath parse_camera_path(const std::string& name) {
   return path;
 }
 
+std::string camera_path_error(const std::string& name) {
+  try {
+    parse_camera_path(name);
+    return std::string();
+  } catch (const std::exception& e) {
+    return std::string(e.what());
+  }
+}
+
 CameraPose camera_path_pose(const CameraPath& path, const glm::vec3& eye, float yaw, int frame) {
   const float turned = yaw + path.degrees_per_frame * static_cast<float>(frame);
   CameraPose pose;

@@ -23,6 +23,8 @@ struct CameraPose {
 // "spin", "spin-slow", "spin-fast", "orbit", "orbit-slow", "orbit-fast"; throws std::invalid_argument
 // listing them otherwise.
 CameraPath parse_camera_path(const std::string& name);
+// What parse_camera_path would throw for `name`, or "" when it is a path: the check of a --camera-path option.
+std::string camera_path_error(const std::string& name);
 // `eye` and `yaw` are where the path starts (the player start at eye height).
 CameraPose camera_path_pose(const CameraPath& path, const glm::vec3& eye, float yaw, int frame);
 

@@ -188,14 +188,7 @@ void add_bench_devices_command(CLI::App& bench, int& exit_code) {
   devices->add_option("--warmup", args->config.warmup, "first frames not counted")->capture_default_str()->check(CLI::NonNegativeNumber);
   devices->add_option("--camera-path", args->config.camera_path, "spin or orbit, -slow or -fast, from the player start")
       ->capture_default_str()
-      ->check([](const std::string& v) {
-        try {
-          parse_camera_path(v);
-          return std::string();
-        } catch (const std::exception& e) {
-          return std::string(e.what());
-        }
-      });
+      ->check(camera_path_error);
   devices->add_option("--balancer", args->config.balancer, "row balancer")
       ->capture_default_str()->check(CLI::IsMember(balance::balancer_names()));
   devices->add_option("--json", args->json, "write every run (per-frame wall ms) as JSON");

@@ -516,14 +516,7 @@ void add_render_command(CLI::App& app, int& exit_code) {
   cmd->add_option("--camera", a->camera, "x y z yaw pitch: Doom 3 angles in degrees, positive pitch looks down (default: the player start at eye height)")->expected(5);
   cmd->add_option("--camera-path", a->camera_path, "scripted camera from the start: spin or orbit, -slow (default) or "
                                                    "-fast, e.g. orbit-fast")
-      ->check([](const std::string& v) {
-        try {
-          parse_camera_path(v);
-          return std::string();
-        } catch (const std::exception& e) {
-          return std::string(e.what());
-        }
-      });
+      ->check(camera_path_error);
   cmd->add_option("--aux-rays", a->aux_rays,
                   "where the G-buffer for reprojection and denoising comes from: auto (first-hit where CUDA GPUs "
                   "render and no OpenCL or mpi tracer does, else centre), centre (a ray of its own through "

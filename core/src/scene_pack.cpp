@@ -5,6 +5,7 @@
 
 #include <fmt/format.h>
 
+#include "cohort/core/byte_reader.h"
 #include "cohort/core/light_sampling.h"
 
 namespace cohort::core {
@@ -46,20 +47,11 @@ class Writer {
   std::vector<uint8_t>& out_;
 };
 
-class Reader {
+class Reader : public ByteReader<Reader> {
  public:
-  Reader(std::string file, std::vector<uint8_t> bytes) : file_(std::move(file)), bytes_(std::move(bytes)) {}
+  Reader(std::string file, const std::vector<uint8_t>& bytes)
+      : ByteReader(bytes.data(), bytes.size()), file_(std::move(file)) {}
   [[noreturn]] void fail(const std::string& what) const { throw PackError(file_, pos_, what); }
-  void raw(void* p, size_t n) {
-    if (n > bytes_.size() - pos_) fail(fmt::format("truncated: needs {} more bytes, {} left", n, bytes_.size() - pos_));
-    std::memcpy(p, bytes_.data() + pos_, n);
-    pos_ += n;
-  }
-  template <class T> T scalar() {
-    T v;
-    raw(&v, sizeof v);
-    return v;
-  }
   template <class T> std::vector<T> section(uint32_t expected_tag, const char* name) {
     uint32_t tag = scalar<uint32_t>();
     if (tag != expected_tag) fail(fmt::format("expected section '{}', found tag 0x{:08x}", name, tag));
@@ -68,22 +60,19 @@ class Reader {
       fail(fmt::format("section '{}': element size {} but this build's layout is {} bytes", name, element_size,
                        sizeof(T)));
     uint64_t count = scalar<uint64_t>();
-    if (count > (bytes_.size() - pos_) / sizeof(T))
-      fail(fmt::format("section '{}': {} elements do not fit in the {} bytes left", name, count, bytes_.size() - pos_));
+    if (count > left() / sizeof(T))
+      fail(fmt::format("section '{}': {} elements do not fit in the {} bytes left", name, count, left()));
     std::vector<T> v(count);
     size_t start = pos_;
     raw(v.data(), count * sizeof(T));
     uint32_t checksum = scalar<uint32_t>();
-    if (checksum != fnv1a(bytes_.data() + start, count * sizeof(T)))
+    if (checksum != fnv1a(data_ + start, count * sizeof(T)))
       fail(fmt::format("section '{}': checksum mismatch (file corrupt)", name));
     return v;
   }
-  bool at_end() const { return pos_ == bytes_.size(); }
 
  private:
   std::string file_;
-  std::vector<uint8_t> bytes_;
-  size_t pos_ = 0;
 };
 
 std::vector<char> join_names(const std::vector<std::string>& names) {
@@ -156,7 +145,7 @@ PackedScene read_scene_pack(const std::filesystem::path& file) {
   std::ifstream in(file, std::ios::binary);
   if (!in) throw PackError(file.string(), 0, "cannot open");
   std::vector<uint8_t> bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  Reader r(file.string(), std::move(bytes));
+  Reader r(file.string(), bytes);   // reads bytes in place: they outlive r
   char magic[sizeof kMagic];
   r.raw(magic, sizeof magic);
   if (std::memcmp(magic, kMagic, sizeof kMagic) != 0) r.fail("not a Cohort scene pack (bad magic)");

@@ -276,32 +276,20 @@ class LwoReader {
     in_.s0("SURF source");
     LwSurface surface;
     surface.name = name;
-    while (!in_.done()) {
-      uint32_t id = in_.u4("SURF subchunk id");
-      uint16_t size = in_.u2("SURF subchunk size");
-      in_.need(size, "SURF subchunk");
-      size_t sub_end = in_.pos() + size;
-      size_t outer = in_.limit(sub_end);
+    read_surf_subchunks([&](uint32_t id) {
       if (id == id4("COLR")) {
         for (int k = 0; k < 3; ++k) surface.color[k] = in_.f4("COLR");
       } else if (id == id4("SMAN")) {
         surface.smoothing = in_.f4("SMAN");
       }
-      in_.limit(outer);
-      in_.seek(std::min(in_.end(), sub_end + (size % 2)));
-    }
+    });
     add_surface(surface);
   }
 
   void read_surf_lwob() {
     LwSurface surface;
     surface.name = in_.s0("SURF name");
-    while (!in_.done()) {
-      uint32_t id = in_.u4("SURF subchunk id");
-      uint16_t size = in_.u2("SURF subchunk size");
-      in_.need(size, "SURF subchunk");
-      size_t sub_end = in_.pos() + size;
-      size_t outer = in_.limit(sub_end);
+    read_surf_subchunks([&](uint32_t id) {
       if (id == id4("COLR")) {
         for (int k = 0; k < 3; ++k) surface.color[k] = in_.u1("COLR") / 255.0f;
       } else if (id == id4("FLAG")) {
@@ -309,10 +297,23 @@ class LwoReader {
       } else if (id == id4("SMAN")) {
         surface.smoothing = in_.f4("SMAN");
       }
+    });
+    add_surface(surface);
+  }
+
+  // The subchunks of a SURF chunk, each read by `read(id)` within its bounds (what it does not read is
+  // skipped, with the pad byte of an odd size).
+  template <class Read> void read_surf_subchunks(Read&& read) {
+    while (!in_.done()) {
+      uint32_t id = in_.u4("SURF subchunk id");
+      uint16_t size = in_.u2("SURF subchunk size");
+      in_.need(size, "SURF subchunk");
+      size_t sub_end = in_.pos() + size;
+      size_t outer = in_.limit(sub_end);
+      read(id);
       in_.limit(outer);
       in_.seek(std::min(in_.end(), sub_end + (size % 2)));
     }
-    add_surface(surface);
   }
 
   void add_surface(const LwSurface& surface) {

@@ -46,6 +46,19 @@ TEST(CameraPath, ParsesNamesAndRejectsUnknownOnes) {
   }
 }
 
+TEST(CameraPath, OptionCheckPassesPathsAndGivesTheParsersMessageOtherwise) {
+  EXPECT_EQ(camera_path_error("orbit-fast"), "");
+  EXPECT_EQ(camera_path_error("spin"), "");
+  std::string parser_message;
+  try {
+    parse_camera_path("spin-medium");
+  } catch (const std::invalid_argument& e) {
+    parser_message = e.what();
+  }
+  EXPECT_FALSE(parser_message.empty());
+  EXPECT_EQ(camera_path_error("spin-medium"), parser_message);
+}
+
 TEST(CameraPath, SpinStaysAndTurnsOrbitCirclesFacingTheStart) {
   const glm::vec3 eye(100, 200, 68);
   const CameraPath spin = parse_camera_path("spin-slow");

@@ -13,63 +13,14 @@ using namespace cohort::core;
 
 namespace {
 
-double mean_idle(const std::string& balancer, int count, double degrees_per_frame) {
-  auto model = std::make_shared<SpinSceneCostModel>(1);
-  std::vector<std::unique_ptr<Tracer>> tracers;
-  for (int i = 0; i < count; ++i) {
-    SimulatedTracerOptions o;
-    o.name = "sim" + std::to_string(i);
-    o.seed = 1001 + static_cast<uint64_t>(i);
-    o.speed = i == 1 ? 0.7 : 1.0;
-    o.noise = 0.02;
-    o.report_row_work = true;
-    tracers.push_back(std::make_unique<SimulatedTracer>(model, o));
-  }
-  RendererOptions options;
-  options.balancer = balancer;
-  options.use_reported_time = true;
-  Renderer renderer(std::move(tracers), options);
-  FrameBuffer fb;
-  double sum = 0.0;
-  int counted = 0;
-  for (int f = 0; f < 200; ++f) {
-    BandJob job;
-    job.camera = spin_camera(4, 720, f * degrees_per_frame * std::numbers::pi / 180.0);
-    job.params.frame_index = static_cast<kuint>(f);
-    const FrameStats stats = renderer.render(job, fb);
-    EXPECT_EQ(stats.dropped, 0);
-    if (f >= 5) {
-      sum += stats.idle_percent;
-      ++counted;
-    }
-  }
-  return sum / counted;
-}
-
-}  // namespace
-
-TEST(BalancingEfficiency, RowCostBeatsPerfectSmoothBeatsNone) {
-  for (double speed : {2.0, 10.0}) {
-    for (int count : {2, 3}) {
-      const double none = mean_idle("none", count, speed);
-      const double smooth = mean_idle("perfect-smooth", count, speed);
-      const double row_cost = mean_idle("row-cost", count, speed);
-      EXPECT_LT(smooth, none) << count << " tracers, " << speed << " deg/frame";
-      EXPECT_LT(row_cost, smooth) << count << " tracers, " << speed << " deg/frame";
-      EXPECT_LT(row_cost, 5.0) << count << " tracers, " << speed << " deg/frame";
-    }
-  }
-}
-
-namespace {
-
 struct SpinRun {
   double mean_idle = 0.0, mean_frame_ms = 0.0, mean_rendering = 0.0;
 };
 
-// 200 frames of a spinning camera over tracers of the given speeds and fixed costs per band.
+// 200 frames of a spinning camera over tracers of the given speeds and fixed costs per band; the means
+// are over the frames after the first `warmup`.
 SpinRun spin(const std::string& balancer, const std::vector<double>& speeds, const std::vector<double>& fixed_ms,
-             double degrees_per_frame, bool row_work, double ms_per_cost = 0.05) {
+             double degrees_per_frame, bool row_work, double ms_per_cost = 0.05, int warmup = 10) {
   auto model = std::make_shared<SpinSceneCostModel>(1);
   std::vector<std::unique_ptr<Tracer>> tracers;
   for (size_t i = 0; i < speeds.size(); ++i) {
@@ -96,7 +47,7 @@ SpinRun spin(const std::string& balancer, const std::vector<double>& speeds, con
     job.params.frame_index = static_cast<kuint>(f);
     const FrameStats stats = renderer.render(job, fb);
     EXPECT_EQ(stats.dropped, 0);
-    if (f < 10) continue;
+    if (f < warmup) continue;
     run.mean_idle += stats.idle_percent;
     run.mean_frame_ms += stats.frame_ms;
     for (const TracerFrameStats& t : stats.tracers) run.mean_rendering += t.outcome == TracerOutcome::rendered;
@@ -108,7 +59,28 @@ SpinRun spin(const std::string& balancer, const std::vector<double>& speeds, con
   return run;
 }
 
+// Mean idle % of `count` tracers (the second at speed 0.7) reporting their rows' work, after 5 frames.
+double mean_idle(const std::string& balancer, int count, double degrees_per_frame) {
+  std::vector<double> speeds(size_t(count), 1.0);
+  if (count > 1) speeds[1] = 0.7;
+  return spin(balancer, speeds, std::vector<double>(size_t(count), 0.0), degrees_per_frame, true, 0.05, 5).mean_idle;
+}
+
 }  // namespace
+
+TEST(BalancingEfficiency, RowCostBeatsPerfectSmoothBeatsNone) {
+  for (double speed : {2.0, 10.0}) {
+    for (int count : {2, 3}) {
+      const double none = mean_idle("none", count, speed);
+      const double smooth = mean_idle("perfect-smooth", count, speed);
+      const double row_cost = mean_idle("row-cost", count, speed);
+      EXPECT_LT(smooth, none) << count << " tracers, " << speed << " deg/frame";
+      EXPECT_LT(row_cost, smooth) << count << " tracers, " << speed << " deg/frame";
+      EXPECT_LT(row_cost, 5.0) << count << " tracers, " << speed << " deg/frame";
+    }
+  }
+}
+
 
 // The simulated target: speeds 1 and 0.02 with a 2 ms fixed cost on the slow one. Whole Cost
 // benches the slow tracer (mean idle <= 2 %) and its frames are as fast as the fast tracer's alone,

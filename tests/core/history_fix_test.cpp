@@ -11,6 +11,7 @@
 
 #include "cohort/core/atrous_filter.h"
 #include "cohort/kernel/svgf.h"
+#include "still_wall.h"
 
 using namespace cohort::core;
 
@@ -18,18 +19,7 @@ namespace {
 
 constexpr int kW = 48, kH = 32;
 
-// A flat wall facing the camera at depth 10 (world, id 0), grey albedo.
-GBuffer wall() {
-  GBuffer g;
-  g.resize(kW, kH);
-  for (size_t p = 0; p < g.pixels(); ++p) {
-    g.depth[p] = g.prev_depth[p] = 10.0f;
-    g.normal[3 * p + 2] = 1.0f;
-    g.id[p] = 0;
-    for (int k = 0; k < 3; ++k) g.albedo[3 * p + k] = 0.5f;
-  }
-  return g;
-}
+GBuffer wall() { return cohort::test::still_wall(kW, kH, 0.5f); }
 
 // Light level `light(x, y)` times (1 + uniform noise of +-noise), times the albedo.
 template <typename Light>

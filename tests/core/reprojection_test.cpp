@@ -5,6 +5,7 @@
 #include <random>
 
 #include "cohort/core/reprojection.h"
+#include "still_wall.h"
 
 using namespace cohort::core;
 
@@ -12,17 +13,7 @@ namespace {
 
 constexpr int kW = 16, kH = 8;
 
-// A flat wall facing the camera at depth 10, all world (id 0), nothing moving.
-GBuffer still_wall() {
-  GBuffer g;
-  g.resize(kW, kH);
-  for (size_t p = 0; p < g.pixels(); ++p) {
-    g.depth[p] = g.prev_depth[p] = 10.0f;
-    g.normal[3 * p + 2] = 1.0f;
-    g.id[p] = 0;
-  }
-  return g;
-}
+GBuffer still_wall() { return cohort::test::still_wall(kW, kH, 0.0f); }
 
 FrameBuffer noise_frame(std::mt19937& rng) {
   std::uniform_real_distribution<float> u(0.0f, 4.0f);

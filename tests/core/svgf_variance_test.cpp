@@ -13,6 +13,7 @@
 #include "cohort/core/atrous_filter.h"
 #include "cohort/core/frame_post.h"
 #include "cohort/core/reprojection.h"
+#include "still_wall.h"
 
 using namespace cohort::core;
 
@@ -23,17 +24,9 @@ constexpr int kW = 48, kH = 32;
 // A flat wall facing the camera at depth 10 (world, id 0), nothing moving; a checkerboard albedo of 0.25
 // and 0.75 in one channel, so illumination (colour over albedo) differs from colour.
 GBuffer still_wall() {
-  GBuffer g;
-  g.resize(kW, kH);
+  GBuffer g = cohort::test::still_wall(kW, kH, 0.5f);
   for (int y = 0; y < kH; ++y)
-    for (int x = 0; x < kW; ++x) {
-      const size_t p = size_t(y) * kW + x;
-      g.depth[p] = g.prev_depth[p] = 10.0f;
-      g.normal[3 * p + 2] = 1.0f;
-      g.id[p] = 0;
-      g.albedo[3 * p] = ((x / 3 + y / 3) & 1) ? 0.75f : 0.25f;
-      g.albedo[3 * p + 1] = g.albedo[3 * p + 2] = 0.5f;
-    }
+    for (int x = 0; x < kW; ++x) g.albedo[3 * (size_t(y) * kW + x)] = ((x / 3 + y / 3) & 1) ? 0.75f : 0.25f;
   return g;
 }
 

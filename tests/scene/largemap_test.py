@@ -22,6 +22,8 @@ import sys
 import tempfile
 import time
 
+from tree_files import read_tree
+
 
 def generator(repo):
     return [sys.executable, os.path.join(repo, "tools", "gen_testmap.py"), "--large"]
@@ -29,12 +31,7 @@ def generator(repo):
 
 def tree_digest(root):
     """The same digest as gen_testmap.py --digest: sorted relative paths, their lengths and bytes."""
-    files = {}
-    for folder, _, names in os.walk(root):
-        for name in names:
-            path = os.path.join(folder, name)
-            with open(path, "rb") as handle:
-                files[os.path.relpath(path, root).replace(os.sep, "/")] = handle.read()
+    files = read_tree(root)
     digest = hashlib.sha256()
     for path, data in sorted(files.items()):
         digest.update(path.encode("utf-8") + b"\0" + str(len(data)).encode("ascii") + b"\0" + data)

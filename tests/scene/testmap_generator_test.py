@@ -10,17 +10,9 @@ import subprocess
 import sys
 import unittest
 
+from tree_files import read_tree
+
 ARGS = None
-
-
-def read_tree(root):
-    files = {}
-    for folder, _, names in os.walk(root):
-        for name in names:
-            path = os.path.join(folder, name)
-            with open(path, "rb") as handle:
-                files[os.path.relpath(path, root).replace(os.sep, "/")] = handle.read()
-    return files
 
 
 class CommittedAssets(unittest.TestCase):

@@ -80,6 +80,19 @@ int add_world_mesh(scene::Scene& scene, scene::Mesh mesh) {
   return static_cast<int>(scene.meshes.size() - 1);
 }
 
+int add_occluder(scene::Scene& scene, int material) {
+  scene::Mesh m;
+  m.name = "occluder";
+  add_quad(m, material, {-20, -20, 0}, {20, -20, 0}, {20, 20, 0}, {-20, 20, 0}, {0, 0, 1});
+  scene.meshes.push_back(m);
+  scene::Entity e;
+  e.name = "occluder";
+  e.mesh = static_cast<int>(scene.meshes.size() - 1);
+  e.origin = {0, 0, 50};
+  scene.entities.push_back(e);
+  return static_cast<int>(scene.entities.size() - 1);
+}
+
 scene::Light point_light(glm::vec3 origin, glm::vec3 radius, glm::vec3 colour) {
   scene::Light l;
   l.name = "light";

@@ -43,11 +43,7 @@ TEST_P(Agreement, EmbreeAndOpenCLImagesMatch) {
   scene::Scene room = test_room();
   const int w = 64, h = 48;
   KCamera cam = test_room_camera(w, h);
-  KFrameParams params = frame_params(c.mode, 16, c.bounces, h);
-  params.firefly_clamp = 10.0f;
-  params.soft_shadow_scale = 1.0f;
-  params.rr_start = 2.0f;
-  params.frame_index = 7;
+  KFrameParams params = agreement_params(c.mode, c.bounces, h);
   params.light_samples = c.light_samples;
   params.light_sampling = c.light_sampling;
   params.emissive_samples = c.emissive_samples;
@@ -171,8 +167,7 @@ TEST(ScenePack, RendersLikeTheCompiledScene) {
 TEST(AgreementOnTestMap, EmbreeAndOpenCLImagesMatch) {
   std::vector<std::string> names = built_tracers();
   if (names.size() < 2 || !tracer_runs_here("opencl")) GTEST_SKIP() << "needs both the Embree and the OpenCL tracer";
-  scene::Vfs vfs;
-  scene::Scene map = scene::load_map(vfs, std::string(COHORT_SOURCE_DIR) + "/assets/testmap/maps/testmap.map");
+  scene::Scene map = load_test_map();
   const int w = 64, h = 36;
   const KCamera cameras[2] = {
       core::make_camera(core::player_eye(map), {map.player_yaw, 0.0f}, core::kDefaultFovX, w, h),

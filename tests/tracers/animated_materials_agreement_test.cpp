@@ -39,8 +39,7 @@ class AnimatedMaterialsAgreement : public ::testing::TestWithParam<std::string> 
 TEST_P(AnimatedMaterialsAgreement, TestMapAtLaterTimesMatchesEmbree) {
   const std::string device = GetParam();
   if (!tracer_runs_here("embree") || !tracer_runs_here(device)) GTEST_SKIP() << "needs the Embree and " << device << " tracers here";
-  scene::Vfs vfs;
-  scene::Scene map = scene::load_map(vfs, std::string(COHORT_SOURCE_DIR) + "/assets/testmap/maps/testmap.map");
+  scene::Scene map = load_test_map();
   scene::RenderWorld world(map);
   const int w = 64, h = 40;
   core::WorldSyncOptions options;

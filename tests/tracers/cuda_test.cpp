@@ -12,6 +12,7 @@
 #include "cohort/core/gpu_scene.h"
 #include "cohort/core/scene_pack.h"
 #include "cohort/core/view.h"
+#include "shadow_walk_cases.h"
 #include "test_scenes.h"
 #include "test_tracers.h"
 
@@ -86,11 +87,7 @@ TEST_P(CudaAgreement, MatchesEmbree) {
   scene::Scene room = test_room();
   const int w = 64, h = 48;
   KCamera cam = test_room_camera(w, h);
-  KFrameParams params = frame_params(c.mode, 16, c.bounces, h);
-  params.firefly_clamp = 10.0f;
-  params.soft_shadow_scale = 1.0f;
-  params.rr_start = 2.0f;
-  params.frame_index = 7;
+  KFrameParams params = agreement_params(c.mode, c.bounces, h);
   params.light_samples = c.light_samples;
   params.light_sampling = c.light_sampling;
   auto embree = make_test_tracer("embree");
@@ -322,12 +319,6 @@ TEST(CudaWaveLanes, DrawTheImageOfOneLane) {
 // shadows: gather chooses among more lights than its budget, two light samples average with the shadow
 // roulette on, `every` with 6 lights leaves 7 rays a vertex, with 96 more than a vertex's slots (then the
 // shading kernels walk them), and the firefly clamp works on the vertex's sum.
-struct ShadowWalkCase {
-  uint32_t light_sampling, light_samples;
-  float shadow_rr;
-  int point_lights, projected_lights;
-  const char* name;
-};
 class CudaShadowWalk : public ::testing::TestWithParam<ShadowWalkCase> {};
 
 TEST_P(CudaShadowWalk, DrawsTheImageOfShadowsWalkedInTheShadingKernels) {
@@ -335,13 +326,7 @@ TEST_P(CudaShadowWalk, DrawsTheImageOfShadowsWalkedInTheShadingKernels) {
   const ShadowWalkCase c = GetParam();
   const int w = 64, h = 48;
   const KCamera cam = camera_looking_down({0, 0, 1400}, 0.7f, w, h);
-  KFrameParams params = frame_params(K_MODE_PATH, 2, 2, h);
-  params.soft_shadow_scale = 1.0f;
-  params.firefly_clamp = 4.0f;
-  params.frame_index = 3;
-  params.light_sampling = c.light_sampling;
-  params.light_samples = c.light_samples;
-  params.shadow_rr = c.shadow_rr;
+  const KFrameParams params = shadow_walk_params(c, h);
   scene::Scene floor = many_lights_floor_under_a_panel(c.point_lights, c.projected_lights);
   auto scene = std::make_shared<commit::TracerScene>(core::compile_scene(floor).tracer_scene);
   ASSERT_EQ(scene->emissive_triangles.size(), 2u) << "the panel's triangles are emitters to sample";
@@ -379,13 +364,7 @@ TEST_P(CudaShadowWalk, DrawsTheImageOfShadowsWalkedInTheShadingKernels) {
   }
 }
 
-INSTANTIATE_TEST_SUITE_P(LightSampling, CudaShadowWalk,
-                         ::testing::Values(ShadowWalkCase{K_LIGHTS_TREE, 1, 0.0f, 88, 8, "tree1"},
-                                           ShadowWalkCase{K_LIGHTS_TREE, 2, 0.03f, 88, 8, "tree2_roulette"},
-                                           ShadowWalkCase{K_LIGHTS_GATHER, 4, 0.03f, 88, 8, "gather4_roulette"},
-                                           ShadowWalkCase{K_LIGHTS_IN_RANGE, 1, 0.03f, 88, 8, "in_range1_roulette"},
-                                           ShadowWalkCase{K_LIGHTS_EVERY, 0, 0.03f, 4, 2, "every_6_lights"},
-                                           ShadowWalkCase{K_LIGHTS_EVERY, 0, 0.03f, 88, 8, "every_past_the_slots"}),
+INSTANTIATE_TEST_SUITE_P(LightSampling, CudaShadowWalk, ::testing::ValuesIn(shadow_walk_cases()),
                          [](const auto& info) { return std::string(info.param.name); });
 
 }  // namespace

@@ -47,8 +47,7 @@ class OidnOnTestMap : public ::testing::Test {
     std::string where;
     if (!core::OidnDenoiser::library_available(&where)) GTEST_SKIP() << where;
     if (!tracer_runs_here("embree")) GTEST_SKIP() << "needs the Embree tracer";
-    scene::Vfs vfs;
-    map_ = scene::load_map(vfs, std::string(COHORT_SOURCE_DIR) + "/assets/testmap/maps/testmap.map");
+    map_ = load_test_map();
     camera_ = core::make_camera(core::player_eye(map_), {map_.player_yaw, 0.0f}, core::kDefaultFovX, kWidth, kHeight);
     tracer_ = make_test_tracer("embree");
   }

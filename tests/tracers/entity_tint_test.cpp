@@ -16,14 +16,7 @@ using namespace cohort::test;
 
 namespace {
 
-class EntityTint : public ::testing::TestWithParam<std::string> {
- protected:
-  void SetUp() override {
-    if (!tracer_runs_here(GetParam())) GTEST_SKIP() << GetParam() << ": no device on this machine";
-    tracer_ = make_test_tracer(GetParam());
-  }
-  std::unique_ptr<core::Tracer> tracer_;
-};
+class EntityTint : public EachTracer {};
 
 scene::Scene three_boxes() {
   scene::Scene s;

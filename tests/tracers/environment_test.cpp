@@ -16,14 +16,7 @@ using namespace cohort::test;
 
 namespace {
 
-class Environment : public ::testing::TestWithParam<std::string> {
- protected:
-  void SetUp() override {
-    if (!tracer_runs_here(GetParam())) GTEST_SKIP() << GetParam() << ": no device on this machine";
-    tracer_ = make_test_tracer(GetParam());
-  }
-  std::unique_ptr<core::Tracer> tracer_;
-};
+class Environment : public EachTracer {};
 
 // One colour per GL face +X, -X, +Y, -Y, +Z, -Z, channels 0 or 255 only (exact after sRGB decoding).
 const glm::u8vec4 kFaceColours[6] = {{255, 0, 0, 255},   {0, 255, 255, 255}, {0, 255, 0, 255},

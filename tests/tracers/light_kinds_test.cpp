@@ -13,14 +13,7 @@ using namespace cohort::test;
 
 namespace {
 
-class LightKinds : public ::testing::TestWithParam<std::string> {
- protected:
-  void SetUp() override {
-    if (!tracer_runs_here(GetParam())) GTEST_SKIP() << GetParam() << ": no device on this machine";
-    tracer_ = make_test_tracer(GetParam());
-  }
-  std::unique_ptr<core::Tracer> tracer_;
-};
+class LightKinds : public EachTracer {};
 
 int add_light_material(scene::Scene& s, const std::string& name, scene::LightKind kind) {
   scene::Material m;
@@ -159,35 +152,12 @@ TEST_P(LightKinds, AmbientLightIsNotShadowed) {
     scene::Light l = point_light({0, 0, 100}, {400, 400, 400});
     l.material = add_light_material(s, "lights/kind", kind);
     s.lights.push_back(l);
-    if (occluder) {
-      int mat = add_diffuse_material(s, "occluder", glm::vec3(0.5f));
-      scene::Mesh m;
-      m.name = "occluder";
-      add_quad(m, mat, {-20, -20, 0}, {20, -20, 0}, {20, 20, 0}, {-20, 20, 0}, {0, 0, 1});
-      s.meshes.push_back(m);
-      scene::Entity e;
-      e.name = "occluder";
-      e.mesh = static_cast<int>(s.meshes.size() - 1);
-      e.origin = {0, 0, 50};
-      s.entities.push_back(e);
-    }
+    if (occluder) add_occluder(s, add_diffuse_material(s, "occluder", glm::vec3(0.5f)));
     return s;
   };
   // A narrow camera grazing the floor from (0, -300, 10) sees the origin below the occluder.
   const int n = 16;
-  KCamera cam{};
-  glm::vec3 origin(0, -300, 10), target(0, 0, 0);
-  glm::vec3 fwd = glm::normalize(target - origin);
-  glm::vec3 right = glm::normalize(glm::cross(fwd, glm::vec3(0, 0, 1)));
-  glm::vec3 up = glm::cross(right, fwd);
-  for (int i = 0; i < 3; ++i) {
-    cam.origin[i] = origin[i];
-    cam.forward[i] = fwd[i];
-    cam.right[i] = right[i];
-    cam.up[i] = up[i];
-  }
-  cam.width = cam.height = n;
-  cam.tan_half_fov_x = cam.tan_half_fov_y = 0.01f;
+  KCamera cam = camera_looking_at({0, -300, 10}, {0, 0, 0}, 0.01f, n, n);
   auto centre = [&](const scene::Scene& s) {
     core::FrameBuffer fb = render(*tracer_, s, cam, frame_params(K_MODE_DIRECT, 4, 0, n));
     return pixel(fb, n / 2, n / 2).x;

@@ -12,14 +12,7 @@ using namespace cohort::test;
 
 namespace {
 
-class Lighting : public ::testing::TestWithParam<std::string> {
- protected:
-  void SetUp() override {
-    if (!tracer_runs_here(GetParam())) GTEST_SKIP() << GetParam() << ": no device on this machine";
-    tracer_ = make_test_tracer(GetParam());
-  }
-  std::unique_ptr<core::Tracer> tracer_;
-};
+class Lighting : public EachTracer {};
 
 scene::Light point_light(glm::vec3 origin, float radius) {
   scene::Light l;
@@ -121,34 +114,13 @@ TEST_P(Lighting, ShadowsRespectNoShadowsAndAlphaTest) {
       s.materials[size_t(mat)].diffuse_image = img;
       s.materials[size_t(mat)].alpha_test = true;
     }
-    scene::Mesh m;
-    m.name = "occluder";
-    add_quad(m, mat, {-20, -20, 0}, {20, -20, 0}, {20, 20, 0}, {-20, 20, 0}, {0, 0, 1});
-    s.meshes.push_back(m);
-    scene::Entity e;
-    e.name = "occluder";
-    e.mesh = static_cast<int>(s.meshes.size() - 1);
-    e.origin = {0, 0, 50};
-    e.no_shadows = no_shadows;
-    s.entities.push_back(e);
+    s.entities[size_t(add_occluder(s, mat))].no_shadows = no_shadows;
     return s;
   };
   const int n = 32;
   // The occluder (z = 50, [-20, 20]^2) shadows the floor around the origin. A narrow camera grazing
   // the floor from (0, -300, 10) sees the origin below the occluder's height.
-  KCamera cam{};
-  glm::vec3 origin(0, -300, 10), target(0, 0, 0);
-  glm::vec3 fwd = glm::normalize(target - origin);
-  glm::vec3 right = glm::normalize(glm::cross(fwd, glm::vec3(0, 0, 1)));
-  glm::vec3 up = glm::cross(right, fwd);
-  for (int i = 0; i < 3; ++i) {
-    cam.origin[i] = origin[i];
-    cam.forward[i] = fwd[i];
-    cam.right[i] = right[i];
-    cam.up[i] = up[i];
-  }
-  cam.width = cam.height = n;
-  cam.tan_half_fov_x = cam.tan_half_fov_y = 0.01f;
+  KCamera cam = camera_looking_at({0, -300, 10}, {0, 0, 0}, 0.01f, n, n);
   auto centre = [&](const scene::Scene& s) {
     core::FrameBuffer fb = render(*tracer_, s, cam, frame_params(K_MODE_DIRECT, 4, 0, n));
     return pixel(fb, n / 2, n / 2).x;

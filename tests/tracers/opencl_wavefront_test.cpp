@@ -20,6 +20,7 @@
 #include "cohort/core/view.h"
 #include "cohort/tracers/device_listing.h"
 #include "cohort/scene/map_loader.h"
+#include "shadow_walk_cases.h"
 #include "test_scenes.h"
 #include "test_tracers.h"
 
@@ -73,8 +74,7 @@ View map_view(int w, int h) {
     float yaw;
   };
   static const Map map = [] {
-    scene::Vfs vfs;
-    const scene::Scene m = scene::load_map(vfs, std::string(COHORT_SOURCE_DIR) + "/assets/testmap/maps/testmap.map");
+    const scene::Scene m = load_test_map();
     return Map{std::make_shared<commit::TracerScene>(core::compile_scene(m).tracer_scene), core::player_eye(m),
                m.player_yaw};
   }();
@@ -231,39 +231,20 @@ INSTANTIATE_TEST_SUITE_P(
 // two bounces, soft shadows, the firefly clamp: gather choosing among more lights than its budget, two light
 // samples averaged with the shadow roulette, `every` with 6 lights (7 rays a vertex: the shadow walk) and
 // with 96 (more than a vertex's slots: the shading kernels walk them); with the shadow walk and without.
-struct LightCase {
-  uint32_t light_sampling, light_samples;
-  float shadow_rr;
-  int point_lights, projected_lights;
-  const char* name;
-};
-void PrintTo(const LightCase& c, std::ostream* os) { *os << c.name; }
-class OpenCLWavefrontShadows : public ::testing::TestWithParam<LightCase> {};
+class OpenCLWavefrontShadows : public ::testing::TestWithParam<ShadowWalkCase> {};
 
 TEST_P(OpenCLWavefrontShadows, DrawTheMegakernelsImage) {
   if (!tracer_runs_here("opencl")) GTEST_SKIP() << "no OpenCL device here";
-  const LightCase c = GetParam();
+  const ShadowWalkCase c = GetParam();
   const int w = 32, h = 24;
   const View view = many_lights_view(c.point_lights, c.projected_lights, w, h);
   ASSERT_EQ(view.scene->emissive_triangles.size(), 2u) << "the panel's triangles are emitters to sample";
-  KFrameParams params = frame_params(K_MODE_PATH, 2, 2, h);
-  params.soft_shadow_scale = 1.0f;
-  params.firefly_clamp = 4.0f;
-  params.frame_index = 3;
-  params.light_sampling = c.light_sampling;
-  params.light_samples = c.light_samples;
-  params.shadow_rr = c.shadow_rr;
+  const KFrameParams params = shadow_walk_params(c, h);
   for (const Variant& v : {kWavefront, kShadowsInTheShadingKernels})
     expect_the_megakernels_frame(v, view, params, {0, 11, h}, c.name);
 }
 
-INSTANTIATE_TEST_SUITE_P(LightSampling, OpenCLWavefrontShadows,
-                         ::testing::Values(LightCase{K_LIGHTS_TREE, 1, 0.0f, 88, 8, "tree1"},
-                                           LightCase{K_LIGHTS_TREE, 2, 0.03f, 88, 8, "tree2_roulette"},
-                                           LightCase{K_LIGHTS_GATHER, 4, 0.03f, 88, 8, "gather4_roulette"},
-                                           LightCase{K_LIGHTS_IN_RANGE, 1, 0.03f, 88, 8, "in_range1_roulette"},
-                                           LightCase{K_LIGHTS_EVERY, 0, 0.03f, 4, 2, "every_6_lights"},
-                                           LightCase{K_LIGHTS_EVERY, 0, 0.03f, 88, 8, "every_past_the_slots"}),
+INSTANTIATE_TEST_SUITE_P(LightSampling, OpenCLWavefrontShadows, ::testing::ValuesIn(shadow_walk_cases()),
                          [](const auto& info) { return std::string(info.param.name); });
 
 // A band that grows between frames grows the wavefront's scratch (a second, taller band on the same

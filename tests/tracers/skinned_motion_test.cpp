@@ -43,8 +43,7 @@ class SkinnedMotion : public ::testing::TestWithParam<std::string> {};
 TEST_P(SkinnedMotion, FollowsThePreviousPoseOfTheJoints) {
   const std::string device = GetParam();
   if (!tracer_runs_here(device)) GTEST_SKIP() << "needs the " << device << " tracer here";
-  scene::Vfs vfs;
-  scene::Scene map = scene::load_map(vfs, std::string(COHORT_SOURCE_DIR) + "/assets/testmap/maps/testmap.map");
+  scene::Scene map = load_test_map();
   scene::RenderWorld world(map);
   const int handle = world.FindEntityDef("walker_1");
   ASSERT_GE(handle, 0);

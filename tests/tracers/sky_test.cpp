@@ -17,14 +17,7 @@ using namespace cohort::test;
 
 namespace {
 
-class Sky : public ::testing::TestWithParam<std::string> {
- protected:
-  void SetUp() override {
-    if (!tracer_runs_here(GetParam())) GTEST_SKIP() << GetParam() << ": no device on this machine";
-    tracer_ = make_test_tracer(GetParam());
-  }
-  std::unique_ptr<core::Tracer> tracer_;
-};
+class Sky : public EachTracer {};
 
 // The six images of a cameraCubeMap, in the file order _forward _back _left _right _up _down, and
 // the views they are (doom3-content.md section 8): forward, back, left and right look along +X, -X,

@@ -21,7 +21,9 @@
 #include "cohort/core/tracer.h"
 #include "cohort/core/frame_defaults.h"
 #include "cohort/core/view.h"
+#include "cohort/scene/map_loader.h"
 #include "cohort/scene/scene.h"
+#include "cohort/scene/vfs.h"
 #include "cohort/test_support/scene_builders.h"
 #include "cohort/test_support/test_scenes.h"
 #include "test_tracers.h"
@@ -35,6 +37,25 @@ inline KCamera camera_looking_down(glm::vec3 origin, float tan_half_fov, int wid
   c.forward[2] = -1.0f;
   c.right[0] = 1.0f;
   c.up[1] = 1.0f;
+  c.width = static_cast<uint32_t>(width);
+  c.height = static_cast<uint32_t>(height);
+  c.tan_half_fov_x = tan_half_fov;
+  c.tan_half_fov_y = tan_half_fov * float(height) / float(width);
+  return c;
+}
+
+// A pinhole camera at `origin` looking at `target`, image up toward +Z.
+inline KCamera camera_looking_at(glm::vec3 origin, glm::vec3 target, float tan_half_fov, int width, int height) {
+  KCamera c{};
+  const glm::vec3 forward = glm::normalize(target - origin);
+  const glm::vec3 right = glm::normalize(glm::cross(forward, glm::vec3(0, 0, 1)));
+  const glm::vec3 up = glm::cross(right, forward);
+  for (int i = 0; i < 3; ++i) {
+    c.origin[i] = origin[i];
+    c.forward[i] = forward[i];
+    c.right[i] = right[i];
+    c.up[i] = up[i];
+  }
   c.width = static_cast<uint32_t>(width);
   c.height = static_cast<uint32_t>(height);
   c.tan_half_fov_x = tan_half_fov;
@@ -59,6 +80,17 @@ inline KFrameParams frame_params(uint32_t mode, uint32_t spp, uint32_t max_bounc
   return p;
 }
 
+// The settings the tracers' agreement tests (agreement_test.cpp, cuda_test.cpp) compare images at: 16 spp
+// with the firefly clamp, soft shadows and Russian roulette from bounce 2 on, at one frame index.
+inline KFrameParams agreement_params(uint32_t mode, uint32_t bounces, int height) {
+  KFrameParams p = frame_params(mode, 16, bounces, height);
+  p.firefly_clamp = 10.0f;
+  p.soft_shadow_scale = 1.0f;
+  p.rr_start = 2.0f;
+  p.frame_index = 7;
+  return p;
+}
+
 // One whole-frame band from the scene the tracer holds now.
 inline core::FrameBuffer render_frame(core::Tracer& tracer, const KCamera& camera, const KFrameParams& params) {
   core::FrameBuffer fb;
@@ -76,6 +108,12 @@ inline core::FrameBuffer render(core::Tracer& tracer, const scene::Scene& scene,
   auto compiled = std::make_shared<commit::TracerScene>(core::compile_scene(scene).tracer_scene);
   tracer.apply(commit::CommitBuffer::full(compiled, 1));
   return render_frame(tracer, camera, params);
+}
+
+// The test map on disk (assets/testmap, made by tools/gen_testmap.py), loaded as `cohort` loads a map.
+inline scene::Scene load_test_map() {
+  scene::Vfs vfs;
+  return scene::load_map(vfs, std::string(COHORT_SOURCE_DIR) + "/assets/testmap/maps/testmap.map");
 }
 
 // The test map agreements' settings (8 spp, 1 bounce, a shadow ray per light, soft shadows, a firefly

@@ -9,6 +9,8 @@
 #include <string>
 #include <vector>
 
+#include <gtest/gtest.h>
+
 #include "cohort/tracers/tracer_registry.h"
 
 namespace cohort::test {
@@ -26,6 +28,17 @@ inline std::unique_ptr<core::Tracer> make_test_tracer(const std::string& name) {
     if (const char* device = std::getenv("COHORT_TEST_OPENCL_DEVICE")) spec.device = std::atoi(device);
   return tracers::make_tracer(spec);
 }
+
+// A fixture for the checks run on each built tracer (INSTANTIATE_TEST_SUITE_P over built_tracers()): the
+// parameter is the tracer's kind; tracer_ is one made for the test, which skips where the kind cannot run.
+class EachTracer : public ::testing::TestWithParam<std::string> {
+ protected:
+  void SetUp() override {
+    if (!tracer_runs_here(GetParam())) GTEST_SKIP() << GetParam() << ": no device on this machine";
+    tracer_ = make_test_tracer(GetParam());
+  }
+  std::unique_ptr<core::Tracer> tracer_;
+};
 
 // The message the registry gives when `variable` holds `value` while it makes `name`'s tracer ("" if none:
 // it made the tracer); the variable is unset afterwards.

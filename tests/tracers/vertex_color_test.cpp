@@ -21,14 +21,7 @@ namespace {
 constexpr float kAlbedo = 0.8f;
 constexpr uint32_t kRed = 0xFF0000FFu, kBlack = 0xFF000000u, kWhite = 0xFFFFFFFFu;
 
-class VertexColors : public ::testing::TestWithParam<std::string> {
- protected:
-  void SetUp() override {
-    if (!tracer_runs_here(GetParam())) GTEST_SKIP() << GetParam() << ": no device on this machine";
-    tracer_ = make_test_tracer(GetParam());
-  }
-  std::unique_ptr<core::Tracer> tracer_;
-};
+class VertexColors : public EachTracer {};
 
 // A quad from x0 to x1 (|y| < 50, z = 0, facing up) whose corners at x0 get colour `left` and at x1 `right`.
 void add_coloured_quad(scene::Mesh& mesh, int material, float x0, float x1, uint32_t left, uint32_t right) {

@@ -429,43 +429,30 @@ class Node {
                                 const std::function<void()>& watch) {
     Rendered rendered;
     rendered.mpi_ms = run_while_sending(mpi, [&] {
-      if (options_.row_delay_ms > 0.0) {
-        // A slower node, in proportion to its rows (tests, and a GPU's timing on a CPU node): each piece is
-        // that much later, so the pieces still leave one by one while the band renders, as a GPU's do.
-        bool complete_work = true;
-        for (size_t i = 0; i + 1 < cuts.size(); ++i) {
-          std::this_thread::sleep_for(
-              std::chrono::duration<double, std::milli>(options_.row_delay_ms * double(cuts[i + 1] - cuts[i])));
-          core::BandJob piece = job;
-          piece.params.row_begin = uint32_t(cuts[i]);
-          piece.params.row_end = uint32_t(cuts[i + 1]);
-          double ms = 0.0;
-          std::vector<float> work = render_split(piece, target, ms);
-          rendered.tracer_ms += ms;
-          complete_work = complete_work && work.size() == size_t(cuts[i + 1] - cuts[i]);
-          if (complete_work) rendered.row_work.insert(rendered.row_work.end(), work.begin(), work.end());
-          post_piece(i);
-        }
-        if (!complete_work) rendered.row_work.clear();
-      } else if (tracers_.size() == 1) {
+      if (options_.row_delay_ms <= 0.0 && tracers_.size() == 1) {
         core::BandResult result = tracers_.front()->render_band_in_pieces(job, target, cuts, post_piece);
         rendered.tracer_ms = result.device_ms;
         rendered.row_work = std::move(result.row_work);
-      } else {
-        bool complete_work = true;
-        for (size_t i = 0; i + 1 < cuts.size(); ++i) {
-          core::BandJob piece = job;
-          piece.params.row_begin = uint32_t(cuts[i]);
-          piece.params.row_end = uint32_t(cuts[i + 1]);
-          double ms = 0.0;
-          std::vector<float> work = render_split(piece, target, ms);
-          rendered.tracer_ms += ms;
-          complete_work = complete_work && work.size() == size_t(cuts[i + 1] - cuts[i]);
-          if (complete_work) rendered.row_work.insert(rendered.row_work.end(), work.begin(), work.end());
-          post_piece(i);
-        }
-        if (!complete_work) rendered.row_work.clear();
+        return;
       }
+      bool complete_work = true;
+      for (size_t i = 0; i + 1 < cuts.size(); ++i) {
+        // A slower node, in proportion to its rows (tests, and a GPU's timing on a CPU node): each piece is
+        // that much later, so the pieces still leave one by one while the band renders, as a GPU's do.
+        if (options_.row_delay_ms > 0.0)
+          std::this_thread::sleep_for(
+              std::chrono::duration<double, std::milli>(options_.row_delay_ms * double(cuts[i + 1] - cuts[i])));
+        core::BandJob piece = job;
+        piece.params.row_begin = uint32_t(cuts[i]);
+        piece.params.row_end = uint32_t(cuts[i + 1]);
+        double ms = 0.0;
+        std::vector<float> work = render_split(piece, target, ms);
+        rendered.tracer_ms += ms;
+        complete_work = complete_work && work.size() == size_t(cuts[i + 1] - cuts[i]);
+        if (complete_work) rendered.row_work.insert(rendered.row_work.end(), work.begin(), work.end());
+        post_piece(i);
+      }
+      if (!complete_work) rendered.row_work.clear();
     }, watch);
     return rendered;
   }

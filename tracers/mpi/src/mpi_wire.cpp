@@ -6,6 +6,8 @@
 
 #include <fmt/format.h>
 
+#include "cohort/core/byte_reader.h"
+
 namespace cohort::tracers::wire {
 namespace {
 
@@ -40,28 +42,18 @@ class Writer {
   std::vector<uint8_t> out;
 };
 
-class Reader {
+class Reader : public core::ByteReader<Reader> {
  public:
   Reader(const std::vector<uint8_t>& bytes, const char* what) : Reader(bytes.data(), bytes.size(), what) {}
-  Reader(const uint8_t* data, size_t size, const char* what) : bytes_{data, size}, what_(what) {}
+  Reader(const uint8_t* data, size_t size, const char* what) : ByteReader(data, size), what_(what) {}
   [[noreturn]] void fail(const std::string& why) const {
-    throw WireError(fmt::format("{} message: byte {} of {}: {}", what_, pos_, bytes_.size(), why));
-  }
-  void raw(void* p, size_t n) {
-    if (n > bytes_.size() - pos_) fail(fmt::format("truncated: needs {} more bytes, {} left", n, bytes_.size() - pos_));
-    std::memcpy(p, bytes_.data() + pos_, n);
-    pos_ += n;
-  }
-  template <class T> T scalar() {
-    T v;
-    raw(&v, sizeof v);
-    return v;
+    throw WireError(fmt::format("{} message: byte {} of {}: {}", what_, pos_, size_, why));
   }
   template <class T> std::vector<T> array(const char* name) {
     const uint64_t count = scalar<uint64_t>();
-    if (count > (bytes_.size() - pos_) / sizeof(T))
+    if (count > left() / sizeof(T))
       fail(fmt::format("{}: {} elements of {} bytes do not fit in the {} bytes left", name, count, sizeof(T),
-                       bytes_.size() - pos_));
+                       left()));
     std::vector<T> v(count);
     raw(v.data(), count * sizeof(T));
     return v;
@@ -71,27 +63,18 @@ class Reader {
     return std::string(chars.begin(), chars.end());
   }
   void expect_end() const {
-    if (pos_ != bytes_.size()) fail(fmt::format("{} bytes left over after the last field", bytes_.size() - pos_));
+    if (!at_end()) fail(fmt::format("{} bytes left over after the last field", left()));
   }
-  size_t left() const { return bytes_.size() - pos_; }
   // The next n bytes where they lie (no copy); valid while the message is.
   const uint8_t* view(uint64_t n, const char* name) {
-    if (n > bytes_.size() - pos_)
-      fail(fmt::format("{}: {} bytes do not fit in the {} bytes left", name, n, bytes_.size() - pos_));
-    const uint8_t* p = bytes_.data() + pos_;
+    if (n > left()) fail(fmt::format("{}: {} bytes do not fit in the {} bytes left", name, n, left()));
+    const uint8_t* p = data_ + pos_;
     pos_ += n;
     return p;
   }
 
  private:
-  struct Bytes {
-    const uint8_t* ptr;
-    size_t count;
-    size_t size() const { return count; }
-    const uint8_t* data() const { return ptr; }
-  } bytes_;
   const char* what_;
-  size_t pos_ = 0;
 };
 
 core::BandFormat band_format_of(uint32_t value, Reader& r) {

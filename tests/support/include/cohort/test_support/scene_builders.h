@@ -25,6 +25,9 @@ int add_diffuse_material(scene::Scene& scene, const std::string& name, glm::vec3
 int add_image(scene::Scene& scene, const std::string& name, int w, int h,
               const std::function<glm::u8vec4(int, int)>& texel);
 int add_world_mesh(scene::Scene& scene, scene::Mesh mesh);  // also an area of the static world
+// An entity named "occluder": a 40 x 40 quad of `material` facing +Z, spanning [-20, 20]^2 at z = 50
+// (over the origin, for shadow tests).
+int add_occluder(scene::Scene& scene, int material);
 
 // A point light named "light": a box of half-size `radius` around `origin`.
 scene::Light point_light(glm::vec3 origin, glm::vec3 radius, glm::vec3 colour = glm::vec3(1.0f));
