@@ -210,6 +210,9 @@ typedef struct KCamera {
 #define K_LIGHTS_IN_RANGE 4u  /* per light sample, one light picked by its unshadowed contribution among
                                  every light whose volume holds the point: the tree walked without its
                                  descent (light_tree.h); the default (core::default_frame_params) */
+#define K_LIGHTS_IN_RANGE_BOUNDED 5u  /* in-range with at most K_IN_RANGE_WEIGH_FIRST + K_IN_RANGE_CANDIDATES
+                                         lights weighed a pick: where more reach the point, candidates drawn
+                                         from the rest and resampled (light_tree.h) */
 
 /* light_count, instance_count, tlas_node_count, light_node_count and emissive_count are the lengths of
  * the scene's arrays, set by the host from the tracer's scene copy and read only by k_scene_view
