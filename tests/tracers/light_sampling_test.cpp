@@ -227,11 +227,12 @@ TEST(LightSampling, InRangeIsTheTreeWithoutItsDescent) {
 
 // In range, bounded (K_LIGHTS_IN_RANGE_BOUNDED): in-range while at most K_IN_RANGE_WEIGH_FIRST lights reach
 // a point (the test room's three: the same image, float for float, with bounces, soft shadows and the
-// shadow roulette); with more, those plus K_IN_RANGE_CANDIDATES drawn from the rest are weighed
-// (resampled importance sampling, light_tree.h). On the 96- and 328-light floors (mostly 2-16 and more
-// than 16 lights in range) its image must differ from in-range's (the bound really ran), its block means
-// and mean must match the every-light image as closely as its own noise allows (unbiased), and its pixel
-// noise must stay below the tree's (the weak descent is not what bounds it).
+// shadow roulette); with more, a descent by k_light_node_guess to a subtree of at most
+// K_IN_RANGE_DESCEND_ABOVE lights, then in-range within it (light_tree.h). On the 96- and 328-light floors
+// (mostly 2-16 and more than 16 lights in range; point lights of random shapes and projected lights, which
+// the guess models only roughly) its image must differ from in-range's (the bound really ran), its block
+// means and mean must match the every-light image as closely as its own noise allows (unbiased), and its
+// pixel noise must stay well below the tree's (about a third here: the tree's descent is what it replaces).
 class InRangeBoundedOnFloor : public ::testing::TestWithParam<int> {};
 
 TEST(LightSampling, InRangeBoundedIsInRangeWhereFewLightsReach) {
@@ -285,7 +286,7 @@ TEST_P(InRangeBoundedOnFloor, MatchesEveryLightWithBoundedWork) {
   EXPECT_LT(bias, 0.95 * noise + 1e-4 * mean);
   // The image mean's own noise: about pixel_noise / sqrt(2 pixels).
   EXPECT_LT(mean_error * mean, 3.0 * pixel_noise / std::sqrt(2.0 * w * h) + 0.005 * mean);
-  EXPECT_LT(pixel_noise, 0.9 * tree_noise);
+  EXPECT_LT(pixel_noise, 0.5 * tree_noise);
 }
 
 // 96 lights: mostly 2-16 in range of a point; 328: mostly more than 16.

@@ -107,8 +107,9 @@ KFN int k_lights_one_ray_each(const KFrameParams* params) {
  *   its unshadowed contribution among every light whose volume holds the point (cost grows with those, not
  *   with the map's lights).
  * - K_LIGHTS_IN_RANGE_BOUNDED: in-range while at most K_IN_RANGE_WEIGH_FIRST lights reach the point; with
- *   more, those plus K_IN_RANGE_CANDIDATES drawn from the rest are weighed (resampled importance sampling,
- *   light_tree.h), so its cost stops growing with the lights in range.
+ *   more, a descent by a guess of each subtree's contribution to a subtree of at most
+ *   K_IN_RANGE_DESCEND_ABOVE lights, then in-range within it (light_tree.h): its cost stops growing with
+ *   the lights in range.
  * - K_LIGHTS_ALL: per light sample, one light picked over every light of the map in proportion to its
  *   unshadowed contribution (the reference for the tree: same pick, cost grows with the map).
  * - K_LIGHTS_GATHER: `every` among the lights whose volume holds the point, found through the tree, while
