@@ -111,7 +111,8 @@ INSTANTIATE_TEST_SUITE_P(Modes, CudaAgreement,
                          [](const auto& info) { return std::string(info.param.name); });
 
 // Under 96 overlapping lights (the tree descends, gather has more lights in range than its budget, the pick
-// in range weighs them all, its bounded form descends by its guess past 8 in range), CUDA draws Embree's image, as AgreementManyLights checks for OpenCL.
+// in range weighs them all, its bounded form descends by its guess past 8 in range), CUDA draws Embree's
+// image, as AgreementManyLights checks for OpenCL.
 TEST(CudaAgreementManyLights, MatchesEmbree) {
   REQUIRE_GPU();
   scene::Scene s = many_lights_floor(88, 8);
