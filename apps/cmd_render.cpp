@@ -496,14 +496,11 @@ void add_render_command(CLI::App& app, int& exit_code) {
                   "there are at most --light-samples of them; beyond that at most --light-samples rays (16 at "
                   "most), the brightest lights first, unbiased) or in-range (one light per sample, picked by its "
                   "unshadowed contribution among every light whose volume holds the point, found through the tree "
-                  "without its descent: cost grows with the lights in range, not the map's) or in-range-bounded "
-                  "(in-range while at most 8 lights reach the point; where more, a descent through the tree by a "
-                  "guess of each subtree's contribution to 16 lights, then in-range among them: cost bounded in "
-                  "dense rooms, unbiased)")
+                  "without its descent: cost grows with the lights in range, not the map's)")
       ->capture_default_str()
       ->check(CLI::IsMember(core::light_sampling_names()));
   cmd->add_option("--light-samples", a->light_samples,
-                  "lights sampled per hit with --light-sampling tree, in-range, in-range-bounded or all, most shadow rays per hit with "
+                  "lights sampled per hit with --light-sampling tree, in-range or all, most shadow rays per hit with "
                   "gather (0: every light, as --light-sampling every)")
       ->capture_default_str()
       ->check(CLI::NonNegativeNumber);

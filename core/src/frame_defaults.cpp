@@ -26,8 +26,7 @@ KFrameParams default_frame_params() {
 }
 
 const std::vector<std::string>& light_sampling_names() {
-  static const std::vector<std::string> names = {"tree", "all", "every", "gather", "in-range",
-                                                      "in-range-bounded"};
+  static const std::vector<std::string> names = {"tree", "all", "every", "gather", "in-range"};
   return names;
 }
 
@@ -37,9 +36,7 @@ kuint light_sampling_mode(const std::string& name) {
   if (name == "every") return K_LIGHTS_EVERY;
   if (name == "gather") return K_LIGHTS_GATHER;
   if (name == "in-range") return K_LIGHTS_IN_RANGE;
-  if (name == "in-range-bounded") return K_LIGHTS_IN_RANGE_BOUNDED;
-  throw std::invalid_argument("light sampling '" + name +
-                              "': choose tree, all, every, gather, in-range or in-range-bounded");
+  throw std::invalid_argument("light sampling '" + name + "': choose tree, all, every, gather or in-range");
 }
 
 const std::string& light_sampling_name(kuint mode) {

@@ -100,12 +100,10 @@ class TreeBuilder {
     KLightNode n{};
     n.parent = parent;
     glm::vec3 lo(INFINITY), hi(-INFINITY), centre_lo(INFINITY), centre_hi(-INFINITY);
-    float power = 0.0f, reach = 0.0f;
+    float power = 0.0f;
     for (size_t i = begin; i < end; ++i) {
       lo = glm::min(lo, items_[i].box.min);
       hi = glm::max(hi, items_[i].box.max);
-      const glm::vec3 half = 0.5f * (items_[i].box.max - items_[i].box.min);
-      reach = std::max(reach, std::max(half.x, std::max(half.y, half.z)));
       centre_lo = glm::min(centre_lo, items_[i].centre);
       centre_hi = glm::max(centre_hi, items_[i].centre);
       power += items_[i].power;
@@ -115,7 +113,6 @@ class TreeBuilder {
       n.bmax[k] = hi[k];
     }
     n.power = power;
-    n.reach = reach;
     n.light_count = uint32_t(end - begin);
     if (end - begin == 1) {
       n.count = 1;

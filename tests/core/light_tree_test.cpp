@@ -12,7 +12,6 @@
 
 #include "cohort/core/gpu_scene.h"
 #include "cohort/core/light_sampling.h"
-#include "cohort/kernel/light_tree.h"
 #include "cohort/kernel/lights.h"
 
 using namespace cohort;
@@ -132,8 +131,6 @@ TEST(LightTree, EveryLightIsOneLeafAndBoxesNest) {
         EXPECT_GE(n.bmax[a], box->max[a]);
       }
       EXPECT_NEAR(n.power, v3_luminance(v3_load(lights[n.left_first].color)), 1e-5f);
-      const glm::vec3 half = 0.5f * (box->max - box->min);
-      EXPECT_FLOAT_EQ(n.reach, std::max(half.x, std::max(half.y, half.z)));
       return;
     }
     ASSERT_EQ(n.count, 0u);
@@ -144,7 +141,6 @@ TEST(LightTree, EveryLightIsOneLeafAndBoxesNest) {
       EXPECT_GE(n.bmax[a], std::max(l.bmax[a], r.bmax[a]));
     }
     EXPECT_EQ(n.light_count, l.light_count + r.light_count);
-    EXPECT_EQ(n.reach, std::max(l.reach, r.reach));
     EXPECT_NEAR(n.power, l.power + r.power, 1e-4f * n.power);
     // Median splits: the two halves differ by at most one light (the kernel's gather stack relies on it).
     EXPECT_LE(std::max(l.light_count, r.light_count) - std::min(l.light_count, r.light_count), 1u);
@@ -158,54 +154,6 @@ TEST(LightTree, EveryLightIsOneLeafAndBoxesNest) {
   EXPECT_EQ(core::build_light_tree(lights).size(), tree.size());
   EXPECT_EQ(std::memcmp(core::build_light_tree(lights).data(), tree.data(), tree.size() * sizeof(KLightNode)), 0)
       << "the build must be deterministic";
-}
-
-// K_LIGHTS_IN_RANGE_BOUNDED's descent weighs a node by k_light_node_guess: above zero wherever the node's box
-// holds the point (or a light reaching it could never be picked: bias), zero elsewhere, whatever the
-// normal; and, in a row of equal point lights, larger for the light whose centre is nearer (what makes it
-// better than the tree's power-only importance).
-TEST(LightTree, GuessIsPositiveExactlyWhereTheBoxHoldsThePoint) {
-  std::mt19937 rng(5);
-  std::uniform_real_distribution<float> pos(-600.0f, 600.0f), size(20.0f, 400.0f), unit(-1.0f, 1.0f);
-  std::vector<KLight> lights;
-  const scene::Scene empty;
-  for (int i = 0; i < 64; ++i) {
-    scene::Light l = i % 4 == 0 ? projected_light({pos(rng), pos(rng), pos(rng)}, {0, 0, -size(rng)},
-                                                   {0, -size(rng), 0}, {size(rng), 0, 0})
-                                : point_light({pos(rng), pos(rng), pos(rng)}, {size(rng), size(rng), size(rng)});
-    lights.push_back(core::to_klight(l, empty));
-  }
-  const std::vector<KLightNode> tree = core::build_light_tree(lights);
-  int held = 0;
-  for (int i = 0; i < 2000; ++i) {
-    const KVec3 p = v3(pos(rng), pos(rng), pos(rng));
-    const KVec3 normal = v3_normalize(v3(unit(rng), unit(rng), unit(rng)));
-    for (const KLightNode& n : tree) {
-      const float g = k_light_node_guess(&n, p, normal);
-      if (k_light_node_holds(&n, p)) {
-        ++held;
-        ASSERT_GT(g, 0.0f) << "point " << p.x << " " << p.y << " " << p.z;
-        ASSERT_TRUE(std::isfinite(g));
-      } else {
-        ASSERT_EQ(g, 0.0f);
-      }
-    }
-  }
-  EXPECT_GT(held, 10000) << "the points must fall in many boxes";
-
-  std::vector<KLight> row;
-  for (int i = 0; i < 2; ++i)
-    row.push_back(core::to_klight(point_light({float(i) * 200.0f, 0.0f, 100.0f}, {400, 400, 400}), empty));
-  const std::vector<KLightNode> pair = core::build_light_tree(row);
-  ASSERT_EQ(pair.size(), 3u);
-  const KLightNode& a = pair[pair[0].left_first];
-  const KLightNode& b = pair[pair[0].left_first + 1];
-  const KLightNode& near = a.bmin[0] < b.bmin[0] ? a : b;
-  const KLightNode& far = a.bmin[0] < b.bmin[0] ? b : a;
-  const KVec3 floor_point = v3(-50.0f, 0.0f, 0.0f), up = v3(0.0f, 0.0f, 1.0f);
-  EXPECT_GT(k_light_node_guess(&near, floor_point, up), 2.0f * k_light_node_guess(&far, floor_point, up));
-  EXPECT_EQ(k_light_node_importance(&near, floor_point), k_light_node_importance(&far, floor_point))
-      << "the tree's importance cannot tell them apart";
 }
 
 TEST(LightTree, LightsWithoutAVolumeAreLeftOut) {

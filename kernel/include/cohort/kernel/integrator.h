@@ -106,10 +106,6 @@ KFN int k_lights_one_ray_each(const KFrameParams* params) {
  * - K_LIGHTS_IN_RANGE: the same without the tree's descent: one light per sample picked in proportion to
  *   its unshadowed contribution among every light whose volume holds the point (cost grows with those, not
  *   with the map's lights).
- * - K_LIGHTS_IN_RANGE_BOUNDED: in-range while at most K_IN_RANGE_WEIGH_FIRST lights reach the point; with
- *   more, a descent by a guess of each subtree's contribution to a subtree of at most
- *   K_IN_RANGE_DESCEND_ABOVE lights, then in-range within it (light_tree.h): its cost stops growing with
- *   the lights in range.
  * - K_LIGHTS_ALL: per light sample, one light picked over every light of the map in proportion to its
  *   unshadowed contribution (the reference for the tree: same pick, cost grows with the map).
  * - K_LIGHTS_GATHER: `every` among the lights whose volume holds the point, found through the tree, while
@@ -145,12 +141,10 @@ KFN void k_direct_lighting(KTraceCtx* ctx, const KFrameParams* params, const KSu
     KVec3 chosen_contrib = v3s(0.0f);
     float pdf = 0.0f;
     float u_pick = k_rng_next(rng);
-    if (params->light_sampling == K_LIGHTS_TREE || params->light_sampling == K_LIGHTS_IN_RANGE ||
-        params->light_sampling == K_LIGHTS_IN_RANGE_BOUNDED) {
+    if (params->light_sampling == K_LIGHTS_TREE || params->light_sampling == K_LIGHTS_IN_RANGE) {
       float u_descend = k_rng_next(rng);
       kuint descend_above = params->light_sampling == K_LIGHTS_TREE ? K_LIGHT_TREE_GATHER : K_NONE;
-      kuint weigh_first = params->light_sampling == K_LIGHTS_IN_RANGE_BOUNDED ? K_IN_RANGE_WEIGH_FIRST : K_NONE;
-      chosen = k_light_tree_pick(scene, sf, wo, params->spec_boost, descend_above, weigh_first, u_descend, u_pick,
+      chosen = k_light_tree_pick(scene, sf, wo, params->spec_boost, descend_above, u_descend, u_pick,
                                  &chosen_contrib, &pdf);
     } else {
       float total = 0.0f, chosen_weight = 0.0f;
