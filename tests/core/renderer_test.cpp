@@ -51,16 +51,25 @@ void expect_complete(const FrameBuffer& fb, uint64_t frame, const FrameStats& st
   }
 }
 
-}  // namespace
-
-TEST(Renderer, DeliversEveryRowAndBalancesUnequalTracers) {
+// Two simulated tracers, the first twice as fast (tags 1 and 2).
+std::vector<std::unique_ptr<Tracer>> unequal_pair() {
   std::vector<std::unique_ptr<Tracer>> tracers;
   tracers.push_back(std::make_unique<SimulatedTracer>(model(), sim(1, 2.0)));
   tracers.push_back(std::make_unique<SimulatedTracer>(model(), sim(2, 1.0)));
+  return tracers;
+}
+
+RendererOptions perfect_on_reported_time() {
   RendererOptions options;
   options.balancer = "perfect";
   options.use_reported_time = true;
-  Renderer renderer(std::move(tracers), options);
+  return options;
+}
+
+}  // namespace
+
+TEST(Renderer, DeliversEveryRowAndBalancesUnequalTracers) {
+  Renderer renderer(unequal_pair(), perfect_on_reported_time());
   FrameBuffer fb;
   FrameStats stats;
   for (uint64_t f = 0; f < 10; ++f) {
@@ -80,14 +89,9 @@ TEST(Renderer, DeliversEveryRowAndBalancesUnequalTracers) {
 // and with one longer than a whole frame (every wait ends while polling), the same bands and complete frames.
 TEST(Renderer, TheHandOffSpinChangesOnlyWhenThreadsWake) {
   auto run = [](std::chrono::microseconds spin) {
-    std::vector<std::unique_ptr<Tracer>> tracers;
-    tracers.push_back(std::make_unique<SimulatedTracer>(model(), sim(1, 2.0)));
-    tracers.push_back(std::make_unique<SimulatedTracer>(model(), sim(2, 1.0)));
-    RendererOptions options;
-    options.balancer = "perfect";
-    options.use_reported_time = true;
+    RendererOptions options = perfect_on_reported_time();
     options.handoff_spin = spin;
-    Renderer renderer(std::move(tracers), options);
+    Renderer renderer(unequal_pair(), options);
     FrameBuffer fb;
     std::vector<std::pair<int, int>> bands;
     for (uint64_t f = 0; f < 12; ++f) {
