@@ -359,8 +359,9 @@ def bench(a):
 def early_announce(a):
     """Rank 0's own frame work (every frame written) far longer than a node's band: announced after that work
     (COHORT_EARLY_ANNOUNCE=0, the order before), bands come back before the next frame is announced and its
-    job cannot go ahead (5-9 of 11 bands in five runs here); announced at hand-out (the default), none does. Every
-    frame matches the single-process render either way."""
+    job cannot go ahead (5-9 of 11 bands a node in five runs here; at least 3 of both nodes' required);
+    announced at hand-out (the default), at most 2 of them do. Every frame matches the single-process render
+    either way."""
     os.makedirs(a.out)
     frames = 12
     args = [a.map, "--width", "320", "--height", "180", "--spp", "1", "--mode", "albedo", "--frames", str(frames), "--write", "all"]
@@ -381,20 +382,24 @@ def early_announce(a):
                                                    cluster] + args + [":"] + flags + ["-np", "1"] + node + [":"] +
                         flags + ["-np", "1"] + node, env=env)
         compare_frames(single, cluster, frames=frames)
+        back_total = 0
         for rank in (1, 2):
             found = re.search(pattern.format(rank), output)
             if not found:
                 sys.exit(f"mpi:{rank}: no line on when its jobs ahead left")
             after_ms, back = float(found.group(1)), int(found.group(2))
+            back_total += back
             print(f"announced at hand-out {early}, mpi:{rank}: a job ahead left {after_ms} ms after its band's job; "
                   f"{back} of {frames - 1} band(s) back before the next frame was announced")
-            if early == "1" and back > 1:
-                sys.exit(f"mpi:{rank}: {back} band(s) came back before the next frame was announced at hand-out")
-            # (At most about half: a band that sent no job ahead is an ordinary one, long enough for the next
-            # announcement to come while it renders; the band after adopts that job and is short again.)
-            if early == "0" and back < frames // 4:
-                sys.exit(f"mpi:{rank}: only {back} band(s) came back before the announcement after rank 0's frame "
-                         f"work: the case no longer shows what the early announcement changes")
+        # Counted over both nodes: on a loaded machine the balancer may give one node few bands (CI once saw a
+        # node with 5 bands, 2 of them back early, with the old order).
+        if early == "1" and back_total > 2:
+            sys.exit(f"{back_total} band(s) came back before the next frame was announced at hand-out")
+        # (At most about half a node's: a band that sent no job ahead is an ordinary one, long enough for the next
+        # announcement to come while it renders; the band after adopts that job and is short again.)
+        if early == "0" and back_total < frames // 4:
+            sys.exit(f"only {back_total} band(s) came back before the announcement after rank 0's frame work: the "
+                     f"case no longer shows what the early announcement changes")
     print("early_announce: ok")
 
 
