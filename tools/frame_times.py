@@ -7,6 +7,7 @@ latency, the Renderer's wall time, and per stage (the frame timeline), over the 
 """
 import argparse
 import json
+import os
 import statistics
 import sys
 
@@ -49,17 +50,22 @@ def main():
     args = parser.parse_args()
     with open(args.stats) as f:
         summary = summarise(json.load(f), args.skip)
-    e2e, wall = summary["end_to_end_ms"], summary["wall_ms"]
-    interval = summary["interval_ms"] or e2e  # stats.json from before the pipeline has no interval
-    print(f"{summary['tracers']}: {summary['frames']} frames at {summary['width']}x{summary['height']}: "
-          f"per frame median {interval['median']:.2f} ms (p95 {interval['p95']:.2f}), "
-          f"latency median {e2e['median']:.2f} ms, renderer wall {wall['median']:.2f} ms, "
-          f"idle {summary['idle_percent']['mean']:.1f}% mean")
-    for name, ms in summary["stages_median_ms"].items():
-        print(f"  {name:60s} {ms:8.3f} ms")
-    if args.json:
+    if args.json:  # first: a reader that stops after the headline (`| head -n 1`) must not lose it
         with open(args.json, "w") as f:
             json.dump(summary, f, indent=2)
+    e2e, wall = summary["end_to_end_ms"], summary["wall_ms"]
+    interval = summary["interval_ms"] or e2e  # stats.json from before the pipeline has no interval
+    try:
+        print(f"{summary['tracers']}: {summary['frames']} frames at {summary['width']}x{summary['height']}: "
+              f"per frame median {interval['median']:.2f} ms (p95 {interval['p95']:.2f}), "
+              f"latency median {e2e['median']:.2f} ms, renderer wall {wall['median']:.2f} ms, "
+              f"idle {summary['idle_percent']['mean']:.1f}% mean")
+        for name, ms in summary["stages_median_ms"].items():
+            print(f"  {name:60s} {ms:8.3f} ms")
+        sys.stdout.flush()
+    except BrokenPipeError:
+        # The reader took what it wanted (`| head -n 1`): no traceback, and none at exit either.
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
     return 0
 
 
