@@ -8,6 +8,7 @@
 
 #include "cohort/commit/commit_buffer.h"
 #include "cohort/core/atrous_filter.h"
+#include "cohort/core/band_buffer.h"
 #include "cohort/core/convergence.h"
 #include "cohort/core/frame_post.h"
 #include "cohort/core/frame_defaults.h"
@@ -113,7 +114,7 @@ PlaySession::PlaySession(const SessionOptions& options) {
   for (const auto& tracer : tracers) s.any_gpu_tracer = s.any_gpu_tracer || tracer->renders_on_gpu();
   core::RendererOptions renderer_options;
   renderer_options.balancer = options.balancer;
-  renderer_options.band_format = core::BandFormat::rgb16f;  // half the bytes; the HUD image cannot tell
+  renderer_options.band_format = core::band_format_from_string(options.band_format);
   renderer_options.benched_commit_every = 8;  // as `cohort render`'s default
   s.renderer = std::make_unique<core::Renderer>(std::move(tracers), renderer_options);
   s.renderer->submit_commit(commit::CommitBuffer::full(initial_scene, 0));
