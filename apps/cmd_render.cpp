@@ -419,8 +419,7 @@ int run_render(const RenderArgs& a) {
   // it is merged, blended and written (FramePipeline::push with prepare_next): a remote tracer's node
   // starts on it then (docs/cluster.md). COHORT_EARLY_ANNOUNCE=0 prepares it after, as before (for
   // comparison).
-  const char* early_text = std::getenv("COHORT_EARLY_ANNOUNCE");
-  const bool early_announce = !(early_text && std::string(early_text) == "0");
+  const bool early_announce = core::FramePipeline::announces_at_hand_out();
   std::optional<Prepared> next = frames > 0 ? prepare(0) : std::nullopt;
   for (int f = 0; next; ++f) {
     Prepared current = std::move(*next);
