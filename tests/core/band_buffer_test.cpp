@@ -145,7 +145,9 @@ TEST(Rgb9e5, EveryChannelIsWithinOneStepOfTheBrightest) {
     // The brightest channel keeps 9 bits: relative error at most 1/511 rounded to the nearest (above the
     // smallest exponent's range).
     const uint32_t brightest = c[0] == top ? 0 : c[1] == top ? 1 : 2;
-    if (top > 0x1p-16f) ASSERT_LE(std::fabs(k_rgb9e5_channel(nearest, brightest) - top), top / 511.0f) << top;
+    if (top > 0x1p-16f) {
+      ASSERT_LE(std::fabs(k_rgb9e5_channel(nearest, brightest) - top), top / 511.0f) << top;
+    }
   }
 }
 
