@@ -385,6 +385,11 @@ void add_play_command(CLI::App& app, int& exit_code) {
   cmd->add_option("--balancer", a->session.balancer, "row balancer (B cycles)")
       ->capture_default_str()
       ->check(CLI::IsMember(balance::balancer_names()));
+  cmd->add_option("--band-format", a->session.band_format,
+                  "what the tracers hand back: RGB half floats (6 bytes a pixel), RGB9E5 (4 bytes a pixel: 9-bit mantissas "
+                  "under a shared exponent, dithered so averaging frames keeps no bias) or RGBA floats (16)")
+      ->capture_default_str()
+      ->check(CLI::IsMember({"rgb16f", "rgb9e5", "rgba32f"}));
   cmd->add_option("--width", a->width, "window width")->capture_default_str()->check(CLI::Range(16, 16384));
   cmd->add_option("--height", a->height, "window height")->capture_default_str()->check(CLI::Range(16, 16384));
   CLI::Option* scale_option = cmd->add_option("--scale", a->scale, "render resolution / window resolution")

@@ -12,6 +12,7 @@
 #include <spdlog/spdlog.h>
 
 #include "cohort/commit/commit_buffer.h"
+#include "cohort/core/band_buffer.h"
 #include "cohort/core/frame_stats.h"
 #include "cohort/core/frame_timeline.h"
 #include "cohort/core/gpu_scene.h"
@@ -117,7 +118,7 @@ int run_render(const RenderArgs& a) {
   core::RendererOptions options;
   options.balancer = a.balancer;
   options.benched_commit_every = a.benched_commit_every;
-  options.band_format = a.band_format == "rgba32f" ? core::BandFormat::rgba32f : core::BandFormat::rgb16f;
+  options.band_format = core::band_format_from_string(a.band_format);
   options.frame_timeout = std::chrono::milliseconds(600000);
   core::Renderer renderer(std::move(tracers), options);
   // Dynamic resolution: sparse paths over the full-size G-buffer, reconstructed after the merge; or, for
@@ -418,8 +419,7 @@ int run_render(const RenderArgs& a) {
   // it is merged, blended and written (FramePipeline::push with prepare_next): a remote tracer's node
   // starts on it then (docs/cluster.md). COHORT_EARLY_ANNOUNCE=0 prepares it after, as before (for
   // comparison).
-  const char* early_text = std::getenv("COHORT_EARLY_ANNOUNCE");
-  const bool early_announce = !(early_text && std::string(early_text) == "0");
+  const bool early_announce = core::FramePipeline::announces_at_hand_out();
   std::optional<Prepared> next = frames > 0 ? prepare(0) : std::nullopt;
   for (int f = 0; next; ++f) {
     Prepared current = std::move(*next);
@@ -442,6 +442,10 @@ int run_render(const RenderArgs& a) {
                            {"camera_path", a.camera_path}, {"denoise", a.denoise},
                            {"render_scale", a.render_scale}, {"upsample", a.upsample},
                            {"convergence", a.no_convergence ? "none" : convergence_mode}, {"frames", stats_json}};
+  // What the tracers' rows take a frame (colour only; aux planes, when asked for, add 32 bytes a pixel).
+  report["band_format"] = a.band_format;
+  report["band_bytes_per_frame"] = size_t(render_width) * size_t(render_height) *
+                                   core::bytes_per_pixel(core::band_format_from_string(a.band_format));
   if (a.write_ids) {
     const scene::RenderWorld* ids_world = world ? world.get() : scene.world.get();
     report["entity_ids"] = ids_world ? entity_plane_ids(*ids_world) : std::map<std::string, uint32_t>();
@@ -471,9 +475,10 @@ void add_render_command(CLI::App& app, int& exit_code) {
       ->capture_default_str();
   cmd->add_option("--balancer", a->balancer, "row balancer when there are several tracers")->capture_default_str();
   cmd->add_option("--band-format", a->band_format,
-                  "what the tracers hand back: RGB half floats (6 bytes a pixel, merged into float) or RGBA floats")
+                  "what the tracers hand back: RGB half floats (6 bytes a pixel), RGB9E5 (4 bytes a pixel: 9-bit mantissas "
+                  "under a shared exponent, dithered so averaging frames keeps no bias) or RGBA floats (16)")
       ->capture_default_str()
-      ->check(CLI::IsMember({"rgb16f", "rgba32f"}));
+      ->check(CLI::IsMember({"rgb16f", "rgb9e5", "rgba32f"}));
   cmd->add_option("--width", a->width, "image width")->capture_default_str()->check(CLI::PositiveNumber);
   cmd->add_option("--height", a->height, "image height")->capture_default_str()->check(CLI::PositiveNumber);
   cmd->add_option("--spp", a->spp, "samples per pixel per frame")->capture_default_str()->check(CLI::PositiveNumber);

@@ -2,12 +2,15 @@
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
 #include <stdexcept>
+#include <vector>
 
 #include <spdlog/spdlog.h>
 
 #include "cohort/commit/commit_buffer.h"
 #include "cohort/core/atrous_filter.h"
+#include "cohort/core/band_buffer.h"
 #include "cohort/core/convergence.h"
 #include "cohort/core/frame_post.h"
 #include "cohort/core/frame_defaults.h"
@@ -67,8 +70,21 @@ struct PlaySession::State {
   std::unique_ptr<core::Renderer> renderer;
   std::unique_ptr<core::FramePipeline> pipeline;  // after the renderer: it finishes the frame in flight first
   kuint aux_mode = K_AUX_CENTRE_RAY;  // KFrameParams.aux_outputs when a frame wants the G-buffer
-  // What the frame in flight was prepared with, for when it comes back.
+  // A frame prepared (scenario advanced, world synced, its commits submitted) and its job.
   struct Prepared {
+    core::BandJob job;
+    std::vector<core::StageSpan> stages;  // the core's stages before the Renderer's own
+    size_t commit_bytes = 0;
+    bool animating = false;
+  };
+  Prepared prepare(const viewer::FlyCamera& camera, double seconds, const FrameSettings& settings, bool paused);
+  // The next frame, prepared and announced as soon as the frame before it was handed out (the input of
+  // the call that handed that one out), pushed by the next call; none while the announcement at hand-out
+  // is off (COHORT_EARLY_ANNOUNCE=0).
+  std::optional<Prepared> next;
+  const bool announce_at_hand_out = core::FramePipeline::announces_at_hand_out();
+  // What the frame in flight was prepared with, for when it comes back.
+  struct InFlight {
     size_t commit_bytes = 0;
     bool animating = false;
   } in_flight;
@@ -113,7 +129,7 @@ PlaySession::PlaySession(const SessionOptions& options) {
   for (const auto& tracer : tracers) s.any_gpu_tracer = s.any_gpu_tracer || tracer->renders_on_gpu();
   core::RendererOptions renderer_options;
   renderer_options.balancer = options.balancer;
-  renderer_options.band_format = core::BandFormat::rgb16f;  // half the bytes; the HUD image cannot tell
+  renderer_options.band_format = core::band_format_from_string(options.band_format);
   renderer_options.benched_commit_every = 8;  // as `cohort render`'s default
   s.renderer = std::make_unique<core::Renderer>(std::move(tracers), renderer_options);
   s.renderer->submit_commit(commit::CommitBuffer::full(initial_scene, 0));
@@ -142,7 +158,18 @@ PlaySession::PlaySession(const SessionOptions& options) {
   }
 }
 
-PlaySession::~PlaySession() = default;
+PlaySession::~PlaySession() {
+  // A frame announced at the last hand-out is handed out and waited for: remote tracers may have sent its
+  // job ahead to their nodes, and a job ahead is answered within the band that adopts it.
+  State& s = *state_;
+  if (!s.next) return;
+  try {
+    s.pipeline->push(s.next->job, std::move(s.next->stages));
+    s.pipeline->drain();
+  } catch (const std::exception& e) {
+    spdlog::warn("cohort play: the frame announced last failed while closing: {}", e.what());
+  }
+}
 
 viewer::FlyCamera PlaySession::start_camera() const {
   const scene::Scene& scene = state_->world.scene();
@@ -152,9 +179,10 @@ viewer::FlyCamera PlaySession::start_camera() const {
   return cam;
 }
 
-SessionFrame PlaySession::frame(const viewer::FlyCamera& camera, double seconds, const FrameSettings& settings) {
-  State& s = *state_;
-  const bool animating = s.scenario && !paused_;
+PlaySession::State::Prepared PlaySession::State::prepare(const viewer::FlyCamera& camera, double seconds,
+                                                        const FrameSettings& settings, bool paused) {
+  State& s = *this;
+  const bool animating = s.scenario && !paused;
   if (animating) s.scenario_seconds += seconds;
   const scene::RenderView view =
       camera.to_render_view(settings.width, settings.height, static_cast<int>(std::lround(s.scenario_seconds * 1000)));
@@ -174,13 +202,15 @@ SessionFrame PlaySession::frame(const viewer::FlyCamera& camera, double seconds,
   s.world.EndFrame();
 
   ++s.frame_index;
-  std::vector<core::StageSpan> stages;  // the core's stages around the Renderer's own
-  core::ScopedStage syncing(stages, core::kCoreTrack, "world sync");
+  Prepared prepared;
+  prepared.animating = animating;
+  core::ScopedStage syncing(prepared.stages, core::kCoreTrack, "world sync");
   const commit::CommitBuffer commit = s.sync->sync(s.world.TakeChanges(), s.frame_index);
   s.renderer->submit_commit(commit, [&s] { return s.sync->snapshot(); });
   syncing.finish();
+  prepared.commit_bytes = commit.bytes();
 
-  core::BandJob job;
+  core::BandJob& job = prepared.job;
   job.camera = camera.to_kcamera(settings.width, settings.height);
   KFrameParams& p = job.params;
   p = core::default_frame_params();
@@ -200,12 +230,29 @@ SessionFrame PlaySession::frame(const viewer::FlyCamera& camera, double seconds,
     job.previous_camera = s.previous_camera;
   }
   s.previous_camera = job.camera;
+  return prepared;
+}
 
+SessionFrame PlaySession::frame(const viewer::FlyCamera& camera, double seconds, const FrameSettings& settings) {
+  State& s = *state_;
+  // With the announcement at hand-out, the frame handed out now was prepared by the call before, from
+  // that call's input, and this call's input prepares the next one as soon as this one is handed out,
+  // before the frame before is blended and shown: remote tracers' nodes start on it while this one
+  // renders (docs/cluster.md, "The next frame announced at hand-out"). The price is a frame more between
+  // input and image. The first call prepares its own frame (at the scenario's start) and the next.
+  std::optional<State::Prepared> current = std::move(s.next);
+  s.next.reset();
+  if (!current) current = s.prepare(camera, s.announce_at_hand_out ? 0.0 : seconds, settings, paused_);
+  const core::FramePipeline::PrepareNext prepare_next = [&]() -> std::optional<core::BandJob> {
+    s.next = s.prepare(camera, seconds, settings, paused_);
+    return s.next->job;
+  };
   // The pipeline hands this frame out and gives back the one before it, which is blended and tone-mapped
   // while this one renders.
-  const State::Prepared prepared = s.in_flight;
-  std::optional<core::FramePipeline::Delivered> done = s.pipeline->push(job, std::move(stages));
-  s.in_flight = {commit.bytes(), animating};
+  const State::InFlight prepared = s.in_flight;
+  std::optional<core::FramePipeline::Delivered> done = s.pipeline->push(
+      current->job, std::move(current->stages), s.announce_at_hand_out ? prepare_next : core::FramePipeline::PrepareNext());
+  s.in_flight = {current->commit_bytes, current->animating};
   SessionFrame out;
   if (!done) return out;
   out.ready = true;

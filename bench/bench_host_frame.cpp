@@ -178,7 +178,7 @@ int main(int argc, char** argv) {
               "convergence ms", "tone map ms", "host ms", "reproject ms", "atrous ms", "+moments ms", "variance ms",
               "spatial ms", "+fix ms");
   nlohmann::json results = nlohmann::json::array();
-  for (BandFormat format : {BandFormat::rgba32f, BandFormat::rgb16f}) {
+  for (BandFormat format : {BandFormat::rgba32f, BandFormat::rgb16f, BandFormat::rgb9e5}) {
     const nlohmann::json r = run(format, width, height, frames);
     std::printf("%-8s %10zu %10.2f %14.2f %12.2f %10.2f %13.2f %10.2f %15.2f %13.2f %13.2f %13.2f\n", to_string(format),
                 bytes_per_pixel(format), r["merge_ms"].get<double>(), r["convergence_ms"].get<double>(),

@@ -24,7 +24,8 @@
 #                              (COHORT_CLUSTER_JOBS_AHEAD="1 0": with and without jobs ahead, back to back)
 #   tools/gpu_run.sh links     there, on a two-GPU kind: remote tracers behind emulated links (COHORT_LINKS, default
 #                              "none 10gbit,0.5ms 1gbit,1ms"): alone, two ranks together, and beside rank 0's cuda:0
-#                              (COHORT_LINKS_EARLY="1 0": with the next frame announced at hand-out and after, back to back)
+#                              (COHORT_LINKS_EARLY="1 0": with the next frame announced at hand-out and after, back to back;
+#                              COHORT_LINKS_FORMATS="rgb16f rgb9e5": each band format in turn, rows of 6 and 4 bytes a pixel)
 #   tools/gpu_run.sh kernels   there: GPU time kernel by kernel (ncu) on the large map at 1080p, cuda:0, Brigade's
 #                              blend / reprojection / reprojection + a-trous, with the same runs' frame times
 #   tools/gpu_run.sh quality   there: bench/quality/bench_quality.py on cuda:0 along the test map's scenario,
@@ -149,8 +150,11 @@ case "${1:-}" in
     echo "in process: cuda:0 $(median /tmp/l_cuda0) ms, cuda:0,cuda:1 $(median /tmp/l_cuda01) ms"
     # COHORT_LINKS_EARLY="1 0": each link with the next frame announced at hand-out (the default) and after
     # rank 0's post of the frame before (COHORT_EARLY_ANNOUNCE=0, the order before), back to back.
+    # COHORT_LINKS_FORMATS="rgb16f rgb9e5": each with the bands in that format (the in-process runs above stay
+    # in the default, rgb16f).
     for link in ${COHORT_LINKS:-none 10gbit,0.5ms 1gbit,1ms}; do
     for early in ${COHORT_LINKS_EARLY:-1}; do
+    for format in ${COHORT_LINKS_FORMATS:-rgb16f}; do
       export COHORT_EARLY_ANNOUNCE=$early
       [ "$link" = none ] && export COHORT_MPI_LINK= || export COHORT_MPI_LINK=$link
       runs() {  # NAME TRACERS NODE-TRACERS... : rank 0 renders TRACERS, one node per NODE-TRACERS
@@ -158,11 +162,11 @@ case "${1:-}" in
         local nodes=() ; for t in "$@"; do nodes+=(: -np 1 "$cohort" node /tmp/largemap.cpk --tracers "$t"); done
         rm -rf /tmp/l_$name
         timeout 180 mpiexec.hydra -np 1 "$cohort" render "${common[@]}" --tracers "$tracers" --out /tmp/l_$name \
-          "${nodes[@]}" >/tmp/l_$name.log 2>&1 || { echo "$name failed"; tail -n 5 /tmp/l_$name.log; }
+          --band-format "$format" "${nodes[@]}" >/tmp/l_$name.log 2>&1 || { echo "$name failed"; tail -n 5 /tmp/l_$name.log; }
       }
       runs m1 mpi:1 cuda:0; runs m2 mpi:2 cuda:0 cuda:1; runs m12 mpi:1,mpi:2 cuda:0 cuda:1
       runs c0m1 cuda:0,mpi:1 cuda:1
-      python3 - "$link (next frame announced at hand-out: $early)" "$(median /tmp/l_m1)" "$(median /tmp/l_m2)" "$(median /tmp/l_m12)" "$(median /tmp/l_cuda0)" \
+      python3 - "$link (next frame announced at hand-out: $early, bands $format)" "$(median /tmp/l_m1)" "$(median /tmp/l_m2)" "$(median /tmp/l_m12)" "$(median /tmp/l_cuda0)" \
         "$(median /tmp/l_c0m1)" <<'PY'
 import sys
 link, m1, m2, m12, c0, c0m1 = sys.argv[1], *map(float, sys.argv[2:])
@@ -170,14 +174,15 @@ print(f"link {link}: mpi:1 alone {m1:.2f} ms, mpi:2 alone {m2:.2f}, mpi:1,mpi:2 
       f"(efficiency {100 / m12 / (1 / m1 + 1 / m2):.1f} %); cuda:0 + mpi:1 {c0m1:.2f} "
       f"(efficiency {100 / c0m1 / (1 / c0 + 1 / m1):.1f} %)")
 PY
-      grep -hE "round trip|a job ahead left" /tmp/l_m12.log | sed "s/^.*\] //" || true
+      grep -hE "round trip|a job ahead left|colour rows a band" /tmp/l_m12.log | sed "s/^.*\] //" || true
       python3 tools/frame_times.py /tmp/l_m12/stats.json --skip 50 | grep " core/" || true
       # Every run's log, and the mix's stats (~0.5 MB), come back, so that a figure can be read again later.
       if [ -n "${OUT:-}" ]; then
-        keep="$OUT/links/${link//[^a-z0-9.]/_}_early$early" && mkdir -p "$keep"
+        keep="$OUT/links/${link//[^a-z0-9.]/_}_early${early}_$format" && mkdir -p "$keep"
         for run in m1 m2 m12 c0m1; do cp /tmp/l_$run.log "$keep/" 2>/dev/null || true; done
         cp /tmp/l_m12/stats.json "$keep/m12.stats.json" 2>/dev/null || true
       fi
+    done
     done
     done
     ;;

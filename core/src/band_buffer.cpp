@@ -2,9 +2,11 @@
 
 #include <algorithm>
 #include <cstring>
+#include <limits>
 #include <stdexcept>
 
 #include "cohort/core/half_float.h"
+#include "cohort/kernel/band_pack.h"
 
 #if defined(__x86_64__)
 #include <immintrin.h>
@@ -12,9 +14,53 @@
 
 namespace cohort::core {
 
-const char* to_string(BandFormat format) { return format == BandFormat::rgb16f ? "rgb16f" : "rgba32f"; }
+const char* to_string(BandFormat format) {
+  switch (format) {
+    case BandFormat::rgb16f: return "rgb16f";
+    case BandFormat::rgb9e5: return "rgb9e5";
+    case BandFormat::rgba32f: break;
+  }
+  return "rgba32f";
+}
 
-size_t bytes_per_pixel(BandFormat format) { return format == BandFormat::rgb16f ? 3 * sizeof(uint16_t) : 4 * sizeof(float); }
+BandFormat band_format_from_string(const std::string& name) {
+  for (BandFormat format : {BandFormat::rgba32f, BandFormat::rgb16f, BandFormat::rgb9e5})
+    if (name == to_string(format)) return format;
+  throw std::invalid_argument("unknown band format '" + name + "' (rgba32f, rgb16f or rgb9e5)");
+}
+
+size_t bytes_per_pixel(BandFormat format) {
+  switch (format) {
+    case BandFormat::rgb16f: return 3 * sizeof(uint16_t);
+    case BandFormat::rgb9e5: return sizeof(uint32_t);
+    case BandFormat::rgba32f: break;
+  }
+  return 4 * sizeof(float);
+}
+
+void rgba32f_to_rgb9e5(const float* rgba, uint32_t* packed, size_t pixels, uint32_t first_pixel, uint32_t frame) {
+  for (size_t p = 0; p < pixels; ++p) {
+    const float dither = k_rgb9e5_dither(first_pixel + static_cast<uint32_t>(p), frame);
+    packed[p] = k_rgb9e5_encode(rgba[4 * p + 0], rgba[4 * p + 1], rgba[4 * p + 2], dither);
+  }
+}
+
+// k_rgb9e5_channel's arithmetic written as selects on bits, so that GCC vectorises the loop (the merge
+// decodes every remote and GPU row of a frame on the host).
+void rgb9e5_to_rgba32f(const uint32_t* __restrict packed, float* __restrict rgba, size_t pixels) {
+  for (size_t p = 0; p < pixels; ++p) {
+    const uint32_t word = packed[p];
+    float scale;
+    const uint32_t scale_bits = ((word >> 27) + 103u) << 23;
+    std::memcpy(&scale, &scale_bits, sizeof scale);
+    const bool nonfinite = word == K_RGB9E5_NONFINITE;
+    for (uint32_t k = 0; k < 3; ++k) {
+      const float value = static_cast<float>((word >> (9u * k)) & 511u) * scale;
+      rgba[4 * p + k] = nonfinite ? std::numeric_limits<float>::quiet_NaN() : value;
+    }
+    rgba[4 * p + 3] = 1.0f;
+  }
+}
 
 namespace {
 
@@ -143,12 +189,15 @@ void BandBuffer::copy_aux_rows_to(GBuffer& out, int row_begin, int row_end) cons
   }
 }
 
-void BandBuffer::store(int y, int x, const float* rgba, size_t pixels) {
+void BandBuffer::store(int y, int x, const float* rgba, size_t pixels, uint32_t frame) {
   if (y < 0 || y >= height_ || x < 0 || static_cast<size_t>(x) + pixels > static_cast<size_t>(width_))
     throw std::out_of_range("BandBuffer::store: pixels outside the buffer");
   unsigned char* at = static_cast<unsigned char*>(row(y)) + static_cast<size_t>(x) * bytes_per_pixel(format_);
   if (format_ == BandFormat::rgba32f) std::memcpy(at, rgba, pixels * 4 * sizeof(float));
-  else rgba32f_to_rgb16f(rgba, reinterpret_cast<uint16_t*>(at), pixels);
+  else if (format_ == BandFormat::rgb16f) rgba32f_to_rgb16f(rgba, reinterpret_cast<uint16_t*>(at), pixels);
+  else
+    rgba32f_to_rgb9e5(rgba, reinterpret_cast<uint32_t*>(at), pixels,
+                      static_cast<uint32_t>(y) * static_cast<uint32_t>(width_) + static_cast<uint32_t>(x), frame);
 }
 
 void BandBuffer::copy_rows_to(FrameBuffer& out, int row_begin, int row_end) const {
@@ -157,7 +206,8 @@ void BandBuffer::copy_rows_to(FrameBuffer& out, int row_begin, int row_end) cons
   const size_t pixels = static_cast<size_t>(width_) * static_cast<size_t>(row_end - row_begin);
   float* to = out.row(row_begin);
   if (format_ == BandFormat::rgba32f) std::memcpy(to, row(row_begin), pixels * 4 * sizeof(float));
-  else rgb16f_to_rgba32f(static_cast<const uint16_t*>(row(row_begin)), to, pixels);
+  else if (format_ == BandFormat::rgb16f) rgb16f_to_rgba32f(static_cast<const uint16_t*>(row(row_begin)), to, pixels);
+  else rgb9e5_to_rgba32f(static_cast<const uint32_t*>(row(row_begin)), to, pixels);
 }
 
 void BandBuffer::copy_rows_from(const BandBuffer& from, int row_begin, int row_end) {

@@ -1,5 +1,8 @@
 #include "cohort/core/frame_pipeline.h"
 
+#include <cstdlib>
+#include <string>
+
 #include <spdlog/spdlog.h>
 
 namespace cohort::core {
@@ -53,6 +56,11 @@ std::optional<FramePipeline::Delivered> FramePipeline::push(const BandJob& job, 
   if (!previous) return std::nullopt;
   renderer_.merge_frame(*stats);
   return delivered(std::move(*previous), std::move(*stats));
+}
+
+bool FramePipeline::announces_at_hand_out() {
+  const char* early = std::getenv("COHORT_EARLY_ANNOUNCE");
+  return !(early && std::string(early) == "0");
 }
 
 std::optional<FramePipeline::Delivered> FramePipeline::drain() {

@@ -122,7 +122,8 @@ BandResult SimulatedTracer::render_band(const BandJob& job, BandBuffer& target) 
     row[x + 2] = 1.0f;
     row[x + 3] = 1.0f;
   }
-  for (int r = std::max(begin, 0); r < std::min(end, target.height()); ++r) target.store(r, 0, row.data(), static_cast<size_t>(target.width()));
+  for (int r = std::max(begin, 0); r < std::min(end, target.height()); ++r)
+    target.store(r, 0, row.data(), static_cast<size_t>(target.width()), static_cast<uint32_t>(frame));
   const auto wait = std::chrono::duration<double, std::milli>(ms * options_.time_scale);
   if (options_.clock == SimulatedClock::sleep) {
     std::this_thread::sleep_for(wait);

@@ -3,7 +3,9 @@
 #include <cmath>
 #include <limits>
 #include <random>
+#include <vector>
 
+#include "cohort/core/band_buffer.h"
 #include "cohort/core/reprojection.h"
 #include "still_wall.h"
 
@@ -168,6 +170,44 @@ TEST(Reprojection, NonFiniteSamplesNeverEnterTheHistory) {
       ++good[p];
     }
     r.accumulate(f, g);
+    ASSERT_TRUE(all_finite(r.image())) << "frame " << n;
+  }
+  for (size_t p = 0; p < static_cast<size_t>(kW * kH); ++p)
+    for (int k = 0; k < 3; ++k) EXPECT_NEAR(r.image().rgba[4 * p + k], sum[4 * p + k] / good[p], 1e-3) << p;
+}
+
+// The same through RGB9E5 bands (kernel/band_pack.h), which have no NaN or infinity of their own: a
+// non-finite sample is stored as the reserved word, decodes to NaN, and is rejected all the same; the
+// history converges to the average of the finite samples as they were decoded.
+TEST(Reprojection, NonFiniteSamplesThroughRgb9e5BandsNeverEnterTheHistory) {
+  TemporalReprojection r;
+  const GBuffer g = still_wall();
+  const float bad[] = {std::numeric_limits<float>::quiet_NaN(), std::numeric_limits<float>::infinity(),
+                       -std::numeric_limits<float>::infinity()};
+  std::mt19937 rng(13);
+  std::vector<double> sum(static_cast<size_t>(kW * kH * 4), 0.0);
+  std::vector<int> good(static_cast<size_t>(kW * kH), 0);
+  BandBuffer band(kW, kH, BandFormat::rgb9e5);
+  FrameBuffer decoded;
+  decoded.resize(kW, kH);
+  for (int n = 0; n < 16; ++n) {
+    FrameBuffer f = noise_frame(rng);
+    std::vector<bool> poisoned(static_cast<size_t>(kW * kH), false);
+    for (size_t p = 0; p < static_cast<size_t>(kW * kH); ++p) {
+      poisoned[p] = (p % 3 == static_cast<size_t>(n % 3) && n % 2 == 0) || (n == 0 && p < kW);
+      if (poisoned[p]) f.rgba[4 * p + static_cast<size_t>(n % 3)] = bad[n % 3];
+    }
+    for (int y = 0; y < kH; ++y) band.store(y, 0, f.row(y), kW, static_cast<uint32_t>(n));
+    band.copy_rows_to(decoded, 0, kH);
+    for (size_t p = 0; p < static_cast<size_t>(kW * kH); ++p) {
+      if (poisoned[p]) {
+        for (int k = 0; k < 3; ++k) ASSERT_TRUE(std::isnan(decoded.rgba[4 * p + k])) << "pixel " << p;
+        continue;
+      }
+      for (int k = 0; k < 3; ++k) sum[4 * p + k] += decoded.rgba[4 * p + k];
+      ++good[p];
+    }
+    r.accumulate(decoded, g);
     ASSERT_TRUE(all_finite(r.image())) << "frame " << n;
   }
   for (size_t p = 0; p < static_cast<size_t>(kW * kH); ++p)

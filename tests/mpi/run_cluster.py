@@ -32,7 +32,12 @@ with COHORT_MPI_JOBS_AHEAD=0 nothing is adopted), early_announce (rank 0 writes 
 longer than a node's band: announced after that work, COHORT_EARLY_ANNOUNCE=0, bands come back before the
 next frame is announced (5-9 of 11 here); announced at hand-out, none does; every frame matches), link (`cohort bench devices` with mpi:1 behind an emulated
 link, COHORT_MPI_LINK=0.1gbit,20ms on every rank: the band's round trip holds the link's latency both ways and
-its bytes at the link's rate).
+its bytes at the link's rate), match_rgb9e5 (match with the rows as RGB9E5, 4 bytes a pixel: the
+dither is a hash of pixel and frame, so the nodes' rows equal the single-process render's, and the nodes log
+4 bytes a pixel), play_early_announce (`cohort play` under a virtual display with mpi:1 and mpi:2 alone, the
+window 320x180 in albedo mode: announced at hand-out (the default) at most 2 bands of both nodes come back
+before the next frame is announced, and its jobs ahead leave sooner after their band's job than with
+COHORT_EARLY_ANNOUNCE=0, where play announces a frame only when it pushes it).
 """
 import argparse
 import json
@@ -403,6 +408,52 @@ def early_announce(a):
     print("early_announce: ok")
 
 
+def play_early_announce(a):
+    """`cohort play` with mpi:1 and mpi:2 alone, both ways of announcing. Play's own frame work (blend,
+    tone map, the window's present under Xvfb) comes between a frame's hand-out and the next push; announced
+    at hand-out, the next job goes ahead before it (as `cohort render`'s, early_announce above)."""
+    if not shutil.which("xvfb-run"):
+        print("SKIP: xvfb-run is not installed")
+        sys.exit(77)
+    if a.viewer_built.upper() not in ("ON", "1", "TRUE", "YES"):
+        print("SKIP: cohort was built without the viewer (COHORT_WITH_VIEWER=OFF)")
+        sys.exit(77)
+    os.makedirs(a.out)
+    testmap = os.path.join(a.testmap_base, "maps", "testmap.map")
+    flags = mpiexec_flags(a.mpiexec)
+    frames = 24
+    pattern = (r"mpi:{}: a job ahead left ([\d.]+) ms a band after its band's job .*?; (\d+) band\(s\) came back "
+               r"before the next frame was announced")
+    left_ms = {}
+    for early in ("1", "0"):
+        shot = os.path.join(a.out, f"play_{early}.png")
+        env = dict(os.environ, COHORT_EARLY_ANNOUNCE=early)
+        flags_env = flags + ["-x", "COHORT_EARLY_ANNOUNCE"] if flags else flags
+        _, output = run([a.mpiexec] + flags_env + ["-np", "1", "xvfb-run", "-a", "-s", "-screen 0 1024x768x24", a.cohort,
+                                                   "play", testmap, "--tracers", "mpi:1,mpi:2", "--frames", str(frames),
+                                                   "--width", "320", "--height", "180", "--scale", "1", "--mode", "albedo",
+                                                   "--screenshot", shot] +
+                        [":"] + flags + ["-np", "2", a.cohort, "node", testmap, "--tracers", "embree"], env=env)
+        back_total, left = 0, []
+        for rank in (1, 2):
+            found = re.search(pattern.format(rank), output)
+            if not found:
+                sys.exit(f"announced at hand-out {early}: mpi:{rank}: no line on when its jobs ahead left")
+            left.append(float(found.group(1)))
+            back_total += int(found.group(2))
+            print(f"announced at hand-out {early}, mpi:{rank}: a job ahead left {found.group(1)} ms after its band's "
+                  f"job; {found.group(2)} band(s) back before the next frame was announced")
+        left_ms[early] = max(left)
+        if early == "1" and back_total > 2:
+            sys.exit(f"{back_total} band(s) came back before the next frame was announced at hand-out")
+        run([sys.executable, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "apps",
+                                          "image_not_uniform.py"), shot])
+    if left_ms["1"] >= left_ms["0"]:
+        sys.exit(f"announced at hand-out, the jobs ahead left {left_ms['1']} ms after their band's job, no sooner "
+                 f"than when play announced a frame at its push ({left_ms['0']} ms)")
+    print("play_early_announce: ok")
+
+
 def link(a):
     """`cohort bench devices` with mpi:1 alone, every rank's sends through an emulated link of 0.1 Gbit/s and
     20 ms one way (COHORT_MPI_LINK): each band's round trip holds the job's way there and the rows' way
@@ -441,7 +492,7 @@ def main():
     parser = argparse.ArgumentParser()
     parser.add_argument("case", choices=["match", "mixed", "stall", "killed", "version", "load_error", "bench", "protocol", "replay",
                                            "play", "link", "bad_piece", "ahead", "ahead_recovery", "jobs_ahead",
-                                           "early_announce"])
+                                           "early_announce", "match_rgb9e5", "play_early_announce"])
     parser.add_argument("--mpiexec", required=True)
     parser.add_argument("--cohort", required=True)
     parser.add_argument("--map", required=True)
@@ -477,6 +528,9 @@ def main():
     if a.case == "early_announce":
         early_announce(a)
         return
+    if a.case == "play_early_announce":
+        play_early_announce(a)
+        return
     if a.case == "bad_piece":
         bad_piece(a)
         return
@@ -487,7 +541,8 @@ def main():
         print("protocol: ok")
         return
     single, cluster = os.path.join(a.out, "single"), os.path.join(a.out, "cluster")
-    run([a.cohort, "render", a.map, "--tracers", "embree", "--out", single] + RENDER_ARGS)
+    render_args = RENDER_ARGS + (["--band-format", "rgb9e5"] if a.case == "match_rgb9e5" else [])
+    run([a.cohort, "render", a.map, "--tracers", "embree", "--out", single] + render_args)
 
     env = dict(os.environ)
     node1 = [a.cohort, "node", a.map, "--tracers", "embree"]
@@ -501,17 +556,21 @@ def main():
         node1 = [a.cohort, "node", a.broken_map, "--tracers", "embree"]
     flags = mpiexec_flags(a.mpiexec)
     command = ([a.mpiexec] + flags + ["-np", "1", a.cohort, "render", a.map, "--tracers", "embree,mpi:1,mpi:2",
-                                      "--out", cluster] + RENDER_ARGS +
+                                      "--out", cluster] + render_args +
                [":"] + flags + ["-np", "1"] + node1 + [":"] + flags + ["-np", "1"] + node2)
-    code, output = run(command, env=env, expect_ok=a.case in ("match", "mixed"))
+    code, output = run(command, env=env, expect_ok=a.case in ("match", "mixed", "match_rgb9e5"))
     compare_frames(single, cluster, tolerant=a.case == "mixed")
     outcomes = tracer_outcomes(cluster)
     print("outcomes per frame:", outcomes)
 
-    if a.case in ("match", "mixed"):
+    if a.case in ("match", "mixed", "match_rgb9e5"):
         for f, o in enumerate(outcomes):
             if o.get("mpi:1") != "rendered" or o.get("mpi:2") != "rendered":
                 sys.exit(f"frame {f}: a remote tracer did not render its band: {o}")
+    if a.case == "match_rgb9e5":
+        for rank in (1, 2):
+            if not re.search(rf"node {rank}: shutdown .* KiB of colour rows a band as rgb9e5 \(4 bytes a pixel\)", output):
+                sys.exit(f"node {rank} did not log its rows as RGB9E5, 4 bytes a pixel")
     elif a.case == "version":
         if not re.search(r"rank 0 runs Cohort \S+ .*rank 1 .* runs Cohort 0\.0\.0-test", output):
             sys.exit("rank 0 did not name both versions")

@@ -259,6 +259,7 @@ TEST(WireCodec, PiecesCoverTheBandInOrderAndTheirTagsNameJobPieceAndPlane) {
   }
   EXPECT_EQ(wire::band_pieces(0, 4), 1u) << "an empty band still closes with one (empty) piece";
   EXPECT_EQ(wire::piece_bytes(3, 8, core::BandFormat::rgb16f, wire::Plane::colour), 3u * 8u * 6u);
+  EXPECT_EQ(wire::piece_bytes(3, 8, core::BandFormat::rgb9e5, wire::Plane::colour), 3u * 8u * 4u);
   EXPECT_EQ(wire::piece_bytes(3, 8, core::BandFormat::rgba32f, wire::Plane::aux), 3u * 8u * sizeof(KAuxTexel));
 
   std::vector<bool> used(32768, false);
@@ -304,6 +305,9 @@ TEST(WireCodec, BandJobsOutsideTheFrameAreRefused) {
             std::string::npos);
   request.pieces = 4;
   EXPECT_EQ(back.format, core::BandFormat::rgb16f);
+  request.format = core::BandFormat::rgb9e5;
+  EXPECT_EQ(wire::decode_band_request(wire::encode_band_request(request)).format, core::BandFormat::rgb9e5);
+  request.format = core::BandFormat::rgb16f;
   request.job.params.row_end = 49;
   EXPECT_NE(refusal([&] { wire::decode_band_request(wire::encode_band_request(request)); }).find("do not fit"),
             std::string::npos);

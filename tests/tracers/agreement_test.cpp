@@ -5,6 +5,7 @@
 // it, so the bound would catch a tracer drawing different samples or shading differently).
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdlib>
 #include <iostream>
@@ -248,6 +249,52 @@ TEST(AgreementBandFormat, HalfFloatBandsEqualFloatBands) {
           ASSERT_NEAR(v, f, 1e-3f * std::fabs(f) + 1e-6f) << kind << " pixel " << x << "," << y;
           lit += f;
         }
+    EXPECT_GT(lit, 0.0) << kind << " rendered a black band";
+    ++checked;
+  }
+  EXPECT_GT(checked, 0);
+}
+
+// A band in RGB9E5 (kernel/band_pack.h) is, word for word, the host's packing of the same tracer's float
+// band with the same dither (pixel and frame): every producer (CUDA and OpenCL kernels, the host for
+// Embree) packs alike, and the band is within one step (under 1/255.5 of the pixel's brightest channel) of the floats.
+TEST(AgreementBandFormat, Rgb9e5BandsArePackedAlikeByEveryTracer) {
+  const int w = 48, h = 32;
+  const KCamera cam = test_room_camera(w, h);
+  auto room = std::make_shared<commit::TracerScene>(core::compile_scene(test_room()).tracer_scene);
+  int checked = 0;
+  for (const std::string& kind : built_tracers()) {
+    if (!tracer_runs_here(kind)) continue;
+    auto tracer = make_test_tracer(kind);
+    tracer->apply(commit::CommitBuffer::full(room, 1));
+    core::BandJob job;
+    job.params = frame_params(K_MODE_PATH, 2, 1, h);
+    job.params.row_begin = 8;  // a band that does not start at row 0: the dither counts pixels from the frame's
+    job.params.frame_index = 37;
+    job.camera = cam;
+    core::BandBuffer floats(w, h, core::BandFormat::rgba32f), packed(w, h, core::BandFormat::rgb9e5);
+    tracer->render_band(job, floats);
+    tracer->render_band(job, packed);
+    const size_t band_pixels = size_t(w) * size_t(h - 8);
+    std::vector<uint32_t> want(band_pixels);
+    core::rgba32f_to_rgb9e5(static_cast<const float*>(floats.row(8)), want.data(), band_pixels, 8u * w, 37u);
+    const uint32_t* got = static_cast<const uint32_t*>(packed.row(8));
+    size_t differ = 0;
+    for (size_t p = 0; p < band_pixels; ++p) differ += got[p] != want[p];
+    EXPECT_EQ(differ, 0u) << kind << ": words that differ from the host's packing of its float band";
+    core::FrameBuffer back;
+    back.resize(w, h);
+    packed.copy_rows_to(back, 8, h);
+    double lit = 0.0;
+    for (int y = 8; y < h; ++y)
+      for (int x = 0; x < w; ++x) {
+        const float* f = static_cast<const float*>(floats.row(y)) + 4 * x;
+        const float top = std::max({f[0], f[1], f[2]});
+        for (int k = 0; k < 3; ++k) {
+          ASSERT_NEAR(back.row(y)[4 * x + k], f[k], top / 255.5f + 1e-6f) << kind << " pixel " << x << "," << y;
+          lit += f[k];
+        }
+      }
     EXPECT_GT(lit, 0.0) << kind << " rendered a black band";
     ++checked;
   }

@@ -135,7 +135,7 @@ TEST(AuxOutputs, SplitBandsWriteTheWholeFramesPlanesAndTheSameColours) {
       job.previous_camera = prev;
       tracer->render_band(job, band);
     };
-    for (core::BandFormat format : {core::BandFormat::rgb16f, core::BandFormat::rgba32f}) {
+    for (core::BandFormat format : {core::BandFormat::rgb16f, core::BandFormat::rgb9e5, core::BandFormat::rgba32f}) {
       core::BandBuffer whole(w, h, format), parts(w, h, format), plain(w, h, format);
       whole.enable_aux(true);
       parts.enable_aux(true);

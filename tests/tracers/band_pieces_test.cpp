@@ -33,12 +33,12 @@ bool same_rows(const core::BandBuffer& a, const core::BandBuffer& b, int begin, 
   return true;
 }
 
-// Renders the band whole and in pieces on `kind`; the checks above, for both band formats.
+// Renders the band whole and in pieces on `kind`; the checks above, for every band format.
 void check_pieces(const std::string& kind) {
   auto tracer = make_test_tracer(kind);
   auto compiled = std::make_shared<commit::TracerScene>(core::compile_scene(test_room()).tracer_scene);
   tracer->apply(commit::CommitBuffer::full(compiled, 1));
-  for (core::BandFormat format : {core::BandFormat::rgb16f, core::BandFormat::rgba32f}) {
+  for (core::BandFormat format : {core::BandFormat::rgb16f, core::BandFormat::rgb9e5, core::BandFormat::rgba32f}) {
     core::BandBuffer whole(kWidth, kHeight, format), pieces(kWidth, kHeight, format), untouched(kWidth, kHeight, format);
     const core::BandResult expected = tracer->render_band(band_job(), whole);
     const std::vector<int> cuts = {kBegin, kBegin + 7, kBegin + 7, kBegin + 20, kEnd};  // one piece empty

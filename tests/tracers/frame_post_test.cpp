@@ -255,17 +255,20 @@ TEST(FramePost, CudaReconstructsSparseFramesAsTheHost) {
   }
 }
 
+namespace {
+
 // The Renderer's packed merge (bands copied as the tracers wrote them) holds exactly what the float merge
-// makes, and every place's post-processing gives the same picture from it.
-TEST(FramePost, PackedMergeUnpacksToTheFloatMergeEverywhere) {
+// makes, and every place's post-processing gives the same picture from it, bands in `format`.
+void check_packed_merge(core::BandFormat format) {
   using namespace cohort::test;
+  SCOPED_TRACE(core::to_string(format));
   auto room = std::make_shared<commit::TracerScene>(core::compile_scene(test_room()).tracer_scene);
   std::vector<std::unique_ptr<core::Tracer>> list;
   list.push_back(make_test_tracer("embree"));
   list.push_back(make_test_tracer("embree"));
   core::RendererOptions options;
   options.balancer = "none";
-  options.band_format = core::BandFormat::rgb16f;
+  options.band_format = format;
   core::Renderer renderer(std::move(list), options);
   renderer.submit_commit(commit::CommitBuffer::full(room, 1));
   const int w = 48, h = 32;
@@ -323,11 +326,17 @@ TEST(FramePost, PackedMergeUnpacksToTheFloatMergeEverywhere) {
   }
 }
 
+}  // namespace
+
+TEST(FramePost, PackedMergeUnpacksToTheFloatMergeEverywhere) {
+  for (core::BandFormat format : {core::BandFormat::rgb16f, core::BandFormat::rgb9e5}) check_packed_merge(format);
+}
+
 namespace {
 
-// cuda:0, Embree and cuda:1 where there is one, the rows split evenly, bands as RGB halves, the test room
+// cuda:0, Embree and cuda:1 where there is one, the rows split evenly, bands in `format`, the test room
 // committed.
-std::unique_ptr<core::Renderer> gpu_room_renderer(int gpus) {
+std::unique_ptr<core::Renderer> gpu_room_renderer(int gpus, core::BandFormat format = core::BandFormat::rgb16f) {
   using namespace cohort::test;
   auto room = std::make_shared<commit::TracerScene>(core::compile_scene(test_room()).tracer_scene);
   std::vector<std::unique_ptr<core::Tracer>> list;
@@ -336,7 +345,7 @@ std::unique_ptr<core::Renderer> gpu_room_renderer(int gpus) {
   if (gpus > 1) list.push_back(make_test_tracer("cuda:1"));
   core::RendererOptions options;
   options.balancer = "none";
-  options.band_format = core::BandFormat::rgb16f;
+  options.band_format = format;
   auto renderer = std::make_unique<core::Renderer>(std::move(list), options);
   renderer->submit_commit(commit::CommitBuffer::full(room, 1));
   return renderer;
@@ -354,31 +363,34 @@ TEST(FramePost, CudaBandsStayingOnTheGpusGiveTheHostRoundTripsPicture) {
   const int w = 64, h = 48;
   core::BandJob job = aux_room_job(w, h);
   const size_t cuda_bands = gpus > 1 ? 2 : 1;
-  std::vector<core::FrameBuffer> shown[2];
-  for (int on_device = 0; on_device < 2; ++on_device) {
-    std::unique_ptr<core::Renderer> room_renderer = gpu_room_renderer(gpus);
-    core::Renderer& renderer = *room_renderer;
-    std::unique_ptr<core::FramePost> post = tracers::make_frame_post("cuda:0", both());
-    ASSERT_EQ(post->cuda_device(), 0);
-    renderer.set_packed_merge(true);
-    if (on_device) renderer.set_device_bands(post->cuda_device());
-    core::FrameBuffer untouched;
-    for (int f = 0; f < 3; ++f) {
-      job.params.frame_index = static_cast<kuint>(f + 1);
-      renderer.render(job, untouched);
-      const std::vector<core::DeviceBandRows>& rows = renderer.packed_device_rows();
-      EXPECT_EQ(rows.size(), on_device ? cuda_bands : 0u) << "every CUDA band, and only those";
-      for (const core::DeviceBandRows& r : rows) EXPECT_LT(r.row_begin, r.row_end);
-      post->process_packed(renderer.packed_frame(), rows, core::kEveryPixel);
-      shown[on_device].push_back(post->image());
+  for (core::BandFormat format : {core::BandFormat::rgb16f, core::BandFormat::rgb9e5}) {
+    SCOPED_TRACE(core::to_string(format));
+    std::vector<core::FrameBuffer> shown[2];
+    for (int on_device = 0; on_device < 2; ++on_device) {
+      std::unique_ptr<core::Renderer> room_renderer = gpu_room_renderer(gpus, format);
+      core::Renderer& renderer = *room_renderer;
+      std::unique_ptr<core::FramePost> post = tracers::make_frame_post("cuda:0", both());
+      ASSERT_EQ(post->cuda_device(), 0);
+      renderer.set_packed_merge(true);
+      if (on_device) renderer.set_device_bands(post->cuda_device());
+      core::FrameBuffer untouched;
+      for (int f = 0; f < 3; ++f) {
+        job.params.frame_index = static_cast<kuint>(f + 1);
+        renderer.render(job, untouched);
+        const std::vector<core::DeviceBandRows>& rows = renderer.packed_device_rows();
+        EXPECT_EQ(rows.size(), on_device ? cuda_bands : 0u) << "every CUDA band, and only those";
+        for (const core::DeviceBandRows& r : rows) EXPECT_LT(r.row_begin, r.row_end);
+        post->process_packed(renderer.packed_frame(), rows, core::kEveryPixel);
+        shown[on_device].push_back(post->image());
+      }
+      core::HostFramePost host(both());
+      if (on_device) {
+        EXPECT_THROW(host.process_packed(renderer.packed_frame(), renderer.packed_device_rows(), core::kEveryPixel), std::invalid_argument);
+      }
     }
-    core::HostFramePost host(both());
-    if (on_device) {
-      EXPECT_THROW(host.process_packed(renderer.packed_frame(), renderer.packed_device_rows(), core::kEveryPixel), std::invalid_argument);
-    }
+    for (size_t f = 0; f < shown[0].size(); ++f)
+      EXPECT_EQ(shown[1][f].rgba, shown[0][f].rgba) << "frame " << f;
   }
-  for (size_t f = 0; f < shown[0].size(); ++f)
-    EXPECT_EQ(shown[1][f].rgba, shown[0][f].rgba) << "frame " << f;
 }
 
 // Brigade's blend as a step of the post (FramePostOptions::blend): the host's gives AdaptiveConvergence's

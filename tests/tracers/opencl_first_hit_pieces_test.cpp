@@ -133,8 +133,8 @@ TEST(OpenCLFirstHitPieces, PiecedBandsEqualTheBandInOnePiece) {
     auto pieced = opencl_in_pieces(4, aux_into_target);
     pieced->apply(commit::CommitBuffer::full(room, 1));
     for (const Band& band : kBands)
-      for (core::BandFormat format : {core::BandFormat::rgb16f, core::BandFormat::rgba32f}) {
-        SCOPED_TRACE(std::string(band.what) + (format == core::BandFormat::rgb16f ? ", half floats" : ", floats") +
+      for (core::BandFormat format : {core::BandFormat::rgb16f, core::BandFormat::rgb9e5, core::BandFormat::rgba32f}) {
+        SCOPED_TRACE(std::string(band.what) + ", " + core::to_string(format) +
                      (aux_into_target ? ", aux read into the target" : ", aux through page-locked staging"));
         const Rendered a = render_band(*whole, band, format);
         const Rendered b = render_band(*pieced, band, format);

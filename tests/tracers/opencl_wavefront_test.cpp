@@ -289,8 +289,8 @@ TEST(OpenCLBandClock, ReportsItsKernelsAndItsWayBack) {
   for (const Variant& v : {kMegakernel, kWavefront}) {
     auto tracer = opencl(v);
     tracer->apply(commit::CommitBuffer::full(view.scene, 1));
-    for (const core::BandFormat format : {core::BandFormat::rgb16f, core::BandFormat::rgba32f}) {
-      SCOPED_TRACE(std::string(v.name) + (format == core::BandFormat::rgb16f ? ", half floats" : ", floats"));
+    for (const core::BandFormat format : {core::BandFormat::rgb16f, core::BandFormat::rgb9e5, core::BandFormat::rgba32f}) {
+      SCOPED_TRACE(std::string(v.name) + ", " + core::to_string(format));
       core::BandBuffer target(w, h, format);
       core::BandJob job;
       job.params = frame_params(K_MODE_PATH, 1, 1, h);

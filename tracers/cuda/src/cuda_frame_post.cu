@@ -9,6 +9,7 @@
 #include <cuda_runtime.h>
 
 #include "cohort/kernel/atrous.h"
+#include "cohort/kernel/band_pack.h"
 #include "cohort/kernel/brigade_blend.h"
 #include "cohort/kernel/reproject.h"
 #include "cohort/kernel/svgf.h"
@@ -46,18 +47,23 @@ __global__ void reproject_kernel(KReprojectParams params, KReprojectFresh fresh,
   if ((threadIdx.x & 31) == 0) atomicAdd(length_sum, static_cast<double>(length));
 }
 
-// The Renderer's packed merge unpacked on the device: the colour from RGB halves (or RGBA floats) and the
+// The Renderer's packed merge unpacked on the device: the colour from RGB halves, RGB9E5 words or RGBA floats
+// (colour_format: 1, 2, 0) and the
 // aux texels (core/band_buffer.h, kernel/layout.h's KAuxTexel) into the float planes the passes read; with
 // `ycocgw` and `geometry` (either may be null) also the reprojection's and the a-trous filter's own planes,
 // while the pixel is at hand, instead of two more passes over the frame.
-__global__ void unpack_kernel(const unsigned char* colour, int half_colour, const KAuxTexel* texels, float* rgba,
+__global__ void unpack_kernel(const unsigned char* colour, int colour_format, const KAuxTexel* texels, float* rgba,
                               float* depth, float* prev_depth, float* motion, float* normal, float* albedo, kuint* id,
                               float* ycocgw, float* geometry, int pixels) {
   const int p = blockIdx.x * blockDim.x + threadIdx.x;
   if (p >= pixels) return;
-  if (half_colour) {
+  if (colour_format == 1) {
     const unsigned short* c = reinterpret_cast<const unsigned short*>(colour) + 3 * size_t(p);
     for (int k = 0; k < 3; ++k) rgba[4 * p + k] = __half2float(__ushort_as_half(c[k]));
+    rgba[4 * p + 3] = 1.0f;
+  } else if (colour_format == 2) {
+    const kuint packed = reinterpret_cast<const kuint*>(colour)[p];
+    for (kuint k = 0; k < 3; ++k) rgba[4 * p + k] = k_rgb9e5_channel(packed, k);
     rgba[4 * p + 3] = 1.0f;
   } else {
     reinterpret_cast<float4*>(rgba)[p] = reinterpret_cast<const float4*>(colour)[p];
@@ -267,7 +273,7 @@ class CudaFramePost final : public core::FramePost {
     float* ycocgw = options_.reproject && !traced.sparse() && aux ? ycocgw_.scratch(4 * pixels) : nullptr;
     float* geometry = options_.atrous && aux ? geometry_.scratch(4 * pixels) : nullptr;
     unpack_kernel<<<blocks_for(pixels), kThreads, 0, stream_>>>(
-        colour, packed.format() == core::BandFormat::rgb16f ? 1 : 0, texels, frame_.scratch(4 * pixels),
+        colour, packed.format() == core::BandFormat::rgb16f ? 1 : packed.format() == core::BandFormat::rgb9e5 ? 2 : 0, texels, frame_.scratch(4 * pixels),
         depth_.scratch(pixels), prev_depth_.scratch(pixels), motion_.scratch(2 * pixels), normal_.scratch(3 * pixels),
         albedo_.scratch(3 * pixels), id_.scratch(pixels), ycocgw, geometry, static_cast<int>(pixels));
     COHORT_CUDA(cudaGetLastError());

@@ -80,7 +80,7 @@ struct CudaTracer::Impl {
   DeviceArray<KAuxTexel> aux_texels;
   DeviceArray<KPathFirstHit> first_hits;  // K_AUX_PATH_FIRST_HIT: the band's paths' records
   float4* band = nullptr;
-  unsigned short* band_rgb16f = nullptr;   // the band as RGB halves, for RGB16F targets
+  unsigned char* band_packed = nullptr;   // the band as RGB halves or RGB9E5 words, for packed targets
   bool count_rays = false;
   // The bounce rays' wavefront (render_band.cu) instead of the megakernel, unless COHORT_CUDA_WAVEFRONT=0.
   bool wavefront = enabled_unless_zero("COHORT_CUDA_WAVEFRONT");
@@ -137,17 +137,25 @@ struct CudaTracer::Impl {
   KeptBand kept[2];
   int next_kept = 0;
 
-  // Device storage for a band of `pixels` in `rows` (the float band, its RGB halves for an RGB16F target,
-  // the per-row ray counts), grown as bands grow, and the band's ray counters cleared on the stream.
-  void prepare_band(size_t pixels, size_t rows, bool half) {
+  // Converts `pixels` of the float band, from frame pixel `first_pixel` on, to the packed `format` on the
+  // stream.
+  void pack_band(core::BandFormat format, const float4* from, void* to, size_t pixels, size_t first_pixel, kuint frame) {
+    if (format == core::BandFormat::rgb16f) launch_band_to_rgb16f(from, static_cast<unsigned short*>(to), pixels, stream);
+    else launch_band_to_rgb9e5(from, static_cast<unsigned*>(to), pixels, unsigned(first_pixel), frame, stream);
+  }
+  // Device storage for a band of `pixels` in `rows` (the float band, its packed copy for an RGB16F or
+  // RGB9E5 target, the per-row ray counts), grown as bands grow, and the band's ray counters cleared on
+  // the stream.
+  void prepare_band(size_t pixels, size_t rows, bool packed) {
     if (pixels > band_capacity) {
       if (band) COHORT_CUDA(cudaFree(band));
-      if (band_rgb16f) COHORT_CUDA(cudaFree(band_rgb16f));
-      band_rgb16f = nullptr;
+      if (band_packed) COHORT_CUDA(cudaFree(band_packed));
+      band_packed = nullptr;
       COHORT_CUDA(cudaMalloc(&band, pixels * sizeof(float4)));
       band_capacity = pixels;
     }
-    if (half && !band_rgb16f) COHORT_CUDA(cudaMalloc(&band_rgb16f, band_capacity * 3 * sizeof(unsigned short)));
+    // Room for the larger packed format (6 bytes a pixel), so a change of format needs no reallocation.
+    if (packed && !band_packed) COHORT_CUDA(cudaMalloc(&band_packed, band_capacity * core::bytes_per_pixel(core::BandFormat::rgb16f)));
     if (rows > row_rays_capacity) {
       if (row_rays) COHORT_CUDA(cudaFree(row_rays));
       COHORT_CUDA(cudaMalloc(&row_rays, rows * sizeof(unsigned)));
@@ -247,7 +255,7 @@ CudaTracer::~CudaTracer() {
   cudaSetDevice(impl_->device);
   if (impl_->texel_texture) cudaDestroyTextureObject(impl_->texel_texture);
   if (impl_->band) cudaFree(impl_->band);
-  if (impl_->band_rgb16f) cudaFree(impl_->band_rgb16f);
+  if (impl_->band_packed) cudaFree(impl_->band_packed);
   if (impl_->ray_counts) cudaFree(impl_->ray_counts);
   if (impl_->row_rays) cudaFree(impl_->row_rays);
   if (impl_->start) cudaEventDestroy(impl_->start);
@@ -344,9 +352,9 @@ core::BandResult CudaTracer::render_band(const core::BandJob& job, core::BandBuf
   if (camera.width != kuint(target.width()) || params.row_end > kuint(target.height()))
     throw std::invalid_argument(m.name + ": band does not fit the frame buffer");
   const size_t pixels = size_t(camera.width) * (params.row_end - params.row_begin);
-  const bool half = target.format() == core::BandFormat::rgb16f;
+  const bool packed = target.format() != core::BandFormat::rgba32f;
   const size_t rows = params.row_end - params.row_begin;
-  m.prepare_band(pixels, rows, half);
+  m.prepare_band(pixels, rows, packed);
   // Kept on the GPU, the band skips both copies: nothing goes down, and the post-processing takes it
   // device to device (or over NVLink from a peer).
   Impl::KeptBand* kept = job.keep_on_device >= 0 ? &m.kept[m.next_kept] : nullptr;
@@ -394,10 +402,10 @@ core::BandResult CudaTracer::render_band(const core::BandJob& job, core::BandBuf
   // The band's rows are contiguous in the target: one copy straight into place, in its format.
   const size_t colour_bytes = pixels * core::bytes_per_pixel(target.format());
   const void* source = m.band;
-  if (half) {
-    unsigned short* rgb = kept ? reinterpret_cast<unsigned short*>(kept->colour.scratch(colour_bytes)) : m.band_rgb16f;
-    launch_band_to_rgb16f(m.band, rgb, pixels, m.stream);
-    source = rgb;
+  if (packed) {
+    void* to = kept ? static_cast<void*>(kept->colour.scratch(colour_bytes)) : m.band_packed;
+    m.pack_band(target.format(), m.band, to, pixels, size_t(params.row_begin) * camera.width, params.frame_index);
+    source = to;
   } else if (kept) {
     COHORT_CUDA(cudaMemcpyAsync(kept->colour.scratch(colour_bytes), m.band, colour_bytes, cudaMemcpyDeviceToDevice, m.stream));
     source = kept->colour.data();
@@ -428,8 +436,8 @@ core::BandResult CudaTracer::render_band_in_pieces(const core::BandJob& job, cor
   const size_t width = camera.width;
   const size_t rows = params.row_end - params.row_begin;
   const size_t pixels = width * rows;
-  const bool half = target.format() == core::BandFormat::rgb16f;
-  m.prepare_band(pixels, rows, half);
+  const bool packed = target.format() != core::BandFormat::rgba32f;
+  m.prepare_band(pixels, rows, packed);
   const size_t pieces = cuts.size() - 1;
   while (m.piece_rendered.size() < pieces) {
     cudaEvent_t rendered = nullptr, downloaded = nullptr;
@@ -456,10 +464,10 @@ core::BandResult CudaTracer::render_band_in_pieces(const core::BandJob& job, cor
       launch_render_band(m.view(piece), piece, camera, band, m.count_rays ? m.ray_counts : nullptr,
                          m.row_rays + first_row, nullptr, wave, m.stream);
     const void* source = band;
-    if (half) {
-      unsigned short* rgb = m.band_rgb16f + first_row * width * 3;
-      if (piece_pixels > 0) launch_band_to_rgb16f(band, rgb, piece_pixels, m.stream);
-      source = rgb;
+    if (packed) {
+      void* to = m.band_packed + first_row * width * pixel_bytes;
+      if (piece_pixels > 0) m.pack_band(target.format(), band, to, piece_pixels, size_t(cuts[i]) * width, params.frame_index);
+      source = to;
     }
     COHORT_CUDA(cudaEventRecord(m.piece_rendered[i], m.stream));
     COHORT_CUDA(cudaStreamWaitEvent(m.aux_copy_stream, m.piece_rendered[i], 0));

@@ -78,5 +78,9 @@ void launch_aux_from_first_hits(const KSceneView& scene, const KFrameParams& par
                                 const KPathFirstHit* first_hits, KAuxTexel* band_aux, cudaStream_t stream);
 // Converts a rendered band (float4 per pixel) to RGB halves (3 x 16 bits per pixel) on the stream.
 void launch_band_to_rgb16f(const float4* band, unsigned short* rgb, size_t pixels, cudaStream_t stream);
+// Converts it to RGB9E5 words (kernel/band_pack.h), dithered by pixel (first_pixel + i over the whole
+// frame) and frame.
+void launch_band_to_rgb9e5(const float4* band, unsigned* packed, size_t pixels, unsigned first_pixel, unsigned frame,
+                           cudaStream_t stream);
 
 }  // namespace cohort::tracers

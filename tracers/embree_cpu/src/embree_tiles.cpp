@@ -105,7 +105,7 @@ void store_rows(const Frame& frame, const Tile& tile, Arena& a, embree_kernel::T
         a.rgba[4 * x + 2] = c.z;
         a.rgba[4 * x + 3] = 1.0f;
       }
-      frame.target->store(y, tile.x0, a.rgba, static_cast<size_t>(w));
+      frame.target->store(y, tile.x0, a.rgba, static_cast<size_t>(w), frame.params.frame_index);
     }
   if (frame.write_aux && frame.target) write_aux(frame, tile, a, ctx, row_rays);
 }

@@ -88,8 +88,10 @@ class Node {
         case wire::Kind::full_local: timed_commit(mpi, [&] { apply_full_local(m); }); break;
         case wire::Kind::band_job: render(mpi, m); break;
         case wire::Kind::shutdown:
-          spdlog::info("node {}: shutdown from rank 0 after {} band(s), {} of them on rows rendered ahead", mpi.rank(),
-                       bands_, adopted_);
+          spdlog::info("node {}: shutdown from rank 0 after {} band(s), {} of them on rows rendered ahead; {:.1f} KiB "
+                       "of colour rows a band as {} ({} bytes a pixel)", mpi.rank(), bands_, adopted_,
+                       bands_ > 0 ? double(colour_bytes_sent_) / 1024.0 / double(bands_) : 0.0,
+                       core::to_string(last_format_), core::bytes_per_pixel(last_format_));
           mpi.flush_sends(kRank0, MpiClock::now() + std::chrono::seconds(2));
           return 0;
         default:
@@ -400,6 +402,8 @@ class Node {
         }
         mpi.send_in_place(kRank0, wire::piece_tag(sequence, uint32_t(i), wire::Plane::colour),
                           target.row(int(pieces[i].begin)), colour_bytes, group);
+        colour_bytes_sent_ += colour_bytes;
+        last_format_ = request.format;
         if (request.aux)
           mpi.send_in_place(kRank0, wire::piece_tag(sequence, uint32_t(i), wire::Plane::aux),
                             target.aux_row(int(pieces[i].begin)),
@@ -577,6 +581,9 @@ class Node {
   double commit_ms_ = 0.0;        // applying commits since the last band, with the next job waiting
   double commit_ahead_ms_ = 0.0;  // applying commits since the last band, before the next job came
   uint64_t bands_ = 0;
+  // The rows' bytes sent (colour in the format rank 0 asked for, which says how many a pixel), for the log.
+  uint64_t colour_bytes_sent_ = 0;
+  core::BandFormat last_format_ = core::BandFormat::rgb16f;
 };
 
 }  // namespace

@@ -80,6 +80,7 @@ class Reader : public core::ByteReader<Reader> {
 core::BandFormat band_format_of(uint32_t value, Reader& r) {
   if (value == uint32_t(core::BandFormat::rgb16f)) return core::BandFormat::rgb16f;
   if (value == uint32_t(core::BandFormat::rgba32f)) return core::BandFormat::rgba32f;
+  if (value == uint32_t(core::BandFormat::rgb9e5)) return core::BandFormat::rgb9e5;
   r.fail(fmt::format("unknown band format {}", value));
 }
 

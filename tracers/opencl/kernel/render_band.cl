@@ -3,6 +3,7 @@
 #include "cohort/kernel/trace_bvh.h"
 #include "cohort/kernel/integrator.h"
 #include "cohort/kernel/aux_outputs.h"
+#include "cohort/kernel/band_pack.h"
 
 #include "band_params.cl"
 
@@ -106,6 +107,16 @@ __kernel void cohort_band_to_rgb16f(__global const float* band, __global half* r
   vstore_half_rte(band[4 * p + 0], 3 * p + 0, rgb);
   vstore_half_rte(band[4 * p + 1], 3 * p + 1, rgb);
   vstore_half_rte(band[4 * p + 2], 3 * p + 2, rgb);
+}
+
+/* Or as RGB9E5 words (BandFormat::rgb9e5, 4 bytes a pixel, kernel/band_pack.h), dithered by the pixel's
+ * place in the frame (band_first_pixel + p) and the frame, as every other producer dithers it. */
+__kernel void cohort_band_to_rgb9e5(__global const float* band, __global kuint* packed, kuint pixels,
+                                    kuint band_first_pixel, kuint frame) {
+  kuint p = (kuint)get_global_id(0);
+  if (p >= pixels) return;
+  packed[p] = k_rgb9e5_encode(band[4 * p + 0], band[4 * p + 1], band[4 * p + 2],
+                              k_rgb9e5_dither(band_first_pixel + p, frame));
 }
 
 __kernel void cohort_aux_to_texels(__global const KAux* aux, __global KAuxTexel* texels, kuint pixels) {

@@ -278,7 +278,7 @@ struct OpenCLTracer::Impl {
          aux = nullptr;
   size_t output_bytes = 0, row_rays_rows = 0, aux_bytes = 0;
   // The band and aux records as they cross the bus (converted on the device, read into the band buffer).
-  cl_kernel to_rgb16f = nullptr, to_texels = nullptr;
+  cl_kernel to_rgb16f = nullptr, to_rgb9e5 = nullptr, to_texels = nullptr;
   cl_mem packed = nullptr, packed_aux = nullptr;
   size_t packed_bytes = 0, packed_aux_bytes = 0;
   // K_AUX_PATH_FIRST_HIT: the band kernel that records its paths' first hits, and the records.
@@ -365,6 +365,15 @@ struct OpenCLTracer::Impl {
     const size_t local = 64, global = (pixels + local - 1) / local * local;
     check(clEnqueueNDRangeKernel(queue, k, 1, &first, &global, &local, 0, nullptr, done), what);
   }
+  // The float band's pixels [first, first + pixels) packed into `to` in `format` (RGB16F or RGB9E5, whose
+  // dither takes the pixel's place in the frame: the band starts at frame pixel `band_first_pixel`).
+  void pack_colour(core::BandFormat format, cl_mem to, size_t first, size_t pixels, size_t band_first_pixel, cl_uint frame) {
+    if (format == core::BandFormat::rgb16f) return pack(to_rgb16f, output, to, first, pixels, "converting the band to half floats");
+    const cl_uint band_first = static_cast<cl_uint>(band_first_pixel);
+    check(clSetKernelArg(to_rgb9e5, 3, sizeof band_first, &band_first), "setting the RGB9E5 band's first pixel");
+    check(clSetKernelArg(to_rgb9e5, 4, sizeof frame, &frame), "setting the RGB9E5 band's frame");
+    pack(to_rgb9e5, output, to, first, pixels, "converting the band to RGB9E5");
+  }
   // Once `read` is done, the aux planes of `rows` band rows from page-locked staging into the target from
   // `first_row` on: packed texels copied on the aux copy threads (`straight`), else full records
   // converted row by row.
@@ -395,7 +404,7 @@ struct OpenCLTracer::Impl {
     for (cl_mem m : {params, camera, previous_camera, output, row_rays, aux, packed, packed_aux, first_hits})
       if (m) clReleaseMemObject(m);
     for (cl_kernel k : {kernel, first_hits_kernel, aux_kernel, skin_positions, skin_faces_kernel, skin_normals, refit_leaves, refit_blas,
-                        to_rgb16f, to_texels})
+                        to_rgb16f, to_rgb9e5, to_texels})
       if (k) clReleaseKernel(k);
     if (program) clReleaseProgram(program);
     if (aux_queue) clReleaseCommandQueue(aux_queue);
@@ -503,6 +512,8 @@ OpenCLTracer::OpenCLTracer(const Options& options) : impl_(std::make_unique<Impl
   check(err, "clCreateKernel(aux)");
   impl_->to_rgb16f = clCreateKernel(impl_->program, "cohort_band_to_rgb16f", &err);
   check(err, "clCreateKernel(cohort_band_to_rgb16f)");
+  impl_->to_rgb9e5 = clCreateKernel(impl_->program, "cohort_band_to_rgb9e5", &err);
+  check(err, "clCreateKernel(cohort_band_to_rgb9e5)");
   impl_->to_texels = clCreateKernel(impl_->program, "cohort_aux_to_texels", &err);
   check(err, "clCreateKernel(cohort_aux_to_texels)");
   impl_->previous_camera = clCreateBuffer(impl_->context, CL_MEM_READ_ONLY, sizeof(KCamera), nullptr, &err);
@@ -664,10 +675,10 @@ core::BandResult OpenCLTracer::render_band(const core::BandJob& job, core::BandB
   cl_mem band_mem = m.output;
   if (!straight) {
     band.resize(pixels * 4);
-  } else if (target.format() == core::BandFormat::rgb16f) {
-    band_mem = m.grow(m.packed, m.packed_bytes, pixels * 6, "clCreateBuffer(half band)");
-    m.pack(m.to_rgb16f, m.output, band_mem, 0, pixels, "converting the band to half floats");
-    band_bytes = pixels * 6;
+  } else if (target.format() != core::BandFormat::rgba32f) {
+    band_bytes = pixels * core::bytes_per_pixel(target.format());
+    band_mem = m.grow(m.packed, m.packed_bytes, band_bytes, "clCreateBuffer(packed band)");
+    m.pack_colour(target.format(), band_mem, 0, pixels, size_t(params.row_begin) * camera.width, params.frame_index);
   }
   // Both kernels are on the device before any read is enqueued: a driver that copies into pageable
   // memory at enqueue time then still overlaps the aux read with the band's kernel.
@@ -684,14 +695,15 @@ core::BandResult OpenCLTracer::render_band(const core::BandJob& job, core::BandB
   if (write_aux) copy_aux_into(target, params, camera, rows, straight);
   check(clFinish(m.queue), "waiting for the band");
   for (size_t r = 0; r < rows && !straight; ++r)
-    target.store(static_cast<int>(params.row_begin + r), 0, band.data() + r * camera.width * 4, camera.width);
+    target.store(static_cast<int>(params.row_begin + r), 0, band.data() + r * camera.width * 4, camera.width,
+                 params.frame_index);
   // Device time from the first kernel (the aux one when it ran first, as the CUDA tracer times it) to the
   // band's last kernel.
   const cl_ulong start = (write_aux ? m.aux_kernel_done : band_started).time(CL_PROFILING_COMMAND_START);
   const cl_ulong end = band_done.time(CL_PROFILING_COMMAND_END);
   core::BandResult result;
   result.device_ms = end > start && start != 0 ? double(end - start) * 1e-6 : 0.0;
-  // The band's way back (the half-float packing, then the read), as the CUDA tracer reports it.
+  // The band's way back (the packing to RGB16F or RGB9E5, then the read), as the CUDA tracer reports it.
   const cl_ulong read_end = band_read.time(CL_PROFILING_COMMAND_END);
   if (result.device_ms > 0.0 && read_end > end) result.transfer_ms = double(read_end - end) * 1e-6;
   if (params.row_end == frame_params(job).row_end) result.row_work.assign(row_rays.begin(), row_rays.end());
@@ -713,9 +725,9 @@ core::BandResult OpenCLTracer::render_first_hits_in_pieces(const core::BandJob& 
   Event band_started;
   std::array<Event, kMaxFirstHitPieces> piece_ready, aux_read, colour_read;
   FinishQueues finish_queues{m.queue, m.aux_queue, m.lane_queue};
-  const bool half = straight && target.format() == core::BandFormat::rgb16f;
-  const size_t colour_bytes = half ? 6 : 4 * sizeof(float);
-  cl_mem colour = half ? m.grow(m.packed, m.packed_bytes, pixels * 6, "clCreateBuffer(half band)") : m.output;
+  const bool packed = straight && target.format() != core::BandFormat::rgba32f;
+  const size_t colour_bytes = packed ? core::bytes_per_pixel(target.format()) : 4 * sizeof(float);
+  cl_mem colour = packed ? m.grow(m.packed, m.packed_bytes, pixels * colour_bytes, "clCreateBuffer(packed band)") : m.output;
   const size_t aux_bytes = straight ? sizeof(KAuxTexel) : sizeof(KAux);
   const bool aux_into_target = straight && m.aux_into_target;
   char* staging = aux_into_target ? nullptr
@@ -731,7 +743,9 @@ core::BandResult OpenCLTracer::render_first_hits_in_pieces(const core::BandJob& 
     m.enqueue_band_rows(m.first_hits_kernel, wave, params, width, first, count, i == 0 ? &band_started : nullptr,
                         nullptr);
     enqueue_aux_rows(camera, first, count, straight);
-    if (half) m.pack(m.to_rgb16f, m.output, colour, first * width, count * width, "converting the band to half floats");
+    if (packed)
+      m.pack_colour(target.format(), colour, first * width, count * width, size_t(params.row_begin) * width,
+                    params.frame_index);
     check(clEnqueueMarkerWithWaitList(m.queue, 0, nullptr, piece_ready[i].out()), "marking a piece's end");
     check(clFlush(m.queue), "clFlush");
   }
@@ -758,7 +772,7 @@ core::BandResult OpenCLTracer::render_first_hits_in_pieces(const core::BandJob& 
     const cl_event read = colour_read[i].get();
     check(clWaitForEvents(1, &read), "waiting for the band");
     for (size_t r = first; r < first + count; ++r)
-      target.store(static_cast<int>(params.row_begin + r), 0, band.data() + r * width * 4, width);
+      target.store(static_cast<int>(params.row_begin + r), 0, band.data() + r * width * 4, width, params.frame_index);
   }
   // Blocking, and only now: a read into pageable memory may return only once the whole queue got there.
   check(clEnqueueReadBuffer(m.queue, m.row_rays, CL_TRUE, 0, rows * sizeof(cl_uint), row_rays.data(), 0, nullptr, nullptr),

@@ -46,6 +46,10 @@ class FramePipeline {
   // one to push next.
   using PrepareNext = std::function<std::optional<BandJob>()>;
   std::optional<Delivered> push(const BandJob& job, std::vector<StageSpan> preparation, const PrepareNext& prepare_next);
+  // Whether the apps announce the next frame at hand-out (push with prepare_next): yes, unless the
+  // environment says COHORT_EARLY_ANNOUNCE=0 (the order before, for comparison). `cohort render` and
+  // `cohort play` both ask here.
+  static bool announces_at_hand_out();
   // Waits for the frame in flight and returns it merged into image(); nothing when none is.
   std::optional<Delivered> drain();
 

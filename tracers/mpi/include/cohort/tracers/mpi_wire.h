@@ -23,8 +23,9 @@ constexpr uint32_t kMagic = 0x504d4843u;  // "CHMP" in memory order
 // 5: KMaterial carries an environment cube (128 bytes); 6: NodeTiming tells commits applied before the
 // job came from those in its way (commits travel ahead of their job, docs/cluster.md); 7: jobs ahead
 // (band_job says whether it is one, or which one it takes the rows of; band_rows too; NodeTiming tells
-// the node's idle time and the time it rendered before the job came).
-constexpr uint16_t kProtocolVersion = 7;
+// the node's idle time and the time it rendered before the job came); 8: band format 2, RGB9E5 rows
+// (4 bytes a pixel).
+constexpr uint16_t kProtocolVersion = 8;
 
 enum class Kind : uint16_t {
   hello = 1,        // node -> 0: versions, what scene it loaded, its tracers
@@ -173,7 +174,7 @@ struct NodeTiming {
 static_assert(sizeof(NodeTiming) == 72, "NodeTiming travels as it lies: nine doubles");
 
 // The band_rows message: the band is done. Its pieces went ahead on their own tags: `pieces` of colour
-// rows in the band format (6 bytes a pixel as rgb16f), and as many of aux texels when `aux`.
+// rows in the band format (6 bytes a pixel as rgb16f, 4 as rgb9e5), and as many of aux texels when `aux`.
 struct BandRows {
   uint32_t row_begin = 0, row_end = 0, width = 0;
   core::BandFormat format = core::BandFormat::rgb16f;
