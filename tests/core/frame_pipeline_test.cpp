@@ -460,9 +460,10 @@ TEST(FramePipeline, PrepareNextAnnouncesTheNextFrameBeforeTheFrameBeforeIsPostPr
       ASSERT_EQ(done->stats.frame, f - 1);
       for (int y = 0; y < kRows; ++y) ASSERT_EQ(pipeline.image().row(y)[0], static_cast<float>(f - 1));
       // The post of frame f-1: frame f renders meanwhile and has seen f+1's job already.
-      if (f + 1 < kFrames)
+      if (f + 1 < kFrames) {
         EXPECT_TRUE(saw_next->wait_for(f, std::chrono::milliseconds(5000)))
             << "the band of frame " << f << " did not see frame " << f + 1 << "'s job during the post of frame " << f - 1;
+      }
     }
     ++f;
   }
