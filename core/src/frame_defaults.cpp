@@ -26,7 +26,7 @@ KFrameParams default_frame_params() {
 }
 
 const std::vector<std::string>& light_sampling_names() {
-  static const std::vector<std::string> names = {"tree", "all", "every", "gather", "in-range"};
+  static const std::vector<std::string> names = {"tree", "all", "every", "gather", "in-range", "dense", "auto"};
   return names;
 }
 
@@ -36,7 +36,9 @@ kuint light_sampling_mode(const std::string& name) {
   if (name == "every") return K_LIGHTS_EVERY;
   if (name == "gather") return K_LIGHTS_GATHER;
   if (name == "in-range") return K_LIGHTS_IN_RANGE;
-  throw std::invalid_argument("light sampling '" + name + "': choose tree, all, every, gather or in-range");
+  if (name == "dense") return K_LIGHTS_DENSE;
+  if (name == "auto") return K_LIGHTS_AUTO;
+  throw std::invalid_argument("light sampling '" + name + "': choose tree, all, every, gather, in-range, dense or auto");
 }
 
 const std::string& light_sampling_name(kuint mode) {

@@ -19,7 +19,8 @@ constexpr int kDefaultHeight = 360;
 KFrameParams default_frame_params();
 
 // The light-sampling modes by their command-line names: "tree" (K_LIGHTS_TREE), "all" (K_LIGHTS_ALL), "every"
-// (K_LIGHTS_EVERY), "gather" (K_LIGHTS_GATHER) and "in-range" (K_LIGHTS_IN_RANGE, the default), in that order.
+// (K_LIGHTS_EVERY), "gather" (K_LIGHTS_GATHER), "in-range" (K_LIGHTS_IN_RANGE, the default), "dense"
+// (K_LIGHTS_DENSE) and "auto" (K_LIGHTS_AUTO: in-range or dense by the scene, core/light_sampling.h), in that order.
 const std::vector<std::string>& light_sampling_names();
 // Throws std::invalid_argument naming the choices for any other name.
 kuint light_sampling_mode(const std::string& name);

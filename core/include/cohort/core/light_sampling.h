@@ -46,4 +46,19 @@ std::vector<KLightNode> build_light_nodes(const std::vector<KLight>& lights, Emi
 // The derived arrays of `scene` (light nodes, emissive triangles) rebuilt from its other arrays.
 void rebuild_light_sampling(commit::TracerScene& scene);
 
+// How crowded the Doom 3 lights' volumes are: the mean, over the lights in the tree, of how many lights' boxes
+// hold the centre of the light's own box (itself included), found by walking the tree. 0 without lights. A
+// light's centre stands for the points it lights; the count is what in-range weighs there (a few on Doom 3
+// maps: the large generated map 4.9, the test map 2.6; 14 / 36 / 109 in bench_scaling's 64 / 256 / 1,024-light
+// room). O(lights x their overlap): computed by the tracers when their light tree changes.
+float light_density(const commit::TracerScene& scene);
+
+// Above this light_density, K_LIGHTS_AUTO is K_LIGHTS_DENSE, at or below it K_LIGHTS_IN_RANGE
+// (docs/integrator.md, "Dense rooms").
+constexpr float kDenseLightDensity = 16.0f;
+
+// The light sampling a frame asked for, with K_LIGHTS_AUTO resolved by the scene's light_density: the mode
+// itself for every other mode.
+kuint resolve_light_sampling(kuint mode, float density);
+
 }  // namespace cohort::core
