@@ -88,7 +88,7 @@ TEST(FrameDefaults, PathTracingWithNeeAndOneBounceAndDoom3SpecularBoost) {
   EXPECT_EQ(p.max_bounces, 1u);
   EXPECT_EQ(p.light_samples, 1u);
   EXPECT_FLOAT_EQ(p.shadow_rr, 0.03f);
-  EXPECT_EQ(p.light_sampling, K_LIGHTS_IN_RANGE);
+  EXPECT_EQ(p.light_sampling, K_LIGHTS_AUTO);
   EXPECT_EQ(p.emissive_samples, 1u);
   EXPECT_FLOAT_EQ(p.spec_boost, 2.0f);
   EXPECT_EQ(p.row_begin, p.row_end);  // no band until the balancer names one
