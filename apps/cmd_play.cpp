@@ -402,7 +402,8 @@ void add_play_command(CLI::App& app, int& exit_code) {
                   "how each hit picks the map's lights: tree (the light tree), gather (the lights in range, "
                   "found through the tree, each its own shadow ray within a budget of one here; `cohort render "
                   "--light-samples N` sets a larger one), in-range (one light among every light in range, by its "
-                  "contribution), all or every (references; see `cohort render --help`)")
+                  "contribution), dense (a bounded pick for rooms where many lights overlap), auto (in-range or dense "
+                  "by the map's light density), all or every (references; see `cohort render --help`)")
       ->capture_default_str()
       ->check(CLI::IsMember(core::light_sampling_names()));
   cmd->add_option("--convergence", a->convergence,

@@ -23,6 +23,7 @@
 #include "cohort/core/frame_defaults.h"
 #include "cohort/core/frame_pipeline.h"
 #include "cohort/core/view.h"
+#include "cohort/core/light_sampling.h"
 #include "cohort/core/world_sync.h"
 #include "cohort/scene/map_loader.h"
 #include "cohort/scene/render_world_stream.h"
@@ -167,6 +168,11 @@ int run_render(const RenderArgs& a) {
       spdlog::info("{}: a scene pack's materials are fixed when it is packed; render the map to animate them", a.map);
     renderer.submit_commit(commit::CommitBuffer::full(scene.tracer_scene, 1));
   }
+
+  // What --light-sampling auto becomes on this scene (each tracer resolves it too, and logs it): for stats.json.
+  const float light_density = core::light_density(sync ? *sync->snapshot() : *scene.tracer_scene);
+  const std::string light_sampling_used =
+      core::light_sampling_name(core::resolve_light_sampling(core::light_sampling_mode(a.light_sampling), light_density));
 
   glm::vec3 eye = scene.player_start + glm::vec3(0.0f, 0.0f, core::kPlayerEyeHeight);
   core::ViewAngles angles{scene.player_yaw, 0.0f};
@@ -438,7 +444,8 @@ int run_render(const RenderArgs& a) {
   nlohmann::json report = {{"map", a.map},       {"scene", scene.name},     {"tracers", a.tracers},
                            {"balancer", a.balancer}, {"width", a.width},     {"height", a.height},
                            {"spp", a.spp},       {"bounces", a.bounces},
-                           {"light_sampling", a.light_sampling}, {"light_samples", a.light_samples},    {"mode", a.mode},
+                           {"light_sampling", a.light_sampling}, {"light_sampling_used", light_sampling_used},
+                           {"light_density", light_density}, {"light_samples", a.light_samples},    {"mode", a.mode},
                            {"camera_path", a.camera_path}, {"denoise", a.denoise},
                            {"render_scale", a.render_scale}, {"upsample", a.upsample},
                            {"convergence", a.no_convergence ? "none" : convergence_mode}, {"frames", stats_json}};
@@ -501,11 +508,15 @@ void add_render_command(CLI::App& app, int& exit_code) {
                   "there are at most --light-samples of them; beyond that at most --light-samples rays (16 at "
                   "most), the brightest lights first, unbiased) or in-range (one light per sample, picked by its "
                   "unshadowed contribution among every light whose volume holds the point, found through the tree "
-                  "without its descent: cost grows with the lights in range, not the map's)")
+                  "without its descent: cost grows with the lights in range, not the map's), dense (for rooms where "
+                  "many lights reach a point: a descent of the tree by a guess of each subtree's contribution to 8 "
+                  "lights, then in-range among them; bounded cost, more noise) or auto (in-range or dense, by how "
+                  "many lights' volumes hold each light's centre on average: dense above 16; logged, and in "
+                  "stats.json as light_sampling_used)")
       ->capture_default_str()
       ->check(CLI::IsMember(core::light_sampling_names()));
   cmd->add_option("--light-samples", a->light_samples,
-                  "lights sampled per hit with --light-sampling tree, in-range or all, most shadow rays per hit with "
+                  "lights sampled per hit with --light-sampling tree, in-range, dense, auto or all, most shadow rays per hit with "
                   "gather (0: every light, as --light-sampling every)")
       ->capture_default_str()
       ->check(CLI::NonNegativeNumber);

@@ -100,10 +100,12 @@ class TreeBuilder {
     KLightNode n{};
     n.parent = parent;
     glm::vec3 lo(INFINITY), hi(-INFINITY), centre_lo(INFINITY), centre_hi(-INFINITY);
-    float power = 0.0f;
+    float power = 0.0f, reach = 0.0f;
     for (size_t i = begin; i < end; ++i) {
       lo = glm::min(lo, items_[i].box.min);
       hi = glm::max(hi, items_[i].box.max);
+      const glm::vec3 half = 0.5f * (items_[i].box.max - items_[i].box.min);
+      reach = std::max(reach, std::max(half.x, std::max(half.y, half.z)));
       centre_lo = glm::min(centre_lo, items_[i].centre);
       centre_hi = glm::max(centre_hi, items_[i].centre);
       power += items_[i].power;
@@ -113,6 +115,7 @@ class TreeBuilder {
       n.bmax[k] = hi[k];
     }
     n.power = power;
+    n.reach = reach;
     n.light_count = uint32_t(end - begin);
     if (end - begin == 1) {
       n.count = 1;
@@ -206,6 +209,44 @@ std::vector<KLightNode> build_light_nodes(const std::vector<KLight>& lights, Emi
     if (tree[n].count > 0) emissive.triangles[tree[n].left_first].leaf = first + n;
   nodes.insert(nodes.end(), tree.begin(), tree.end());
   return nodes;
+}
+
+float light_density(const commit::TracerScene& scene) {
+  const std::vector<KLightNode>& nodes = scene.light_nodes;
+  const size_t e = scene.emissive_triangles.size();
+  const size_t emissive_nodes = e > 0 && nodes.size() >= 2 * e - 1 ? 2 * e - 1 : 0;
+  const size_t tree = nodes.size() - emissive_nodes;   // kernel/scene_view.h's k_light_tree_nodes
+  if (tree == 0) return 0.0f;
+  auto holds = [](const KLightNode& n, const glm::vec3& p) {
+    return p.x >= n.bmin[0] && p.x <= n.bmax[0] && p.y >= n.bmin[1] && p.y <= n.bmax[1] && p.z >= n.bmin[2] &&
+           p.z <= n.bmax[2];
+  };
+  size_t lights = 0, in_range = 0;
+  std::vector<uint32_t> stack;
+  for (size_t leaf = 0; leaf < tree; ++leaf) {
+    if (nodes[leaf].count == 0) continue;
+    const glm::vec3 centre = 0.5f * (glm::vec3(nodes[leaf].bmin[0], nodes[leaf].bmin[1], nodes[leaf].bmin[2]) +
+                                     glm::vec3(nodes[leaf].bmax[0], nodes[leaf].bmax[1], nodes[leaf].bmax[2]));
+    ++lights;
+    stack.assign(1, 0u);
+    while (!stack.empty()) {
+      const KLightNode& n = nodes[stack.back()];
+      stack.pop_back();
+      if (!holds(n, centre)) continue;
+      if (n.count > 0) {
+        ++in_range;
+      } else {
+        stack.push_back(n.left_first);
+        stack.push_back(n.left_first + 1);
+      }
+    }
+  }
+  return lights > 0 ? float(double(in_range) / double(lights)) : 0.0f;
+}
+
+kuint resolve_light_sampling(kuint mode, float density) {
+  if (mode != K_LIGHTS_AUTO) return mode;
+  return density > kDenseLightDensity ? K_LIGHTS_DENSE : K_LIGHTS_IN_RANGE;
 }
 
 }  // namespace cohort::core

@@ -6,13 +6,17 @@
 #include <cmath>
 #include <cstring>
 #include <functional>
+#include <iostream>
 #include <limits>
 #include <random>
 #include <set>
 
 #include "cohort/core/gpu_scene.h"
 #include "cohort/core/light_sampling.h"
+#include "cohort/kernel/light_tree.h"
 #include "cohort/kernel/lights.h"
+#include "cohort/scene/map_loader.h"
+#include "cohort/scene/vfs.h"
 
 using namespace cohort;
 
@@ -131,6 +135,8 @@ TEST(LightTree, EveryLightIsOneLeafAndBoxesNest) {
         EXPECT_GE(n.bmax[a], box->max[a]);
       }
       EXPECT_NEAR(n.power, v3_luminance(v3_load(lights[n.left_first].color)), 1e-5f);
+      const glm::vec3 half = 0.5f * (box->max - box->min);
+      EXPECT_FLOAT_EQ(n.reach, std::max(half.x, std::max(half.y, half.z)));
       return;
     }
     ASSERT_EQ(n.count, 0u);
@@ -141,6 +147,7 @@ TEST(LightTree, EveryLightIsOneLeafAndBoxesNest) {
       EXPECT_GE(n.bmax[a], std::max(l.bmax[a], r.bmax[a]));
     }
     EXPECT_EQ(n.light_count, l.light_count + r.light_count);
+    EXPECT_EQ(n.reach, std::max(l.reach, r.reach));
     EXPECT_NEAR(n.power, l.power + r.power, 1e-4f * n.power);
     // Median splits: the two halves differ by at most one light (the kernel's gather stack relies on it).
     EXPECT_LE(std::max(l.light_count, r.light_count) - std::min(l.light_count, r.light_count), 1u);
@@ -154,6 +161,89 @@ TEST(LightTree, EveryLightIsOneLeafAndBoxesNest) {
   EXPECT_EQ(core::build_light_tree(lights).size(), tree.size());
   EXPECT_EQ(std::memcmp(core::build_light_tree(lights).data(), tree.data(), tree.size() * sizeof(KLightNode)), 0)
       << "the build must be deterministic";
+}
+
+// K_LIGHTS_DENSE's descent weighs a node by k_light_node_guess: above zero wherever the node's box holds the
+// point (or a light reaching it could never be picked: bias), zero elsewhere, whatever the normal; and, in a
+// row of equal point lights, larger for the light whose centre is nearer (what makes it better than the
+// tree's power-only importance).
+TEST(LightTree, GuessIsPositiveExactlyWhereTheBoxHoldsThePoint) {
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<float> pos(-600.0f, 600.0f), size(20.0f, 400.0f), unit(-1.0f, 1.0f);
+  std::vector<KLight> lights;
+  const scene::Scene empty;
+  for (int i = 0; i < 64; ++i) {
+    scene::Light l = i % 4 == 0 ? projected_light({pos(rng), pos(rng), pos(rng)}, {0, 0, -size(rng)},
+                                                   {0, -size(rng), 0}, {size(rng), 0, 0})
+                                : point_light({pos(rng), pos(rng), pos(rng)}, {size(rng), size(rng), size(rng)});
+    lights.push_back(core::to_klight(l, empty));
+  }
+  const std::vector<KLightNode> tree = core::build_light_tree(lights);
+  int held = 0;
+  for (int i = 0; i < 2000; ++i) {
+    const KVec3 p = v3(pos(rng), pos(rng), pos(rng));
+    const KVec3 normal = v3_normalize(v3(unit(rng), unit(rng), unit(rng)));
+    for (const KLightNode& n : tree) {
+      const float g = k_light_node_guess(&n, p, normal);
+      if (k_light_node_holds(&n, p)) {
+        ++held;
+        ASSERT_GT(g, 0.0f) << "point " << p.x << " " << p.y << " " << p.z;
+        ASSERT_TRUE(std::isfinite(g));
+      } else {
+        ASSERT_EQ(g, 0.0f);
+      }
+    }
+  }
+  EXPECT_GT(held, 10000) << "the points must fall in many boxes";
+
+  std::vector<KLight> row;
+  for (int i = 0; i < 2; ++i)
+    row.push_back(core::to_klight(point_light({float(i) * 200.0f, 0.0f, 100.0f}, {400, 400, 400}), empty));
+  const std::vector<KLightNode> pair = core::build_light_tree(row);
+  ASSERT_EQ(pair.size(), 3u);
+  const KLightNode& a = pair[pair[0].left_first];
+  const KLightNode& b = pair[pair[0].left_first + 1];
+  const KLightNode& near = a.bmin[0] < b.bmin[0] ? a : b;
+  const KLightNode& far = a.bmin[0] < b.bmin[0] ? b : a;
+  const KVec3 floor_point = v3(-50.0f, 0.0f, 0.0f), up = v3(0.0f, 0.0f, 1.0f);
+  EXPECT_GT(k_light_node_guess(&near, floor_point, up), 2.0f * k_light_node_guess(&far, floor_point, up));
+  EXPECT_EQ(k_light_node_importance(&near, floor_point), k_light_node_importance(&far, floor_point))
+      << "the tree's importance cannot tell them apart";
+}
+
+// core::light_density counts, per light, the lights whose box holds its box's centre (itself included), and
+// K_LIGHTS_AUTO follows it: in-range on the test map's few overlapping lights, dense in a room under a grid of
+// 16 x 16 lights each reaching several rows around it (bench_scaling's kind of room); any other mode is kept.
+TEST(LightDensity, CountsTheBoxesHoldingEachLightsCentreAndPicksTheAutoMode) {
+  const scene::Scene empty;
+  commit::TracerScene apart;
+  for (int i = 0; i < 3; ++i) apart.lights.push_back(core::to_klight(point_light({i * 500.0f, 0, 0}, {100, 100, 100}), empty));
+  apart.light_nodes = core::build_light_tree(apart.lights);
+  EXPECT_FLOAT_EQ(core::light_density(apart), 1.0f) << "three lights apart: each holds only its own centre";
+  // A large light whose box holds a small one's centre, but not the other way round: (2 + 1) / 2.
+  commit::TracerScene nested;
+  nested.lights = {core::to_klight(point_light({0, 0, 0}, {1000, 1000, 1000}), empty),
+                   core::to_klight(point_light({600, 0, 0}, {50, 50, 50}), empty)};
+  nested.light_nodes = core::build_light_tree(nested.lights);
+  EXPECT_FLOAT_EQ(core::light_density(nested), 1.5f);
+  EXPECT_EQ(core::light_density(commit::TracerScene{}), 0.0f);
+
+  scene::Vfs vfs;
+  const core::CompiledScene map =
+      core::compile_scene(scene::load_map(vfs, std::string(COHORT_SOURCE_DIR) + "/assets/testmap/maps/testmap.map"));
+  const float map_density = core::light_density(map.tracer_scene);
+  commit::TracerScene grid;
+  for (int x = 0; x < 16; ++x)
+    for (int y = 0; y < 16; ++y)
+      grid.lights.push_back(core::to_klight(point_light({x * 100.0f, y * 100.0f, 200.0f}, {350, 350, 300}), empty));
+  grid.light_nodes = core::build_light_tree(grid.lights);
+  const float grid_density = core::light_density(grid);
+  std::cout << "light density: test map " << map_density << ", 256-light grid " << grid_density << "\n";
+  EXPECT_GT(map_density, 1.0f) << "some of the test map's lights overlap";
+  EXPECT_EQ(core::resolve_light_sampling(K_LIGHTS_AUTO, map_density), K_LIGHTS_IN_RANGE);
+  EXPECT_EQ(core::resolve_light_sampling(K_LIGHTS_AUTO, grid_density), K_LIGHTS_DENSE);
+  for (kuint mode : {K_LIGHTS_TREE, K_LIGHTS_ALL, K_LIGHTS_EVERY, K_LIGHTS_GATHER, K_LIGHTS_IN_RANGE, K_LIGHTS_DENSE})
+    EXPECT_EQ(core::resolve_light_sampling(mode, grid_density), mode);
 }
 
 TEST(LightTree, LightsWithoutAVolumeAreLeftOut) {

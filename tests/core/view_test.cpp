@@ -88,7 +88,7 @@ TEST(FrameDefaults, PathTracingWithNeeAndOneBounceAndDoom3SpecularBoost) {
   EXPECT_EQ(p.max_bounces, 1u);
   EXPECT_EQ(p.light_samples, 1u);
   EXPECT_FLOAT_EQ(p.shadow_rr, 0.03f);
-  EXPECT_EQ(p.light_sampling, K_LIGHTS_IN_RANGE);
+  EXPECT_EQ(p.light_sampling, K_LIGHTS_AUTO);
   EXPECT_EQ(p.emissive_samples, 1u);
   EXPECT_FLOAT_EQ(p.spec_boost, 2.0f);
   EXPECT_EQ(p.row_begin, p.row_end);  // no band until the balancer names one
@@ -96,16 +96,18 @@ TEST(FrameDefaults, PathTracingWithNeeAndOneBounceAndDoom3SpecularBoost) {
 
 TEST(FrameDefaults, LightSamplingNamesRoundTrip) {
   const std::vector<std::string>& names = light_sampling_names();
-  ASSERT_EQ(names.size(), 5u);
+  ASSERT_EQ(names.size(), 7u);
   EXPECT_EQ(light_sampling_mode(names[0]), K_LIGHTS_TREE);
   EXPECT_EQ(light_sampling_mode("all"), K_LIGHTS_ALL);
   EXPECT_EQ(light_sampling_mode("every"), K_LIGHTS_EVERY);
   EXPECT_EQ(light_sampling_mode("gather"), K_LIGHTS_GATHER);
   EXPECT_EQ(light_sampling_mode(names[4]), K_LIGHTS_IN_RANGE);
   EXPECT_EQ(names[4], "in-range");
+  EXPECT_EQ(light_sampling_mode("dense"), K_LIGHTS_DENSE);
+  EXPECT_EQ(light_sampling_mode("auto"), K_LIGHTS_AUTO);
   EXPECT_THROW(light_sampling_mode("bvh"), std::invalid_argument);
   for (const std::string& name : names) EXPECT_EQ(light_sampling_name(light_sampling_mode(name)), name);
-  EXPECT_THROW(light_sampling_name(5u), std::invalid_argument);
+  EXPECT_THROW(light_sampling_name(7u), std::invalid_argument);
 }
 
 TEST(FrameDefaults, AuxRaysNamesRoundTrip) {

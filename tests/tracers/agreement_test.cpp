@@ -90,8 +90,8 @@ INSTANTIATE_TEST_SUITE_P(Modes, Agreement,
                          [](const auto& info) { return std::string(info.param.name); });
 
 // The light tree's descent (more lights than K_LIGHT_TREE_GATHER overlap), the emissive-triangle
-// sampling, gather's choice among more lights than its budget and the pick among every light in range
-// give the same image on both tracers.
+// sampling, gather's choice among more lights than its budget, the pick among every light in range and the
+// dense rooms' descent by its guess give the same image on both tracers.
 TEST(AgreementManyLights, EmbreeAndOpenCLImagesMatch) {
   std::vector<std::string> names = built_tracers();
   if (names.size() < 2 || !tracer_runs_here("opencl")) GTEST_SKIP() << "needs both the Embree and the OpenCL tracer";
@@ -125,6 +125,13 @@ TEST(AgreementManyLights, EmbreeAndOpenCLImagesMatch) {
   b = render(*opencl, s, cam, params);
   error = rgb_rmse(a, b, &mean);
   std::cout << "many lights, in range: RMSE embree/opencl " << error << ", mean " << mean << "\n";
+  EXPECT_GT(mean, 0.05);
+  EXPECT_LT(error, 0.005 * mean);  // Dense rooms: the descent by k_light_node_guess to at most K_LIGHT_DENSE_LEAF lights, then in-range.
+  params.light_sampling = K_LIGHTS_DENSE;
+  a = render(*embree, s, cam, params);
+  b = render(*opencl, s, cam, params);
+  error = rgb_rmse(a, b, &mean);
+  std::cout << "many lights, dense: RMSE embree/opencl " << error << ", mean " << mean << "\n";
   EXPECT_GT(mean, 0.05);
   EXPECT_LT(error, 0.005 * mean);
 }

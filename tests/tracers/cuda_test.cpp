@@ -111,7 +111,8 @@ INSTANTIATE_TEST_SUITE_P(Modes, CudaAgreement,
                          [](const auto& info) { return std::string(info.param.name); });
 
 // Under 96 overlapping lights (the tree descends, gather has more lights in range than its budget, the pick
-// in range weighs them all), CUDA draws Embree's image, as AgreementManyLights checks for OpenCL.
+// in range weighs them all, the dense pick descends by its guess in kernels of their own,
+// render_band_dense.cu), CUDA draws Embree's image, as AgreementManyLights checks for OpenCL.
 TEST(CudaAgreementManyLights, MatchesEmbree) {
   REQUIRE_GPU();
   scene::Scene s = many_lights_floor(88, 8);
@@ -119,7 +120,7 @@ TEST(CudaAgreementManyLights, MatchesEmbree) {
   const KCamera cam = camera_looking_down({0, 0, 1400}, 0.7f, w, h);
   auto embree = make_test_tracer("embree");
   auto cuda = make_test_tracer("cuda");
-  for (kuint sampling : {K_LIGHTS_TREE, K_LIGHTS_GATHER, K_LIGHTS_IN_RANGE}) {
+  for (kuint sampling : {K_LIGHTS_TREE, K_LIGHTS_GATHER, K_LIGHTS_IN_RANGE, K_LIGHTS_DENSE}) {
     KFrameParams params = frame_params(K_MODE_PATH, 8, 1, h);
     params.soft_shadow_scale = 1.0f;
     params.light_sampling = sampling;

@@ -225,6 +225,101 @@ TEST(LightSampling, InRangeIsTheTreeWithoutItsDescent) {
   EXPECT_LT(pixel_noise, 0.9 * tree_pixel_noise);
 }
 
+// Dense rooms (K_LIGHTS_DENSE): a descent by k_light_node_guess to at most K_LIGHT_DENSE_LEAF lights, then
+// in-range among them (light_tree.h). Where the map has at most that many lights there is no descent: the
+// test room's three give in-range's image, float for float, with bounces, soft shadows and the shadow
+// roulette. On the 96- and 328-light floors (mostly 2-16 and more than 16 lights in range; point lights of
+// random shapes and projected lights, which the guess models only roughly) its image must differ from
+// in-range's (the descent ran), its block means and mean must match the every-light image as closely as its
+// own noise allows (unbiased), and its pixel noise must stay well below the tree's.
+TEST(LightSampling, DenseIsInRangeWhereTheMapHasFewLights) {
+  if (!tracer_runs_here("embree")) GTEST_SKIP();
+  auto tracer = make_test_tracer("embree");
+  scene::Scene room = test_room();
+  ASSERT_LE(room.lights.size(), size_t(K_LIGHT_DENSE_LEAF));
+  const int w = 64, h = 48;
+  const KCamera cam = test_room_camera(w, h);
+  auto render_with = [&](kuint sampling) {
+    KFrameParams p = frame_params(K_MODE_PATH, 4, 2, h);
+    p.soft_shadow_scale = 1.0f;
+    p.shadow_rr = 0.03f;
+    p.light_sampling = sampling;
+    return render(*tracer, room, cam, p);
+  };
+  const core::FrameBuffer in_range = render_with(K_LIGHTS_IN_RANGE), dense = render_with(K_LIGHTS_DENSE);
+  EXPECT_GT(mean_luminance(in_range), 0.01) << "the room should be lit";
+  for (size_t i = 0; i < in_range.rgba.size(); ++i)
+    ASSERT_EQ(dense.rgba[i], in_range.rgba[i]) << "pixel " << (i / 4) % size_t(w) << "," << (i / 4) / size_t(w);
+}
+
+class DenseOnFloor : public ::testing::TestWithParam<int> {};
+
+TEST_P(DenseOnFloor, MatchesEveryLightWithBoundedWork) {
+  if (!tracer_runs_here("embree")) GTEST_SKIP();
+  auto tracer = make_test_tracer("embree");
+  scene::Scene s = many_lights_floor(GetParam(), 8);
+  const int w = 64, h = 48;
+  const KCamera cam = camera_looking_down({0, 0, 1400}, 0.7f, w, h);
+  auto render_with = [&](kuint sampling, kuint frame) {
+    KFrameParams p = frame_params(K_MODE_DIRECT, 16, 0, h);
+    p.light_sampling = sampling;
+    p.frame_index = frame;
+    return render(*tracer, s, cam, p);
+  };
+  const core::FrameBuffer every = render_with(K_LIGHTS_EVERY, 1);
+  const double mean = mean_luminance(every);
+  ASSERT_GT(mean, 0.05) << "the floor should be lit";
+  const core::FrameBuffer a = render_with(K_LIGHTS_DENSE, 1), b = render_with(K_LIGHTS_DENSE, 2);
+  const core::FrameBuffer in_range_a = render_with(K_LIGHTS_IN_RANGE, 1), in_range_b = render_with(K_LIGHTS_IN_RANGE, 2);
+  const core::FrameBuffer tree_a = render_with(K_LIGHTS_TREE, 1), tree_b = render_with(K_LIGHTS_TREE, 2);
+  expect_finite(a, "dense");
+  EXPECT_GT(pixel_rmse(a, in_range_a), 0.0) << "points with more than K_LIGHT_DENSE_LEAF lights must descend";
+  const double bias = rms_difference(block_means(a, 8), block_means(every, 8));
+  const double noise = rms_difference(block_means(a, 8), block_means(b, 8));
+  const double mean_error = std::fabs(mean_luminance(a) - mean) / mean;
+  const double pixel_noise = pixel_rmse(a, b);
+  const double in_range_noise = pixel_rmse(in_range_a, in_range_b), tree_noise = pixel_rmse(tree_a, tree_b);
+  std::cout << "dense: block RMS vs every light " << bias << ", between two seeds " << noise << ", mean error "
+            << 100.0 * mean_error << "%, pixel noise " << pixel_noise << " (in range " << in_range_noise << ", tree "
+            << tree_noise << ")\n";
+  EXPECT_LT(bias, 0.95 * noise + 1e-4 * mean);
+  // The image mean's own noise: about pixel_noise / sqrt(2 pixels).
+  EXPECT_LT(mean_error * mean, 3.0 * pixel_noise / std::sqrt(2.0 * w * h) + 0.005 * mean);
+  // About 0.55x the tree's at 96 lights, 0.35x at 328 (in-range 0.30x and 0.19x): the price of its bound.
+  EXPECT_LT(pixel_noise, 0.7 * tree_noise);
+}
+
+// 96 lights: mostly 2-16 in range of a point; 328: mostly more than 16.
+INSTANTIATE_TEST_SUITE_P(LightSampling, DenseOnFloor, ::testing::Values(88, 320),
+                         [](const auto& info) { return std::to_string(info.param + 8) + "_lights"; });
+
+// K_LIGHTS_AUTO is resolved by the tracer from the scene's light density (core::resolve_light_sampling): the
+// test map's few lights in range give in-range's image, the 328-light floor the dense pick's, pixel for pixel.
+TEST(LightSampling, AutoIsInRangeOnTheTestMapAndDenseOnACrowdedFloor) {
+  if (!tracer_runs_here("embree")) GTEST_SKIP();
+  auto tracer = make_test_tracer("embree");
+  const int w = 48, h = 32;
+  auto same_image = [&](const scene::Scene& s, const KCamera& cam, kuint expected) {
+    auto render_with = [&](kuint sampling) {
+      KFrameParams p = frame_params(K_MODE_PATH, 2, 1, h);
+      p.light_sampling = sampling;
+      return render(*tracer, s, cam, p);
+    };
+    const core::FrameBuffer chosen = render_with(K_LIGHTS_AUTO), wanted = render_with(expected);
+    const core::FrameBuffer other = render_with(expected == K_LIGHTS_DENSE ? K_LIGHTS_IN_RANGE : K_LIGHTS_DENSE);
+    EXPECT_GT(mean_luminance(wanted), 0.01) << "the scene should be lit";
+    EXPECT_EQ(chosen.rgba, wanted.rgba) << "auto should be " << core::light_sampling_name(expected);
+    return pixel_rmse(wanted, other);
+  };
+  const scene::Scene map = load_test_map();
+  const KCamera map_camera =
+      core::make_camera(core::player_eye(map), {map.player_yaw, 0.0f}, core::kDefaultFovX, w, h);
+  same_image(map, map_camera, K_LIGHTS_IN_RANGE);
+  const double differs = same_image(many_lights_floor(320, 8), camera_looking_down({0, 0, 1400}, 0.7f, w, h),
+                                    K_LIGHTS_DENSE);
+  EXPECT_GT(differs, 0.0) << "on the floor dense and in-range must draw different images";
+}
+
 // An emissive panel over a floor, no lights: one bounce finds the panel by chance, NEE with MIS aims at
 // it. Both estimate the same radiance; MIS with far less noise.
 TEST(LightSampling, EmissiveTrianglesWithMisMatchBounceOnly) {
@@ -290,7 +385,8 @@ TEST(LightSampling, LightsWithDefectsAreSkippedAndNoPixelIsNaN) {
   for (const std::string& kind : built_tracers()) {
     if (!tracer_runs_here(kind)) continue;
     auto tracer = make_test_tracer(kind);
-    for (kuint sampling : {K_LIGHTS_TREE, K_LIGHTS_ALL, K_LIGHTS_EVERY, K_LIGHTS_GATHER, K_LIGHTS_IN_RANGE}) {
+    for (kuint sampling : {K_LIGHTS_TREE, K_LIGHTS_ALL, K_LIGHTS_EVERY, K_LIGHTS_GATHER, K_LIGHTS_IN_RANGE,
+                           K_LIGHTS_DENSE, K_LIGHTS_AUTO}) {
       for (kuint frame = 0; frame < 3; ++frame) {
         KFrameParams p = frame_params(K_MODE_PATH, 2, 2, h);
         p.light_sampling = sampling;

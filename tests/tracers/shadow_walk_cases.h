@@ -23,6 +23,7 @@ inline std::vector<ShadowWalkCase> shadow_walk_cases() {
           ShadowWalkCase{K_LIGHTS_TREE, 2, 0.03f, 88, 8, "tree2_roulette"},
           ShadowWalkCase{K_LIGHTS_GATHER, 4, 0.03f, 88, 8, "gather4_roulette"},
           ShadowWalkCase{K_LIGHTS_IN_RANGE, 1, 0.03f, 88, 8, "in_range1_roulette"},
+          ShadowWalkCase{K_LIGHTS_DENSE, 1, 0.03f, 88, 8, "dense1_roulette"},
           ShadowWalkCase{K_LIGHTS_EVERY, 0, 0.03f, 4, 2, "every_6_lights"},
           ShadowWalkCase{K_LIGHTS_EVERY, 0, 0.03f, 88, 8, "every_past_the_slots"}};
 }

@@ -4,6 +4,11 @@
 #include <cstdint>
 #include <unordered_map>
 
+#include <spdlog/spdlog.h>
+
+#include "cohort/core/frame_defaults.h"
+#include "cohort/core/light_sampling.h"
+
 namespace cohort::tracers {
 
 void TracerBase::apply(const commit::CommitBuffer& commit) {
@@ -15,6 +20,7 @@ void TracerBase::apply(const commit::CommitBuffer& commit) {
   remember_previous_transforms(before);
   remember_previous_joints(skins_before, std::move(joints_before));
   if (!has_scene_) changes.full_resync = true;
+  if (changes.full_resync || changes.light_tree || changes.emissive) light_density_ = core::light_density(scene_);
   upload(changes);
   has_scene_ = true;   // only now: after a failed first upload the next commit is sent whole again
 }
@@ -50,6 +56,10 @@ KFrameParams TracerBase::frame_params(const core::BandJob& job) const {
   params.tlas_node_count = static_cast<kuint>(scene_.tlas_nodes.size());
   params.light_node_count = static_cast<kuint>(scene_.light_nodes.size());
   params.emissive_count = static_cast<kuint>(scene_.emissive_triangles.size());
+  params.light_sampling = core::resolve_light_sampling(job.params.light_sampling, light_density_);
+  if (job.params.light_sampling == K_LIGHTS_AUTO && logged_auto_.exchange(params.light_sampling) != params.light_sampling)
+    spdlog::info("light sampling auto: {} ({:.1f} lights in range of a light's centre on average, dense above {:.0f})",
+                 core::light_sampling_name(params.light_sampling), light_density_, core::kDenseLightDensity);
   params.volume_light_begin = params.volume_light_end = 0u;
   for (size_t i = 0; i < scene_.lights.size(); ++i) {
     if (!(scene_.lights[i].flags & K_LIGHT_VOLUME_EFFECT)) continue;

@@ -6,6 +6,7 @@
 
 #define K_CUDA_DEVICE_ONLY 1
 #define K_BVH_TRIANGLE_EDGES 1  // leaves read KTriangleEdges (CudaTracer keeps them with the triangles)
+#define K_LIGHTS_DENSE_BUILD 0  // K_LIGHTS_DENSE's kernels are render_band_dense.cu's (render_band_kernels.cuh)
 __constant__ cudaTextureObject_t cohort_texel_texture;
 #define K_TEXEL_LOAD(texels, index) tex1Dfetch<unsigned int>(cohort_texel_texture, (int)(index))
 
@@ -19,107 +20,7 @@ __constant__ cudaTextureObject_t cohort_texel_texture;
 
 namespace cohort::tracers {
 
-// At least 4 blocks of 128 threads per SM: caps the kernel at 128 registers (25% occupancy) instead of
-// 164. Measured on one H100 (docs/integrator.md, "CUDA kernel shape"): 3 blocks 15.8 ms, 4 blocks 13.7 ms,
-// 5-6 blocks 13.2-13.4 ms on the large map at 1080p but slower on the test map, where spills cost more.
-// Two builds: with every pixel tracing paths the sparse pattern's test is compiled out, since in this
-// 128-register kernel even that early exit cost 1.5-2% of a full frame (nvidia-h100-x1, docs/integrator.md).
-// kFirstHit: the first sample's first surface is recorded for the aux planes (K_AUX_PATH_FIRST_HIT), a
-// build of its own so that the kernel without it stays as it was.
-template <bool kSparse, bool kFirstHit>
-__global__ void __launch_bounds__(128, 4) render_band_kernel(KSceneView scene, KFrameParams params, KCamera camera,
-                                                          float4* band, unsigned long long* ray_counts,
-                                                          unsigned* row_rays, KPathFirstHit* first_hits) {
-  const BandPixel px = band_pixel(params, camera);
-  KTraceCtx ctx = fresh_trace_ctx(scene);
-  if (px.inside) {
-    const size_t p = px.index(camera);
-    KVec3 c = kSparse ? k_render_pixel(&ctx, &params, &camera, px.x, px.y)
-                      : k_render_pixel_paths(&ctx, &params, &camera, px.x, px.y, kFirstHit ? first_hits + p : nullptr);
-    band[p] = make_float4(c.x, c.y, c.z, 1.0f);
-  }
-  count_rays(ctx, px.inside, px.row, px.y < params.row_end, ray_counts, row_rays);
-}
-
-// The wavefront. The megakernel above keeps a whole path in one thread of a 128-register kernel at a
-// quarter occupancy, where an incoherent bounce ray's walk waits on memory with few warps to hide it. Here
-// the camera rays and each bounce's rays are walked by small kernels of their own (wavefront_walk.cu, at
-// twice the occupancy), and a path's segments (what its camera ray meets up to the first bounce; then, per
-// bounce, what the bounce ray meets up to the next) are shaded by kernels like the megakernel. The paths
-// wait in memory between them (KPathState, kernel/path_state.h): same integrator, same random numbers, the
-// megakernel's image. Transparent layers are walked inline by the shading kernels; next-event estimation's
-// shadow rays are left in memory for a walk of their own (wavefront_walk.cu's shadow_walk_kernel), unless a
-// vertex may emit more than its slots or COHORT_CUDA_SHADOW_WALK=0 (then walked inline too).
-
-// k_path_segment (kernel/path_segment.h) behind a call of default inlining: forced inline into the shading
-// kernels, their spill stores moved by -48 to +24 bytes (ptxas, sm_90); through this they are as they were.
-__device__ bool path_segment(KTraceCtx* ctx, const KFrameParams* params, KPathState* s, const KHit* traced,
-                             KPathFirstHit* first_hit, KShadowQueue* shadows, KVertexLight* vertex) {
-  return k_path_segment(ctx, params, s, traced, first_hit, shadows, vertex) != 0;
-}
-
-// Pixel p's slots for its vertex's shadow rays (kShadowWalk; else none: walked as they come). The
-// capacity is a constant, so that each build keeps one way (the launch gives a vertex all the slots it
-// needs, k_shadow_queue_slots).
-template <bool kShadowWalk>
-__device__ KShadowQueue shadow_slots(const WavefrontScratch& wave, size_t p) {
-  KShadowQueue q = k_shadow_queue_inline();
-  if (kShadowWalk) {
-    q.rays = wave.shadow_rays + p;
-    q.stride = wave.shadow_stride;
-    q.capacity = K_SHADOW_QUEUE_MAX;
-  }
-  return q;
-}
-
-// What the live paths' rays (walked by wavefront_walk.cu's kernels) met, shaded, and the paths on to their
-// next bounce. kCameraRays: the camera rays' segment, whose paths begin here from the pixel (the walk kept
-// only the hits: 88 bytes a pixel less each way); kFirstHit: that segment of the frame's first sample,
-// which records first hits. kShadowWalk: the shadow rays left in their slots for the shadow walk (else
-// walked here). With the shadow rays out, six blocks an SM (80 registers): 6.94-7.02 ms a 1080p frame of the
-// large map on one H100 against 7.12-7.16 at five and 7.33-7.35 at four (docs/integrator.md); with them in
-// (`every` past the slots, COHORT_CUDA_SHADOW_WALK=0) four, as the megakernel (at six that build spills 2.5 KB).
-template <bool kCameraRays, bool kFirstHit, bool kShadowWalk>
-__global__ void __launch_bounds__(128, kShadowWalk ? 6 : 4) wave_shade_kernel(KSceneView scene, KFrameParams params, KCamera camera,
-                                                         kuint sample, float4* band, WavefrontScratch wave,
-                                                         unsigned long long* ray_counts, unsigned* row_rays,
-                                                         KPathFirstHit* first_hits) {
-  const BandPixel px = band_pixel(params, camera);
-  const size_t p = px.index(camera);
-  bool inside = px.inside && (kCameraRays || (wave.active[p] & kWaveLive));
-  KTraceCtx ctx = fresh_trace_ctx(scene);
-  if (kCameraRays && inside && !k_pixel_traces_path(params.path_pixels, params.path_phase, px.x, px.y)) {
-    // Dynamic resolution's sparse pattern leaves this pixel out: black, at no cost (k_render_pixel's way).
-    wave.active[p] = 0u;
-    finish_sample(band, p, v3s(0.0f), sample, params);
-    inside = false;
-  }
-  if (inside) {
-    KPathState s;
-    if (kCameraRays) {
-      KRng rng;
-      const KVec3 dir = k_camera_sample(&params, &camera, px.x, px.y, sample, &rng);
-      k_path_begin(&s, v3_load(camera.origin), dir, k_pixel_spread(&camera), rng);
-    } else {
-      s = wave.states[p];
-    }
-    const KHit hit = wave.hits[p];
-    KShadowQueue shadows = shadow_slots<kShadowWalk>(wave, p);
-    KVertexLight vertex;
-    const bool goes_on =
-        path_segment(&ctx, &params, &s, &hit, kFirstHit ? first_hits + p : nullptr, &shadows, &vertex);
-    // A vertex whose shadow rays are out waits for the shadow walk, which adds its light and finishes the
-    // sample of a path that ended there.
-    const bool shadows_out = shadows.count > 0u;
-    if (goes_on || shadows_out) wave.states[p] = s;
-    if (shadows_out) wave.vertices[p] = vertex;
-    if (kCameraRays || !goes_on || shadows_out)
-      wave.active[p] = (goes_on ? kWaveLive : 0u) | (shadows_out ? kWaveShadowsOut : 0u);
-    if (!goes_on && !shadows_out)
-      finish_sample(band, p, s.radiance, sample, params);
-  }
-  count_rays(ctx, inside, px.row, px.y < params.row_end, ray_counts, row_rays);
-}
+#include "render_band_kernels.cuh"
 
 // The 32-byte texel the host's BandBuffer keeps (halves for normal and albedo).
 __device__ void store_aux_texel(const KAux& a, KAuxTexel* out) {
@@ -191,9 +92,16 @@ void launch_aux_from_first_hits(const KSceneView& scene, const KFrameParams& par
 void set_texel_texture(cudaTextureObject_t texture) {
   COHORT_CUDA(cudaMemcpyToSymbol(cohort_texel_texture, &texture, sizeof texture));
   set_walk_texel_texture(texture);
+  dense::set_texel_texture(texture);
 }
 
 namespace {
+
+// Whether the band's frame runs K_LIGHTS_DENSE's kernels (render_band_dense.cu): with light_samples 0 every
+// way is `every`, which only the other build compiles.
+bool dense_lights(const KFrameParams& params) {
+  return params.light_sampling == K_LIGHTS_DENSE && params.light_samples > 0u;
+}
 
 // One lane of a band (all of it, or launch_render_band's rows of it) as a wavefront on `stream`: per sample
 // the camera walk, then per bounce a shading kernel, its shadow walk and the next bounce's walk.
@@ -205,17 +113,11 @@ void render_wavefront(const KSceneView& scene, const KFrameParams& params, const
   const dim3 grid((camera.width + block.x - 1) / block.x, (rows + block.y - 1) / block.y);
   const kuint spp = params.spp > 0u ? params.spp : 1u;  // k_paths_per_pixel (device-only in this translation unit)
   const bool shadow_walk = scratch.shadow_slots > 0u;
+  const auto shade_kernels = dense_lights(params) ? dense::launch_wave_shade : launch_wave_shade;
   // A shading kernel and, after it, the shadow rays it left, before the next one shades the paths further.
   auto shade = [&](kuint sample, bool camera_rays, KPathFirstHit* records) {
-    auto launch = [&](auto kernel) {
-      kernel<<<grid, block, 0, stream>>>(scene, params, camera, sample, band, scratch, ray_counts, row_rays, records);
-    };
-    if (!camera_rays)
-      shadow_walk ? launch(wave_shade_kernel<false, false, true>) : launch(wave_shade_kernel<false, false, false>);
-    else if (records)
-      shadow_walk ? launch(wave_shade_kernel<true, true, true>) : launch(wave_shade_kernel<true, true, false>);
-    else
-      shadow_walk ? launch(wave_shade_kernel<true, false, true>) : launch(wave_shade_kernel<true, false, false>);
+    shade_kernels(camera_rays, records, shadow_walk, grid, block, scene, params, camera, sample, band, scratch,
+                  ray_counts, row_rays, stream);
     if (shadow_walk)
       launch_wave_shadow_walk(grid, block, scene, params, camera, sample, band, scratch, ray_counts, row_rays, stream);
   };
@@ -269,14 +171,10 @@ void launch_render_band(const KSceneView& scene, const KFrameParams& params, con
       COHORT_CUDA(cudaEventRecord(wave->lanes->joined[lane], wave->lanes->streams[lane]));
       COHORT_CUDA(cudaStreamWaitEvent(stream, wave->lanes->joined[lane], 0));
     }
-  } else if (sparse)
-    render_band_kernel<true, false><<<grid, block, 0, stream>>>(scene, params, camera, band, ray_counts, row_rays, nullptr);
-  else if (first_hits)
-    render_band_kernel<false, true><<<grid, block, 0, stream>>>(scene, params, camera, band, ray_counts, row_rays,
-                                                                first_hits);
-  else
-    render_band_kernel<false, false><<<grid, block, 0, stream>>>(scene, params, camera, band, ray_counts, row_rays,
-                                                                 nullptr);
+  } else {
+    const auto megakernels = dense_lights(params) ? dense::launch_band_megakernel : launch_band_megakernel;
+    megakernels(sparse, first_hits, grid, block, scene, params, camera, band, ray_counts, row_rays, stream);
+  }
   COHORT_CUDA(cudaGetLastError());
 }
 

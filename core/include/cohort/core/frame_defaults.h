@@ -12,14 +12,16 @@ namespace cohort::core {
 constexpr int kDefaultWidth = 640;
 constexpr int kDefaultHeight = 360;
 
-// Path tracing, 1 spp, next-event estimation with one light sample picked among the lights in range and
+// Path tracing, 1 spp, next-event estimation with one light sample picked among the lights in range (or, where
+// many overlap, by the dense rooms' bounded pick: K_LIGHTS_AUTO) and
 // one emissive-triangle sample (MIS with the bounce), plus one bounce, Doom 3's 2x
 // specular boost, fireflies clamped at 5, soft shadows at 0.2 of a light's extent, Russian roulette
 // from the second bounce. The band (row_begin, row_end) is left empty for the caller.
 KFrameParams default_frame_params();
 
 // The light-sampling modes by their command-line names: "tree" (K_LIGHTS_TREE), "all" (K_LIGHTS_ALL), "every"
-// (K_LIGHTS_EVERY), "gather" (K_LIGHTS_GATHER) and "in-range" (K_LIGHTS_IN_RANGE, the default), in that order.
+// (K_LIGHTS_EVERY), "gather" (K_LIGHTS_GATHER), "in-range" (K_LIGHTS_IN_RANGE), "dense" (K_LIGHTS_DENSE) and
+// "auto" (K_LIGHTS_AUTO, the default: in-range or dense by the scene, core/light_sampling.h), in that order.
 const std::vector<std::string>& light_sampling_names();
 // Throws std::invalid_argument naming the choices for any other name.
 kuint light_sampling_mode(const std::string& name);

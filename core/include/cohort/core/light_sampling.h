@@ -46,4 +46,21 @@ std::vector<KLightNode> build_light_nodes(const std::vector<KLight>& lights, Emi
 // The derived arrays of `scene` (light nodes, emissive triangles) rebuilt from its other arrays.
 void rebuild_light_sampling(commit::TracerScene& scene);
 
+// How crowded the Doom 3 lights' volumes are: the mean, over the lights in the tree, of how many lights' boxes
+// hold the centre of the light's own box (itself included), found by walking the tree. 0 without lights. A
+// light's centre stands for the points it lights; the count is about what in-range weighs there: a few on
+// Doom 3 maps (the large generated map 5.1, the test map 2.1), 8.0 / 18.1 / 21.4 / 70.1 in bench_scaling's
+// 8 / 64 / 256 / 1,024-light rooms (3k triangles). O(lights x their overlap): computed by the tracers when
+// their light tree changes (tracers::TracerBase), and by `cohort render` for stats.json.
+float light_density(const commit::TracerScene& scene);
+
+// Above this light_density, K_LIGHTS_AUTO is K_LIGHTS_DENSE, at or below it K_LIGHTS_IN_RANGE: between the
+// Doom 3 maps' few and the bench rooms' many, where dense already costs less than in-range on the CPU (64
+// lights: 59 against 81 ms a frame; docs/integrator.md, "Dense rooms").
+constexpr float kDenseLightDensity = 16.0f;
+
+// The light sampling a frame asked for, with K_LIGHTS_AUTO resolved by the scene's light_density: the mode
+// itself for every other mode.
+kuint resolve_light_sampling(kuint mode, float density);
+
 }  // namespace cohort::core

@@ -28,6 +28,15 @@
 #define K_CTX_SCENE(ctx) (&(ctx)->scene)
 #endif
 
+/* Which builds compile K_LIGHTS_DENSE's pick (light_tree.h's k_light_dense_pick): 1 (the default), beside
+ * the other ways, chosen at run time (Embree, OpenCL); 0, not at all (CUDA's kernels for the other ways, so
+ * that their code and registers stay what they are without it: a frame asking for it is given `all`'s pick
+ * there); 2, the only way compiled (CUDA's dense kernels, render_band_dense.cu, launched only for frames with
+ * K_LIGHTS_DENSE and light_samples > 0). Why CUDA builds it apart: docs/integrator.md, "Dense rooms". */
+#ifndef K_LIGHTS_DENSE_BUILD
+#define K_LIGHTS_DENSE_BUILD 1
+#endif
+
 #define K_MAX_LAYERS 16   /* transparent layers a ray may cross without consuming a bounce */
 #define K_REGULARIZED_ROUGHNESS 0.5f  /* least roughness of surfaces reached by a bounce */
 #define K_BOUNCE_SPREAD 0.1f          /* ray-cone widening per bounce (radians), for mip selection */
@@ -98,7 +107,7 @@ KFN int k_lights_one_ray_each(const KFrameParams* params) {
          params->light_sampling == K_LIGHTS_EVERY;
 }
 
-/* Next-event estimation toward the Doom 3 lights, five ways (KFrameParams.light_sampling):
+/* Next-event estimation toward the Doom 3 lights, six ways (KFrameParams.light_sampling):
  * - K_LIGHTS_EVERY (or light_samples == 0): every light that reaches the point, one shadow ray each
  *   (as Doom 3 draws every interaction; lowest noise where few lights overlap, cost grows with them).
  * - K_LIGHTS_TREE (default): per light sample, one light picked through the light tree among those
@@ -106,6 +115,9 @@ KFN int k_lights_one_ray_each(const KFrameParams* params) {
  * - K_LIGHTS_IN_RANGE: the same without the tree's descent: one light per sample picked in proportion to
  *   its unshadowed contribution among every light whose volume holds the point (cost grows with those, not
  *   with the map's lights).
+ * - K_LIGHTS_DENSE: per light sample, a descent of the tree by a guess of each subtree's contribution to at
+ *   most K_LIGHT_DENSE_LEAF lights, then in-range's pick among them (light_tree.h): bounded work where many
+ *   lights reach a point (K_LIGHTS_DENSE_BUILD says which builds compile it).
  * - K_LIGHTS_ALL: per light sample, one light picked over every light of the map in proportion to its
  *   unshadowed contribution (the reference for the tree: same pick, cost grows with the map).
  * - K_LIGHTS_GATHER: `every` among the lights whose volume holds the point, found through the tree, while
@@ -116,6 +128,7 @@ KFN int k_lights_one_ray_each(const KFrameParams* params) {
 KFN void k_direct_lighting(KTraceCtx* ctx, const KFrameParams* params, const KSurface* sf, KVec3 wo, float path_weight,
                            KRng* rng, KShadowQueue* queue, KVertexLight* vertex) {
   const KSceneView* scene = K_CTX_SCENE(ctx);
+#if K_LIGHTS_DENSE_BUILD != 2
   int gather = params->light_sampling == K_LIGHTS_GATHER && params->light_samples > 0u;
   if (k_lights_one_ray_each(params)) {
     /* `every` walks the whole light array; gather, the lights k_light_gather chose (outlined, on values,
@@ -135,18 +148,29 @@ KFN void k_direct_lighting(KTraceCtx* ctx, const KFrameParams* params, const KSu
     }
     return;
   }
+#endif
   kuint samples = params->light_samples;
   for (kuint k = 0u; k < samples; ++k) {
     kuint chosen = K_NONE;
     KVec3 chosen_contrib = v3s(0.0f);
     float pdf = 0.0f;
     float u_pick = k_rng_next(rng);
+#if K_LIGHTS_DENSE_BUILD == 2
+    chosen = k_light_dense_pick(scene, sf, wo, params->spec_boost, k_rng_next(rng), u_pick, &chosen_contrib, &pdf);
+#else
     if (params->light_sampling == K_LIGHTS_TREE || params->light_sampling == K_LIGHTS_IN_RANGE) {
       float u_descend = k_rng_next(rng);
       kuint descend_above = params->light_sampling == K_LIGHTS_TREE ? K_LIGHT_TREE_GATHER : K_NONE;
-      chosen = k_light_tree_pick(scene, sf, wo, params->spec_boost, descend_above, u_descend, u_pick,
+      chosen = k_light_tree_pick(scene, sf, wo, params->spec_boost, descend_above, 0, u_descend, u_pick,
                                  &chosen_contrib, &pdf);
-    } else {
+    }
+#if K_LIGHTS_DENSE_BUILD == 1
+    else if (params->light_sampling == K_LIGHTS_DENSE) {
+      float u_descend = k_rng_next(rng);
+      chosen = k_light_dense_pick(scene, sf, wo, params->spec_boost, u_descend, u_pick, &chosen_contrib, &pdf);
+    }
+#endif
+    else {
       float total = 0.0f, chosen_weight = 0.0f;
       for (kuint i = 0u; i < scene->light_count; ++i) {
         KVec3 c = k_light_unshadowed(scene, &scene->lights[i], sf, wo, params->spec_boost);
@@ -165,6 +189,7 @@ KFN void k_direct_lighting(KTraceCtx* ctx, const KFrameParams* params, const KSu
       }
       pdf = chosen != K_NONE ? chosen_weight / total : 0.0f;
     }
+#endif
     float u1 = k_rng_next(rng), u2 = k_rng_next(rng);
     if (chosen == K_NONE || !(pdf > 0.0f)) continue;
     KVec3 value = v3_scale(chosen_contrib, 1.0f / pdf);

@@ -167,11 +167,13 @@ typedef struct KLight {
  *     triangles' boxes; a leaf holds emissive triangle left_first (an index into KEmissiveTriangle).
  * count == 0: interior node, children at left_first and left_first + 1 (absolute indices). power: the
  * summed power of the sources below (light colour luminance; emissive area x power density);
- * light_count: how many; parent: the parent node, K_NONE at a root. */
+ * light_count: how many; parent: the parent node, K_NONE at a root; reach: the largest half-extent (any
+ * axis) of a source's box below, the size of a light in light_tree.h's k_light_node_guess (set in both
+ * trees, read in the Doom 3 lights' only). */
 typedef struct KLightNode {
   float bmin[3]; kuint left_first;
   float bmax[3]; kuint count;
-  float power;   kuint light_count; kuint parent; kuint pad1;
+  float power;   kuint light_count; kuint parent; float reach;
 } KLightNode;
 
 /* ---- Emissive triangles: every triangle whose material emits, in world space, sorted by (instance,
@@ -209,7 +211,13 @@ typedef struct KCamera {
                                light_samples shadow rays (integrator.h, light_gather.h) */
 #define K_LIGHTS_IN_RANGE 4u  /* per light sample, one light picked by its unshadowed contribution among
                                  every light whose volume holds the point: the tree walked without its
-                                 descent (light_tree.h); the default (core::default_frame_params) */
+                                 descent (light_tree.h); what the default, K_LIGHTS_AUTO, is on Doom 3 maps */
+#define K_LIGHTS_DENSE 5u     /* for rooms where many lights reach a point: a descent of the tree by a guess
+                                 of each subtree's contribution to at most K_LIGHT_DENSE_LEAF lights, then
+                                 in-range within them (light_tree.h); a kernel build of its own on CUDA */
+#define K_LIGHTS_AUTO 6u      /* the default (core::default_frame_params): in-range or dense, chosen per frame
+                                 from the lights' density (core::resolve_light_sampling); the tracers resolve
+                                 it before a kernel sees it */
 
 /* light_count, instance_count, tlas_node_count, light_node_count and emissive_count are the lengths of
  * the scene's arrays, set by the host from the tracer's scene copy and read only by k_scene_view

@@ -31,11 +31,60 @@ KFN float k_light_node_importance(KGLOBAL const KLightNode* n, KVec3 p) {
   return k_light_node_holds(n, p) ? n->power : 0.0f;
 }
 
+/* The integral over t in [a, b] (clamped to [-1, 1]) of the window (1 - t^2)^2: its antiderivative
+ * t - 2t^3/3 + t^5/5 at both ends. */
+KFN float k_window_integral(float a, float b) {
+  a = k_fmin(k_fmax(a, -1.0f), 1.0f);
+  b = k_fmin(k_fmax(b, -1.0f), 1.0f);
+  float a2 = a * a, b2 = b * b;
+  return b * (1.0f + b2 * (-2.0f / 3.0f + b2 * 0.2f)) - a * (1.0f + a2 * (-2.0f / 3.0f + a2 * 0.2f));
+}
+
+/* A guess, from a node alone, of how much its lights give the point p with normal `normal`: the importance
+ * of K_LIGHTS_DENSE's descent (from the reverted in-range-bounded, docs/integrator.md). Model: the node's
+ * lights are point lights of half-extent reach (layout.h: the largest below) with their centres spread evenly
+ * over the node's box shrunk by reach, each lighting p by its box's window (1 - d^2)^2, taken per axis. Their
+ * mean is a product over the axes of the window's mean over the centres' interval (its integral over the
+ * interval's length, or its value at the one centre where that length is zero: a leaf, lights in one plane),
+ * times the power and the cosine toward the centres' box (1 where p's tangent plane cuts it). The tree's own
+ * importance, power wherever the box holds p, weighs a subtree of lights all beyond reach of p like one
+ * around it. Floors (K_LIGHT_GUESS_FLOOR, K_LIGHT_GUESS_MEAN_FLOOR) keep every node whose box holds p above
+ * zero: a light's own falloff image, projection, shape or centre may differ from the model, and an unbiased
+ * pick needs every light that reaches p to be reachable. The constants were chosen on the bench rooms and
+ * the test floors by the branch that introduced the guess (lightbound). */
+#define K_LIGHT_GUESS_FLOOR 0.02f
+#define K_LIGHT_GUESS_MEAN_FLOOR 1e-4f
+KFN float k_light_node_guess(KGLOBAL const KLightNode* n, KVec3 p, KVec3 normal) {
+  if (!k_light_node_holds(n, p)) return 0.0f;
+  float r = n->reach;
+  if (!(r > 0.0f)) return n->power;   /* no size known: the tree's importance */
+  float mean = 1.0f, facing = 0.0f, centre_dist2 = 0.0f;
+  float pv[3] = {p.x, p.y, p.z}, nv[3] = {normal.x, normal.y, normal.z};
+  for (int k = 0; k < 3; ++k) {
+    float lo = n->bmin[k] + r, hi = n->bmax[k] - r;
+    if (lo > hi) lo = hi = 0.5f * (n->bmin[k] + n->bmax[k]);
+    float len = hi - lo, mid = 0.5f * (lo + hi);
+    if (len > 1e-3f * r) {
+      mean *= r * k_window_integral((lo - pv[k]) / r, (hi - pv[k]) / r) / len;
+    } else {
+      float t = (mid - pv[k]) / r;
+      mean *= k_window_falloff(t * t);
+    }
+    /* How far the centres' box reaches along the normal from p, and p's distance to its middle. */
+    facing += nv[k] * (mid - pv[k]) + k_fabs(nv[k]) * 0.5f * len;
+    centre_dist2 += (mid - pv[k]) * (mid - pv[k]);
+  }
+  float cosine = centre_dist2 > 0.0f ? k_fmin(k_fmax(facing / k_sqrt(centre_dist2), 0.0f), 1.0f) : 1.0f;
+  return n->power * (k_fmax(mean, 0.0f) + K_LIGHT_GUESS_MEAN_FLOOR) * (cosine + K_LIGHT_GUESS_FLOOR);
+}
+
 /* One light for the surface point, or K_NONE when none can reach it. On a pick, *contribution is its
  * unshadowed contribution toward wo and *pdf the probability that it was picked. u_descend and u_pick
  * are independent uniform numbers. descend_above: the descent goes on while a node holds more lights than
  * this (K_LIGHT_TREE_GATHER: the tree; K_NONE: no descent, the reservoir over every light whose box holds
- * the point, K_LIGHTS_IN_RANGE).
+ * the point, K_LIGHTS_IN_RANGE; K_LIGHT_DENSE_LEAF with by_guess, K_LIGHTS_DENSE). by_guess: each step
+ * weighs a child by k_light_node_guess instead of its power wherever its box holds the point (a constant
+ * at every call, so that each caller's inlined copy keeps one importance only).
  *
  * Why the second: the descent weighs a child by its lights' power wherever its box holds the point, and a
  * child's box (the union of its lights') holds many points that none of its lights reach. On the large
@@ -44,15 +93,17 @@ KFN float k_light_node_importance(KGLOBAL const KLightNode* n, KVec3 p) {
  * the shadow roulette), and its RMSE was 3.3x the pick in range's (docs/integrator.md, "One light among those
  * in range"). */
 KFN kuint k_light_tree_pick(const KSceneView* scene, const KSurface* sf, KVec3 wo, float spec_boost, kuint descend_above,
-                            float u_descend, float u_pick, KVec3* contribution, float* pdf) {
+                            int by_guess, float u_descend, float u_pick, KVec3* contribution, float* pdf) {
   KVec3 p = sf->position;
   if (k_light_tree_nodes(scene) == 0u || !k_light_node_holds(&scene->light_nodes[0], p)) return K_NONE;
   kuint node = 0u;
   float prob = 1.0f;
   while (scene->light_nodes[node].count == 0u && scene->light_nodes[node].light_count > descend_above) {
     kuint left = scene->light_nodes[node].left_first;
-    float wl = k_light_node_importance(&scene->light_nodes[left], p);
-    float wr = k_light_node_importance(&scene->light_nodes[left + 1u], p);
+    float wl = by_guess ? k_light_node_guess(&scene->light_nodes[left], p, sf->normal)
+                        : k_light_node_importance(&scene->light_nodes[left], p);
+    float wr = by_guess ? k_light_node_guess(&scene->light_nodes[left + 1u], p, sf->normal)
+                        : k_light_node_importance(&scene->light_nodes[left + 1u], p);
     float total = wl + wr;
     if (!(total > 0.0f)) return K_NONE;
     float pl = wl / total;
@@ -103,6 +154,19 @@ KFN kuint k_light_tree_pick(const KSceneView* scene, const KSurface* sf, KVec3 w
   *contribution = chosen_contribution;
   *pdf = prob * chosen_weight / total;
   return chosen;
+}
+
+/* K_LIGHTS_DENSE, for rooms where many lights reach a point: the descent by k_light_node_guess to a node of
+ * at most K_LIGHT_DENSE_LEAF lights, then the reservoir over the lights below it whose box holds p. At most
+ * K_LIGHT_DENSE_LEAF lights weighed and two guesses a level however many lights reach p, where in-range
+ * weighs every one (about 88 in bench_scaling's 1,024-light room). pdf = the steps' probabilities x
+ * w / (sum of w in the node); the guess is above zero wherever a node's box holds p, so every light that
+ * reaches p keeps a nonzero pdf: unbiased. Where the map has at most K_LIGHT_DENSE_LEAF lights it is
+ * in-range's pick, float for float. */
+#define K_LIGHT_DENSE_LEAF 8u
+KFN kuint k_light_dense_pick(const KSceneView* scene, const KSurface* sf, KVec3 wo, float spec_boost, float u_descend,
+                             float u_pick, KVec3* contribution, float* pdf) {
+  return k_light_tree_pick(scene, sf, wo, spec_boost, K_LIGHT_DENSE_LEAF, 1, u_descend, u_pick, contribution, pdf);
 }
 
 #endif

@@ -3,6 +3,7 @@
 // parameters with the scene's counts, and a KSceneView over the arrays wherever the tracer keeps them.
 #pragma once
 
+#include <atomic>
 #include <vector>
 
 #include "cohort/commit/tracer_scene.h"
@@ -28,7 +29,8 @@ class TracerBase : public core::Tracer {
   // skins in ChangeSet::posed_skins; otherwise they run on the host while the commit is applied.
   virtual bool skins_on_device() const { return false; }
 
-  // The band's parameters with the scene's light, instance and TLAS node counts filled in.
+  // The band's parameters with the scene's light, instance and TLAS node counts filled in, and
+  // K_LIGHTS_AUTO resolved by the scene's light density (core::resolve_light_sampling).
   KFrameParams frame_params(const core::BandJob& job) const;
   // The kernel's view of the scene copy itself, for tracers that trace from host memory.
   KSceneView host_scene_view(const KFrameParams& params) const;
@@ -46,6 +48,8 @@ class TracerBase : public core::Tracer {
   void remember_previous_joints(const std::vector<KSkin>& skins_before, std::vector<KJoint> joints_before);
 
   commit::TracerScene scene_;
+  float light_density_ = 0.0f;          // core::light_density(scene_), kept with the light tree
+  mutable std::atomic<kuint> logged_auto_{K_NONE};  // the choice K_LIGHTS_AUTO last logged
   std::vector<float> previous_transforms_;
   std::vector<KJoint> previous_joints_;
   bool has_scene_ = false;
