@@ -79,7 +79,7 @@ struct RenderArgs {
   float history_fix_min = core::AtrousOptions{}.history_fix_min_length;
   float anti_lag = -1.0f;     // < 0: ReprojectionOptions' default
   std::string post_on = "auto";
-  std::string band_format = "rgb16f";
+  std::string band_format = "rgb9e5";
   bool frames_given = false;
   bool write_ids = false;  // the G-buffer's id plane of every written frame, and which entities moved
   bool bands_through_host = false;  // A/B: CUDA bands go down and back up even where the post could take them on the GPU

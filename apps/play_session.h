@@ -35,7 +35,7 @@ struct SessionOptions {
   // (the first sample's own first surface: no extra ray; kernel/aux_outputs.h).
   std::string aux_rays = "auto";
   // What the tracers hand back (core::BandFormat's names): half floats by default, the HUD image cannot tell.
-  std::string band_format = "rgb16f";
+  std::string band_format = "rgb9e5";
   int window_height = 360;
 };
 
