@@ -25,21 +25,6 @@
 #include "portable.h"
 #include "rng.h"
 
-/* A float from its bits, the reverse of portable.h's k_as_uint (only this format builds floats by hand). */
-#if defined(__OPENCL_VERSION__)
-  #define k_bits_to_float(u) as_float(u)
-#else
-KFN float k_bits_to_float(kuint u) {
-  #if defined(__CUDA_ARCH__)
-  return __uint_as_float(u);
-  #else
-  float f;
-  memcpy(&f, &u, sizeof f);
-  return f;
-  #endif
-}
-#endif
-
 #define K_RGB9E5_NONFINITE 0xffffffffu
 /* 510 * 2^(31 - 15 - 9): one step below GL's 65408, whose all-ones word here means "not finite". */
 #define K_RGB9E5_MAX 65280.0f

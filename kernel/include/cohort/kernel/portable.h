@@ -82,11 +82,13 @@
 /* k_load4(p): four consecutive floats from a global array whose element size keeps them 16-byte
  * aligned (BVH nodes, vertex positions, triangles, instance matrices). On the GPU this is one 128-bit
  * load through the read-only cache where scalar loads of a struct's fields cost four instructions and,
- * in the BVH walk, most of its latency. k_as_uint reads an integer stored in a float lane. */
+ * in the BVH walk, most of its latency. k_as_uint reads an integer stored in a float lane;
+ * k_bits_to_float builds a float from its bits (band_pack.h's shared exponent). */
 #if defined(__OPENCL_VERSION__)
   typedef float4 KFloat4;
   #define k_load4(p) vload4(0, (p))
   #define k_as_uint(f) as_uint(f)
+  #define k_bits_to_float(u) as_float(u)
 #elif defined(__CUDACC__)
   typedef float4 KFloat4;
   KFN KFloat4 k_load4(const float* p) {
@@ -105,6 +107,15 @@
     return u;
   #endif
   }
+  KFN float k_bits_to_float(kuint u) {
+  #if defined(__CUDA_ARCH__)
+    return __uint_as_float(u);
+  #else
+    float f;
+    memcpy(&f, &u, sizeof f);
+    return f;
+  #endif
+  }
 #else
   typedef struct KFloat4 { float x, y, z, w; } KFloat4;
   static inline KFloat4 k_load4(const float* p) {
@@ -115,6 +126,11 @@
     kuint u;
     memcpy(&u, &f, sizeof u);
     return u;
+  }
+  static inline float k_bits_to_float(kuint u) {
+    float f;
+    memcpy(&f, &u, sizeof f);
+    return f;
   }
 #endif
 
