@@ -55,6 +55,24 @@ void expect_finite(const core::FrameBuffer& fb, const std::string& what) {
                                             << (i / 4) / size_t(fb.width) << " is " << fb.rgba[i];
 }
 
+
+// The test room (3 lights) at 64x48, paths of 2 bounces at 4 spp, soft shadows, with `sampling`.
+core::FrameBuffer render_test_room(core::Tracer& tracer, kuint sampling) {
+  const scene::Scene room = test_room();
+  const int h = 48;
+  KFrameParams p = frame_params(K_MODE_PATH, 4, 2, h);
+  p.soft_shadow_scale = 1.0f;
+  p.shadow_rr = 0.03f;
+  p.light_sampling = sampling;
+  return render(tracer, room, test_room_camera(64, h), p);
+}
+
+// Float for float, naming the first pixel that differs.
+void expect_same_image(const core::FrameBuffer& a, const core::FrameBuffer& b) {
+  for (size_t i = 0; i < a.rgba.size(); ++i)
+    ASSERT_EQ(a.rgba[i], b.rgba[i]) << "pixel " << (i / 4) % size_t(a.width) << "," << (i / 4) / size_t(a.width);
+}
+
 }  // namespace
 
 // Direct lighting only, hard shadows: the every-light image has no light-selection noise, so a biased
@@ -183,21 +201,10 @@ TEST(LightSampling, InRangeIsTheTreeWithoutItsDescent) {
   if (!tracer_runs_here("embree")) GTEST_SKIP();
   auto tracer = make_test_tracer("embree");
   {
-    scene::Scene room = test_room();
-    ASSERT_EQ(room.lights.size(), 3u);
-    const int w = 64, h = 48;
-    const KCamera cam = test_room_camera(w, h);
-    auto render_with = [&](kuint sampling) {
-      KFrameParams p = frame_params(K_MODE_PATH, 4, 2, h);
-      p.soft_shadow_scale = 1.0f;
-      p.shadow_rr = 0.03f;
-      p.light_sampling = sampling;
-      return render(*tracer, room, cam, p);
-    };
-    const core::FrameBuffer tree = render_with(K_LIGHTS_TREE), in_range = render_with(K_LIGHTS_IN_RANGE);
+    ASSERT_EQ(test_room().lights.size(), 3u);
+    const core::FrameBuffer tree = render_test_room(*tracer, K_LIGHTS_TREE);
     EXPECT_GT(mean_luminance(tree), 0.01) << "the room should be lit";
-    for (size_t i = 0; i < tree.rgba.size(); ++i)
-      ASSERT_EQ(in_range.rgba[i], tree.rgba[i]) << "pixel " << (i / 4) % size_t(w) << "," << (i / 4) / size_t(w);
+    expect_same_image(render_test_room(*tracer, K_LIGHTS_IN_RANGE), tree);
   }
   scene::Scene s = many_lights_floor(88, 8);
   const int w = 64, h = 48;
@@ -235,21 +242,10 @@ TEST(LightSampling, InRangeIsTheTreeWithoutItsDescent) {
 TEST(LightSampling, DenseIsInRangeWhereTheMapHasFewLights) {
   if (!tracer_runs_here("embree")) GTEST_SKIP();
   auto tracer = make_test_tracer("embree");
-  scene::Scene room = test_room();
-  ASSERT_LE(room.lights.size(), size_t(K_LIGHT_DENSE_LEAF));
-  const int w = 64, h = 48;
-  const KCamera cam = test_room_camera(w, h);
-  auto render_with = [&](kuint sampling) {
-    KFrameParams p = frame_params(K_MODE_PATH, 4, 2, h);
-    p.soft_shadow_scale = 1.0f;
-    p.shadow_rr = 0.03f;
-    p.light_sampling = sampling;
-    return render(*tracer, room, cam, p);
-  };
-  const core::FrameBuffer in_range = render_with(K_LIGHTS_IN_RANGE), dense = render_with(K_LIGHTS_DENSE);
+  ASSERT_LE(test_room().lights.size(), size_t(K_LIGHT_DENSE_LEAF));
+  const core::FrameBuffer in_range = render_test_room(*tracer, K_LIGHTS_IN_RANGE);
   EXPECT_GT(mean_luminance(in_range), 0.01) << "the room should be lit";
-  for (size_t i = 0; i < in_range.rgba.size(); ++i)
-    ASSERT_EQ(dense.rgba[i], in_range.rgba[i]) << "pixel " << (i / 4) % size_t(w) << "," << (i / 4) / size_t(w);
+  expect_same_image(render_test_room(*tracer, K_LIGHTS_DENSE), in_range);
 }
 
 class DenseOnFloor : public ::testing::TestWithParam<int> {};
