@@ -34,7 +34,7 @@ struct SessionOptions {
   // Where the G-buffer comes from: "centre" (a ray of its own through each pixel's centre) or "first-hit"
   // (the first sample's own first surface: no extra ray; kernel/aux_outputs.h).
   std::string aux_rays = "auto";
-  // What the tracers hand back (core::BandFormat's names): half floats by default, the HUD image cannot tell.
+  // What the tracers hand back (core::BandFormat's names): RGB9E5 by default (4 bytes a pixel, docs/cluster.md).
   std::string band_format = "rgb9e5";
   int window_height = 360;
 };

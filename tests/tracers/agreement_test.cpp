@@ -226,8 +226,8 @@ INSTANTIATE_TEST_SUITE_P(Modes, AgreementAux, ::testing::Values(K_AUX_CENTRE_RAY
                            return std::string(info.param == K_AUX_CENTRE_RAY ? "CentreRays" : "FirstHits");
                          });
 
-// A band in half floats (what `cohort render` and `play` use by default: GPU tracers convert it on the
-// device) equals the same tracer's band in floats within half precision.
+// A band in half floats (`--band-format rgb16f`: GPU tracers convert it on the device) equals the same
+// tracer's band in floats within half precision.
 TEST(AgreementBandFormat, HalfFloatBandsEqualFloatBands) {
   const int w = 48, h = 32;
   const KCamera cam = test_room_camera(w, h);

@@ -53,7 +53,7 @@ struct RendererOptions {
   // Per tracer: past this many bytes of pending records, it gets a full resync instead.
   size_t commit_budget_bytes = 32u << 20;
   // What the tracers render their bands into (core/band_buffer.h); the merge converts to the float
-  // frame. The apps take RGB16F; RGBA32F keeps values exact.
+  // frame. The apps take RGB9E5 (4 bytes a pixel); RGBA32F keeps values exact.
   BandFormat band_format = BandFormat::rgba32f;
   // A benched tracer with no probe to render gets its commits every this many frames (they coalesce in
   // its channel meanwhile), not every frame: applying them is pure overhead while it sits out, and a CPU
