@@ -80,9 +80,10 @@ struct PlaySession::State {
   Prepared prepare(const viewer::FlyCamera& camera, double seconds, const FrameSettings& settings, bool paused);
   // The next frame, prepared and announced as soon as the frame before it was handed out (the input of
   // the call that handed that one out), pushed by the next call; none while the announcement at hand-out
-  // is off (COHORT_EARLY_ANNOUNCE=0).
+  // is off: COHORT_EARLY_ANNOUNCE=0, or no tracer takes jobs ahead (only remote tracers do), where it would
+  // add a frame between input and image for nothing.
   std::optional<Prepared> next;
-  const bool announce_at_hand_out = core::FramePipeline::announces_at_hand_out();
+  bool announce_at_hand_out = false;
   // What the frame in flight was prepared with, for when it comes back.
   struct InFlight {
     size_t commit_bytes = 0;
@@ -132,6 +133,7 @@ PlaySession::PlaySession(const SessionOptions& options) {
   renderer_options.band_format = core::band_format_from_string(options.band_format);
   renderer_options.benched_commit_every = 8;  // as `cohort render`'s default
   s.renderer = std::make_unique<core::Renderer>(std::move(tracers), renderer_options);
+  s.announce_at_hand_out = core::FramePipeline::announces_at_hand_out() && s.renderer->takes_jobs_ahead();
   s.renderer->submit_commit(commit::CommitBuffer::full(initial_scene, 0));
   s.pipeline = std::make_unique<core::FramePipeline>(*s.renderer);
   s.post_place = tracers::auto_frame_post_place(started);

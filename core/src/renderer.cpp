@@ -233,11 +233,13 @@ Renderer::Renderer(std::vector<std::unique_ptr<Tracer>> tracers, RendererOptions
     w->handoff_spin = options_.handoff_spin;
     // The worker owns the tracer, so the hook never outlives what it points at.
     if (w->tracer->takes_commits_ahead()) w->tracer->set_commits_ahead([worker = w.get()] { worker->apply_ahead(); });
-    if (w->tracer->takes_jobs_ahead())
+    if (w->tracer->takes_jobs_ahead()) {
+      any_takes_jobs_ahead_ = true;
       w->tracer->set_next_job([announcement = announcement_]() -> std::optional<BandJob> {
         std::lock_guard lock(announcement->mutex);
         return announcement->job;
       });
+    }
     workers_.push_back(std::move(w));
   }
   // Each thread shares its worker, so a worker whose tracer never returns can be left behind at

@@ -397,6 +397,20 @@ TEST(FramePipeline, ATracerThatTakesJobsAheadSeesTheNextFramesJobWhileItRendersT
   for (const AnnouncementTracer::Seen& s : *other_seen) EXPECT_TRUE(s.announced.empty()) << "it did not ask for jobs ahead";
 }
 
+// `cohort play` announces at hand-out only where a tracer takes jobs ahead (it costs a frame of input
+// latency): the Renderer says whether one does.
+TEST(FramePipeline, TheRendererSaysWhetherATracerTakesJobsAhead) {
+  auto gates = std::make_shared<FrameGates>();
+  auto seen = std::make_shared<std::vector<AnnouncementTracer::Seen>>();
+  for (bool ahead : {false, true}) {
+    std::vector<std::unique_ptr<Tracer>> tracers;
+    tracers.push_back(std::make_unique<AnnouncementTracer>(false, gates, seen));
+    tracers.push_back(std::make_unique<AnnouncementTracer>(ahead, gates, seen));
+    Renderer renderer(std::move(tracers), RendererOptions{});
+    EXPECT_EQ(renderer.takes_jobs_ahead(), ahead);
+  }
+}
+
 namespace {
 
 // Takes jobs ahead; each band renders until the next frame's job is announced (or its frame's gate

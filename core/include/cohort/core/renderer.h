@@ -105,6 +105,8 @@ class Renderer {
   // commits submitted): tracers that take jobs ahead (Tracer::takes_jobs_ahead) may start on it while
   // their band of the frame in flight ends. begin_frame() withdraws it. FramePipeline::push calls it.
   void announce_frame(const BandJob& job);
+  // Whether any tracer takes jobs ahead (remote tracers): only then does an early announcement help.
+  bool takes_jobs_ahead() const { return any_takes_jobs_ahead_; }
   FrameStats wait_frame();
   void merge_frame(FrameStats& stats);
   FrameStats finish_frame();
@@ -194,6 +196,7 @@ class Renderer {
     std::optional<BandJob> job;
   };
   std::shared_ptr<Announcement> announcement_ = std::make_shared<Announcement>();
+  bool any_takes_jobs_ahead_ = false;
   std::unique_ptr<PendingFrame> pending_;    // begun, not yet waited for
   std::unique_ptr<PendingFrame> unmerged_;   // waited for, bands not yet merged
   int next_slot_ = 0;
