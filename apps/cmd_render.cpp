@@ -506,7 +506,7 @@ void add_render_command(CLI::App& app, int& exit_code) {
                   "contribution over every light), every (reference: every light, one shadow ray each), gather (a "
                   "shadow ray for each light whose volume holds the point, found through the light tree, while "
                   "there are at most --light-samples of them; beyond that at most --light-samples rays (16 at "
-                  "most), the brightest lights first, unbiased) or in-range (one light per sample, picked by its "
+                  "most), the brightest lights first, unbiased), in-range (one light per sample, picked by its "
                   "unshadowed contribution among every light whose volume holds the point, found through the tree "
                   "without its descent: cost grows with the lights in range, not the map's), dense (for rooms where "
                   "many lights reach a point: a descent of the tree by a guess of each subtree's contribution to 8 "
