@@ -50,7 +50,7 @@ __global__ void __launch_bounds__(128, 8) bounce_walk_kernel(KSceneView scene, K
                                                              unsigned* row_rays) {
   const BandPixel px = band_pixel(params, camera);
   const size_t p = px.index(camera);
-  const bool inside = px.inside && (wave.active[p] & kWaveLive);
+  const bool inside = px.inside && (wave.active[p] & K_WAVE_LIVE);
   KTraceCtx ctx = fresh_trace_ctx(scene);
   if (inside) {
     const KPathState* s = wave.states + p;
@@ -72,7 +72,7 @@ __global__ void __launch_bounds__(128, 8) shadow_walk_kernel(KSceneView scene, K
   const BandPixel px = band_pixel(params, camera);
   const size_t p = px.index(camera);
   const kuint flags = px.inside ? wave.active[p] : 0u;
-  const bool inside = (flags & kWaveShadowsOut) != 0u;
+  const bool inside = (flags & K_WAVE_SHADOWS_OUT) != 0u;
   KTraceCtx ctx = fresh_trace_ctx(scene);
   if (inside) {
     const KShadowRay* rays = wave.shadow_rays + p;
@@ -89,9 +89,9 @@ __global__ void __launch_bounds__(128, 8) shadow_walk_kernel(KSceneView scene, K
         k_shadow_ray_add(&v, &ray);
       }
     const KVec3 radiance = v3_add(wave.states[p].radiance, k_vertex_light_sum(&v));
-    if (flags & kWaveLive) {
+    if (flags & K_WAVE_LIVE) {
       wave.states[p].radiance = radiance;
-      wave.active[p] = kWaveLive;
+      wave.active[p] = K_WAVE_LIVE;
     } else {
       wave.active[p] = 0u;
       finish_sample(band, p, radiance, sample, params);
