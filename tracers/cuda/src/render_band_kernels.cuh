@@ -3,8 +3,8 @@
 // light sampling but K_LIGHTS_DENSE, and by render_band_dense.cu into cohort::tracers::dense, with
 // K_LIGHTS_DENSE_BUILD 2, for K_LIGHTS_DENSE alone. The dense pick's code is not in the first build at all,
 // so in-range's kernels keep their registers and spills (docs/integrator.md, "Dense rooms": a bounded pick
-// that shared them made the default 8-11 % slower on one H100). The includer includes integrator.h and
-// band_samples.cuh, ray_counting.cuh and render_band_launch.h first, and includes this inside its namespace.
+// that shared them made the default 8-11 % slower on one H100). The includer includes integrator.h,
+// ray_counting.cuh and render_band_launch.h first, and includes this inside its namespace.
 
 // At least 4 blocks of 128 threads per SM: caps the kernel at 128 registers (25% occupancy) instead of
 // 164. Measured on one H100 (docs/integrator.md, "CUDA kernel shape"): 3 blocks 15.8 ms, 4 blocks 13.7 ms,
