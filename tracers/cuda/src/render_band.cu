@@ -14,7 +14,6 @@ __constant__ cudaTextureObject_t cohort_texel_texture;
 #include "cohort/kernel/integrator.h"
 #include "cohort/kernel/aux_outputs.h"
 #include "cohort/tracers/wave_lanes.h"
-#include "band_samples.cuh"
 #include "ray_counting.cuh"
 #include "render_band_launch.h"
 

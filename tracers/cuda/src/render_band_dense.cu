@@ -13,7 +13,6 @@ static __constant__ cudaTextureObject_t cohort_dense_texel_texture;
 
 #include "cohort/kernel/trace_bvh.h"
 #include "cohort/kernel/integrator.h"
-#include "band_samples.cuh"
 #include "ray_counting.cuh"
 #include "render_band_launch.h"
 

@@ -3,8 +3,8 @@
 // light sampling but K_LIGHTS_DENSE, and by render_band_dense.cu into cohort::tracers::dense, with
 // K_LIGHTS_DENSE_BUILD 2, for K_LIGHTS_DENSE alone. The dense pick's code is not in the first build at all,
 // so in-range's kernels keep their registers and spills (docs/integrator.md, "Dense rooms": a bounded pick
-// that shared them made the default 8-11 % slower on one H100). The includer includes integrator.h and
-// band_samples.cuh, ray_counting.cuh and render_band_launch.h first, and includes this inside its namespace.
+// that shared them made the default 8-11 % slower on one H100). The includer includes integrator.h,
+// ray_counting.cuh and render_band_launch.h first, and includes this inside its namespace.
 
 // At least 4 blocks of 128 threads per SM: caps the kernel at 128 registers (25% occupancy) instead of
 // 164. Measured on one H100 (docs/integrator.md, "CUDA kernel shape"): 3 blocks 15.8 ms, 4 blocks 13.7 ms,
@@ -45,27 +45,16 @@ __device__ bool path_segment(KTraceCtx* ctx, const KFrameParams* params, KPathSt
   return k_path_segment(ctx, params, s, traced, first_hit, shadows, vertex) != 0;
 }
 
-// Pixel p's slots for its vertex's shadow rays (kShadowWalk; else none: walked as they come). The
-// capacity is a constant, so that each build keeps one way (the launch gives a vertex all the slots it
-// needs, k_shadow_queue_slots).
-template <bool kShadowWalk>
-__device__ KShadowQueue shadow_slots(const WavefrontScratch& wave, size_t p) {
-  KShadowQueue q = k_shadow_queue_inline();
-  if (kShadowWalk) {
-    q.rays = wave.shadow_rays + p;
-    q.stride = wave.shadow_stride;
-    q.capacity = K_SHADOW_QUEUE_MAX;
-  }
-  return q;
-}
+#include "cohort/kernel/wave_shade.h"
 
 // What the live paths' rays (walked by wavefront_walk.cu's kernels) met, shaded, and the paths on to their
-// next bounce. kCameraRays: the camera rays' segment, whose paths begin here from the pixel (the walk kept
-// only the hits: 88 bytes a pixel less each way); kFirstHit: that segment of the frame's first sample,
-// which records first hits. kShadowWalk: the shadow rays left in their slots for the shadow walk (else
-// walked here). With the shadow rays out, six blocks an SM (80 registers): 6.94-7.02 ms a 1080p frame of the
-// large map on one H100 against 7.12-7.16 at five and 7.33-7.35 at four (docs/integrator.md); with them in
-// (`every` past the slots, COHORT_CUDA_SHADOW_WALK=0) four, as the megakernel (at six that build spills 2.5 KB).
+// next bounce (kernel/wave_shade.h, the OpenCL tracer's too). kCameraRays: the camera rays' segment, whose
+// paths begin here from the pixel (the walk kept only the hits: 88 bytes a pixel less each way); kFirstHit:
+// that segment of the frame's first sample, which records first hits. kShadowWalk: the shadow rays left in
+// their slots for the shadow walk (else walked here). With the shadow rays out, six blocks an SM (80
+// registers): 6.94-7.02 ms a 1080p frame of the large map on one H100 against 7.12-7.16 at five and
+// 7.33-7.35 at four (docs/integrator.md); with them in (`every` past the slots, COHORT_CUDA_SHADOW_WALK=0)
+// four, as the megakernel (at six that build spills 2.5 KB).
 template <bool kCameraRays, bool kFirstHit, bool kShadowWalk>
 __global__ void __launch_bounds__(128, kShadowWalk ? 6 : 4) wave_shade_kernel(KSceneView scene, KFrameParams params, KCamera camera,
                                                          kuint sample, float4* band, WavefrontScratch wave,
@@ -73,37 +62,21 @@ __global__ void __launch_bounds__(128, kShadowWalk ? 6 : 4) wave_shade_kernel(KS
                                                          KPathFirstHit* first_hits) {
   const BandPixel px = band_pixel(params, camera);
   const size_t p = px.index(camera);
-  bool inside = px.inside && (kCameraRays || (wave.active[p] & kWaveLive));
+  float* const band_floats = reinterpret_cast<float*>(band);
+  bool inside = k_wave_shades(px.inside, p, wave.active, kCameraRays);
   KTraceCtx ctx = fresh_trace_ctx(scene);
-  if (kCameraRays && inside && !k_pixel_traces_path(params.path_pixels, params.path_phase, px.x, px.y)) {
-    // Dynamic resolution's sparse pattern leaves this pixel out: black, at no cost (k_render_pixel's way).
-    wave.active[p] = 0u;
-    finish_sample(band, p, v3s(0.0f), sample, params);
-    inside = false;
-  }
+  inside = k_wave_shade_begin(&params, px.x, px.y, inside, p, sample, band_floats, wave.active, kCameraRays);
   if (inside) {
     KPathState s;
-    if (kCameraRays) {
-      KRng rng;
-      const KVec3 dir = k_camera_sample(&params, &camera, px.x, px.y, sample, &rng);
-      k_path_begin(&s, v3_load(camera.origin), dir, k_pixel_spread(&camera), rng);
-    } else {
-      s = wave.states[p];
-    }
-    const KHit hit = wave.hits[p];
-    KShadowQueue shadows = shadow_slots<kShadowWalk>(wave, p);
+    KHit hit;
+    KShadowQueue shadows;
+    k_wave_path_load(&params, &camera, px.x, px.y, p, sample, wave.states, wave.hits, wave.shadow_rays,
+                     wave.shadow_stride, kCameraRays, kShadowWalk, &s, &hit, &shadows);
     KVertexLight vertex;
     const bool goes_on =
         path_segment(&ctx, &params, &s, &hit, kFirstHit ? first_hits + p : nullptr, &shadows, &vertex);
-    // A vertex whose shadow rays are out waits for the shadow walk, which adds its light and finishes the
-    // sample of a path that ended there.
-    const bool shadows_out = shadows.count > 0u;
-    if (goes_on || shadows_out) wave.states[p] = s;
-    if (shadows_out) wave.vertices[p] = vertex;
-    if (kCameraRays || !goes_on || shadows_out)
-      wave.active[p] = (goes_on ? kWaveLive : 0u) | (shadows_out ? kWaveShadowsOut : 0u);
-    if (!goes_on && !shadows_out)
-      finish_sample(band, p, s.radiance, sample, params);
+    k_wave_path_store(&params, p, sample, goes_on, &s, &shadows, &vertex, band_floats, wave.states, wave.active,
+                      wave.vertices, kCameraRays);
   }
   count_rays(ctx, inside, px.row, px.y < params.row_end, ray_counts, row_rays);
 }

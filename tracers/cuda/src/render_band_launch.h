@@ -31,7 +31,7 @@ struct WaveLanes {
 struct WavefrontScratch {
   KPathState* states = nullptr;
   KHit* hits = nullptr;
-  kuint* active = nullptr;  // kWaveLive | kWaveShadowsOut
+  kuint* active = nullptr;  // K_WAVE_LIVE | K_WAVE_SHADOWS_OUT (kernel/path_state.h)
   // Next-event estimation's shadow rays, walked by a kernel of their own (wavefront_walk.cu) when
   // shadow_slots > 0; 0: the shading kernels walk them as they come. The shading kernel leaves a pixel's
   // vertex in vertices and its rays in slots k * shadow_stride + pixel (launch_render_band sets the stride).
@@ -40,8 +40,6 @@ struct WavefrontScratch {
   kuint shadow_slots = 0u, shadow_stride = 0u;
   const WaveLanes* lanes = nullptr;  // null: one lane
 };
-// A pixel's wavefront flags: its path goes on; its last vertex waits for its shadow rays.
-constexpr kuint kWaveLive = 1u, kWaveShadowsOut = 2u;
 // The wavefront's walks (wavefront_walk.cu): the camera rays of a sample (records: the
 // first-hit records to clear, or null), and the live paths' bounce rays; each ray's hit into wave.hits.
 void launch_wave_camera_walk(dim3 grid, dim3 block, const KSceneView& scene, const KFrameParams& params,
@@ -50,7 +48,7 @@ void launch_wave_camera_walk(dim3 grid, dim3 block, const KSceneView& scene, con
 void launch_wave_bounce_walk(dim3 grid, dim3 block, const KSceneView& scene, const KFrameParams& params,
                              const KCamera& camera, const WavefrontScratch& wave, unsigned long long* ray_counts,
                              unsigned* row_rays, cudaStream_t stream);
-// The shadow rays the shading kernel left (pixels flagged kWaveShadowsOut): each walked, its vertex's light
+// The shadow rays the shading kernel left (pixels flagged K_WAVE_SHADOWS_OUT): each walked, its vertex's light
 // added to its path's radiance, and a path that ended there finished into the band.
 void launch_wave_shadow_walk(dim3 grid, dim3 block, const KSceneView& scene, const KFrameParams& params,
                              const KCamera& camera, kuint sample, float4* band, const WavefrontScratch& wave,

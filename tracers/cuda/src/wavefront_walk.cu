@@ -14,13 +14,15 @@ static __constant__ cudaTextureObject_t cohort_walk_texel_texture;
 
 #include "cohort/kernel/trace_bvh.h"
 #include "cohort/kernel/integrator.h"
-#include "band_samples.cuh"
+#include "cohort/kernel/wave_walk.h"
 #include "ray_counting.cuh"
 #include "render_band_launch.h"
 
 namespace cohort::tracers {
 
 namespace {
+
+// The bodies are kernel/wave_walk.h's (the OpenCL tracer's too).
 
 // A sample's camera rays: each pixel's first hit in wave.hits (the shading kernel begins the paths).
 __global__ void __launch_bounds__(128, 8) camera_walk_kernel(KSceneView scene, KFrameParams params, KCamera camera,
@@ -29,18 +31,8 @@ __global__ void __launch_bounds__(128, 8) camera_walk_kernel(KSceneView scene, K
                                                              unsigned* row_rays) {
   const BandPixel px = band_pixel(params, camera);
   KTraceCtx ctx = fresh_trace_ctx(scene);
-  // Pixels the sparse pattern of dynamic resolution leaves out trace nothing (the shading kernel paints them).
-  const bool traces = px.inside && k_pixel_traces_path(params.path_pixels, params.path_phase, px.x, px.y);
-  if (traces) {
-    const size_t p = px.index(camera);
-    if (records) k_record_first_hit(records + p, K_NONE, 0u, 0u);
-    KRng rng;
-    const KVec3 dir = k_camera_sample(&params, &camera, px.x, px.y, sample, &rng);
-    KHit hit;
-    hit.cost = 0u;
-    if (!k_trace_closest(&ctx, v3_load(camera.origin), dir, K_INF, K_RAY_PRIMARY, &hit)) hit.instance = K_NONE;
-    wave.hits[p] = hit;
-  }
+  const bool traces = k_wave_camera_walk_pixel(&ctx, &params, &camera, px.x, px.y, px.inside, px.index(camera),
+                                               sample, wave.hits, records);
   count_rays(ctx, traces, px.row, px.y < params.row_end, ray_counts, row_rays);
 }
 
@@ -49,54 +41,21 @@ __global__ void __launch_bounds__(128, 8) bounce_walk_kernel(KSceneView scene, K
                                                              WavefrontScratch wave, unsigned long long* ray_counts,
                                                              unsigned* row_rays) {
   const BandPixel px = band_pixel(params, camera);
-  const size_t p = px.index(camera);
-  const bool inside = px.inside && (wave.active[p] & kWaveLive);
   KTraceCtx ctx = fresh_trace_ctx(scene);
-  if (inside) {
-    const KPathState* s = wave.states + p;
-    KHit hit;
-    hit.cost = 0u;
-    if (!k_trace_closest(&ctx, s->org, s->dir, K_INF, K_RAY_PRIMARY, &hit)) hit.instance = K_NONE;
-    wave.hits[p] = hit;
-  }
+  const bool inside = k_wave_bounce_walk_pixel(&ctx, px.inside, px.index(camera), wave.states, wave.hits, wave.active);
   count_rays(ctx, inside, px.row, px.y < params.row_end, ray_counts, row_rays);
 }
 
-// The shadow rays a shading kernel left: each vertex's rays walked, then the visible ones' values added in
-// their order and the vertex's light to its path's radiance (k_vertex_light_sum, the integrator's order of
-// additions), a path that ended there finished. Only a bit per ray is carried through the walks, and the
-// vertex is read after them, to keep its sums out of the walk's registers (spills otherwise).
+// The shadow rays a shading kernel left: each vertex's rays walked, its light added to its path's radiance,
+// a path that ended there finished.
 __global__ void __launch_bounds__(128, 8) shadow_walk_kernel(KSceneView scene, KFrameParams params, KCamera camera,
                                                              kuint sample, float4* band, WavefrontScratch wave,
                                                              unsigned long long* ray_counts, unsigned* row_rays) {
   const BandPixel px = band_pixel(params, camera);
-  const size_t p = px.index(camera);
-  const kuint flags = px.inside ? wave.active[p] : 0u;
-  const bool inside = (flags & kWaveShadowsOut) != 0u;
   KTraceCtx ctx = fresh_trace_ctx(scene);
-  if (inside) {
-    const KShadowRay* rays = wave.shadow_rays + p;
-    const kuint count = wave.vertices[p].ray_count;  // at most K_SHADOW_QUEUE_MAX
-    kuint visible = 0u;
-    for (kuint k = 0u; k < count; ++k) {
-      const KShadowRay ray = rays[size_t(k) * wave.shadow_stride];
-      if (k_shadow_ray_visible(&ctx, &ray)) visible |= 1u << k;
-    }
-    KVertexLight v = wave.vertices[p];
-    for (kuint k = 0u; k < count; ++k)
-      if (visible & (1u << k)) {
-        const KShadowRay ray = rays[size_t(k) * wave.shadow_stride];
-        k_shadow_ray_add(&v, &ray);
-      }
-    const KVec3 radiance = v3_add(wave.states[p].radiance, k_vertex_light_sum(&v));
-    if (flags & kWaveLive) {
-      wave.states[p].radiance = radiance;
-      wave.active[p] = kWaveLive;
-    } else {
-      wave.active[p] = 0u;
-      finish_sample(band, p, radiance, sample, params);
-    }
-  }
+  const bool inside = k_wave_shadow_walk_pixel(&ctx, &params, px.inside, px.index(camera), sample,
+                                               reinterpret_cast<float*>(band), wave.states, wave.active,
+                                               wave.vertices, wave.shadow_rays, wave.shadow_stride);
   count_rays(ctx, inside, px.row, px.y < params.row_end, ray_counts, row_rays);
 }
 

@@ -17,10 +17,6 @@
 #define COHORT_WAVE_KERNEL_ARGS                                                                                \
   COHORT_BAND_KERNEL_ARGS, states, hits, active, vertex_lights, shadow_rays, shadow_stride, sample, first_hits
 
-/* A pixel's flags in `active`: its path goes on; its last vertex waits for its shadow rays. */
-#define K_WAVE_LIVE 1u
-#define K_WAVE_SHADOWS_OUT 2u
-
 /* The host sizes the scratch with its own sizeof: the device's structs must be the same. */
 typedef char k_wave_path_state_size[sizeof(KPathState) == 88 ? 1 : -1];
 typedef char k_wave_hit_size[sizeof(KHit) == 32 ? 1 : -1];

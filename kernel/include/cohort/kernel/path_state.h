@@ -20,6 +20,11 @@ typedef struct KPathState {
   kuint pad;
 } KPathState;
 
+/* A pixel's flags in a wavefront's `active` scratch: its path goes on; its last vertex waits for its shadow
+ * rays (wave_shade.h sets them, wave_walk.h's walks read them). */
+#define K_WAVE_LIVE 1u
+#define K_WAVE_SHADOWS_OUT 2u
+
 /* Whether a wavefront tracer renders a frame with these parameters as a wavefront: lit paths that bounce
  * (dynamic resolution's sparse pattern too); the debug views and frames without a bounce take its
  * megakernel. */
