@@ -32,6 +32,30 @@ struct Case {
   uint32_t emissive_samples = 1;
 };
 
+// The band format tests' band: the test room at 48x32, paths of one bounce at 2 spp, rows 8 to the end (a
+// band that does not start at row 0: the RGB9E5 dither counts pixels from the frame's first).
+constexpr int kBandWidth = 48, kBandHeight = 32, kBandFirstRow = 8;
+core::BandJob room_band_job() {
+  core::BandJob job;
+  job.params = frame_params(K_MODE_PATH, 2, 1, kBandHeight);
+  job.params.row_begin = kBandFirstRow;
+  job.camera = test_room_camera(kBandWidth, kBandHeight);
+  return job;
+}
+
+// Each tracer this build has and this machine runs, with the test room applied, by name.
+std::vector<std::pair<std::string, std::unique_ptr<core::Tracer>>> tracers_with_the_room() {
+  auto room = std::make_shared<commit::TracerScene>(core::compile_scene(test_room()).tracer_scene);
+  std::vector<std::pair<std::string, std::unique_ptr<core::Tracer>>> out;
+  for (const std::string& kind : built_tracers()) {
+    if (!tracer_runs_here(kind)) continue;
+    auto tracer = make_test_tracer(kind);
+    tracer->apply(commit::CommitBuffer::full(room, 1));
+    out.emplace_back(kind, std::move(tracer));
+  }
+  return out;
+}
+
 }  // namespace
 
 class Agreement : public ::testing::TestWithParam<Case> {};
@@ -229,18 +253,10 @@ INSTANTIATE_TEST_SUITE_P(Modes, AgreementAux, ::testing::Values(K_AUX_CENTRE_RAY
 // A band in half floats (`--band-format rgb16f`: GPU tracers convert it on the device) equals the same
 // tracer's band in floats within half precision.
 TEST(AgreementBandFormat, HalfFloatBandsEqualFloatBands) {
-  const int w = 48, h = 32;
-  const KCamera cam = test_room_camera(w, h);
-  auto room = std::make_shared<commit::TracerScene>(core::compile_scene(test_room()).tracer_scene);
+  const int w = kBandWidth, h = kBandHeight;
+  const core::BandJob job = room_band_job();
   int checked = 0;
-  for (const std::string& kind : built_tracers()) {
-    if (!tracer_runs_here(kind)) continue;
-    auto tracer = make_test_tracer(kind);
-    tracer->apply(commit::CommitBuffer::full(room, 1));
-    core::BandJob job;
-    job.params = frame_params(K_MODE_PATH, 2, 1, h);
-    job.params.row_begin = 8;  // a band that does not start at row 0
-    job.camera = cam;
+  for (auto& [kind, tracer] : tracers_with_the_room()) {
     core::FrameBuffer as_float, as_half;
     for (auto [format, out] : {std::pair{core::BandFormat::rgba32f, &as_float}, std::pair{core::BandFormat::rgb16f, &as_half}}) {
       core::BandBuffer band(w, h, format);
@@ -249,7 +265,7 @@ TEST(AgreementBandFormat, HalfFloatBandsEqualFloatBands) {
       band.copy_rows_to(*out, 0, h);
     }
     double lit = 0.0;
-    for (int y = 8; y < h; ++y)
+    for (int y = kBandFirstRow; y < h; ++y)
       for (int x = 0; x < w; ++x)
         for (int k = 0; k < 3; ++k) {
           const float f = as_float.row(y)[4 * x + k], v = as_half.row(y)[4 * x + k];
@@ -266,34 +282,27 @@ TEST(AgreementBandFormat, HalfFloatBandsEqualFloatBands) {
 // band with the same dither (pixel and frame): every producer (CUDA and OpenCL kernels, the host for
 // Embree) packs alike, and the band is within one step (under 1/255.5 of the pixel's brightest channel) of the floats.
 TEST(AgreementBandFormat, Rgb9e5BandsArePackedAlikeByEveryTracer) {
-  const int w = 48, h = 32;
-  const KCamera cam = test_room_camera(w, h);
-  auto room = std::make_shared<commit::TracerScene>(core::compile_scene(test_room()).tracer_scene);
+  const int w = kBandWidth, h = kBandHeight;
+  core::BandJob job = room_band_job();
+  job.params.frame_index = 37;
   int checked = 0;
-  for (const std::string& kind : built_tracers()) {
-    if (!tracer_runs_here(kind)) continue;
-    auto tracer = make_test_tracer(kind);
-    tracer->apply(commit::CommitBuffer::full(room, 1));
-    core::BandJob job;
-    job.params = frame_params(K_MODE_PATH, 2, 1, h);
-    job.params.row_begin = 8;  // a band that does not start at row 0: the dither counts pixels from the frame's
-    job.params.frame_index = 37;
-    job.camera = cam;
+  for (auto& [kind, tracer] : tracers_with_the_room()) {
     core::BandBuffer floats(w, h, core::BandFormat::rgba32f), packed(w, h, core::BandFormat::rgb9e5);
     tracer->render_band(job, floats);
     tracer->render_band(job, packed);
-    const size_t band_pixels = size_t(w) * size_t(h - 8);
+    const size_t band_pixels = size_t(w) * size_t(h - kBandFirstRow);
     std::vector<uint32_t> want(band_pixels);
-    core::rgba32f_to_rgb9e5(static_cast<const float*>(floats.row(8)), want.data(), band_pixels, 8u * w, 37u);
-    const uint32_t* got = static_cast<const uint32_t*>(packed.row(8));
+    core::rgba32f_to_rgb9e5(static_cast<const float*>(floats.row(kBandFirstRow)), want.data(), band_pixels,
+                            kuint(kBandFirstRow * w), 37u);
+    const uint32_t* got = static_cast<const uint32_t*>(packed.row(kBandFirstRow));
     size_t differ = 0;
     for (size_t p = 0; p < band_pixels; ++p) differ += got[p] != want[p];
     EXPECT_EQ(differ, 0u) << kind << ": words that differ from the host's packing of its float band";
     core::FrameBuffer back;
     back.resize(w, h);
-    packed.copy_rows_to(back, 8, h);
+    packed.copy_rows_to(back, kBandFirstRow, h);
     double lit = 0.0;
-    for (int y = 8; y < h; ++y)
+    for (int y = kBandFirstRow; y < h; ++y)
       for (int x = 0; x < w; ++x) {
         const float* f = static_cast<const float*>(floats.row(y)) + 4 * x;
         const float top = std::max({f[0], f[1], f[2]});
