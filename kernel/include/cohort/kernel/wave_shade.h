@@ -7,8 +7,9 @@
  * kernel's figures are main's with these): with the segment called inside one body function, a shading kernel
  * spilled up to 128 bytes more (the dense build's bounce kernel with the shadow walk, 200 -> 328 bytes of
  * stores); with k_wave_shades inside k_wave_shade_begin, after the trace context or before it, spill
- * stores and loads moved by -16 to +16 bytes. The segment is the kernel's own call: the CUDA tracer's goes through a function of default
- * inlining (render_band_kernels.cuh says why). integrator.h must be included first.
+ * stores and loads moved by -16 to +16 bytes. The segment is the kernel's own call: the CUDA tracer's goes
+ * through a function of default inlining (render_band_kernels.cuh says why). integrator.h must be included
+ * first.
  *
  * The kernels' choices are constants of each kernel, so that each keeps one way: camera_rays: the camera
  * rays' segment, whose paths begin here from the pixel (the camera walk kept only the hits); shadow_walk: the
