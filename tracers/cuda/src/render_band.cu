@@ -112,11 +112,11 @@ void render_wavefront(const KSceneView& scene, const KFrameParams& params, const
   const dim3 grid((camera.width + block.x - 1) / block.x, (rows + block.y - 1) / block.y);
   const kuint spp = params.spp > 0u ? params.spp : 1u;  // k_paths_per_pixel (device-only in this translation unit)
   const bool shadow_walk = scratch.shadow_slots > 0u;
-  const auto shade_kernels = dense_lights(params) ? dense::launch_wave_shade : launch_wave_shade;
+  const PathKernels& kernels = dense_lights(params) ? dense::path_kernels : path_kernels;
   // A shading kernel and, after it, the shadow rays it left, before the next one shades the paths further.
   auto shade = [&](kuint sample, bool camera_rays, KPathFirstHit* records) {
-    shade_kernels(camera_rays, records, shadow_walk, grid, block, scene, params, camera, sample, band, scratch,
-                  ray_counts, row_rays, stream);
+    kernels.wave_shade(camera_rays, records, shadow_walk, grid, block, scene, params, camera, sample, band, scratch,
+                       ray_counts, row_rays, stream);
     if (shadow_walk)
       launch_wave_shadow_walk(grid, block, scene, params, camera, sample, band, scratch, ray_counts, row_rays, stream);
   };
@@ -171,8 +171,9 @@ void launch_render_band(const KSceneView& scene, const KFrameParams& params, con
       COHORT_CUDA(cudaStreamWaitEvent(stream, wave->lanes->joined[lane], 0));
     }
   } else {
-    const auto megakernels = dense_lights(params) ? dense::launch_band_megakernel : launch_band_megakernel;
-    megakernels(sparse, first_hits, grid, block, scene, params, camera, band, ray_counts, row_rays, stream);
+    const PathKernels& kernels = dense_lights(params) ? dense::path_kernels : path_kernels;
+    kernels.band_megakernel(sparse, first_hits, grid, block, scene, params, camera, band, ray_counts, row_rays,
+                            stream);
   }
   COHORT_CUDA(cudaGetLastError());
 }

@@ -81,12 +81,11 @@ __global__ void __launch_bounds__(128, kShadowWalk ? 6 : 4) wave_shade_kernel(KS
   count_rays(ctx, inside, px.row, px.y < params.row_end, ray_counts, row_rays);
 }
 
-// This build's shading kernel for a wavefront step (render_band.cu's render_wavefront): the camera rays'
-// segment (with first-hit records or without) or a bounce's, shadow rays left for the shadow walk or not.
-void launch_wave_shade(bool camera_rays, KPathFirstHit* records, bool shadow_walk, dim3 grid, dim3 block,
-                       const KSceneView& scene, const KFrameParams& params, const KCamera& camera, kuint sample,
-                       float4* band, const WavefrontScratch& scratch, unsigned long long* ray_counts,
-                       unsigned* row_rays, cudaStream_t stream) {
+// PathKernels::wave_shade (render_band_launch.h) for this build.
+static void launch_wave_shade(bool camera_rays, KPathFirstHit* records, bool shadow_walk, dim3 grid, dim3 block,
+                              const KSceneView& scene, const KFrameParams& params, const KCamera& camera,
+                              kuint sample, float4* band, const WavefrontScratch& scratch,
+                              unsigned long long* ray_counts, unsigned* row_rays, cudaStream_t stream) {
   auto launch = [&](auto kernel) {
     kernel<<<grid, block, 0, stream>>>(scene, params, camera, sample, band, scratch, ray_counts, row_rays, records);
   };
@@ -98,10 +97,11 @@ void launch_wave_shade(bool camera_rays, KPathFirstHit* records, bool shadow_wal
     shadow_walk ? launch(wave_shade_kernel<true, false, true>) : launch(wave_shade_kernel<true, false, false>);
 }
 
-// This build's megakernel over a band: the sparse pattern's build, the first-hit records' or the plain one.
-void launch_band_megakernel(bool sparse, KPathFirstHit* first_hits, dim3 grid, dim3 block, const KSceneView& scene,
-                            const KFrameParams& params, const KCamera& camera, float4* band,
-                            unsigned long long* ray_counts, unsigned* row_rays, cudaStream_t stream) {
+// PathKernels::band_megakernel for this build.
+static void launch_band_megakernel(bool sparse, KPathFirstHit* first_hits, dim3 grid, dim3 block,
+                                   const KSceneView& scene, const KFrameParams& params, const KCamera& camera,
+                                   float4* band, unsigned long long* ray_counts, unsigned* row_rays,
+                                   cudaStream_t stream) {
   if (sparse)
     render_band_kernel<true, false><<<grid, block, 0, stream>>>(scene, params, camera, band, ray_counts, row_rays, nullptr);
   else if (first_hits)
@@ -111,3 +111,5 @@ void launch_band_megakernel(bool sparse, KPathFirstHit* first_hits, dim3 grid, d
     render_band_kernel<false, false><<<grid, block, 0, stream>>>(scene, params, camera, band, ray_counts, row_rays,
                                                                  nullptr);
 }
+
+const PathKernels path_kernels = {launch_wave_shade, launch_band_megakernel};

@@ -56,23 +56,23 @@ void launch_wave_shadow_walk(dim3 grid, dim3 block, const KSceneView& scene, con
 // That translation unit's copy of the texel texture (its alpha-tested surfaces read it).
 void set_walk_texel_texture(cudaTextureObject_t texture);
 
-// One build's path kernels (render_band_kernels.cuh): render_band.cu's, here, for every light sampling but
-// K_LIGHTS_DENSE; render_band_dense.cu's, in namespace dense, for it.
-void launch_wave_shade(bool camera_rays, KPathFirstHit* records, bool shadow_walk, dim3 grid, dim3 block,
-                       const KSceneView& scene, const KFrameParams& params, const KCamera& camera, kuint sample,
-                       float4* band, const WavefrontScratch& scratch, unsigned long long* ray_counts,
-                       unsigned* row_rays, cudaStream_t stream);
-void launch_band_megakernel(bool sparse, KPathFirstHit* first_hits, dim3 grid, dim3 block, const KSceneView& scene,
-                            const KFrameParams& params, const KCamera& camera, float4* band,
-                            unsigned long long* ray_counts, unsigned* row_rays, cudaStream_t stream);
+// One build's path kernels (render_band_kernels.cuh): render_band.cu's, `path_kernels` here, for every light
+// sampling but K_LIGHTS_DENSE; render_band_dense.cu's, `dense::path_kernels`, for it. wave_shade: a wavefront
+// step's shading kernel (the camera rays' segment, with first-hit records or without, or a bounce's; shadow
+// rays left for the shadow walk or not); band_megakernel: the megakernel over a band (the sparse pattern's
+// build, the first-hit records' or the plain one).
+struct PathKernels {
+  void (*wave_shade)(bool camera_rays, KPathFirstHit* records, bool shadow_walk, dim3 grid, dim3 block,
+                     const KSceneView& scene, const KFrameParams& params, const KCamera& camera, kuint sample,
+                     float4* band, const WavefrontScratch& scratch, unsigned long long* ray_counts,
+                     unsigned* row_rays, cudaStream_t stream);
+  void (*band_megakernel)(bool sparse, KPathFirstHit* first_hits, dim3 grid, dim3 block, const KSceneView& scene,
+                          const KFrameParams& params, const KCamera& camera, float4* band,
+                          unsigned long long* ray_counts, unsigned* row_rays, cudaStream_t stream);
+};
+extern const PathKernels path_kernels;
 namespace dense {
-void launch_wave_shade(bool camera_rays, KPathFirstHit* records, bool shadow_walk, dim3 grid, dim3 block,
-                       const KSceneView& scene, const KFrameParams& params, const KCamera& camera, kuint sample,
-                       float4* band, const WavefrontScratch& scratch, unsigned long long* ray_counts,
-                       unsigned* row_rays, cudaStream_t stream);
-void launch_band_megakernel(bool sparse, KPathFirstHit* first_hits, dim3 grid, dim3 block, const KSceneView& scene,
-                            const KFrameParams& params, const KCamera& camera, float4* band,
-                            unsigned long long* ray_counts, unsigned* row_rays, cudaStream_t stream);
+extern const PathKernels path_kernels;
 void set_texel_texture(cudaTextureObject_t texture);
 }  // namespace dense
 // The scene view holds device pointers (built on the host with k_scene_view, passed by value).
