@@ -7,6 +7,7 @@
 #include <glm/gtc/matrix_inverse.hpp>
 
 #include "cohort/core/light_sampling.h"
+#include "cohort/kernel/light_tree.h"
 #include "cohort/kernel/vec.h"
 
 namespace cohort::core {
@@ -213,26 +214,25 @@ std::vector<KLightNode> build_light_nodes(const std::vector<KLight>& lights, Emi
 
 float light_density(const commit::TracerScene& scene) {
   const std::vector<KLightNode>& nodes = scene.light_nodes;
-  const size_t e = scene.emissive_triangles.size();
-  const size_t emissive_nodes = e > 0 && nodes.size() >= 2 * e - 1 ? 2 * e - 1 : 0;
-  const size_t tree = nodes.size() - emissive_nodes;   // kernel/scene_view.h's k_light_tree_nodes
+  // The Doom 3 lights' tree, before the emissive triangles' (kernel/scene_view.h, as the kernel finds it).
+  KSceneView view{};
+  view.light_node_count = static_cast<kuint>(nodes.size());
+  view.emissive_count = static_cast<kuint>(scene.emissive_triangles.size());
+  const size_t tree = k_light_tree_nodes(&view);
   if (tree == 0) return 0.0f;
-  auto holds = [](const KLightNode& n, const glm::vec3& p) {
-    return p.x >= n.bmin[0] && p.x <= n.bmax[0] && p.y >= n.bmin[1] && p.y <= n.bmax[1] && p.z >= n.bmin[2] &&
-           p.z <= n.bmax[2];
-  };
   size_t lights = 0, in_range = 0;
   std::vector<uint32_t> stack;
   for (size_t leaf = 0; leaf < tree; ++leaf) {
     if (nodes[leaf].count == 0) continue;
-    const glm::vec3 centre = 0.5f * (glm::vec3(nodes[leaf].bmin[0], nodes[leaf].bmin[1], nodes[leaf].bmin[2]) +
-                                     glm::vec3(nodes[leaf].bmax[0], nodes[leaf].bmax[1], nodes[leaf].bmax[2]));
+    const KVec3 centre = v3(0.5f * (nodes[leaf].bmin[0] + nodes[leaf].bmax[0]),
+                            0.5f * (nodes[leaf].bmin[1] + nodes[leaf].bmax[1]),
+                            0.5f * (nodes[leaf].bmin[2] + nodes[leaf].bmax[2]));
     ++lights;
     stack.assign(1, 0u);
     while (!stack.empty()) {
       const KLightNode& n = nodes[stack.back()];
       stack.pop_back();
-      if (!holds(n, centre)) continue;
+      if (!k_light_node_holds(&n, centre)) continue;
       if (n.count > 0) {
         ++in_range;
       } else {
