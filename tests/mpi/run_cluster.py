@@ -304,13 +304,18 @@ def ahead_recovery_check(single, cluster, output):
     print("ahead_recovery: ok")
 
 
-def play(a):
+def skip_without_viewer(a):
+    """`cohort play` needs a window: skip (ctest's 77) where Xvfb or the viewer build is missing."""
     if not shutil.which("xvfb-run"):
         print("SKIP: xvfb-run is not installed")
         sys.exit(77)
     if a.viewer_built.upper() not in ("ON", "1", "TRUE", "YES"):
         print("SKIP: cohort was built without the viewer (COHORT_WITH_VIEWER=OFF)")
         sys.exit(77)
+
+
+def play(a):
+    skip_without_viewer(a)
     os.makedirs(a.out)
     shot = os.path.join(a.out, "play.png")
     testmap = os.path.join(a.testmap_base, "maps", "testmap.map")
@@ -412,12 +417,7 @@ def play_early_announce(a):
     """`cohort play` with mpi:1 and mpi:2 alone, both ways of announcing. Play's own frame work (blend,
     tone map, the window's present under Xvfb) comes between a frame's hand-out and the next push; announced
     at hand-out, the next job goes ahead before it (as `cohort render`'s, early_announce above)."""
-    if not shutil.which("xvfb-run"):
-        print("SKIP: xvfb-run is not installed")
-        sys.exit(77)
-    if a.viewer_built.upper() not in ("ON", "1", "TRUE", "YES"):
-        print("SKIP: cohort was built without the viewer (COHORT_WITH_VIEWER=OFF)")
-        sys.exit(77)
+    skip_without_viewer(a)
     os.makedirs(a.out)
     testmap = os.path.join(a.testmap_base, "maps", "testmap.map")
     flags = mpiexec_flags(a.mpiexec)
