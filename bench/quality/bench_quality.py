@@ -200,6 +200,14 @@ def load_ppm(path):
             np.float32(255.0))
 
 
+def linear_light(image):
+    """The frame's mean light: its sRGB values linearised (the EOTF) and averaged. Against the reference's it shows
+    a method that loses or adds light (a clamp or an edge stop biased by skewed noise), which FLIP and PSNR mix
+    with noise. A mean of tone-mapped values, so a guide to bias, not a radiometric measure."""
+    v = image.astype(np.float64)
+    return float(np.mean(np.where(v <= 0.04045, v / 12.92, ((v + 0.055) / 1.055) ** 2.4)))
+
+
 def psnr(reference, test):
     mse = float(np.mean((reference.astype(np.float64) - test.astype(np.float64)) ** 2))
     return float("inf") if mse == 0.0 else 10.0 * np.log10(1.0 / mse)
@@ -276,6 +284,7 @@ def main():
     else:
         ref_seconds = render(args, ref_dir, args.ref_spp, ["--no-convergence"] + (["--write-ids"] if args.replay else []))
     references = [load_ldr(frame_path(ref_dir, f)) for f in range(args.frames)]
+    reference_light = [linear_light(r) for r in references]
     masks = object_masks(args, ref_dir) if args.replay else None
     still_frame = None
     if masks:
@@ -302,17 +311,18 @@ def main():
         out_dir = os.path.join(args.out, m.replace("+", "_"))
         print(f"{m} ...", flush=True)
         render(args, out_dir, args.spp, METHODS[m] + args.extra_args.split())
-        flips, psnrs, object_flips, swept_flips = [], [], [], []
+        flips, psnrs, lights, object_flips, swept_flips = [], [], [], [], []
         for f in range(args.frames):
             test = load_ldr(frame_path(out_dir, f))
             flip_map, mean_flip, _ = flip_evaluator.evaluate(references[f], test, "LDR", applyMagma=False)
             flips.append(float(mean_flip))
             psnrs.append(psnr(references[f], test))
+            lights.append(100.0 * (linear_light(test) / reference_light[f] - 1.0) if reference_light[f] > 0 else 0.0)
             if masks:
                 flip_map = np.asarray(flip_map).reshape(test.shape[0], test.shape[1])
                 object_flips.append(masked_mean(flip_map, masks["recent"][f]))
                 swept_flips.append(masked_mean(flip_map, masks["swept"][f]))
-        r = {"flip": flips, "psnr": psnrs, "ms": stage_ms(os.path.join(out_dir, "stats.json"))}
+        r = {"flip": flips, "psnr": psnrs, "light_percent": lights, "ms": stage_ms(os.path.join(out_dir, "stats.json"))}
         if masks:
             r["object_flip"] = object_flips
             r["object_swept_flip"] = swept_flips
@@ -328,8 +338,10 @@ def main():
               f"{masks['last_moving_frame'] if masks['moving_frames'] else '-'}; 'still' columns: frame "
               f"{still_frame if still_frame is not None else '-'} ({args.still_frames} frames still); 'obj' = its "
               f"pixels and last {args.mask_history} frames' trail, 'swept' = its whole path")
+    print("'light %': the frames' mean linearised light against the reference's, averaged over the frames after "
+          "the first 8 (a bias: light lost or added)")
     object_header = f"{'obj FLIP':>9}{'obj still':>10}{'swept still':>12}" if masks else ""
-    print(f"{'method':<26}{'mean FLIP':>10}{'last FLIP':>10}{'mean PSNR':>10}{object_header}{'frame ms':>10}"
+    print(f"{'method':<26}{'mean FLIP':>10}{'last FLIP':>10}{'mean PSNR':>10}{'light %':>9}{object_header}{'frame ms':>10}"
           f"{'blend ms':>10}{'denoise ms':>11}{'both ms':>9}")
 
     def cell(v, width):
@@ -341,8 +353,9 @@ def main():
             seen = [v for v in r["object_flip"] if v is not None]
             object_cells = (cell(statistics.mean(seen) if seen else None, 9) + cell(r["object_flip_still"], 10) +
                             cell(r["object_swept_flip_still"], 12))
+        settled = r["light_percent"][8:] or r["light_percent"]
         print(f"{m:<26}{statistics.mean(r['flip']):>10.4f}{r['flip'][-1]:>10.4f}{statistics.mean(r['psnr']):>10.2f}"
-              f"{object_cells}{ms['frame']:>10.1f}{ms.get('convergence', 0.0):>10.2f}{ms.get('denoise', 0.0):>11.1f}"
+              f"{statistics.mean(settled):>+9.1f}{object_cells}{ms['frame']:>10.1f}{ms.get('convergence', 0.0):>10.2f}{ms.get('denoise', 0.0):>11.1f}"
               f"{ms.get('convergence+denoise', 0.0):>9.1f}")
     os.makedirs(args.out, exist_ok=True)
     json_path = os.path.join(args.out, "bench_quality.json")

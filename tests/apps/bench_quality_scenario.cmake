@@ -21,6 +21,7 @@ for name, r in d['methods'].items():
     v = r['object_flip_still']
     print(name, 'mean FLIP', sum(r['flip']) / len(r['flip']), 'door after 4 still frames', v)
     ok = ok and v is not None and 0.0 < v < 1.0 and len(r['object_flip']) == 45
+    ok = ok and len(r['light_percent']) == 45 and all(math.isfinite(x) and abs(x) < 100.0 for x in r['light_percent'])
 sys.exit(0 if ok else 1)\"")
   set_tests_properties(apps.bench_quality_scenario PROPERTIES LABELS apps TIMEOUT 300 SKIP_RETURN_CODE 77)
 endif()
