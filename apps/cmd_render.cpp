@@ -78,6 +78,7 @@ struct RenderArgs {
   float history_fix_sigma = core::AtrousOptions{}.history_fix_sigma_scale;
   float history_fix_min = core::AtrousOptions{}.history_fix_min_length;
   float anti_lag = -1.0f;     // < 0: ReprojectionOptions' default
+  float reproject_clamp = -1.0f;  // < 0: ReprojectionOptions' default
   std::string post_on = "auto";
   std::string band_format = "rgb9e5";
   bool frames_given = false;
@@ -205,6 +206,7 @@ int run_render(const RenderArgs& a) {
     post_options.reproject = reproject;
     post_options.atrous = atrous;
     if (a.anti_lag >= 0.0f) post_options.reprojection.anti_lag_sigma = a.anti_lag;
+    if (a.reproject_clamp >= 0.0f) post_options.reprojection.clamp_sigma = a.reproject_clamp;
     // Sparse-path frames keep centre rays (one fixed ray a pixel), whatever --aux-rays says.
     post_options.reprojection.jittered_planes = aux_mode == K_AUX_PATH_FIRST_HIT && !sparse;
     post_options.upsample = upsample;
@@ -595,6 +597,12 @@ void add_render_command(CLI::App& app, int& exit_code) {
                   "more than this many standard errors of that mean is shortened in proportion (stale lighting: a "
                   "flashlight, a flicker, a door letting light in); 0 turns it off; default " +
                       std::to_string(core::ReprojectionOptions{}.anti_lag_sigma).substr(0, 4))
+      ->check(CLI::Range(0.0f, 1000.0f));
+  cmd->add_option("--reproject-clamp", a->reproject_clamp,
+                  "reprojection's neighbourhood clamp: a moving pixel's history is held within the fresh 3x3 "
+                  "samples' mean +- this many standard deviations (YCoCg); larger ghosts more, smaller loses the "
+                  "light of rare bright samples; default " +
+                      std::to_string(core::ReprojectionOptions{}.clamp_sigma).substr(0, 4))
       ->check(CLI::Range(0.0f, 1000.0f));
   cmd->add_option("--post-on", a->post_on,
                   "where reprojection and the a-trous filter run: host (the CPU's threads), cuda:N (a GPU; the "
