@@ -65,6 +65,11 @@ class FramePipeline {
     std::vector<StageSpan> preparation;
   };
   Delivered delivered(InFlight frame, FrameStats stats);
+  // push() with the Renderer's frames_in_flight 2: `job` is handed out before the frame before it is
+  // waited for (begin, then wait and merge of the one before), so the tracers never wait for the core's
+  // turnaround. Where the frame before cannot be rendered, `job` is already handed out and stays in flight.
+  std::optional<Delivered> push_two_in_flight(const BandJob& job, std::vector<StageSpan> preparation,
+                                              const PrepareNext& prepare_next);
 
   Renderer& renderer_;
   FrameBuffer image_;
