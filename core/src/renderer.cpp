@@ -720,9 +720,9 @@ FrameStats Renderer::wait_frame() {
   if (options_.frames_in_flight == 2 && !options_.use_reported_time) {
     // Frames overlap: a tracer is idle only while it has no job, from the end of its job before to the
     // start of this one (at most the time between the two frames' hand-outs), and busy for its band.
-    for (TracerFrameStats& t : stats.tracers) {
-      if (t.outcome != TracerOutcome::rendered) continue;
-      const double waited = first.of(t.id).waited_ms;
+    for (int id : first.finished) {
+      TracerFrameStats& t = stats.tracers[static_cast<size_t>(id)];
+      const double waited = first.of(id).waited_ms;
       t.idle_ms = waited < 0.0 ? 0.0 : std::clamp(waited, 0.0, frame->since_previous_ms);
       stats.idle_ms += t.idle_ms;
       stats.summed_tracer_ms += t.idle_ms + t.ms;
