@@ -53,7 +53,7 @@ void add_bench_command(CLI::App& app, int& exit_code) {
     bool row_work = true;
     std::string clock = "virtual";
     double time_scale = 1.0;
-    int frames = 360, warmup = 5, rows = 720;
+    int frames = 360, warmup = 5, rows = 720, frames_in_flight = 1;
     uint64_t seed = 1;
     balance::BalancerOptions options;
   };
@@ -96,6 +96,11 @@ void add_bench_command(CLI::App& app, int& exit_code) {
   balance->add_option("--real", args->real,
                       "real tracers instead of simulated ones, e.g. embree,opencl:0 or cuda:all (they render --scene)");
   balance->add_option("--scene", args->scene, "map or scene pack the real tracers render")->capture_default_str();
+  balance->add_option("--frames-in-flight", args->frames_in_flight,
+                      "2: frame N+1 handed out before N is waited for (the Renderer's two frames in flight, through the "
+                      "frame pipeline); compare the interval column on a sleep or spin clock")
+      ->capture_default_str()
+      ->check(CLI::Range(1, 2));
   balance->add_option("--json", args->json, "write every run (per-frame idle %) as JSON");
   balance->add_option("--plot", args->plot, "write a PNG chart of idle % per frame per balancer");
   balance->callback([args, tracers_option, &exit_code] {
@@ -119,6 +124,7 @@ void add_bench_command(CLI::App& app, int& exit_code) {
     config.warmup = args->warmup;
     config.rows = args->rows;
     config.seed = args->seed;
+    config.frames_in_flight = args->frames_in_flight;
     config.balancer_options = args->options;
     config.real = split_list<std::string>(args->real, "--real");
     config.real_scene = args->scene;

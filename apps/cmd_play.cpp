@@ -385,6 +385,12 @@ void add_play_command(CLI::App& app, int& exit_code) {
   cmd->add_option("--balancer", a->session.balancer, "row balancer (B cycles)")
       ->capture_default_str()
       ->check(CLI::IsMember(balance::balancer_names()));
+  cmd->add_option("--frames-in-flight", a->session.frames_in_flight,
+                  "2: hand the next frame's bands out as soon as this one's are, so that each tracer starts it the "
+                  "moment its band before is done; where the tracers set the pace this adds a frame of input latency "
+                  "(the frame waits in each tracer's queue behind the one before; docs/balancing.md)")
+      ->capture_default_str()
+      ->check(CLI::Range(1, 2));
   cmd->add_option("--band-format", a->session.band_format,
                   "what the tracers hand back: RGB half floats (6 bytes a pixel), RGB9E5 (4 bytes a pixel: 9-bit mantissas "
                   "under a shared exponent, dithered so averaging frames keeps no bias) or RGBA floats (16)")

@@ -85,6 +85,7 @@ struct RenderArgs {
   bool write_ids = false;  // the G-buffer's id plane of every written frame, and which entities moved
   bool bands_through_host = false;  // A/B: CUDA bands go down and back up even where the post could take them on the GPU
   int benched_commit_every = 8;     // RendererOptions::benched_commit_every
+  int frames_in_flight = 1;         // RendererOptions::frames_in_flight
   double render_scale = 1.0;  // dynamic resolution (core/upsample.h)
   std::string upsample = "joint-bilateral";
 };
@@ -120,6 +121,7 @@ int run_render(const RenderArgs& a) {
   core::RendererOptions options;
   options.balancer = a.balancer;
   options.benched_commit_every = a.benched_commit_every;
+  options.frames_in_flight = a.frames_in_flight;
   options.band_format = core::band_format_from_string(a.band_format);
   options.frame_timeout = std::chrono::milliseconds(600000);
   core::Renderer renderer(std::move(tracers), options);
@@ -444,7 +446,7 @@ int run_render(const RenderArgs& a) {
   if (std::optional<core::FramePipeline::Delivered> done = pipeline.drain()) finish(std::move(*done));
   progress.finish();
   nlohmann::json report = {{"map", a.map},       {"scene", scene.name},     {"tracers", a.tracers},
-                           {"balancer", a.balancer}, {"width", a.width},     {"height", a.height},
+                           {"balancer", a.balancer}, {"frames_in_flight", a.frames_in_flight}, {"width", a.width},     {"height", a.height},
                            {"spp", a.spp},       {"bounces", a.bounces},
                            {"light_sampling", a.light_sampling}, {"light_sampling_used", light_sampling_used},
                            {"light_density", light_density}, {"light_samples", a.light_samples},    {"mode", a.mode},
@@ -614,6 +616,13 @@ void add_render_command(CLI::App& app, int& exit_code) {
                   "instead of every frame (1: every frame); it catches up before it renders again")
       ->capture_default_str()
       ->check(CLI::Range(1, 1000));
+  cmd->add_option("--frames-in-flight", a->frames_in_flight,
+                  "2: hand frame N+1's bands out as soon as N's are, so that each tracer starts N+1 the moment its "
+                  "band of N is done instead of waiting for the slowest band and the core's turnaround; the "
+                  "balancer then divides each frame by the costs of the frame two before (docs/balancing.md, "
+                  "\"Two frames in flight\")")
+      ->capture_default_str()
+      ->check(CLI::Range(1, 2));
   cmd->add_flag("--bands-through-host", a->bands_through_host,
                "with the post-processing on a CUDA GPU, copy CUDA tracers' bands down to the host and back up "
                "like any other (by default they stay on the GPUs: device to device, or over NVLink from a peer)");

@@ -132,6 +132,7 @@ PlaySession::PlaySession(const SessionOptions& options) {
   renderer_options.balancer = options.balancer;
   renderer_options.band_format = core::band_format_from_string(options.band_format);
   renderer_options.benched_commit_every = 8;  // as `cohort render`'s default
+  renderer_options.frames_in_flight = options.frames_in_flight;
   s.renderer = std::make_unique<core::Renderer>(std::move(tracers), renderer_options);
   s.announce_at_hand_out = core::FramePipeline::announces_at_hand_out() && s.renderer->takes_jobs_ahead();
   s.renderer->submit_commit(commit::CommitBuffer::full(initial_scene, 0));

@@ -36,6 +36,9 @@ struct SessionOptions {
   std::string aux_rays = "auto";
   // What the tracers hand back (core::BandFormat's names): RGB9E5 by default (4 bytes a pixel, docs/cluster.md).
   std::string band_format = "rgb9e5";
+  // RendererOptions::frames_in_flight: 2 hands the next frame out before the one before is back (a frame more
+  // between input and image where the tracers set the pace; docs/balancing.md, "Two frames in flight").
+  int frames_in_flight = 1;
   int window_height = 360;
 };
 

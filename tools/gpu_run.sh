@@ -11,7 +11,10 @@
 #                              Embree and OpenCL), bench devices on both maps, Table 1 with two real GPUs. The
 #                              OpenCL tracer of the mixes is the OpenCL device on the second GPU (the one cuda:1
 #                              drives), found by PCI bus id in `cohort devices --json`; COHORT_GPU_OPENCL=opencl:N
-#                              names another (opencl:N counts every platform's devices: PoCL's CPU may be one)
+#                              names another (opencl:N counts every platform's devices: PoCL's CPU may be one);
+#                              COHORT_GPU_IN_FLIGHT="1 2" renders each mix with --frames-in-flight 1 then 2, back to
+#                              back, COHORT_GPU_ROUNDS times (default 1; docs/balancing.md, "Two frames in flight");
+#                              OPENCL in COHORT_GPU_MIXES stands for that OpenCL tracer (e.g. "embree,cuda:0,OPENCL")
 #   tools/gpu_run.sh compare BASE.tar.xz [MORE.tar.xz ...]  there: A/B of payloads on one machine (the staged
 #                              one against earlier stages' payload.tar.xz, renamed and carried in .gpu/): the CUDA
 #                              tracer tests of the staged one, then end-to-end ms per frame, cuda:0, both maps,
@@ -398,14 +401,26 @@ print(pick[0]["tracer"] if pick else "")' || true)}"
       else args=("$stage/testmap.cpk" --width 1280 --height 720); fi
       for convergence in ${COHORT_GPU_CONVERGENCE:-auto brigade}; do
         for mix in ${COHORT_GPU_MIXES:-cuda:0 cuda:0,cuda:1 embree,cuda:0 embree,cuda:0,cuda:1 $opencl_mixes}; do
+        mix=${mix//OPENCL/$opencl}
+        for round in $(seq ${COHORT_GPU_ROUNDS:-1}); do
+        # Unset: the option is not passed (payloads from before it still run).
+        for in_flight in ${COHORT_GPU_IN_FLIGHT:-default}; do
           run=/tmp/mg_${map}_${convergence}_$(echo "$mix" | tr ',:' '__')
+          in_flight_args=()
+          if [ "$in_flight" != default ]; then
+            run=${run}_if${in_flight}_r${round}
+            in_flight_args=(--frames-in-flight "$in_flight")
+          fi
           timeout 120 "$stage/bin/cohort" render "${args[@]}" --tracers "$mix" --spp 1 --light-samples 1 --bounces 1 \
-            ${COHORT_GPU_RENDER_ARGS:-} --convergence $convergence --frames ${COHORT_GPU_FRAMES:-100} --camera-path spin-slow \
-            --write last --out $run >$run.log 2>&1 || { echo "== $map $convergence $mix: failed"; tail -n 3 $run.log; continue; }
-          echo "== $map map, $convergence, $mix"
+            ${COHORT_GPU_RENDER_ARGS:-} "${in_flight_args[@]}" --convergence $convergence --frames ${COHORT_GPU_FRAMES:-100} \
+            --camera-path spin-slow --write last --out $run >$run.log 2>&1 ||
+            { echo "== $map $convergence $mix: failed"; tail -n 3 $run.log; continue; }
+          echo "== $map map, $convergence, $mix${in_flight_args[*]:+, ${in_flight_args[*]}, round $round}"
           python3 tools/frame_times.py $run/stats.json --skip ${COHORT_GPU_SKIP:-20} --json $out/$(basename $run).json > $run/summary.txt
           head -n 1 $run/summary.txt
           grep -E "sits out|keeps its rows" $run.log | sed 's/^.*\] //' | head -n 3 || true
+        done
+        done
         done
       done
       [ "${COHORT_GPU_SKIP_DEVICES:-0}" = 1 ] || timeout 300 "$stage/bin/cohort" bench devices --scene "${args[0]}" --width "${args[2]}" --height "${args[4]}" \

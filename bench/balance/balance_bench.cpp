@@ -2,10 +2,13 @@
 
 #include <algorithm>
 #include <cstdio>
+#include <chrono>
 #include <numbers>
+#include <optional>
 #include <stdexcept>
 
 #include "cohort/core/frame_defaults.h"
+#include "cohort/core/frame_pipeline.h"
 #include "cohort/core/renderer.h"
 #include "cohort/core/simulated_tracer.h"
 #include "real_tracers.h"
@@ -52,7 +55,9 @@ BalanceBenchRun run_one(const BalanceBenchConfig& config, const std::string& pat
   options.balancer = balancer;
   options.balancer_options = config.balancer_options;
   options.use_reported_time = config.real.empty() && config.clock == "virtual";
+  options.frames_in_flight = config.frames_in_flight;
   core::Renderer renderer(std::move(tracers), options);
+  core::FramePipeline pipeline(renderer);
 
   BalanceBenchRun run;
   run.path = path;
@@ -60,7 +65,25 @@ BalanceBenchRun run_one(const BalanceBenchConfig& config, const std::string& pat
   run.tracers = renderer.tracer_count();
   const double step = path_degrees_per_frame(path) * std::numbers::pi / 180.0;
   core::FrameBuffer frame;
-  int counted = 0;
+  int counted = 0, intervals = 0;
+  std::optional<std::chrono::steady_clock::time_point> last_delivery;
+  auto take = [&](const core::FrameStats& stats) {
+    const int f = static_cast<int>(stats.frame);
+    const auto now = std::chrono::steady_clock::now();
+    if (last_delivery && f >= config.warmup) {
+      run.mean_interval_ms += std::chrono::duration<double, std::milli>(now - *last_delivery).count();
+      ++intervals;
+    }
+    last_delivery = now;
+    run.idle_percent.push_back(stats.idle_percent);
+    if (f >= config.warmup) {
+      run.mean_idle_percent += stats.idle_percent;
+      run.worst_idle_percent = std::max(run.worst_idle_percent, stats.idle_percent);
+      run.mean_frame_ms += stats.frame_ms;
+      for (const core::TracerFrameStats& t : stats.tracers) run.mean_rendering_tracers += t.outcome == core::TracerOutcome::rendered;
+      ++counted;
+    }
+  };
   for (int f = 0; f < config.frames; ++f) {
     core::BandJob job;
     // Simulated tracers only need rows; real ones get a 16:9 image so the view is not a sliver.
@@ -75,16 +98,14 @@ BalanceBenchRun run_one(const BalanceBenchConfig& config, const std::string& pat
       job.camera.origin[1] = eye.y;
       job.camera.origin[2] = eye.z;
     }
-    const core::FrameStats stats = renderer.render(job, frame);
-    run.idle_percent.push_back(stats.idle_percent);
-    if (f >= config.warmup) {
-      run.mean_idle_percent += stats.idle_percent;
-      run.worst_idle_percent = std::max(run.worst_idle_percent, stats.idle_percent);
-      run.mean_frame_ms += stats.frame_ms;
-      for (const core::TracerFrameStats& t : stats.tracers) run.mean_rendering_tracers += t.outcome == core::TracerOutcome::rendered;
-      ++counted;
+    if (config.frames_in_flight == 1) {
+      take(renderer.render(job, frame));
+    } else if (std::optional<core::FramePipeline::Delivered> done = pipeline.push(job)) {
+      take(done->stats);
     }
   }
+  if (std::optional<core::FramePipeline::Delivered> done = pipeline.drain()) take(done->stats);
+  if (intervals > 0) run.mean_interval_ms /= intervals;
   if (counted > 0) {
     run.mean_idle_percent /= counted;
     run.mean_frame_ms /= counted;
@@ -118,7 +139,10 @@ nlohmann::json balance_bench_json(const BalanceBenchConfig& config, const std::v
                  {"robin_hood_units", config.balancer_options.robin_hood_units},
                  {"row_cost_rates", {config.balancer_options.cost_rate, config.balancer_options.speed_rate}},
                  {"real", config.real}, {"clock", config.clock}, {"time_scale", config.time_scale},
-                 {"metric", "idle % = sum over tracers of (frame time - tracer time) / (tracers * frame time)"}};
+                 {"frames_in_flight", config.frames_in_flight},
+                 {"metric", config.frames_in_flight == 1
+                                ? "idle % = sum over tracers of (frame time - tracer time) / (tracers * frame time)"
+                                : "idle % = sum over tracers of time without a job before the band / sum of that and band times"}};
   j["runs"] = nlohmann::json::array();
   for (const BalanceBenchRun& r : runs) {
     j["runs"].push_back({{"path", r.path},
@@ -128,6 +152,7 @@ nlohmann::json balance_bench_json(const BalanceBenchConfig& config, const std::v
                          {"worst_idle_percent", r.worst_idle_percent},
                          {"mean_frame_ms", r.mean_frame_ms},
                          {"mean_rendering_tracers", r.mean_rendering_tracers},
+                         {"mean_interval_ms", r.mean_interval_ms},
                          {"idle_percent_per_frame", r.idle_percent}});
   }
   return j;
@@ -136,16 +161,17 @@ nlohmann::json balance_bench_json(const BalanceBenchConfig& config, const std::v
 std::string balance_bench_table(const std::vector<BalanceBenchRun>& runs) {
   std::string out;
   char line[256];
-  std::snprintf(line, sizeof line, "%-6s %-8s %-16s %12s %12s %14s %10s\n", "path", "tracers", "balancer", "mean idle %", "worst idle %",
-                "mean frame ms", "rendering");
+  std::snprintf(line, sizeof line, "%-6s %-8s %-16s %12s %12s %14s %10s %12s\n", "path", "tracers", "balancer", "mean idle %",
+                "worst idle %", "mean frame ms", "rendering", "interval ms");
   out += line;
   std::string last_group;
   for (const BalanceBenchRun& r : runs) {
     const std::string group = r.path + std::to_string(r.tracers);
     if (!last_group.empty() && group != last_group) out += "\n";
     last_group = group;
-    std::snprintf(line, sizeof line, "%-6s %-8d %-16s %12.2f %12.2f %14.3f %10.2f\n", r.path.c_str(), r.tracers, r.balancer.c_str(),
-                  r.mean_idle_percent, r.worst_idle_percent, r.mean_frame_ms, r.mean_rendering_tracers);
+    std::snprintf(line, sizeof line, "%-6s %-8d %-16s %12.2f %12.2f %14.3f %10.2f %12.3f\n", r.path.c_str(), r.tracers,
+                  r.balancer.c_str(), r.mean_idle_percent, r.worst_idle_percent, r.mean_frame_ms, r.mean_rendering_tracers,
+                  r.mean_interval_ms);
     out += line;
   }
   return out;

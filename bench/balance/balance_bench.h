@@ -33,6 +33,9 @@ struct BalanceBenchConfig {
   balance::BalancerOptions balancer_options;
   std::vector<std::string> real;         // real tracer names; empty: simulated
   std::string real_scene = kTestMapFile;   // what real tracers render
+  // RendererOptions::frames_in_flight: 2 drives the Renderer through core::FramePipeline with frame N+1
+  // handed out before N is waited for (compare the wall interval on a sleep or spin clock).
+  int frames_in_flight = 1;
 };
 
 struct BalanceBenchRun {
@@ -41,6 +44,7 @@ struct BalanceBenchRun {
   double mean_idle_percent = 0.0, worst_idle_percent = 0.0;
   double mean_frame_ms = 0.0;            // slowest band per frame (what idle % cannot show: a faster frame)
   double mean_rendering_tracers = 0.0;   // tracers given rows per frame (a balancer may bench a slow one)
+  double mean_interval_ms = 0.0;         // wall time between frames delivered (meaningless on the virtual clock)
   std::vector<double> idle_percent;      // per frame, warm-up included
 };
 

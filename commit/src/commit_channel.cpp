@@ -32,18 +32,22 @@ void CommitChannel::publish(const CommitBuffer& frame_records, const Snapshot& s
 const CommitBuffer& CommitChannel::begin_frame() {
   // The tracer is done with applying_ (same thread), so it can become the next pending buffer; keeping
   // it around reuses its capacity.
-  applying_.clear();
+  take(applying_);
+  return applying_;
+}
+
+void CommitChannel::take(CommitBuffer& into) {
+  into.clear();
   std::lock_guard lock(mutex_);
-  applying_.set_frame(pending_.frame());
-  std::swap(applying_, pending_);
+  into.set_frame(pending_.frame());
+  std::swap(into, pending_);
   pending_taken_ = true;
   ++stats_.commits_taken;
-  if (applying_.is_full_resync()) ++stats_.full_resyncs_taken;
-  stats_.last_bytes = applying_.bytes();
-  stats_.last_records = applying_.record_count();
-  stats_.total_bytes += applying_.bytes();
-  stats_.total_records += applying_.record_count();
-  return applying_;
+  if (into.is_full_resync()) ++stats_.full_resyncs_taken;
+  stats_.last_bytes = into.bytes();
+  stats_.last_records = into.record_count();
+  stats_.total_bytes += into.bytes();
+  stats_.total_records += into.record_count();
 }
 
 void CommitChannel::request_resync() {

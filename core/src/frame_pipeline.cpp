@@ -28,6 +28,7 @@ std::optional<FramePipeline::Delivered> FramePipeline::push(const BandJob& job, 
 
 std::optional<FramePipeline::Delivered> FramePipeline::push(const BandJob& job, std::vector<StageSpan> preparation,
                                                             const PrepareNext& prepare_next) {
+  if (renderer_.frames_in_flight() == 2) return push_two_in_flight(job, std::move(preparation), prepare_next);
   std::optional<InFlight> previous = std::move(in_flight_);
   in_flight_.reset();
   std::optional<FrameStats> stats;
@@ -56,6 +57,37 @@ std::optional<FramePipeline::Delivered> FramePipeline::push(const BandJob& job, 
   if (!previous) return std::nullopt;
   renderer_.merge_frame(*stats);
   return delivered(std::move(*previous), std::move(*stats));
+}
+
+std::optional<FramePipeline::Delivered> FramePipeline::push_two_in_flight(const BandJob& job,
+                                                                          std::vector<StageSpan> preparation,
+                                                                          const PrepareNext& prepare_next) {
+  // Handed out at once, while the frame before still renders: each worker queues it behind that frame's
+  // band and starts it the moment that band is done (Renderer: frames_in_flight 2).
+  std::optional<InFlight> previous = std::move(in_flight_);
+  in_flight_.reset();
+  try {
+    renderer_.begin_frame(job, image_);
+  } catch (...) {
+    in_flight_ = std::move(previous);  // still the Renderer's frame in flight
+    throw;
+  }
+  in_flight_ = InFlight{job, std::move(preparation)};
+  if (prepare_next) {
+    std::optional<BandJob> next;
+    try {
+      next = prepare_next();
+    } catch (...) {
+      if (previous) renderer_.finish_frame();  // leave one frame in flight, as push() promises
+      throw;
+    }
+    // For workers with no job queued when they end this one (remote tracers start on it ahead).
+    if (next) renderer_.announce_frame(*next);
+  }
+  if (!previous) return std::nullopt;
+  FrameStats stats = renderer_.wait_frame();
+  renderer_.merge_frame(stats);
+  return delivered(std::move(*previous), std::move(stats));
 }
 
 bool FramePipeline::announces_at_hand_out() {

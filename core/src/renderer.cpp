@@ -4,6 +4,7 @@
 #include <atomic>
 #include <condition_variable>
 #include <cstring>
+#include <deque>
 #include <functional>
 #include <mutex>
 #include <stdexcept>
@@ -37,26 +38,32 @@ struct Renderer::Worker {
   std::string name;  // asked once: the tracer may be busy on its own thread whenever the core looks
   std::shared_ptr<Completion> completion;
 
-  // Inbox, guarded by inbox_mutex.
+  // One job handed out and not yet started.
+  struct Queued {
+    uint64_t id = 0;
+    BandJob job;
+    bool recovery = false;  // re-rendering rows a dropped tracer did not deliver
+    bool probe = false;     // rendering rows only to be measured (a benched tracer)
+    int slot = 0;           // which of the two targets the job renders into
+    // Taken from the channel by the core at hand-out; the job owns it, so that the core may hand out the
+    // next job (and take the next commit) while this one's is still being applied. Applied ahead, by a
+    // tracer that takes commits ahead, while the job before renders: then it is gone from here.
+    std::optional<commit::CommitBuffer> commit;
+    // The channel the job's tracer may take commits ahead from (Tracer::takes_commits_ahead), handed over
+    // with the job: the core creates a channel on its first submit_commit, which may come while a job runs.
+    commit::CommitChannel* channel = nullptr;
+  };
+
+  // Inbox, guarded by inbox_mutex: at most two frames' jobs, and a recovery job behind them.
   std::mutex inbox_mutex;
   std::condition_variable inbox_cv;
   bool quit = false;
-  bool has_job = false;
-  std::atomic<bool> job_posted{false};  // has_job, for polling without the lock
+  std::deque<Queued> inbox;
+  std::atomic<bool> job_posted{false};  // !inbox.empty(), for polling without the lock
   std::chrono::microseconds handoff_spin{0};  // RendererOptions::handoff_spin
-  // Core thread only: when this worker's job should end (handed out + its last job's wall time).
+  // Core thread only: when this worker's last job handed out should end, and its last wall time.
   Clock::time_point expected_end{};
-  uint64_t job_id = 0;
-  BandJob job;
-  bool job_is_recovery = false;    // re-rendering rows a dropped tracer did not deliver
-  int job_slot = 0;                // which of the two targets the job renders into
-  bool job_is_probe = false;       // rendering rows only to be measured (a benched tracer)
-  // Taken from the channel by the core when it hands out a job; the buffer stays valid (and untouched
-  // by the core) until the next hand-over, which happens only once this job has ended.
-  const commit::CommitBuffer* job_commit = nullptr;
-  // The channel the job's tracer may take commits ahead from (Tracer::takes_commits_ahead), handed over
-  // with the job: the core creates a channel on its first submit_commit, which may come while a job runs.
-  commit::CommitChannel* job_channel = nullptr;
+  double last_wall_ms = 0.0;
 
   // Created by the first submit_commit; publish and take are the core's, the channel locks itself.
   std::shared_ptr<commit::CommitChannel> channel;
@@ -67,25 +74,39 @@ struct Renderer::Worker {
   // stages of what it applied ahead.
   commit::CommitChannel* ahead_channel = nullptr;
   std::vector<StageSpan> ahead_spans;
-  // Core thread only: the unwaited job of a benched tracer (0: none) and its probe band, and the rows
-  // per ms this tracer showed last (how much of a dropped tracer's rows it is given).
-  uint64_t side_job = 0;
-  balance::Band side_band;
+  // Worker thread only: when its last job ended (for the time it waited for the next).
+  std::optional<Clock::time_point> last_end;
+  // Core thread only: the unwaited jobs of a benched tracer (at most one a frame in flight) with their
+  // probe bands, and the rows per ms this tracer showed last (how much of a dropped tracer's rows it is
+  // given).
+  struct SideJob {
+    uint64_t id = 0;
+    balance::Band band;
+  };
+  std::vector<SideJob> side_jobs;
   double rows_per_ms = 0.0;
   int benched_frames_without_job = 0;  // frames benched since its last side job (RendererOptions::benched_commit_every)
 
-  // Outcome of the last job, guarded by completion->mutex.
-  bool busy = false;
-  uint64_t done_job_id = 0;
-  bool ok = false;
-  std::string error;
-  double wall_ms = 0.0;
-  double reported_ms = 0.0;
-  double balance_ms = 0.0;  // BandResult::balance_ms of the last job
-  double apply_ms = 0.0;
-  std::vector<float> row_work;
-  DeviceBand device_band;        // the last job's band, when it stayed on a GPU
-  std::vector<StageSpan> spans;  // the last job's apply and render stages
+  // Guarded by completion->mutex: the jobs handed out that have not ended, and what the ended ones
+  // reported until the core takes it.
+  std::vector<uint64_t> unfinished;
+  std::deque<Outcome> outcomes;
+
+  bool busy() const { return !unfinished.empty(); }
+  // The outcome of job `job_id`, taken out of the list; nothing while it has not ended. Call with
+  // completion->mutex held.
+  std::optional<Outcome> take_outcome(uint64_t job_id) {
+    for (auto it = outcomes.begin(); it != outcomes.end(); ++it) {
+      if (it->job_id != job_id) continue;
+      Outcome o = std::move(*it);
+      outcomes.erase(it);
+      return o;
+    }
+    return std::nullopt;
+  }
+  bool ended(uint64_t job_id) const {
+    return std::find(unfinished.begin(), unfinished.end(), job_id) == unfinished.end();
+  }
 
   // The tracer's private targets, one per frame parity, so that the core merges frame N from one
   // while the tracer renders N+1 into the other. Only the worker writes a target while its job runs;
@@ -95,107 +116,120 @@ struct Renderer::Worker {
 
   void loop() {
     for (;;) {
-      BandJob current;
-      uint64_t current_id = 0;
-      bool recovery = false, probe = false;
-      int slot = 0;
-      const commit::CommitBuffer* to_apply = nullptr;
-      commit::CommitChannel* channel_of_job = nullptr;
+      Queued current;
       if (handoff_spin.count() > 0)
         spin_until(Clock::now() + handoff_spin, [&] { return job_posted.load(std::memory_order_acquire); });
       {
         std::unique_lock lock(inbox_mutex);
-        inbox_cv.wait(lock, [&] { return quit || has_job; });
-        if (quit && !has_job) return;
-        current = job;
-        current_id = job_id;
-        recovery = job_is_recovery;
-        slot = job_slot;
-        probe = job_is_probe;
-        has_job = false;
-        job_posted.store(false, std::memory_order_relaxed);
-        to_apply = job_commit;
-        job_commit = nullptr;
-        channel_of_job = job_channel;
+        inbox_cv.wait(lock, [&] { return quit || !inbox.empty(); });
+        if (quit && inbox.empty()) return;
+        current = std::move(inbox.front());
+        inbox.pop_front();
+        job_posted.store(!inbox.empty(), std::memory_order_relaxed);
       }
-      bool success = false;
-      std::string what;
-      double wall = 0.0, reported = 0.0, applied = 0.0, balance = 0.0;
-      std::vector<float> work;
-      DeviceBand kept;
-      std::vector<StageSpan> job_spans;
+      Outcome outcome;
+      outcome.job_id = current.id;
+      const auto start = Clock::now();
+      if (last_end) outcome.waited_ms = std::chrono::duration<double, std::milli>(start - *last_end).count();
       const std::string track = tracer_track(id, name);
       try {
         // Apply time is part of what the tracer costs the frame, so the balancer sees it.
-        const auto start = Clock::now();
-        if (to_apply && !to_apply->empty()) apply(*to_apply, job_spans, track);
-        applied = std::chrono::duration<double, std::milli>(Clock::now() - start).count();
+        if (current.commit && !current.commit->empty()) apply(*current.commit, outcome.spans, track);
+        outcome.apply_ms = std::chrono::duration<double, std::milli>(Clock::now() - start).count();
         if (scene_diverged)
           throw std::runtime_error("its scene diverged after a failed commit; waiting for a full resync");
-        if (current.params.row_end > current.params.row_begin) {  // a benched tracer may only apply
-          ScopedStage rendering(job_spans, track, recovery ? "re-render" : probe ? "probe" : "render");
-          if (tracer->takes_commits_ahead()) ahead_channel = channel_of_job;
+        const BandJob& job = current.job;
+        if (job.params.row_end > job.params.row_begin) {  // a benched tracer may only apply
+          ScopedStage rendering(outcome.spans, track, current.recovery ? "re-render" : current.probe ? "probe" : "render");
+          if (tracer->takes_commits_ahead()) ahead_channel = current.channel;
           BandResult result;
           try {
-            result = tracer->render_band(current, targets[slot]);
+            result = tracer->render_band(job, targets[current.slot]);
           } catch (...) {
-            end_ahead(job_spans);
+            end_ahead(outcome.spans);
             throw;
           }
-          end_ahead(job_spans);
-          wall = std::chrono::duration<double, std::milli>(Clock::now() - start).count();
+          end_ahead(outcome.spans);
+          outcome.wall_ms = std::chrono::duration<double, std::milli>(Clock::now() - start).count();
           rendering.finish();
           if (result.transfer_ms > 0.0) {
             // The tracer's own clock inside its render span: kernels then transfer, ending with the span.
-            const StageSpan render = job_spans.back();
-            append_spans_ending_at(job_spans, track, render.start_ms + render.ms,
+            const StageSpan render = outcome.spans.back();
+            append_spans_ending_at(outcome.spans, track, render.start_ms + render.ms,
                                    {{"kernels", result.device_ms}, {"transfer", result.transfer_ms}}, render.start_ms);
           }
-          reported = result.device_ms;
-          balance = result.balance_ms;
-          if (result.row_work.size() == current.params.row_end - current.params.row_begin) work = result.row_work;
-          if (current.keep_on_device >= 0) kept = result.device;
+          outcome.reported_ms = result.device_ms;
+          outcome.balance_ms = result.balance_ms;
+          if (result.row_work.size() == job.params.row_end - job.params.row_begin) outcome.row_work = std::move(result.row_work);
+          if (job.keep_on_device >= 0) outcome.device_band = result.device;
         } else {
-          wall = applied;
+          outcome.wall_ms = outcome.apply_ms;
         }
-        success = true;
+        outcome.ok = true;
       } catch (const std::exception& e) {
-        what = e.what();
+        outcome.error = e.what();
       } catch (...) {
-        what = "unknown exception";
+        outcome.error = "unknown exception";
       }
+      current.commit.reset();  // the records (and a resync's scene) are not kept for the next job's wait
+      last_end = Clock::now();
       {
         std::lock_guard lock(completion->mutex);
-        busy = false;
-        done_job_id = current_id;
-        ok = success;
-        error = std::move(what);
-        wall_ms = wall;
-        reported_ms = reported;
-        balance_ms = balance;
-        apply_ms = applied;
-        row_work = std::move(work);
-        device_band = kept;
-        spans = std::move(job_spans);
+        std::erase(unfinished, current.id);
+        outcomes.push_back(std::move(outcome));
         completion->count.fetch_add(1, std::memory_order_release);
       }
       completion->cv.notify_all();
     }
   }
 
-  // Tracer::apply_commits_ahead, on this worker's thread inside render_band: what the core published
-  // since the job was handed out is applied now; the next job brings what is published after it. Not
-  // while a resync is asked for or the scene diverged: the next job's commit answers those, as always.
+  // Tracer::apply_commits_ahead, on this worker's thread inside render_band. With the next job already
+  // queued (two frames in flight), that job's commit is what the core published after this one's: it is
+  // applied now, and what is published after it stays in the channel for the job after. Otherwise what the
+  // core published since the job was handed out is applied now; the next job brings what is published
+  // after it. Not while a resync is asked for or the scene diverged: the next job's commit answers those,
+  // as always.
   void apply_ahead() {
-    commit::CommitChannel* channel = ahead_channel;
-    if (!channel || scene_diverged || !channel->has_pending() || channel->resync_requested()) return;
-    const commit::CommitBuffer& commit = channel->begin_frame();
-    if (commit.empty()) return;
+    commit::CommitChannel* channel_now = ahead_channel;
+    if (!channel_now || scene_diverged) return;
+    std::optional<commit::CommitBuffer> queued;
+    const commit::CommitBuffer* commit = nullptr;
+    {
+      std::lock_guard lock(inbox_mutex);  // the core takes from the channel under it when it queues a job
+      if (!inbox.empty()) {
+        Queued& next = inbox.front();
+        if (next.recovery || !next.commit) return;
+        queued = std::move(next.commit);
+        next.commit.reset();
+        commit = &*queued;
+      } else {
+        if (!channel_now->has_pending() || channel_now->resync_requested()) return;
+        commit = &channel_now->begin_frame();
+      }
+    }
+    if (commit->empty()) return;
     try {
-      apply(commit, ahead_spans, tracer_track(id, name), " ahead");
+      apply(*commit, ahead_spans, tracer_track(id, name), " ahead");
     } catch (...) {
       // apply() marked the scene diverged and asked for a resync: the next job fails until it comes.
     }
+  }
+  // Tracer::next_job_announced: the job this worker renders next, when it is queued already (without its
+  // rows, as an announcement has none), else the core's announcement.
+  std::optional<BandJob> next_job(const std::shared_ptr<Announcement>& announcement) {
+    {
+      std::lock_guard lock(inbox_mutex);
+      if (!inbox.empty()) {
+        const Queued& next = inbox.front();
+        if (next.recovery || next.probe || next.job.params.row_end <= next.job.params.row_begin) return std::nullopt;
+        BandJob job = next.job;
+        job.params.row_begin = job.params.row_end = 0;
+        job.keep_on_device = -1;
+        return job;
+      }
+    }
+    std::lock_guard lock(announcement->mutex);
+    return announcement->job;
   }
   void end_ahead(std::vector<StageSpan>& spans) {
     ahead_channel = nullptr;
@@ -221,6 +255,8 @@ struct Renderer::Worker {
 Renderer::Renderer(std::vector<std::unique_ptr<Tracer>> tracers, RendererOptions options)
     : options_(std::move(options)) {
   if (tracers.empty()) throw std::invalid_argument("Renderer: no tracers");
+  if (options_.frames_in_flight != 1 && options_.frames_in_flight != 2)
+    throw std::invalid_argument("Renderer: frames_in_flight is 1 or 2, not " + std::to_string(options_.frames_in_flight));
   balancer_ = balance::make_balancer(options_.balancer, options_.balancer_options);
   auto completion = std::make_shared<Completion>();
   for (size_t i = 0; i < tracers.size(); ++i) {
@@ -235,9 +271,8 @@ Renderer::Renderer(std::vector<std::unique_ptr<Tracer>> tracers, RendererOptions
     if (w->tracer->takes_commits_ahead()) w->tracer->set_commits_ahead([worker = w.get()] { worker->apply_ahead(); });
     if (w->tracer->takes_jobs_ahead()) {
       any_takes_jobs_ahead_ = true;
-      w->tracer->set_next_job([announcement = announcement_]() -> std::optional<BandJob> {
-        std::lock_guard lock(announcement->mutex);
-        return announcement->job;
+      w->tracer->set_next_job([worker = w.get(), announcement = announcement_]() -> std::optional<BandJob> {
+        return worker->next_job(announcement);
       });
     }
     workers_.push_back(std::move(w));
@@ -249,17 +284,15 @@ Renderer::Renderer(std::vector<std::unique_ptr<Tracer>> tracers, RendererOptions
 
 Renderer::~Renderer() {
   for (auto& w : workers_) {
-    bool dropped_job = false;
+    std::deque<Worker::Queued> dropped;  // handed out but not started: they never will be
     {
       std::lock_guard lock(w->inbox_mutex);
       w->quit = true;
-      dropped_job = w->has_job;  // handed out but not started: it never will be
-      w->has_job = false;
-      w->job_commit = nullptr;
+      dropped.swap(w->inbox);
     }
-    if (dropped_job) {
+    {
       std::lock_guard lock(w->completion->mutex);
-      w->busy = false;
+      for (const Worker::Queued& job : dropped) std::erase(w->unfinished, job.id);
     }
     w->inbox_cv.notify_all();
   }
@@ -271,7 +304,7 @@ Renderer::~Renderer() {
     bool returned = false;
     {
       std::unique_lock lock(completion.mutex);
-      returned = completion.cv.wait_until(lock, deadline, [&] { return !w->busy; });
+      returned = completion.cv.wait_until(lock, deadline, [&] { return !w->busy(); });
     }
     if (returned) {
       w->thread.join();
@@ -335,56 +368,76 @@ void Renderer::reset_balancer() {
   last_measurements_.clear();
 }
 
-double Renderer::measured_ms(const Worker& w) const {
+double Renderer::measured_ms(const Outcome& o) const {
   // Reported times are the tracer's own (kernel time); its commit apply is part of its cost too.
-  if (options_.use_reported_time && w.reported_ms > 0.0) return w.reported_ms + w.apply_ms;
-  return w.balance_ms > 0.0 ? w.balance_ms + w.apply_ms : w.wall_ms;
+  if (options_.use_reported_time && o.reported_ms > 0.0) return o.reported_ms + o.apply_ms;
+  return o.balance_ms > 0.0 ? o.balance_ms + o.apply_ms : o.wall_ms;
+}
+
+const Renderer::Outcome& Renderer::RoundResult::of(int worker) const {
+  for (const auto& [id, outcome] : outcomes)
+    if (id == worker) return outcome;
+  throw std::logic_error("Renderer: no outcome of tracer " + std::to_string(worker) + " in this round");
 }
 
 void Renderer::harvest_side_job(Worker& w, std::vector<StageSpan>& stages) {
-  if (w.side_job == 0 || w.done_job_id != w.side_job) return;
-  w.side_job = 0;
-  stages.insert(stages.end(), std::make_move_iterator(w.spans.begin()), std::make_move_iterator(w.spans.end()));
-  w.spans.clear();
-  if (!w.ok) {
-    spdlog::warn("tracer {} ({}) failed while benched{}: {}", w.id, w.name, w.side_band.empty() ? "" : " on its probe band", w.error);
-    return;
+  for (auto side = w.side_jobs.begin(); side != w.side_jobs.end();) {
+    std::optional<Outcome> o = w.take_outcome(side->id);
+    if (!o) {
+      if (w.ended(side->id)) {
+        side = w.side_jobs.erase(side);  // ended, and its outcome pruned (a frame that moved on)
+      } else {
+        ++side;
+      }
+      continue;
+    }
+    const balance::Band band = side->band;
+    side = w.side_jobs.erase(side);
+    stages.insert(stages.end(), std::make_move_iterator(o->spans.begin()), std::make_move_iterator(o->spans.end()));
+    if (!o->ok) {
+      spdlog::warn("tracer {} ({}) failed while benched{}: {}", w.id, w.name, band.empty() ? "" : " on its probe band", o->error);
+      continue;
+    }
+    if (band.empty()) continue;
+    const double ms = measured_ms(*o);
+    std::erase_if(last_measurements_, [&](const balance::TracerMeasurement& m) { return m.tracer == w.id; });
+    last_measurements_.push_back({w.id, band, ms});
+    if (ms > 0.0) w.rows_per_ms = band.rows() / ms;
   }
-  if (w.side_band.empty()) return;
-  const double ms = measured_ms(w);
-  std::erase_if(last_measurements_, [&](const balance::TracerMeasurement& m) { return m.tracer == w.id; });
-  last_measurements_.push_back({w.id, w.side_band, ms});
-  if (ms > 0.0) w.rows_per_ms = w.side_band.rows() / ms;
 }
 
-std::vector<uint64_t> Renderer::assign(const std::vector<Assignment>& assignments, const BandJob& job, int slot,
+std::vector<uint64_t> Renderer::assign(std::vector<Assignment>& assignments, const BandJob& job, int slot,
                                        bool with_commits) {
   const int width = static_cast<int>(job.camera.width), height = static_cast<int>(job.camera.height);
   std::vector<uint64_t> ids(assignments.size());
   for (size_t i = 0; i < assignments.size(); ++i) {
     Worker& w = *workers_[static_cast<size_t>(assignments[i].worker)];
+    // Only the worker's job of the other slot may be running: this slot's target is the core's.
     w.targets[slot].resize(width, height, options_.band_format);
     w.targets[slot].enable_aux(job.params.aux_outputs != 0u);
     ids[i] = next_job_++;
+    const auto now = Clock::now();
     {
       std::lock_guard lock(w.completion->mutex);
-      w.busy = true;
-      w.expected_end = Clock::now() + std::chrono::duration_cast<Clock::duration>(
-                                          std::chrono::duration<double, std::milli>(w.wall_ms));
+      // Queued behind a job still running, it starts when that one ends.
+      const Clock::time_point begins = w.busy() ? std::max(now, w.expected_end) : now;
+      w.unfinished.push_back(ids[i]);
+      w.expected_end = begins + std::chrono::duration_cast<Clock::duration>(
+                                    std::chrono::duration<double, std::milli>(w.last_wall_ms));
+      assignments[i].due = w.expected_end;
     }
-    std::lock_guard lock(w.inbox_mutex);
-    w.job = job;
-    w.job.params.row_begin = static_cast<kuint>(assignments[i].band.begin);
-    w.job.params.row_end = static_cast<kuint>(assignments[i].band.end);
-    w.job_id = ids[i];
-    w.job_channel = w.channel.get();
-    w.job_is_recovery = !with_commits;
-    w.job_slot = slot;
-    w.job_is_probe = assignments[i].probe;
+    Worker::Queued queued;
+    queued.id = ids[i];
+    queued.job = job;
+    queued.job.params.row_begin = static_cast<kuint>(assignments[i].band.begin);
+    queued.job.params.row_end = static_cast<kuint>(assignments[i].band.end);
+    queued.channel = w.channel.get();
+    queued.recovery = !with_commits;
+    queued.slot = slot;
+    queued.probe = assignments[i].probe;
     // Only a frame's own bands may stay on a GPU: re-rendered rows and probes come through the host.
-    w.job.keep_on_device = with_commits && !assignments[i].probe && packed_merge_ ? device_bands_for_ : -1;
-    w.has_job = true;
-    w.job_posted.store(true, std::memory_order_release);
+    queued.job.keep_on_device = with_commits && !assignments[i].probe && packed_merge_ ? device_bands_for_ : -1;
+    std::lock_guard lock(w.inbox_mutex);
     // What was published so far belongs to this frame; commits submitted from now on wait for the
     // next. Re-rendering a dropped tracer's rows happens within the same frame, so it takes none.
     if (with_commits && w.channel) {
@@ -393,8 +446,11 @@ std::vector<uint64_t> Renderer::assign(const std::vector<Assignment>& assignment
         nothing_new.set_frame(commit_frame_);
         w.channel->publish(nothing_new, [this] { return resync_scene(); });
       }
-      w.job_commit = &w.channel->begin_frame();
+      queued.commit.emplace();
+      w.channel->take(*queued.commit);
     }
+    w.inbox.push_back(std::move(queued));
+    w.job_posted.store(true, std::memory_order_release);
     w.inbox_cv.notify_one();
   }
   return ids;
@@ -408,14 +464,14 @@ Renderer::RoundResult Renderer::collect(const std::vector<Assignment>& assignmen
   std::unique_lock lock(completion.mutex);
   auto all_done = [&] {
     for (size_t i = 0; i < assignments.size(); ++i) {
-      if (workers_[static_cast<size_t>(assignments[i].worker)]->done_job_id != ids[i]) return false;
+      if (!workers_[static_cast<size_t>(assignments[i].worker)]->ended(ids[i])) return false;
     }
     return true;
   };
   if (options_.handoff_spin.count() > 0 && !all_done()) {
     // Asleep until shortly before the slowest band is due, then polling the count of ended jobs.
     Clock::time_point due{};
-    for (const Assignment& a : assignments) due = std::max(due, workers_[static_cast<size_t>(a.worker)]->expected_end);
+    for (const Assignment& a : assignments) due = std::max(due, a.due);
     const auto spin = std::chrono::duration_cast<Clock::duration>(options_.handoff_spin);
     completion.cv.wait_until(lock, std::min(due - spin, deadline), all_done);
     uint64_t seen = completion.count.load(std::memory_order_acquire);
@@ -431,24 +487,27 @@ Renderer::RoundResult Renderer::collect(const std::vector<Assignment>& assignmen
   completion.cv.wait_until(lock, deadline, all_done);
   for (size_t i = 0; i < assignments.size(); ++i) {
     Worker& w = *workers_[static_cast<size_t>(assignments[i].worker)];
-    if (w.done_job_id == ids[i]) {
-      stages.insert(stages.end(), std::make_move_iterator(w.spans.begin()), std::make_move_iterator(w.spans.end()));
-      w.spans.clear();
-    }
-    if (w.done_job_id != ids[i]) {
+    std::optional<Outcome> o = w.take_outcome(ids[i]);
+    if (!o) {
       result.timed_out.push_back(w.id);
-    } else if (!w.ok) {
+      continue;
+    }
+    stages.insert(stages.end(), std::make_move_iterator(o->spans.begin()), std::make_move_iterator(o->spans.end()));
+    o->spans.clear();
+    if (o->ok) w.last_wall_ms = o->wall_ms;
+    if (!o->ok) {
       result.threw.push_back(w.id);
     } else {
       result.finished.push_back(w.id);
       result.delivered.push_back(assignments[i]);
-      result.delivered.back().device = w.device_band;
+      result.delivered.back().device = o->device_band;
       const balance::Band& band = assignments[i].band;
-      if (w.row_work.size() == static_cast<size_t>(band.rows())) {
-        std::copy(w.row_work.begin(), w.row_work.end(), row_work_.begin() + band.begin);
+      if (o->row_work.size() == static_cast<size_t>(band.rows()) && static_cast<int>(row_work_.size()) >= band.end) {
+        std::copy(o->row_work.begin(), o->row_work.end(), row_work_.begin() + band.begin);
         std::fill(row_work_known_.begin() + band.begin, row_work_known_.begin() + band.end, 1);
       }
     }
+    result.outcomes.emplace_back(w.id, std::move(*o));
   }
   return result;
 }
@@ -468,6 +527,7 @@ void Renderer::merge(const std::vector<Assignment>& bands, int slot, FrameBuffer
 }
 
 FrameStats Renderer::render(const BandJob& job, FrameBuffer& out, const std::vector<float>& row_cost_proxy) {
+  if (!pending_.empty()) throw std::logic_error("Renderer::render: a frame is in flight");
   begin_frame(job, out, row_cost_proxy);
   return finish_frame();
 }
@@ -480,7 +540,8 @@ void Renderer::announce_frame(const BandJob& job) {
 }
 
 void Renderer::begin_frame(const BandJob& job, FrameBuffer& out, const std::vector<float>& row_cost_proxy) {
-  if (pending_) throw std::logic_error("Renderer::begin_frame: the previous frame was not waited for");
+  if (static_cast<int>(pending_.size()) >= options_.frames_in_flight)
+    throw std::logic_error("Renderer::begin_frame: the previous frame was not waited for");
   if (unmerged_ && unmerged_->slot == next_slot_)
     throw std::logic_error("Renderer::begin_frame: the frame before the previous one was not merged");
   {
@@ -498,16 +559,29 @@ void Renderer::begin_frame(const BandJob& job, FrameBuffer& out, const std::vect
   stats.tracers.resize(workers_.size());
   stats.start_ms = timeline_ms(frame_start);
 
-  // Tracers still finishing late work sit this frame out; the balancer sees them as removed.
+  // Tracers still finishing late work sit this frame out; the balancer sees them as removed. With two
+  // frames in flight, a tracer whose one unfinished job belongs to the frame in flight is ready: this
+  // frame's job queues behind it.
+  const PendingFrame* in_flight = pending_.empty() ? nullptr : pending_.back().get();
   std::vector<int> ready;
   {
     std::lock_guard lock(workers_.front()->completion->mutex);
     for (auto& w : workers_) {
       harvest_side_job(*w, stats.stages);
+      // What nobody will collect any more (late jobs of frames that moved on) is dropped.
+      std::erase_if(w->outcomes, [&](const Outcome& o) {
+        const auto wanted = [&](uint64_t id) { return id == o.job_id; };
+        return !(in_flight && std::any_of(in_flight->handed_out.begin(), in_flight->handed_out.end(), wanted)) &&
+               !std::any_of(w->side_jobs.begin(), w->side_jobs.end(), [&](const Worker::SideJob& j) { return wanted(j.id); });
+      });
       TracerFrameStats& t = stats.tracers[static_cast<size_t>(w->id)];
       t.id = w->id;
       t.name = w->name;
-      if (w->busy) t.outcome = TracerOutcome::busy;
+      const bool queues_behind_the_frame_in_flight =
+          in_flight && w->unfinished.size() == 1 &&
+          std::find(in_flight->handed_out.begin(), in_flight->handed_out.end(), w->unfinished.front()) !=
+              in_flight->handed_out.end();
+      if (w->busy() && !queues_behind_the_frame_in_flight) t.outcome = TracerOutcome::busy;
       else ready.push_back(w->id);
     }
   }
@@ -523,9 +597,9 @@ void Renderer::begin_frame(const BandJob& job, FrameBuffer& out, const std::vect
   ScopedStage balancing(stats.stages, kCoreTrack, "balance");
   // The interval since the previous frame began is what the loop delivers (with a virtual clock it
   // means nothing, and the balancer gets none).
-  double interval_ms = 0.0;
-  if (last_frame_start_ && !options_.use_reported_time)
-    interval_ms = std::chrono::duration<double, std::milli>(frame_start - *last_frame_start_).count();
+  double interval_ms = 0.0, since_previous_ms = 0.0;
+  if (last_frame_start_) since_previous_ms = std::chrono::duration<double, std::milli>(frame_start - *last_frame_start_).count();
+  if (!options_.use_reported_time) interval_ms = since_previous_ms;
   last_frame_start_ = frame_start;
   const std::vector<balance::Band> bands =
       balancer_->divide({rows, ready, last_measurements_, std::move(proxy), interval_ms});
@@ -564,17 +638,20 @@ void Renderer::begin_frame(const BandJob& job, FrameBuffer& out, const std::vect
   const std::vector<uint64_t> side_ids = assign(side_jobs, job, slot, true);
   for (size_t i = 0; i < side_jobs.size(); ++i) {
     Worker& w = *workers_[static_cast<size_t>(side_jobs[i].worker)];
-    w.side_job = side_ids[i];
-    w.side_band = side_jobs[i].band;
+    w.side_jobs.push_back({side_ids[i], side_jobs[i].band});
   }
-  pending_ = std::make_unique<PendingFrame>();
-  pending_->job = job;
-  pending_->out = &out;
-  pending_->stats = std::move(stats);
-  pending_->assignments = std::move(assignments);
-  pending_->ids = std::move(ids);
-  pending_->start = frame_start;
-  pending_->slot = slot;
+  auto frame = std::make_unique<PendingFrame>();
+  frame->job = job;
+  frame->out = &out;
+  frame->stats = std::move(stats);
+  frame->assignments = std::move(assignments);
+  frame->handed_out = ids;
+  frame->handed_out.insert(frame->handed_out.end(), side_ids.begin(), side_ids.end());
+  frame->ids = std::move(ids);
+  frame->start = frame_start;
+  frame->slot = slot;
+  frame->since_previous_ms = since_previous_ms;
+  pending_.push_back(std::move(frame));
 }
 
 FrameStats Renderer::finish_frame() {
@@ -618,45 +695,61 @@ void Renderer::merge_frame(FrameStats& stats) {
 }
 
 FrameStats Renderer::wait_frame() {
-  if (!pending_) throw std::logic_error("Renderer::finish_frame: no frame was begun");
+  if (pending_.empty()) throw std::logic_error("Renderer::finish_frame: no frame was begun");
   if (unmerged_) throw std::logic_error("Renderer::wait_frame: the previous frame was not merged");
-  std::unique_ptr<PendingFrame> frame = std::move(pending_);
+  std::unique_ptr<PendingFrame> frame = std::move(pending_.front());
+  pending_.pop_front();
   FrameStats& stats = frame->stats;
   const BandJob& job = frame->job;
-  RoundResult first = collect(frame->assignments, frame->ids, frame->start + options_.frame_timeout, stats.stages);
+  // With two frames in flight a frame's bands start only when the frame before's have ended: its time
+  // counts from then.
+  const Clock::time_point counted_from =
+      options_.frames_in_flight == 2 ? std::max(frame->start, last_round_end_) : frame->start;
+  RoundResult first = collect(frame->assignments, frame->ids, counted_from + options_.frame_timeout, stats.stages);
+  last_round_end_ = Clock::now();
   frame->delivered = first.delivered;
   last_measurements_.clear();
   for (int id : first.finished) {
     TracerFrameStats& t = stats.tracers[static_cast<size_t>(id)];
-    t.ms = measured_ms(*workers_[static_cast<size_t>(id)]);
+    t.ms = measured_ms(first.of(id));
     t.outcome = TracerOutcome::rendered;
     stats.frame_ms = std::max(stats.frame_ms, t.ms);
     last_measurements_.push_back({id, balance::Band{t.row_begin, t.row_end}, t.ms});
     if (t.ms > 0.0) workers_[static_cast<size_t>(id)]->rows_per_ms = (t.row_end - t.row_begin) / t.ms;
   }
-  int taking_part = 0;
-  for (TracerFrameStats& t : stats.tracers) {
-    if (t.outcome == TracerOutcome::rendered) {
-      t.idle_ms = stats.frame_ms - t.ms;
+  if (options_.frames_in_flight == 2 && !options_.use_reported_time) {
+    // Frames overlap: a tracer is idle only while it has no job, from the end of its job before to the
+    // start of this one (at most the time between the two frames' hand-outs), and busy for its band.
+    for (int id : first.finished) {
+      TracerFrameStats& t = stats.tracers[static_cast<size_t>(id)];
+      const double waited = first.of(id).waited_ms;
+      t.idle_ms = waited < 0.0 ? 0.0 : std::clamp(waited, 0.0, frame->since_previous_ms);
       stats.idle_ms += t.idle_ms;
-      ++taking_part;
+      stats.summed_tracer_ms += t.idle_ms + t.ms;
     }
+  } else {
+    int taking_part = 0;
+    for (TracerFrameStats& t : stats.tracers) {
+      if (t.outcome == TracerOutcome::rendered) {
+        t.idle_ms = stats.frame_ms - t.ms;
+        stats.idle_ms += t.idle_ms;
+        ++taking_part;
+      }
+    }
+    stats.summed_tracer_ms = taking_part * stats.frame_ms;
   }
-  stats.summed_tracer_ms = taking_part * stats.frame_ms;
   stats.idle_percent = stats.summed_tracer_ms > 0.0 ? 100.0 * stats.idle_ms / stats.summed_tracer_ms : 0.0;
 
   // Re-render what the dropped tracers did not deliver, split among those that finished, in
   // proportion to the speed they just showed, until every row is covered or nobody is left.
   std::vector<balance::Band> missing;
-  auto drop = [&](const std::vector<int>& ids, TracerOutcome why, const std::vector<balance::Band>& their_bands) {
+  auto drop = [&](const std::vector<int>& ids, TracerOutcome why, const std::vector<balance::Band>& their_bands,
+                  const RoundResult& round) {
     for (size_t i = 0; i < ids.size(); ++i) {
       TracerFrameStats& t = stats.tracers[static_cast<size_t>(ids[i])];
       if (t.outcome != TracerOutcome::threw && t.outcome != TracerOutcome::timed_out) ++stats.dropped;
       t.outcome = why;
-      if (why == TracerOutcome::threw) {
-        std::lock_guard lock(workers_.front()->completion->mutex);
-        t.error = workers_[static_cast<size_t>(ids[i])]->error;
-      }
+      if (why == TracerOutcome::threw) t.error = round.of(ids[i]).error;
       missing.push_back(their_bands[i]);
       spdlog::warn("frame {}: tracer {} ({}) {} on rows [{}, {}){}{}; re-rendering them on the others", stats.frame,
                    t.id, t.name, why == TracerOutcome::threw ? "threw" : "timed out", their_bands[i].begin,
@@ -668,8 +761,8 @@ FrameStats Renderer::wait_frame() {
     for (int id : ids) b.push_back({stats.tracers[static_cast<size_t>(id)].row_begin, stats.tracers[static_cast<size_t>(id)].row_end});
     return b;
   };
-  drop(first.threw, TracerOutcome::threw, band_of(first.threw));
-  drop(first.timed_out, TracerOutcome::timed_out, band_of(first.timed_out));
+  drop(first.threw, TracerOutcome::threw, band_of(first.threw), first);
+  drop(first.timed_out, TracerOutcome::timed_out, band_of(first.timed_out), first);
 
   std::vector<int> helpers = first.finished, needs_commits;
   if (!missing.empty()) {
@@ -681,14 +774,20 @@ FrameStats Renderer::wait_frame() {
     // One still on an earlier frame's side job missed this frame's commits: it gets them with its rows.
     for (const TracerFrameStats& t : stats.tracers) {
       Worker& w = *workers_[static_cast<size_t>(t.id)];
-      const bool behind = t.outcome == TracerOutcome::busy && w.side_job != 0;
+      const bool behind = t.outcome == TracerOutcome::busy && !w.side_jobs.empty();
       if (t.outcome != TracerOutcome::no_rows && !behind) continue;
-      if (first.finished.empty() && w.side_job != 0)
-        completion.cv.wait_until(lock, deadline, [&] { return w.done_job_id == w.side_job; });
-      if (w.busy) continue;
-      const bool side_job_failed = w.side_job != 0 && !w.ok;
+      const auto side_jobs_ended = [&] {
+        return std::all_of(w.side_jobs.begin(), w.side_jobs.end(), [&](const Worker::SideJob& j) { return w.ended(j.id); });
+      };
+      if (first.finished.empty() && !w.side_jobs.empty()) completion.cv.wait_until(lock, deadline, side_jobs_ended);
+      // Busy also with the next frame's side job queued (two frames in flight): it does not help.
+      if (w.busy()) continue;
+      const bool side_job_failed = std::any_of(w.outcomes.begin(), w.outcomes.end(), [&](const Outcome& o) {
+        return !o.ok && std::any_of(w.side_jobs.begin(), w.side_jobs.end(),
+                                    [&](const Worker::SideJob& j) { return j.id == o.job_id; });
+      });
       harvest_side_job(w, stats.stages);
-      if (side_job_failed || w.side_job != 0) continue;
+      if (side_job_failed || !w.side_jobs.empty()) continue;
       helpers.push_back(t.id);
       if (behind) needs_commits.push_back(t.id);
     }
@@ -718,10 +817,12 @@ FrameStats Renderer::wait_frame() {
     const auto with_commits = std::find_if(round.begin(), round.end(), [&](const Assignment& a) {
       return std::find(needs_commits.begin(), needs_commits.end(), a.worker) == needs_commits.end();
     });
-    const std::vector<Assignment> first_part(round.begin(), with_commits), second_part(with_commits, round.end());
+    std::vector<Assignment> first_part(round.begin(), with_commits), second_part(with_commits, round.end());
     std::vector<uint64_t> round_ids = assign(first_part, job, frame->slot, true);
     const std::vector<uint64_t> rest_ids = assign(second_part, job, frame->slot, false);
     round_ids.insert(round_ids.end(), rest_ids.begin(), rest_ids.end());
+    round = first_part;  // with their due times
+    round.insert(round.end(), second_part.begin(), second_part.end());
     for (const Assignment& a : first_part) std::erase(needs_commits, a.worker);
     const auto round_start = Clock::now();
     RoundResult r = collect(round, round_ids, round_start + options_.frame_timeout, stats.stages);
@@ -730,7 +831,7 @@ FrameStats Renderer::wait_frame() {
       TracerFrameStats& t = stats.tracers[static_cast<size_t>(a.worker)];
       if (std::find(r.finished.begin(), r.finished.end(), a.worker) != r.finished.end()) {
         t.recovery_rows += a.band.rows();
-        t.recovery_ms += measured_ms(*workers_[static_cast<size_t>(a.worker)]);
+        t.recovery_ms += measured_ms(r.of(a.worker));
       }
     }
     std::vector<int> failed = r.threw;
@@ -744,8 +845,8 @@ FrameStats Renderer::wait_frame() {
       std::erase_if(last_measurements_, [id](const balance::TracerMeasurement& m) { return m.tracer == id; });
     }
     std::vector<int> threw_ids = r.threw, late_ids = r.timed_out;
-    drop(threw_ids, TracerOutcome::threw, std::vector<balance::Band>(failed_bands.begin(), failed_bands.begin() + static_cast<long>(threw_ids.size())));
-    drop(late_ids, TracerOutcome::timed_out, std::vector<balance::Band>(failed_bands.begin() + static_cast<long>(threw_ids.size()), failed_bands.end()));
+    drop(threw_ids, TracerOutcome::threw, std::vector<balance::Band>(failed_bands.begin(), failed_bands.begin() + static_cast<long>(threw_ids.size())), r);
+    drop(late_ids, TracerOutcome::timed_out, std::vector<balance::Band>(failed_bands.begin() + static_cast<long>(threw_ids.size()), failed_bands.end()), r);
   }
   for (const TracerFrameStats& t : stats.tracers) stats.recovery_ms = std::max(stats.recovery_ms, t.recovery_ms);
   if (!options_.use_reported_time && stats.dropped > 0)

@@ -3,6 +3,6 @@
 # under ThreadSanitizer.
 if(TARGET cohort_core_tests)
   add_test(NAME core.concurrency
-           COMMAND cohort_core_tests --gtest_filter=HostThreads.*:Renderer.*:FrameTimeline.*:FramePipeline.*:Soak.*)
+           COMMAND cohort_core_tests --gtest_filter=HostThreads.*:Renderer.*:FrameTimeline.*:FramePipeline.*:FramesInFlight.*:Soak.*)
   set_tests_properties(core.concurrency PROPERTIES LABELS "core;concurrency" TIMEOUT 600)
 endif()

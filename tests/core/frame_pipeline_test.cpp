@@ -357,7 +357,9 @@ class AnnouncementTracer final : public Tracer {
 
 }  // namespace
 
-TEST(FramePipeline, ATracerThatTakesJobsAheadSeesTheNextFramesJobWhileItRendersTheFrameBefore) {
+// With two frames in flight the next frame's job is queued behind the band before it is rendered: the
+// tracer sees that one (its rows cleared, as an announcement has none).
+static void expect_jobs_ahead_seen(int frames_in_flight) {
   auto gates = std::make_shared<FrameGates>();
   auto ahead_seen = std::make_shared<std::vector<AnnouncementTracer::Seen>>();
   auto other_seen = std::make_shared<std::vector<AnnouncementTracer::Seen>>();
@@ -366,6 +368,7 @@ TEST(FramePipeline, ATracerThatTakesJobsAheadSeesTheNextFramesJobWhileItRendersT
   tracers.push_back(std::make_unique<AnnouncementTracer>(false, gates, other_seen));
   RendererOptions options;
   options.balancer = "none";
+  options.frames_in_flight = frames_in_flight;
   Renderer renderer(std::move(tracers), options);
   FramePipeline pipeline(renderer);
   constexpr uint64_t kFrames = 6;
@@ -395,6 +398,79 @@ TEST(FramePipeline, ATracerThatTakesJobsAheadSeesTheNextFramesJobWhileItRendersT
     }
   }
   for (const AnnouncementTracer::Seen& s : *other_seen) EXPECT_TRUE(s.announced.empty()) << "it did not ask for jobs ahead";
+}
+
+TEST(FramePipeline, ATracerThatTakesJobsAheadSeesTheNextFramesJobWhileItRendersTheFrameBefore) {
+  expect_jobs_ahead_seen(1);
+}
+
+TEST(FramePipeline, WithTwoFramesInFlightATracerThatTakesJobsAheadSeesItsQueuedJob) { expect_jobs_ahead_seen(2); }
+
+TEST(FramePipeline, WithTwoFramesInFlightATracerThatTakesCommitsAheadAppliesItsQueuedJobsCommitInOrder) {
+  auto gates = std::make_shared<FrameGates>();
+  auto ahead_log = std::make_shared<CommitLoggingTracer::Log>();
+  auto job_log = std::make_shared<CommitLoggingTracer::Log>();
+  std::vector<std::unique_ptr<Tracer>> tracers;
+  tracers.push_back(std::make_unique<CommitLoggingTracer>(true, gates, ahead_log));
+  tracers.push_back(std::make_unique<CommitLoggingTracer>(false, gates, job_log));
+  RendererOptions options;
+  options.balancer = "none";
+  options.frames_in_flight = 2;
+  Renderer renderer(std::move(tracers), options);
+  auto scene = std::make_shared<cohort::commit::TracerScene>();
+  renderer.submit_commit(cohort::commit::CommitBuffer::full(scene, 0));
+  constexpr uint64_t kFrames = 6;
+  FrameBuffer images[2];
+  auto submit = [&](uint64_t f) {  // frame f's commit carries frame number f + 1
+    cohort::commit::CommitBuffer commit;
+    commit.set_frame(f + 1);
+    commit.set_camera(job_for(f).camera);
+    renderer.submit_commit(commit, [&] { return scene; });
+  };
+  submit(0);
+  renderer.begin_frame(job_for(0), images[0]);
+  for (uint64_t f = 1; f < kFrames; ++f) {
+    submit(f);
+    // Handed out while frame f - 1 renders: the job holds frame f's commit, and the next commit, submitted
+    // only after this hand-out, stays in the channel for the job after.
+    renderer.begin_frame(job_for(f), images[f % 2]);
+    auto has_it = [&] {
+      for (const auto& e : ahead_log->read())
+        if (!e.band && e.frame == f + 1) return true;
+      return false;
+    };
+    for (int i = 0; i < 5000 && !has_it(); ++i) std::this_thread::sleep_for(std::chrono::microseconds(200));
+    gates->open(f - 1);
+    FrameStats stats = renderer.wait_frame();
+    renderer.merge_frame(stats);
+    EXPECT_EQ(stats.frame, f - 1);
+    for (int y = 0; y < kRows; ++y) ASSERT_EQ(images[(f - 1) % 2].row(y)[0], static_cast<float>(f - 1));
+  }
+  gates->open(kFrames - 1);
+  FrameStats last = renderer.wait_frame();
+  renderer.merge_frame(last);
+  EXPECT_FALSE(gates->gave_up);
+
+  auto applied_before_band = [](const std::vector<CommitLoggingTracer::Event>& log, uint64_t commit) {
+    int64_t last_band = -1;
+    for (const auto& e : log) {
+      if (e.band) last_band = static_cast<int64_t>(e.frame);
+      else if (e.frame == commit) return std::make_pair(last_band, e.during_band);
+    }
+    return std::make_pair(int64_t(-2), false);
+  };
+  const std::vector<CommitLoggingTracer::Event> ahead_events = ahead_log->read(), job_events = job_log->read();
+  for (uint64_t f = 1; f < kFrames; ++f) {
+    // The queued job's commit, applied while frame f - 1's band rendered.
+    EXPECT_EQ(applied_before_band(ahead_events, f + 1), std::make_pair(static_cast<int64_t>(f) - 1, true)) << f;
+    EXPECT_EQ(applied_before_band(job_events, f + 1), std::make_pair(static_cast<int64_t>(f) - 1, false)) << f;
+  }
+  for (const auto* log : {&ahead_events, &job_events}) {
+    std::vector<uint64_t> commits;
+    for (const auto& e : *log)
+      if (!e.band) commits.push_back(e.frame);
+    EXPECT_EQ(commits, (std::vector<uint64_t>{1, 2, 3, 4, 5, 6})) << "every commit once, in order";
+  }
 }
 
 // `cohort play` announces at hand-out only where a tracer takes jobs ahead (it costs a frame of input

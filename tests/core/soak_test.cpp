@@ -42,9 +42,7 @@ double resident_mib() {
   return static_cast<double>(resident) * static_cast<double>(::sysconf(_SC_PAGESIZE)) / (1024.0 * 1024.0);
 }
 
-}  // namespace
-
-TEST(Soak, ScenarioReplayWithFailingAndStallingTracersLosesNoCommitAndKeepsMemoryFlat) {
+void soak(int frames_in_flight) {
   const int frames = soak_frames();
   constexpr auto kTimeout = std::chrono::milliseconds(400);  // far above a frame here, even on a loaded 2-core CI box
   std::mt19937 rng(14);
@@ -78,6 +76,7 @@ TEST(Soak, ScenarioReplayWithFailingAndStallingTracersLosesNoCommitAndKeepsMemor
   RendererOptions renderer_options;
   renderer_options.use_reported_time = true;
   renderer_options.frame_timeout = kTimeout;
+  renderer_options.frames_in_flight = frames_in_flight;
   Renderer renderer(std::move(tracers), renderer_options);
 
   scene::RenderWorld world(test::small_test_map());
@@ -125,8 +124,15 @@ TEST(Soak, ScenarioReplayWithFailingAndStallingTracersLosesNoCommitAndKeepsMemor
   // them: on a loaded machine a healthy tracer may miss the timeout now and then and so skip one.
   std::set<uint64_t> injected = failing.throw_on_frames;
   for (uint64_t f : failing.throw_on_commits) injected.insert(f - 1);
-  for (uint64_t f : threw) EXPECT_EQ(injected.count(f), 1u) << "the failing tracer threw on frame " << f;
-  EXPECT_GE(threw.size() + 1, injected.size());
+  // With two in flight the frame after a failed commit may have been handed out before the failure, with
+  // records that no longer fit: its band fails too, and the resync comes with the one after.
+  std::set<uint64_t> allowed = injected;
+  if (frames_in_flight == 2)
+    for (uint64_t f : failing.throw_on_commits) allowed.insert(f);
+  for (uint64_t f : threw) EXPECT_EQ(allowed.count(f), 1u) << "the failing tracer threw on frame " << f;
+  size_t injected_seen = 0;
+  for (uint64_t f : injected) injected_seen += threw.count(f);
+  EXPECT_GE(injected_seen + 1, injected.size());
   EXPECT_GE(stalls, 1);
   std::printf("soak: %d frames delivered, %zu failures and %d stalls injected, resident memory %.1f MiB after "
               "warm-up, %.1f MiB at most after\n",
@@ -155,3 +161,10 @@ TEST(Soak, ScenarioReplayWithFailingAndStallingTracersLosesNoCommitAndKeepsMemor
   EXPECT_LE(renderer.commit_stats(1).resyncs_requested, failing.throw_on_commits.size());
   EXPECT_GE(renderer.commit_stats(1).resyncs_requested + 1, failing.throw_on_commits.size());
 }
+
+}  // namespace
+
+TEST(Soak, ScenarioReplayWithFailingAndStallingTracersLosesNoCommitAndKeepsMemoryFlat) { soak(1); }
+
+// The same with frame N+1 handed out before N is waited for (RendererOptions::frames_in_flight 2).
+TEST(Soak, WithTwoFramesInFlightTheReplayLosesNoCommitAndDeliversEveryFrame) { soak(2); }

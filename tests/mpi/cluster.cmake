@@ -9,7 +9,7 @@ if(TARGET cohort AND TARGET cohort_tracer_mpi AND TARGET cohort_tracer_embree AN
   target_link_libraries(mpi_protocol_check PRIVATE cohort_tracer_registry cohort_core cohort_test_support cohort_warnings)
   find_package(Python3 COMPONENTS Interpreter QUIET)
   if(Python3_Interpreter_FOUND)
-    set(_cases match stall killed version load_error bench protocol replay play bad_piece ahead ahead_recovery jobs_ahead early_announce link
+    set(_cases match stall killed version load_error bench protocol replay play bad_piece ahead ahead_recovery jobs_ahead jobs_ahead_two_in_flight early_announce link
                 match_rgb9e5 play_early_announce)
     if(TARGET cohort_tracer_opencl)
       list(APPEND _cases mixed)

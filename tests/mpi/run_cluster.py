@@ -28,7 +28,9 @@ and 6 ms slower a row (bands far longer than rank 0's own frame work, so that ea
 while they render), so that the balancer moves rows every frame: each later frame's job goes to the
 node while its band before renders, the node renders it right after that band, and the frame's job
 adopts those rows, rendering only the rows beyond them; every frame matches the single-process render;
-with COHORT_MPI_JOBS_AHEAD=0 nothing is adopted), early_announce (rank 0 writes every frame, which takes
+with COHORT_MPI_JOBS_AHEAD=0 nothing is adopted), jobs_ahead_two_in_flight (the same with rank 0 rendering
+--frames-in-flight 2, jobs ahead on: the job queued behind a band is the one sent ahead, its commit before
+it; every later job adopted, every frame matches), early_announce (rank 0 writes every frame, which takes
 longer than a node's band: announced after that work, COHORT_EARLY_ANNOUNCE=0, bands come back before the
 next frame is announced (5-9 of 11 here); announced at hand-out, none does; every frame matches), link (`cohort bench devices` with mpi:1 behind an emulated
 link, COHORT_MPI_LINK=0.1gbit,20ms on every rank: the band's round trip holds the link's latency both ways and
@@ -240,7 +242,9 @@ def ahead(a, stalled=False):
     print("ahead: ok")
 
 
-def jobs_ahead(a):
+def jobs_ahead(a, in_flight="1"):
+    """in_flight "2": rank 0 renders with --frames-in-flight 2 (its next frame's job queued behind the band
+    before: the remote tracer sends that one ahead), jobs ahead on only."""
     os.makedirs(a.out)
     stream = os.path.join(a.out, "scenario.cdelta")
     run([a.cohort, "record-scenario", "testmap", "--base", a.testmap_base, "--frames", str(FRAMES), "--out", stream])
@@ -251,12 +255,12 @@ def jobs_ahead(a):
     node = [a.cohort, "node", "testmap", "--base", a.testmap_base, "--tracers", "embree", "--row-delay-ms"]
     pattern = (r"mpi:{}: the node idled ([\d.]+) ms a band waiting for a job; jobs ahead: (\d+) sent, (\d+) adopted "
                r"by their frame's band, (\d+) dropped; (\d+) row\(s\) rendered ahead for nothing, (\d+) rendered after")
-    for enabled in ("1", "0"):
+    for enabled in ("1", "0") if in_flight == "1" else ("1",):
         cluster = os.path.join(a.out, "cluster_" + enabled)
         env = dict(os.environ)
         env["COHORT_MPI_JOBS_AHEAD"] = enabled
         _, output = run([a.mpiexec] + flags + ["-np", "1", a.cohort, "render", "--tracers", "mpi:1,mpi:2", "--out",
-                                               cluster] + args +
+                                               cluster, "--frames-in-flight", in_flight] + args +
                         [":"] + flags + ["-np", "1"] + node + ["3"] + [":"] + flags + ["-np", "1"] + node + ["6"],
                         env=env)
         compare_frames(single, cluster)
@@ -278,7 +282,7 @@ def jobs_ahead(a):
                          f"have gone ahead and been adopted")
         if enabled == "1" and moved == 0:
             sys.exit("the balancer never moved the rows between frames: the rows beyond a job ahead went untested")
-    print("jobs_ahead: ok")
+    print("jobs_ahead: ok" if in_flight == "1" else "jobs_ahead_two_in_flight: ok")
 
 
 def ahead_recovery_check(single, cluster, output):
@@ -492,6 +496,7 @@ def main():
     parser = argparse.ArgumentParser()
     parser.add_argument("case", choices=["match", "mixed", "stall", "killed", "version", "load_error", "bench", "protocol", "replay",
                                            "play", "link", "bad_piece", "ahead", "ahead_recovery", "jobs_ahead",
+                                           "jobs_ahead_two_in_flight",
                                            "early_announce", "match_rgb9e5", "play_early_announce"])
     parser.add_argument("--mpiexec", required=True)
     parser.add_argument("--cohort", required=True)
@@ -522,8 +527,8 @@ def main():
     if a.case == "play":
         play(a)
         return
-    if a.case == "jobs_ahead":
-        jobs_ahead(a)
+    if a.case in ("jobs_ahead", "jobs_ahead_two_in_flight"):
+        jobs_ahead(a, in_flight="2" if a.case == "jobs_ahead_two_in_flight" else "1")
         return
     if a.case == "early_announce":
         early_announce(a)

@@ -45,6 +45,10 @@ class CommitChannel {
   // Tracer thread, at frame start: swap the buffers and return the one to apply, valid until the next
   // begin_frame on this channel. It is empty (frame() unchanged) when nothing changed.
   const CommitBuffer& begin_frame();
+  // The same into a buffer the caller owns (cleared first; its capacity becomes the next pending
+  // buffer's): for a core that hands a tracer its next commit while the tracer may still be applying the
+  // one before (two frames in flight, core/renderer.h).
+  void take(CommitBuffer& into);
 
   // Whether something was published since the last begin_frame (a full resync still to be taken, too).
   bool has_pending() const;

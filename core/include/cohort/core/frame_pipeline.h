@@ -35,7 +35,8 @@ class FramePipeline {
   // merged into image(); nothing on the first push. `preparation`: the core's spans for this frame so
   // far (e.g. world sync), carried into its stats. When the previous frame cannot be rendered
   // (Renderer::wait_frame throws), `job` is not handed out and the exception propagates; the next push
-  // starts afresh.
+  // starts afresh. With the Renderer's frames_in_flight 2, `job` is handed out first, before the frame
+  // before is waited for (it stays in flight when that one throws): docs/balancing.md, "Two frames in flight".
   std::optional<Delivered> push(const BandJob& job, std::vector<StageSpan> preparation = {});
   // The same, and as soon as `job` is handed out, before the frame before it is merged, `prepare_next`
   // prepares the next frame (submits its commits) and returns its job (or nothing, at the end), which is
@@ -65,6 +66,11 @@ class FramePipeline {
     std::vector<StageSpan> preparation;
   };
   Delivered delivered(InFlight frame, FrameStats stats);
+  // push() with the Renderer's frames_in_flight 2: `job` is handed out before the frame before it is
+  // waited for (begin, then wait and merge of the one before), so the tracers never wait for the core's
+  // turnaround. Where the frame before cannot be rendered, `job` is already handed out and stays in flight.
+  std::optional<Delivered> push_two_in_flight(const BandJob& job, std::vector<StageSpan> preparation,
+                                              const PrepareNext& prepare_next);
 
   Renderer& renderer_;
   FrameBuffer image_;

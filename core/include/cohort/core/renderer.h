@@ -17,10 +17,16 @@
 // frame; its rows are split among the tracers that finished (and benched ones that are idle) and re-rendered, and the frame is still
 // delivered. A timed-out tracer keeps running on its own thread; it takes part again from the first
 // frame that starts after it has finished. One that never returns does not block shutdown.
+//
+// Two frames in flight (RendererOptions::frames_in_flight = 2): frame N+1 may be begun before N is
+// waited for, so each worker holds up to two jobs and starts N+1 the moment its band of N is done,
+// instead of idling through the core's turnaround and the slowest band (docs/balancing.md, "Two frames
+// in flight").
 #pragma once
 
 #include <chrono>
 #include <cstdint>
+#include <deque>
 #include <functional>
 #include <memory>
 #include <mutex>
@@ -64,6 +70,10 @@ struct RendererOptions {
   // a worker after its band, for its next job; the core from shortly before the frame's bands are due
   // (the slowest one's last time) to this long after. 0: block at once.
   std::chrono::microseconds handoff_spin{150};
+  // 1: a frame is begun only once the one before it has been waited for. 2: begin_frame() may hand out
+  // frame N+1 while N is still in flight (each worker then queues N+1's job behind N's); the balancer
+  // divides N+1 by the costs measured for N-1. Anything else throws std::invalid_argument.
+  int frames_in_flight = 1;
 };
 
 class Renderer {
@@ -98,6 +108,9 @@ class Renderer {
   // needed). Between wait_frame() and merge_frame() the next frame may be begun: every tracer renders
   // into one of two targets by frame parity, so frame N is merged while N+1 renders. finish_frame()
   // is wait_frame() then merge_frame(). Commits submitted after begin_frame() go to the next frame.
+  // With frames_in_flight 2, begin_frame() may also come before wait_frame() of the frame before (but
+  // never a third frame, nor one whose target parity is still unmerged): wait_frame() waits for the
+  // oldest frame begun. render() needs no frame in flight.
   // `out` must stay alive until merge_frame() returns; only merge_frame() writes it. Calls out of order
   // throw std::logic_error.
   void begin_frame(const BandJob& job, FrameBuffer& out, const std::vector<float>& row_cost_proxy = {});
@@ -107,6 +120,9 @@ class Renderer {
   void announce_frame(const BandJob& job);
   // Whether any tracer takes jobs ahead (remote tracers): only then does an early announcement help.
   bool takes_jobs_ahead() const { return any_takes_jobs_ahead_; }
+  int frames_in_flight() const { return options_.frames_in_flight; }
+  // Frames begun and not yet waited for.
+  int frames_begun() const { return static_cast<int>(pending_.size()); }
   FrameStats wait_frame();
   void merge_frame(FrameStats& stats);
   FrameStats finish_frame();
@@ -137,17 +153,35 @@ class Renderer {
 
  private:
   struct Worker;
+  // What a worker reports of one job (kept per job: with two jobs queued, the second may end before the
+  // core has collected the first).
+  struct Outcome {
+    uint64_t job_id = 0;
+    bool ok = false;
+    std::string error;
+    double wall_ms = 0.0;
+    double reported_ms = 0.0;
+    double balance_ms = 0.0;  // BandResult::balance_ms
+    double apply_ms = 0.0;
+    double waited_ms = -1.0;  // from the end of the worker's job before to this one's start (< 0: no job before)
+    std::vector<float> row_work;
+    DeviceBand device_band;        // the band, when it stayed on a GPU
+    std::vector<StageSpan> spans;  // the job's apply and render stages
+  };
   struct Assignment {
     int worker;
     balance::Band band;
     bool probe = false;  // rendered to be measured only: nobody waits for it, its rows are not merged
     DeviceBand device;   // where its rows are when the tracer kept them on a GPU (set once delivered)
+    std::chrono::steady_clock::time_point due{};  // when its band should end (set by assign)
   };
   struct RoundResult {
     std::vector<int> finished;   // workers that rendered their band
     std::vector<Assignment> delivered;  // their bands, to merge
     std::vector<int> threw;
     std::vector<int> timed_out;
+    std::vector<std::pair<int, Outcome>> outcomes;  // of the workers that finished or threw
+    const Outcome& of(int worker) const;
   };
 
   struct PendingFrame {
@@ -158,12 +192,14 @@ class Renderer {
     std::vector<uint64_t> ids;
     std::chrono::steady_clock::time_point start;
     int slot = 0;                        // the workers' target this frame renders into
+    std::vector<uint64_t> handed_out;    // every job of it, side jobs included
+    double since_previous_ms = 0.0;      // from the previous frame's start to this one's
     std::vector<Assignment> delivered;   // bands (and re-rendered rows) waiting to be merged
   };
 
   // Hands each assignment to its worker (with the queued commits when with_commits), to render into
   // its target `slot`, and returns the job ids; collect() waits for them until the deadline.
-  std::vector<uint64_t> assign(const std::vector<Assignment>& assignments, const BandJob& job, int slot,
+  std::vector<uint64_t> assign(std::vector<Assignment>& assignments, const BandJob& job, int slot,
                                bool with_commits);
   RoundResult collect(const std::vector<Assignment>& assignments, const std::vector<uint64_t>& ids,
                       std::chrono::steady_clock::time_point deadline, std::vector<StageSpan>& stages);
@@ -173,7 +209,7 @@ class Renderer {
   // host's threads: the one loop of every merge (floats, aux planes, packed).
   void for_band_rows(const std::vector<Assignment>& bands, int slot,
                      const std::function<void(const BandBuffer&, int, int)>& copy) const;
-  double measured_ms(const Worker& w) const;
+  double measured_ms(const Outcome& o) const;
   // A benched tracer's unwaited job (commits, maybe a probe) that has ended: its measurement joins
   // last_measurements_ and its stages the frame's. Call with the completion mutex held.
   void harvest_side_job(Worker& w, std::vector<StageSpan>& stages);
@@ -197,10 +233,13 @@ class Renderer {
   };
   std::shared_ptr<Announcement> announcement_ = std::make_shared<Announcement>();
   bool any_takes_jobs_ahead_ = false;
-  std::unique_ptr<PendingFrame> pending_;    // begun, not yet waited for
+  std::deque<std::unique_ptr<PendingFrame>> pending_;  // begun, not yet waited for, oldest first
   std::unique_ptr<PendingFrame> unmerged_;   // waited for, bands not yet merged
   int next_slot_ = 0;
   std::optional<std::chrono::steady_clock::time_point> last_frame_start_;  // for the balancer's frame interval
+  // When the last wait_frame's bands were back: with two frames in flight, the next frame's timeout
+  // counts from there (its bands start only after the frame before's).
+  std::chrono::steady_clock::time_point last_round_end_{};
   GBuffer gbuffer_;
   bool packed_merge_ = false;
   BandBuffer packed_;
