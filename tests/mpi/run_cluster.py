@@ -491,9 +491,8 @@ def link(a):
 
 class JoinLauncher:
     """Separately launched jobs (rank 0 with --node-port, each node with its own mpiexec -np 1) that meet through
-    rank 0's port. Open MPI connects such jobs only through its name server: ompi-server runs for the test and
-    every mpirun is pointed at it (--ompi-server file:URI). MPICH needs nothing, but its UCX netmod offers this
-    VM no address for a port (the name comes out empty): its OFI netmod is asked for unless the caller chose."""
+    rank 0's port (MPI_Comm_join). Open MPI joins such jobs only through its name server: ompi-server runs for
+    the test and every mpirun is pointed at it (--ompi-server file:URI). MPICH needs nothing."""
 
     def __init__(self, a):
         self.a = a
@@ -518,8 +517,6 @@ class JoinLauncher:
             else:
                 sys.exit("ompi-server wrote no URI")
             self.flags = ["--ompi-server", "file:" + uri]
-        else:
-            self.env.setdefault("MPICH_CH4_NETMOD", "ofi")
 
     def start(self, name, command):
         log = os.path.join(self.a.out, name + ".log")
@@ -657,6 +654,8 @@ def rejoin(a):
         if f"killing itself before frame {die}" not in jobs.output(dying):
             jobs.dump()
             sys.exit(f"node2 ended without dying at frame {die}")
+        # The slot is free once the dead node's band has timed out (until then mpi:2 is busy: its node answers).
+        jobs.wait_for_line(rank0, r"mpi:2: no answer for rows")
         fresh = jobs.start("node2_again", node + ["--as", "2"])
         code = jobs.finish(rank0)
         codes = [jobs.finish(n) for n in (first, fresh)]

@@ -30,9 +30,6 @@ int finalize_timeout_seconds() {
 }
 
 std::atomic<bool> want_thread_multiple{false};
-// Set before MPI_Finalize: an accept that returns then (its port's thread outlives the session) touches
-// nothing of the session, which may be gone.
-std::atomic<bool> mpi_ending{false};
 
 std::string mpi_error_text(int code) {
   char text[MPI_MAX_ERROR_STRING] = {};
@@ -45,12 +42,10 @@ std::string mpi_error_text(int code) {
 struct MpiSession::Impl {
   MPI_Comm comm = MPI_COMM_NULL;
   bool we_initialized = false;
-  // Peers that joined through a port (rank 0), or rank 0 seen from a node that joined (peer 0): each is
+  // Peers that joined the running session (rank 0), or rank 0 seen from a node that joined (peer 0): each is
   // rank 0 of its intercommunicator. Every other peer is a rank of `comm`.
   std::map<int, MPI_Comm> intercomms;
   int next_joined_peer = kFirstJoinedPeer;
-  std::string port_name;
-  bool port_closing = false;
   struct Endpoint {
     MPI_Comm comm;
     int rank;
@@ -151,53 +146,32 @@ MpiSession& MpiSession::get() {
 
 void MpiSession::require_thread_multiple() { want_thread_multiple.store(true); }
 
-std::string MpiSession::open_port() {
-  std::lock_guard lock(mutex_);
-  if (!thread_multiple_)
-    throw std::runtime_error("a port for joining nodes needs MPI_THREAD_MULTIPLE (MpiSession::require_thread_multiple "
-                             "before the session starts)");
-  if (!impl_->port_name.empty()) return impl_->port_name;
-  char name[MPI_MAX_PORT_NAME] = {};
-  if (const int code = MPI_Open_port(MPI_INFO_NULL, name); code != MPI_SUCCESS)
-    throw std::runtime_error("MPI_Open_port failed: " + mpi_error_text(code));
-  impl_->port_name = name;
-  return impl_->port_name;
-}
-
-int MpiSession::accept() {
-  std::string port;
+int MpiSession::join_peer(int socket) {
   {
     std::lock_guard lock(mutex_);
-    if (finalized_ || impl_->port_name.empty() || impl_->port_closing) return -1;
-    port = impl_->port_name;
+    if (finalized_) return -1;
+    if (!thread_multiple_)
+      throw std::runtime_error("taking joining nodes needs MPI_THREAD_MULTIPLE (MpiSession::require_thread_multiple "
+                               "before the session starts)");
   }
   MPI_Comm inter = MPI_COMM_NULL;
-  const int code = MPI_Comm_accept(port.c_str(), MPI_INFO_NULL, 0, MPI_COMM_SELF, &inter);
-  if (mpi_ending.load()) return -1;
+  const int code = MPI_Comm_join(socket, &inter);
   std::lock_guard lock(mutex_);
   if (code != MPI_SUCCESS) {
-    if (!impl_->port_closing) spdlog::warn("rank 0: MPI_Comm_accept failed: {}", mpi_error_text(code));
+    spdlog::warn("rank 0: MPI_Comm_join with a joining node failed: {}", mpi_error_text(code));
     return -1;
   }
-  if (impl_->port_closing || finalized_) return -1;  // a node that came as rank 0 ends: it hears nothing
+  if (finalized_) return -1;
   MPI_Comm_set_errhandler(inter, MPI_ERRORS_RETURN);
   const int peer = impl_->next_joined_peer++;
   impl_->intercomms[peer] = inter;
   return peer;
 }
 
-void MpiSession::close_port() {
-  std::lock_guard lock(mutex_);
-  if (finalized_ || impl_->port_name.empty()) return;
-  // MPI offers no way to end an MPI_Comm_accept but a connection (and a process cannot connect to its own
-  // port: Open MPI 4.1 crashes, MPICH 5.0 hangs), so the accept is left waiting; finalize() copes.
-  impl_->port_closing = true;
-}
-
-void MpiSession::join(const std::string& port, int slot) {
+void MpiSession::join(int socket, int slot) {
   MPI_Comm inter = MPI_COMM_NULL;
-  if (const int code = MPI_Comm_connect(port.c_str(), MPI_INFO_NULL, 0, MPI_COMM_SELF, &inter); code != MPI_SUCCESS)
-    throw std::runtime_error("MPI_Comm_connect to rank 0's port failed: " + mpi_error_text(code));
+  if (const int code = MPI_Comm_join(socket, &inter); code != MPI_SUCCESS)
+    throw std::runtime_error("MPI_Comm_join with rank 0 failed: " + mpi_error_text(code));
   std::lock_guard lock(mutex_);
   MPI_Comm_set_errhandler(inter, MPI_ERRORS_RETURN);
   impl_->intercomms[0] = inter;
@@ -252,11 +226,10 @@ MpiSession::MpiSession() : impl_(new Impl) {
   MPI_Query_thread(&provided);
   thread_multiple_ = provided >= MPI_THREAD_MULTIPLE;
   if (want_thread_multiple.load() && !thread_multiple_)
-    throw std::runtime_error("this MPI library offers no MPI_THREAD_MULTIPLE, which a port for joining nodes needs "
-                             "(its accept waits on a thread of its own); start the nodes under rank 0's mpirun instead");
-  // Errors come back as codes on the world and self communicators too (a port's accept and connect use
-  // MPI_COMM_SELF; a library may report a lost rank on the world's): a lost node fails its tracer, not
-  // the process.
+    throw std::runtime_error("this MPI library offers no MPI_THREAD_MULTIPLE, which taking joining nodes needs (they "
+                             "join on a thread of their own); start the nodes under rank 0's mpirun instead");
+  // Errors come back as codes on the world and self communicators too (a library may report a lost rank
+  // or a failed join on them): a lost node fails its tracer, not the process.
   MPI_Comm_set_errhandler(MPI_COMM_WORLD, MPI_ERRORS_RETURN);
   MPI_Comm_set_errhandler(MPI_COMM_SELF, MPI_ERRORS_RETURN);
   // A communicator of our own, so that Cohort's messages never meet another library's.
@@ -359,7 +332,7 @@ void MpiSession::finalize() {
   int mpi_finalized = 0;
   MPI_Finalized(&mpi_finalized);
   if (!impl_->we_initialized || mpi_finalized) return;
-  // MPI_Finalize synchronizes with every rank, and with every process still connected through a port, so
+  // MPI_Finalize synchronizes with every rank, and with every process still connected by a join, so
   // a rank that was lost (killed, under a launcher that let the job go on) can keep it from returning, as
   // can the disconnect of a node that joined. Everything is written by now: past the deadline the process
   // leaves without them rather than hang.
@@ -376,23 +349,11 @@ void MpiSession::finalize() {
   }).detach();
   // Both ends of a joined node's intercommunicator disconnect (collective over it): rank 0 once it has
   // said shutdown to the node, the node once it has heard it; then neither waits for the other to finalize.
-  mpi_ending.store(true);
   for (auto& [peer, inter] : impl_->intercomms) {
     drain(inter);
     MPI_Comm_disconnect(&inter);
   }
   impl_->intercomms.clear();
-  if (!impl_->port_name.empty()) {
-    MPI_Close_port(impl_->port_name.c_str());
-#ifdef MPICH_VERSION
-    // The port's accept still waits on its thread (close_port). Open MPI's MPI_Finalize returns regardless;
-    // MPICH's aborts the process ("Internal error"), and its mpiexec takes a process that leaves without
-    // MPI_Finalize as a normal exit: everything is written and the nodes were told, so it leaves so.
-    done->store(true);
-    spdlog::debug("rank 0: leaving without MPI_Finalize (MPICH: the port's accept still waits)");
-    return;
-#endif
-  }
   MPI_Finalize();
   done->store(true);
 }

@@ -20,6 +20,7 @@
 
 #include "cohort/balance/bands.h"
 #include "cohort/core/band_buffer.h"
+#include "cohort/tracers/mpi_join_socket.h"
 #include "cohort/tracers/mpi_link.h"
 #include "cohort/tracers/mpi_wire.h"
 
@@ -592,31 +593,39 @@ class Node {
 
 void join_session(const std::string& port_file, int slot, std::chrono::seconds timeout) {
   const auto deadline = MpiClock::now() + timeout;
-  std::string port;
+  std::string host;
+  int port = 0;
   for (;;) {
     std::ifstream in(port_file);
-    if (in && std::getline(in, port) && !port.empty()) break;
+    if (in >> host >> port && port > 0) break;
     if (MpiClock::now() >= deadline)
-      throw std::runtime_error(fmt::format("no port name in {} after {} s: is rank 0 running with --node-port {}?",
-                                           port_file, timeout.count(), port_file));
+      throw std::runtime_error(fmt::format("no port in {} after {} s: is rank 0 running with --node-port {}?", port_file,
+                                           timeout.count(), port_file));
     std::this_thread::sleep_for(std::chrono::milliseconds(100));
   }
+  const auto start = MpiClock::now();
+  const int socket = join_socket::connect_within(
+      host, port, std::chrono::duration_cast<std::chrono::milliseconds>(deadline - MpiClock::now()));
+  if (!join_socket::send_all(socket, join_socket::kMagic)) {
+    join_socket::close_socket(socket);
+    throw std::runtime_error(fmt::format("rank 0's port {}:{} closed the connection", host, port));
+  }
   MpiSession& mpi = MpiSession::get();
-  // MPI_Comm_connect cannot be cancelled: past the deadline a watchdog ends the process with the reason.
-  auto connected = std::make_shared<std::atomic<bool>>(false);
-  std::thread([connected, deadline, port_file, seconds = timeout.count()] {
-    while (!connected->load() && MpiClock::now() < deadline) std::this_thread::sleep_for(std::chrono::milliseconds(50));
-    if (connected->load()) return;
-    spdlog::error("node: could not connect to rank 0's port (named in {}) within {} s; leaving. A stale file from an "
-                  "earlier run? With Open MPI, rank 0's and this node's mpirun need the same name server "
-                  "(--ompi-server file:URI; docs/cluster.md)", port_file, seconds);
+  // MPI_Comm_join cannot be cancelled: past the deadline a watchdog ends the process with the reason.
+  auto joined = std::make_shared<std::atomic<bool>>(false);
+  std::thread([joined, deadline, host, port, seconds = timeout.count()] {
+    while (!joined->load() && MpiClock::now() < deadline) std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    if (joined->load()) return;
+    spdlog::error("node: MPI_Comm_join with rank 0 ({}:{}) did not complete within {} s; leaving. With Open MPI, rank "
+                  "0's and this node's mpirun need the same name server (--ompi-server file:URI; docs/cluster.md)",
+                  host, port, seconds);
     std::fflush(nullptr);
     std::_Exit(1);
   }).detach();
-  const auto start = MpiClock::now();
-  mpi.join(port, slot);
-  connected->store(true);
-  spdlog::info("node: connected to rank 0's port in {:.0f} ms", ms_since(start));
+  mpi.join(socket, slot);
+  joined->store(true);
+  join_socket::close_socket(socket);
+  spdlog::info("node: joined rank 0's session through {}:{} in {:.0f} ms", host, port, ms_since(start));
 }
 
 int run_node(std::vector<std::unique_ptr<core::Tracer>> tracers, const NodeOptions& options) {

@@ -2,12 +2,17 @@
 
 #include <algorithm>
 #include <cstdio>
+#include <cstdlib>
 #include <fstream>
 #include <memory>
 #include <stdexcept>
 
+#include <unistd.h>
+
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
+
+#include "cohort/tracers/mpi_join_socket.h"
 
 namespace cohort::tracers {
 
@@ -16,7 +21,10 @@ namespace {
 // at once: this bounds a node that connects and then says nothing.
 constexpr std::chrono::seconds kGreetingTimeout{10};
 
-// Never destroyed: the accept's thread may outlive everything (MPI cannot cancel an accept).
+// A connection that does not say the magic words by then is dropped.
+constexpr std::chrono::seconds kMagicTimeout{5};
+
+// Never destroyed: the session's finalize closes it (static destruction order would not promise that).
 NodePort*& the_port() {
   static NodePort* port = nullptr;
   return port;
@@ -59,44 +67,51 @@ NodePort::NodePort(std::string path, std::chrono::milliseconds first_wait, const
   // Every slot is known before the first node may come (the tracers are made one after another); one
   // that a world rank serves (mpirun -np N) is busy until that node fails.
   for (int slot : slots) slots_[slot].busy = slot < mpi.size();
-  const std::string name = mpi.open_port();
+  const char* fixed = std::getenv("COHORT_NODE_PORT_TCP");
+  listening_ = join_socket::listen_on(fixed && *fixed ? std::atoi(fixed) : 0);
+  std::string host;
+  if (const char* named = std::getenv("COHORT_NODE_PORT_HOST"); named && *named) {
+    host = named;
+  } else {
+    char name[256] = {};
+    host = gethostname(name, sizeof name - 1) == 0 ? name : "localhost";
+  }
   const std::string partial = path_ + ".partial";
   {
     std::ofstream out(partial);
-    out << name << "\n";
-    if (!out) throw std::runtime_error("cannot write the port's name to " + partial);
+    out << host << " " << join_socket::port_of(listening_) << "\n";
+    if (!out) throw std::runtime_error("cannot write the port to " + partial);
   }
   if (std::rename(partial.c_str(), path_.c_str()) != 0)
     throw std::runtime_error("cannot rename " + partial + " to " + path_);
-  spdlog::info("rank 0: nodes join through the port named in {} (cohort node MAP --join {} --as N)", path_, path_);
+  spdlog::info("rank 0: nodes join through {}:{} (named in {}: cohort node MAP --join {} --as N)", host,
+               join_socket::port_of(listening_), path_, path_);
   accepting_ = std::thread([this] { accept_loop(); });
 }
 
 void NodePort::close() {
-  {
-    std::lock_guard lock(mutex_);
-    if (closed_) return;
-    closed_ = true;
-  }
-  MpiSession::get().close_port();
-  // The accept waits until a node connects (MPI cannot cancel it): its thread is left to the session's end.
-  std::unique_lock lock(mutex_);
-  if (accept_ended_) {
-    lock.unlock();
-    accepting_.join();
-  } else {
-    lock.unlock();
-    accepting_.detach();
-  }
+  if (closed_.exchange(true)) return;
+  // The thread sees it within its next poll (at most a greeting in progress, bounded, later).
+  accepting_.join();
+  join_socket::close_socket(listening_);
   std::remove(path_.c_str());
 }
 
 void NodePort::accept_loop() {
   MpiSession& mpi = MpiSession::get();
-  for (;;) {
-    const int peer = mpi.accept();
-    if (peer < 0) break;
-    greet(peer);
+  while (!closed_.load()) {
+    const int connection = join_socket::accept_within(listening_, std::chrono::milliseconds(100));
+    if (connection < 0) continue;
+    // Only a node that is joining right now goes to MPI_Comm_join, which waits for its other end.
+    if (!join_socket::receive_exactly(connection, join_socket::kMagic, kMagicTimeout)) {
+      spdlog::warn("rank 0: dropped a connection to the node port that did not say it joins within {} s",
+                   kMagicTimeout.count());
+      join_socket::close_socket(connection);
+      continue;
+    }
+    const int peer = mpi.join_peer(connection);
+    join_socket::close_socket(connection);
+    if (peer >= 0) greet(peer);
   }
   std::lock_guard lock(mutex_);
   accept_ended_ = true;
@@ -182,7 +197,7 @@ void NodePort::greet(int peer) {
     found->second.waiting = JoiningNode{peer, hello, connected};
   }
   mpi.send(peer, wire::frame_message(wire::Kind::welcome, 0, wire::encode_text(fmt::format("mpi:{}", slot))));
-  spdlog::info("rank 0: a node on {} ({}) joined mpi:{}, greeted {:.1f} ms after it connected", hello.host,
+  spdlog::info("rank 0: a node on {} ({}) joined mpi:{}, greeted {:.1f} ms after its MPI_Comm_join", hello.host,
                hello.tracers, slot, std::chrono::duration<double, std::milli>(MpiClock::now() - connected).count());
   changed_.notify_all();
 }

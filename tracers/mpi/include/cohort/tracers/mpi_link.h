@@ -5,7 +5,7 @@
 // Standard MPI-3 only (Open MPI and MPICH alike).
 //
 // A peer is named by an int: the world ranks of `mpirun -np N` are themselves (peer 2 is world rank 2);
-// a node that joined through rank 0's port (MPI-2 dynamic processes, docs/cluster.md "Joining a running
+// a node that joined rank 0's running session (MPI-2's MPI_Comm_join, docs/cluster.md "Joining a running
 // session") is a peer id of its own, kFirstJoinedPeer and up, that stands for rank 0 of its
 // intercommunicator. On a node that joined, peer 0 is rank 0 across the intercommunicator.
 #pragma once
@@ -40,7 +40,7 @@ class MpiSession {
  public:
   // Initializes MPI on first use (MPI_Init_thread) unless the program already did; finalizes at exit.
   static MpiSession& get();
-  // Before the first get(): ask for MPI_THREAD_MULTIPLE (a port's accept runs on a thread of its own,
+  // Before the first get(): ask for MPI_THREAD_MULTIPLE (joining nodes are taken on a thread of its own,
   // outside the session's lock). get() then throws when the library does not offer it.
   static void require_thread_multiple();
   // This process's rank in Cohort's session: its world rank, or for a node that joined, the slot it serves.
@@ -48,16 +48,13 @@ class MpiSession {
   int size() const { return size_; }
   bool thread_multiple() const { return thread_multiple_; }
 
-  // Rank 0: opens a port (MPI_Open_port) for nodes to join; its name, to hand to them.
-  std::string open_port();
-  // Rank 0: waits for the next node on the port (MPI_Comm_accept: blocks, outside the session's lock;
-  // needs MPI_THREAD_MULTIPLE); its peer id, or -1 once the port is closed or the accept failed.
-  int accept();
-  // Rank 0: closes the port, ending a pending accept() (by connecting to the port itself).
-  void close_port();
-  // A node: connects to rank 0's port (MPI_Comm_connect, blocking); peer 0 then is rank 0, and rank()
-  // says `slot`. Throws when the connection fails.
-  void join(const std::string& port, int slot);
+  // Rank 0: makes the node at the other end of `socket` (a TCP connection rank 0's NodePort accepted) a
+  // peer: MPI_Comm_join (MPI-2), which waits until the node joins too; outside the session's lock (needs
+  // MPI_THREAD_MULTIPLE). Its peer id, or -1 when the join failed.
+  int join_peer(int socket);
+  // A node: joins rank 0 over `socket` (MPI_Comm_join); peer 0 then is rank 0 across the
+  // intercommunicator, and rank() says `slot`. Throws when the join fails.
+  void join(int socket, int slot);
   bool joined() const { return joined_; }
   // Forget a peer that left or was replaced: its messages are dropped, sends to it given up; its
   // intercommunicator is disconnected in the background (bounded) where it said goodbye.

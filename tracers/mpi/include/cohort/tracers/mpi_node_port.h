@@ -1,14 +1,20 @@
 // Rank 0's port for nodes that join a running session (docs/cluster.md, "Joining a running session"):
-// nodes started on their own (their own mpiexec, any host) connect through it (MPI-2's MPI_Open_port /
-// MPI_Comm_accept) and serve a remote tracer's slot, mpi:N. A slot whose node died, left or never came is
-// served by the next node that joins it; until then its rows go to the other tracers.
+// nodes started on their own (their own mpiexec, any host) join it and serve a remote tracer's slot,
+// mpi:N. A slot whose node died, left or never came is served by the next node that joins it; until then
+// its rows go to the other tracers.
 //
-// The accept waits on a thread of its own (MPI_THREAD_MULTIPLE), outside the session's lock, and so does
-// each newcomer's greeting (join, hello: bounded waits), so frames never wait for a node that joins. A
-// node that asks for a busy slot, runs another version, or says nothing in time is refused with the
-// reason, logged on both sides; the remote tracer of its slot then picks up the one that was welcomed.
+// The port is a TCP socket: a node connects, says the join's magic words, and both hand the connection
+// to MPI_Comm_join (MPI-2), which makes it an intercommunicator. Not MPI_Open_port and MPI_Comm_accept:
+// an accept blocks until a node comes, and MPICH 5.0 holds its global lock all the while, so every other
+// MPI call of rank 0 (its tracers' bands) would wait for the next node; nor can an accept be cancelled at
+// exit. Here rank 0 calls into MPI only for a node that is joining right then. That and each newcomer's
+// greeting (join, hello: bounded waits) run on a thread of their own (MPI_THREAD_MULTIPLE), outside the
+// session's lock, so frames do not wait for a node that joins. A node that asks for a busy slot, runs
+// another version, or says nothing in time is refused with the reason, logged on both sides; the remote
+// tracer of its slot then picks up the one that was welcomed.
 #pragma once
 
+#include <atomic>
 #include <chrono>
 #include <condition_variable>
 #include <map>
@@ -32,8 +38,9 @@ struct JoiningNode {
 
 class NodePort {
  public:
-  // Opens the port for the remote tracers' `slots` (mpi:N) and writes its name to `path` (whole, by a
-  // rename, so that a node never reads half of it). Remote tracers made within `first_wait` of now wait
+  // Opens the port for the remote tracers' `slots` (mpi:N) and writes where it is to `path` ("HOST PORT":
+  // this host's name, or COHORT_NODE_PORT_HOST; the TCP port COHORT_NODE_PORT_TCP, or any free one),
+  // whole, by a rename, so that a node never reads half of it. Remote tracers made within `first_wait` of now wait
   // that long for their node (a run that starts with nodes still joining). Call before the first MPI use
   // of the process (it asks for MPI_THREAD_MULTIPLE); throws where the library lacks it or the port
   // cannot be opened or written.
@@ -52,8 +59,7 @@ class NodePort {
   MpiClock::time_point first_deadline() const { return first_deadline_; }
   const std::string& path() const { return path_; }
 
-  // Stops taking nodes and removes the port's file (the session's finalize calls it). The accept itself
-  // cannot be cancelled: its thread is left waiting (MpiSession::finalize copes).
+  // Stops taking nodes and removes the port's file (the session's finalize calls it first).
   void close();
 
  private:
@@ -73,7 +79,8 @@ class NodePort {
   };
   std::map<int, Slot> slots_;
   bool accept_ended_ = false;
-  bool closed_ = false;
+  std::atomic<bool> closed_{false};
+  int listening_ = -1;
   std::thread accepting_;
 };
 
