@@ -106,8 +106,11 @@ def stall(a, killed=False):
     flags = mpiexec_flags(a.mpiexec)
     if killed:
         if "--oversubscribe" not in flags:
-            print("SKIP: only Open MPI's mpirun is known here to let a job outlive a killed rank")
-            sys.exit(77)
+            # MPICH's mpiexec ends the whole job when a rank is killed, -disable-auto-cleanup or not (its
+            # per-host proxy fails writing to the dead rank's PMI socket); nodes that join on their own
+            # launch are separate jobs: the killed one's launcher ends alone.
+            killed_joined(a)
+            return
         flags = flags + ["--mca", "orte_enable_recovery", "1"]
     frames = 400
     args = ["--width", "192", "--height", "128", "--spp", "2", "--frames", str(frames), "--write", "last",
@@ -572,11 +575,55 @@ def last_frame_differs(single, cluster, frames):
     return differing
 
 
+def killed_joined(a):
+    """The killed case with nodes that joined through rank 0's port (each its own mpiexec): rank 2 kills itself
+    before its band of frame 1; frame 1 is the one late frame, every frame is delivered, the surviving node
+    renders every frame, the last frame matches the single-process render, and rank 0 ends cleanly."""
+    os.makedirs(a.out)
+    frames = 400
+    args = ["--width", "192", "--height", "128", "--spp", "2", "--frames", str(frames), "--write", "last",
+            "--balancer", "perfect-smooth"]
+    single, cluster = os.path.join(a.out, "single"), os.path.join(a.out, "cluster")
+    run([a.cohort, "render", a.map, "--tracers", "embree", "--out", single] + args)
+    port = os.path.join(a.out, "port")
+    jobs = JoinLauncher(a)
+    jobs.env["COHORT_MPI_BAND_TIMEOUT_MS"] = "1000"
+    flags = ["-x", "COHORT_MPI_BAND_TIMEOUT_MS"] if jobs.flags else []
+    try:
+        rank0 = jobs.start("rank0", flags + [a.cohort, "render", a.map, "--tracers", "embree,mpi:1,mpi:2", "--node-port",
+                                             port, "--node-wait", "120", "--out", cluster] + args)
+        node = [a.cohort, "node", a.map, "--tracers", "embree", "--join", port]
+        survivor = jobs.start("node1", node + ["--as", "1"])
+        dying = jobs.start("node2", node + ["--as", "2", "--die-frame", "1"])
+        code, survived, died = jobs.finish(rank0), jobs.finish(survivor), jobs.finish(dying)
+        jobs.dump()
+    finally:
+        jobs.close()
+    if code != 0 or survived != 0:
+        sys.exit(f"exit statuses: rank 0 {code}, the surviving node {survived}")
+    if died == 0 or "killing itself before frame 1" not in JoinLauncher.output(dying):
+        sys.exit("rank 2 should have killed itself before frame 1")
+    with open(os.path.join(cluster, "stats.json")) as f:
+        stats = json.load(f)["frames"]
+    late = [f["frame"] for f in stats if f["wall_ms"] > 500]
+    outcome = [{t["name"]: t["outcome"] for t in f["tracers"]} for f in stats]
+    print("late frames:", late)
+    if len(stats) != frames:
+        sys.exit(f"{len(stats)} of {frames} frames delivered")
+    if late != [1]:
+        sys.exit(f"the death should make frame 1, and only it, late: {late}")
+    if any(o["mpi:2"] == "rendered" for o in outcome[1:]) or any(o["mpi:1"] != "rendered" for o in outcome):
+        sys.exit("the killed node cannot have rendered after frame 0, and the surviving one should render every frame")
+    if last_frame_differs(single, cluster, frames):
+        sys.exit("the last frame differs from the single-process render")
+    print("killed (nodes joined on their own launch): ok")
+
+
 def join(a):
     """Rank 0 alone with a port; two nodes started on their own join mpi:1 and mpi:2 before the first frame
-    (--node-wait) and render every frame; the last frame matches the single-process render. Meanwhile a node
-    that asks for the busy mpi:1 and one that runs another version are refused, with the reason logged on
-    both sides, and rank 0 goes on."""
+    (--node-wait) and render every frame; the last frame matches the single-process render. Before that, a
+    node that runs another version and one that asks for the busy mpi:1 are refused, with the reason logged
+    on both sides, and rank 0 goes on."""
     os.makedirs(a.out)
     frames = 300
     args = ["--width", "192", "--height", "128", "--spp", "2", "--frames", str(frames), "--write", "last",
@@ -589,15 +636,18 @@ def join(a):
         rank0 = jobs.start("rank0", [a.cohort, "render", a.map, "--tracers", "embree,mpi:1,mpi:2", "--node-port", port,
                                      "--node-wait", "120", "--out", cluster] + args)
         node = [a.cohort, "node", a.map, "--tracers", "embree", "--join", port]
-        nodes = [jobs.start(f"node{n}", node + ["--as", str(n)]) for n in (1, 2)]
-        # Both joined: a third asks for mpi:1, a fourth announces another version.
-        jobs.wait_for_line(rank0, r"mpi:2: node joined through the port")
-        busy = jobs.start("busy", node + ["--as", "1"])
+        # In an order that leaves nothing to chance: rank 0 waits for mpi:2's node (--node-wait) until the end.
         other = jobs.start("other_version", node + ["--as", "0", "--announce-version", "0.0.0-test"])
-        for job in (busy, other):
-            if jobs.finish(job, timeout=120) == 0:
-                jobs.dump()
-                sys.exit(f"{job.name}: a refused node should end with an error")
+        if jobs.finish(other, timeout=120) == 0:
+            jobs.dump()
+            sys.exit("the node of another version should end with an error")
+        nodes = [jobs.start("node1", node + ["--as", "1"])]
+        jobs.wait_for_line(rank0, r"mpi:1: node joined through the port")
+        busy = jobs.start("busy", node + ["--as", "1"])
+        if jobs.finish(busy, timeout=120) == 0:
+            jobs.dump()
+            sys.exit("the node that asked for the busy mpi:1 should end with an error")
+        nodes.append(jobs.start("node2", node + ["--as", "2"]))
         code = jobs.finish(rank0)
         codes = [jobs.finish(n) for n in nodes]
         output = jobs.output(rank0)
