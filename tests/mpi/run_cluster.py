@@ -44,6 +44,7 @@ import json
 import os
 import re
 import shutil
+import socket
 import subprocess
 import sys
 import time
@@ -623,7 +624,8 @@ def join(a):
     """Rank 0 alone with a port; two nodes started on their own join mpi:1 and mpi:2 before the first frame
     (--node-wait) and render every frame; the last frame matches the single-process render. Before that, a
     node that runs another version and one that asks for the busy mpi:1 are refused, with the reason logged
-    on both sides, and rank 0 goes on."""
+    on both sides, a connection that says nothing is dropped after 5 s, and rank 0 goes on. A node whose
+    port file never appears fails after its --join-timeout."""
     os.makedirs(a.out)
     frames = 300
     args = ["--width", "192", "--height", "128", "--spp", "2", "--frames", str(frames), "--write", "last",
@@ -632,6 +634,13 @@ def join(a):
     run([a.cohort, "render", a.map, "--tracers", "embree", "--out", single] + args)
     port = os.path.join(a.out, "port")
     jobs = JoinLauncher(a)
+    # A port file that never appears: the node says so after its bounded wait and fails.
+    code, output = run([a.mpiexec] + jobs.flags + ["-np", "1", a.cohort, "node", a.map, "--join",
+                                                   os.path.join(a.out, "no_such_port"), "--join-timeout", "1"],
+                       env=jobs.env, expect_ok=False)
+    if code == 0 or "no port in" not in output:
+        jobs.close()
+        sys.exit("a node whose port file never appears should fail after --join-timeout, saying so")
     try:
         rank0 = jobs.start("rank0", [a.cohort, "render", a.map, "--tracers", "embree,mpi:1,mpi:2", "--node-port", port,
                                      "--node-wait", "120", "--out", cluster] + args)
@@ -647,6 +656,12 @@ def join(a):
         if jobs.finish(busy, timeout=120) == 0:
             jobs.dump()
             sys.exit("the node that asked for the busy mpi:1 should end with an error")
+        # A connection that says nothing is dropped after a bounded wait, and rank 0 goes on waiting for mpi:2.
+        with open(port) as f:
+            host, tcp_port = f.read().split()
+        silent = socket.create_connection((host, int(tcp_port)), timeout=10)
+        jobs.wait_for_line(rank0, r"dropped a connection to the node port that did not say it joins within 5 s", 30)
+        silent.close()
         nodes.append(jobs.start("node2", node + ["--as", "2"]))
         code = jobs.finish(rank0)
         codes = [jobs.finish(n) for n in nodes]
