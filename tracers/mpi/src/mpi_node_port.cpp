@@ -48,10 +48,10 @@ std::optional<wire::Message> receive_message(MpiSession& mpi, int peer, MpiClock
 
 NodePort& NodePort::open(const std::string& path, std::chrono::milliseconds first_wait, const std::vector<int>& slots) {
   MpiSession::require_thread_multiple();
-  MpiSession& mpi = MpiSession::get();  // first, so that the session outlives the port (static order)
+  MpiSession& mpi = MpiSession::get();
   if (the_port()) throw std::runtime_error("a node port is already open (" + the_port()->path() + ")");
   the_port() = new NodePort(path, first_wait, slots);
-  // The accept must end before MPI does, whoever finalizes first.
+  // The port's thread must stop calling MPI before MPI ends, whoever finalizes first.
   mpi.before_finalize([] {
     if (NodePort* port = NodePort::get()) port->close();
   });

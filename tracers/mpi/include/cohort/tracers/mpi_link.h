@@ -61,7 +61,7 @@ class MpiSession {
   void abandon(int peer);
   // Finalize now (sends still pending are given up to a second). Later MPI use throws.
   void finalize();
-  // Runs `work` at the start of finalize(), before anything else (a port's accept thread ends there).
+  // Runs `work` at the start of finalize(), before anything else (the node port stops taking nodes there).
   void before_finalize(std::function<void()> work);
   bool finalized() const { return finalized_; }
 
