@@ -3,6 +3,11 @@
 // its own tracers and renders the bands it is sent. Started by mpirun next to `cohort render` on rank 0:
 //
 //   mpirun -np 1 cohort render MAP --tracers embree,mpi:1 : -np 1 cohort node MAP --tracers embree
+//
+// or on its own, joining a running rank 0 through its port (docs/cluster.md, "Joining a running session"):
+//
+//   mpiexec -np 1 cohort render MAP --tracers embree,mpi:1 --node-port PORT_FILE
+//   mpiexec -np 1 cohort node MAP --join PORT_FILE --as 1
 #include <iostream>
 
 #include <spdlog/spdlog.h>
@@ -31,6 +36,9 @@ struct NodeArgs {
   int stall_frame = -1, stall_ms = 0, die_frame = -1, short_piece_frame = -1, band_delay_ms = 0;
   double row_delay_ms = 0.0;
   int idle_timeout_s = 600;
+  std::string join;  // rank 0's port file: join its running session instead of being one of mpirun's ranks
+  int join_as = 0;
+  int join_timeout_s = 60;
 };
 
 #ifdef COHORT_HAVE_MPI
@@ -67,6 +75,15 @@ int run_node_command(const NodeArgs& a) {
   } catch (const std::exception& e) {
     options.load_error = e.what();
   }
+  if (!a.join.empty()) {
+    try {
+      tracers::join_session(a.join, a.join_as, std::chrono::seconds(a.join_timeout_s));
+    } catch (const std::exception& e) {
+      spdlog::error("node: {}", e.what());
+      tracers::MpiSession::get().finalize();
+      return 1;
+    }
+  }
   int code = tracers::run_node(std::move(tracers), options);
   tracers::MpiSession::get().finalize();
   return code;
@@ -88,6 +105,16 @@ void add_node_command(CLI::App& app, int& exit_code) {
   cmd->add_option("--time", a->time, "game time rank 0 renders frame 0 at (its --time), for the materials")
       ->capture_default_str();
   cmd->add_option("--idle-timeout", a->idle_timeout_s, "leave when rank 0 has been silent this many seconds")
+      ->capture_default_str()
+      ->check(CLI::PositiveNumber);
+  cmd->add_option("--join", a->join, "join rank 0's running session through the port named in this file (rank 0's "
+                                     "--node-port), started on its own instead of under rank 0's mpirun")
+      ->check(CLI::NonexistentPath | CLI::ExistingFile);
+  cmd->add_option("--as", a->join_as, "with --join: the slot to serve, mpi:N (0: the first free one)")
+      ->capture_default_str()
+      ->check(CLI::NonNegativeNumber);
+  cmd->add_option("--join-timeout", a->join_timeout_s, "with --join: leave when the port file has not appeared or "
+                                                       "the connection has not been made within this many seconds")
       ->capture_default_str()
       ->check(CLI::PositiveNumber);
   // Test hooks, hidden from the help.

@@ -24,6 +24,9 @@
 #                              (e.g. COHORT_BLAS_LAYOUT bvh2 cwbvh): its tracer tests, then ms per frame, three rounds
 #   tools/gpu_run.sh stage-mpi here: the travelling cohort built against PyPI's MPICH, with its libraries (.gpu/mpi.tar.xz)
 #   tools/gpu_run.sh cluster   there, on a two-GPU kind: two ranks with one GPU each against the in-process two GPUs
+#   tools/gpu_run.sh rejoin    there, on a two-GPU kind: two nodes that joined rank 0 on their own mpiexec, one GPU
+#                              each; mpi:2's node dies, a fresh one joins its slot: frame times around the death
+#                              and the return, and the newcomer's join -> first band (docs/cluster.md)
 #                              (COHORT_CLUSTER_JOBS_AHEAD="1 0": with and without jobs ahead, back to back)
 #   tools/gpu_run.sh links     there, on a two-GPU kind: remote tracers behind emulated links (COHORT_LINKS, default
 #                              "none 10gbit,0.5ms 1gbit,1ms"): alone, two ranks together, and beside rank 0's cuda:0
@@ -138,6 +141,45 @@ case "${1:-}" in
         done
       done
     done
+    ;;
+  rejoin)
+    # There, on a two-GPU kind, with the staged MPICH build (stage-mpi): issue 19's rejoin. Rank 0 (no GPU of its
+    # own, Brigade's blend on the host) opens a port; two nodes join it on their own mpiexec, one GPU each; mpi:2's
+    # node kills itself before frame 600 and, once its band has timed out, a fresh node joins mpi:2.
+    mpi_cohort_and_large_map
+    size=(--width 1920 --height 1080 --camera 1690 300 80 5 -12)
+    common=(--spp 1 --light-samples 1 --bounces 1 --convergence brigade --frames 3000 --camera-path spin-slow
+            --write last --balancer perfect-smooth)
+    port=/tmp/rejoin.port; rm -rf "$port" /tmp/rejoin
+    COHORT_MPI_BAND_TIMEOUT_MS=1000 timeout 300 mpiexec.hydra -np 1 "$cohort" render /tmp/largemap.cpk "${size[@]}" \
+      "${common[@]}" --tracers mpi:1,mpi:2 --node-port "$port" --node-wait 120 --out /tmp/rejoin >/tmp/rejoin_r0.log 2>&1 &
+    r0=$!
+    timeout 300 mpiexec.hydra -np 1 "$cohort" node /tmp/largemap.cpk --tracers cuda:0 --join "$port" --as 1 \
+      >/tmp/rejoin_n1.log 2>&1 &
+    timeout 300 mpiexec.hydra -np 1 "$cohort" node /tmp/largemap.cpk --tracers cuda:1 --join "$port" --as 2 \
+      --die-frame 600 >/tmp/rejoin_n2.log 2>&1 || true
+    until grep -q "mpi:2: no answer for rows" /tmp/rejoin_r0.log || ! kill -0 $r0 2>/dev/null; do sleep 0.2; done
+    timeout 300 mpiexec.hydra -np 1 "$cohort" node /tmp/largemap.cpk --tracers cuda:1 --join "$port" --as 2 \
+      >/tmp/rejoin_n3.log 2>&1 &
+    wait $r0 || { echo "rank 0 failed"; tail -n 20 /tmp/rejoin_r0.log; }
+    wait
+    grep -hE "joined mpi|first band|killing itself|no answer for rows|joined rank 0" /tmp/rejoin_*.log | sed 's/^.*\] //'
+    python3 - <<'PY'
+import json
+frames = json.load(open("/tmp/rejoin/stats.json"))["frames"]
+slot = [{t["name"]: t["outcome"] for t in f["tracers"]}["mpi:2"] for f in frames]
+ms = [f["wall_ms"] for f in frames]
+gone = [i for i, s in enumerate(slot) if s != "rendered" and i >= 1]
+back = next((i for i in range(gone[0], len(slot)) if slot[i] == "rendered"), None) if gone else None
+median = sorted(ms[50:])[len(ms[50:]) // 2]
+print(f"{len(frames)} frames, median {median:.2f} ms; late (> 3x median): {[i for i, t in enumerate(ms) if i > 0 and t > 3 * median]}")
+if gone:
+    print(f"mpi:2 away from frame {gone[0]}, back at {back}; frames around the death: "
+          + ", ".join(f"{t:.2f}" for t in ms[gone[0] - 3:gone[0] + 4]))
+if back:
+    print("frames around the return: " + ", ".join(f"{t:.2f}" for t in ms[back - 4:back + 4])
+          + f"; median of the 100 frames after: {sorted(ms[back:back + 100])[50]:.2f} ms")
+PY
     ;;
   links)
     # There, on a two-GPU kind: issue 19's emulated links (COHORT_MPI_LINK on every rank, docs/cluster.md),

@@ -441,6 +441,7 @@ std::vector<uint64_t> Renderer::assign(std::vector<Assignment>& assignments, con
     // What was published so far belongs to this frame; commits submitted from now on wait for the
     // next. Re-rendering a dropped tracer's rows happens within the same frame, so it takes none.
     if (with_commits && w.channel) {
+      if (w.tracer->wants_full_resync()) w.channel->request_resync();
       if (w.channel->resync_requested()) {  // answer a failed apply even when the scene is still
         commit::CommitBuffer nothing_new;
         nothing_new.set_frame(commit_frame_);

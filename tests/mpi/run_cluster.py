@@ -46,8 +46,10 @@ import json
 import os
 import re
 import shutil
+import socket
 import subprocess
 import sys
+import time
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "apps"))
 from compare_images import read_image  # noqa: E402
@@ -107,8 +109,11 @@ def stall(a, killed=False):
     flags = mpiexec_flags(a.mpiexec)
     if killed:
         if "--oversubscribe" not in flags:
-            print("SKIP: only Open MPI's mpirun is known here to let a job outlive a killed rank")
-            sys.exit(77)
+            # MPICH's mpiexec ends the whole job when a rank is killed, -disable-auto-cleanup or not (its
+            # per-host proxy fails writing to the dead rank's PMI socket); nodes that join on their own
+            # launch are separate jobs: the killed one's launcher ends alone.
+            killed_joined(a)
+            return
         flags = flags + ["--mca", "orte_enable_recovery", "1"]
     frames = 400
     args = ["--width", "192", "--height", "128", "--spp", "2", "--frames", str(frames), "--write", "last",
@@ -492,12 +497,286 @@ def link(a):
     print(f"link: ok ({wire_ms:.1f} ms on the wire, {40 + rows_ms:.1f} ms emulated)")
 
 
+class JoinLauncher:
+    """Separately launched jobs (rank 0 with --node-port, each node with its own mpiexec -np 1) that meet through
+    rank 0's port (MPI_Comm_join). Open MPI joins such jobs only through its name server: ompi-server runs for
+    the test and every mpirun is pointed at it (--ompi-server file:URI). MPICH needs nothing."""
+
+    def __init__(self, a):
+        self.a = a
+        self.flags = []
+        self.env = dict(os.environ)
+        self.server = None
+        self.jobs = []
+        version = subprocess.run([a.mpiexec, "--version"], capture_output=True, text=True).stdout
+        if "Open MPI" in version or "OpenRTE" in version:
+            server = os.path.join(os.path.dirname(a.mpiexec), "ompi-server")
+            if not os.path.exists(server):
+                server = shutil.which("ompi-server")
+            if not server:
+                print("SKIP: Open MPI without ompi-server: separately launched jobs cannot connect")
+                sys.exit(77)
+            uri = os.path.join(a.out, "ompi-server.uri")
+            self.server = subprocess.Popen([server, "--no-daemonize", "-r", uri])
+            for _ in range(100):
+                if os.path.exists(uri) and os.path.getsize(uri) > 0:
+                    break
+                time.sleep(0.1)
+            else:
+                sys.exit("ompi-server wrote no URI")
+            self.flags = ["--ompi-server", "file:" + uri]
+
+    def start(self, name, command):
+        log = os.path.join(self.a.out, name + ".log")
+        full = [self.a.mpiexec] + self.flags + ["-np", "1"] + command
+        print(f"$ {' '.join(full)}  > {log}", flush=True)
+        job = subprocess.Popen(full, stdout=open(log, "w"), stderr=subprocess.STDOUT, env=self.env)
+        job.log = log
+        job.name = name
+        self.jobs.append(job)
+        return job
+
+    def wait_for_line(self, job, pattern, timeout=90):
+        end = time.time() + timeout
+        while time.time() < end:
+            if re.search(pattern, self.output(job)):
+                return
+            if job.poll() is not None and not re.search(pattern, self.output(job)):
+                break
+            time.sleep(0.1)
+        self.dump()
+        sys.exit(f"{job.name}: no line matching {pattern!r}")
+
+    @staticmethod
+    def output(job):
+        with open(job.log) as f:
+            return f.read()
+
+    def finish(self, job, timeout=240):
+        try:
+            return job.wait(timeout=timeout)
+        except subprocess.TimeoutExpired:
+            self.dump()
+            sys.exit(f"{job.name} did not end within {timeout} s")
+
+    def dump(self):
+        for job in self.jobs:
+            print(f"---- {job.name} (exit {job.poll()}):\n{self.output(job)[-5000:]}")
+
+    def close(self):
+        for job in self.jobs:
+            if job.poll() is None:
+                job.kill()
+        if self.server:
+            self.server.terminate()
+            self.server.wait()
+
+
+def last_frame_differs(single, cluster, frames):
+    name = f"frame_{frames - 1:04d}.png"
+    (w, h, ca, pa), (_, _, cb, pb) = read_image(os.path.join(single, name)), read_image(os.path.join(cluster, name))
+    differing = sum(1 for p in range(w * h) if pa[p * ca:p * ca + 3] != pb[p * cb:p * cb + 3])
+    print(f"{name}: {differing} of {w * h} pixels differ")
+    return differing
+
+
+def killed_joined(a):
+    """The killed case with nodes that joined through rank 0's port (each its own mpiexec): rank 2 kills itself
+    before its band of frame 1; frame 1 is the one late frame, every frame is delivered, the surviving node
+    renders every frame, the last frame matches the single-process render, and rank 0 ends cleanly."""
+    os.makedirs(a.out)
+    frames = 400
+    args = ["--width", "192", "--height", "128", "--spp", "2", "--frames", str(frames), "--write", "last",
+            "--balancer", "perfect-smooth"]
+    single, cluster = os.path.join(a.out, "single"), os.path.join(a.out, "cluster")
+    run([a.cohort, "render", a.map, "--tracers", "embree", "--out", single] + args)
+    port = os.path.join(a.out, "port")
+    jobs = JoinLauncher(a)
+    jobs.env["COHORT_MPI_BAND_TIMEOUT_MS"] = "1000"
+    flags = ["-x", "COHORT_MPI_BAND_TIMEOUT_MS"] if jobs.flags else []
+    try:
+        rank0 = jobs.start("rank0", flags + [a.cohort, "render", a.map, "--tracers", "embree,mpi:1,mpi:2", "--node-port",
+                                             port, "--node-wait", "120", "--out", cluster] + args)
+        node = [a.cohort, "node", a.map, "--tracers", "embree", "--join", port]
+        survivor = jobs.start("node1", node + ["--as", "1"])
+        dying = jobs.start("node2", node + ["--as", "2", "--die-frame", "1"])
+        code, survived, died = jobs.finish(rank0), jobs.finish(survivor), jobs.finish(dying)
+        jobs.dump()
+    finally:
+        jobs.close()
+    if code != 0 or survived != 0:
+        sys.exit(f"exit statuses: rank 0 {code}, the surviving node {survived}")
+    if died == 0 or "killing itself before frame 1" not in JoinLauncher.output(dying):
+        sys.exit("rank 2 should have killed itself before frame 1")
+    with open(os.path.join(cluster, "stats.json")) as f:
+        stats = json.load(f)["frames"]
+    late = [f["frame"] for f in stats if f["wall_ms"] > 500]
+    outcome = [{t["name"]: t["outcome"] for t in f["tracers"]} for f in stats]
+    print("late frames:", late)
+    if len(stats) != frames:
+        sys.exit(f"{len(stats)} of {frames} frames delivered")
+    if late != [1]:
+        sys.exit(f"the death should make frame 1, and only it, late: {late}")
+    if any(o["mpi:2"] == "rendered" for o in outcome[1:]) or any(o["mpi:1"] != "rendered" for o in outcome):
+        sys.exit("the killed node cannot have rendered after frame 0, and the surviving one should render every frame")
+    if last_frame_differs(single, cluster, frames):
+        sys.exit("the last frame differs from the single-process render")
+    print("killed (nodes joined on their own launch): ok")
+
+
+def join(a):
+    """Rank 0 alone with a port; two nodes started on their own join mpi:1 and mpi:2 before the first frame
+    (--node-wait) and render every frame; the last frame matches the single-process render. Before that, a
+    node that runs another version and one that asks for the busy mpi:1 are refused, with the reason logged
+    on both sides, a connection that says nothing is dropped after 5 s, and rank 0 goes on. A node whose
+    port file never appears fails after its --join-timeout."""
+    os.makedirs(a.out)
+    frames = 300
+    args = ["--width", "192", "--height", "128", "--spp", "2", "--frames", str(frames), "--write", "last",
+            "--balancer", "perfect-smooth"]
+    single, cluster = os.path.join(a.out, "single"), os.path.join(a.out, "cluster")
+    run([a.cohort, "render", a.map, "--tracers", "embree", "--out", single] + args)
+    port = os.path.join(a.out, "port")
+    jobs = JoinLauncher(a)
+    # A port file that never appears: the node says so after its bounded wait and fails.
+    code, output = run([a.mpiexec] + jobs.flags + ["-np", "1", a.cohort, "node", a.map, "--join",
+                                                   os.path.join(a.out, "no_such_port"), "--join-timeout", "1"],
+                       env=jobs.env, expect_ok=False)
+    if code == 0 or "no port in" not in output:
+        jobs.close()
+        sys.exit("a node whose port file never appears should fail after --join-timeout, saying so")
+    try:
+        rank0 = jobs.start("rank0", [a.cohort, "render", a.map, "--tracers", "embree,mpi:1,mpi:2", "--node-port", port,
+                                     "--node-wait", "120", "--out", cluster] + args)
+        node = [a.cohort, "node", a.map, "--tracers", "embree", "--join", port]
+        # In an order that leaves nothing to chance: rank 0 waits for mpi:2's node (--node-wait) until the end.
+        other = jobs.start("other_version", node + ["--as", "0", "--announce-version", "0.0.0-test"])
+        if jobs.finish(other, timeout=120) == 0:
+            jobs.dump()
+            sys.exit("the node of another version should end with an error")
+        nodes = [jobs.start("node1", node + ["--as", "1"])]
+        jobs.wait_for_line(rank0, r"mpi:1: node joined through the port")
+        busy = jobs.start("busy", node + ["--as", "1"])
+        if jobs.finish(busy, timeout=120) == 0:
+            jobs.dump()
+            sys.exit("the node that asked for the busy mpi:1 should end with an error")
+        # A connection that says nothing is dropped after a bounded wait, and rank 0 goes on waiting for mpi:2.
+        with open(port) as f:
+            host, tcp_port = f.read().split()
+        silent = socket.create_connection((host, int(tcp_port)), timeout=10)
+        jobs.wait_for_line(rank0, r"dropped a connection to the node port that did not say it joins within 5 s", 30)
+        silent.close()
+        nodes.append(jobs.start("node2", node + ["--as", "2"]))
+        code = jobs.finish(rank0)
+        codes = [jobs.finish(n) for n in nodes]
+        output = jobs.output(rank0)
+        jobs.dump()
+        if code != 0 or any(codes):
+            sys.exit(f"exit statuses: rank 0 {code}, nodes {codes}")
+        if not re.search(r"refused a node that joined: mpi:1 is busy", output):
+            sys.exit("rank 0 did not log why it refused the node that asked for the busy mpi:1")
+        if "rank 0 refused this node: mpi:1 is busy" not in jobs.output(busy):
+            sys.exit("the node that asked for the busy mpi:1 did not log the refusal")
+        if not re.search(r"refused a node that joined: version mismatch: rank 0 runs Cohort \S+ .* runs Cohort "
+                         r"0\.0\.0-test", output):
+            sys.exit("rank 0 did not name both versions when it refused the other version")
+        if "rank 0 refused this node: version mismatch" not in jobs.output(other):
+            sys.exit("the node of another version did not log the refusal")
+    finally:
+        jobs.close()
+    if last_frame_differs(single, cluster, frames):
+        sys.exit("the last frame differs from the single-process render")
+    outcomes = tracer_outcomes(cluster)
+    for f, o in enumerate(outcomes):
+        if o.get("mpi:1") != "rendered" or o.get("mpi:2") != "rendered":
+            sys.exit(f"frame {f}: a node that joined did not render its band: {o}")
+    for found in re.finditer(r"mpi:(\d): the node that joined delivered its first band \(frame (\d+)\) (\d+) ms after it "
+                             r"connected", output):
+        print(f"mpi:{found.group(1)}: first band (frame {found.group(2)}) {found.group(3)} ms after its connect")
+    print("join: ok")
+
+
+def rejoin(a):
+    """mpi:2's node dies before its band of frame 5 (--die-frame); once it is gone a fresh node joins mpi:2. Its
+    band of the dead node times out (the one late frame), its rows go to the others until the newcomer's full
+    resync, then the slot renders again; every frame is delivered and the last matches the single-process
+    render."""
+    os.makedirs(a.out)
+    frames = 1500
+    die = 5
+    args = ["--width", "192", "--height", "128", "--spp", "2", "--frames", str(frames), "--write", "last",
+            "--balancer", "perfect-smooth"]
+    single, cluster = os.path.join(a.out, "single"), os.path.join(a.out, "cluster")
+    run([a.cohort, "render", a.map, "--tracers", "embree", "--out", single] + args)
+    port = os.path.join(a.out, "port")
+    jobs = JoinLauncher(a)
+    jobs.env["COHORT_MPI_BAND_TIMEOUT_MS"] = "1000"
+    flags = ["-x", "COHORT_MPI_BAND_TIMEOUT_MS"] if jobs.flags else []
+    try:
+        rank0 = jobs.start("rank0", flags + [a.cohort, "render", a.map, "--tracers", "embree,mpi:1,mpi:2", "--node-port",
+                                             port, "--node-wait", "120", "--out", cluster] + args)
+        node = [a.cohort, "node", a.map, "--tracers", "embree", "--join", port]
+        first = jobs.start("node1", node + ["--as", "1"])
+        dying = jobs.start("node2", node + ["--as", "2", "--die-frame", str(die)])
+        jobs.finish(dying, timeout=120)
+        died_at = time.time()
+        if f"killing itself before frame {die}" not in jobs.output(dying):
+            jobs.dump()
+            sys.exit(f"node2 ended without dying at frame {die}")
+        # The slot is free once the dead node's band has timed out (until then mpi:2 is busy: its node answers).
+        jobs.wait_for_line(rank0, r"mpi:2: no answer for rows")
+        fresh = jobs.start("node2_again", node + ["--as", "2"])
+        code = jobs.finish(rank0)
+        codes = [jobs.finish(n) for n in (first, fresh)]
+        output = jobs.output(rank0)
+        jobs.dump()
+        if code != 0 or any(codes):
+            sys.exit(f"exit statuses: rank 0 {code}, nodes {codes}")
+    finally:
+        jobs.close()
+    with open(os.path.join(cluster, "stats.json")) as f:
+        stats = json.load(f)["frames"]
+    if len(stats) != frames:
+        sys.exit(f"{len(stats)} of {frames} frames delivered")
+    outcome = [{t["name"]: t for t in f["tracers"]} for f in stats]
+    slot = [o["mpi:2"]["outcome"] for o in outcome]
+    gone = [f for f, s in enumerate(slot) if s != "rendered"]
+    late = [f["frame"] for f in stats if f["wall_ms"] > 500]
+    back = next((f for f in range(die + 1, frames) if slot[f] == "rendered"), None)
+    print(f"mpi:2 away in frames {gone[0] if gone else '-'}..{gone[-1] if gone else '-'} ({len(gone)} frames), back from "
+          f"frame {back}; late frames: {late}")
+    if back is None:
+        sys.exit("the fresh node never rendered mpi:2's rows (did it join before the run ended?)")
+    if slot[die] == "rendered" or "no answer for rows" not in outcome[die]["mpi:2"].get("error", ""):
+        sys.exit(f"frame {die}: the dead node's band should have timed out: {outcome[die]['mpi:2']}")
+    if any(s != "rendered" for s in slot[back:]):
+        sys.exit("once back, mpi:2 should render every frame")
+    last = outcome[-10:]
+    if any(o["mpi:2"]["row_end"] <= o["mpi:2"]["row_begin"] for o in last):
+        sys.exit("mpi:2 should have rows in the last frames")
+    if late != [die]:
+        sys.exit(f"the death should make frame {die}, and only it, late: {late}")
+    if last_frame_differs(single, cluster, frames):
+        sys.exit("the last frame differs from the single-process render")
+    times = [f["wall_ms"] for f in stats]
+    around = times[max(back - 3, 0):back + 4]
+    print(f"frame times around the rejoin (frames {max(back - 3, 0)}..{back + 3}): "
+          f"{', '.join(f'{t:.1f}' for t in around)} ms; median of the run {sorted(times)[len(times) // 2]:.1f} ms")
+    found = re.findall(r"mpi:2: the node that joined delivered its first band \(frame (\d+)\) (\d+) ms after it "
+                       r"connected", output)
+    if len(found) != 2 or int(found[-1][0]) != back:
+        sys.exit(f"rank 0 should have logged the first band of both nodes that joined mpi:2, the second's in frame {back}")
+    print(f"mpi:2's new node: first band (frame {found[-1][0]}) {found[-1][1]} ms after its connect; "
+          f"{(time.time() - died_at):.1f} s from the death to the end of the run")
+    print("rejoin: ok")
+
+
 def main():
     parser = argparse.ArgumentParser()
     parser.add_argument("case", choices=["match", "mixed", "stall", "killed", "version", "load_error", "bench", "protocol", "replay",
                                            "play", "link", "bad_piece", "ahead", "ahead_recovery", "jobs_ahead",
                                            "jobs_ahead_two_in_flight",
-                                           "early_announce", "match_rgb9e5", "play_early_announce"])
+                                           "early_announce", "match_rgb9e5", "play_early_announce", "join", "rejoin"])
     parser.add_argument("--mpiexec", required=True)
     parser.add_argument("--cohort", required=True)
     parser.add_argument("--map", required=True)
@@ -514,6 +793,12 @@ def main():
         return
     if a.case == "bench":
         bench(a)
+        return
+    if a.case == "join":
+        join(a)
+        return
+    if a.case == "rejoin":
+        rejoin(a)
         return
     if a.case == "link":
         link(a)

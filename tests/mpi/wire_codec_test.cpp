@@ -138,6 +138,32 @@ TEST(WireCodec, MalformedCommitsAreRefusedWithTheReason) {
             std::string::npos);
 }
 
+TEST(WireCodec, AJoinNamesItsSlotAndNothingElse) {
+  const std::vector<uint8_t> join = wire::frame_message(wire::Kind::join, 0, wire::encode_join(2));
+  const wire::Message m = wire::parse_message(join.data(), join.size());
+  EXPECT_EQ(m.kind, wire::Kind::join);
+  EXPECT_EQ(wire::decode_join(m.payload), 2u);
+  std::vector<uint8_t> longer = m.payload;
+  longer.push_back(0);
+  EXPECT_THROW(wire::decode_join(longer), wire::WireError);
+  EXPECT_THROW(wire::decode_join(std::vector<uint8_t>(m.payload.begin(), m.payload.end() - 1)), wire::WireError);
+}
+
+TEST(WireCodec, AVersionMismatchNamesBothVersionsAndTheSlot) {
+  wire::Hello hello;
+  hello.cohort_version = wire::cohort_version();
+  hello.host = "gpu2";
+  EXPECT_EQ(wire::version_mismatch(hello, 2), "");
+  hello.cohort_version = "0.0.0-test";
+  const std::string why = wire::version_mismatch(hello, 2);
+  EXPECT_NE(why.find("rank 0 runs Cohort " + wire::cohort_version()), std::string::npos) << why;
+  EXPECT_NE(why.find("rank 2 on gpu2 runs Cohort 0.0.0-test"), std::string::npos) << why;
+  hello.cohort_version = wire::cohort_version();
+  hello.protocol = wire::kProtocolVersion - 1;
+  EXPECT_NE(wire::version_mismatch(hello, 1).find("(protocol " + std::to_string(wire::kProtocolVersion - 1) + ")"),
+            std::string::npos);
+}
+
 TEST(WireCodec, HeadersAreCheckedBeforeThePayload) {
   const std::vector<uint8_t> payload = wire::encode_text("hello there");
   const std::vector<uint8_t> good = wire::frame_message(wire::Kind::load_failed, 42, payload);
@@ -158,8 +184,9 @@ TEST(WireCodec, HeadersAreCheckedBeforeThePayload) {
   bad_magic[0] ^= 0xff;
   EXPECT_NE(refused(bad_magic).find("bad magic"), std::string::npos);
   std::vector<uint8_t> other_protocol = good;
-  other_protocol[4] = 9;
-  EXPECT_NE(refused(other_protocol).find("protocol version 9"), std::string::npos);
+  other_protocol[4] = uint8_t(wire::kProtocolVersion + 1);
+  EXPECT_NE(refused(other_protocol).find("protocol version " + std::to_string(wire::kProtocolVersion + 1)),
+            std::string::npos);
   std::vector<uint8_t> unknown_kind = good;
   unknown_kind[6] = 77;
   EXPECT_NE(refused(unknown_kind).find("unknown message kind 77"), std::string::npos);

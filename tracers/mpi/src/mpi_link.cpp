@@ -7,6 +7,7 @@
 #include <limits>
 #include <memory>
 #include <map>
+#include <set>
 #include <stdexcept>
 #include <string>
 #include <thread>
@@ -27,11 +28,33 @@ int finalize_timeout_seconds() {
   const int seconds = text && *text ? std::atoi(text) : 10;
   return seconds > 0 ? seconds : 10;
 }
+
+std::atomic<bool> want_thread_multiple{false};
+
+std::string mpi_error_text(int code) {
+  char text[MPI_MAX_ERROR_STRING] = {};
+  int length = 0;
+  MPI_Error_string(code, text, &length);
+  return std::string(text, size_t(std::max(length, 0)));
+}
 }  // namespace
 
 struct MpiSession::Impl {
   MPI_Comm comm = MPI_COMM_NULL;
   bool we_initialized = false;
+  // Peers that joined the running session (rank 0), or rank 0 seen from a node that joined (peer 0): each is
+  // rank 0 of its intercommunicator. Every other peer is a rank of `comm`.
+  std::map<int, MPI_Comm> intercomms;
+  int next_joined_peer = kFirstJoinedPeer;
+  struct Endpoint {
+    MPI_Comm comm;
+    int rank;
+  };
+  Endpoint endpoint(int peer) const {
+    auto found = intercomms.find(peer);
+    if (found != intercomms.end()) return {found->second, 0};
+    return {comm, peer};
+  }
   struct Outgoing {
     int destination;
     std::vector<uint8_t> bytes;  // empty for a send in place
@@ -52,7 +75,8 @@ struct MpiSession::Impl {
   bool isend(Outgoing& out) {
     out.held = false;
     // MPI-3 takes a const buffer; the cast is for MPI-2 headers that still declare void*.
-    return MPI_Isend(const_cast<void*>(out.data), out.size, MPI_BYTE, out.destination, out.tag, comm, &out.request) ==
+    const Endpoint to = endpoint(out.destination);
+    return MPI_Isend(const_cast<void*>(out.data), out.size, MPI_BYTE, to.rank, out.tag, to.comm, &out.request) ==
            MPI_SUCCESS;
   }
   // Queues a send: to MPI now, or held until the emulated link would deliver it. False if MPI refused it.
@@ -110,7 +134,9 @@ struct MpiSession::Impl {
     for (auto it = sends.begin(); it != sends.end();) it = completed(*it) ? sends.erase(it) : std::next(it);
   }
   std::vector<uint8_t> farewell;
-  std::vector<bool> released;
+  std::set<int> released;            // peers that left: no farewell for them
+  std::vector<MPI_Comm> abandoned;   // intercommunicators of peers that were abandoned
+  std::vector<std::function<void()>> before_finalize;
 };
 
 MpiSession& MpiSession::get() {
@@ -118,17 +144,94 @@ MpiSession& MpiSession::get() {
   return session;
 }
 
+void MpiSession::require_thread_multiple() { want_thread_multiple.store(true); }
+
+int MpiSession::join_peer(int socket) {
+  {
+    std::lock_guard lock(mutex_);
+    if (finalized_) return -1;
+    if (!thread_multiple_)
+      throw std::runtime_error("taking joining nodes needs MPI_THREAD_MULTIPLE (MpiSession::require_thread_multiple "
+                               "before the session starts)");
+  }
+  MPI_Comm inter = MPI_COMM_NULL;
+  const int code = MPI_Comm_join(socket, &inter);
+  std::lock_guard lock(mutex_);
+  if (code != MPI_SUCCESS) {
+    spdlog::warn("rank 0: MPI_Comm_join with a joining node failed: {}", mpi_error_text(code));
+    return -1;
+  }
+  if (finalized_) return -1;
+  MPI_Comm_set_errhandler(inter, MPI_ERRORS_RETURN);
+  const int peer = impl_->next_joined_peer++;
+  impl_->intercomms[peer] = inter;
+  return peer;
+}
+
+void MpiSession::join(int socket, int slot) {
+  MPI_Comm inter = MPI_COMM_NULL;
+  if (const int code = MPI_Comm_join(socket, &inter); code != MPI_SUCCESS)
+    throw std::runtime_error("MPI_Comm_join with rank 0 failed: " + mpi_error_text(code));
+  std::lock_guard lock(mutex_);
+  MPI_Comm_set_errhandler(inter, MPI_ERRORS_RETURN);
+  impl_->intercomms[0] = inter;
+  joined_ = true;
+  rank_ = slot;
+}
+
+void MpiSession::abandon(int peer) {
+  std::lock_guard lock(mutex_);
+  if (finalized_) return;
+  auto release = [](MPI_Request& request) {
+    if (request != MPI_REQUEST_NULL) MPI_Request_free(&request);
+  };
+  for (auto it = impl_->sends.begin(); it != impl_->sends.end();) {
+    if (it->destination != peer) {
+      ++it;
+      continue;
+    }
+    if (!it->held) release(it->request);
+    it = impl_->sends.erase(it);
+  }
+  if (auto r = impl_->receives.find(peer); r != impl_->receives.end()) {
+    release(r->second.request);
+    impl_->receives.erase(r);
+  }
+  if (auto p = impl_->pieces.find(peer); p != impl_->pieces.end()) {
+    for (auto& piece : p->second) release(piece.request);
+    impl_->pieces.erase(p);
+  }
+  // The intercommunicator is kept, not freed: a lost peer may have left messages in it (MPICH aborts on
+  // freeing such a communicator), and nothing is sent on it again.
+  if (auto found = impl_->intercomms.find(peer); found != impl_->intercomms.end()) {
+    impl_->abandoned.push_back(found->second);
+    impl_->intercomms.erase(found);
+  }
+  released_locked(peer);
+}
+
 MpiSession::MpiSession() : impl_(new Impl) {
   int initialized = 0;
   MPI_Initialized(&initialized);
   if (!initialized) {
     int provided = 0;
-    if (MPI_Init_thread(nullptr, nullptr, MPI_THREAD_SERIALIZED, &provided) != MPI_SUCCESS)
+    const int wanted = want_thread_multiple.load() ? MPI_THREAD_MULTIPLE : MPI_THREAD_SERIALIZED;
+    if (MPI_Init_thread(nullptr, nullptr, wanted, &provided) != MPI_SUCCESS)
       throw std::runtime_error("MPI_Init_thread failed");
     impl_->we_initialized = true;
     if (provided < MPI_THREAD_SERIALIZED)
       throw std::runtime_error("this MPI library offers no MPI_THREAD_SERIALIZED; remote tracers need it");
   }
+  int provided = 0;
+  MPI_Query_thread(&provided);
+  thread_multiple_ = provided >= MPI_THREAD_MULTIPLE;
+  if (want_thread_multiple.load() && !thread_multiple_)
+    throw std::runtime_error("this MPI library offers no MPI_THREAD_MULTIPLE, which taking joining nodes needs (they "
+                             "join on a thread of their own); start the nodes under rank 0's mpirun instead");
+  // Errors come back as codes on the world and self communicators too (a library may report a lost rank
+  // or a failed join on them): a lost node fails its tracer, not the process.
+  MPI_Comm_set_errhandler(MPI_COMM_WORLD, MPI_ERRORS_RETURN);
+  MPI_Comm_set_errhandler(MPI_COMM_SELF, MPI_ERRORS_RETURN);
   // A communicator of our own, so that Cohort's messages never meet another library's.
   MPI_Comm_dup(MPI_COMM_WORLD, &impl_->comm);
   // Failures come back as error codes (a lost peer fails that peer's tracer, not the process), where
@@ -160,7 +263,18 @@ MpiSession::~MpiSession() {
   delete impl_;
 }
 
+void MpiSession::before_finalize(std::function<void()> work) {
+  std::lock_guard lock(mutex_);
+  impl_->before_finalize.push_back(std::move(work));
+}
+
 void MpiSession::finalize() {
+  std::vector<std::function<void()>> first;
+  {
+    std::lock_guard lock(mutex_);
+    first.swap(impl_->before_finalize);
+  }
+  for (auto& work : first) work();
   impl_->link_pump_stop.store(true);
   if (impl_->link_pump.joinable()) impl_->link_pump.join();
   std::lock_guard lock(mutex_);
@@ -169,13 +283,16 @@ void MpiSession::finalize() {
   // Sends an emulated link still holds leave now.
   for (Impl::Outgoing& out : impl_->sends)
     if (out.held) impl_->isend(out);
-  if (rank_ == 0 && !impl_->farewell.empty()) {
-    impl_->released.resize(size_t(size_), false);
-    for (int r = 1; r < size_; ++r) {
-      if (impl_->released[size_t(r)]) continue;
-      impl_->sends.push_back({r, impl_->farewell, MPI_REQUEST_NULL});
+  if (rank_ == 0 && !joined_ && !impl_->farewell.empty()) {
+    std::vector<int> peers;
+    for (int r = 1; r < size_; ++r) peers.push_back(r);
+    for (const auto& [peer, inter] : impl_->intercomms) peers.push_back(peer);
+    for (int peer : peers) {
+      if (impl_->released.count(peer)) continue;
+      impl_->sends.push_back({peer, impl_->farewell, MPI_REQUEST_NULL});
       Impl::Outgoing& out = impl_->sends.back();
-      MPI_Isend(out.bytes.data(), int(out.bytes.size()), MPI_BYTE, r, kTag, impl_->comm, &out.request);
+      const Impl::Endpoint to = impl_->endpoint(peer);
+      MPI_Isend(out.bytes.data(), int(out.bytes.size()), MPI_BYTE, to.rank, kTag, to.comm, &out.request);
     }
   }
   // Sends still queued get a second; then they are freed (the library completes or drops them).
@@ -198,23 +315,27 @@ void MpiSession::finalize() {
   impl_->pieces.clear();
   // Messages that came and that nobody received (a node's hello to a rank 0 that never named it): MPICH
   // refuses to free a communicator that holds any (it aborts the process), so they are received and dropped.
-  for (;;) {
-    int found = 0;
-    MPI_Message message;
-    MPI_Status status;
-    if (MPI_Improbe(MPI_ANY_SOURCE, MPI_ANY_TAG, impl_->comm, &found, &message, &status) != MPI_SUCCESS || !found) break;
-    int count = 0;
-    MPI_Get_count(&status, MPI_BYTE, &count);
-    std::vector<uint8_t> dropped(size_t(std::max(count, 1)));
-    MPI_Mrecv(dropped.data(), count, MPI_BYTE, &message, MPI_STATUS_IGNORE);
-  }
+  auto drain = [](MPI_Comm comm) {
+    for (;;) {
+      int found = 0;
+      MPI_Message message;
+      MPI_Status status;
+      if (MPI_Improbe(MPI_ANY_SOURCE, MPI_ANY_TAG, comm, &found, &message, &status) != MPI_SUCCESS || !found) break;
+      int count = 0;
+      MPI_Get_count(&status, MPI_BYTE, &count);
+      std::vector<uint8_t> dropped(size_t(std::max(count, 1)));
+      MPI_Mrecv(dropped.data(), count, MPI_BYTE, &message, MPI_STATUS_IGNORE);
+    }
+  };
+  drain(impl_->comm);
   MPI_Comm_free(&impl_->comm);
   int mpi_finalized = 0;
   MPI_Finalized(&mpi_finalized);
   if (!impl_->we_initialized || mpi_finalized) return;
-  // MPI_Finalize synchronizes with every rank, so a rank that was lost (killed, under a launcher that let
-  // the job go on) can keep it from returning. Everything is written by now: past the deadline the
-  // process leaves without it rather than hang.
+  // MPI_Finalize synchronizes with every rank, and with every process still connected by a join, so
+  // a rank that was lost (killed, under a launcher that let the job go on) can keep it from returning, as
+  // can the disconnect of a node that joined. Everything is written by now: past the deadline the process
+  // leaves without them rather than hang.
   auto done = std::make_shared<std::atomic<bool>>(false);
   const int seconds = finalize_timeout_seconds();
   std::thread([done, seconds] {
@@ -226,6 +347,13 @@ void MpiSession::finalize() {
     std::fflush(nullptr);
     std::_Exit(0);
   }).detach();
+  // Both ends of a joined node's intercommunicator disconnect (collective over it): rank 0 once it has
+  // said shutdown to the node, the node once it has heard it; then neither waits for the other to finalize.
+  for (auto& [peer, inter] : impl_->intercomms) {
+    drain(inter);
+    MPI_Comm_disconnect(&inter);
+  }
+  impl_->intercomms.clear();
   MPI_Finalize();
   done->store(true);
 }
@@ -263,11 +391,12 @@ void MpiSession::set_farewell(std::vector<uint8_t> bytes) {
   impl_->farewell = std::move(bytes);
 }
 
-void MpiSession::released(int rank) {
+void MpiSession::released(int peer) {
   std::lock_guard lock(mutex_);
-  impl_->released.resize(size_t(size_), false);
-  if (rank >= 0 && rank < size_) impl_->released[size_t(rank)] = true;
+  released_locked(peer);
 }
+
+void MpiSession::released_locked(int peer) { impl_->released.insert(peer); }
 
 size_t MpiSession::progress_sends() {
   std::lock_guard lock(mutex_);
@@ -329,7 +458,9 @@ std::optional<std::vector<uint8_t>> MpiSession::receive(int source, MpiClock::ti
         int found = 0;
         MPI_Message message;
         MPI_Status status;
-        MPI_Improbe(source, pieces ? MPI_ANY_TAG : kTag, impl_->comm, &found, &message, &status);
+        const Impl::Endpoint from = impl_->endpoint(source);
+        if (MPI_Improbe(from.rank, pieces ? MPI_ANY_TAG : kTag, from.comm, &found, &message, &status) != MPI_SUCCESS)
+          found = 0;  // a lost peer: nothing more comes
         if (!found) break;
         int count = 0;
         MPI_Get_count(&status, MPI_BYTE, &count);
@@ -377,7 +508,8 @@ bool MpiSession::control_waiting(int source) {
   if (finalized_) return false;
   if (impl_->receives.count(source)) return true;  // matched, still arriving
   int found = 0;
-  MPI_Iprobe(source, kTag, impl_->comm, &found, MPI_STATUS_IGNORE);
+  const Impl::Endpoint from = impl_->endpoint(source);
+  if (MPI_Iprobe(from.rank, kTag, from.comm, &found, MPI_STATUS_IGNORE) != MPI_SUCCESS) return false;
   return found != 0;
 }
 

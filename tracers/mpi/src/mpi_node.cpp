@@ -9,6 +9,8 @@
 #include <csignal>
 #include <cstring>
 #include <exception>
+#include <fstream>
+#include <memory>
 #include <functional>
 #include <optional>
 #include <thread>
@@ -18,6 +20,7 @@
 
 #include "cohort/balance/bands.h"
 #include "cohort/core/band_buffer.h"
+#include "cohort/tracers/mpi_join_socket.h"
 #include "cohort/tracers/mpi_link.h"
 #include "cohort/tracers/mpi_wire.h"
 
@@ -588,11 +591,50 @@ class Node {
 
 }  // namespace
 
+void join_session(const std::string& port_file, int slot, std::chrono::seconds timeout) {
+  const auto deadline = MpiClock::now() + timeout;
+  std::string host;
+  int port = 0;
+  for (;;) {
+    std::ifstream in(port_file);
+    if (in >> host >> port && port > 0) break;
+    if (MpiClock::now() >= deadline)
+      throw std::runtime_error(fmt::format("no port in {} after {} s: is rank 0 running with --node-port {}?", port_file,
+                                           timeout.count(), port_file));
+    std::this_thread::sleep_for(std::chrono::milliseconds(100));
+  }
+  const auto start = MpiClock::now();
+  const int socket = join_socket::connect_within(
+      host, port, std::chrono::duration_cast<std::chrono::milliseconds>(deadline - MpiClock::now()));
+  if (!join_socket::send_all(socket, join_socket::kMagic)) {
+    join_socket::close_socket(socket);
+    throw std::runtime_error(fmt::format("rank 0's port {}:{} closed the connection", host, port));
+  }
+  MpiSession& mpi = MpiSession::get();
+  // MPI_Comm_join cannot be cancelled: past the deadline a watchdog ends the process with the reason.
+  auto joined = std::make_shared<std::atomic<bool>>(false);
+  std::thread([joined, deadline, host, port, seconds = timeout.count()] {
+    while (!joined->load() && MpiClock::now() < deadline) std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    if (joined->load()) return;
+    spdlog::error("node: MPI_Comm_join with rank 0 ({}:{}) did not complete within {} s; leaving. With Open MPI, rank "
+                  "0's and this node's mpirun need the same name server (--ompi-server file:URI; docs/cluster.md)",
+                  host, port, seconds);
+    std::fflush(nullptr);
+    std::_Exit(1);
+  }).detach();
+  mpi.join(socket, slot);
+  joined->store(true);
+  join_socket::close_socket(socket);
+  spdlog::info("node: joined rank 0's session through {}:{} in {:.0f} ms", host, port, ms_since(start));
+}
+
 int run_node(std::vector<std::unique_ptr<core::Tracer>> tracers, const NodeOptions& options) {
   MpiSession& mpi = MpiSession::get();
-  if (mpi.rank() == 0)
-    throw std::runtime_error("cohort node runs on ranks 1 and up; rank 0 runs `cohort render` or `cohort play` "
-                             "(docs/cluster.md)");
+  if (mpi.rank() == 0 && !mpi.joined())
+    throw std::runtime_error("cohort node runs on ranks 1 and up, or joins rank 0 through its port (--join); rank 0 "
+                             "runs `cohort render` or `cohort play` (docs/cluster.md)");
+  // Through a port, the slot asked for comes first: rank 0 greets a newcomer before it knows what it serves.
+  if (mpi.joined()) send(mpi, wire::Kind::join, 0, wire::encode_join(uint32_t(mpi.rank())));
   if (!options.load_error.empty()) {
     spdlog::error("node {}: {}; leaving", mpi.rank(), options.load_error);
     send(mpi, wire::Kind::load_failed, 0, wire::encode_text(options.load_error));
@@ -621,7 +663,16 @@ int run_node(std::vector<std::unique_ptr<core::Tracer>> tracers, const NodeOptio
       return 1;
     }
     if (m.kind == wire::Kind::shutdown) return 0;  // rank 0 ended before it needed this node
-    if (m.kind == wire::Kind::welcome) break;
+    if (m.kind == wire::Kind::welcome) {
+      if (!m.payload.empty()) {  // through a port: the slot rank 0 gave it
+        try {
+          spdlog::info("node: rank 0 welcomed this node as {}", wire::decode_text(m.payload));
+        } catch (const wire::WireError& e) {
+          spdlog::warn("node: unreadable welcome: {}", e.what());
+        }
+      }
+      break;
+    }
     spdlog::warn("node {}: ignored a {} message before the welcome", mpi.rank(), wire::to_string(m.kind));
   }
   spdlog::info("node {}: serving rank 0 with {}", mpi.rank(), options.tracers_text);

@@ -10,6 +10,7 @@
 #include <spdlog/spdlog.h>
 
 #include "cohort/tracers/mpi_link.h"
+#include "cohort/tracers/mpi_node_port.h"
 #include "cohort/tracers/mpi_wire.h"
 
 namespace cohort::tracers {
@@ -23,6 +24,7 @@ double ms_since(MpiClock::time_point start) {
 // find it here and start with a full resync like any tracer.
 struct JoinedNode {
   wire::Hello hello;
+  int peer = -1;
 };
 std::mutex joined_mutex;
 std::map<int, JoinedNode>& joined_nodes() {
@@ -160,21 +162,43 @@ MpiTracer::MpiTracer(MpiTracerOptions options) : options_(options) {
   if (mpi.rank() != 0)
     throw NodeUnavailable(fmt::format("mpi:{}: remote tracers are driven from rank 0; this process is rank {}",
                                       options_.rank, mpi.rank()));
-  if (options_.rank < 1 || options_.rank >= mpi.size())
+  port_ = NodePort::get();
+  if (options_.rank < 1 || (options_.rank >= mpi.size() && !port_))
     throw NodeUnavailable(fmt::format("mpi:{}: no such rank: the MPI world has {} rank(s) (launch under mpirun, "
-                                      "with `cohort node` on ranks 1 and up; docs/cluster.md)",
+                                      "with `cohort node` on ranks 1 and up, or open a port for nodes to join: "
+                                      "--node-port; docs/cluster.md)",
                                       options_.rank, mpi.size()));
+  if (port_) port_->serve_slot(options_.rank);
   {
     std::lock_guard lock(joined_mutex);
     auto known = joined_nodes().find(options_.rank);
     if (known != joined_nodes().end()) {
+      peer_ = known->second.peer;
       adopt(known->second.hello);
+      if (port_) port_->set_busy(options_.rank, true);
       return;
     }
   }
+  if (options_.rank < mpi.size()) {
+    greet_world_rank();
+    if (port_) port_->set_busy(options_.rank, true);
+    return;
+  }
+  // A slot served through the port: its node may be joining still (at most until the port's first wait).
+  if (std::optional<JoiningNode> node = port_->wait_for(options_.rank, port_->first_deadline())) {
+    take_node(*node);
+  } else {
+    spdlog::info("mpi:{}: no node has joined yet; its rows go to the others until one does (cohort node MAP --join {} "
+                 "--as {})", options_.rank, port_->path(), options_.rank);
+  }
+}
+
+void MpiTracer::greet_world_rank() {
+  MpiSession& mpi = MpiSession::get();
+  const int peer = options_.rank;
   const auto deadline = MpiClock::now() + options_.hello_timeout;
   for (;;) {
-    std::optional<std::vector<uint8_t>> bytes = mpi.receive(options_.rank, deadline);
+    std::optional<std::vector<uint8_t>> bytes = mpi.receive(peer, deadline);
     if (!bytes)
       throw NodeUnavailable(fmt::format("mpi:{}: the node sent no hello within {} ms (is `cohort node` running on "
                                         "that rank?)", options_.rank, options_.hello_timeout.count()));
@@ -186,7 +210,7 @@ MpiTracer::MpiTracer(MpiTracerOptions options) : options_(options) {
       continue;
     }
     if (m.kind == wire::Kind::load_failed) {
-      mpi.released(options_.rank);  // it has left
+      mpi.released(peer);  // it has left
       std::string reason;
       try {
         reason = wire::decode_text(m.payload);
@@ -204,30 +228,57 @@ MpiTracer::MpiTracer(MpiTracerOptions options) : options_(options) {
     try {
       hello = wire::decode_hello(m.payload);
     } catch (const wire::WireError& e) {
-      mpi.released(options_.rank);
-      send(int(wire::Kind::refuse), 0, wire::encode_text(std::string("malformed hello: ") + e.what()));
+      mpi.released(peer);
+      mpi.send(peer, wire::frame_message(wire::Kind::refuse, 0, wire::encode_text(std::string("malformed hello: ") + e.what())));
       throw NodeUnavailable(fmt::format("mpi:{}: refused the node's malformed hello: {}", options_.rank, e.what()));
     }
-    const std::string mine = wire::cohort_version();
-    if (hello.cohort_version != mine || hello.protocol != wire::kProtocolVersion) {
-      const std::string why = fmt::format(
-          "version mismatch: rank 0 runs Cohort {} (protocol {}), rank {} on {} runs Cohort {} (protocol {}); run the "
-          "same build on every rank", mine, wire::kProtocolVersion, options_.rank, hello.host, hello.cohort_version,
-          hello.protocol);
-      send(int(wire::Kind::refuse), 0, wire::encode_text(why));
-      mpi.released(options_.rank);
-      mpi.flush_sends(options_.rank, MpiClock::now() + std::chrono::seconds(1));
+    if (const std::string why = wire::version_mismatch(hello, options_.rank); !why.empty()) {
+      mpi.send(peer, wire::frame_message(wire::Kind::refuse, 0, wire::encode_text(why)));
+      mpi.released(peer);
+      mpi.flush_sends(peer, MpiClock::now() + std::chrono::seconds(1));
       throw NodeUnavailable("mpi:" + std::to_string(options_.rank) + ": " + why);
     }
+    peer_ = peer;
     send(int(wire::Kind::welcome), 0, {});
     adopt(hello);
     {
       std::lock_guard lock(joined_mutex);
-      joined_nodes()[options_.rank] = {hello};
+      joined_nodes()[options_.rank] = {hello, peer};
     }
     spdlog::info("mpi:{}: node joined ({})", options_.rank, description_);
     return;
   }
+}
+
+void MpiTracer::take_node(const JoiningNode& node) {
+  MpiSession& mpi = MpiSession::get();
+  if (peer_ >= 0) {
+    // The node it replaces stalled or died: nothing of it is read or sent again (a send to a dead process
+    // crashes MPICH 5.0 under UCX); one that only stalled leaves after its --idle-timeout.
+    mpi.abandon(peer_);
+  }
+  peer_ = node.peer;
+  adopt(node.hello);
+  {
+    std::lock_guard lock(joined_mutex);
+    joined_nodes()[options_.rank] = {node.hello, node.peer};
+  }
+  // A new node: nothing it had is known here. Its first commit must be a full resync, which the Renderer
+  // sends with this tracer's next job (wants_full_resync).
+  timed_out_job_ = 0;
+  ahead_.reset();
+  back_unannounced_ = commits_ahead_of_band_ = false;
+  after_full_resync_ = false;
+  node_needs_resync_ = true;
+  node_failure_ = "a new node joined";
+  wants_resync_.store(true);
+  joined_at_ = node.connected;
+  first_band_after_join_ = true;
+  {
+    std::lock_guard lock(stats_mutex_);
+    ++stats_.nodes_joined;
+  }
+  spdlog::info("mpi:{}: node joined through the port ({}); it renders after a full resync", options_.rank, description_);
 }
 
 void MpiTracer::adopt(const wire::Hello& hello) {
@@ -276,7 +327,7 @@ MpiTracer::~MpiTracer() {
   // The node stays for later tracers of this run; the session's end tells every node to leave.
   try {
     MpiSession& mpi = MpiSession::get();
-    if (!mpi.finalized()) mpi.flush_sends(options_.rank, MpiClock::now() + std::chrono::seconds(1));
+    if (!mpi.finalized() && peer_ >= 0) mpi.flush_sends(peer_, MpiClock::now() + std::chrono::seconds(1));
   } catch (const std::exception& e) {
     spdlog::warn("mpi:{}: {}", options_.rank, e.what());
   }
@@ -291,10 +342,11 @@ void MpiTracer::send(int kind, uint64_t sequence, const std::vector<uint8_t>& pa
     stats_.bytes_sent += message.size();
     pending_sent_ += message.size();
   }
-  MpiSession::get().send(options_.rank, std::move(message));
+  MpiSession::get().send(peer_, std::move(message));
 }
 
 void MpiTracer::apply(const commit::CommitBuffer& commit) {
+  if (peer_ < 0) return;  // no node yet: the one that joins gets a full resync
   if (in_band_) {
     // Taken ahead (from inside render_band, after the band's job): the node applies it once that band
     // is rendered, before the next job comes.
@@ -323,6 +375,7 @@ void MpiTracer::apply(const commit::CommitBuffer& commit) {
   }
   ++commits_sent_;
   node_needs_resync_ = false;
+  wants_resync_.store(false);
   after_full_resync_ = true;
   ++full_resyncs_sent_;
 }
@@ -331,7 +384,7 @@ void MpiTracer::take_late_answers() {
   MpiSession& mpi = MpiSession::get();
   while (timed_out_job_ != 0) {
     DropPieces dropped;
-    std::optional<std::vector<uint8_t>> bytes = mpi.receive(options_.rank, MpiClock::now(), &dropped);
+    std::optional<std::vector<uint8_t>> bytes = mpi.receive(peer_, MpiClock::now(), &dropped);
     std::lock_guard lock(stats_mutex_);
     stats_.bytes_received += dropped.bytes;
     if (!bytes) return;
@@ -342,6 +395,7 @@ void MpiTracer::take_late_answers() {
       if ((m.kind == wire::Kind::band_rows || m.kind == wire::Kind::band_failed) && m.sequence == timed_out_job_) {
         stats_.last_round_trip_ms = std::max(stats_.last_round_trip_ms, ms_since(timed_out_start_));
         timed_out_job_ = 0;
+        if (port_) port_->set_busy(options_.rank, true);
         spdlog::info("mpi:{}: the node answered again, {:.0f} ms after its band was sent", options_.rank,
                      ms_since(timed_out_start_));
       }
@@ -355,9 +409,10 @@ void MpiTracer::take_late_answers() {
 void MpiTracer::fail_timed_out(uint64_t id, MpiClock::time_point start, const core::BandJob& job) {
   timed_out_job_ = id;
   timed_out_start_ = start;
+  if (port_) port_->set_busy(options_.rank, false);  // a node may join this slot now
   // A piece matched before the deadline is being received into the target's rows, which the Renderer
   // now hands to the other tracers: let it land first (it is in flight; this takes microseconds).
-  if (!MpiSession::get().settle_pieces(options_.rank, MpiClock::now() + std::chrono::milliseconds(500)))
+  if (!MpiSession::get().settle_pieces(peer_, MpiClock::now() + std::chrono::milliseconds(500)))
     spdlog::warn("mpi:{}: a piece of rows [{}, {}) is still arriving after the band timed out", options_.rank,
                  job.params.row_begin, job.params.row_end);
   throw std::runtime_error(fmt::format("mpi:{}: no answer for rows [{}, {}) within {:.0f} ms (node stalled?)",
@@ -420,6 +475,19 @@ core::BandResult MpiTracer::render_band(const core::BandJob& job, core::BandBuff
     stats_.rows_ahead_unused += ahead->request.job.params.row_end - ahead->request.job.params.row_begin;
     ahead.reset();
   };
+  if (port_) {
+    // A node that joined this slot (free: its node had not answered, left, or never came) takes it over.
+    if (std::optional<JoiningNode> node = port_->take(options_.rank)) {
+      drop_ahead("a new node took the slot");
+      take_node(*node);
+    }
+  }
+  if (peer_ < 0)
+    throw std::runtime_error(fmt::format("mpi:{}: no node serves this slot yet; its rows go to the others until one "
+                                         "joins", options_.rank));
+  if (wants_resync_.load())
+    throw std::runtime_error(fmt::format("mpi:{}: the node that joined waits for its full resync (with the next "
+                                         "frame); its rows go to the others", options_.rank));
   if (timed_out_job_ != 0) {
     // A node that has not answered its last band yet (stalled, or gone) is not sent another: its band
     // fails at once, so it costs one late frame, not one per frame, and it is back when it answers.
@@ -528,7 +596,7 @@ core::BandResult MpiTracer::render_band(const core::BandJob& job, core::BandBuff
   };
   bool ahead_closed = false;  // the adopted job ahead's band_rows has come, its pieces in place
   for (;;) {
-    std::optional<std::vector<uint8_t>> bytes = mpi.receive(options_.rank, deadline, &pieces, between_polls);
+    std::optional<std::vector<uint8_t>> bytes = mpi.receive(peer_, deadline, &pieces, between_polls);
     count_pieces();
     if (!bytes) fail_timed_out(id, start, job);
     {
@@ -610,6 +678,14 @@ core::BandResult MpiTracer::render_band(const core::BandJob& job, core::BandBuff
     const double round_trip = ms_since(start);
     if (full_resyncs_sent_ == resyncs_before) after_full_resync_ = false;  // not when one went ahead of the next band
     leave_band.done = true;
+    if (first_band_after_join_) {
+      first_band_after_join_ = false;
+      const double since_connect = std::chrono::duration<double, std::milli>(MpiClock::now() - joined_at_).count();
+      spdlog::info("mpi:{}: the node that joined delivered its first band (frame {}) {:.0f} ms after it connected",
+                   options_.rank, job.params.frame_index, since_connect);
+      std::lock_guard lock(stats_mutex_);
+      stats_.last_join_to_first_band_ms = since_connect;
+    }
     {
       std::lock_guard lock(stats_mutex_);
       ++stats_.bands;

@@ -140,6 +140,7 @@ const char* to_string(Kind kind) {
     case Kind::band_rows: return "band_rows";
     case Kind::band_failed: return "band_failed";
     case Kind::shutdown: return "shutdown";
+    case Kind::join: return "join";
   }
   return "unknown";
 }
@@ -163,7 +164,7 @@ Header parse_header(const uint8_t* bytes, size_t size) {
   if (h.magic != kMagic) throw WireError(fmt::format("bad magic 0x{:08x} (not a Cohort message)", h.magic));
   if (h.protocol != kProtocolVersion)
     throw WireError(fmt::format("protocol version {} (this build speaks {})", h.protocol, kProtocolVersion));
-  if (h.kind < uint16_t(Kind::hello) || h.kind > uint16_t(Kind::shutdown))
+  if (h.kind < uint16_t(Kind::hello) || h.kind > uint16_t(Kind::join))
     throw WireError(fmt::format("unknown message kind {}", h.kind));
   if (h.payload_bytes != size - sizeof h)
     throw WireError(fmt::format("{} header announces {} payload bytes but {} arrived", to_string(Kind(h.kind)),
@@ -202,6 +203,27 @@ Hello decode_hello(const std::vector<uint8_t>& payload) {
   h.scene_name = r.text("scene name");
   r.expect_end();
   return h;
+}
+
+std::vector<uint8_t> encode_join(uint32_t slot) {
+  Writer w;
+  w.scalar(slot);
+  return std::move(w.out);
+}
+
+uint32_t decode_join(const std::vector<uint8_t>& payload) {
+  Reader r(payload, "join");
+  const uint32_t slot = r.scalar<uint32_t>();
+  r.expect_end();
+  return slot;
+}
+
+std::string version_mismatch(const Hello& hello, int slot) {
+  const std::string mine = cohort_version();
+  if (hello.cohort_version == mine && hello.protocol == kProtocolVersion) return {};
+  return fmt::format("version mismatch: rank 0 runs Cohort {} (protocol {}), rank {} on {} runs Cohort {} (protocol {}); "
+                     "run the same build on every rank", mine, kProtocolVersion, slot, hello.host, hello.cohort_version,
+                     hello.protocol);
 }
 
 std::vector<uint8_t> encode_text(const std::string& text) {

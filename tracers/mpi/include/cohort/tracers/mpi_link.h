@@ -3,6 +3,11 @@
 // forever. Every MPI call goes through one mutex: rank 0 talks to its nodes from several tracer
 // threads, and a library that offers less than MPI_THREAD_MULTIPLE is then still used correctly.
 // Standard MPI-3 only (Open MPI and MPICH alike).
+//
+// A peer is named by an int: the world ranks of `mpirun -np N` are themselves (peer 2 is world rank 2);
+// a node that joined rank 0's running session (MPI-2's MPI_Comm_join, docs/cluster.md "Joining a running
+// session") is a peer id of its own, kFirstJoinedPeer and up, that stands for rank 0 of its
+// intercommunicator. On a node that joined, peer 0 is rank 0 across the intercommunicator.
 #pragma once
 
 #include <chrono>
@@ -11,6 +16,7 @@
 #include <list>
 #include <mutex>
 #include <optional>
+#include <string>
 #include <vector>
 
 namespace cohort::tracers {
@@ -28,14 +34,35 @@ class PieceSink {
   virtual void* place(int tag, size_t bytes) = 0;
 };
 
+constexpr int kFirstJoinedPeer = 1 << 16;
+
 class MpiSession {
  public:
   // Initializes MPI on first use (MPI_Init_thread) unless the program already did; finalizes at exit.
   static MpiSession& get();
+  // Before the first get(): ask for MPI_THREAD_MULTIPLE (joining nodes are taken on a thread of its own,
+  // outside the session's lock). get() then throws when the library does not offer it.
+  static void require_thread_multiple();
+  // This process's rank in Cohort's session: its world rank, or for a node that joined, the slot it serves.
   int rank() const { return rank_; }
   int size() const { return size_; }
+  bool thread_multiple() const { return thread_multiple_; }
+
+  // Rank 0: makes the node at the other end of `socket` (a TCP connection rank 0's NodePort accepted) a
+  // peer: MPI_Comm_join (MPI-2), which waits until the node joins too; outside the session's lock (needs
+  // MPI_THREAD_MULTIPLE). Its peer id, or -1 when the join failed.
+  int join_peer(int socket);
+  // A node: joins rank 0 over `socket` (MPI_Comm_join); peer 0 then is rank 0 across the
+  // intercommunicator, and rank() says `slot`. Throws when the join fails.
+  void join(int socket, int slot);
+  bool joined() const { return joined_; }
+  // Forget a peer that left or was replaced: its messages are dropped, sends to it given up; its
+  // intercommunicator is disconnected in the background (bounded) where it said goodbye.
+  void abandon(int peer);
   // Finalize now (sends still pending are given up to a second). Later MPI use throws.
   void finalize();
+  // Runs `work` at the start of finalize(), before anything else (the node port stops taking nodes there).
+  void before_finalize(std::function<void()> work);
   bool finalized() const { return finalized_; }
 
   // Queues `bytes` for `destination`; the session keeps them until the send has completed.
@@ -69,16 +96,19 @@ class MpiSession {
   // Rank 0: the message finalize() sends to every rank above 0 that was not released, so that nodes
   // no tracer talked to (or whose tracer failed to start) leave too.
   void set_farewell(std::vector<uint8_t> bytes);
-  void released(int rank);
+  void released(int peer);
 
   ~MpiSession();
 
  private:
   MpiSession();
+  void released_locked(int peer);
   struct Impl;
   Impl* impl_ = nullptr;
   int rank_ = 0, size_ = 1;
   bool finalized_ = false;
+  bool thread_multiple_ = false;
+  bool joined_ = false;
   std::mutex mutex_;
 };
 

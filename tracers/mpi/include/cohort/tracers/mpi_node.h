@@ -44,6 +44,13 @@ struct NodeOptions {
   std::chrono::seconds idle_timeout{600};
 };
 
+// A node started on its own (its own mpiexec, any host) joins rank 0's running session through the port
+// rank 0 wrote to `port_file` (`cohort render --node-port FILE`: "HOST PORT"): waits for the file,
+// connects, and joins (MPI_Comm_join over that connection). Every wait is bounded by `timeout`: past it
+// an error says which (a join that never returns cannot be cancelled: the process ends). run_node() then
+// asks for `slot` (mpi:N; 0: the first free one) before its hello. Call before any other MPI use.
+void join_session(const std::string& port_file, int slot, std::chrono::seconds timeout);
+
 // Serves rank 0 until it says shutdown; returns the process's exit code (0 after a clean shutdown).
 // Call on a rank above 0; MPI stays initialized (MpiSession::finalize ends it).
 int run_node(std::vector<std::unique_ptr<core::Tracer>> tracers, const NodeOptions& options);

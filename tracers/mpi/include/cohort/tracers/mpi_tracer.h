@@ -12,6 +12,7 @@
 // exit) tells every node to leave.
 #pragma once
 
+#include <atomic>
 #include <chrono>
 #include <cstdint>
 #include <memory>
@@ -21,11 +22,14 @@
 
 #include "cohort/core/tracer.h"
 #include "cohort/tracers/mpi_link.h"
+#include "cohort/tracers/mpi_node_port.h"
 #include "cohort/tracers/mpi_wire.h"
 
 namespace cohort::tracers {
 
 struct MpiTracerOptions {
+  // The slot, mpi:N: world rank N under `mpirun -np`, or a node that joins through rank 0's port (NodePort)
+  // and asks for N. A slot whose world rank died is served by the next node that joins it, where a port is open.
   int rank = 1;
   // A band that has not come back after this long (plus four times the last round trip; ten times as long
   // for the first band after a full resync, which the node spends building its BVHs) fails. A late
@@ -98,6 +102,10 @@ struct MpiLinkStats {
   uint32_t last_pieces = 0;
   uint64_t stale_answers = 0;       // late answers to jobs that had timed out, dropped
   uint64_t refused_messages = 0;    // malformed answers, refused
+  // Nodes that took this slot through rank 0's port, and the last one's time from its connect to its
+  // first band delivered (greeting, the full resync with its BVH build, the band).
+  uint64_t nodes_joined = 0;
+  double last_join_to_first_band_ms = 0.0;
 };
 
 class MpiTracer : public core::Tracer {
@@ -115,6 +123,8 @@ class MpiTracer : public core::Tracer {
   // It sends the announced next job to its node while its band renders (MpiTracerOptions::jobs_ahead).
   bool takes_jobs_ahead() const override { return options_.jobs_ahead; }
   void apply(const commit::CommitBuffer& commit) override;
+  // A node that joined the slot has no scene: it needs a full resync before its first band.
+  bool wants_full_resync() const override { return wants_resync_.load(); }
   using core::Tracer::render_band;
   core::BandResult render_band(const core::BandJob& job, core::BandBuffer& target) override;
 
@@ -125,6 +135,10 @@ class MpiTracer : public core::Tracer {
  private:
   void send(int kind, uint64_t sequence, const std::vector<uint8_t>& payload);
   void adopt(const wire::Hello& hello);
+  // World rank N's hello, checked (NodeUnavailable when it cannot serve).
+  void greet_world_rank();
+  // From now on, `node` (greeted by the port) serves this slot; the one before, if any, is let go.
+  void take_node(const JoiningNode& node);
   // Reads, without waiting, what the node sent since a band timed out; clears timed_out_job_ once the
   // answer to that band is among it.
   void take_late_answers();
@@ -145,6 +159,11 @@ class MpiTracer : public core::Tracer {
   std::string why_not_adopt(const JobAhead& ahead, const core::BandJob& job, const core::BandBuffer& target) const;
 
   MpiTracerOptions options_;
+  int peer_ = -1;                 // the session's peer of the node serving the slot; -1: none yet
+  NodePort* port_ = nullptr;      // rank 0's port for joining nodes, when open
+  std::atomic<bool> wants_resync_{false};
+  MpiClock::time_point joined_at_{};
+  bool first_band_after_join_ = false;
   std::string description_;
   bool gpu_ = false;
   uint64_t node_fingerprint_ = 0;  // of the scene the node holds from its own load; 0: none usable

@@ -24,8 +24,8 @@ constexpr uint32_t kMagic = 0x504d4843u;  // "CHMP" in memory order
 // job came from those in its way (commits travel ahead of their job, docs/cluster.md); 7: jobs ahead
 // (band_job says whether it is one, or which one it takes the rows of; band_rows too; NodeTiming tells
 // the node's idle time and the time it rendered before the job came); 8: band format 2, RGB9E5 rows
-// (4 bytes a pixel).
-constexpr uint16_t kProtocolVersion = 8;
+// (4 bytes a pixel); 9: join (a node that connects through rank 0's port names the slot it serves first).
+constexpr uint16_t kProtocolVersion = 9;
 
 enum class Kind : uint16_t {
   hello = 1,        // node -> 0: versions, what scene it loaded, its tracers
@@ -38,6 +38,7 @@ enum class Kind : uint16_t {
   band_rows = 8,    // node -> 0: the band is done (its rows went ahead as pieces): row work and timing
   band_failed = 9,  // node -> 0: the band could not be rendered (the reason)
   shutdown = 10,    // 0 -> node: leave cleanly
+  join = 11,        // node -> 0, first through rank 0's port: the slot (mpi:N) it asks to serve, 0 for any free one
 };
 const char* to_string(Kind kind);
 
@@ -81,7 +82,15 @@ struct Hello {
 std::vector<uint8_t> encode_hello(const Hello& hello);
 Hello decode_hello(const std::vector<uint8_t>& payload);
 
-// load_failed, refuse: one text.
+// join: the slot asked for (0: the first free one).
+std::vector<uint8_t> encode_join(uint32_t slot);
+uint32_t decode_join(const std::vector<uint8_t>& payload);
+
+// Why rank 0 cannot take this node's hello (Cohort version or protocol differ from this build's: both
+// named), or empty.
+std::string version_mismatch(const Hello& hello, int slot);
+
+// load_failed, refuse, welcome (the slot, for a node that joined): one text.
 std::vector<uint8_t> encode_text(const std::string& text);
 std::string decode_text(const std::vector<uint8_t>& payload);
 
