@@ -92,12 +92,13 @@ class Tracer {
   // target; the job it is handed next is what counts (its rows, and its commit, which may change the
   // scene after the announcement).
   virtual bool takes_jobs_ahead() const { return false; }
+  using NextJob = std::function<std::optional<BandJob>()>;
+  void set_next_job(NextJob hook) { next_job_ = std::move(hook); }
+
   // A tracer whose scene is gone (a remote tracer whose slot a new node took: it starts with nothing)
   // asks for a full resync here; the Renderer sends one with its next job. Read on the core thread
   // between the tracer's jobs.
   virtual bool wants_full_resync() const { return false; }
-  using NextJob = std::function<std::optional<BandJob>()>;
-  void set_next_job(NextJob hook) { next_job_ = std::move(hook); }
 
  protected:
   void apply_commits_ahead() {
