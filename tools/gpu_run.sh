@@ -125,7 +125,7 @@ case "${1:-}" in
         # COHORT_CLUSTER_PIECES="1 2 4 8": the two-rank run once per piece count a band's rows travel in;
         # COHORT_CLUSTER_JOBS_AHEAD="1 0": with and without jobs ahead (docs/cluster.md), back to back.
         for ahead in ${COHORT_CLUSTER_JOBS_AHEAD:-1}; do
-        for pieces in ${COHORT_CLUSTER_PIECES:-4}; do
+        for pieces in ${COHORT_CLUSTER_PIECES:-1}; do
           rm -rf /tmp/mpi_$map
           COHORT_MPI_JOBS_AHEAD=$ahead COHORT_MPI_BAND_PIECES=$pieces timeout 180 mpiexec.hydra -np 1 "$cohort" render \
             "$pack" "${size[@]}" "${common[@]}" --tracers mpi:1,mpi:2 --out /tmp/mpi_$map : \

@@ -41,8 +41,10 @@ struct MpiTracerOptions {
   // the node sends each as soon as it is on its host while it renders the next, and this tracer
   // receives each straight into its target rows, so the round trip is the node's render plus one
   // piece's way back instead of the whole band's. With jobs ahead (below) that way back is off the node's
-  // path and only the last piece's download is on it: 2 measured best then (docs/cluster.md).
-  uint32_t pieces = 2;
+  // path and only the last piece's download is on it. 2 measured best with the CUDA megakernel; since the
+  // wavefront every piece restarts its lanes (about 0.15 ms at 1080p on an H100), and one piece is best:
+  // 96 % of the in-process two-GPU rate at 1080p against 89 % with 2 (docs/cluster.md).
+  uint32_t pieces = 1;
   // Forward the commits the core submits while a band renders right after that band's job
   // (Tracer::takes_commits_ahead), so that the node applies them once its band is rendered, before the
   // next job comes, instead of with it. COHORT_MPI_COMMITS_AHEAD=0 turns it off (for comparison).
