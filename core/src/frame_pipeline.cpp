@@ -44,16 +44,9 @@ std::optional<FramePipeline::Delivered> FramePipeline::push(const BandJob& job, 
     throw;
   }
   in_flight_ = InFlight{job, std::move(preparation)};
-  if (prepare_next) {
-    std::optional<BandJob> next;
-    try {
-      next = prepare_next();
-    } catch (...) {
-      if (previous) renderer_.merge_frame(*stats);
-      throw;
-    }
-    if (next) renderer_.announce_frame(*next);
-  }
+  prepare_and_announce(prepare_next, [&] {
+    if (previous) renderer_.merge_frame(*stats);
+  });
   if (!previous) return std::nullopt;
   renderer_.merge_frame(*stats);
   return delivered(std::move(*previous), std::move(*stats));
@@ -73,21 +66,27 @@ std::optional<FramePipeline::Delivered> FramePipeline::push_two_in_flight(const 
     throw;
   }
   in_flight_ = InFlight{job, std::move(preparation)};
-  if (prepare_next) {
-    std::optional<BandJob> next;
-    try {
-      next = prepare_next();
-    } catch (...) {
-      if (previous) renderer_.finish_frame();  // leave one frame in flight, as push() promises
-      throw;
-    }
-    // For workers with no job queued when they end this one (remote tracers start on it ahead).
-    if (next) renderer_.announce_frame(*next);
-  }
+  // The announcement is for workers with no job queued when they end this one (remote tracers start on it
+  // ahead). Should the preparation fail, one frame stays in flight, as push() promises.
+  prepare_and_announce(prepare_next, [&] {
+    if (previous) renderer_.finish_frame();
+  });
   if (!previous) return std::nullopt;
   FrameStats stats = renderer_.wait_frame();
   renderer_.merge_frame(stats);
   return delivered(std::move(*previous), std::move(stats));
+}
+
+void FramePipeline::prepare_and_announce(const PrepareNext& prepare_next, const std::function<void()>& restore) {
+  if (!prepare_next) return;
+  std::optional<BandJob> next;
+  try {
+    next = prepare_next();
+  } catch (...) {
+    restore();
+    throw;
+  }
+  if (next) renderer_.announce_frame(*next);
 }
 
 bool FramePipeline::announces_at_hand_out() {
