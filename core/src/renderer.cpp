@@ -44,6 +44,7 @@ struct Renderer::Worker {
     BandJob job;
     bool recovery = false;  // re-rendering rows a dropped tracer did not deliver
     bool probe = false;     // rendering rows only to be measured (a benched tracer)
+    bool away = false;      // its commits on the side while the tracer is away (Tracer::while_away)
     int slot = 0;           // which of the two targets the job renders into
     // Taken from the channel by the core at hand-out; the job owns it, so that the core may hand out the
     // next job (and take the next commit) while this one's is still being applied. Applied ahead, by a
@@ -133,6 +134,7 @@ struct Renderer::Worker {
       if (last_end) outcome.waited_ms = std::chrono::duration<double, std::milli>(start - *last_end).count();
       const std::string track = tracer_track(id, name);
       try {
+        if (current.away) tracer->while_away();
         // Apply time is part of what the tracer costs the frame, so the balancer sees it.
         if (current.commit && !current.commit->empty()) apply(*current.commit, outcome.spans, track);
         outcome.apply_ms = std::chrono::duration<double, std::milli>(Clock::now() - start).count();
@@ -435,6 +437,7 @@ std::vector<uint64_t> Renderer::assign(std::vector<Assignment>& assignments, con
     queued.recovery = !with_commits;
     queued.slot = slot;
     queued.probe = assignments[i].probe;
+    queued.away = assignments[i].away;
     // Only a frame's own bands may stay on a GPU: re-rendered rows and probes come through the host.
     queued.job.keep_on_device = with_commits && !assignments[i].probe && packed_merge_ ? device_bands_for_ : -1;
     std::lock_guard lock(w.inbox_mutex);
@@ -644,6 +647,7 @@ void Renderer::begin_frame(const BandJob& job, FrameBuffer& out, const std::vect
     if (++w.benched_frames_without_job < options_.benched_commit_every && !w.tracer->wants_full_resync()) continue;
     w.benched_frames_without_job = 0;
     side_jobs.push_back({id, {}, false, {}});
+    side_jobs.back().away = true;
   }
 
   const int slot = next_slot_;

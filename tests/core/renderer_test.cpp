@@ -608,6 +608,7 @@ class AwayTracer final : public Tracer {
   explicit AwayTracer(std::unique_ptr<SimulatedTracer> inner) : inner_(std::move(inner)) {}
   std::string name() const override { return inner_->name(); }
   bool available() const override { return !away->load(); }
+  void while_away() override { checks->fetch_add(1); }
   void apply(const cohort::commit::CommitBuffer& commit) override {
     inner_->apply(commit);
     last_commit->store(commit.frame());
@@ -620,6 +621,7 @@ class AwayTracer final : public Tracer {
   std::shared_ptr<std::atomic<bool>> away = std::make_shared<std::atomic<bool>>(false);
   std::shared_ptr<std::atomic<uint64_t>> last_commit = std::make_shared<std::atomic<uint64_t>>(0);
   std::shared_ptr<std::atomic<int>> bands = std::make_shared<std::atomic<int>>(0);
+  std::shared_ptr<std::atomic<int>> checks = std::make_shared<std::atomic<int>>(0);
 
  private:
   std::unique_ptr<SimulatedTracer> inner_;
@@ -632,6 +634,7 @@ TEST(Renderer, AnAwayTracerGetsNoRowsIsNotWaitedForKeepsItsCommitsAndIsBackWhenA
   const auto away = away_tracer->away;
   const auto last_commit = away_tracer->last_commit;
   const auto bands = away_tracer->bands;
+  const auto checks = away_tracer->checks;
   std::vector<std::unique_ptr<Tracer>> tracers;
   tracers.push_back(std::make_unique<SimulatedTracer>(model(), sim(1)));
   tracers.push_back(std::move(away_tracer));
@@ -664,10 +667,12 @@ TEST(Renderer, AnAwayTracerGetsNoRowsIsNotWaitedForKeepsItsCommitsAndIsBackWhenA
       for (int i = 0; i < 2000 && last_commit->load() != f + 1; ++i)
         std::this_thread::sleep_for(std::chrono::microseconds(100));
       EXPECT_EQ(last_commit->load(), f + 1) << "frame " << f << ": an away tracer keeps getting its commits";
+      EXPECT_EQ(checks->load(), static_cast<int>(f + 1 - kAwayFrom)) << "frame " << f << ": Tracer::while_away with each";
     } else {
       EXPECT_EQ(t.outcome, TracerOutcome::rendered) << "frame " << f;
       EXPECT_GT(t.row_end - t.row_begin, 0) << "frame " << f;
       EXPECT_EQ(bands->load(), bands_before + 1) << "frame " << f;
     }
   }
+  EXPECT_EQ(checks->load(), static_cast<int>(kBackAt - kAwayFrom)) << "while_away only while away";
 }

@@ -107,6 +107,10 @@ class Tracer {
   // after the others' bands: one late frame per frame instead of one in all. Read on the core thread
   // while the tracer's own thread may be inside apply() or render_band(): it must be thread-safe.
   virtual bool available() const { return true; }
+  // Called on the tracer's thread with each job the Renderer hands it while it is away (its commits on the
+  // side, which may be empty): a tracer that waits for something to come back (a remote node's late answer)
+  // looks for it here, so that available() turns true again.
+  virtual void while_away() {}
 
  protected:
   void apply_commits_ahead() {
