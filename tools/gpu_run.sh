@@ -176,6 +176,12 @@ print(f"{len(frames)} frames, median {median:.2f} ms; late (> 3x median): {[i fo
 if gone:
     print(f"mpi:2 away from frame {gone[0]}, back at {back}; frames around the death: "
           + ", ".join(f"{t:.2f}" for t in ms[gone[0] - 3:gone[0] + 4]))
+    # Since issue 19's away slot: "away" (left out, no re-render) after the death's one timed_out/threw frame.
+    outcomes = {}
+    for s in slot[gone[0]:back]: outcomes[s] = outcomes.get(s, 0) + 1
+    between = ms[gone[0] + 1:back] if back else ms[gone[0] + 1:]
+    print(f"mpi:2 outcomes from the death to its return: {outcomes}; median frame between: "
+          f"{sorted(between)[len(between) // 2]:.2f} ms" if between else "")
 if back:
     print("frames around the return: " + ", ".join(f"{t:.2f}" for t in ms[back - 4:back + 4])
           + f"; median of the 100 frames after: {sorted(ms[back:back + 100])[50]:.2f} ms")

@@ -11,6 +11,7 @@ const char* to_string(TracerOutcome outcome) {
     case TracerOutcome::threw: return "threw";
     case TracerOutcome::timed_out: return "timed_out";
     case TracerOutcome::busy: return "busy";
+    case TracerOutcome::away: return "away";
   }
   return "unknown";
 }

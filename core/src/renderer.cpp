@@ -44,6 +44,7 @@ struct Renderer::Worker {
     BandJob job;
     bool recovery = false;  // re-rendering rows a dropped tracer did not deliver
     bool probe = false;     // rendering rows only to be measured (a benched tracer)
+    bool away = false;      // its commits on the side while the tracer is away (Tracer::while_away)
     int slot = 0;           // which of the two targets the job renders into
     // Taken from the channel by the core at hand-out; the job owns it, so that the core may hand out the
     // next job (and take the next commit) while this one's is still being applied. Applied ahead, by a
@@ -133,6 +134,7 @@ struct Renderer::Worker {
       if (last_end) outcome.waited_ms = std::chrono::duration<double, std::milli>(start - *last_end).count();
       const std::string track = tracer_track(id, name);
       try {
+        if (current.away) tracer->while_away();
         // Apply time is part of what the tracer costs the frame, so the balancer sees it.
         if (current.commit && !current.commit->empty()) apply(*current.commit, outcome.spans, track);
         outcome.apply_ms = std::chrono::duration<double, std::milli>(Clock::now() - start).count();
@@ -435,6 +437,7 @@ std::vector<uint64_t> Renderer::assign(std::vector<Assignment>& assignments, con
     queued.recovery = !with_commits;
     queued.slot = slot;
     queued.probe = assignments[i].probe;
+    queued.away = assignments[i].away;
     // Only a frame's own bands may stay on a GPU: re-rendered rows and probes come through the host.
     queued.job.keep_on_device = with_commits && !assignments[i].probe && packed_merge_ ? device_bands_for_ : -1;
     std::lock_guard lock(w.inbox_mutex);
@@ -564,7 +567,7 @@ void Renderer::begin_frame(const BandJob& job, FrameBuffer& out, const std::vect
   // frames in flight, a tracer whose one unfinished job belongs to the frame in flight is ready: this
   // frame's job queues behind it.
   const PendingFrame* in_flight = pending_.empty() ? nullptr : pending_.back().get();
-  std::vector<int> ready;
+  std::vector<int> ready, away;
   {
     std::lock_guard lock(workers_.front()->completion->mutex);
     for (auto& w : workers_) {
@@ -583,9 +586,12 @@ void Renderer::begin_frame(const BandJob& job, FrameBuffer& out, const std::vect
           std::find(in_flight->handed_out.begin(), in_flight->handed_out.end(), w->unfinished.front()) !=
               in_flight->handed_out.end();
       if (w->busy() && !queues_behind_the_frame_in_flight) t.outcome = TracerOutcome::busy;
+      else if (!w->tracer->available()) away.push_back(w->id);
       else ready.push_back(w->id);
     }
   }
+  // Nobody else left: those away are asked anyway (their bands fail, and the frame says why).
+  if (ready.empty()) ready.swap(away);
   if (ready.empty()) throw std::runtime_error("frame " + std::to_string(stats.frame) + ": every tracer is still busy with an earlier frame");
 
   // Without a proxy from the caller, last frame's per-row work counts serve, when every row has one.
@@ -630,6 +636,18 @@ void Renderer::begin_frame(const BandJob& job, FrameBuffer& out, const std::vect
     } else {
       assignments.push_back({ready[i], bands[i], false, {}});
     }
+  }
+
+  // Away: no rows, and nobody waits for it; it keeps its scene current as a benched tracer does (its
+  // commits coalesce meanwhile), so that it renders at once when it is back; one that asks for a full resync
+  // (a remote tracer whose slot a new node joined) gets it at once, so that it is back the frame after.
+  for (int id : away) {
+    stats.tracers[static_cast<size_t>(id)].outcome = TracerOutcome::away;
+    Worker& w = *workers_[static_cast<size_t>(id)];
+    if (++w.benched_frames_without_job < options_.benched_commit_every && !w.tracer->wants_full_resync()) continue;
+    w.benched_frames_without_job = 0;
+    side_jobs.push_back({id, {}, false, {}});
+    side_jobs.back().away = true;
   }
 
   const int slot = next_slot_;

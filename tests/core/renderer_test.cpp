@@ -598,3 +598,81 @@ TEST(Renderer, TheBalancerChargesATracerTheCostItReportsForABandBegunAhead) {
   EXPECT_EQ(stats.tracers[1].row_end - stats.tracers[1].row_begin, 24);
   EXPECT_NEAR(stats.tracers[0].ms, 72.0, 1.0) << "the cost it reported (and its commit's apply), not its wall time";
 }
+
+namespace {
+
+// A simulated tracer that can say it is away (Tracer::available), counts its bands and publishes the
+// last commit frame it applied, readable from any thread.
+class AwayTracer final : public Tracer {
+ public:
+  explicit AwayTracer(std::unique_ptr<SimulatedTracer> inner) : inner_(std::move(inner)) {}
+  std::string name() const override { return inner_->name(); }
+  bool available() const override { return !away->load(); }
+  void while_away() override { checks->fetch_add(1); }
+  void apply(const cohort::commit::CommitBuffer& commit) override {
+    inner_->apply(commit);
+    last_commit->store(commit.frame());
+  }
+  using Tracer::render_band;
+  BandResult render_band(const BandJob& job, BandBuffer& target) override {
+    bands->fetch_add(1);
+    return inner_->render_band(job, target);
+  }
+  std::shared_ptr<std::atomic<bool>> away = std::make_shared<std::atomic<bool>>(false);
+  std::shared_ptr<std::atomic<uint64_t>> last_commit = std::make_shared<std::atomic<uint64_t>>(0);
+  std::shared_ptr<std::atomic<int>> bands = std::make_shared<std::atomic<int>>(0);
+  std::shared_ptr<std::atomic<int>> checks = std::make_shared<std::atomic<int>>(0);
+
+ private:
+  std::unique_ptr<SimulatedTracer> inner_;
+};
+
+}  // namespace
+
+TEST(Renderer, AnAwayTracerGetsNoRowsIsNotWaitedForKeepsItsCommitsAndIsBackWhenAvailable) {
+  auto away_tracer = std::make_unique<AwayTracer>(std::make_unique<SimulatedTracer>(model(), sim(2)));
+  const auto away = away_tracer->away;
+  const auto last_commit = away_tracer->last_commit;
+  const auto bands = away_tracer->bands;
+  const auto checks = away_tracer->checks;
+  std::vector<std::unique_ptr<Tracer>> tracers;
+  tracers.push_back(std::make_unique<SimulatedTracer>(model(), sim(1)));
+  tracers.push_back(std::move(away_tracer));
+  tracers.push_back(std::make_unique<SimulatedTracer>(model(), sim(3)));
+  RendererOptions options;
+  options.use_reported_time = true;
+  Renderer renderer(std::move(tracers), options);
+  auto scene = std::make_shared<cohort::commit::TracerScene>();
+  FrameBuffer fb;
+  constexpr uint64_t kAwayFrom = 3, kBackAt = 9;
+  for (uint64_t f = 0; f < 14; ++f) {
+    away->store(f >= kAwayFrom && f < kBackAt);
+    const int bands_before = bands->load();
+    renderer.submit_commit(cohort::commit::CommitBuffer::full(scene, f + 1));
+    const FrameStats stats = renderer.render(job_for(f), fb);
+    expect_complete(fb, f, stats, {1, 2, 3});
+    EXPECT_EQ(stats.dropped, 0) << "frame " << f << ": nothing failed, nothing was re-rendered";
+    const TracerFrameStats& t = stats.tracers[1];
+    if (f >= kAwayFrom && f < kBackAt) {
+      EXPECT_EQ(t.outcome, TracerOutcome::away) << "frame " << f;
+      EXPECT_EQ(t.row_end - t.row_begin, 0) << "frame " << f;
+      EXPECT_EQ(bands->load(), bands_before) << "frame " << f << ": an away tracer was asked for a band";
+      EXPECT_EQ(stats.tracers[0].recovery_rows + stats.tracers[2].recovery_rows, 0) << "frame " << f;
+      EXPECT_EQ((stats.tracers[0].row_end - stats.tracers[0].row_begin) +
+                    (stats.tracers[2].row_end - stats.tracers[2].row_begin), kRows)
+          << "frame " << f << ": the others share the whole frame";
+      EXPECT_EQ(nlohmann::json(stats)["tracers"][1]["outcome"], "away");
+      // Its commits come on the side, unwaited: let this one land (bounded) before the next frame, so
+      // that it is not still busy with it then.
+      for (int i = 0; i < 2000 && last_commit->load() != f + 1; ++i)
+        std::this_thread::sleep_for(std::chrono::microseconds(100));
+      EXPECT_EQ(last_commit->load(), f + 1) << "frame " << f << ": an away tracer keeps getting its commits";
+      EXPECT_EQ(checks->load(), static_cast<int>(f + 1 - kAwayFrom)) << "frame " << f << ": Tracer::while_away with each";
+    } else {
+      EXPECT_EQ(t.outcome, TracerOutcome::rendered) << "frame " << f;
+      EXPECT_GT(t.row_end - t.row_begin, 0) << "frame " << f;
+      EXPECT_EQ(bands->load(), bands_before + 1) << "frame " << f;
+    }
+  }
+  EXPECT_EQ(checks->load(), static_cast<int>(kBackAt - kAwayFrom)) << "while_away only while away";
+}

@@ -94,6 +94,50 @@ def compare_frames(a_dir, b_dir, tolerant=False, frames=FRAMES):
             sys.exit(f"{name}: the cluster's image differs from the single-process render")
 
 
+# Below this a frame is not called late whatever the median: the tests' frames take 2-5 ms, and on the loaded
+# 2-core VM (rank 0 and two nodes on two cores) a node waking from its stall, or the scheduler, stretches a frame
+# to 7-9 ms now and then (seen in mpi.cluster_stall); a lost band costs the 1000 ms band timeout.
+LATE_FLOOR_MS = 25.0
+
+
+def late_after_fault(stats, fault, until=None):
+    """The frames from `fault` up to `until` (the end of the run when None) that took more than 3x the run's
+    median (and LATE_FLOOR_MS): a fault should cost at most one such frame (issue 19), not one per frame while
+    the node is away."""
+    times = sorted(f["wall_ms"] for f in stats)
+    median = times[len(times) // 2]
+    end = len(stats) if until is None else until
+    over_3x = [f["frame"] for f in stats[fault:end] if f["wall_ms"] > 3 * median]
+    late = [f["frame"] for f in stats[fault:end] if f["wall_ms"] > max(3 * median, LATE_FLOOR_MS)]
+    window = [f["wall_ms"] for f in stats[max(fault - 3, 0):fault + 6]]
+    rest = [f["wall_ms"] for f in stats[fault + 1:end]]
+    print(f"frames {max(fault - 3, 0)}..{fault + 5} around the fault: {', '.join(f'{t:.1f}' for t in window)} ms; "
+          f"median of the run {median:.1f} ms, of the frames after the fault up to "
+          f"{'the end' if until is None else until} {sorted(rest)[len(rest) // 2]:.1f} ms; over 3x the median there: "
+          f"{over_3x}; late (and over {LATE_FLOOR_MS:.0f} ms): {late}")
+    return late
+
+
+def away_check(stats, name, fault, until=None):
+    """From the frame after the fault: the slot's tracer is left out ("away", or "busy" with its commits) until it renders again (or until
+    `until`, the rejoin), nothing is dropped and re-rendered meanwhile, and from the fault up to `until` (the
+    end of the run when None) at most the fault's frame is late. Exits with the reason otherwise."""
+    end = len(stats) if until is None else until
+    for f in stats[fault + 1:end]:
+        t = next(t for t in f["tracers"] if t["name"] == name)
+        if t["outcome"] == "rendered" and until is None:
+            break  # a stalled node that answered: back
+        # "busy": still on its commits handed out on the side (while away) when the frame began: not asked either.
+        if t["outcome"] not in ("away", "busy"):
+            sys.exit(f"frame {f['frame']}: {name} should be away (its node has not answered), not {t['outcome']} "
+                     f"{t.get('error', '')}")
+        if f["dropped"] != 0:
+            sys.exit(f"frame {f['frame']}: {f['dropped']} tracer(s) dropped while {name} was away")
+    late = late_after_fault(stats, fault, until)
+    if len(late) > 1 or (late and late[0] != fault):
+        sys.exit(f"the fault at frame {fault} should make at most that frame late: {late}")
+
+
 def tracer_outcomes(out_dir):
     with open(os.path.join(out_dir, "stats.json")) as f:
         stats = json.load(f)
@@ -148,8 +192,10 @@ def stall(a, killed=False):
         sys.exit(f"the fault should make frame 1, and only it, late: {late}")
     if "no answer for rows" not in outcome[1]["mpi:2"][1]:
         sys.exit(f"frame 1: the node's band should have timed out: {outcome[1]['mpi:2']}")
-    if outcome[2]["mpi:2"][0] != "threw" or "has not answered" not in outcome[2]["mpi:2"][1]:
-        sys.exit(f"frame 2: the silent node should have been skipped at once: {outcome[2]['mpi:2']}")
+    if outcome[2]["mpi:2"][0] != "away":
+        sys.exit(f"frame 2: the silent node should have been left out (away): {outcome[2]['mpi:2']}")
+    # Away until it answers (stall: then rendered again), never asked for a band meanwhile.
+    away_check(stats, "mpi:2", 1)
     if killed:
         if any(o["mpi:2"][0] == "rendered" for o in outcome[1:]):
             sys.exit("a killed node cannot have rendered")
@@ -619,6 +665,7 @@ def killed_joined(a):
         sys.exit(f"the death should make frame 1, and only it, late: {late}")
     if any(o["mpi:2"] == "rendered" for o in outcome[1:]) or any(o["mpi:1"] != "rendered" for o in outcome):
         sys.exit("the killed node cannot have rendered after frame 0, and the surviving one should render every frame")
+    away_check(stats, "mpi:2", 1)
     if last_frame_differs(single, cluster, frames):
         sys.exit("the last frame differs from the single-process render")
     print("killed (nodes joined on their own launch): ok")
@@ -756,6 +803,7 @@ def rejoin(a):
         sys.exit("mpi:2 should have rows in the last frames")
     if late != [die]:
         sys.exit(f"the death should make frame {die}, and only it, late: {late}")
+    away_check(stats, "mpi:2", die, back)
     if last_frame_differs(single, cluster, frames):
         sys.exit("the last frame differs from the single-process render")
     times = [f["wall_ms"] for f in stats]

@@ -222,6 +222,12 @@ std::optional<JoiningNode> NodePort::take(int slot) {
   return node;
 }
 
+bool NodePort::waiting(int slot) {
+  std::lock_guard lock(mutex_);
+  auto found = slots_.find(slot);
+  return found != slots_.end() && found->second.waiting.has_value();
+}
+
 std::optional<JoiningNode> NodePort::wait_for(int slot, MpiClock::time_point deadline) {
   {
     std::unique_lock lock(mutex_);

@@ -188,6 +188,7 @@ MpiTracer::MpiTracer(MpiTracerOptions options) : options_(options) {
   if (std::optional<JoiningNode> node = port_->wait_for(options_.rank, port_->first_deadline())) {
     take_node(*node);
   } else {
+    away_.store(true);
     spdlog::info("mpi:{}: no node has joined yet; its rows go to the others until one does (cohort node MAP --join {} "
                  "--as {})", options_.rank, port_->path(), options_.rank);
   }
@@ -274,6 +275,7 @@ void MpiTracer::take_node(const JoiningNode& node) {
   wants_resync_.store(true);
   joined_at_ = node.connected;
   first_band_after_join_ = true;
+  away_.store(false);
   {
     std::lock_guard lock(stats_mutex_);
     ++stats_.nodes_joined;
@@ -335,6 +337,21 @@ MpiTracer::~MpiTracer() {
 
 std::string MpiTracer::name() const { return "mpi:" + std::to_string(options_.rank); }
 
+bool MpiTracer::wants_full_resync() const {
+  return wants_resync_.load() || (away_.load() && port_ && port_->waiting(options_.rank));
+}
+
+void MpiTracer::while_away() {
+  // Asked for no band while away, it still gets its commits on its own thread: whether its node has answered
+  // since is read here, so that it takes rows again from the next frame.
+  if (peer_ >= 0 && timed_out_job_ != 0) take_late_answers();
+}
+
+bool MpiTracer::available() const {
+  if (!away_.load()) return true;
+  return port_ && port_->waiting(options_.rank);
+}
+
 void MpiTracer::send(int kind, uint64_t sequence, const std::vector<uint8_t>& payload) {
   std::vector<uint8_t> message = wire::frame_message(wire::Kind(kind), sequence, payload);
   {
@@ -346,6 +363,11 @@ void MpiTracer::send(int kind, uint64_t sequence, const std::vector<uint8_t>& pa
 }
 
 void MpiTracer::apply(const commit::CommitBuffer& commit) {
+  if (!in_band_ && commit.is_full_resync() && port_) {
+    // The resync asked for a node that joined an away slot (wants_full_resync): that node takes the slot
+    // now and gets it, so that its next band is its first.
+    if (std::optional<JoiningNode> node = port_->take(options_.rank)) take_node(*node);
+  }
   if (peer_ < 0) return;  // no node yet: the one that joins gets a full resync
   if (in_band_) {
     // Taken ahead (from inside render_band, after the band's job): the node applies it once that band
@@ -395,6 +417,7 @@ void MpiTracer::take_late_answers() {
       if ((m.kind == wire::Kind::band_rows || m.kind == wire::Kind::band_failed) && m.sequence == timed_out_job_) {
         stats_.last_round_trip_ms = std::max(stats_.last_round_trip_ms, ms_since(timed_out_start_));
         timed_out_job_ = 0;
+        away_.store(false);
         if (port_) port_->set_busy(options_.rank, true);
         spdlog::info("mpi:{}: the node answered again, {:.0f} ms after its band was sent", options_.rank,
                      ms_since(timed_out_start_));
@@ -409,6 +432,7 @@ void MpiTracer::take_late_answers() {
 void MpiTracer::fail_timed_out(uint64_t id, MpiClock::time_point start, const core::BandJob& job) {
   timed_out_job_ = id;
   timed_out_start_ = start;
+  away_.store(true);  // asked for no band until it answers or a node takes its slot
   if (port_) port_->set_busy(options_.rank, false);  // a node may join this slot now
   // A piece matched before the deadline is being received into the target's rows, which the Renderer
   // now hands to the other tracers: let it land first (it is in flight; this takes microseconds).
@@ -627,6 +651,7 @@ core::BandResult MpiTracer::render_band(const core::BandJob& job, core::BandBuff
       if (header.sequence == timed_out_job_) {
         stats_.last_round_trip_ms = std::max(stats_.last_round_trip_ms, ms_since(timed_out_start_));
         timed_out_job_ = 0;
+        away_.store(false);
       }
       spdlog::debug("mpi:{}: dropped the late answer to job {}", options_.rank, header.sequence);
       continue;

@@ -18,6 +18,8 @@ enum class TracerOutcome {
   threw,      // render_band or apply threw: dropped for this frame
   timed_out,  // missed the frame timeout: dropped; it rejoins once it has finished the late work
   busy,       // still finishing late work from an earlier frame: not asked this frame
+  away,       // said it cannot take rows now (Tracer::available): given none, not waited for; it gets
+              // its commits on the side as a benched tracer does
 };
 const char* to_string(TracerOutcome outcome);
 

@@ -174,6 +174,7 @@ class Renderer {
     bool probe = false;  // rendered to be measured only: nobody waits for it, its rows are not merged
     DeviceBand device;   // where its rows are when the tracer kept them on a GPU (set once delivered)
     std::chrono::steady_clock::time_point due{};  // when its band should end (set by assign)
+    bool away = false;   // an away tracer's commits on the side (Tracer::while_away)
   };
   struct RoundResult {
     std::vector<int> finished;   // workers that rendered their band

@@ -100,6 +100,18 @@ class Tracer {
   // between the tracer's jobs.
   virtual bool wants_full_resync() const { return false; }
 
+  // Whether the tracer can take rows now. One that cannot (a remote tracer whose node has not answered
+  // its last band and whose slot no new node has taken) is given none: the frame is divided among the
+  // others, it is not waited for, and it keeps getting its commits as a benched tracer does (FrameStats:
+  // outcome "away"). Without this its band would fail at once every frame and its rows be re-rendered
+  // after the others' bands: one late frame per frame instead of one in all. Read on the core thread
+  // while the tracer's own thread may be inside apply() or render_band(): it must be thread-safe.
+  virtual bool available() const { return true; }
+  // Called on the tracer's thread with each job the Renderer hands it while it is away (its commits on the
+  // side, which may be empty): a tracer that waits for something to come back (a remote node's late answer)
+  // looks for it here, so that available() turns true again.
+  virtual void while_away() {}
+
  protected:
   void apply_commits_ahead() {
     if (commits_ahead_) commits_ahead_();

@@ -54,6 +54,8 @@ class NodePort {
   void set_busy(int slot, bool busy);
   // The node that joined `slot` and waits for its tracer, if any (taken: the slot is busy from then on).
   std::optional<JoiningNode> take(int slot);
+  // Whether a node that joined `slot` waits for its tracer to take it.
+  bool waiting(int slot);
   // Waits until a node joins `slot`, at most until the deadline.
   std::optional<JoiningNode> wait_for(int slot, MpiClock::time_point deadline);
   MpiClock::time_point first_deadline() const { return first_deadline_; }

@@ -125,8 +125,15 @@ class MpiTracer : public core::Tracer {
   // It sends the announced next job to its node while its band renders (MpiTracerOptions::jobs_ahead).
   bool takes_jobs_ahead() const override { return options_.jobs_ahead; }
   void apply(const commit::CommitBuffer& commit) override;
-  // A node that joined the slot has no scene: it needs a full resync before its first band.
-  bool wants_full_resync() const override { return wants_resync_.load(); }
+  // A node that joined the slot has no scene: it needs a full resync before its first band. Asked for as
+  // soon as one waits in the port of an away slot, so that the job that brings it (a band's, or an away
+  // tracer's commits on the side) lets apply() take the node and resync it at once.
+  bool wants_full_resync() const override;
+  // Not while its node has not answered its last band (stalled or dead) or no node serves the slot yet,
+  // unless a new node waits in the port to take the slot (it takes it with this tracer's next band).
+  bool available() const override;
+  // Away: reads whether its node has answered since (the late answer to its last band).
+  void while_away() override;
   using core::Tracer::render_band;
   core::BandResult render_band(const core::BandJob& job, core::BandBuffer& target) override;
 
@@ -164,6 +171,9 @@ class MpiTracer : public core::Tracer {
   int peer_ = -1;                 // the session's peer of the node serving the slot; -1: none yet
   NodePort* port_ = nullptr;      // rank 0's port for joining nodes, when open
   std::atomic<bool> wants_resync_{false};
+  // Set while the slot's node cannot take a band: its last band timed out and it has not answered since,
+  // or no node has joined; read by available() on the core thread.
+  std::atomic<bool> away_{false};
   MpiClock::time_point joined_at_{};
   bool first_band_after_join_ = false;
   std::string description_;
