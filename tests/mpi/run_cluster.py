@@ -618,6 +618,36 @@ class JoinLauncher:
             self.server.wait()
 
 
+class JoinedRun:
+    """What the join cases share: the single-process render to compare with, and a JoinLauncher for rank 0 with
+    a port (tracers embree, mpi:1, mpi:2; waiting up to 120 s for its first nodes) and for nodes on Embree that
+    join it. With band_timeout_ms every job gets COHORT_MPI_BAND_TIMEOUT_MS."""
+
+    def __init__(self, a, frames, band_timeout_ms=None):
+        os.makedirs(a.out)
+        self.frames = frames
+        args = ["--width", "192", "--height", "128", "--spp", "2", "--frames", str(frames), "--write", "last",
+                "--balancer", "perfect-smooth"]
+        self.single, self.cluster = os.path.join(a.out, "single"), os.path.join(a.out, "cluster")
+        run([a.cohort, "render", a.map, "--tracers", "embree", "--out", self.single] + args)
+        self.port = os.path.join(a.out, "port")
+        self.jobs = JoinLauncher(a)
+        flags = []
+        if band_timeout_ms is not None:
+            self.jobs.env["COHORT_MPI_BAND_TIMEOUT_MS"] = str(band_timeout_ms)
+            flags = ["-x", "COHORT_MPI_BAND_TIMEOUT_MS"] if self.jobs.flags else []
+        self.rank0 = flags + [a.cohort, "render", a.map, "--tracers", "embree,mpi:1,mpi:2", "--node-port", self.port,
+                              "--node-wait", "120", "--out", self.cluster] + args
+        self.node = [a.cohort, "node", a.map, "--tracers", "embree", "--join", self.port]
+
+    def stats(self):
+        with open(os.path.join(self.cluster, "stats.json")) as f:
+            return json.load(f)["frames"]
+
+    def last_frame_differs(self):
+        return last_frame_differs(self.single, self.cluster, self.frames)
+
+
 def last_frame_differs(single, cluster, frames):
     name = f"frame_{frames - 1:04d}.png"
     (w, h, ca, pa), (_, _, cb, pb) = read_image(os.path.join(single, name)), read_image(os.path.join(cluster, name))
@@ -630,20 +660,11 @@ def killed_joined(a):
     """The killed case with nodes that joined through rank 0's port (each its own mpiexec): rank 2 kills itself
     before its band of frame 1; frame 1 is the one late frame, every frame is delivered, the surviving node
     renders every frame, the last frame matches the single-process render, and rank 0 ends cleanly."""
-    os.makedirs(a.out)
     frames = 400
-    args = ["--width", "192", "--height", "128", "--spp", "2", "--frames", str(frames), "--write", "last",
-            "--balancer", "perfect-smooth"]
-    single, cluster = os.path.join(a.out, "single"), os.path.join(a.out, "cluster")
-    run([a.cohort, "render", a.map, "--tracers", "embree", "--out", single] + args)
-    port = os.path.join(a.out, "port")
-    jobs = JoinLauncher(a)
-    jobs.env["COHORT_MPI_BAND_TIMEOUT_MS"] = "1000"
-    flags = ["-x", "COHORT_MPI_BAND_TIMEOUT_MS"] if jobs.flags else []
+    session = JoinedRun(a, frames, band_timeout_ms=1000)
+    jobs, node = session.jobs, session.node
     try:
-        rank0 = jobs.start("rank0", flags + [a.cohort, "render", a.map, "--tracers", "embree,mpi:1,mpi:2", "--node-port",
-                                             port, "--node-wait", "120", "--out", cluster] + args)
-        node = [a.cohort, "node", a.map, "--tracers", "embree", "--join", port]
+        rank0 = jobs.start("rank0", session.rank0)
         survivor = jobs.start("node1", node + ["--as", "1"])
         dying = jobs.start("node2", node + ["--as", "2", "--die-frame", "1"])
         code, survived, died = jobs.finish(rank0), jobs.finish(survivor), jobs.finish(dying)
@@ -654,8 +675,7 @@ def killed_joined(a):
         sys.exit(f"exit statuses: rank 0 {code}, the surviving node {survived}")
     if died == 0 or "killing itself before frame 1" not in JoinLauncher.output(dying):
         sys.exit("rank 2 should have killed itself before frame 1")
-    with open(os.path.join(cluster, "stats.json")) as f:
-        stats = json.load(f)["frames"]
+    stats = session.stats()
     late = [f["frame"] for f in stats if f["wall_ms"] > 500]
     outcome = [{t["name"]: t["outcome"] for t in f["tracers"]} for f in stats]
     print("late frames:", late)
@@ -666,7 +686,7 @@ def killed_joined(a):
     if any(o["mpi:2"] == "rendered" for o in outcome[1:]) or any(o["mpi:1"] != "rendered" for o in outcome):
         sys.exit("the killed node cannot have rendered after frame 0, and the surviving one should render every frame")
     away_check(stats, "mpi:2", 1)
-    if last_frame_differs(single, cluster, frames):
+    if session.last_frame_differs():
         sys.exit("the last frame differs from the single-process render")
     print("killed (nodes joined on their own launch): ok")
 
@@ -677,14 +697,8 @@ def join(a):
     node that runs another version and one that asks for the busy mpi:1 are refused, with the reason logged
     on both sides, a connection that says nothing is dropped after 5 s, and rank 0 goes on. A node whose
     port file never appears fails after its --join-timeout."""
-    os.makedirs(a.out)
-    frames = 300
-    args = ["--width", "192", "--height", "128", "--spp", "2", "--frames", str(frames), "--write", "last",
-            "--balancer", "perfect-smooth"]
-    single, cluster = os.path.join(a.out, "single"), os.path.join(a.out, "cluster")
-    run([a.cohort, "render", a.map, "--tracers", "embree", "--out", single] + args)
-    port = os.path.join(a.out, "port")
-    jobs = JoinLauncher(a)
+    session = JoinedRun(a, 300)
+    jobs, node = session.jobs, session.node
     # A port file that never appears: the node says so after its bounded wait and fails.
     code, output = run([a.mpiexec] + jobs.flags + ["-np", "1", a.cohort, "node", a.map, "--join",
                                                    os.path.join(a.out, "no_such_port"), "--join-timeout", "1"],
@@ -693,9 +707,7 @@ def join(a):
         jobs.close()
         sys.exit("a node whose port file never appears should fail after --join-timeout, saying so")
     try:
-        rank0 = jobs.start("rank0", [a.cohort, "render", a.map, "--tracers", "embree,mpi:1,mpi:2", "--node-port", port,
-                                     "--node-wait", "120", "--out", cluster] + args)
-        node = [a.cohort, "node", a.map, "--tracers", "embree", "--join", port]
+        rank0 = jobs.start("rank0", session.rank0)
         # In an order that leaves nothing to chance: rank 0 waits for mpi:2's node (--node-wait) until the end.
         other = jobs.start("other_version", node + ["--as", "0", "--announce-version", "0.0.0-test"])
         if jobs.finish(other, timeout=120) == 0:
@@ -708,7 +720,7 @@ def join(a):
             jobs.dump()
             sys.exit("the node that asked for the busy mpi:1 should end with an error")
         # A connection that says nothing is dropped after a bounded wait, and rank 0 goes on waiting for mpi:2.
-        with open(port) as f:
+        with open(session.port) as f:
             host, tcp_port = f.read().split()
         silent = socket.create_connection((host, int(tcp_port)), timeout=10)
         jobs.wait_for_line(rank0, r"dropped a connection to the node port that did not say it joins within 5 s", 30)
@@ -731,9 +743,9 @@ def join(a):
             sys.exit("the node of another version did not log the refusal")
     finally:
         jobs.close()
-    if last_frame_differs(single, cluster, frames):
+    if session.last_frame_differs():
         sys.exit("the last frame differs from the single-process render")
-    outcomes = tracer_outcomes(cluster)
+    outcomes = tracer_outcomes(session.cluster)
     for f, o in enumerate(outcomes):
         if o.get("mpi:1") != "rendered" or o.get("mpi:2") != "rendered":
             sys.exit(f"frame {f}: a node that joined did not render its band: {o}")
@@ -748,21 +760,12 @@ def rejoin(a):
     band of the dead node times out (the one late frame), its rows go to the others until the newcomer's full
     resync, then the slot renders again; every frame is delivered and the last matches the single-process
     render."""
-    os.makedirs(a.out)
     frames = 1500
     die = 5
-    args = ["--width", "192", "--height", "128", "--spp", "2", "--frames", str(frames), "--write", "last",
-            "--balancer", "perfect-smooth"]
-    single, cluster = os.path.join(a.out, "single"), os.path.join(a.out, "cluster")
-    run([a.cohort, "render", a.map, "--tracers", "embree", "--out", single] + args)
-    port = os.path.join(a.out, "port")
-    jobs = JoinLauncher(a)
-    jobs.env["COHORT_MPI_BAND_TIMEOUT_MS"] = "1000"
-    flags = ["-x", "COHORT_MPI_BAND_TIMEOUT_MS"] if jobs.flags else []
+    session = JoinedRun(a, frames, band_timeout_ms=1000)
+    jobs, node = session.jobs, session.node
     try:
-        rank0 = jobs.start("rank0", flags + [a.cohort, "render", a.map, "--tracers", "embree,mpi:1,mpi:2", "--node-port",
-                                             port, "--node-wait", "120", "--out", cluster] + args)
-        node = [a.cohort, "node", a.map, "--tracers", "embree", "--join", port]
+        rank0 = jobs.start("rank0", session.rank0)
         first = jobs.start("node1", node + ["--as", "1"])
         dying = jobs.start("node2", node + ["--as", "2", "--die-frame", str(die)])
         jobs.finish(dying, timeout=120)
@@ -781,8 +784,7 @@ def rejoin(a):
             sys.exit(f"exit statuses: rank 0 {code}, nodes {codes}")
     finally:
         jobs.close()
-    with open(os.path.join(cluster, "stats.json")) as f:
-        stats = json.load(f)["frames"]
+    stats = session.stats()
     if len(stats) != frames:
         sys.exit(f"{len(stats)} of {frames} frames delivered")
     outcome = [{t["name"]: t for t in f["tracers"]} for f in stats]
@@ -804,7 +806,7 @@ def rejoin(a):
     if late != [die]:
         sys.exit(f"the death should make frame {die}, and only it, late: {late}")
     away_check(stats, "mpi:2", die, back)
-    if last_frame_differs(single, cluster, frames):
+    if session.last_frame_differs():
         sys.exit("the last frame differs from the single-process render")
     times = [f["wall_ms"] for f in stats]
     around = times[max(back - 3, 0):back + 4]
