@@ -251,6 +251,17 @@ class CommitLoggingTracer final : public Tracer {
   std::shared_ptr<Log> log_;
 };
 
+// In a tracer's log, where commit `commit` was applied: the frame of the last band begun before it (-1:
+// none) and whether that band was still rendering; (-2, false) if it never was.
+std::pair<int64_t, bool> applied_before_band(const std::vector<CommitLoggingTracer::Event>& log, uint64_t commit) {
+  int64_t last_band = -1;
+  for (const auto& e : log) {
+    if (e.band) last_band = static_cast<int64_t>(e.frame);
+    else if (e.frame == commit) return {last_band, e.during_band};
+  }
+  return {-2, false};
+}
+
 }  // namespace
 
 TEST(FramePipeline, ATracerThatTakesCommitsAheadAppliesThemWhileItRendersTheOthersWithTheirNextJob) {
@@ -296,14 +307,6 @@ TEST(FramePipeline, ATracerThatTakesCommitsAheadAppliesThemWhileItRendersTheOthe
   EXPECT_FALSE(gates->gave_up);
 
   // Each log: the commit of frame f + 1 (with the full resync of frame 0 first) against the band starts.
-  auto applied_before_band = [](const std::vector<CommitLoggingTracer::Event>& log, uint64_t commit) {
-    int64_t last_band = -1;
-    for (const auto& e : log) {
-      if (e.band) last_band = static_cast<int64_t>(e.frame);
-      else if (e.frame == commit) return std::make_pair(last_band, e.during_band);
-    }
-    return std::make_pair(int64_t(-2), false);
-  };
   const std::vector<CommitLoggingTracer::Event> ahead_events = ahead_log->read(), job_events = job_log->read();
   for (uint64_t f = 1; f < kFrames; ++f) {
     // Ahead: applied while frame f - 1's band rendered, after that band's start, never under an earlier one.
@@ -451,14 +454,6 @@ TEST(FramePipeline, WithTwoFramesInFlightATracerThatTakesCommitsAheadAppliesItsQ
   renderer.merge_frame(last);
   EXPECT_FALSE(gates->gave_up);
 
-  auto applied_before_band = [](const std::vector<CommitLoggingTracer::Event>& log, uint64_t commit) {
-    int64_t last_band = -1;
-    for (const auto& e : log) {
-      if (e.band) last_band = static_cast<int64_t>(e.frame);
-      else if (e.frame == commit) return std::make_pair(last_band, e.during_band);
-    }
-    return std::make_pair(int64_t(-2), false);
-  };
   const std::vector<CommitLoggingTracer::Event> ahead_events = ahead_log->read(), job_events = job_log->read();
   for (uint64_t f = 1; f < kFrames; ++f) {
     // The queued job's commit, applied while frame f - 1's band rendered.
