@@ -262,38 +262,70 @@ std::pair<int64_t, bool> applied_before_band(const std::vector<CommitLoggingTrac
   return {-2, false};
 }
 
+// Two commit-logging tracers on one Renderer with `frames_in_flight`: the first takes commits ahead, the
+// second with its job. The scene's full resync is submitted as frame 0's commit (number 0).
+struct CommitsAheadPair {
+  explicit CommitsAheadPair(int frames_in_flight) {
+    std::vector<std::unique_ptr<Tracer>> tracers;
+    tracers.push_back(std::make_unique<CommitLoggingTracer>(true, gates, ahead_log));
+    tracers.push_back(std::make_unique<CommitLoggingTracer>(false, gates, job_log));
+    RendererOptions options;
+    options.balancer = "none";
+    options.frames_in_flight = frames_in_flight;
+    renderer = std::make_unique<Renderer>(std::move(tracers), options);
+    renderer->submit_commit(cohort::commit::CommitBuffer::full(scene, 0));
+  }
+  // Frame f's commit, which carries frame number f + 1.
+  void submit(uint64_t f) {
+    cohort::commit::CommitBuffer commit;
+    commit.set_frame(f + 1);
+    commit.set_camera(job_for(f).camera);
+    renderer->submit_commit(commit, [this] { return scene; });
+  }
+  // Over `frames` frames: each commit of frame f + 1 applied while frame f - 1's band rendered by the tracer
+  // that takes commits ahead, after that band by the other; every commit reached both once, in order.
+  void expect_each_commit_beside_the_band_before(uint64_t frames) const {
+    const std::vector<CommitLoggingTracer::Event> ahead_events = ahead_log->read(), job_events = job_log->read();
+    for (uint64_t f = 1; f < frames; ++f) {
+      EXPECT_EQ(applied_before_band(ahead_events, f + 1), std::make_pair(static_cast<int64_t>(f) - 1, true)) << f;
+      EXPECT_EQ(applied_before_band(job_events, f + 1), std::make_pair(static_cast<int64_t>(f) - 1, false)) << f;
+    }
+    std::vector<uint64_t> expected;
+    for (uint64_t c = 1; c <= frames; ++c) expected.push_back(c);
+    for (const auto* log : {&ahead_events, &job_events}) {
+      std::vector<uint64_t> commits;
+      for (const auto& e : *log)
+        if (!e.band) commits.push_back(e.frame);
+      EXPECT_EQ(commits, expected) << "every commit once, in order";
+    }
+  }
+
+  std::shared_ptr<FrameGates> gates = std::make_shared<FrameGates>();
+  std::shared_ptr<CommitLoggingTracer::Log> ahead_log = std::make_shared<CommitLoggingTracer::Log>();
+  std::shared_ptr<CommitLoggingTracer::Log> job_log = std::make_shared<CommitLoggingTracer::Log>();
+  std::shared_ptr<cohort::commit::TracerScene> scene = std::make_shared<cohort::commit::TracerScene>();
+  std::unique_ptr<Renderer> renderer;
+};
+
 }  // namespace
 
 TEST(FramePipeline, ATracerThatTakesCommitsAheadAppliesThemWhileItRendersTheOthersWithTheirNextJob) {
-  auto gates = std::make_shared<FrameGates>();
-  auto ahead_log = std::make_shared<CommitLoggingTracer::Log>();
-  auto job_log = std::make_shared<CommitLoggingTracer::Log>();
-  std::vector<std::unique_ptr<Tracer>> tracers;
-  tracers.push_back(std::make_unique<CommitLoggingTracer>(true, gates, ahead_log));
-  tracers.push_back(std::make_unique<CommitLoggingTracer>(false, gates, job_log));
-  RendererOptions options;
-  options.balancer = "none";
-  Renderer renderer(std::move(tracers), options);
-  FramePipeline pipeline(renderer);
-  auto scene = std::make_shared<cohort::commit::TracerScene>();
-  renderer.submit_commit(cohort::commit::CommitBuffer::full(scene, 0));
+  CommitsAheadPair pair(1);
+  FramePipeline pipeline(*pair.renderer);
   constexpr uint64_t kFrames = 6;
   uint64_t delivered = 0;
   for (uint64_t f = 0; f < kFrames; ++f) {
     // Frame f's commit (frame number f + 1) is submitted while frame f - 1 renders, as the core does.
-    cohort::commit::CommitBuffer commit;
-    commit.set_frame(f + 1);
-    commit.set_camera(job_for(f).camera);
-    renderer.submit_commit(commit, [&] { return scene; });
+    pair.submit(f);
     if (f > 0) {
       // The tracer that takes commits ahead has this one before frame f - 1 may finish.
       auto has_it = [&] {
-        const auto events = ahead_log->read();
+        const auto events = pair.ahead_log->read();
         return !events.empty() && !events.back().band && events.back().frame == f + 1;
       };
       for (int i = 0; i < 5000 && !has_it(); ++i)
         std::this_thread::sleep_for(std::chrono::microseconds(200));
-      gates->open(f - 1);
+      pair.gates->open(f - 1);
     }
     if (std::optional<FramePipeline::Delivered> done = pipeline.push(job_for(f))) {
       for (int y = 0; y < kRows; ++y) ASSERT_EQ(pipeline.image().row(y)[0], static_cast<float>(done->stats.frame));
@@ -301,27 +333,17 @@ TEST(FramePipeline, ATracerThatTakesCommitsAheadAppliesThemWhileItRendersTheOthe
       ++delivered;
     }
   }
-  gates->open(kFrames - 1);
+  pair.gates->open(kFrames - 1);
   ASSERT_TRUE(pipeline.drain().has_value());
   EXPECT_EQ(delivered + 1, kFrames);
-  EXPECT_FALSE(gates->gave_up);
+  EXPECT_FALSE(pair.gates->gave_up);
 
-  // Each log: the commit of frame f + 1 (with the full resync of frame 0 first) against the band starts.
-  const std::vector<CommitLoggingTracer::Event> ahead_events = ahead_log->read(), job_events = job_log->read();
-  for (uint64_t f = 1; f < kFrames; ++f) {
-    // Ahead: applied while frame f - 1's band rendered, after that band's start, never under an earlier one.
-    EXPECT_EQ(applied_before_band(ahead_events, f + 1), std::make_pair(static_cast<int64_t>(f) - 1, true)) << f;
-    // With its job: after frame f - 1's band was done, before frame f's.
-    EXPECT_EQ(applied_before_band(job_events, f + 1), std::make_pair(static_cast<int64_t>(f) - 1, false)) << f;
-  }
-  EXPECT_EQ(applied_before_band(ahead_events, 1), std::make_pair(int64_t(-1), false)) << "the first commits come with the first job";
-  // Every commit reached both once, in order.
-  for (const auto* log : {&ahead_events, &job_events}) {
-    std::vector<uint64_t> commits;
-    for (const auto& e : *log)
-      if (!e.band) commits.push_back(e.frame);
-    EXPECT_EQ(commits, (std::vector<uint64_t>{1, 2, 3, 4, 5, 6}));
-  }
+  // Each log: the commit of frame f + 1 (with the full resync of frame 0 first) against the band starts:
+  // ahead, applied while frame f - 1's band rendered, never under an earlier one; with its job, after frame
+  // f - 1's band was done, before frame f's.
+  pair.expect_each_commit_beside_the_band_before(kFrames);
+  EXPECT_EQ(applied_before_band(pair.ahead_log->read(), 1), std::make_pair(int64_t(-1), false))
+      << "the first commits come with the first job";
 }
 
 namespace {
@@ -410,62 +432,35 @@ TEST(FramePipeline, ATracerThatTakesJobsAheadSeesTheNextFramesJobWhileItRendersT
 TEST(FramePipeline, WithTwoFramesInFlightATracerThatTakesJobsAheadSeesItsQueuedJob) { expect_jobs_ahead_seen(2); }
 
 TEST(FramePipeline, WithTwoFramesInFlightATracerThatTakesCommitsAheadAppliesItsQueuedJobsCommitInOrder) {
-  auto gates = std::make_shared<FrameGates>();
-  auto ahead_log = std::make_shared<CommitLoggingTracer::Log>();
-  auto job_log = std::make_shared<CommitLoggingTracer::Log>();
-  std::vector<std::unique_ptr<Tracer>> tracers;
-  tracers.push_back(std::make_unique<CommitLoggingTracer>(true, gates, ahead_log));
-  tracers.push_back(std::make_unique<CommitLoggingTracer>(false, gates, job_log));
-  RendererOptions options;
-  options.balancer = "none";
-  options.frames_in_flight = 2;
-  Renderer renderer(std::move(tracers), options);
-  auto scene = std::make_shared<cohort::commit::TracerScene>();
-  renderer.submit_commit(cohort::commit::CommitBuffer::full(scene, 0));
+  CommitsAheadPair pair(2);
+  Renderer& renderer = *pair.renderer;
   constexpr uint64_t kFrames = 6;
   FrameBuffer images[2];
-  auto submit = [&](uint64_t f) {  // frame f's commit carries frame number f + 1
-    cohort::commit::CommitBuffer commit;
-    commit.set_frame(f + 1);
-    commit.set_camera(job_for(f).camera);
-    renderer.submit_commit(commit, [&] { return scene; });
-  };
-  submit(0);
+  pair.submit(0);
   renderer.begin_frame(job_for(0), images[0]);
   for (uint64_t f = 1; f < kFrames; ++f) {
-    submit(f);
+    pair.submit(f);
     // Handed out while frame f - 1 renders: the job holds frame f's commit, and the next commit, submitted
     // only after this hand-out, stays in the channel for the job after.
     renderer.begin_frame(job_for(f), images[f % 2]);
     auto has_it = [&] {
-      for (const auto& e : ahead_log->read())
+      for (const auto& e : pair.ahead_log->read())
         if (!e.band && e.frame == f + 1) return true;
       return false;
     };
     for (int i = 0; i < 5000 && !has_it(); ++i) std::this_thread::sleep_for(std::chrono::microseconds(200));
-    gates->open(f - 1);
+    pair.gates->open(f - 1);
     FrameStats stats = renderer.wait_frame();
     renderer.merge_frame(stats);
     EXPECT_EQ(stats.frame, f - 1);
     for (int y = 0; y < kRows; ++y) ASSERT_EQ(images[(f - 1) % 2].row(y)[0], static_cast<float>(f - 1));
   }
-  gates->open(kFrames - 1);
+  pair.gates->open(kFrames - 1);
   FrameStats last = renderer.wait_frame();
   renderer.merge_frame(last);
-  EXPECT_FALSE(gates->gave_up);
-
-  const std::vector<CommitLoggingTracer::Event> ahead_events = ahead_log->read(), job_events = job_log->read();
-  for (uint64_t f = 1; f < kFrames; ++f) {
-    // The queued job's commit, applied while frame f - 1's band rendered.
-    EXPECT_EQ(applied_before_band(ahead_events, f + 1), std::make_pair(static_cast<int64_t>(f) - 1, true)) << f;
-    EXPECT_EQ(applied_before_band(job_events, f + 1), std::make_pair(static_cast<int64_t>(f) - 1, false)) << f;
-  }
-  for (const auto* log : {&ahead_events, &job_events}) {
-    std::vector<uint64_t> commits;
-    for (const auto& e : *log)
-      if (!e.band) commits.push_back(e.frame);
-    EXPECT_EQ(commits, (std::vector<uint64_t>{1, 2, 3, 4, 5, 6})) << "every commit once, in order";
-  }
+  EXPECT_FALSE(pair.gates->gave_up);
+  // The queued job's commit, applied while frame f - 1's band rendered.
+  pair.expect_each_commit_beside_the_band_before(kFrames);
 }
 
 // `cohort play` announces at hand-out only where a tracer takes jobs ahead (it costs a frame of input
