@@ -415,10 +415,7 @@ void MpiTracer::take_late_answers() {
       const wire::Message m = wire::parse_message(bytes->data(), bytes->size());
       ++stats_.stale_answers;
       if ((m.kind == wire::Kind::band_rows || m.kind == wire::Kind::band_failed) && m.sequence == timed_out_job_) {
-        stats_.last_round_trip_ms = std::max(stats_.last_round_trip_ms, ms_since(timed_out_start_));
-        timed_out_job_ = 0;
-        away_.store(false);
-        if (port_) port_->set_busy(options_.rank, true);
+        node_answered_again();
         spdlog::info("mpi:{}: the node answered again, {:.0f} ms after its band was sent", options_.rank,
                      ms_since(timed_out_start_));
       }
@@ -427,6 +424,13 @@ void MpiTracer::take_late_answers() {
       spdlog::warn("mpi:{}: refused a message: {}", options_.rank, e.what());
     }
   }
+}
+
+void MpiTracer::node_answered_again() {
+  stats_.last_round_trip_ms = std::max(stats_.last_round_trip_ms, ms_since(timed_out_start_));
+  timed_out_job_ = 0;
+  away_.store(false);
+  if (port_) port_->set_busy(options_.rank, true);
 }
 
 void MpiTracer::fail_timed_out(uint64_t id, MpiClock::time_point start, const core::BandJob& job) {
@@ -648,11 +652,7 @@ core::BandResult MpiTracer::render_band(const core::BandJob& job, core::BandBuff
       std::lock_guard lock(stats_mutex_);
       ++stats_.stale_answers;
       // A band that merely took longer than the timeout teaches the next deadline how long bands take.
-      if (header.sequence == timed_out_job_) {
-        stats_.last_round_trip_ms = std::max(stats_.last_round_trip_ms, ms_since(timed_out_start_));
-        timed_out_job_ = 0;
-        away_.store(false);
-      }
+      if (header.sequence == timed_out_job_) node_answered_again();
       spdlog::debug("mpi:{}: dropped the late answer to job {}", options_.rank, header.sequence);
       continue;
     }

@@ -151,6 +151,9 @@ class MpiTracer : public core::Tracer {
   // Reads, without waiting, what the node sent since a band timed out; clears timed_out_job_ once the
   // answer to that band is among it.
   void take_late_answers();
+  // The answer to the band that timed out has come: the node is back (no longer away), its slot is its own
+  // again (no newcomer may take it), and its round trip teaches the next deadline. With stats_mutex_ held.
+  void node_answered_again();
   // The answer to the current job has not come: its pieces already matched get a moment to land (they
   // write the target's rows), and the node is sent no band until it answers this one.
   [[noreturn]] void fail_timed_out(uint64_t id, MpiClock::time_point start, const core::BandJob& job);
