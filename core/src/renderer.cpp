@@ -87,6 +87,13 @@ struct Renderer::Worker {
   std::vector<SideJob> side_jobs;
   double rows_per_ms = 0.0;
   int benched_frames_without_job = 0;  // frames benched since its last side job (RendererOptions::benched_commit_every)
+  // Core thread: whether a benched or away tracer is handed its side job this frame: at once when `now` (a
+  // probe to render, a full resync asked for), else every `every` frames, its commits coalescing meanwhile.
+  bool side_job_due(bool now, int every) {
+    if (!now && ++benched_frames_without_job < every) return false;
+    benched_frames_without_job = 0;
+    return true;
+  }
 
   // Guarded by completion->mutex: the jobs handed out that have not ended, and what the ended ones
   // reported until the core takes it.
@@ -630,8 +637,7 @@ void Renderer::begin_frame(const BandJob& job, FrameBuffer& out, const std::vect
       const balance::Band probe = probes.size() == ready.size() ? probes[i] : balance::Band{};
       t.probe_rows = probe.rows();
       Worker& w = *workers_[static_cast<size_t>(ready[i])];
-      if (probe.empty() && ++w.benched_frames_without_job < options_.benched_commit_every) continue;
-      w.benched_frames_without_job = 0;
+      if (!w.side_job_due(!probe.empty(), options_.benched_commit_every)) continue;
       side_jobs.push_back({ready[i], probe, !probe.empty(), {}});
     } else {
       assignments.push_back({ready[i], bands[i], false, {}});
@@ -644,8 +650,7 @@ void Renderer::begin_frame(const BandJob& job, FrameBuffer& out, const std::vect
   for (int id : away) {
     stats.tracers[static_cast<size_t>(id)].outcome = TracerOutcome::away;
     Worker& w = *workers_[static_cast<size_t>(id)];
-    if (++w.benched_frames_without_job < options_.benched_commit_every && !w.tracer->wants_full_resync()) continue;
-    w.benched_frames_without_job = 0;
+    if (!w.side_job_due(w.tracer->wants_full_resync(), options_.benched_commit_every)) continue;
     side_jobs.push_back({id, {}, false, {}});
     side_jobs.back().away = true;
   }
