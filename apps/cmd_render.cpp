@@ -501,9 +501,9 @@ void add_render_command(CLI::App& app, int& exit_code) {
                   "`cohort devices` lists which device each opencl:N is")
       ->capture_default_str();
   cmd->add_option("--node-port", a->node_port,
-                  "open an MPI port and write its name to this file: `cohort node MAP --join FILE --as N` started on its "
-                  "own (its own mpiexec, any host) serves mpi:N, and a slot whose node died is served by the next that "
-                  "joins it (docs/cluster.md)");
+                  "open a port for nodes (a TCP socket whose host and port this file names; the connection is handed to "
+                  "MPI_Comm_join): `cohort node MAP --join FILE --as N` started on its own (its own mpiexec, any host) "
+                  "serves mpi:N, and a slot whose node died is served by the next that joins it (docs/cluster.md)");
   cmd->add_option("--node-wait", a->node_wait_s, "with --node-port: how long the remote tracers wait for their nodes to "
                                                  "join before the first frame (seconds; later joins are taken any time)")
       ->capture_default_str()
@@ -643,8 +643,8 @@ void add_render_command(CLI::App& app, int& exit_code) {
   cmd->add_option("--frames-in-flight", a->frames_in_flight,
                   "2: hand frame N+1's bands out as soon as N's are, so that each tracer starts N+1 the moment its "
                   "band of N is done instead of waiting for the slowest band and the core's turnaround; the "
-                  "balancer then divides each frame by the costs of the frame two before (docs/balancing.md, "
-                  "\"Two frames in flight\")")
+                  "balancer then divides each frame by the costs of the frame two before, and each frame comes up to a "
+                  "frame later (docs/balancing.md, \"Two frames in flight\")")
       ->capture_default_str()
       ->check(CLI::Range(1, 2));
   cmd->add_flag("--bands-through-host", a->bands_through_host,
