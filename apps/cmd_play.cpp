@@ -20,6 +20,7 @@
 #include "convergence_choice.h"
 #include "workload_choice.h"
 #include "play_rate.h"
+#include "node_port_options.h"
 #include "play_session.h"
 #include "viewer/hud.h"
 #include "viewer/viewer_actions.h"
@@ -46,6 +47,7 @@ struct PlayArgs {
   std::string screenshot;    // written from the last frame
   std::string window_shot;   // the last frame as the window showed it, HUD included
   std::string trace;         // Chrome trace event file of every frame's timeline
+  NodePortArgs node_port;    // rank 0's port for nodes that join
   // How a scale below 1 reaches the window (core/upsample.h). auto: joint-bilateral where the reprojection
   // runs on a GPU (it reconstructs there, about 1 ms at 1080p), else bilinear: on the host the reconstruction
   // costs more than it gives at play's frame rates (docs/denoising.md, "Dynamic resolution").
@@ -113,6 +115,8 @@ int run_play(PlayArgs a) {
   using clock = std::chrono::steady_clock;
   a.session.bases = bases_or_test_map(a.session.bases);
   a.session.window_height = a.height;
+  a.session.node_port_file = a.node_port.port_file;
+  a.session.node_wait_s = a.node_port.first_wait_s;
   std::unique_ptr<PlaySession> session;
   try {
     session = std::make_unique<PlaySession>(a.session);
@@ -391,6 +395,7 @@ void add_play_command(CLI::App& app, int& exit_code) {
                   "(the frame waits in each tracer's queue behind the one before; docs/balancing.md)")
       ->capture_default_str()
       ->check(CLI::Range(1, 2));
+  add_node_port_options(cmd, a->node_port);
   cmd->add_option("--band-format", a->session.band_format,
                   "what the tracers hand back: RGB half floats (6 bytes a pixel), RGB9E5 (4 bytes a pixel: 9-bit mantissas "
                   "under a shared exponent, dithered so averaging frames keeps no bias) or RGBA floats (16)")

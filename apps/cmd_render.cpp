@@ -28,9 +28,6 @@
 #include "cohort/scene/map_loader.h"
 #include "cohort/scene/render_world_stream.h"
 #include "cohort/tracers/tracer_registry.h"
-#ifdef COHORT_HAVE_MPI
-#include "cohort/tracers/mpi_node_port.h"
-#endif
 #include <limits>
 #include "cohort/core/image_output.h"
 #include "cohort/core/renderer.h"
@@ -41,6 +38,7 @@
 #include "convergence_choice.h"
 #include "default_map.h"
 #include "id_plane_output.h"
+#include "node_port_options.h"
 #include "progress_bar.h"
 #include "render_scene_source.h"
 
@@ -51,8 +49,7 @@ namespace {
 struct RenderArgs {
   std::string map;
   std::string tracers = "all";
-  std::string node_port;  // rank 0's port file for nodes that join (empty: none)
-  double node_wait_s = 0.0;
+  NodePortArgs node_port;  // rank 0's port for nodes that join
   std::string balancer = "whole-cost";  // benches a tracer that would slow the frame (docs/balancing.md)
   std::string mode = "path";
   std::string out = "render_out";
@@ -118,17 +115,8 @@ int run_render(const RenderArgs& a) {
   RenderScene scene = a.replay.empty() ? load_render_scene(a.map, bases_or_test_map(a.bases)) : RenderScene{};
   // Parsed once: "all" probes the devices.
   const std::vector<tracers::TracerSpec> specs = tracers::parse_tracer_list(a.tracers);
-  if (!a.node_port.empty()) {
-#ifdef COHORT_HAVE_MPI
-    // Before the remote tracers start MPI: the port's accept thread needs MPI_THREAD_MULTIPLE.
-    std::vector<int> slots;
-    for (const tracers::TracerSpec& spec : specs)
-      if (spec.kind == "mpi") slots.push_back(spec.device);
-    tracers::NodePort::open(a.node_port, std::chrono::milliseconds(int64_t(a.node_wait_s * 1000.0)), slots);
-#else
-    throw std::invalid_argument("--node-port: this build has no MPI (docs/cluster.md)");
-#endif
-  }
+  // Before the remote tracers start MPI: the port's accept thread needs MPI_THREAD_MULTIPLE.
+  if (!a.node_port.port_file.empty()) tracers::open_node_port(a.node_port.port_file, a.node_port.first_wait_s, specs);
   std::vector<std::unique_ptr<core::Tracer>> tracers = tracers::make_tracers(specs);
   bool any_gpu_tracer = false;
   for (const auto& tracer : tracers) any_gpu_tracer = any_gpu_tracer || tracer->renders_on_gpu();
@@ -500,14 +488,7 @@ void add_render_command(CLI::App& app, int& exit_code) {
                   "comma-separated: embree, opencl[:N|:all], cuda[:N|:all], or all (Embree on the CPU plus every GPU once); "
                   "`cohort devices` lists which device each opencl:N is")
       ->capture_default_str();
-  cmd->add_option("--node-port", a->node_port,
-                  "open a port for nodes (a TCP socket whose host and port this file names; the connection is handed to "
-                  "MPI_Comm_join): `cohort node MAP --join FILE --as N` started on its own (its own mpiexec, any host) "
-                  "serves mpi:N, and a slot whose node died is served by the next that joins it (docs/cluster.md)");
-  cmd->add_option("--node-wait", a->node_wait_s, "with --node-port: how long the remote tracers wait for their nodes to "
-                                                 "join before the first frame (seconds; later joins are taken any time)")
-      ->capture_default_str()
-      ->check(CLI::NonNegativeNumber);
+  add_node_port_options(cmd, a->node_port);
   cmd->add_option("--balancer", a->balancer, "row balancer when there are several tracers")->capture_default_str();
   cmd->add_option("--band-format", a->band_format,
                   "what the tracers hand back: RGB half floats (6 bytes a pixel), RGB9E5 (4 bytes a pixel: 9-bit mantissas "

@@ -115,7 +115,10 @@ PlaySession::PlaySession(const SessionOptions& options) {
   // parse_tracer_list expands "all" and ":all" by probing devices; a device that then fails to open
   // is dropped with a warning and the others carry on.
   std::vector<tracers::TracerSpec> started;
-  for (const tracers::TracerSpec& spec : tracers::parse_tracer_list(list)) {
+  const std::vector<tracers::TracerSpec> specs = tracers::parse_tracer_list(list);
+  // Before the remote tracers start MPI: the port's accept thread needs MPI_THREAD_MULTIPLE.
+  if (!options.node_port_file.empty()) tracers::open_node_port(options.node_port_file, options.node_wait_s, specs);
+  for (const tracers::TracerSpec& spec : specs) {
     try {
       tracers.push_back(tracers::make_tracer(spec));
       started.push_back(spec);

@@ -39,6 +39,10 @@ struct SessionOptions {
   // RendererOptions::frames_in_flight: 2 hands the next frame out before the one before is back (a frame more
   // between input and image where the tracers set the pace; docs/balancing.md, "Two frames in flight").
   int frames_in_flight = 1;
+  // Rank 0's port for nodes that join (docs/cluster.md): the file it writes, and how long the remote
+  // tracers wait for their first nodes (empty file: no port).
+  std::string node_port_file;
+  double node_wait_s = 0.0;
   int window_height = 360;
 };
 

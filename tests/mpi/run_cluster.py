@@ -39,7 +39,8 @@ dither is a hash of pixel and frame, so the nodes' rows equal the single-process
 4 bytes a pixel), play_early_announce (`cohort play` under a virtual display with mpi:1 and mpi:2 alone, the
 window 320x180 in albedo mode: announced at hand-out (the default) at most 2 bands of both nodes come back
 before the next frame is announced, and its jobs ahead leave sooner after their band's job than with
-COHORT_EARLY_ANNOUNCE=0, where play announces a frame only when it pushes it).
+COHORT_EARLY_ANNOUNCE=0, where play announces a frame only when it pushes it), play_join (`cohort play` with
+--node-port: a node started on its own joins mpi:1 and renders in play).
 """
 import argparse
 import json
@@ -821,12 +822,43 @@ def rejoin(a):
     print("rejoin: ok")
 
 
+def play_join(a):
+    """`cohort play` as rank 0 with a port (--node-port, --node-wait) under a virtual display: a node started on
+    its own joins mpi:1 before the first frame, renders bands in play, and both end with status 0; the
+    screenshot is an image, not a uniform colour."""
+    skip_without_viewer(a)
+    os.makedirs(a.out)
+    shot, port = os.path.join(a.out, "play.png"), os.path.join(a.out, "port")
+    testmap = os.path.join(a.testmap_base, "maps", "testmap.map")
+    jobs = JoinLauncher(a)
+    try:
+        rank0 = jobs.start("rank0", ["xvfb-run", "-a", "-s", "-screen 0 1024x768x24", a.cohort, "play", testmap,
+                                     "--tracers", "embree,mpi:1", "--node-port", port, "--node-wait", "120",
+                                     "--frames", "20", "--width", "160", "--height", "120", "--scale", "1",
+                                     "--screenshot", shot])
+        node = jobs.start("node1", [a.cohort, "node", testmap, "--tracers", "embree", "--join", port, "--as", "1"])
+        code, node_code = jobs.finish(rank0), jobs.finish(node)
+        jobs.dump()
+    finally:
+        jobs.close()
+    if code != 0 or node_code != 0:
+        sys.exit(f"exit statuses: rank 0 {code}, the node {node_code}")
+    if "rank 0 welcomed this node as mpi:1" not in JoinLauncher.output(node):
+        sys.exit("the node was not welcomed as mpi:1")
+    if not re.search(r"mpi:1: [1-9]\d* band\(s\)", JoinLauncher.output(rank0)):
+        sys.exit("mpi:1 rendered no band in cohort play")
+    run([sys.executable, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "apps", "image_not_uniform.py"),
+         shot])
+    print("play_join: ok")
+
+
 def main():
     parser = argparse.ArgumentParser()
     parser.add_argument("case", choices=["match", "mixed", "stall", "killed", "version", "load_error", "bench", "protocol", "replay",
                                            "play", "link", "bad_piece", "ahead", "ahead_recovery", "jobs_ahead",
                                            "jobs_ahead_two_in_flight",
-                                           "early_announce", "match_rgb9e5", "play_early_announce", "join", "rejoin"])
+                                           "early_announce", "match_rgb9e5", "play_early_announce", "join", "rejoin",
+                                           "play_join"])
     parser.add_argument("--mpiexec", required=True)
     parser.add_argument("--cohort", required=True)
     parser.add_argument("--map", required=True)
@@ -849,6 +881,9 @@ def main():
         return
     if a.case == "rejoin":
         rejoin(a)
+        return
+    if a.case == "play_join":
+        play_join(a)
         return
     if a.case == "link":
         link(a)

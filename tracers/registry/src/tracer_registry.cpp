@@ -23,6 +23,7 @@
 #include <cstdlib>
 
 #include "cohort/tracers/mpi_tracer.h"
+#include "cohort/tracers/mpi_node_port.h"
 #endif
 
 namespace cohort::tracers {
@@ -260,6 +261,20 @@ bool remote_tracers_built() {
   return true;
 #else
   return false;
+#endif
+}
+
+void open_node_port(const std::string& port_file, double first_wait_s, const std::vector<TracerSpec>& specs) {
+  std::vector<int> slots;
+  for (const TracerSpec& spec : specs)
+    if (spec.kind == "mpi") slots.push_back(spec.device);
+  if (slots.empty())
+    throw std::invalid_argument("--node-port: no remote tracer (mpi:N) in the tracer list for nodes to serve");
+#ifdef COHORT_HAVE_MPI
+  NodePort::open(port_file, std::chrono::milliseconds(int64_t(first_wait_s * 1000.0)), slots);
+#else
+  (void)port_file, (void)first_wait_s;
+  throw std::invalid_argument("--node-port: this build has no MPI (docs/cluster.md)");
 #endif
 }
 

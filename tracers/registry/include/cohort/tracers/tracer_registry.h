@@ -40,6 +40,12 @@ std::vector<std::unique_ptr<core::Tracer>> make_tracers(const std::string& list)
 // OpenCL device of the same GPU), and still makes them: it may be meant, as a measurement.
 std::vector<std::unique_ptr<core::Tracer>> make_tracers(const std::vector<TracerSpec>& specs);
 
+// Opens rank 0's port for nodes that join (docs/cluster.md, "Joining a running session") for the list's
+// remote tracers (mpi:N), whose first nodes may take up to `first_wait_s` seconds to come. Call before
+// make_tracers (the port asks MPI for MPI_THREAD_MULTIPLE); throws std::invalid_argument where this build
+// has no remote tracers or the list names none, std::runtime_error where the port cannot be opened.
+void open_node_port(const std::string& port_file, double first_wait_s, const std::vector<TracerSpec>& specs);
+
 // The tracer kinds this binary was built with that render in this process (the remote `mpi` kind is
 // not among them: it needs a node on another MPI rank).
 std::vector<std::string> built_tracer_kinds();
