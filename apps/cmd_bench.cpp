@@ -197,6 +197,13 @@ void add_bench_devices_command(CLI::App& bench, int& exit_code) {
       ->check(camera_path_error);
   devices->add_option("--balancer", args->config.balancer, "row balancer")
       ->capture_default_str()->check(CLI::IsMember(balance::balancer_names()));
+  devices->add_option("--frames-in-flight", args->config.frames_in_flight,
+                      "0: frame by frame (each frame handed out, waited for and merged before the next: wall ms is "
+                      "that frame); 1 or 2: through the frame pipeline as `cohort render` runs it (the next frame "
+                      "announced at hand-out, with 2 handed out before the one before is back): wall ms is the "
+                      "interval between frames")
+      ->capture_default_str()
+      ->check(CLI::Range(0, 2));
   devices->add_option("--json", args->json, "write every run (per-frame wall ms) as JSON");
   devices->add_option("--plot", args->plot, "write a PNG bar chart of median wall ms per mix");
   devices->callback([args, &exit_code] {
@@ -216,7 +223,11 @@ void add_bench_devices_command(CLI::App& bench, int& exit_code) {
       return;
     }
     std::cout << config.scene << ", " << config.width << "x" << config.height << ", " << config.camera_path << ", "
-              << config.frames << " frames (first " << config.warmup << " not counted), balancer " << config.balancer << "\n"
+              << config.frames << " frames (first " << config.warmup << " not counted), balancer " << config.balancer
+              << (config.frames_in_flight == 0
+                      ? ", frame by frame\n"
+                      : ", through the frame pipeline with " + std::to_string(config.frames_in_flight) +
+                            " in flight (ms: the interval between frames)\n")
               << devices_bench_table(runs);
     if (!args->json.empty()) {
       std::ofstream out(args->json);

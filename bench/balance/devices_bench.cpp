@@ -1,8 +1,10 @@
 #include "devices_bench.h"
 
 #include <algorithm>
+#include <chrono>
 #include <cstdio>
 #include <map>
+#include <optional>
 #include <stdexcept>
 
 #include <spdlog/spdlog.h>
@@ -10,6 +12,7 @@
 #include "camera_path.h"
 #include "cohort/balance/order_statistics.h"
 #include "cohort/core/frame_defaults.h"
+#include "cohort/core/frame_pipeline.h"
 #include "cohort/core/renderer.h"
 #include "cohort/core/view.h"
 #include "cohort/tracers/tracer_registry.h"
@@ -41,30 +44,65 @@ DevicesBenchRun run_mix(const DevicesBenchConfig& config, const std::vector<std:
     if (const auto* m = dynamic_cast<const tracers::MpiTracer*>(t.get())) remote.push_back(m);
   std::vector<tracers::MpiLinkStats> before(remote.size());
 #endif
+  if (config.frames_in_flight < 0 || config.frames_in_flight > 2)
+    throw std::invalid_argument("bench devices: frames in flight must be 0 (frame by frame), 1 or 2");
+  options.frames_in_flight = std::max(1, config.frames_in_flight);
   core::Renderer renderer(std::move(real.tracers), options);
   const CameraPath path = parse_camera_path(config.camera_path);
-
-  DevicesBenchRun run;
-  run.tracers = names;
-  core::FrameBuffer frame;
-  int counted = 0;
-  for (int f = 0; f < config.frames; ++f) {
+  const auto job_of_frame = [&](int f) {
     const CameraPose pose = camera_path_pose(path, real.eye, real.yaw, f);
     core::BandJob job;
     job.camera = core::make_camera(pose.origin, {pose.yaw, 0.0f}, core::kDefaultFovX, config.width, config.height);
     job.params = core::default_frame_params();
     job.params.frame_index = static_cast<kuint>(f);
+    return job;
+  };
+
+  DevicesBenchRun run;
+  run.tracers = names;
+  int counted = 0;
+  const auto take = [&](int f, const core::FrameStats& stats, double frame_ms) {
 #ifdef COHORT_HAVE_MPI
-    if (f == config.warmup)
+    // The link counters from the delivery of the last frame not counted (with the pipeline the first counted
+    // frame's job is out by then: its bytes out are left out, its rows back counted).
+    if (f == config.warmup - 1)
       for (size_t i = 0; i < remote.size(); ++i) before[i] = remote[i]->link_stats();
 #endif
-    const core::FrameStats stats = renderer.render(job, frame);
-    if (f < config.warmup) continue;
-    run.wall_ms.push_back(stats.wall_ms);
+    if (f < config.warmup) return;
+    run.wall_ms.push_back(frame_ms);
     run.mean_idle_percent += stats.idle_percent;
     run.worst_idle_percent = std::max(run.worst_idle_percent, stats.idle_percent);
     for (const core::TracerFrameStats& t : stats.tracers) run.mean_rendering_tracers += t.outcome == core::TracerOutcome::rendered;
     ++counted;
+  };
+#ifdef COHORT_HAVE_MPI
+  if (config.warmup == 0)
+    for (size_t i = 0; i < remote.size(); ++i) before[i] = remote[i]->link_stats();
+#endif
+  if (config.frames_in_flight == 0) {
+    core::FrameBuffer frame;
+    for (int f = 0; f < config.frames; ++f) {
+      const core::FrameStats stats = renderer.render(job_of_frame(f), frame);
+      take(f, stats, stats.wall_ms);
+    }
+  } else {
+    core::FramePipeline pipeline(renderer);
+    std::optional<std::chrono::steady_clock::time_point> last_delivery;
+    const auto delivered = [&](const std::optional<core::FramePipeline::Delivered>& done) {
+      if (!done) return;
+      const auto now = std::chrono::steady_clock::now();
+      const double interval =
+          last_delivery ? std::chrono::duration<double, std::milli>(now - *last_delivery).count() : done->stats.wall_ms;
+      last_delivery = now;
+      take(static_cast<int>(done->job.params.frame_index), done->stats, interval);
+    };
+    for (int f = 0; f < config.frames; ++f) {
+      delivered(pipeline.push(job_of_frame(f), {}, [&]() -> std::optional<core::BandJob> {
+        if (f + 1 < config.frames) return job_of_frame(f + 1);
+        return std::nullopt;
+      }));
+    }
+    delivered(pipeline.drain());
   }
   if (counted == 0) throw std::invalid_argument("bench devices: --frames must exceed --warmup");
 #ifdef COHORT_HAVE_MPI
@@ -203,8 +241,11 @@ nlohmann::json devices_bench_json(const DevicesBenchConfig& config, const std::v
   nlohmann::json j;
   j["config"] = {{"scene", config.scene},   {"width", config.width},         {"height", config.height},
                  {"frames", config.frames}, {"warmup", config.warmup},       {"camera_path", config.camera_path},
-                 {"balancer", config.balancer},
-                 {"metric", "wall ms = Renderer frame (bands, merge, recovery); efficiency = (1/T_mix) / sum(1/T_alone)"}};
+                 {"balancer", config.balancer}, {"frames_in_flight", config.frames_in_flight},
+                 {"metric", config.frames_in_flight == 0
+                                ? "wall ms = Renderer frame (bands, merge, recovery); efficiency = (1/T_mix) / sum(1/T_alone)"
+                                : "wall ms = interval between frames delivered by the FramePipeline (bands, merge, "
+                                  "recovery, overlapped); efficiency = (1/T_mix) / sum(1/T_alone)"}};
   j["runs"] = nlohmann::json::array();
   for (const DevicesBenchRun& r : runs) {
     j["runs"].push_back({{"tracers", r.tracers},

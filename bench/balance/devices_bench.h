@@ -21,6 +21,11 @@ struct DevicesBenchConfig {
   int frames = 60, warmup = 10;                  // the first `warmup` frames are not counted
   std::string camera_path = "spin-slow";
   std::string balancer = "whole-cost";
+  // 0: frame by frame (Renderer::render: each frame handed out, waited for and merged before the next; wall
+  // ms = that frame). 1 or 2: through the FramePipeline as `cohort render` runs it (without the post), the
+  // next frame announced at hand-out (remote tracers' jobs ahead), with RendererOptions::frames_in_flight;
+  // wall ms = the interval between delivered frames (1 / frame rate).
+  int frames_in_flight = 0;
 };
 
 // A remote tracer's traffic over the counted frames (tracers/mpi): what crossed the wire per frame
@@ -49,7 +54,7 @@ struct DevicesBenchRun {
   double mean_idle_percent = 0.0, worst_idle_percent = 0.0;
   double mean_rendering_tracers = 0.0;  // tracers given rows per frame (a balancer may bench one)
   double efficiency = 0.0;              // scaling efficiency; 1 for a tracer alone
-  std::vector<double> wall_ms;          // per counted frame
+  std::vector<double> wall_ms;          // per counted frame (with the pipeline: the interval before it)
   std::vector<RemoteLinkRun> remote;    // one per remote tracer of the mix
 };
 
