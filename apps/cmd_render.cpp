@@ -79,6 +79,7 @@ struct RenderArgs {
   float history_fix_stride = core::AtrousOptions{}.history_fix_stride;
   float history_fix_sigma = core::AtrousOptions{}.history_fix_sigma_scale;
   float history_fix_min = core::AtrousOptions{}.history_fix_min_length;
+  float atrous_firefly = core::AtrousOptions{}.firefly_factor;
   float anti_lag = -1.0f;     // < 0: ReprojectionOptions' default
   float reproject_clamp = -1.0f;  // < 0: ReprojectionOptions' default
   std::string post_on = "auto";
@@ -227,6 +228,7 @@ int run_render(const RenderArgs& a) {
     ao.history_fix_stride = a.history_fix_stride;
     ao.history_fix_sigma_scale = a.history_fix_sigma;
     ao.history_fix_min_length = a.history_fix_min;
+    ao.firefly_factor = a.atrous_firefly;
     post = tracers::make_frame_post(post_place, post_options);
     spdlog::info("{}{}{} on {}", reproject ? "reprojection" : "", reproject && atrous ? " and " : "",
                  atrous ? "the a-trous filter (" + std::to_string(ao.passes) + " passes, " + a.atrous_guide + " guide)"
@@ -590,6 +592,11 @@ void add_render_command(CLI::App& app, int& exit_code) {
                   "from the image height (1 at 180 rows, 2 at 360, 4 at 720)")
       ->capture_default_str()
       ->check(CLI::Range(0.0f, 32.0f));
+  cmd->add_option("--atrous-firefly", a->atrous_firefly,
+                  "before the a-trous passes, a pixel brighter than this many times its brightest neighbour is scaled "
+                  "down to that (a lone 1-spp firefly; the history keeps its light); 0: off")
+      ->capture_default_str()
+      ->check(CLI::Range(0.0f, 1000.0f));
   cmd->add_option("--history-fix-min", a->history_fix_min,
                   "the history fix leaves histories shorter than this many frames to the passes (1: a fresh "
                   "sample; 1.5 also those the anti-lag cut to under half a frame; 0: fixes every short history)")

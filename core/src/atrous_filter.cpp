@@ -6,6 +6,7 @@
 
 #include "cohort/core/host_threads.h"
 #include "cohort/kernel/atrous.h"
+#include "cohort/kernel/firefly.h"
 #include "cohort/kernel/svgf.h"
 
 namespace cohort::core {
@@ -74,6 +75,15 @@ void AtrousFilter::apply(const FrameBuffer& frame, const GBuffer& gbuffer, Frame
     for (size_t p = begin; p < end; ++p)
       k_atrous_modulate(frame.rgba.data(), gbuffer.albedo.data(), ping_.rgba.data(), static_cast<kint>(p), 0);
   });
+  if (options_.firefly_factor > 0.0f) {
+    const float factor = options_.firefly_factor;
+    threads.for_ranges(static_cast<size_t>(height), kRowsPerTask, [&](size_t row_begin, size_t row_end) {
+      for (int y = static_cast<int>(row_begin); y < static_cast<int>(row_end); ++y)
+        for (int x = 0; x < width; ++x)
+          k_firefly_clamp_pixel(ping_.rgba.data(), pong_.rgba.data(), width, height, factor, x, y);
+    });
+    std::swap(ping_, pong_);
+  }
   const bool variance = atrous_guide_uses_variance(options_.guide);
   KAtrousParams params{};
   params.width = width;

@@ -200,8 +200,8 @@ TEST(FramePost, CudaMatchesTheHostOverAMovingSequence) {
   EXPECT_EQ(tracers::auto_frame_post_place(tracers::parse_tracer_list("embree,cuda:0")), "cuda:0");
   // No filter, the fixed guide, the variance guide over the history's moments, the variance guide alone
   // (spatial estimate only), the variance of the mean, that with first-hit planes' footprint taps, and the
-  // history fix before the variance-of-mean and the fixed guides' passes.
-  for (int variant = 0; variant < 8; ++variant) {
+  // history fix before the variance-of-mean and the fixed guides' passes, and the firefly clamp before them.
+  for (int variant = 0; variant < 9; ++variant) {
     const bool atrous = variant > 0;
     core::FramePostOptions options = both();
     options.atrous = atrous;
@@ -211,7 +211,8 @@ TEST(FramePost, CudaMatchesTheHostOverAMovingSequence) {
                                                   : core::AtrousGuide::variance;
     // First-hit planes: history taps of another surface in the pixel's footprint (the sliding box's edges).
     options.reprojection.jittered_planes = variant == 5;
-    if (variant >= 6) options.atrous_options.history_fix_frames = 4.0f;  // lengths 1-6 along the sequence
+    if (variant == 6 || variant == 7) options.atrous_options.history_fix_frames = 4.0f;  // lengths 1-6 along the sequence
+    if (variant == 8) options.atrous_options.firefly_factor = 3.0f;
     core::HostFramePost host(options);
     std::unique_ptr<core::FramePost> gpu = tracers::make_frame_post("cuda:0", options);
     EXPECT_EQ(gpu->where(), "cuda:0");
@@ -219,6 +220,8 @@ TEST(FramePost, CudaMatchesTheHostOverAMovingSequence) {
     core::GBuffer g;
     for (int f = 0; f < 6; ++f) {
       make_frame(f, frame, g);
+      if (variant == 8)  // a firefly for the clamp, somewhere else each frame
+        for (int k = 0; k < 3; ++k) frame.rgba[4 * (size_t(5 + f) * kW + 7 + 3 * f) + k] = 60.0f;
       host.process(frame, g, core::kEveryPixel);
       gpu->process(frame, g, core::kEveryPixel);
       ASSERT_EQ(gpu->image().width, kW);

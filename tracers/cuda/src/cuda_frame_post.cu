@@ -11,6 +11,7 @@
 #include "cohort/kernel/atrous.h"
 #include "cohort/kernel/band_pack.h"
 #include "cohort/kernel/brigade_blend.h"
+#include "cohort/kernel/firefly.h"
 #include "cohort/kernel/reproject.h"
 #include "cohort/kernel/svgf.h"
 #include "cohort/kernel/upsample.h"
@@ -121,6 +122,11 @@ __global__ void pack_geometry_kernel(const float* depth, const float* normal, fl
 __global__ void atrous_kernel(const float* in, float* out, const float* geometry, KAtrousParams params) {
   const int x = blockIdx.x * blockDim.x + threadIdx.x, y = blockIdx.y * blockDim.y + threadIdx.y;
   if (x < params.width && y < params.height) k_atrous_pixel(in, out, geometry, &params, x, y);
+}
+
+__global__ void firefly_kernel(const float* in, float* out, int width, int height, float factor) {
+  const int x = blockIdx.x * blockDim.x + threadIdx.x, y = blockIdx.y * blockDim.y + threadIdx.y;
+  if (x < width && y < height) k_firefly_clamp_pixel(in, out, width, height, factor, x, y);
 }
 
 // The estimate goes into the illumination's alpha, where the passes read it: each pixel writes only its
@@ -375,6 +381,10 @@ class CudaFramePost final : public core::FramePost {
       if (!geometry_ready)
         pack_geometry_kernel<<<blocks_for(pixels), kThreads, 0, stream_>>>(depth_.data(), normal_.data(), geometry,
                                                                             static_cast<int>(pixels));
+      if (ao.firefly_factor > 0.0f) {
+        firefly_kernel<<<tile_grid(width, height), kTile, 0, stream_>>>(ping, pong, width, height, ao.firefly_factor);
+        std::swap(ping, pong);
+      }
       if (variance) {
         KSvgfVarianceParams v{};
         v.width = width, v.height = height, v.normal_squarings = normal_squarings_;

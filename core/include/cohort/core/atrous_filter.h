@@ -52,6 +52,11 @@ struct AtrousOptions {
   // fresh sample, just above 1 one whose history the anti-lag nearly dropped). 1.5 spared the moving door at 320x180 (every figure better than without the fix) but cost the door after
   // it stops at 640x360 (0.1024 -> 0.1045) and the camera path (docs/denoising.md); 0: every short history.
   float history_fix_min_length = 0.0f;
+  // Firefly clamp before the passes (kernel/firefly.h): a pixel brighter than this many times its brightest
+  // neighbour is scaled down to that; 0: off. Off by default: 3 took the test map's door 4 frames after it
+  // stops from 0.116 to 0.097 at 320x180, but at 640x360 it made it a little worse (0.111 -> 0.114), the mean
+  // FLIP unchanged at both (docs/denoising.md, "Fireflies").
+  float firefly_factor = 0.0f;
 };
 
 // "variance", "variance-of-mean" or "fixed" (std::invalid_argument otherwise, naming the word).
