@@ -182,6 +182,12 @@ class Event {
     return &event_;
   }
   cl_event get() const { return event_; }
+  // Takes `other`'s event over (a band's own copy of an event the tracer keeps for the band being enqueued).
+  void take(Event& other) {
+    if (event_) clReleaseEvent(event_);
+    event_ = other.event_;
+    other.event_ = nullptr;
+  }
   // The command's start or end on the device clock (the queue profiles), 0 when unknown.
   cl_ulong time(cl_profiling_info which) const {
     cl_ulong t = 0;
@@ -249,6 +255,11 @@ struct OpenCLTracer::EnqueuedBand {
   bool whole_band = false;  // its rows end where the frame's do (row_work is reported then)
   OpenCLWavefront* wave = nullptr;
   Event band_started, band_done, band_read, last;  // last: the row counts' read, the band's last command
+  // With aux planes from centre rays: the aux kernel (the band's clock starts there) and the texels' read
+  // into page-locked staging, taken over from Impl's once enqueued, so that the next band's may follow.
+  Event aux_kernel_done, aux_read;
+  double enqueue_ms = 0.0;  // the host's time enqueueing it (enqueue_band), for the debug log
+  bool ahead = false;       // enqueued ahead, inside the band before
 };
 
 struct OpenCLTracer::Impl {
@@ -719,6 +730,8 @@ bool same_job(const core::BandJob& a, const core::BandJob& b) {
 core::BandResult OpenCLTracer::render_band(const core::BandJob& job, core::BandBuffer& target) {
   Impl& m = *impl_;
   if (!has_scene()) throw std::runtime_error("OpenCLTracer: render_band before any commit was applied");
+  using Clock = std::chrono::steady_clock;
+  const auto entry = Clock::now();
   std::unique_ptr<EnqueuedBand> band;
   // A throw from here on (the aux copy, the wait, the next band's enqueueing) drains every queue before the
   // band's memory goes; the band enqueued ahead, if any, stays for its job.
@@ -738,16 +751,33 @@ core::BandResult OpenCLTracer::render_band(const core::BandJob& job, core::BandB
     if (band->rows == 0) return {};
     if (band->aux_from_paths)
       return render_first_hits_in_pieces(job, target, band->params, band->camera, band->straight, band->wave);
-    // The host's share of the aux planes (out of page-locked memory into the target) while the band renders.
-    if (band->write_aux) copy_aux_into(target, band->params, band->camera, band->rows, band->straight);
   }
+  // The host's share of the aux planes (out of page-locked memory into the target) while the band renders;
+  // done before the next band is enqueued, whose aux texels are read into the same staging.
+  if (band->write_aux)
+    m.copy_aux_rows_into(target, int(band->params.row_begin), band->camera.width, band->rows, m.aux_staging.host(),
+                         band->straight, band->aux_read.get());
+  // The host's time from this job's start until its band is all in the queue: the whole enqueueing, or
+  // nothing where it was enqueued ahead.
+  const auto queued = Clock::now();
   enqueue_next_ahead(*band);
-  return finish_band(*band);
+  const auto waiting = Clock::now();
+  core::BandResult result = finish_band(*band);
+  if (spdlog::should_log(spdlog::level::debug)) {
+    const auto ms = [](Clock::time_point a, Clock::time_point b) { return std::chrono::duration<double, std::milli>(b - a).count(); };
+    spdlog::debug("opencl ({}): band [{}, {}) of frame {}: {} in {:.3f} ms; {:.3f} ms before it was all in the queue, "
+                  "{:.3f} ms on the next band ahead ({}), {:.3f} ms waiting",
+                  m.label, band->params.row_begin, band->params.row_end, band->params.frame_index,
+                  band->ahead ? "enqueued ahead" : "enqueued", band->enqueue_ms, ms(entry, queued), ms(queued, waiting),
+                  m.ahead ? "enqueued" : "none", ms(waiting, Clock::now()));
+  }
+  return result;
 }
 
 std::unique_ptr<OpenCLTracer::EnqueuedBand> OpenCLTracer::enqueue_band(const core::BandJob& job,
                                                                       core::BandBuffer& target) {
   Impl& m = *impl_;
+  const auto started = std::chrono::steady_clock::now();
   auto b = std::make_unique<EnqueuedBand>();
   b->job = job;
   b->target = &target;
@@ -832,7 +862,11 @@ std::unique_ptr<OpenCLTracer::EnqueuedBand> OpenCLTracer::enqueue_band(const cor
   // Both kernels are on the device before any read is enqueued: a driver that copies into pageable
   // memory at enqueue time then still overlaps the aux read with the band's kernel.
   check(clFlush(m.queue), "clFlush");
-  if (write_aux) read_aux_when_packed(rows * camera.width, straight);
+  if (write_aux) {
+    read_aux_when_packed(rows * camera.width, straight);
+    b->aux_kernel_done.take(m.aux_kernel_done);
+    b->aux_read.take(m.aux_read);
+  }
   void* band_destination = straight ? target.row(int(params.row_begin)) : b->band.data();
   check(clEnqueueReadBuffer(m.queue, band_mem, CL_FALSE, 0, band_bytes, band_destination, 0, nullptr, b->band_read.out()),
         "reading the band");
@@ -840,6 +874,7 @@ std::unique_ptr<OpenCLTracer::EnqueuedBand> OpenCLTracer::enqueue_band(const cor
                             b->last.out()),
         "reading the row ray counts");
   check(clFlush(m.queue), "clFlush");
+  b->enqueue_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - started).count();
   return b;
 }
 
@@ -870,15 +905,17 @@ void OpenCLTracer::enqueue_next_ahead(const EnqueuedBand& current) {
     next = queued_next(band_done);
   }
   if (!next) return;
-  if (next->job.params.aux_outputs != 0u && next->target->has_aux()) {
-    // Its aux planes use the tracer's one set of aux events and page-locked staging, which this band's may
-    // still hold: it is enqueued when its job starts.
-    spdlog::debug("opencl ({}): the next band has aux planes; not enqueued ahead", m.label);
+  if (next->job.params.aux_outputs != 0u && next->target->has_aux() && k_aux_from_paths(&next->job.params)) {
+    // Its aux planes from its paths' first hits come in pieces whose host copies interleave with the waits
+    // (render_first_hits_in_pieces): it is enqueued when its job starts. (Centre rays go ahead: this band's
+    // aux texels are out of the page-locked staging by now, and its aux read done.)
+    spdlog::debug("opencl ({}): the next band's aux planes come from its paths' first hits; not enqueued ahead", m.label);
     return;
   }
   try {
     std::unique_ptr<EnqueuedBand> b = enqueue_band(next->job, *next->target);
     if (b->rows == 0) return;
+    b->ahead = true;
     m.ahead = std::move(b);
     ++m.enqueued_ahead;
   } catch (const std::exception& e) {
@@ -889,7 +926,6 @@ void OpenCLTracer::enqueue_next_ahead(const EnqueuedBand& current) {
 }
 
 core::BandResult OpenCLTracer::finish_band(EnqueuedBand& b) {
-  Impl& m = *impl_;
   const cl_event last = b.last.get();
   check(clWaitForEvents(1, &last), "waiting for the band");
   const KFrameParams& params = b.params;
@@ -898,7 +934,7 @@ core::BandResult OpenCLTracer::finish_band(EnqueuedBand& b) {
     b.target->store(static_cast<int>(params.row_begin + r), 0, b.band.data() + r * width * 4, width, params.frame_index);
   // Device time from the first kernel (the aux one when it ran first, as the CUDA tracer times it) to the
   // band's last kernel.
-  const cl_ulong start = (b.write_aux ? m.aux_kernel_done : b.band_started).time(CL_PROFILING_COMMAND_START);
+  const cl_ulong start = (b.write_aux ? b.aux_kernel_done : b.band_started).time(CL_PROFILING_COMMAND_START);
   const cl_ulong end = b.band_done.time(CL_PROFILING_COMMAND_END);
   core::BandResult result;
   result.device_ms = end > start && start != 0 ? double(end - start) * 1e-6 : 0.0;
@@ -1075,13 +1111,6 @@ void OpenCLTracer::read_aux_when_packed(size_t pixels, bool straight) {
                             m.aux_read.out()),
         "reading the aux band");
   check(clFlush(m.aux_queue), "clFlush(aux)");
-}
-
-void OpenCLTracer::copy_aux_into(core::BandBuffer& target, const KFrameParams& params, const KCamera& camera,
-                                 size_t rows, bool straight) {
-  Impl& m = *impl_;
-  m.copy_aux_rows_into(target, int(params.row_begin), camera.width, rows, m.aux_staging.host(), straight,
-                       m.aux_read.get());
 }
 
 }  // namespace cohort::tracers

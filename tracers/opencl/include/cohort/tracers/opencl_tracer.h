@@ -105,11 +105,9 @@ class OpenCLTracer : public TracerBase {
   // The band's auxiliary planes from centre rays (kernel/aux_outputs.h), in three steps around the band's
   // kernel: the aux kernel (and the packing to texels when the band spans the target's width,
   // `straight`) enqueued before it; the read into page-locked memory on the second queue, overlapping it;
-  // the copy into the target once that read is done.
+  // the copy into the target once that read is done (render_band, before the next band is enqueued).
   void enqueue_aux(const core::BandJob& job, const KCamera& camera, size_t rows, bool straight);
   void read_aux_when_packed(size_t pixels, bool straight);
-  void copy_aux_into(core::BandBuffer& target, const KFrameParams& params, const KCamera& camera, size_t rows,
-                     bool straight);
   // The aux kernel's arguments for this band (and the previous camera, transforms and joints it reads),
   // then its launch (and packing) over the band's rows [first_row, first_row + rows).
   void prepare_aux(const core::BandJob& job, const KCamera& camera, size_t rows);
