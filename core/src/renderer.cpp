@@ -246,7 +246,9 @@ struct Renderer::Worker {
   // the scene diverged or when the job brings a full resync: that one is applied as always, when its job
   // starts, and its band enqueued then.
   // With two in flight it waits for the job until the band is done (band_done, polled every millisecond
-  // besides the tracer's wake-ups): the core hands it out once it has turned the frame before around.
+  // besides the tracer's wake-ups): the core hands it out once it has turned the frame before around. Once
+  // the band is done it stops waiting: a job that comes later starts as usual (there is nothing left to
+  // overlap, and enqueueing it first would only hold back the band's return, for which the core waits).
   std::optional<Tracer::QueuedNext> queued_next(const Tracer::BandDone& band_done) {
     if (scene_diverged) return std::nullopt;
     std::optional<commit::CommitBuffer> commit;
@@ -260,7 +262,7 @@ struct Renderer::Worker {
           lock.unlock();
           const bool done = band_done();
           lock.lock();
-          if (done) break;
+          if (done) return std::nullopt;
           inbox_cv.wait_for(lock, std::chrono::milliseconds(1), [&] { return quit || !inbox.empty() || woken; });
           woken = false;
         }
