@@ -14,7 +14,10 @@
 #                              names another (opencl:N counts every platform's devices: PoCL's CPU may be one);
 #                              COHORT_GPU_IN_FLIGHT="1 2" renders each mix with --frames-in-flight 1 then 2, back to
 #                              back, COHORT_GPU_ROUNDS times (default 1; docs/balancing.md, "Two frames in flight");
-#                              OPENCL in COHORT_GPU_MIXES stands for that OpenCL tracer (e.g. "embree,cuda:0,OPENCL")
+#                              OPENCL in COHORT_GPU_MIXES stands for that OpenCL tracer (e.g. "embree,cuda:0,OPENCL");
+#                              COHORT_GPU_ENQUEUE_AHEAD="1 0" renders each of those with COHORT_OPENCL_ENQUEUE_AHEAD=1
+#                              then 0, back to back (the OpenCL tracer's next band enqueued while the current one
+#                              renders, with two in flight; docs/balancing.md, "OpenCL enqueues its next band ahead")
 #   tools/gpu_run.sh compare BASE.tar.xz [MORE.tar.xz ...]  there: A/B of payloads on one machine (the staged
 #                              one against earlier stages' payload.tar.xz, renamed and carried in .gpu/): the CUDA
 #                              tracer tests of the staged one, then end-to-end ms per frame, cuda:0, both maps,
@@ -453,20 +456,27 @@ print(pick[0]["tracer"] if pick else "")' || true)}"
         for round in $(seq ${COHORT_GPU_ROUNDS:-1}); do
         # Unset: the option is not passed (payloads from before it still run).
         for in_flight in ${COHORT_GPU_IN_FLIGHT:-default}; do
+        for ahead in ${COHORT_GPU_ENQUEUE_AHEAD:-default}; do
           run=/tmp/mg_${map}_${convergence}_$(echo "$mix" | tr ',:' '__')
           in_flight_args=()
           if [ "$in_flight" != default ]; then
             run=${run}_if${in_flight}_r${round}
             in_flight_args=(--frames-in-flight "$in_flight")
           fi
-          timeout 120 "$stage/bin/cohort" render "${args[@]}" --tracers "$mix" --spp 1 --light-samples 1 --bounces 1 \
+          ahead_env=(); ahead_label=""
+          if [ "$ahead" != default ]; then
+            run=${run}_ea${ahead}
+            ahead_env=(COHORT_OPENCL_ENQUEUE_AHEAD=$ahead); ahead_label=", COHORT_OPENCL_ENQUEUE_AHEAD=$ahead"
+          fi
+          env "${ahead_env[@]}" timeout 120 "$stage/bin/cohort" render "${args[@]}" --tracers "$mix" --spp 1 --light-samples 1 --bounces 1 \
             ${COHORT_GPU_RENDER_ARGS:-} "${in_flight_args[@]}" --convergence $convergence --frames ${COHORT_GPU_FRAMES:-100} \
             --camera-path spin-slow --write last --out $run >$run.log 2>&1 ||
             { echo "== $map $convergence $mix: failed"; tail -n 3 $run.log; continue; }
-          echo "== $map map, $convergence, $mix${in_flight_args[*]:+, ${in_flight_args[*]}, round $round}"
+          echo "== $map map, $convergence, $mix${in_flight_args[*]:+, ${in_flight_args[*]}, round $round}$ahead_label"
           python3 tools/frame_times.py $run/stats.json --skip ${COHORT_GPU_SKIP:-20} --json $out/$(basename $run).json > $run/summary.txt
           head -n 1 $run/summary.txt
           grep -E "sits out|keeps its rows" $run.log | sed 's/^.*\] //' | head -n 3 || true
+        done
         done
         done
         done

@@ -53,6 +53,9 @@ struct Renderer::Worker {
     // The channel the job's tracer may take commits ahead from (Tracer::takes_commits_ahead), handed over
     // with the job: the core creates a channel on its first submit_commit, which may come while a job runs.
     commit::CommitChannel* channel = nullptr;
+    // Handed to the tracer ahead (Tracer::queued_next) while the job before rendered: its commit is applied
+    // and its commands may be in the device's queue already.
+    bool enqueued_ahead = false;
   };
 
   // Inbox, guarded by inbox_mutex: at most two frames' jobs, and a recovery job behind them.
@@ -62,6 +65,8 @@ struct Renderer::Worker {
   std::deque<Queued> inbox;
   std::atomic<bool> job_posted{false};  // !inbox.empty(), for polling without the lock
   std::chrono::microseconds handoff_spin{0};  // RendererOptions::handoff_spin
+  bool two_in_flight = false;                 // RendererOptions::frames_in_flight == 2
+  bool woken = false;  // guarded by inbox_mutex: the tracer's wake_queued_next() since queued_next looked
   // Core thread only: when this worker's last job handed out should end, and its last wall time.
   Clock::time_point expected_end{};
   double last_wall_ms = 0.0;
@@ -75,6 +80,9 @@ struct Renderer::Worker {
   // stages of what it applied ahead.
   commit::CommitChannel* ahead_channel = nullptr;
   std::vector<StageSpan> ahead_spans;
+  // Worker thread only: a job was handed to the tracer ahead (Tracer::queued_next) and has not started yet;
+  // if it never does (shutdown drops it), the tracer drains it before the thread ends.
+  bool handed_ahead = false;
   // Worker thread only: when its last job ended (for the time it waited for the next).
   std::optional<Clock::time_point> last_end;
   // Core thread only: the unwaited jobs of a benched tracer (at most one a frame in flight) with their
@@ -130,7 +138,11 @@ struct Renderer::Worker {
       {
         std::unique_lock lock(inbox_mutex);
         inbox_cv.wait(lock, [&] { return quit || !inbox.empty(); });
-        if (quit && inbox.empty()) return;
+        if (quit && inbox.empty()) {
+          lock.unlock();
+          drop_ahead();
+          return;
+        }
         current = std::move(inbox.front());
         inbox.pop_front();
         job_posted.store(!inbox.empty(), std::memory_order_relaxed);
@@ -140,6 +152,8 @@ struct Renderer::Worker {
       const auto start = Clock::now();
       if (last_end) outcome.waited_ms = std::chrono::duration<double, std::milli>(start - *last_end).count();
       const std::string track = tracer_track(id, name);
+      if (current.enqueued_ahead) handed_ahead = false;
+      bool rendered = false;  // whether render_band took the job (one enqueued ahead is then its business)
       try {
         if (current.away) tracer->while_away();
         // Apply time is part of what the tracer costs the frame, so the balancer sees it.
@@ -153,6 +167,7 @@ struct Renderer::Worker {
           if (tracer->takes_commits_ahead()) ahead_channel = current.channel;
           BandResult result;
           try {
+            rendered = true;
             result = tracer->render_band(job, targets[current.slot]);
           } catch (...) {
             end_ahead(outcome.spans);
@@ -180,6 +195,8 @@ struct Renderer::Worker {
       } catch (...) {
         outcome.error = "unknown exception";
       }
+      // Enqueued ahead but not rendered (its scene diverged): nothing may write its target once it has ended.
+      if (current.enqueued_ahead && !rendered) tracer->drop_enqueued_ahead();
       current.commit.reset();  // the records (and a resync's scene) are not kept for the next job's wait
       last_end = Clock::now();
       {
@@ -222,6 +239,71 @@ struct Renderer::Worker {
     } catch (...) {
       // apply() marked the scene diverged and asked for a resync: the next job fails until it comes.
     }
+  }
+  // Tracer::queued_next, on this worker's thread inside render_band: the next job when it is queued with
+  // final rows (two frames in flight; not a recovery job, a probe or an away tracer's side job), its commit
+  // applied here first (with the stages of what was applied ahead; the job no longer brings it). Not while
+  // the scene diverged or when the job brings a full resync: that one is applied as always, when its job
+  // starts, and its band enqueued then.
+  // With two in flight it waits for the job until the band is done (band_done, polled every millisecond
+  // besides the tracer's wake-ups): the core hands it out once it has turned the frame before around. Once
+  // the band is done it stops waiting: a job that comes later starts as usual (there is nothing left to
+  // overlap, and enqueueing it first would only hold back the band's return, for which the core waits).
+  std::optional<Tracer::QueuedNext> queued_next(const Tracer::BandDone& band_done) {
+    if (scene_diverged) return std::nullopt;
+    std::optional<commit::CommitBuffer> commit;
+    Tracer::QueuedNext next;
+    {
+      std::unique_lock lock(inbox_mutex);
+      if (two_in_flight && band_done) {
+        woken = false;
+        while (!quit && inbox.empty()) {
+          // Outside the lock: band_done may ask the device, whose completion callback may be taking it (wake).
+          lock.unlock();
+          const bool done = band_done();
+          lock.lock();
+          if (done) return std::nullopt;
+          inbox_cv.wait_for(lock, std::chrono::milliseconds(1), [&] { return quit || !inbox.empty() || woken; });
+          woken = false;
+        }
+      }
+      if (quit || inbox.empty()) return std::nullopt;
+      Queued& queued = inbox.front();
+      if (queued.recovery || queued.probe || queued.away || queued.enqueued_ahead ||
+          queued.job.params.row_end <= queued.job.params.row_begin)
+        return std::nullopt;
+      if (queued.commit && queued.commit->is_full_resync()) {
+        spdlog::debug("tracer {} ({}): not enqueueing ahead, the next job brings a full resync", id, name);
+        return std::nullopt;
+      }
+      commit = std::move(queued.commit);
+      queued.commit.reset();
+      queued.enqueued_ahead = true;
+      next.job = queued.job;
+      next.target = &targets[queued.slot];
+    }
+    handed_ahead = true;
+    if (commit && !commit->empty()) {
+      try {
+        apply(*commit, ahead_spans, tracer_track(id, name), " ahead");
+      } catch (...) {
+        // apply() marked the scene diverged and asked for a resync: the job fails when it starts.
+        return std::nullopt;
+      }
+    }
+    return next;
+  }
+  void wake() {
+    {
+      std::lock_guard lock(inbox_mutex);
+      woken = true;
+    }
+    inbox_cv.notify_all();
+  }
+  void drop_ahead() {
+    if (!handed_ahead) return;
+    handed_ahead = false;
+    tracer->drop_enqueued_ahead();
   }
   // Tracer::next_job_announced: the job this worker renders next, when it is queued already (without its
   // rows, as an announcement has none), else the core's announcement.
@@ -278,6 +360,10 @@ Renderer::Renderer(std::vector<std::unique_ptr<Tracer>> tracers, RendererOptions
     w->handoff_spin = options_.handoff_spin;
     // The worker owns the tracer, so the hook never outlives what it points at.
     if (w->tracer->takes_commits_ahead()) w->tracer->set_commits_ahead([worker = w.get()] { worker->apply_ahead(); });
+    w->two_in_flight = options_.frames_in_flight == 2;
+    if (w->tracer->enqueues_ahead())
+      w->tracer->set_queued_next([worker = w.get()](const Tracer::BandDone& done) { return worker->queued_next(done); },
+                                 [worker = w.get()] { worker->wake(); });
     if (w->tracer->takes_jobs_ahead()) {
       any_takes_jobs_ahead_ = true;
       w->tracer->set_next_job([worker = w.get(), announcement = announcement_]() -> std::optional<BandJob> {

@@ -3,12 +3,15 @@
 // own bands, faults recovered and shutdown prompt.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <chrono>
 #include <condition_variable>
 #include <future>
 #include <map>
 #include <mutex>
+#include <string>
 #include <thread>
+#include <vector>
 
 #include "cohort/core/frame_pipeline.h"
 #include "cohort/core/renderer.h"
@@ -84,6 +87,68 @@ class GatedTracer final : public Tracer {
   mutable std::mutex mutex_;
   std::vector<uint64_t> rendered_;
   std::vector<uint64_t> commits_;
+};
+
+// Enqueues ahead (Tracer::enqueues_ahead), as the OpenCL tracer does: inside each band, once its rows are
+// written, it asks for its queued next job until the band's time is up, and "enqueues" it (writes that job's
+// rows into that job's target at once). Notes in order every commit applied, band rendered and job taken ahead.
+struct AheadLog {
+  std::mutex mutex;
+  std::vector<std::string> events;
+  int dropped = 0;
+  std::promise<void> took_ahead;  // set the first time a job is taken ahead
+  bool signalled = false;
+  void note(const std::string& event) {
+    std::lock_guard lock(mutex);
+    events.push_back(event);
+  }
+  std::vector<std::string> taken() {
+    std::lock_guard lock(mutex);
+    return events;
+  }
+};
+
+class AheadTracer final : public Tracer {
+ public:
+  AheadTracer(std::shared_ptr<AheadLog> log, std::chrono::milliseconds band_time)
+      : log_(std::move(log)), band_time_(band_time) {}
+  std::string name() const override { return "ahead"; }
+  bool enqueues_ahead() const override { return true; }
+  void apply(const cohort::commit::CommitBuffer& commit) override { log_->note("apply " + std::to_string(commit.frame())); }
+  using Tracer::render_band;
+  BandResult render_band(const BandJob& job, BandBuffer& target) override {
+    const kuint frame = job.params.frame_index;
+    if (!ahead_ || ahead_->job.params.frame_index != frame || ahead_->target != &target) write_rows(job, target);
+    ahead_.reset();
+    log_->note("render " + std::to_string(frame));
+    const auto band_end = std::chrono::steady_clock::now() + band_time_;
+    if (std::optional<QueuedNext> next = queued_next([&] { return std::chrono::steady_clock::now() >= band_end; })) {
+      log_->note("ahead " + std::to_string(next->job.params.frame_index));
+      if (next->target == &target) log_->note("same target");
+      write_rows(next->job, *next->target);
+      ahead_ = next;
+      std::lock_guard lock(log_->mutex);
+      if (!log_->signalled) log_->took_ahead.set_value();
+      log_->signalled = true;
+    }
+    std::this_thread::sleep_until(band_end);
+    return {};
+  }
+  void drop_enqueued_ahead() override {
+    ahead_.reset();
+    std::lock_guard lock(log_->mutex);
+    ++log_->dropped;
+  }
+
+ private:
+  static void write_rows(const BandJob& job, BandBuffer& target) {
+    std::vector<float> row(static_cast<size_t>(target.width()) * 4, static_cast<float>(job.params.frame_index));
+    for (kuint y = job.params.row_begin; y < job.params.row_end; ++y)
+      target.store(static_cast<int>(y), 0, row.data(), static_cast<size_t>(target.width()));
+  }
+  std::shared_ptr<AheadLog> log_;
+  std::chrono::milliseconds band_time_;
+  std::optional<QueuedNext> ahead_;
 };
 
 void submit_frame_commit(Renderer& renderer, uint64_t frame, const std::shared_ptr<cohort::commit::TracerScene>& scene) {
@@ -291,6 +356,87 @@ TEST(FramesInFlight, ShutdownWithTwoFramesInFlightDoesNotHang) {
   ASSERT_EQ(closed.wait_for(std::chrono::seconds(10)), std::future_status::ready) << "shutdown hung";
   // The queued jobs of frame 1 were dropped: only the running bands of frame 0 were waited for.
   EXPECT_LT(std::chrono::steady_clock::now() - start, std::chrono::milliseconds(1500));
+}
+
+// With two in flight a tracer that enqueues ahead gets its next job inside the band before, with that job's
+// commit applied first, once; the job then brings no commit, every frame is delivered whole with its own
+// rows, and with one in flight nothing is queued to take.
+void expect_enqueued_ahead_in_order(int in_flight) {
+  auto log = std::make_shared<AheadLog>();
+  std::vector<std::unique_ptr<Tracer>> tracers;
+  tracers.push_back(std::make_unique<AheadTracer>(log, std::chrono::milliseconds(15)));
+  auto gates = std::make_shared<Gates>();
+  gates->open(1000);  // a second tracer that never waits
+  tracers.push_back(std::make_unique<GatedTracer>("open", gates));
+  RendererOptions options;
+  options.frames_in_flight = in_flight;
+  Renderer renderer(std::move(tracers), options);
+  FramePipeline pipeline(renderer);
+  auto scene = std::make_shared<cohort::commit::TracerScene>();
+  int delivered = 0;
+  auto take = [&](std::optional<FramePipeline::Delivered> done) {
+    if (!done) return;
+    expect_every_row_of_frame(pipeline.image(), done->stats.frame);
+    ++delivered;
+  };
+  constexpr uint64_t kFrames = 10;
+  for (uint64_t f = 0; f < kFrames; ++f) {
+    submit_frame_commit(renderer, f, scene);
+    take(pipeline.push(job_for(f)));
+  }
+  take(pipeline.drain());
+  EXPECT_EQ(delivered, int(kFrames));
+  const std::vector<std::string> events = log->taken();
+  auto at = [&](const std::string& event) {
+    const auto it = std::find(events.begin(), events.end(), event);
+    EXPECT_EQ(std::count(events.begin(), events.end(), event), it == events.end() ? 0 : 1) << event << " twice";
+    return it == events.end() ? -1 : static_cast<int>(it - events.begin());
+  };
+  int ahead = 0;
+  for (uint64_t f = 0; f < kFrames; ++f) {
+    const std::string n = std::to_string(f);
+    const int applied = at("apply " + n), rendered = at("render " + n), taken = at("ahead " + n);
+    ASSERT_GE(applied, 0) << "frame " << f << "'s commit was never applied";
+    ASSERT_GE(rendered, 0);
+    EXPECT_LT(applied, rendered) << "frame " << f;
+    if (taken < 0) continue;
+    ++ahead;
+    EXPECT_EQ(applied + 1, taken) << "frame " << f << "'s commit is applied just before it is handed over";
+    if (f > 0) {
+      EXPECT_LT(at("render " + std::to_string(f - 1)), applied) << "inside the band before";
+    }
+  }
+  EXPECT_EQ(std::count(events.begin(), events.end(), "same target"), 0) << "the next job renders into the other target";
+  if (in_flight == 1) {
+    EXPECT_EQ(ahead, 0);
+  } else {
+    EXPECT_GE(ahead, int(kFrames) / 2) << "the next job should be queued while most bands render";
+  }
+}
+
+TEST(FramesInFlight, ATracerThatEnqueuesAheadGetsItsQueuedJobWithItsCommitAppliedOnce) { expect_enqueued_ahead_in_order(2); }
+TEST(FramesInFlight, WithOneInFlightNothingIsEnqueuedAhead) { expect_enqueued_ahead_in_order(1); }
+
+TEST(FramesInFlight, ShutdownDrainsAJobEnqueuedAheadThatWillNotRender) {
+  auto log = std::make_shared<AheadLog>();
+  std::future<void> took_ahead = log->took_ahead.get_future();
+  std::vector<std::unique_ptr<Tracer>> tracers;
+  tracers.push_back(std::make_unique<AheadTracer>(log, std::chrono::milliseconds(200)));
+  RendererOptions options = two_in_flight();
+  options.shutdown_timeout = std::chrono::milliseconds(5000);
+  auto renderer = std::make_unique<Renderer>(std::move(tracers), options);
+  auto scene = std::make_shared<cohort::commit::TracerScene>();
+  FrameBuffer image0, image1;
+  submit_frame_commit(*renderer, 0, scene);
+  renderer->begin_frame(job_for(0), image0);
+  submit_frame_commit(*renderer, 1, scene);
+  renderer->begin_frame(job_for(1), image1);
+  ASSERT_EQ(took_ahead.wait_for(std::chrono::seconds(10)), std::future_status::ready) << "frame 1 never taken ahead";
+  renderer.reset();  // frame 1's job is dropped while frame 0's band still sleeps
+  const std::vector<std::string> events = log->taken();
+  EXPECT_EQ(std::count(events.begin(), events.end(), "render 1"), 0) << "a dropped job is not rendered";
+  std::lock_guard lock(log->mutex);
+  EXPECT_EQ(log->dropped, 1) << "the tracer is told to drain what it enqueued for the dropped job";
 }
 
 TEST(FramesInFlight, OnlyOneOrTwoFramesInFlight) {

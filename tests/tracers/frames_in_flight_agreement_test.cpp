@@ -2,19 +2,31 @@
 // with its animated materials (commits every frame) and a turning camera, the frames the pipeline delivers
 // are the frames it delivers with one in flight, bit for bit where the band split is the same (the even
 // split of `none`) or where one integrator draws both sides of the border (two Embree tracers), else within
-// the agreement bound.
+// the agreement bound. With two in flight the OpenCL tracer enqueues each band while the one before renders
+// (Tracer::enqueues_ahead): the frames must be the same bits, and the tests check that it did.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <chrono>
+#include <cstdlib>
+#include <cstring>
+#include <functional>
 #include <string>
+#include <thread>
 
 #include "cohort/core/frame_pipeline.h"
 #include "cohort/core/renderer.h"
 #include "cohort/core/view.h"
 #include "cohort/core/world_sync.h"
 #include "cohort/scene/map_loader.h"
+#include "cohort/scene/md5.h"
 #include "cohort/scene/render_world.h"
 #include "test_scenes.h"
 #include "test_tracers.h"
+
+#ifdef COHORT_HAVE_OPENCL
+#include "cohort/tracers/opencl_tracer.h"
+#endif
 
 using namespace cohort;
 using namespace cohort::test;
@@ -25,24 +37,59 @@ constexpr int kWidth = 64, kHeight = 40, kFrames = 8;
 
 struct Rendered {
   std::vector<core::FrameBuffer> images;
+  std::vector<core::GBuffer> planes;  // with aux outputs
   std::vector<core::FrameStats> stats;
+  // Summed over the OpenCL tracers: bands enqueued ahead, and those their job then found enqueued.
+  size_t enqueued_ahead = 0, finished_ahead = 0, dropped_ahead = 0;
+};
+
+#ifdef COHORT_HAVE_OPENCL
+// Counts what the OpenCL tracer enqueued ahead (OpenCLTracer::bands_enqueued_ahead, _finished_ahead).
+void count_ahead(const std::vector<core::Tracer*>& tracers, Rendered& out) {
+  for (core::Tracer* t : tracers)
+    if (const auto* opencl = dynamic_cast<const tracers::OpenCLTracer*>(t)) {
+      out.enqueued_ahead += opencl->bands_enqueued_ahead();
+      out.finished_ahead += opencl->bands_finished_ahead();
+      out.dropped_ahead += opencl->bands_dropped_ahead();
+    }
+}
+#else
+void count_ahead(const std::vector<core::Tracer*>&, Rendered&) {}
+#endif
+
+using MakeTracer = std::function<std::unique_ptr<core::Tracer>(const std::string&)>;
+
+struct Extras {
+  bool move_walker = false;  // the walker posed and moved every frame (skins, instances, the TLAS in every commit)
+  kuint aux = 0;             // KFrameParams::aux_outputs
+  MakeTracer make = make_test_tracer;
+  std::chrono::milliseconds frame_timeout{120000};
 };
 
 // kFrames of the test map's hall, each frame a little later (its materials change: commits every frame)
 // and the camera a little further round, through the pipeline as `cohort render` drives it.
-Rendered render_sequence(const std::vector<std::string>& tracer_names, const std::string& balancer, int in_flight) {
+Rendered render_sequence(const std::vector<std::string>& tracer_names, const std::string& balancer, int in_flight,
+                         const Extras& extras = {}) {
+  const bool move_walker = extras.move_walker;
+  const MakeTracer& make = extras.make;
+  const std::chrono::milliseconds frame_timeout = extras.frame_timeout;
   scene::Scene map = load_test_map();
   scene::RenderWorld world(map);
+  const int walker = world.FindEntityDef("walker_1");
+  EXPECT_GE(walker, 0);
+  const scene::RenderEntity walker_start = walker >= 0 ? *world.EntityDef(walker) : scene::RenderEntity{};
   core::WorldSyncOptions sync_options;
   sync_options.width = kWidth, sync_options.height = kHeight;
   core::WorldSync sync(world, sync_options);
   world.TakeChanges();
   std::vector<std::unique_ptr<core::Tracer>> tracers;
-  for (const std::string& name : tracer_names) tracers.push_back(make_test_tracer(name));
+  for (const std::string& name : tracer_names) tracers.push_back(make(name));
+  std::vector<core::Tracer*> made;
+  for (const auto& t : tracers) made.push_back(t.get());
   core::RendererOptions options;
   options.balancer = balancer;
   options.frames_in_flight = in_flight;
-  options.frame_timeout = std::chrono::milliseconds(120000);
+  options.frame_timeout = frame_timeout;
   core::Renderer renderer(std::move(tracers), options);
   renderer.submit_commit(commit::CommitBuffer::full(sync.snapshot(), 0));
   core::FramePipeline pipeline(renderer);
@@ -50,13 +97,23 @@ Rendered render_sequence(const std::vector<std::string>& tracer_names, const std
   auto take = [&](std::optional<core::FramePipeline::Delivered> done) {
     if (!done) return;
     out.images.push_back(pipeline.image());
+    if (extras.aux) out.planes.push_back(pipeline.gbuffer());
     out.stats.push_back(std::move(done->stats));
   };
   for (int f = 0; f < kFrames; ++f) {
     if (f > 0) {
       sync.set_time(0.3 * f);
+      if (move_walker && walker >= 0 && map.entities[size_t(walker)].anim) {
+        scene::RenderEntity def = walker_start;
+        def.joints = scene::anim_pose(*map.entities[size_t(walker)].anim, 100 * f);
+        def.origin += walker_start.axis[0] * (4.0f * float(f));
+        world.UpdateEntityDef(walker, def);
+      }
       const commit::CommitBuffer records = sync.sync(world.TakeChanges(), uint64_t(f));
       EXPECT_FALSE(records.empty()) << "frame " << f << ": the materials change every frame";
+      if (move_walker) {
+        EXPECT_FALSE(records.skin_joints().empty()) << "frame " << f << ": the walker should move";
+      }
       renderer.submit_commit(records, [&] { return sync.snapshot(); });
     }
     core::BandJob job;
@@ -64,9 +121,12 @@ Rendered render_sequence(const std::vector<std::string>& tracer_names, const std
     job.params = testmap_agreement_params(kHeight);
     job.params.spp = 2;
     job.params.frame_index = static_cast<kuint>(f);
+    job.params.aux_outputs = extras.aux;
+    if (f > 0) job.previous_camera = core::make_camera({300, 192, 80}, {180.0f + 4.0f * float(f - 1), 0.0f}, 90.0f, kWidth, kHeight);
     take(pipeline.push(job));
   }
   take(pipeline.drain());
+  count_ahead(made, out);
   return out;
 }
 
@@ -106,12 +166,198 @@ TEST(FramesInFlightAgreement, TwoEmbreeTracersDrawTheSameFramesWithTwoInFlightWh
   EXPECT_GT(moved, 0) << "the border should sit elsewhere in some frame with two in flight, or nothing was tested";
 }
 
+// With two in flight the OpenCL tracer enqueued bands while the band before rendered (their commit applied
+// ahead), and each band's job found it enqueued; with one in flight, none. Not every band: one that ends
+// before the core has handed the next frame out (it turns the frame before around meanwhile) has nothing to
+// enqueue; on this loaded 2-core VM 5 to 7 of 8 a tracer go ahead.
+void expect_enqueued_ahead(const Rendered& one, const Rendered& two, size_t opencl_tracers, const std::string& label) {
+  EXPECT_EQ(one.enqueued_ahead, 0u) << label << ": one frame in flight has no next job to enqueue";
+  EXPECT_GE(two.finished_ahead, opencl_tracers * 2) << label << ": bands were not enqueued ahead";
+  EXPECT_EQ(two.finished_ahead, two.enqueued_ahead) << label << ": a band enqueued ahead was not taken by its job";
+}
+
 TEST(FramesInFlightAgreement, EmbreeAndOpenCLDrawTheSameFramesWithTwoInFlight) {
   if (!tracer_runs_here("embree") || !tracer_runs_here("opencl")) GTEST_SKIP() << "needs the Embree and OpenCL tracers";
-  // The even split: the same rows on the same tracer either way, so the same bits.
-  expect_same_frames(render_sequence({"embree", "opencl"}, "none", 1), render_sequence({"embree", "opencl"}, "none", 2),
-                     true, "embree,opencl even split");
+  // The even split: the same rows on the same tracer either way, so the same bits; with two in flight the
+  // OpenCL bands were enqueued ahead.
+  const Rendered one = render_sequence({"embree", "opencl"}, "none", 1), two = render_sequence({"embree", "opencl"}, "none", 2);
+  expect_same_frames(one, two, true, "embree,opencl even split");
+  expect_enqueued_ahead(one, two, 1, "embree,opencl even split");
   // Rows divided by measured costs move between the two tracers differently: the agreement bound.
-  expect_same_frames(render_sequence({"embree", "opencl"}, "perfect-smooth", 1),
-                     render_sequence({"embree", "opencl"}, "perfect-smooth", 2), false, "embree,opencl balanced");
+  const Rendered balanced_one = render_sequence({"embree", "opencl"}, "perfect-smooth", 1);
+  const Rendered balanced_two = render_sequence({"embree", "opencl"}, "perfect-smooth", 2);
+  expect_same_frames(balanced_one, balanced_two, false, "embree,opencl balanced");
+  expect_enqueued_ahead(balanced_one, balanced_two, 1, "embree,opencl balanced");
 }
+
+TEST(FramesInFlightAgreement, OpenCLAloneDrawsTheSameFramesWithTwoInFlightWithAMovingWalker) {
+  if (!tracer_runs_here("opencl")) GTEST_SKIP() << "needs the OpenCL tracer";
+  // Every commit (materials, the walker's pose, its instance and the TLAS) applied ahead while the band
+  // before is still in the queue: the same bits as applied before each band.
+  const Rendered one = render_sequence({"opencl"}, "none", 1, {true}), two = render_sequence({"opencl"}, "none", 2, {true});
+  expect_same_frames(one, two, true, "opencl, moving walker");
+  expect_enqueued_ahead(one, two, 1, "opencl, moving walker");
+  // Switched off (COHORT_OPENCL_ENQUEUE_AHEAD=0), the same frames and nothing ahead.
+#ifdef COHORT_HAVE_OPENCL
+  Extras off_extras;
+  off_extras.move_walker = true;
+  off_extras.make = [](const std::string&) -> std::unique_ptr<core::Tracer> {
+    tracers::OpenCLTracer::Options o;
+    if (const char* device = std::getenv("COHORT_TEST_OPENCL_DEVICE")) o.device = std::atoi(device);
+    o.enqueue_ahead = false;
+    return std::make_unique<tracers::OpenCLTracer>(o);
+  };
+  const Rendered off = render_sequence({"opencl"}, "none", 2, off_extras);
+  expect_same_frames(one, off, true, "opencl, enqueue ahead off");
+  EXPECT_EQ(off.enqueued_ahead, 0u);
+#endif
+}
+
+TEST(FramesInFlightAgreement, TwoOpenCLTracersDrawTheSameFramesWithTwoInFlightWithAMovingWalker) {
+  if (!tracer_runs_here("opencl")) GTEST_SKIP() << "needs the OpenCL tracer";
+  const Rendered one = render_sequence({"opencl", "opencl"}, "none", 1, {true});
+  const Rendered two = render_sequence({"opencl", "opencl"}, "none", 2, {true});
+  expect_same_frames(one, two, true, "opencl,opencl, moving walker");
+  expect_enqueued_ahead(one, two, 2, "opencl,opencl, moving walker");
+}
+
+TEST(FramesInFlightAgreement, OpenCLWithCentreRayAuxPlanesDrawsTheSameFramesAndPlanesWithTwoInFlight) {
+  if (!tracer_runs_here("opencl")) GTEST_SKIP() << "needs the OpenCL tracer";
+  // The aux planes from centre rays (the apps' choice where OpenCL renders) go ahead too: their kernel, the
+  // texels' read into page-locked staging and the host copy out of it; the motion vectors read the previous
+  // frame's transforms and joints, which the next commit, applied ahead, replaces.
+  Extras extras;
+  extras.move_walker = true;
+  extras.aux = K_AUX_CENTRE_RAY;
+  const Rendered one = render_sequence({"opencl", "opencl"}, "none", 1, extras);
+  const Rendered two = render_sequence({"opencl", "opencl"}, "none", 2, extras);
+  expect_same_frames(one, two, true, "opencl,opencl, centre-ray aux");
+  expect_enqueued_ahead(one, two, 2, "opencl,opencl, centre-ray aux");
+  ASSERT_EQ(one.planes.size(), size_t(kFrames));
+  ASSERT_EQ(two.planes.size(), size_t(kFrames));
+  int moving = 0;
+  for (int f = 0; f < kFrames; ++f) {
+    const core::GBuffer& a = one.planes[f];
+    const core::GBuffer& b = two.planes[f];
+    ASSERT_FALSE(a.empty());
+    EXPECT_EQ(a.depth, b.depth) << "frame " << f;
+    EXPECT_EQ(a.prev_depth, b.prev_depth) << "frame " << f;
+    EXPECT_EQ(a.motion, b.motion) << "frame " << f;
+    EXPECT_EQ(a.normal, b.normal) << "frame " << f;
+    EXPECT_EQ(a.albedo, b.albedo) << "frame " << f;
+    EXPECT_EQ(a.id, b.id) << "frame " << f;
+    moving += std::any_of(a.motion.begin(), a.motion.end(), [](float m) { return m != 0.0f; });
+  }
+  EXPECT_GT(moving, kFrames / 2) << "the camera turns: motion vectors should not all be 0";
+}
+
+#ifdef COHORT_HAVE_OPENCL
+// What an OpenCL tracer enqueued ahead, finished and dropped, as it is destroyed (after its last job).
+struct AheadCounts {
+  size_t enqueued = 0, finished = 0, dropped = 0;
+  bool faulted_with_next_enqueued = false;  // the next band was enqueued ahead inside the faulty one
+  bool destroyed = false;
+};
+
+// The OpenCL tracer failing on one frame after its band (and the next one, enqueued ahead inside it) is in
+// the queue: throwing, or returning only after `stall`, past the frame's timeout.
+class FaultyOpenCL final : public tracers::OpenCLTracer {
+ public:
+  FaultyOpenCL(const Options& options, kuint fault_frame, std::chrono::milliseconds stall,
+               std::shared_ptr<AheadCounts> counts)
+      : tracers::OpenCLTracer(options), fault_frame_(fault_frame), stall_(stall), counts_(std::move(counts)) {}
+  ~FaultyOpenCL() override {
+    *counts_ = {bands_enqueued_ahead(), bands_finished_ahead(), bands_dropped_ahead(), faulted_with_next_enqueued_, true};
+  }
+  using core::Tracer::render_band;
+  core::BandResult render_band(const core::BandJob& job, core::BandBuffer& target) override {
+    const bool fault = job.params.frame_index == fault_frame_;
+    // Long enough for the core to hand the next frame out (it does not wait for this band to do so): the
+    // band then enqueues its successor ahead, whatever the load on this machine.
+    if (fault) std::this_thread::sleep_for(std::chrono::milliseconds(300));
+    const size_t ahead_before = bands_enqueued_ahead();
+    core::BandResult result = tracers::OpenCLTracer::render_band(job, target);
+    if (!fault) return result;
+    faulted_with_next_enqueued_ = bands_enqueued_ahead() > ahead_before;
+    if (stall_.count() == 0) throw std::runtime_error("injected fault after the band");
+    std::this_thread::sleep_for(stall_);
+    return result;
+  }
+
+ private:
+  kuint fault_frame_;
+  std::chrono::milliseconds stall_;
+  std::shared_ptr<AheadCounts> counts_;
+  bool faulted_with_next_enqueued_ = false;
+};
+
+// stall: 0 for a throw. A stall of 3 s outlasts the sequence: the Renderer shuts down while the band stalls,
+// and drops the next job, whose band the tracer enqueued ahead: it drains it (the shutdown waits up to 2 s).
+void expect_fault_recovered(std::chrono::milliseconds stall_time) {
+  const bool stall = stall_time.count() > 0;
+  const bool outlasts = stall_time >= std::chrono::seconds(2);
+  if (!tracer_runs_here("embree") || !tracer_runs_here("opencl")) GTEST_SKIP() << "needs the Embree and OpenCL tracers";
+  constexpr kuint kFaultFrame = 3;
+  bool made = false;
+  auto counts = std::make_shared<AheadCounts>();
+  const MakeTracer make = [&](const std::string& name) -> std::unique_ptr<core::Tracer> {
+    if (name != "opencl") return make_test_tracer(name);
+    tracers::OpenCLTracer::Options o;
+    if (const char* device = std::getenv("COHORT_TEST_OPENCL_DEVICE")) o.device = std::atoi(device);
+    auto t = std::make_unique<FaultyOpenCL>(o, kFaultFrame, stall_time, counts);
+    made = true;
+    return t;
+  };
+  const Rendered reference = render_sequence({"embree", "opencl"}, "none", 1);
+  // A PoCL band here takes tens of ms; the timeout 0.8 s.
+  Extras extras;
+  extras.make = make;
+  extras.frame_timeout = std::chrono::milliseconds(800);
+  const Rendered faulted = render_sequence({"embree", "opencl"}, "none", 2, extras);
+  ASSERT_TRUE(made);
+  ASSERT_TRUE(counts->destroyed) << "the stalled tracer outlived the Renderer's shutdown";
+  EXPECT_TRUE(counts->faulted_with_next_enqueued) << "the next band should have been enqueued ahead of the fault";
+  EXPECT_GT(counts->finished, 0u);
+  EXPECT_EQ(counts->enqueued, counts->finished + counts->dropped) << "a band enqueued ahead was neither taken nor drained";
+  EXPECT_EQ(counts->dropped, outlasts ? 1u : 0u) << "the job dropped at shutdown had its band enqueued ahead";
+  ASSERT_EQ(faulted.images.size(), size_t(kFrames));
+  ASSERT_EQ(faulted.stats.size(), size_t(kFrames));
+  const core::TracerOutcome expected = stall ? core::TracerOutcome::timed_out : core::TracerOutcome::threw;
+  EXPECT_EQ(faulted.stats[kFaultFrame].tracers[1].outcome, expected);
+  // Every frame whole and in order. The rows each tracer rendered in its own band of its own frame are the
+  // reference's bits; rows re-rendered after a fault show the frame after's scene (docs/balancing.md, "Two
+  // frames in flight"), and a frame one tracer sat out has another split: those are only checked lit.
+  for (int f = 0; f < kFrames; ++f) {
+    EXPECT_EQ(faulted.stats[f].frame, uint64_t(f));
+    const core::FrameBuffer& a = reference.images[f];
+    const core::FrameBuffer& b = faulted.images[f];
+    for (int y = 0; y < kHeight; ++y) {
+      double sum = 0.0;
+      for (int x = 0; x < kWidth * 4; ++x) sum += b.row(y)[x];
+      EXPECT_GT(sum, 0.0) << "frame " << f << " row " << y << " is black: not delivered whole";
+    }
+    for (size_t t = 0; t < 2; ++t) {
+      const core::TracerFrameStats& mine = faulted.stats[f].tracers[t];
+      const core::TracerFrameStats& theirs = reference.stats[f].tracers[t];
+      if (mine.outcome != core::TracerOutcome::rendered || mine.row_begin != theirs.row_begin || mine.row_end != theirs.row_end)
+        continue;
+      for (int y = mine.row_begin; y < mine.row_end; ++y)
+        ASSERT_EQ(std::memcmp(a.row(y), b.row(y), sizeof(float) * 4 * kWidth), 0)
+            << "frame " << f << " row " << y << " of tracer " << t << "'s own band differs from the reference";
+    }
+  }
+  if (!outlasts) {
+    EXPECT_EQ(faulted.stats[kFrames - 1].tracers[1].outcome, core::TracerOutcome::rendered) << "the OpenCL tracer rejoins";
+  }
+}
+
+TEST(FramesInFlightAgreement, AThrownOpenCLBandWithItsSuccessorEnqueuedAheadIsRecovered) {
+  expect_fault_recovered(std::chrono::milliseconds(0));
+}
+TEST(FramesInFlightAgreement, AStalledOpenCLBandWithItsSuccessorEnqueuedAheadIsRecovered) {
+  expect_fault_recovered(std::chrono::milliseconds(700));
+}
+TEST(FramesInFlightAgreement, ShutdownDuringAStalledOpenCLBandDrainsTheBandEnqueuedAheadForTheDroppedJob) {
+  expect_fault_recovered(std::chrono::milliseconds(3000));
+}
+#endif

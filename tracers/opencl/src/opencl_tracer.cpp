@@ -4,6 +4,11 @@
 
 #include <algorithm>
 #include <array>
+#include <atomic>
+#include <exception>
+#include <memory>
+#include <mutex>
+#include <optional>
 #include <chrono>
 #include <cstring>
 #include <stdexcept>
@@ -110,16 +115,22 @@ class DeviceBuffer {
   DeviceBuffer() = default;
   DeviceBuffer(const DeviceBuffer&) = delete;
   DeviceBuffer& operator=(const DeviceBuffer&) = delete;
-  ~DeviceBuffer() { reset(); }
+  ~DeviceBuffer() {
+    settle();
+    reset();
+  }
   void reset() {
     if (mem_) clReleaseMemObject(mem_);
     mem_ = nullptr;
     bytes_ = 0;
   }
-  // blocking: CL_FALSE only where `data` stays untouched until the queue is finished.
+  // blocking: CL_FALSE only where `data` stays untouched until the queue is finished. staged: `data` copied
+  // here and written from the copy without blocking, the copy kept until the write is done (a commit applied
+  // ahead, while the band before is still in the queue: a blocking write would wait for that band, and the
+  // scene's arrays change with the next commit).
   template <class T>
   void upload(cl_context context, cl_command_queue queue, const std::vector<T>& data, const char* what,
-              cl_bool blocking = CL_TRUE) {
+              cl_bool blocking = CL_TRUE, bool staged = false) {
     size_t bytes = std::max<size_t>(data.size() * sizeof(T), 16);
     if (bytes > bytes_) {
       reset();
@@ -129,15 +140,31 @@ class DeviceBuffer {
       check(err, what);
       bytes_ = bytes;
     }
-    if (!data.empty())
-      check(clEnqueueWriteBuffer(queue, mem_, blocking, 0, data.size() * sizeof(T), data.data(), 0, nullptr, nullptr),
-            what);
+    if (data.empty()) return;
+    if (staged) {
+      settle();
+      const auto* from = reinterpret_cast<const unsigned char*>(data.data());
+      staged_.assign(from, from + data.size() * sizeof(T));
+      check(clEnqueueWriteBuffer(queue, mem_, CL_FALSE, 0, staged_.size(), staged_.data(), 0, nullptr, &written_), what);
+      return;
+    }
+    check(clEnqueueWriteBuffer(queue, mem_, blocking, 0, data.size() * sizeof(T), data.data(), 0, nullptr, nullptr),
+          what);
   }
   cl_mem mem() const { return mem_; }
 
  private:
+  // The last staged write done (and its copy free to go or be overwritten).
+  void settle() {
+    if (!written_) return;
+    clWaitForEvents(1, &written_);
+    clReleaseEvent(written_);
+    written_ = nullptr;
+  }
   cl_mem mem_ = nullptr;
   size_t bytes_ = 0;
+  std::vector<unsigned char> staged_;
+  cl_event written_ = nullptr;
 };
 
 // An event the tracer waits on or times, released when it goes out of scope (also on a throw).
@@ -155,6 +182,12 @@ class Event {
     return &event_;
   }
   cl_event get() const { return event_; }
+  // Takes `other`'s event over (a band's own copy of an event the tracer keeps for the band being enqueued).
+  void take(Event& other) {
+    if (event_) clReleaseEvent(event_);
+    event_ = other.event_;
+    other.event_ = nullptr;
+  }
   // The command's start or end on the device clock (the queue profiles), 0 when unknown.
   cl_ulong time(cl_profiling_info which) const {
     cl_ulong t = 0;
@@ -208,6 +241,26 @@ class PinnedStaging {
 };
 
 }  // namespace
+
+struct OpenCLTracer::EnqueuedBand {
+  core::BandJob job;  // as handed over: render_band matches the next job against it
+  core::BandBuffer* target = nullptr;
+  // Written to the device without blocking and read into without blocking: kept until the band is done.
+  KFrameParams params{};
+  KCamera camera{};
+  std::vector<float> band;  // a band narrower than the target, read before it is stored row by row
+  std::vector<cl_uint> row_rays;
+  size_t rows = 0;
+  bool straight = false, write_aux = false, aux_from_paths = false;
+  bool whole_band = false;  // its rows end where the frame's do (row_work is reported then)
+  OpenCLWavefront* wave = nullptr;
+  Event band_started, band_done, band_read, last;  // last: the row counts' read, the band's last command
+  // With aux planes from centre rays: the aux kernel (the band's clock starts there) and the texels' read
+  // into page-locked staging, taken over from Impl's once enqueued, so that the next band's may follow.
+  Event aux_kernel_done, aux_read;
+  double enqueue_ms = 0.0;  // the host's time enqueueing it (enqueue_band), for the debug log
+  bool ahead = false;       // enqueued ahead, inside the band before
+};
 
 struct OpenCLTracer::Impl {
   std::string label;
@@ -290,6 +343,17 @@ struct OpenCLTracer::Impl {
   Event aux_kernel_done, aux_packed, aux_read;
   KCamera previous_camera_host{};
   PinnedStaging aux_staging;
+
+  // Enqueueing ahead (Options::enqueue_ahead): the next band, enqueued while the one before rendered, until
+  // render_band takes it; whether a commit is being applied ahead (its uploads then staged, not blocking).
+  bool enqueue_ahead = true;
+  bool applying_ahead = false;
+  std::unique_ptr<EnqueuedBand> ahead;
+  std::atomic<size_t> enqueued_ahead{0}, finished_ahead{0}, dropped_ahead{0};
+  void finish_queues() {
+    for (cl_command_queue q : {queue, aux_queue, lane_queue})
+      if (q) clFinish(q);
+  }
 
   // A device buffer of at least `bytes`, reallocated (contents lost) when it is smaller.
   cl_mem& grow(cl_mem& mem, size_t& capacity, size_t bytes, const char* what) {
@@ -397,8 +461,9 @@ struct OpenCLTracer::Impl {
   }
 
   ~Impl() {
-    if (aux_queue) clFinish(aux_queue);
-    if (lane_queue) clFinish(lane_queue);
+    // A band enqueued ahead may still read into its target: done before anything goes.
+    finish_queues();
+    ahead.reset();
     wavefront.reset();
     aux_staging.reset();
     for (cl_mem m : {params, camera, previous_camera, output, row_rays, aux, packed, packed_aux, first_hits})
@@ -440,6 +505,7 @@ OpenCLTracer::OpenCLTracer(const Options& options) : impl_(std::make_unique<Impl
                                 " is outside 1-" + std::to_string(kMaxFirstHitPieces));
   impl_->first_hit_pieces = options.first_hit_pieces;
   impl_->aux_into_target = options.aux_into_target;
+  impl_->enqueue_ahead = options.enqueue_ahead;
   std::vector<DeviceEntry> devices = all_devices();
   if (devices.empty()) throw std::runtime_error("OpenCLTracer: no OpenCL platform/device found");
   if (options.device < 0 || static_cast<size_t>(options.device) >= devices.size())
@@ -538,34 +604,38 @@ void OpenCLTracer::upload(const commit::ChangeSet& changes) {
   const bool all = changes.full_resync;
   cl_context c = m.context;
   cl_command_queue q = m.queue;
+  // Applied ahead (enqueue_next_ahead), the band before is still in the queue: written without blocking, from
+  // copies (the in-order queue runs the writes after that band's kernels).
+  const bool staged = m.applying_ahead;
+  auto up = [&](DeviceBuffer& buffer, const auto& data, const char* what) { buffer.upload(c, q, data, what, CL_TRUE, staged); };
   if (all || changes.geometry) {
-    m.vertices.upload(c, q, s.vertices, "uploading vertices");
-    m.vertex_colors.upload(c, q, s.vertex_colors, "uploading vertex colours");
-    m.triangles.upload(c, q, s.triangles, "uploading triangles");
-    m.blas_nodes.upload(c, q, s.blas_nodes, "uploading BLAS nodes");
-    m.blases.upload(c, q, s.blases, "uploading BLASes");
+    up(m.vertices, s.vertices, "uploading vertices");
+    up(m.vertex_colors, s.vertex_colors, "uploading vertex colours");
+    up(m.triangles, s.triangles, "uploading triangles");
+    up(m.blas_nodes, s.blas_nodes, "uploading BLAS nodes");
+    up(m.blases, s.blases, "uploading BLASes");
   }
   if (all || changes.instances || changes.tlas) {
-    m.instances.upload(c, q, s.instances, "uploading instances");
-    m.tlas_nodes.upload(c, q, s.tlas_nodes, "uploading TLAS nodes");
+    up(m.instances, s.instances, "uploading instances");
+    up(m.tlas_nodes, s.tlas_nodes, "uploading TLAS nodes");
   }
-  if (all || changes.materials) m.materials.upload(c, q, s.materials, "uploading materials");
+  if (all || changes.materials) up(m.materials, s.materials, "uploading materials");
   if (all || changes.textures) {
-    m.textures.upload(c, q, s.textures, "uploading textures");
-    m.texels.upload(c, q, s.texels, "uploading texels");
+    up(m.textures, s.textures, "uploading textures");
+    up(m.texels, s.texels, "uploading texels");
   }
-  if (all || changes.lights) m.lights.upload(c, q, s.lights, "uploading lights");
-  if (all || changes.light_tree) m.light_nodes.upload(c, q, s.light_nodes, "uploading the light tree");
-  if (all || changes.emissive) m.emissive.upload(c, q, s.emissive_triangles, "uploading emissive triangles");
+  if (all || changes.lights) up(m.lights, s.lights, "uploading lights");
+  if (all || changes.light_tree) up(m.light_nodes, s.light_nodes, "uploading the light tree");
+  if (all || changes.emissive) up(m.emissive, s.emissive_triangles, "uploading emissive triangles");
   if (all || changes.skin_data) {
-    m.skins.upload(c, q, s.skins, "uploading skins");
-    m.skin_vertices.upload(c, q, s.skin_vertices, "uploading skin vertices");
-    m.skin_weights.upload(c, q, s.skin_weights, "uploading skin weights");
-    m.skin_triangles.upload(c, q, s.skin_triangles, "uploading skin triangles");
-    m.skin_adjacency.upload(c, q, s.skin_adjacency, "uploading skin adjacency");
-    m.skin_faces.upload(c, q, s.skin_faces, "sizing the skin faces");   // the kernels write them
+    up(m.skins, s.skins, "uploading skins");
+    up(m.skin_vertices, s.skin_vertices, "uploading skin vertices");
+    up(m.skin_weights, s.skin_weights, "uploading skin weights");
+    up(m.skin_triangles, s.skin_triangles, "uploading skin triangles");
+    up(m.skin_adjacency, s.skin_adjacency, "uploading skin adjacency");
+    up(m.skin_faces, s.skin_faces, "sizing the skin faces");   // the kernels write them
   }
-  if (all || !changes.posed_skins.empty()) m.joints.upload(c, q, s.joints, "uploading joints");
+  if (all || !changes.posed_skins.empty()) up(m.joints, s.joints, "uploading joints");
   // Vertices just uploaded from the host copy are not posed there (the host keeps only the joints), so
   // every skin runs again after a geometry upload; otherwise only the skins whose joints changed.
   if (all || changes.geometry) {
@@ -606,16 +676,123 @@ std::vector<size_t> OpenCLTracer::piece_starts(size_t rows, int pieces, size_t g
   return starts;
 }
 
+namespace {
+
+// On a throw, every queue drained before the host memory its commands use goes: declared after that memory.
+struct DrainOnThrow {
+  cl_command_queue a, b, c;
+  int exceptions = std::uncaught_exceptions();
+  ~DrainOnThrow() {
+    if (std::uncaught_exceptions() <= exceptions) return;
+    for (cl_command_queue q : {a, b, c})
+      if (q) clFinish(q);
+  }
+};
+
+// Set by the OpenCL runtime's completion callback on a band's last command (on a thread of its own, maybe
+// after the band's wait has returned): while armed, it wakes the worker waiting for the next job.
+struct BandSignal {
+  std::atomic<bool> done{false};
+  std::mutex mutex;
+  bool armed = true;
+  const core::Tracer* tracer = nullptr;
+  void fire() {
+    done = true;
+    std::lock_guard lock(mutex);
+    if (armed) tracer->wake_queued_next();
+  }
+  void disarm() {
+    std::lock_guard lock(mutex);
+    armed = false;
+  }
+};
+
+void CL_CALLBACK band_completed(cl_event, cl_int, void* user) {
+  auto* signal = static_cast<std::shared_ptr<BandSignal>*>(user);
+  (*signal)->fire();
+  delete signal;
+}
+
+bool event_ended(cl_event event) {
+  cl_int status = CL_COMPLETE;
+  if (clGetEventInfo(event, CL_EVENT_COMMAND_EXECUTION_STATUS, sizeof status, &status, nullptr) != CL_SUCCESS) return true;
+  return status <= CL_COMPLETE;  // complete, or failed (negative)
+}
+
+bool same_job(const core::BandJob& a, const core::BandJob& b) {
+  return std::memcmp(&a.params, &b.params, sizeof a.params) == 0 && std::memcmp(&a.camera, &b.camera, sizeof a.camera) == 0 &&
+         std::memcmp(&a.previous_camera, &b.previous_camera, sizeof a.previous_camera) == 0 &&
+         a.keep_on_device == b.keep_on_device;
+}
+
+}  // namespace
+
 core::BandResult OpenCLTracer::render_band(const core::BandJob& job, core::BandBuffer& target) {
   Impl& m = *impl_;
   if (!has_scene()) throw std::runtime_error("OpenCLTracer: render_band before any commit was applied");
-  KFrameParams params = frame_params(job);
-  KCamera camera = job.camera;
+  using Clock = std::chrono::steady_clock;
+  const auto entry = Clock::now();
+  std::unique_ptr<EnqueuedBand> band;
+  // A throw from here on (the aux copy, the wait, the next band's enqueueing) drains every queue before the
+  // band's memory goes; the band enqueued ahead, if any, stays for its job.
+  DrainOnThrow drain{m.queue, m.aux_queue, m.lane_queue};
+  if (m.ahead) {
+    if (m.ahead->target == &target && same_job(m.ahead->job, job)) {
+      band = std::move(m.ahead);
+      ++m.finished_ahead;
+    } else {
+      spdlog::debug("opencl ({}): the band enqueued ahead is not this job's; drained, and this one enqueued now",
+                    m.label);
+      drop_enqueued_ahead();
+    }
+  }
+  if (!band) {
+    band = enqueue_band(job, target);
+    if (band->rows == 0) return {};
+    if (band->aux_from_paths)
+      return render_first_hits_in_pieces(job, target, band->params, band->camera, band->straight, band->wave);
+  }
+  // The host's share of the aux planes (out of page-locked memory into the target) while the band renders;
+  // done before the next band is enqueued, whose aux texels are read into the same staging.
+  if (band->write_aux)
+    m.copy_aux_rows_into(target, int(band->params.row_begin), band->camera.width, band->rows, m.aux_staging.host(),
+                         band->straight, band->aux_read.get());
+  // The host's time from this job's start until its band is all in the queue: the whole enqueueing, or
+  // nothing where it was enqueued ahead.
+  const auto queued = Clock::now();
+  enqueue_next_ahead(*band);
+  const auto waiting = Clock::now();
+  core::BandResult result = finish_band(*band);
+  if (spdlog::should_log(spdlog::level::debug)) {
+    const auto ms = [](Clock::time_point a, Clock::time_point b) { return std::chrono::duration<double, std::milli>(b - a).count(); };
+    spdlog::debug("opencl ({}): band [{}, {}) of frame {}: {} in {:.3f} ms; {:.3f} ms before it was all in the queue, "
+                  "{:.3f} ms on the next band ahead ({}), {:.3f} ms waiting",
+                  m.label, band->params.row_begin, band->params.row_end, band->params.frame_index,
+                  band->ahead ? "enqueued ahead" : "enqueued", band->enqueue_ms, ms(entry, queued), ms(queued, waiting),
+                  m.ahead ? "enqueued" : "none", ms(waiting, Clock::now()));
+  }
+  return result;
+}
+
+std::unique_ptr<OpenCLTracer::EnqueuedBand> OpenCLTracer::enqueue_band(const core::BandJob& job,
+                                                                      core::BandBuffer& target) {
+  Impl& m = *impl_;
+  const auto started = std::chrono::steady_clock::now();
+  auto b = std::make_unique<EnqueuedBand>();
+  b->job = job;
+  b->target = &target;
+  KFrameParams& params = b->params;
+  KCamera& camera = b->camera;
+  params = frame_params(job);
+  camera = job.camera;
   params.row_end = std::min<kuint>(params.row_end, static_cast<kuint>(target.height()));
   camera.width = std::min<kuint>(camera.width, static_cast<kuint>(target.width()));
-  if (params.row_end <= params.row_begin || camera.width == 0) return {};
+  if (params.row_end <= params.row_begin || camera.width == 0) return b;
+  b->whole_band = params.row_end == frame_params(job).row_end;
   const size_t rows = params.row_end - params.row_begin;
   const size_t bytes = rows * camera.width * 4 * sizeof(float);
+  // Grown buffers are released under the band before still in the queue: OpenCL keeps a memory object until
+  // the commands that use it are done.
   cl_int err = CL_SUCCESS;
   if (bytes > m.output_bytes) {
     if (m.output) clReleaseMemObject(m.output);
@@ -629,11 +806,10 @@ core::BandResult OpenCLTracer::render_band(const core::BandJob& job, core::BandB
     check(err, "clCreateBuffer(row rays)");
     m.row_rays_rows = rows;
   }
-  std::vector<float> band;  // a band narrower than the target, read before it is stored row by row
-  std::vector<cl_uint> row_rays(rows);
-  // The reads and writes below run from and into this function's locals without blocking: whatever way
-  // it leaves, both queues are done first (the guard goes after those locals).
-  FinishQueues finish_queues{m.queue, m.aux_queue, m.lane_queue};
+  b->row_rays.resize(rows);
+  // The reads and writes below run from and into the band's own memory without blocking: on a throw every
+  // queue is done before it goes (the guard goes after it).
+  DrainOnThrow drain{m.queue, m.aux_queue, m.lane_queue};
   const cl_uint zero = 0;
   check(clEnqueueFillBuffer(m.queue, m.row_rays, &zero, sizeof zero, 0, rows * sizeof(cl_uint), 0, nullptr, nullptr),
         "clearing the row ray counts");
@@ -648,6 +824,10 @@ core::BandResult OpenCLTracer::render_band(const core::BandJob& job, core::BandB
   const bool write_aux = params.aux_outputs != 0u && target.has_aux();
   const bool aux_from_paths = write_aux && k_aux_from_paths(&params);
   const bool straight = target.width() == static_cast<int>(camera.width);
+  b->rows = rows;
+  b->straight = straight;
+  b->write_aux = write_aux;
+  b->aux_from_paths = aux_from_paths;
   cl_mem args[] = {m.vertices.mem(),  m.vertex_colors.mem(), m.triangles.mem(), m.blas_nodes.mem(), m.blases.mem(),
                    m.instances.mem(), m.tlas_nodes.mem(), m.materials.mem(), m.textures.mem(),
                    m.texels.mem(),    m.lights.mem(),     m.light_nodes.mem(), m.emissive.mem(),
@@ -664,17 +844,16 @@ core::BandResult OpenCLTracer::render_band(const core::BandJob& job, core::BandB
   }
   OpenCLWavefront::BandArgs band_args;
   std::copy(std::begin(args), std::end(args), band_args.begin());
-  OpenCLWavefront* wave = m.wavefront_for(params, band_args, rows * camera.width, records);
-  if (aux_from_paths) return render_first_hits_in_pieces(job, target, params, camera, straight, wave);
+  b->wave = m.wavefront_for(params, band_args, rows * camera.width, records);
+  if (aux_from_paths) return b;  // the rest in pieces, in render_first_hits_in_pieces
   if (write_aux) enqueue_aux(job, camera, rows, straight);
-  Event band_started, band_done;
-  m.enqueue_band_rows(band_kernel, wave, params, camera.width, 0, rows, &band_started, &band_done);
+  m.enqueue_band_rows(band_kernel, b->wave, params, camera.width, 0, rows, &b->band_started, &b->band_done);
   // The band goes straight into its rows of the target, converted on the device to the target's format.
   const size_t pixels = rows * camera.width;
   size_t band_bytes = bytes;
   cl_mem band_mem = m.output;
   if (!straight) {
-    band.resize(pixels * 4);
+    b->band.resize(pixels * 4);
   } else if (target.format() != core::BandFormat::rgba32f) {
     band_bytes = pixels * core::bytes_per_pixel(target.format());
     band_mem = m.grow(m.packed, m.packed_bytes, band_bytes, "clCreateBuffer(packed band)");
@@ -683,32 +862,102 @@ core::BandResult OpenCLTracer::render_band(const core::BandJob& job, core::BandB
   // Both kernels are on the device before any read is enqueued: a driver that copies into pageable
   // memory at enqueue time then still overlaps the aux read with the band's kernel.
   check(clFlush(m.queue), "clFlush");
-  if (write_aux) read_aux_when_packed(rows * camera.width, straight);
-  void* band_destination = straight ? target.row(int(params.row_begin)) : band.data();
-  Event band_read;
-  check(clEnqueueReadBuffer(m.queue, band_mem, CL_FALSE, 0, band_bytes, band_destination, 0, nullptr, band_read.out()),
+  if (write_aux) {
+    read_aux_when_packed(rows * camera.width, straight);
+    b->aux_kernel_done.take(m.aux_kernel_done);
+    b->aux_read.take(m.aux_read);
+  }
+  void* band_destination = straight ? target.row(int(params.row_begin)) : b->band.data();
+  check(clEnqueueReadBuffer(m.queue, band_mem, CL_FALSE, 0, band_bytes, band_destination, 0, nullptr, b->band_read.out()),
         "reading the band");
-  check(clEnqueueReadBuffer(m.queue, m.row_rays, CL_FALSE, 0, rows * sizeof(cl_uint), row_rays.data(), 0, nullptr, nullptr),
+  check(clEnqueueReadBuffer(m.queue, m.row_rays, CL_FALSE, 0, rows * sizeof(cl_uint), b->row_rays.data(), 0, nullptr,
+                            b->last.out()),
         "reading the row ray counts");
   check(clFlush(m.queue), "clFlush");
-  // The host's share of the aux planes (out of page-locked memory into the target) while the band renders.
-  if (write_aux) copy_aux_into(target, params, camera, rows, straight);
-  check(clFinish(m.queue), "waiting for the band");
-  for (size_t r = 0; r < rows && !straight; ++r)
-    target.store(static_cast<int>(params.row_begin + r), 0, band.data() + r * camera.width * 4, camera.width,
-                 params.frame_index);
+  b->enqueue_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - started).count();
+  return b;
+}
+
+void OpenCLTracer::enqueue_next_ahead(const EnqueuedBand& current) {
+  Impl& m = *impl_;
+  if (!m.enqueue_ahead || m.ahead) return;
+  // The worker waits for the next job until the current band's last command is done: the runtime's callback
+  // wakes it then (it also looks at the event's status every millisecond).
+  const cl_event last = current.last.get();
+  auto signal = std::make_shared<BandSignal>();
+  signal->tracer = this;
+  auto* user = new std::shared_ptr<BandSignal>(signal);
+  if (clSetEventCallback(last, CL_COMPLETE, band_completed, user) != CL_SUCCESS) delete user;
+  struct Disarm {
+    BandSignal& signal;
+    ~Disarm() { signal.disarm(); }
+  } disarm{*signal};
+  const BandDone band_done = [&] { return signal->done.load() || event_ended(last); };
+  // The next job's commit is applied inside queued_next, on this thread: its uploads staged, not blocking.
+  struct Applying {
+    bool& flag;
+    explicit Applying(bool& f) : flag(f) { flag = true; }
+    ~Applying() { flag = false; }
+  };
+  std::optional<QueuedNext> next;
+  {
+    Applying applying(m.applying_ahead);
+    next = queued_next(band_done);
+  }
+  if (!next) return;
+  if (next->job.params.aux_outputs != 0u && next->target->has_aux() && k_aux_from_paths(&next->job.params)) {
+    // Its aux planes from its paths' first hits come in pieces whose host copies interleave with the waits
+    // (render_first_hits_in_pieces): it is enqueued when its job starts. (Centre rays go ahead: this band's
+    // aux texels are out of the page-locked staging by now, and its aux read done.)
+    spdlog::debug("opencl ({}): the next band's aux planes come from its paths' first hits; not enqueued ahead", m.label);
+    return;
+  }
+  try {
+    std::unique_ptr<EnqueuedBand> b = enqueue_band(next->job, *next->target);
+    if (b->rows == 0) return;
+    b->ahead = true;
+    m.ahead = std::move(b);
+    ++m.enqueued_ahead;
+  } catch (const std::exception& e) {
+    // enqueue_band drained the queues: nothing of it is left to write anywhere. Its job enqueues it again.
+    spdlog::warn("opencl ({}): enqueueing the next band ahead failed ({}); it is enqueued when its job starts", m.label,
+                 e.what());
+  }
+}
+
+core::BandResult OpenCLTracer::finish_band(EnqueuedBand& b) {
+  const cl_event last = b.last.get();
+  check(clWaitForEvents(1, &last), "waiting for the band");
+  const KFrameParams& params = b.params;
+  const size_t width = b.camera.width;
+  for (size_t r = 0; r < b.rows && !b.straight; ++r)
+    b.target->store(static_cast<int>(params.row_begin + r), 0, b.band.data() + r * width * 4, width, params.frame_index);
   // Device time from the first kernel (the aux one when it ran first, as the CUDA tracer times it) to the
   // band's last kernel.
-  const cl_ulong start = (write_aux ? m.aux_kernel_done : band_started).time(CL_PROFILING_COMMAND_START);
-  const cl_ulong end = band_done.time(CL_PROFILING_COMMAND_END);
+  const cl_ulong start = (b.write_aux ? b.aux_kernel_done : b.band_started).time(CL_PROFILING_COMMAND_START);
+  const cl_ulong end = b.band_done.time(CL_PROFILING_COMMAND_END);
   core::BandResult result;
   result.device_ms = end > start && start != 0 ? double(end - start) * 1e-6 : 0.0;
   // The band's way back (the packing to RGB16F or RGB9E5, then the read), as the CUDA tracer reports it.
-  const cl_ulong read_end = band_read.time(CL_PROFILING_COMMAND_END);
+  const cl_ulong read_end = b.band_read.time(CL_PROFILING_COMMAND_END);
   if (result.device_ms > 0.0 && read_end > end) result.transfer_ms = double(read_end - end) * 1e-6;
-  if (params.row_end == frame_params(job).row_end) result.row_work.assign(row_rays.begin(), row_rays.end());
+  if (b.whole_band) result.row_work.assign(b.row_rays.begin(), b.row_rays.end());
   return result;
 }
+
+bool OpenCLTracer::enqueues_ahead() const { return impl_->enqueue_ahead; }
+
+void OpenCLTracer::drop_enqueued_ahead() {
+  Impl& m = *impl_;
+  if (!m.ahead) return;
+  m.finish_queues();
+  m.ahead.reset();
+  ++m.dropped_ahead;
+}
+
+size_t OpenCLTracer::bands_enqueued_ahead() const { return impl_->enqueued_ahead.load(); }
+size_t OpenCLTracer::bands_finished_ahead() const { return impl_->finished_ahead.load(); }
+size_t OpenCLTracer::bands_dropped_ahead() const { return impl_->dropped_ahead.load(); }
 
 core::BandResult OpenCLTracer::render_first_hits_in_pieces(const core::BandJob& job, core::BandBuffer& target,
                                                            const KFrameParams& params, const KCamera& camera,
@@ -862,13 +1111,6 @@ void OpenCLTracer::read_aux_when_packed(size_t pixels, bool straight) {
                             m.aux_read.out()),
         "reading the aux band");
   check(clFlush(m.aux_queue), "clFlush(aux)");
-}
-
-void OpenCLTracer::copy_aux_into(core::BandBuffer& target, const KFrameParams& params, const KCamera& camera,
-                                 size_t rows, bool straight) {
-  Impl& m = *impl_;
-  m.copy_aux_rows_into(target, int(params.row_begin), camera.width, rows, m.aux_staging.host(), straight,
-                       m.aux_read.get());
 }
 
 }  // namespace cohort::tracers

@@ -95,6 +95,40 @@ class Tracer {
   using NextJob = std::function<std::optional<BandJob>()>;
   void set_next_job(NextJob hook) { next_job_ = std::move(hook); }
 
+  // Enqueue ahead. With two frames in flight a worker holds its next job (rows final, target known) while
+  // the current band renders. A tracer whose device runs its commands in order behind the host's enqueueing
+  // (an OpenCL queue, whose driver costs tens of microseconds a command) says so here and may call
+  // queued_next(band_done) from inside render_band(), once the current band's commands are all enqueued,
+  // instead of waiting for them: with two frames in flight it waits until the next job is queued (the core
+  // hands it out once it has turned the frame before around) or band_done() is true, with one it only looks.
+  // It gives the next job and its target, that job's commit applied first on this thread (through apply(),
+  // exactly once: the job no longer brings it), or nothing (the band ended first, no job queued, a recovery
+  // or probe job, a full resync due, a diverged scene). band_done is called on this thread (not under the
+  // worker's lock); the tracer calls wake_queued_next() from any thread (a device's completion callback) once
+  // it may have turned true (without that it is asked again every millisecond). The tracer then
+  // enqueues that band's commands into that target and waits for the current band only; the next
+  // render_band() with the same job and target finds them enqueued and only waits and finishes. What the core publishes after the next job's hand-out still goes
+  // with the job after. When a job that was enqueued ahead will not be rendered (the Renderer shuts down
+  // first), the worker calls drop_enqueued_ahead() on this thread: the tracer waits for those commands, so
+  // that nothing writes into the target after.
+  virtual bool enqueues_ahead() const { return false; }
+  struct QueuedNext {
+    BandJob job;
+    BandBuffer* target = nullptr;
+  };
+  using BandDone = std::function<bool()>;
+  using QueuedNextHook = std::function<std::optional<QueuedNext>(const BandDone&)>;
+  // The Renderer's hooks (set once, before the first job).
+  void set_queued_next(QueuedNextHook hook, std::function<void()> wake) {
+    queued_next_ = std::move(hook);
+    wake_queued_next_ = std::move(wake);
+  }
+  // Wakes a queued_next() waiting on band_done (thread-safe; nothing when none waits).
+  void wake_queued_next() const {
+    if (wake_queued_next_) wake_queued_next_();
+  }
+  virtual void drop_enqueued_ahead() {}
+
   // A tracer whose scene is gone (a remote tracer whose slot a new node took: it starts with nothing)
   // asks for a full resync here; the Renderer sends one with its next job. Read on the core thread
   // between the tracer's jobs.
@@ -117,10 +151,15 @@ class Tracer {
     if (commits_ahead_) commits_ahead_();
   }
   std::optional<BandJob> next_job_announced() const { return next_job_ ? next_job_() : std::nullopt; }
+  std::optional<QueuedNext> queued_next(const BandDone& band_done) const {
+    return queued_next_ ? queued_next_(band_done) : std::nullopt;
+  }
 
  private:
   CommitsAhead commits_ahead_;
   NextJob next_job_;
+  QueuedNextHook queued_next_;
+  std::function<void()> wake_queued_next_;
 };
 
 }  // namespace cohort::core

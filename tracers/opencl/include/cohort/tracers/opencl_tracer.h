@@ -50,6 +50,12 @@ class OpenCLTracer : public TracerBase {
     // device: nothing to fill there, and the PoCL 5 of Ubuntu 24.04 aborts on the same kernels in two queues
     // (a reference count in its kernel cache). COHORT_OPENCL_WAVE_LANES=0: one lane.
     bool wave_lanes = true;
+    // With two frames in flight, the next band's commands (its commit applied first) are enqueued before the
+    // tracer waits for the current band, so that the driver's enqueueing (20-30 us a command on NVIDIA)
+    // overlaps the band on the device and the next band's kernels follow it without a gap
+    // (core::Tracer::enqueues_ahead; docs/balancing.md, "OpenCL enqueues its next band ahead").
+    // COHORT_OPENCL_ENQUEUE_AHEAD=0: each band enqueued when its job starts.
+    bool enqueue_ahead = true;
   };
   static constexpr int kMaxFirstHitPieces = 8;
   // The pieces' first rows, relative to the band, and `rows` last: up to `pieces` ranges of whole work
@@ -72,6 +78,14 @@ class OpenCLTracer : public TracerBase {
   bool shadow_walk() const;
   using core::Tracer::render_band;
   core::BandResult render_band(const core::BandJob& job, core::BandBuffer& target) override;
+  bool enqueues_ahead() const override;
+  void drop_enqueued_ahead() override;
+  // Bands enqueued ahead while the band before rendered, those of them that render_band then found
+  // enqueued (and only waited for), and those drained unrendered (drop_enqueued_ahead, or a job that did not
+  // match); for tests and logs.
+  size_t bands_enqueued_ahead() const;
+  size_t bands_finished_ahead() const;
+  size_t bands_dropped_ahead() const;
 
   // "platform / device" for every OpenCL device on this machine, in the order Options::device counts.
   static std::vector<std::string> list_devices();
@@ -91,11 +105,9 @@ class OpenCLTracer : public TracerBase {
   // The band's auxiliary planes from centre rays (kernel/aux_outputs.h), in three steps around the band's
   // kernel: the aux kernel (and the packing to texels when the band spans the target's width,
   // `straight`) enqueued before it; the read into page-locked memory on the second queue, overlapping it;
-  // the copy into the target once that read is done.
+  // the copy into the target once that read is done (render_band, before the next band is enqueued).
   void enqueue_aux(const core::BandJob& job, const KCamera& camera, size_t rows, bool straight);
   void read_aux_when_packed(size_t pixels, bool straight);
-  void copy_aux_into(core::BandBuffer& target, const KFrameParams& params, const KCamera& camera, size_t rows,
-                     bool straight);
   // The aux kernel's arguments for this band (and the previous camera, transforms and joints it reads),
   // then its launch (and packing) over the band's rows [first_row, first_row + rows).
   void prepare_aux(const core::BandJob& job, const KCamera& camera, size_t rows);
@@ -107,6 +119,15 @@ class OpenCLTracer : public TracerBase {
   core::BandResult render_first_hits_in_pieces(const core::BandJob& job, core::BandBuffer& target,
                                                const KFrameParams& params, const KCamera& camera, bool straight,
                                                OpenCLWavefront* wave);
+
+  // A band whose commands are all enqueued (render_band's, or the next one's ahead), and its end: the wait
+  // for its last command, its rows stored where they came down elsewhere, its clock.
+  struct EnqueuedBand;
+  std::unique_ptr<EnqueuedBand> enqueue_band(const core::BandJob& job, core::BandBuffer& target);
+  core::BandResult finish_band(EnqueuedBand& band);
+  // Inside render_band, the current band enqueued: the next band enqueued too when the worker has it
+  // queued before the current band is done (Tracer::queued_next) and it can go ahead.
+  void enqueue_next_ahead(const EnqueuedBand& current);
 
   struct Impl;
   std::unique_ptr<Impl> impl_;
