@@ -909,6 +909,9 @@ def rejoin_unready(a):
     rejoined_check(session, stats, output, die, frames, lost_band_ms=150, late_while_away=False)
     if len(re.findall(r"mpi:2: node joined through the port", output)) != 3:
         sys.exit("three nodes should have joined mpi:2: the first, the slow one and the last")
+    if not re.search(r"mpi:2: 3 node\(s\) joined through the port; the last delivered its first band \d+ ms after its "
+                     r"connect \(ready after \d+ ms: .*\); 1 let go for not saying ready in time", output):
+        sys.exit("rank 0's summary of mpi:2 should count three nodes joined and one let go")
     ready_check(output, fresh_output)
     print("rejoin_unready: ok")
 

@@ -421,6 +421,15 @@ MpiTracer::~MpiTracer() {
                    options_.rank, s.total_ahead_sent_after_ms / double(s.jobs_ahead),
                    s.bands_back_before_announcement);
   }
+  if (s.nodes_joined > 0)
+    spdlog::info("mpi:{}: {} node(s) joined through the port; the last delivered its first band {:.0f} ms after its "
+                 "connect{}; {} let go for not saying ready in time", options_.rank, s.nodes_joined,
+                 s.last_join_to_first_band_ms,
+                 s.last_join_to_ready_ms > 0.0
+                     ? fmt::format(" (ready after {:.0f} ms: full resync {:.1f} ms, warm-up band {:.1f} ms)",
+                                   s.last_join_to_ready_ms, s.last_ready_resync_ms, s.last_ready_warm_ms)
+                     : "",
+                 s.nodes_never_ready);
   // The node stays for later tracers of this run; the session's end tells every node to leave.
   try {
     MpiSession& mpi = MpiSession::get();
