@@ -33,7 +33,7 @@ struct NodeArgs {
   int width = 0, height = 0;
   double time = 0.0;
   std::string announced_version;
-  int stall_frame = -1, stall_ms = 0, die_frame = -1, short_piece_frame = -1, band_delay_ms = 0;
+  int stall_frame = -1, stall_ms = 0, die_frame = -1, short_piece_frame = -1, band_delay_ms = 0, resync_delay_ms = 0;
   double row_delay_ms = 0.0;
   int idle_timeout_s = 600;
   std::string join;  // rank 0's port file: join its running session instead of being one of mpirun's ranks
@@ -52,6 +52,7 @@ int run_node_command(const NodeArgs& a) {
   options.short_piece_frame = a.short_piece_frame;
   options.band_delay_ms = a.band_delay_ms;
   options.row_delay_ms = a.row_delay_ms;
+  options.resync_delay_ms = a.resync_delay_ms;
   options.idle_timeout = std::chrono::seconds(a.idle_timeout_s);
   std::vector<std::unique_ptr<core::Tracer>> tracers;
   try {
@@ -125,6 +126,7 @@ void add_node_command(CLI::App& app, int& exit_code) {
   cmd->add_option("--short-piece-frame", a->short_piece_frame, "")->group("");
   cmd->add_option("--band-delay-ms", a->band_delay_ms, "")->group("");
   cmd->add_option("--row-delay-ms", a->row_delay_ms, "")->group("");
+  cmd->add_option("--resync-delay-ms", a->resync_delay_ms, "")->group("");
   cmd->callback([a, &exit_code] {
 #ifdef COHORT_HAVE_MPI
     exit_code = run_node_command(*a);

@@ -31,6 +31,8 @@
 #                              each; mpi:2's node dies, a fresh one joins its slot: frame times around the death
 #                              and the return, and the newcomer's join -> first band (docs/cluster.md)
 #                              (COHORT_CLUSTER_JOBS_AHEAD="1 0": with and without jobs ahead, back to back)
+#                              (COHORT_REJOIN_WARM_UP="1 0", the default: the newcomer's full resync on the side
+#                              and its ready (protocol 10), then without, back to back)
 #   tools/gpu_run.sh links     there, on a two-GPU kind: remote tracers behind emulated links (COHORT_LINKS, default
 #                              "none 10gbit,0.5ms 1gbit,1ms"): alone, two ranks together, and beside rank 0's cuda:0
 #                              (COHORT_LINKS_EARLY="1 0": with the next frame announced at hand-out and after, back to back;
@@ -153,21 +155,25 @@ case "${1:-}" in
     size=(--width 1920 --height 1080 --camera 1690 300 80 5 -12)
     common=(--spp 1 --light-samples 1 --bounces 1 --convergence brigade --frames 3000 --camera-path spin-slow
             --write last --balancer perfect-smooth)
-    port=/tmp/rejoin.port; rm -rf "$port" /tmp/rejoin
-    COHORT_MPI_BAND_TIMEOUT_MS=1000 timeout 300 mpiexec.hydra -np 1 "$cohort" render /tmp/largemap.cpk "${size[@]}" \
-      "${common[@]}" --tracers mpi:1,mpi:2 --node-port "$port" --node-wait 120 --out /tmp/rejoin >/tmp/rejoin_r0.log 2>&1 &
-    r0=$!
-    timeout 300 mpiexec.hydra -np 1 "$cohort" node /tmp/largemap.cpk --tracers cuda:0 --join "$port" --as 1 \
-      >/tmp/rejoin_n1.log 2>&1 &
-    timeout 300 mpiexec.hydra -np 1 "$cohort" node /tmp/largemap.cpk --tracers cuda:1 --join "$port" --as 2 \
-      --die-frame 600 >/tmp/rejoin_n2.log 2>&1 || true
-    until grep -q "mpi:2: no answer for rows" /tmp/rejoin_r0.log || ! kill -0 $r0 2>/dev/null; do sleep 0.2; done
-    timeout 300 mpiexec.hydra -np 1 "$cohort" node /tmp/largemap.cpk --tracers cuda:1 --join "$port" --as 2 \
-      >/tmp/rejoin_n3.log 2>&1 &
-    wait $r0 || { echo "rank 0 failed"; tail -n 20 /tmp/rejoin_r0.log; }
-    wait
-    grep -hE "joined mpi|first band|killing itself|no answer for rows|joined rank 0" /tmp/rejoin_*.log | sed 's/^.*\] //'
-    python3 - <<'PY'
+    # Protocol 10: the newcomer takes its full resync on the side and says ready; COHORT_REJOIN_WARM_UP="1 0"
+    # (default) runs with it and without it (COHORT_MPI_WARM_UP=0: its first band waits for the resync), back to back.
+    for warm in ${COHORT_REJOIN_WARM_UP:-1 0}; do
+      echo "== COHORT_MPI_WARM_UP=$warm"
+      port=/tmp/rejoin.port; rm -rf "$port" /tmp/rejoin
+      COHORT_MPI_WARM_UP=$warm COHORT_MPI_BAND_TIMEOUT_MS=1000 timeout 300 mpiexec.hydra -np 1 "$cohort" render /tmp/largemap.cpk "${size[@]}" \
+        "${common[@]}" --tracers mpi:1,mpi:2 --node-port "$port" --node-wait 120 --out /tmp/rejoin >/tmp/rejoin_r0.log 2>&1 &
+      r0=$!
+      timeout 300 mpiexec.hydra -np 1 "$cohort" node /tmp/largemap.cpk --tracers cuda:0 --join "$port" --as 1 \
+        >/tmp/rejoin_n1.log 2>&1 &
+      timeout 300 mpiexec.hydra -np 1 "$cohort" node /tmp/largemap.cpk --tracers cuda:1 --join "$port" --as 2 \
+        --die-frame 600 >/tmp/rejoin_n2.log 2>&1 || true
+      until grep -q "mpi:2: no answer for rows" /tmp/rejoin_r0.log || ! kill -0 $r0 2>/dev/null; do sleep 0.2; done
+      timeout 300 mpiexec.hydra -np 1 "$cohort" node /tmp/largemap.cpk --tracers cuda:1 --join "$port" --as 2 \
+        >/tmp/rejoin_n3.log 2>&1 &
+      wait $r0 || { echo "rank 0 failed"; tail -n 20 /tmp/rejoin_r0.log; }
+      wait
+      grep -hE "joined mpi|first band|killing itself|no answer for rows|joined rank 0|is ready|: ready|not ready|let go" /tmp/rejoin_*.log | sed 's/^.*\] //'
+      python3 - <<'PY'
 import json
 frames = json.load(open("/tmp/rejoin/stats.json"))["frames"]
 slot = [{t["name"]: t["outcome"] for t in f["tracers"]}["mpi:2"] for f in frames]
@@ -189,6 +195,7 @@ if back:
     print("frames around the return: " + ", ".join(f"{t:.2f}" for t in ms[back - 4:back + 4])
           + f"; median of the 100 frames after: {sorted(ms[back:back + 100])[50]:.2f} ms")
 PY
+    done
     ;;
   links)
     # There, on a two-GPU kind: issue 19's emulated links (COHORT_MPI_LINK on every rank, docs/cluster.md),

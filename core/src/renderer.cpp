@@ -732,11 +732,13 @@ void Renderer::begin_frame(const BandJob& job, FrameBuffer& out, const std::vect
 
   // Away: no rows, and nobody waits for it; it keeps its scene current as a benched tracer does (its
   // commits coalesce meanwhile), so that it renders at once when it is back; one that asks for a full resync
-  // (a remote tracer whose slot a new node joined) gets it at once, so that it is back the frame after.
+  // (a remote tracer whose slot a new node joined) gets it at once, and one that waits for an answer (that
+  // node saying it is ready) gets its side job every frame, so that it is back the frame after.
   for (int id : away) {
     stats.tracers[static_cast<size_t>(id)].outcome = TracerOutcome::away;
     Worker& w = *workers_[static_cast<size_t>(id)];
-    if (!w.side_job_due(w.tracer->wants_full_resync(), options_.benched_commit_every)) continue;
+    if (!w.side_job_due(w.tracer->wants_full_resync() || w.tracer->checks_in_every_frame(), options_.benched_commit_every))
+      continue;
     side_jobs.push_back({id, {}, false, {}});
     side_jobs.back().away = true;
   }

@@ -609,6 +609,7 @@ class AwayTracer final : public Tracer {
   std::string name() const override { return inner_->name(); }
   bool available() const override { return !away->load(); }
   void while_away() override { checks->fetch_add(1); }
+  bool checks_in_every_frame() const override { return every_frame->load(); }
   void apply(const cohort::commit::CommitBuffer& commit) override {
     inner_->apply(commit);
     last_commit->store(commit.frame());
@@ -622,12 +623,52 @@ class AwayTracer final : public Tracer {
   std::shared_ptr<std::atomic<uint64_t>> last_commit = std::make_shared<std::atomic<uint64_t>>(0);
   std::shared_ptr<std::atomic<int>> bands = std::make_shared<std::atomic<int>>(0);
   std::shared_ptr<std::atomic<int>> checks = std::make_shared<std::atomic<int>>(0);
+  std::shared_ptr<std::atomic<bool>> every_frame = std::make_shared<std::atomic<bool>>(false);
 
  private:
   std::unique_ptr<SimulatedTracer> inner_;
 };
 
 }  // namespace
+
+// An away tracer gets its commits on the side every benched_commit_every frames (coalesced meanwhile),
+// unless it waits for an answer (Tracer::checks_in_every_frame: a remote node warming up): then every frame,
+// so that it is back the frame after the answer comes.
+TEST(Renderer, AnAwayTracerThatChecksInEveryFrameGetsItsSideJobEveryFrame) {
+  auto away_tracer = std::make_unique<AwayTracer>(std::make_unique<SimulatedTracer>(model(), sim(2)));
+  const auto away = away_tracer->away;
+  const auto last_commit = away_tracer->last_commit;
+  const auto checks = away_tracer->checks;
+  const auto every_frame = away_tracer->every_frame;
+  std::vector<std::unique_ptr<Tracer>> tracers;
+  tracers.push_back(std::make_unique<SimulatedTracer>(model(), sim(1)));
+  tracers.push_back(std::move(away_tracer));
+  RendererOptions options;
+  options.use_reported_time = true;
+  options.benched_commit_every = 4;
+  Renderer renderer(std::move(tracers), options);
+  auto scene = std::make_shared<cohort::commit::TracerScene>();
+  FrameBuffer fb;
+  constexpr uint64_t kAwayFrom = 1, kEveryFrameFrom = 9, kFrames = 17;
+  int checks_coalesced = 0, checks_every_frame = 0;
+  for (uint64_t f = 0; f < kFrames; ++f) {
+    away->store(f >= kAwayFrom);
+    every_frame->store(f >= kEveryFrameFrom);
+    const int checks_before = checks->load();
+    renderer.submit_commit(cohort::commit::CommitBuffer::full(scene, f + 1));
+    const FrameStats stats = renderer.render(job_for(f), fb);
+    expect_complete(fb, f, stats, {1, 2});
+    if (f < kAwayFrom) continue;
+    EXPECT_EQ(stats.tracers[1].outcome, TracerOutcome::away) << "frame " << f;
+    // A side job handed out this frame brings this frame's commit: let it land (bounded), so that the
+    // tracer is not still busy with it when the next frame begins.
+    for (int i = 0; i < 500 && last_commit->load() != f + 1; ++i) std::this_thread::sleep_for(std::chrono::microseconds(100));
+    (f < kEveryFrameFrom ? checks_coalesced : checks_every_frame) += checks->load() - checks_before;
+  }
+  EXPECT_EQ(checks_coalesced, int(kEveryFrameFrom - kAwayFrom) / 4) << "every 4th frame while it waits for nothing";
+  EXPECT_EQ(checks_every_frame, int(kFrames - kEveryFrameFrom)) << "every frame while it checks in every frame";
+  EXPECT_EQ(last_commit->load(), kFrames) << "its commits keep coming";
+}
 
 TEST(Renderer, AnAwayTracerGetsNoRowsIsNotWaitedForKeepsItsCommitsAndIsBackWhenAvailable) {
   auto away_tracer = std::make_unique<AwayTracer>(std::make_unique<SimulatedTracer>(model(), sim(2)));

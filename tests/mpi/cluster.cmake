@@ -10,7 +10,7 @@ if(TARGET cohort AND TARGET cohort_tracer_mpi AND TARGET cohort_tracer_embree AN
   find_package(Python3 COMPONENTS Interpreter QUIET)
   if(Python3_Interpreter_FOUND)
     set(_cases match stall killed version load_error bench protocol replay play bad_piece ahead ahead_recovery jobs_ahead jobs_ahead_two_in_flight early_announce link
-                match_rgb9e5 play_early_announce join rejoin play_join)
+                match_rgb9e5 play_early_announce join rejoin rejoin_unready play_join)
     if(TARGET cohort_tracer_opencl)
       list(APPEND _cases mixed)
     endif()

@@ -119,9 +119,9 @@ def late_after_fault(stats, fault, until=None):
     return late
 
 
-def away_check(stats, name, fault, until=None):
+def away_check(stats, name, fault, until=None, check_late=True):
     """From the frame after the fault: the slot's tracer is left out ("away", or "busy" with its commits) until it renders again (or until
-    `until`, the rejoin), nothing is dropped and re-rendered meanwhile, and from the fault up to `until` (the
+    `until`, the rejoin), nothing is dropped and re-rendered meanwhile, and (check_late) from the fault up to `until` (the
     end of the run when None) at most the fault's frame is late. Exits with the reason otherwise."""
     end = len(stats) if until is None else until
     for f in stats[fault + 1:end]:
@@ -134,6 +134,8 @@ def away_check(stats, name, fault, until=None):
                      f"{t.get('error', '')}")
         if f["dropped"] != 0:
             sys.exit(f"frame {f['frame']}: {f['dropped']} tracer(s) dropped while {name} was away")
+    if not check_late:
+        return
     late = late_after_fault(stats, fault, until)
     if len(late) > 1 or (late and late[0] != fault):
         sys.exit(f"the fault at frame {fault} should make at most that frame late: {late}")
@@ -756,11 +758,21 @@ def join(a):
     print("join: ok")
 
 
+# The fresh node's full resync takes this much longer in the rejoin cases (--resync-delay-ms): a large map's
+# upload and BVH build on the test's small one. A first band that waited for it would be a late frame.
+RESYNC_DELAY_MS = 300
+# How many frames after the slot's return the rejoin cases still call a frame over the lateness bound a failure.
+AFTER_RETURN = 100
+
+
 def rejoin(a):
-    """mpi:2's node dies before its band of frame 5 (--die-frame); once it is gone a fresh node joins mpi:2. Its
-    band of the dead node times out (the one late frame), its rows go to the others until the newcomer's full
-    resync, then the slot renders again; every frame is delivered and the last matches the single-process
-    render."""
+    """mpi:2's node dies before its band of frame 5 (--die-frame); once it is gone a fresh node joins mpi:2, its
+    full resync taking RESYNC_DELAY_MS longer to apply. The dead node's band times out (the one late frame), its
+    rows go to the others while the newcomer takes its full resync on the side (away: no rows, nobody waits for
+    it) and renders a warm-up band, until it says it is ready; then the slot renders again. No frame after the
+    death's is late up to AFTER_RETURN frames after the return (the newcomer's first band included), every frame
+    is delivered and the last matches the single-process render. With COHORT_MPI_WARM_UP=0 the newcomer's first band waits for its resync and is a
+    second late frame: this case then fails."""
     frames = 1500
     die = 5
     session = JoinedRun(a, frames, band_timeout_ms=1000)
@@ -776,25 +788,46 @@ def rejoin(a):
             sys.exit(f"node2 ended without dying at frame {die}")
         # The slot is free once the dead node's band has timed out (until then mpi:2 is busy: its node answers).
         jobs.wait_for_line(rank0, r"mpi:2: no answer for rows")
-        fresh = jobs.start("node2_again", node + ["--as", "2"])
+        fresh = jobs.start("node2_again", node + ["--as", "2", "--resync-delay-ms", str(RESYNC_DELAY_MS)])
         code = jobs.finish(rank0)
         codes = [jobs.finish(n) for n in (first, fresh)]
         output = jobs.output(rank0)
+        fresh_output = jobs.output(fresh)
         jobs.dump()
         if code != 0 or any(codes):
             sys.exit(f"exit statuses: rank 0 {code}, nodes {codes}")
     finally:
         jobs.close()
     stats = session.stats()
+    back = rejoined_check(session, stats, output, die, frames)
+    found = re.findall(r"mpi:2: the node that joined delivered its first band \(frame (\d+)\) (\d+) ms after it "
+                       r"connected", output)
+    if len(found) != 2 or int(found[-1][0]) != back:
+        sys.exit(f"rank 0 should have logged the first band of both nodes that joined mpi:2, the second's in frame {back}")
+    ready_check(output, fresh_output)
+    print(f"mpi:2's new node: first band (frame {found[-1][0]}) {found[-1][1]} ms after its connect; "
+          f"{(time.time() - died_at):.1f} s from the death to the end of the run")
+    print("rejoin: ok")
+
+
+def rejoined_check(session, stats, output, die, frames, lost_band_ms=500, late_while_away=True):
+    """What the rejoin cases check of the frames: all delivered; mpi:2's band of frame `die` timed out; the slot
+    away (not asked, nothing re-rendered) until its new node renders, and from then on every frame with rows;
+    no frame late after the death's up to AFTER_RETURN frames after the return (the newcomer's first band
+    included); the last frame matches the single-process render. The death's frame waits for the band timeout:
+    over lost_band_ms, and only it. Without late_while_away the frames over 3x the median are looked for only
+    from the return on (the slot's time away holds three node starts in rejoin_unready, each loading its map on
+    the VM's 2 cores beside rank 0; the rejoin case checks that time). Returns the frame the slot rendered
+    again."""
     if len(stats) != frames:
         sys.exit(f"{len(stats)} of {frames} frames delivered")
     outcome = [{t["name"]: t for t in f["tracers"]} for f in stats]
     slot = [o["mpi:2"]["outcome"] for o in outcome]
     gone = [f for f, s in enumerate(slot) if s != "rendered"]
-    late = [f["frame"] for f in stats if f["wall_ms"] > 500]
+    late = [f["frame"] for f in stats if f["wall_ms"] > lost_band_ms]
     back = next((f for f in range(die + 1, frames) if slot[f] == "rendered"), None)
     print(f"mpi:2 away in frames {gone[0] if gone else '-'}..{gone[-1] if gone else '-'} ({len(gone)} frames), back from "
-          f"frame {back}; late frames: {late}")
+          f"frame {back}; late frames (over {lost_band_ms} ms): {late}")
     if back is None:
         sys.exit("the fresh node never rendered mpi:2's rows (did it join before the run ended?)")
     if slot[die] == "rendered" or "no answer for rows" not in outcome[die]["mpi:2"].get("error", ""):
@@ -806,20 +839,82 @@ def rejoin(a):
         sys.exit("mpi:2 should have rows in the last frames")
     if late != [die]:
         sys.exit(f"the death should make frame {die}, and only it, late: {late}")
-    away_check(stats, "mpi:2", die, back)
-    if session.last_frame_differs():
-        sys.exit("the last frame differs from the single-process render")
+    away_check(stats, "mpi:2", die, back, check_late=late_while_away)
     times = [f["wall_ms"] for f in stats]
     around = times[max(back - 3, 0):back + 4]
     print(f"frame times around the rejoin (frames {max(back - 3, 0)}..{back + 3}): "
           f"{', '.join(f'{t:.1f}' for t in around)} ms; median of the run {sorted(times)[len(times) // 2]:.1f} ms")
-    found = re.findall(r"mpi:2: the node that joined delivered its first band \(frame (\d+)\) (\d+) ms after it "
-                       r"connected", output)
-    if len(found) != 2 or int(found[-1][0]) != back:
-        sys.exit(f"rank 0 should have logged the first band of both nodes that joined mpi:2, the second's in frame {back}")
-    print(f"mpi:2's new node: first band (frame {found[-1][0]}) {found[-1][1]} ms after its connect; "
-          f"{(time.time() - died_at):.1f} s from the death to the end of the run")
-    print("rejoin: ok")
+    # The newcomer's first band is an ordinary one: from the death to AFTER_RETURN frames after the return, only
+    # the death's frame may be late (issue 19: "A killed node costs at most one late frame"). Not to the end of
+    # the run: on the shared 2-core VM the scheduler alone stretches a frame past 25 ms now and then (seen
+    # 900 frames after the return under MPICH), which says nothing of the newcomer.
+    late = late_after_fault(stats, die if late_while_away else back, min(back + AFTER_RETURN, len(stats)))
+    if len(late) > 1 or (late and late[0] != die):
+        sys.exit(f"after the death's frame {die}, no frame should be late, the newcomer's first band (frame {back}) "
+                 f"included: {late}")
+    if session.last_frame_differs():
+        sys.exit("the last frame differs from the single-process render")
+    return back
+
+
+def ready_check(output, node_output):
+    """The newcomer applied its delayed full resync and a warm-up band on the side and said so; rank 0 logged its
+    ready with those times before its first band."""
+    ready = re.search(r"mpi:2: the node that joined is ready (\d+) ms after it connected \(full resync applied in "
+                      r"([\d.]+) ms, warm-up band ([\d.]+) ms\)", output)
+    if not ready:
+        sys.exit("rank 0 did not log the newcomer's ready")
+    if float(ready.group(2)) < RESYNC_DELAY_MS:
+        sys.exit(f"the newcomer's full resync took {ready.group(2)} ms, less than its {RESYNC_DELAY_MS} ms delay")
+    if float(ready.group(3)) <= 0.0:
+        sys.exit("the newcomer rendered no warm-up band (the dead node's last band)")
+    if not re.search(r"node \d+: ready \(full resync applied in [\d.]+ ms, warm-up band [\d.]+ ms\)", node_output):
+        sys.exit("the newcomer did not log its ready")
+    if output.index(ready.group(0)) > output.rindex("mpi:2: the node that joined delivered its first band"):
+        sys.exit("the newcomer delivered its first band before it was ready")
+    print(f"mpi:2's new node: ready {ready.group(1)} ms after its connect (full resync {ready.group(2)} ms, warm-up "
+          f"band {ready.group(3)} ms)")
+
+
+def rejoin_unready(a):
+    """As rejoin, with band timeout 300 ms, but the first node that joins mpi:2 after the death takes 6 s to
+    apply its full resync: it does not say it is ready within ten times the band timeout, so rank 0 lets it go
+    (logged, with the reason) and frees the slot, the frames going on without it meanwhile (none re-rendered); a
+    second newcomer then joins and renders. Its first band is not late (up to AFTER_RETURN frames after the
+    return), and the last frame matches the single-process render."""
+    frames = 4000
+    die = 5
+    session = JoinedRun(a, frames, band_timeout_ms=300)
+    jobs, node = session.jobs, session.node
+    try:
+        rank0 = jobs.start("rank0", session.rank0)
+        first = jobs.start("node1", node + ["--as", "1"])
+        dying = jobs.start("node2", node + ["--as", "2", "--die-frame", str(die)])
+        jobs.finish(dying, timeout=120)
+        jobs.wait_for_line(rank0, r"mpi:2: no answer for rows")
+        # Let go, it hears nothing more from rank 0 and leaves after its --idle-timeout.
+        slow = jobs.start("node2_slow", node + ["--as", "2", "--resync-delay-ms", "6000", "--idle-timeout", "8"])
+        jobs.wait_for_line(rank0, r"mpi:2: the node that joined did not say it is ready within 3000 ms", 60)
+        fresh = jobs.start("node2_again", node + ["--as", "2", "--resync-delay-ms", str(RESYNC_DELAY_MS)])
+        code = jobs.finish(rank0)
+        codes = [jobs.finish(n) for n in (first, fresh)]
+        jobs.finish(slow, timeout=60)  # whatever its status: it was let go
+        output = jobs.output(rank0)
+        fresh_output = jobs.output(fresh)
+        jobs.dump()
+        if code != 0 or any(codes):
+            sys.exit(f"exit statuses: rank 0 {code}, nodes {codes}")
+    finally:
+        jobs.close()
+    stats = session.stats()
+    rejoined_check(session, stats, output, die, frames, lost_band_ms=150, late_while_away=False)
+    if len(re.findall(r"mpi:2: node joined through the port", output)) != 3:
+        sys.exit("three nodes should have joined mpi:2: the first, the slow one and the last")
+    if not re.search(r"mpi:2: 3 node\(s\) joined through the port; the last delivered its first band \d+ ms after its "
+                     r"connect \(ready after \d+ ms: .*\); 1 let go for not saying ready in time", output):
+        sys.exit("rank 0's summary of mpi:2 should count three nodes joined and one let go")
+    ready_check(output, fresh_output)
+    print("rejoin_unready: ok")
 
 
 def play_join(a):
@@ -858,7 +953,7 @@ def main():
                                            "play", "link", "bad_piece", "ahead", "ahead_recovery", "jobs_ahead",
                                            "jobs_ahead_two_in_flight",
                                            "early_announce", "match_rgb9e5", "play_early_announce", "join", "rejoin",
-                                           "play_join"])
+                                           "play_join", "rejoin_unready"])
     parser.add_argument("--mpiexec", required=True)
     parser.add_argument("--cohort", required=True)
     parser.add_argument("--map", required=True)
@@ -884,6 +979,9 @@ def main():
         return
     if a.case == "play_join":
         play_join(a)
+        return
+    if a.case == "rejoin_unready":
+        rejoin_unready(a)
         return
     if a.case == "link":
         link(a)

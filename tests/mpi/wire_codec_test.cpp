@@ -149,6 +149,74 @@ TEST(WireCodec, AJoinNamesItsSlotAndNothingElse) {
   EXPECT_THROW(wire::decode_join(std::vector<uint8_t>(m.payload.begin(), m.payload.end() - 1)), wire::WireError);
 }
 
+TEST(WireCodec, WarmCarriesTheWarmUpBandOrNone) {
+  wire::Warm none;
+  const std::vector<uint8_t> bare = wire::frame_message(wire::Kind::warm, 0, wire::encode_warm(none));
+  const wire::Message m = wire::parse_message(bare.data(), bare.size());
+  EXPECT_EQ(m.kind, wire::Kind::warm);
+  EXPECT_FALSE(wire::decode_warm(m.payload).has_job);
+  EXPECT_EQ(m.payload.size(), 1u);
+
+  wire::Warm warm;
+  warm.has_job = true;
+  warm.request.job.camera.width = 64;
+  warm.request.job.camera.height = 48;
+  warm.request.job.params.row_begin = 8;
+  warm.request.job.params.row_end = 40;
+  warm.request.job.params.frame_index = 17;
+  warm.request.format = core::BandFormat::rgb9e5;
+  const wire::Warm back = wire::decode_warm(wire::encode_warm(warm));
+  ASSERT_TRUE(back.has_job);
+  EXPECT_EQ(back.request.job.params.row_begin, 8u);
+  EXPECT_EQ(back.request.job.params.row_end, 40u);
+  EXPECT_EQ(back.request.job.params.frame_index, 17u);
+  EXPECT_EQ(back.request.format, core::BandFormat::rgb9e5);
+  expect_every_prefix_refused(wire::encode_warm(warm), [](const auto& p) { return wire::decode_warm(p); });
+
+  std::vector<uint8_t> bad_flag = wire::encode_warm(none);
+  bad_flag[0] = 2;
+  EXPECT_NE(refusal([&] { wire::decode_warm(bad_flag); }).find("job flag 2"), std::string::npos);
+  std::vector<uint8_t> longer = wire::encode_warm(none);
+  longer.push_back(0);
+  EXPECT_NE(refusal([&] { wire::decode_warm(longer); }).find("left over"), std::string::npos);
+  // The band inside is checked as any band job is, and may be neither ahead nor adopting.
+  warm.request.job.params.row_end = 49;
+  EXPECT_NE(refusal([&] { wire::decode_warm(wire::encode_warm(warm)); }).find("do not fit"), std::string::npos);
+  warm.request.job.params.row_end = 40;
+  warm.request.ahead = true;
+  EXPECT_NE(refusal([&] { wire::decode_warm(wire::encode_warm(warm)); }).find("neither a job ahead"), std::string::npos);
+}
+
+TEST(WireCodec, ReadyCarriesItsTimesAndFailure) {
+  wire::Ready ready;
+  ready.resync_ms = 41.5;
+  ready.warm_ms = 7.25;
+  const std::vector<uint8_t> framed = wire::frame_message(wire::Kind::ready, 3, wire::encode_ready(ready));
+  const wire::Message m = wire::parse_message(framed.data(), framed.size());
+  EXPECT_EQ(m.kind, wire::Kind::ready);
+  EXPECT_EQ(m.sequence, 3u);
+  const wire::Ready back = wire::decode_ready(m.payload);
+  EXPECT_EQ(back.resync_ms, 41.5);
+  EXPECT_EQ(back.warm_ms, 7.25);
+  EXPECT_TRUE(back.failure.empty());
+  ready.failure = "the node's scene is behind: refused full resync";
+  EXPECT_EQ(wire::decode_ready(wire::encode_ready(ready)).failure, ready.failure);
+  expect_every_prefix_refused(wire::encode_ready(ready), [](const auto& p) { return wire::decode_ready(p); });
+  std::vector<uint8_t> longer = wire::encode_ready(ready);
+  longer.push_back(0);
+  EXPECT_NE(refusal([&] { wire::decode_ready(longer); }).find("left over"), std::string::npos);
+  for (double bad : {-1.0, std::nan(""), 1e12}) {
+    wire::Ready odd;
+    odd.warm_ms = bad;
+    EXPECT_NE(refusal([&] { wire::decode_ready(wire::encode_ready(odd)); }).find("out of range"), std::string::npos) << bad;
+  }
+  // A kind past ready is unknown to this protocol.
+  std::vector<uint8_t> unknown = framed;
+  unknown[6] = uint8_t(wire::Kind::ready) + 1;
+  EXPECT_NE(refusal([&] { wire::parse_message(unknown.data(), unknown.size()); }).find("unknown message kind"),
+            std::string::npos);
+}
+
 TEST(WireCodec, AVersionMismatchNamesBothVersionsAndTheSlot) {
   wire::Hello hello;
   hello.cohort_version = wire::cohort_version();

@@ -90,6 +90,7 @@ class Node {
         case wire::Kind::commit: timed_commit(mpi, [&] { apply_commit(m); }); break;
         case wire::Kind::full_local: timed_commit(mpi, [&] { apply_full_local(m); }); break;
         case wire::Kind::band_job: render(mpi, m); break;
+        case wire::Kind::warm: warm_up(mpi, m); break;
         case wire::Kind::shutdown:
           spdlog::info("node {}: shutdown from rank 0 after {} band(s), {} of them on rows rendered ahead; {:.1f} KiB "
                        "of colour rows a band as {} ({} bytes a pixel)", mpi.rank(), bands_, adopted_,
@@ -124,6 +125,7 @@ class Node {
   // A refused or failed commit leaves the scene behind rank 0's: every band fails, asking for a full
   // resync, until one arrives.
   void apply_commit(const wire::Message& m) {
+    const auto start = MpiClock::now();
     commit::CommitBuffer commit;
     try {
       commit = wire::decode_commit(m.payload);
@@ -132,9 +134,11 @@ class Node {
       return;
     }
     apply(commit);
+    if (commit.is_full_resync()) resync_ms_ = ms_since(start);
   }
 
   void apply_full_local(const wire::Message& m) {
+    const auto start = MpiClock::now();
     if (!options_.scene) {
       diverge("rank 0 sent a full resync to the node's own scene, but it loaded none");
       return;
@@ -147,10 +151,54 @@ class Node {
       return;
     }
     apply(full);
+    resync_ms_ = ms_since(start);
+  }
+
+  // A node that joined a running session: its full resync came right before this (and was applied on
+  // arrival, as every commit is). It renders the warm-up band, when rank 0 sent one, for nothing (its
+  // kernels load, its buffers are made, the band buffer its first band will use is page-locked), then
+  // says it is ready, so that its first real band is an ordinary one (docs/cluster.md, "Joining a running
+  // session"). A scene that is behind says so instead: rank 0 sends another full resync.
+  void warm_up(MpiSession& mpi, const wire::Message& m) {
+    wire::Ready ready;
+    ready.resync_ms = resync_ms_;
+    wire::Warm warm;
+    try {
+      warm = wire::decode_warm(m.payload);
+    } catch (const wire::WireError& e) {
+      spdlog::warn("node {}: refused a warm message: {}", mpi.rank(), e.what());
+      warm.has_job = false;
+    }
+    if (diverged_) {
+      ready.failure = "the node's scene is behind: " + divergence_;
+    } else if (warm.has_job) {
+      const auto start = MpiClock::now();
+      double send_ms = 0.0;
+      const size_t slot = take_slot(mpi, send_ms);
+      next_slot_ = slot;  // the first real band renders into the buffer warmed here
+      core::BandBuffer& target = slots_[slot].buffer;
+      core::BandJob job = warm.request.job;
+      job.keep_on_device = -1;
+      target.resize(int(job.camera.width), int(job.camera.height), warm.request.format);
+      target.enable_aux(warm.request.aux);
+      try {
+        render_while_sending(mpi, job, target, {int(job.params.row_begin), int(job.params.row_end)}, [](size_t) {},
+                             nullptr);
+      } catch (const std::exception& e) {
+        ready.failure = std::string("the warm-up band failed: ") + e.what();
+      }
+      ready.warm_ms = ms_since(start);
+    }
+    spdlog::info("node {}: {} (full resync applied in {:.1f} ms, warm-up band {:.1f} ms)", mpi.rank(),
+                 ready.failure.empty() ? "ready" : "not ready: " + ready.failure, ready.resync_ms, ready.warm_ms);
+    send(mpi, wire::Kind::ready, m.sequence, wire::encode_ready(ready));
+    idle_ms_ = 0.0;  // warming is not waiting for rank 0
   }
 
   void apply(const commit::CommitBuffer& commit) {
     if (diverged_ && !commit.is_full_resync()) return;  // records on top of a stale scene would be garbage
+    if (commit.is_full_resync() && options_.resync_delay_ms > 0)
+      std::this_thread::sleep_for(std::chrono::milliseconds(options_.resync_delay_ms));
     try {
       for (auto& tracer : tracers_) tracer->apply(commit);
       diverged_ = false;
@@ -583,6 +631,7 @@ class Node {
   bool stalled_ = false;
   double commit_ms_ = 0.0;        // applying commits since the last band, with the next job waiting
   double commit_ahead_ms_ = 0.0;  // applying commits since the last band, before the next job came
+  double resync_ms_ = 0.0;        // decoding and applying the last full resync, for the ready message
   uint64_t bands_ = 0;
   // The rows' bytes sent (colour in the format rank 0 asked for, which says how many a pixel), for the log.
   uint64_t colour_bytes_sent_ = 0;

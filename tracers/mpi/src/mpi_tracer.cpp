@@ -186,7 +186,7 @@ MpiTracer::MpiTracer(MpiTracerOptions options) : options_(options) {
   }
   // A slot served through the port: its node may be joining still (at most until the port's first wait).
   if (std::optional<JoiningNode> node = port_->wait_for(options_.rank, port_->first_deadline())) {
-    take_node(*node);
+    take_node(*node, false);  // before the first frame: its first band comes with the session's first resync
   } else {
     away_.store(true);
     spdlog::info("mpi:{}: no node has joined yet; its rows go to the others until one does (cohort node MAP --join {} "
@@ -251,7 +251,7 @@ void MpiTracer::greet_world_rank() {
   }
 }
 
-void MpiTracer::take_node(const JoiningNode& node) {
+void MpiTracer::take_node(const JoiningNode& node, bool warm_up) {
   MpiSession& mpi = MpiSession::get();
   if (peer_ >= 0) {
     // The node it replaces stalled or died: nothing of it is read or sent again (a send to a dead process
@@ -275,12 +275,107 @@ void MpiTracer::take_node(const JoiningNode& node) {
   wants_resync_.store(true);
   joined_at_ = node.connected;
   first_band_after_join_ = true;
-  away_.store(false);
+  // Joining a running session, the node takes its full resync on the side and stays away until it says
+  // it is ready: its first band would otherwise hold the frame while it applies the whole scene and builds
+  // its BVHs (66 ms at 1080p on the large map, docs/cluster.md).
+  warm_pending_ = warm_up;
+  warming_.store(false);
+  warm_deadline_ = {};
+  away_.store(warm_up);
   {
     std::lock_guard lock(stats_mutex_);
     ++stats_.nodes_joined;
   }
-  spdlog::info("mpi:{}: node joined through the port ({}); it renders after a full resync", options_.rank, description_);
+  spdlog::info("mpi:{}: node joined through the port ({}); {}", options_.rank, description_,
+               warm_up ? "it takes its full resync on the side and rows once it says it is ready"
+                       : "it renders after a full resync");
+}
+
+void MpiTracer::send_warm() {
+  wire::Warm warm;
+  if (last_request_) {
+    warm.has_job = true;
+    warm.request = *last_request_;
+    warm.request.pieces = 1;
+    warm.request.ahead = false;
+    warm.request.adopt = 0;
+  }
+  warm_id_ = new_band_job();
+  send(int(wire::Kind::warm), warm_id_, wire::encode_warm(warm));
+  warm_pending_ = false;
+  if (warm_deadline_ == MpiClock::time_point{}) warm_deadline_ = MpiClock::now() + options_.band_timeout * 10;
+  warming_.store(true);
+}
+
+bool MpiTracer::take_ready(MpiClock::time_point deadline) {
+  MpiSession& mpi = MpiSession::get();
+  while (warming_.load()) {
+    DropPieces dropped;
+    std::optional<std::vector<uint8_t>> bytes = mpi.receive(peer_, deadline, &dropped);
+    std::lock_guard lock(stats_mutex_);
+    stats_.bytes_received += dropped.bytes;
+    if (!bytes) return false;
+    stats_.bytes_received += bytes->size();
+    wire::Ready ready;
+    try {
+      const wire::Message m = wire::parse_message(bytes->data(), bytes->size());
+      if (m.kind != wire::Kind::ready || m.sequence != warm_id_) {
+        spdlog::warn("mpi:{}: ignored a {} message from the node warming up", options_.rank, wire::to_string(m.kind));
+        continue;
+      }
+      ready = wire::decode_ready(m.payload);
+    } catch (const wire::WireError& e) {
+      ++stats_.refused_messages;
+      spdlog::warn("mpi:{}: refused a message: {}", options_.rank, e.what());
+      continue;
+    }
+    warming_.store(false);
+    if (!ready.failure.empty()) {
+      // Its scene is behind (the resync was refused, or failed to apply): the whole scene goes again, with
+      // another warm, under the same deadline.
+      node_needs_resync_ = warm_pending_ = true;
+      node_failure_ = ready.failure;
+      node_fingerprint_ = 0;
+      wants_resync_.store(true);
+      spdlog::warn("mpi:{}: the node that joined is not ready: {}; sending it the whole scene again", options_.rank,
+                   ready.failure);
+      return false;
+    }
+    const double since_connect = ms_since(joined_at_);
+    stats_.last_join_to_ready_ms = since_connect;
+    stats_.last_ready_resync_ms = ready.resync_ms;
+    stats_.last_ready_warm_ms = ready.warm_ms;
+    after_full_resync_ = false;  // applied and warmed: its first band is an ordinary one
+    away_.store(false);
+    spdlog::info("mpi:{}: the node that joined is ready {:.0f} ms after it connected (full resync applied in {:.1f} ms, "
+                 "warm-up band {:.1f} ms); it takes rows from the next frame", options_.rank, since_connect,
+                 ready.resync_ms, ready.warm_ms);
+    return true;
+  }
+  return !away_.load();
+}
+
+void MpiTracer::give_up_warming() {
+  spdlog::warn("mpi:{}: the node that joined did not say it is ready within {} ms of its full resync (ten times the "
+               "band timeout; {}); it is let go and the slot is free for another", options_.rank,
+               options_.band_timeout.count() * 10,
+               warm_pending_ ? "it said it was not: " + node_failure_ : "no answer to its warm");
+  // As for a dead node: nothing of it is read or sent again; one that only stalled leaves after its --idle-timeout.
+  MpiSession::get().abandon(peer_);
+  peer_ = -1;
+  {
+    std::lock_guard lock(joined_mutex);
+    joined_nodes().erase(options_.rank);
+  }
+  warming_.store(false);
+  warm_pending_ = false;
+  wants_resync_.store(false);
+  node_needs_resync_ = false;
+  first_band_after_join_ = false;
+  away_.store(true);
+  if (port_) port_->set_busy(options_.rank, false);
+  std::lock_guard lock(stats_mutex_);
+  ++stats_.nodes_never_ready;
 }
 
 void MpiTracer::adopt(const wire::Hello& hello) {
@@ -326,6 +421,15 @@ MpiTracer::~MpiTracer() {
                    options_.rank, s.total_ahead_sent_after_ms / double(s.jobs_ahead),
                    s.bands_back_before_announcement);
   }
+  if (s.nodes_joined > 0)
+    spdlog::info("mpi:{}: {} node(s) joined through the port; the last delivered its first band {:.0f} ms after its "
+                 "connect{}; {} let go for not saying ready in time", options_.rank, s.nodes_joined,
+                 s.last_join_to_first_band_ms,
+                 s.last_join_to_ready_ms > 0.0
+                     ? fmt::format(" (ready after {:.0f} ms: full resync {:.1f} ms, warm-up band {:.1f} ms)",
+                                   s.last_join_to_ready_ms, s.last_ready_resync_ms, s.last_ready_warm_ms)
+                     : "",
+                 s.nodes_never_ready);
   // The node stays for later tracers of this run; the session's end tells every node to leave.
   try {
     MpiSession& mpi = MpiSession::get();
@@ -343,14 +447,17 @@ bool MpiTracer::wants_full_resync() const {
 
 void MpiTracer::while_away() {
   // Asked for no band while away, it still gets its commits on its own thread: whether its node has answered
-  // since is read here, so that it takes rows again from the next frame.
+  // since, or the node that joined says it is ready, is read here, so that it takes rows again from the next frame.
   if (peer_ >= 0 && timed_out_job_ != 0) take_late_answers();
+  if (peer_ >= 0 && (warming_.load() || warm_pending_)) {
+    if (warming_.load()) take_ready(MpiClock::now());
+    if ((warming_.load() || warm_pending_) && warm_deadline_ != MpiClock::time_point{} &&
+        MpiClock::now() >= warm_deadline_)
+      give_up_warming();
+  }
 }
 
-bool MpiTracer::available() const {
-  if (!away_.load()) return true;
-  return port_ && port_->waiting(options_.rank);
-}
+bool MpiTracer::available() const { return !away_.load(); }
 
 void MpiTracer::send(int kind, uint64_t sequence, const std::vector<uint8_t>& payload) {
   std::vector<uint8_t> message = wire::frame_message(wire::Kind(kind), sequence, payload);
@@ -366,7 +473,7 @@ void MpiTracer::apply(const commit::CommitBuffer& commit) {
   if (!in_band_ && commit.is_full_resync() && port_) {
     // The resync asked for a node that joined an away slot (wants_full_resync): that node takes the slot
     // now and gets it, so that its next band is its first.
-    if (std::optional<JoiningNode> node = port_->take(options_.rank)) take_node(*node);
+    if (std::optional<JoiningNode> node = port_->take(options_.rank)) take_node(*node, options_.warm_up);
   }
   if (peer_ < 0) return;  // no node yet: the one that joins gets a full resync
   if (in_band_) {
@@ -400,6 +507,8 @@ void MpiTracer::apply(const commit::CommitBuffer& commit) {
   wants_resync_.store(false);
   after_full_resync_ = true;
   ++full_resyncs_sent_;
+  // Behind it, on the same ordered stream: the node answers once the resync is applied.
+  if (warm_pending_) send_warm();
 }
 
 void MpiTracer::take_late_answers() {
@@ -507,7 +616,7 @@ core::BandResult MpiTracer::render_band(const core::BandJob& job, core::BandBuff
     // A node that joined this slot (free: its node had not answered, left, or never came) takes it over.
     if (std::optional<JoiningNode> node = port_->take(options_.rank)) {
       drop_ahead("a new node took the slot");
-      take_node(*node);
+      take_node(*node, options_.warm_up);
     }
   }
   if (peer_ < 0)
@@ -516,6 +625,19 @@ core::BandResult MpiTracer::render_band(const core::BandJob& job, core::BandBuff
   if (wants_resync_.load())
     throw std::runtime_error(fmt::format("mpi:{}: the node that joined waits for its full resync (with the next "
                                          "frame); its rows go to the others", options_.rank));
+  if (warming_.load()) {
+    // Asked while it warms up: nobody else could take the rows (or it would be left out, away). It may
+    // still say it is ready before its deadline; past that it is let go.
+    take_ready(warm_deadline_);
+    if (warming_.load()) {
+      give_up_warming();
+      throw std::runtime_error(fmt::format("mpi:{}: the node that joined did not say it is ready in time; its rows "
+                                           "go to the others", options_.rank));
+    }
+  }
+  if (warm_pending_)
+    throw std::runtime_error(fmt::format("mpi:{}: the node that joined is not ready ({}); it gets the whole scene "
+                                         "again", options_.rank, node_failure_));
   if (timed_out_job_ != 0) {
     // A node that has not answered its last band yet (stalled, or gone) is not sent another: its band
     // fails at once, so it costs one late frame, not one per frame, and it is back when it answers.
@@ -575,6 +697,7 @@ core::BandResult MpiTracer::render_band(const core::BandJob& job, core::BandBuff
   }
   const auto start = MpiClock::now();
   send(int(wire::Kind::band_job), id, wire::encode_band_request(request));
+  last_request_ = request;
   // From here on, what the core submits goes to the node behind this job (Tracer::apply_commits_ahead,
   // between polls): the node applies it once this band is rendered, while rank 0 waits for the frame.
   // Once the core announces the next frame's job, that goes too (a job ahead, after its commits).

@@ -141,6 +141,8 @@ const char* to_string(Kind kind) {
     case Kind::band_failed: return "band_failed";
     case Kind::shutdown: return "shutdown";
     case Kind::join: return "join";
+    case Kind::warm: return "warm";
+    case Kind::ready: return "ready";
   }
   return "unknown";
 }
@@ -164,7 +166,7 @@ Header parse_header(const uint8_t* bytes, size_t size) {
   if (h.magic != kMagic) throw WireError(fmt::format("bad magic 0x{:08x} (not a Cohort message)", h.magic));
   if (h.protocol != kProtocolVersion)
     throw WireError(fmt::format("protocol version {} (this build speaks {})", h.protocol, kProtocolVersion));
-  if (h.kind < uint16_t(Kind::hello) || h.kind > uint16_t(Kind::join))
+  if (h.kind < uint16_t(Kind::hello) || h.kind > uint16_t(Kind::ready))
     throw WireError(fmt::format("unknown message kind {}", h.kind));
   if (h.payload_bytes != size - sizeof h)
     throw WireError(fmt::format("{} header announces {} payload bytes but {} arrived", to_string(Kind(h.kind)),
@@ -536,6 +538,46 @@ BandRows decode_band_rows(const uint8_t* payload, size_t size) {
   for (double t : times)
     if (!(t >= 0.0 && t < 1e9)) r.fail(fmt::format("time {} ms is not a duration", t));
   return b;
+}
+
+std::vector<uint8_t> encode_warm(const Warm& warm) {
+  Writer w;
+  w.scalar(uint8_t(warm.has_job ? 1 : 0));
+  if (warm.has_job) w.array(encode_band_request(warm.request));
+  return std::move(w.out);
+}
+
+Warm decode_warm(const std::vector<uint8_t>& payload) {
+  Reader r(payload, "warm");
+  Warm warm;
+  const uint8_t has_job = r.scalar<uint8_t>();
+  if (has_job > 1) r.fail(fmt::format("job flag {} is neither 0 nor 1", has_job));
+  warm.has_job = has_job == 1;
+  if (warm.has_job) warm.request = decode_band_request(r.array<uint8_t>("band job"));
+  r.expect_end();
+  if (warm.has_job && (warm.request.ahead || warm.request.adopt != 0))
+    r.fail("a warm-up band can be neither a job ahead nor adopt one");
+  return warm;
+}
+
+std::vector<uint8_t> encode_ready(const Ready& ready) {
+  Writer w;
+  w.scalar(ready.resync_ms);
+  w.scalar(ready.warm_ms);
+  w.text(ready.failure);
+  return std::move(w.out);
+}
+
+Ready decode_ready(const std::vector<uint8_t>& payload) {
+  Reader r(payload, "ready");
+  Ready ready;
+  ready.resync_ms = r.scalar<double>();
+  ready.warm_ms = r.scalar<double>();
+  if (!(ready.resync_ms >= 0.0 && ready.resync_ms < 1e9) || !(ready.warm_ms >= 0.0 && ready.warm_ms < 1e9))
+    r.fail(fmt::format("times {} and {} ms are out of range", ready.resync_ms, ready.warm_ms));
+  ready.failure = r.text("failure");
+  r.expect_end();
+  return ready;
 }
 
 std::vector<uint8_t> encode_band_failure(const BandFailure& failure) {

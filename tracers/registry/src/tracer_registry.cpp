@@ -206,6 +206,8 @@ std::unique_ptr<core::Tracer> make_tracer(const TracerSpec& spec) {
       options.commits_ahead = std::string(ahead) != "0";
     if (const char* ahead = std::getenv("COHORT_MPI_JOBS_AHEAD"); ahead && *ahead)
       options.jobs_ahead = std::string(ahead) != "0";
+    if (const char* warm = std::getenv("COHORT_MPI_WARM_UP"); warm && *warm)
+      options.warm_up = std::string(warm) != "0";
     return std::make_unique<MpiTracer>(options);
   }
 #endif

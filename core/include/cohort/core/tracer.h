@@ -145,6 +145,11 @@ class Tracer {
   // side, which may be empty): a tracer that waits for something to come back (a remote node's late answer)
   // looks for it here, so that available() turns true again.
   virtual void while_away() {}
+  // Whether, while away, the tracer wants its side job (and so while_away()) every frame rather than every
+  // RendererOptions::benched_commit_every frames: one that waits for an answer that brings it back soon (a
+  // remote node that joined, warming up after its full resync, says when it is ready) would otherwise take
+  // rows up to that many frames late. Read on the core thread, like available(): it must be thread-safe.
+  virtual bool checks_in_every_frame() const { return false; }
 
  protected:
   void apply_commits_ahead() {

@@ -38,6 +38,9 @@ struct NodeOptions {
   double row_delay_ms = 0.0;
   // Tests: before rendering the band of this frame index, the process kills itself (a lost node).
   int die_frame = -1;
+  // Tests: applying a full resync takes this much longer (a large scene's upload and BVH build, on the
+  // tests' small map).
+  int resync_delay_ms = 0;
   // Tests: piece 0 of this frame index's band goes out a byte short (a malformed piece).
   int short_piece_frame = -1;
   // Rank 0 silent this long: the node leaves.

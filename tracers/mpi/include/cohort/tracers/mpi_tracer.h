@@ -54,6 +54,12 @@ struct MpiTracerOptions {
   // idling until the frame's job comes; that job then adopts the rows rendered ahead where they are its
   // own (docs/cluster.md, "Jobs ahead"). COHORT_MPI_JOBS_AHEAD=0 turns it off (for comparison).
   bool jobs_ahead = true;
+  // A node that joins a running session takes its full resync on the side: the slot stays away (no rows)
+  // until the node has applied it, rendered a warm-up band and said it is ready (protocol 10), at most ten
+  // times the band timeout, so that its first band is an ordinary one instead of a late frame
+  // (docs/cluster.md, "Joining a running session"). COHORT_MPI_WARM_UP=0 turns it off (for comparison):
+  // its first band then waits for the resync, as before.
+  bool warm_up = true;
 };
 
 // What crossed the wire for this tracer, for `cohort bench devices` and the logs.
@@ -108,6 +114,12 @@ struct MpiLinkStats {
   // first band delivered (greeting, the full resync with its BVH build, the band).
   uint64_t nodes_joined = 0;
   double last_join_to_first_band_ms = 0.0;
+  // Protocol 10: the last node that joined a running session took its full resync on the side: from its
+  // connect to its ready, and what it said it took (applying the resync; its warm-up band). Nodes that did
+  // not say ready in time (let go).
+  double last_join_to_ready_ms = 0.0;
+  double last_ready_resync_ms = 0.0, last_ready_warm_ms = 0.0;
+  uint64_t nodes_never_ready = 0;
 };
 
 class MpiTracer : public core::Tracer {
@@ -126,14 +138,18 @@ class MpiTracer : public core::Tracer {
   bool takes_jobs_ahead() const override { return options_.jobs_ahead; }
   void apply(const commit::CommitBuffer& commit) override;
   // A node that joined the slot has no scene: it needs a full resync before its first band. Asked for as
-  // soon as one waits in the port of an away slot, so that the job that brings it (a band's, or an away
-  // tracer's commits on the side) lets apply() take the node and resync it at once.
+  // soon as one waits in the port of an away slot, so that the job that brings it (the away tracer's
+  // commits on the side) lets apply() take the node and resync it at once, with a warm behind it.
   bool wants_full_resync() const override;
-  // Not while its node has not answered its last band (stalled or dead) or no node serves the slot yet,
-  // unless a new node waits in the port to take the slot (it takes it with this tracer's next band).
+  // Not while its node has not answered its last band (stalled or dead), no node serves the slot yet, or
+  // the node that took the slot has not said it is ready (it applies its full resync and renders a
+  // warm-up band on the side, so that its first band is an ordinary one: docs/cluster.md).
   bool available() const override;
-  // Away: reads whether its node has answered since (the late answer to its last band).
+  // Away: reads whether its node has answered since (the late answer to its last band), or whether the
+  // node that joined says it is ready; drops a newcomer that has not within ten times the band timeout.
   void while_away() override;
+  // While the node that joined warms up: every frame, so that it takes rows the frame after it is ready.
+  bool checks_in_every_frame() const override { return warming_.load(); }
   using core::Tracer::render_band;
   core::BandResult render_band(const core::BandJob& job, core::BandBuffer& target) override;
 
@@ -147,7 +163,18 @@ class MpiTracer : public core::Tracer {
   // World rank N's hello, checked (NodeUnavailable when it cannot serve).
   void greet_world_rank();
   // From now on, `node` (greeted by the port) serves this slot; the one before, if any, is let go.
-  void take_node(const JoiningNode& node);
+  // With `warm_up` (a node that joins a running session, not one there before the first frame) it stays
+  // away until it says it is ready: its full resync goes with a warm (send_warm).
+  void take_node(const JoiningNode& node, bool warm_up);
+  // Right behind the full resync to a node that joined: the warm (with the slot's last band, when there
+  // was one, to render once for nothing); the node answers ready.
+  void send_warm();
+  // Reads the node's ready, waiting at most until `deadline`; true once it is ready (no longer away). A
+  // ready that says its scene is behind asks for another full resync (and warm).
+  bool take_ready(MpiClock::time_point deadline);
+  // The node that joined has not said it is ready by its deadline: it is let go like a dead node, and the
+  // slot is free for the next one.
+  void give_up_warming();
   // Reads, without waiting, what the node sent since a band timed out; clears timed_out_job_ once the
   // answer to that band is among it.
   void take_late_answers();
@@ -177,6 +204,13 @@ class MpiTracer : public core::Tracer {
   // Set while the slot's node cannot take a band: its last band timed out and it has not answered since,
   // or no node has joined; read by available() on the core thread.
   std::atomic<bool> away_{false};
+  // Set from the warm's send until the node that joined says it is ready (away_ all the while); read by
+  // checks_in_every_frame() on the core thread. warm_pending_: the next full resync goes with a warm.
+  std::atomic<bool> warming_{false};
+  bool warm_pending_ = false;
+  uint64_t warm_id_ = 0;                   // the warm's sequence, which its ready answers
+  MpiClock::time_point warm_deadline_{};   // the first warm's send + ten times the band timeout
+  std::optional<wire::BandRequest> last_request_;  // the last band sent to the slot: a newcomer's warm-up band
   MpiClock::time_point joined_at_{};
   bool first_band_after_join_ = false;
   std::string description_;

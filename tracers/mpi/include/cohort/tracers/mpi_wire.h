@@ -24,8 +24,10 @@ constexpr uint32_t kMagic = 0x504d4843u;  // "CHMP" in memory order
 // job came from those in its way (commits travel ahead of their job, docs/cluster.md); 7: jobs ahead
 // (band_job says whether it is one, or which one it takes the rows of; band_rows too; NodeTiming tells
 // the node's idle time and the time it rendered before the job came); 8: band format 2, RGB9E5 rows
-// (4 bytes a pixel); 9: join (a node that connects through rank 0's port names the slot it serves first).
-constexpr uint16_t kProtocolVersion = 9;
+// (4 bytes a pixel); 9: join (a node that connects through rank 0's port names the slot it serves first);
+// 10: warm and ready (a node that joined a running session takes its full resync on the side and says when
+// it can render: docs/cluster.md, "Joining a running session").
+constexpr uint16_t kProtocolVersion = 10;
 
 enum class Kind : uint16_t {
   hello = 1,        // node -> 0: versions, what scene it loaded, its tracers
@@ -39,6 +41,8 @@ enum class Kind : uint16_t {
   band_failed = 9,  // node -> 0: the band could not be rendered (the reason)
   shutdown = 10,    // 0 -> node: leave cleanly
   join = 11,        // node -> 0, first through rank 0's port: the slot (mpi:N) it asks to serve, 0 for any free one
+  warm = 12,        // 0 -> node: once what came before is applied (its full resync), warm up and say ready
+  ready = 13,       // node -> 0: the answer to warm: it can render (or why not), and what its warm-up took
 };
 const char* to_string(Kind kind);
 
@@ -199,6 +203,27 @@ BandRows decode_band_rows(const std::vector<uint8_t>& payload);
 BandRows decode_band_rows(const uint8_t* payload, size_t size);
 // The bytes of one piece's plane: its rows of colour in `format`, or of aux texels.
 uint64_t piece_bytes(uint32_t rows, uint32_t width, core::BandFormat format, Plane plane);
+
+// warm (protocol 10): sent to a node that joined a running session right behind its full resync; the node
+// answers ready once everything before it is applied. With a job (the last band its slot was sent, when
+// there was one), the node renders that band once, for nothing, before it answers, so that its first real
+// band finds its kernels loaded and its buffers made; the rows are not sent.
+struct Warm {
+  bool has_job = false;
+  BandRequest request;  // when has_job; pieces and ahead/adopt are not used
+};
+std::vector<uint8_t> encode_warm(const Warm& warm);
+Warm decode_warm(const std::vector<uint8_t>& payload);
+
+// ready: the node can render (failure empty), or why not (its scene is behind: rank 0 sends another full
+// resync). Its times: applying the last full resync (decoding it included) and the warm-up band.
+struct Ready {
+  double resync_ms = 0.0;
+  double warm_ms = 0.0;
+  std::string failure;
+};
+std::vector<uint8_t> encode_ready(const Ready& ready);
+Ready decode_ready(const std::vector<uint8_t>& payload);
 
 struct BandFailure {
   bool needs_full_resync = false;  // the node's scene is behind or diverged: the next commit must be whole
