@@ -15,6 +15,7 @@
 #                              COHORT_GPU_IN_FLIGHT="1 2" renders each mix with --frames-in-flight 1 then 2, back to
 #                              back, COHORT_GPU_ROUNDS times (default 1; docs/balancing.md, "Two frames in flight");
 #                              OPENCL in COHORT_GPU_MIXES stands for that OpenCL tracer (e.g. "embree,cuda:0,OPENCL");
+#                              COHORT_GPU_MAPS="test" leaves the large map out;
 #                              COHORT_GPU_ENQUEUE_AHEAD="1 0" renders each of those with COHORT_OPENCL_ENQUEUE_AHEAD=1
 #                              then 0, back to back (the OpenCL tracer's next band enqueued while the current one
 #                              renders, with two in flight; docs/balancing.md, "OpenCL enqueues its next band ahead")
@@ -454,7 +455,7 @@ print(pick[0]["tracer"] if pick else "")' || true)}"
       "$stage/bin/cohort" pack /tmp/largemap/maps/largemap.map --out /tmp/largemap.cpk | tail -n 1; }
     COHORT_PACK="$stage/testmap.cpk" "$stage/bin/cohort_tracers_tests" --gtest_filter='CudaMultiGpu*:FramePost*' 2>&1 |
       grep -E "^\[  (PASSED|FAILED|SKIPPED) |^\[       OK" || true
-    for map in test large; do
+    for map in ${COHORT_GPU_MAPS:-test large}; do
       if [ $map = large ]; then args=(/tmp/largemap.cpk --width 1920 --height 1080 --camera 1690 300 80 5 -12)
       else args=("$stage/testmap.cpk" --width 1280 --height 720); fi
       for convergence in ${COHORT_GPU_CONVERGENCE:-auto brigade}; do
