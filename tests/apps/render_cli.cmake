@@ -16,3 +16,13 @@ if(TARGET cohort AND (TARGET cohort_tracer_embree OR TARGET cohort_tracer_opencl
                    -P ${CMAKE_CURRENT_LIST_DIR}/check_render_cli.cmake-script)
   set_tests_properties(apps.render_cli PROPERTIES LABELS apps TIMEOUT 600)
 endif()
+
+# A port for joining nodes with no remote tracer (mpi:N) for them to serve is refused, naming the option
+# (or, in a build without MPI, refused as needing it).
+if(TARGET cohort)
+  add_test(NAME apps.render_node_port_without_remote_tracer
+           COMMAND cohort render ${CMAKE_SOURCE_DIR}/tests/scene/data/base/maps/two_rooms.map --tracers embree
+                   --node-port ${CMAKE_BINARY_DIR}/test_output/unused_node_port --frames 1)
+  set_tests_properties(apps.render_node_port_without_remote_tracer PROPERTIES LABELS apps
+                       PASS_REGULAR_EXPRESSION "--node-port: (no remote tracer \\(mpi:N\\)|this build has no MPI)")
+endif()
