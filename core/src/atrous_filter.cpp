@@ -57,8 +57,10 @@ KHistoryFixParams history_fix_params(const AtrousOptions& options, int width, in
 int history_fix_stride_for_height(int height) { return std::max(1, (height + 90) / 180); }
 
 int atrous_passes_for_height(int height) {
-  int passes = 1;
-  for (int rows = 360; rows < height && passes < 5; rows *= 2) ++passes;
+  if (height <= 360) return 1;
+  if (height <= 540) return 2;
+  int passes = 3;
+  for (int rows = 1440; rows < height && passes < 5; rows *= 2) ++passes;
   return passes;
 }
 

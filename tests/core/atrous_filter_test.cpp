@@ -124,8 +124,10 @@ TEST(AtrousFilter, KeepsTexturesSharpThroughTheAlbedo) {
 TEST(AtrousFilter, PassesGrowWithTheImageHeight) {
   EXPECT_EQ(atrous_passes_for_height(108), 1);
   EXPECT_EQ(atrous_passes_for_height(360), 1);
-  EXPECT_EQ(atrous_passes_for_height(720), 2);
+  EXPECT_EQ(atrous_passes_for_height(480), 2);
+  EXPECT_EQ(atrous_passes_for_height(720), 3);
   EXPECT_EQ(atrous_passes_for_height(1080), 3);
+  EXPECT_EQ(atrous_passes_for_height(2160), 4);
   EXPECT_EQ(atrous_passes_for_height(100000), 5);
 }
 

@@ -73,9 +73,11 @@ struct AtrousHistory {
   const float* length = nullptr;
 };
 
-// Passes whose footprint is about the same share of the image at any size: 1 up to 360 rows, one more
-// per doubling (3 at 1080). Measured on the test map at 192x108 (docs/denoising.md): more passes than
-// that blur lighting detail that FLIP sees, and reprojected frames need little spatial help.
+// 1 pass up to 360 rows, 2 up to 540, 3 up to 1440 (720p and 1080p), one more per doubling beyond. Up to 360
+// rows (the CPU's sizes) a second pass would cost the host more than issue 17's 20 ms at 640x360 allow and
+// blurs lighting detail at 192x108; at 720p a third pass lowers the mean FLIP by 3.5-4 % (nvidia-h100-x1,
+// scenario and spin-slow against 1,024-spp references) for about 0.1 ms; at 1080p a fourth would break the
+// 1.5 ms budget (docs/denoising.md, "A third pass at 720p").
 int atrous_passes_for_height(int height);
 
 // The history fix's stride at a one-frame history for a frame of this height (history_fix_stride 0): one pixel
