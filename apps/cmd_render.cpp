@@ -562,7 +562,7 @@ void add_render_command(CLI::App& app, int& exit_code) {
       ->check(CLI::IsMember({"none", "atrous", "oidn", "oidn-cuda"}));
   cmd->add_option("--atrous-passes", a->atrous_passes,
                   "passes of --denoise atrous (steps 1, 2, 4, ...: 1 pass is a 5x5 filter, 3 a 29-pixel one); "
-                  "0 picks them from the image height (1 up to 360 rows, 3 at 1080)")
+                  "0 picks them from the image height (1 up to 360 rows, 2 up to 540, 3 at 720 and 1080)")
       ->capture_default_str()
       ->check(CLI::Range(0, 6));
   cmd->add_option("--atrous-guide", a->atrous_guide,
