@@ -778,16 +778,7 @@ def rejoin(a):
     session = JoinedRun(a, frames, band_timeout_ms=1000)
     jobs, node = session.jobs, session.node
     try:
-        rank0 = jobs.start("rank0", session.rank0)
-        first = jobs.start("node1", node + ["--as", "1"])
-        dying = jobs.start("node2", node + ["--as", "2", "--die-frame", str(die)])
-        jobs.finish(dying, timeout=120)
-        died_at = time.time()
-        if f"killing itself before frame {die}" not in jobs.output(dying):
-            jobs.dump()
-            sys.exit(f"node2 ended without dying at frame {die}")
-        # The slot is free once the dead node's band has timed out (until then mpi:2 is busy: its node answers).
-        jobs.wait_for_line(rank0, r"mpi:2: no answer for rows")
+        rank0, first, died_at = start_with_mpi2_dying(session, die)
         fresh = jobs.start("node2_again", node + ["--as", "2", "--resync-delay-ms", str(RESYNC_DELAY_MS)])
         code = jobs.finish(rank0)
         codes = [jobs.finish(n) for n in (first, fresh)]
@@ -808,6 +799,23 @@ def rejoin(a):
     print(f"mpi:2's new node: first band (frame {found[-1][0]}) {found[-1][1]} ms after its connect; "
           f"{(time.time() - died_at):.1f} s from the death to the end of the run")
     print("rejoin: ok")
+
+
+def start_with_mpi2_dying(session, die):
+    """Rank 0 and two nodes that join it, the one of mpi:2 killing itself before frame `die`. Returns rank 0's and
+    mpi:1's jobs and when mpi:2's died, once its band has timed out: the slot is free for a newcomer only then
+    (until then mpi:2 is busy, its node answers)."""
+    jobs, node = session.jobs, session.node
+    rank0 = jobs.start("rank0", session.rank0)
+    first = jobs.start("node1", node + ["--as", "1"])
+    dying = jobs.start("node2", node + ["--as", "2", "--die-frame", str(die)])
+    jobs.finish(dying, timeout=120)
+    died_at = time.time()
+    if f"killing itself before frame {die}" not in jobs.output(dying):
+        jobs.dump()
+        sys.exit(f"node2 ended without dying at frame {die}")
+    jobs.wait_for_line(rank0, r"mpi:2: no answer for rows")
+    return rank0, first, died_at
 
 
 def rejoined_check(session, stats, output, die, frames, lost_band_ms=500, late_while_away=True):
@@ -887,11 +895,7 @@ def rejoin_unready(a):
     session = JoinedRun(a, frames, band_timeout_ms=300)
     jobs, node = session.jobs, session.node
     try:
-        rank0 = jobs.start("rank0", session.rank0)
-        first = jobs.start("node1", node + ["--as", "1"])
-        dying = jobs.start("node2", node + ["--as", "2", "--die-frame", str(die)])
-        jobs.finish(dying, timeout=120)
-        jobs.wait_for_line(rank0, r"mpi:2: no answer for rows")
+        rank0, first, _ = start_with_mpi2_dying(session, die)
         # Let go, it hears nothing more from rank 0 and leaves after its --idle-timeout.
         slow = jobs.start("node2_slow", node + ["--as", "2", "--resync-delay-ms", "6000", "--idle-timeout", "8"])
         jobs.wait_for_line(rank0, r"mpi:2: the node that joined did not say it is ready within 3000 ms", 60)
