@@ -156,9 +156,14 @@ struct Renderer::Worker {
       bool rendered = false;  // whether render_band took the job (one enqueued ahead is then its business)
       try {
         if (current.away) tracer->while_away();
-        // Apply time is part of what the tracer costs the frame, so the balancer sees it.
-        if (current.commit && !current.commit->empty()) apply(*current.commit, outcome.spans, track);
-        outcome.apply_ms = std::chrono::duration<double, std::milli>(Clock::now() - start).count();
+        // Apply time is part of what the tracer costs the frame, so the balancer sees it: the apply's own
+        // time, nothing when there is nothing to apply (the clock's jitter around an empty step would reach
+        // the costs of tracers on a virtual clock, RendererOptions::use_reported_time, and move their rows).
+        if (current.commit && !current.commit->empty()) {
+          const auto apply_start = Clock::now();
+          apply(*current.commit, outcome.spans, track);
+          outcome.apply_ms = std::chrono::duration<double, std::milli>(Clock::now() - apply_start).count();
+        }
         if (scene_diverged)
           throw std::runtime_error("its scene diverged after a failed commit; waiting for a full resync");
         const BandJob& job = current.job;
