@@ -780,13 +780,8 @@ def rejoin(a):
     try:
         rank0, first, died_at = start_with_mpi2_dying(session, die)
         fresh = jobs.start("node2_again", node + ["--as", "2", "--resync-delay-ms", str(RESYNC_DELAY_MS)])
-        code = jobs.finish(rank0)
-        codes = [jobs.finish(n) for n in (first, fresh)]
-        output = jobs.output(rank0)
+        output = finish_rejoined_run(jobs, rank0, (first, fresh))
         fresh_output = jobs.output(fresh)
-        jobs.dump()
-        if code != 0 or any(codes):
-            sys.exit(f"exit statuses: rank 0 {code}, nodes {codes}")
     finally:
         jobs.close()
     stats = session.stats()
@@ -816,6 +811,20 @@ def start_with_mpi2_dying(session, die):
         sys.exit(f"node2 ended without dying at frame {die}")
     jobs.wait_for_line(rank0, r"mpi:2: no answer for rows")
     return rank0, first, died_at
+
+
+def finish_rejoined_run(jobs, rank0, nodes, let_go=()):
+    """Waits for rank 0 and the nodes, then for those it let go (whatever their status), prints every log, and
+    ends the case unless rank 0 and every node exited with 0. Returns rank 0's output."""
+    code = jobs.finish(rank0)
+    codes = [jobs.finish(n) for n in nodes]
+    for job in let_go:
+        jobs.finish(job, timeout=60)
+    output = jobs.output(rank0)
+    jobs.dump()
+    if code != 0 or any(codes):
+        sys.exit(f"exit statuses: rank 0 {code}, nodes {codes}")
+    return output
 
 
 def rejoined_check(session, stats, output, die, frames, lost_band_ms=500, late_while_away=True):
@@ -900,14 +909,8 @@ def rejoin_unready(a):
         slow = jobs.start("node2_slow", node + ["--as", "2", "--resync-delay-ms", "6000", "--idle-timeout", "8"])
         jobs.wait_for_line(rank0, r"mpi:2: the node that joined did not say it is ready within 3000 ms", 60)
         fresh = jobs.start("node2_again", node + ["--as", "2", "--resync-delay-ms", str(RESYNC_DELAY_MS)])
-        code = jobs.finish(rank0)
-        codes = [jobs.finish(n) for n in (first, fresh)]
-        jobs.finish(slow, timeout=60)  # whatever its status: it was let go
-        output = jobs.output(rank0)
+        output = finish_rejoined_run(jobs, rank0, (first, fresh), let_go=(slow,))
         fresh_output = jobs.output(fresh)
-        jobs.dump()
-        if code != 0 or any(codes):
-            sys.exit(f"exit statuses: rank 0 {code}, nodes {codes}")
     finally:
         jobs.close()
     stats = session.stats()
