@@ -193,7 +193,6 @@ int run_render(const RenderArgs& a) {
   nlohmann::json stats_json = nlohmann::json::array();
   core::AdaptiveConvergence convergence;
   const bool reproject = convergence_mode == "reproject" && !a.no_convergence;
-  core::FrameBuffer albedo_guide, normal_guide;
   KCamera previous_camera{};  // none yet: the first frame is its own previous
   const std::optional<CameraPath> path =
       a.camera_path.empty() ? std::nullopt : std::optional<CameraPath>(parse_camera_path(a.camera_path));
@@ -325,10 +324,8 @@ int run_render(const RenderArgs& a) {
       core::ScopedStage denoising(stats.stages, core::kCoreTrack, "denoise");
       core::DenoiseGuides guides;
       if (!gbuffer.empty()) {  // the aux planes guide the filter where the frame has them
-        core::plane_to_frame(gbuffer.albedo, gbuffer.width, gbuffer.height, albedo_guide);
-        core::plane_to_frame(gbuffer.normal, gbuffer.width, gbuffer.height, normal_guide);
-        guides.albedo = &albedo_guide;
-        guides.normal = &normal_guide;
+        guides.albedo = &gbuffer.albedo;
+        guides.normal = &gbuffer.normal;
       }
       denoiser->denoise(*shown_image, denoised, guides);
       shown_image = &denoised;

@@ -47,6 +47,11 @@
 #                              table, JSON, plot and door crops back in $OUT; COHORT_QUALITY_PATH=spin-slow
 #                              follows that camera path instead, COHORT_QUALITY_VARIANTS="opts;opts" reruns the
 #                              methods with other render options against the same references
+#   tools/gpu_run.sh stage-oidn  here: Open Image Denoise's API, core, CUDA and CPU device libraries (tools/fetch_oidn.sh)
+#                              as .gpu-oidn/oidn.tar.xz (~46 MB: too big to travel with the payload, so in a call of
+#                              its own: device tool, carry [".gpu-oidn"], command "bash tools/gpu_run.sh unpack-oidn")
+#   tools/gpu_run.sh unpack-oidn  there: unpacks them to /tmp/oidn/lib, kept on the warm machine for the next call:
+#                              `quality` then points COHORT_OIDN_DIR at them (methods oidn-cuda, reproject+oidn-cuda)
 #   tools/gpu_run.sh frametimes  there: only the end-to-end frame times (large map 1080p generated there,
 #                              test map 720p; cuda:0, 1 spp, NEE + 1 bounce; reprojection on the GPU with and
 #                              without the a-trous filter, on the host, and Brigade's blend; per-stage medians;
@@ -99,6 +104,19 @@ case "${1:-}" in
         --platform manylinux_2_17_x86_64 --platform manylinux2014_x86_64 -d "$stage/wheels" flip-evaluator==1.7
     fi
     du -sh "$stage"
+    ;;
+  stage-oidn)
+    lib=third_party/oidn/lib
+    [ -f "$lib/libOpenImageDenoise_core.so.2.5.1" ] || bash tools/fetch_oidn.sh
+    mkdir -p .gpu-oidn
+    tar -C "$lib" -cJf .gpu-oidn/oidn.tar.xz libOpenImageDenoise.so.2 libOpenImageDenoise_core.so.2.5.1 \
+      libOpenImageDenoise_device_cuda.so.2.5.1 libOpenImageDenoise_device_cpu.so.2.5.1
+    du -sh .gpu-oidn/oidn.tar.xz
+    ;;
+  unpack-oidn)
+    # In a folder named lib: the libraries find each other through their RUNPATH, $ORIGIN/../lib.
+    rm -rf /tmp/oidn && mkdir -p /tmp/oidn/lib && tar -C /tmp/oidn/lib -xJf .gpu-oidn/oidn.tar.xz
+    ls -la /tmp/oidn/lib
     ;;
   stage-mpi)
     # Here: the travelling cohort built against MPICH from PyPI (docs/cluster.md), with MPICH's libraries and
@@ -371,6 +389,8 @@ print(f"  {sum(total.values()) / frames:7.3f} ms  all kernels a frame")'
     python3 -m pip install -q --no-index --no-deps --no-compile --no-cache-dir --upgrade --target /tmp/site \
       "$stage"/wheels/*.whl
     export PYTHONPATH=/tmp/site${PYTHONPATH:+:$PYTHONPATH} PYTHONUNBUFFERED=1
+    # Open Image Denoise, where an earlier call on this warm machine unpacked it (stage-oidn, unpack-oidn).
+    [ -d /tmp/oidn/lib ] && export COHORT_OIDN_DIR=/tmp/oidn/lib
     nvidia-smi --query-gpu=index,name --format=csv,noheader
     out=${OUT:-/tmp/out}; mkdir -p "$out"
     methods=${COHORT_QUALITY_METHODS:-none,brigade,reproject+atrous,reproject+atrous-first-hit}

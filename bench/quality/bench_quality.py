@@ -48,6 +48,9 @@ METHODS = {
     "brigade+oidn": ["--convergence", "brigade", "--denoise", "oidn"],
     "reproject": ["--convergence", "reproject"],
     "reproject+oidn": ["--convergence", "reproject", "--denoise", "oidn"],
+    # The same filter on an NVIDIA GPU (OIDN's CUDA device), as a player with a GPU would get it.
+    "oidn-cuda": ["--no-convergence", "--denoise", "oidn-cuda"],
+    "reproject+oidn-cuda": ["--convergence", "reproject", "--denoise", "oidn-cuda"],
     "atrous": ["--no-convergence", "--denoise", "atrous"],
     "atrous-fixed": ["--no-convergence", "--denoise", "atrous", "--atrous-guide", "fixed"],
     "reproject+atrous": ["--convergence", "reproject", "--denoise", "atrous"],

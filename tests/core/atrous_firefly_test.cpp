@@ -54,9 +54,10 @@ TEST(FireflyClamp, ScalesALonePixelDownToTheFactorTimesItsBrightestNeighbour) {
   EXPECT_EQ(at(out, 3, 2)[3], 7.0f) << "alpha is copied";
   // Everything else, the bright neighbour included (its own brightest neighbour is the firefly), is unchanged.
   for (int y = 0; y < kH; ++y)
-    for (int x = 0; x < kW; ++x)
-      if (!(x == 3 && y == 2) && !(x == 0 && y == 0))
-        for (int k = 0; k < 4; ++k) ASSERT_EQ(at(out, x, y)[k], at(in, x, y)[k]) << x << "," << y;
+    for (int x = 0; x < kW; ++x) {
+      if ((x == 3 && y == 2) || (x == 0 && y == 0)) continue;
+      for (int k = 0; k < 4; ++k) ASSERT_EQ(at(out, x, y)[k], at(in, x, y)[k]) << x << "," << y;
+    }
 }
 
 TEST(FireflyClamp, LeavesAFeatureTwoPixelsWideAlone) {

@@ -7,7 +7,6 @@
 #include <cstdint>
 #include <vector>
 
-#include "cohort/core/frame_buffer.h"
 
 namespace cohort::core {
 
@@ -35,17 +34,5 @@ struct GBuffer {
   }
   void clear() { resize(0, 0); }
 };
-
-// A three-channel plane (normal or albedo) as an RGBA frame, e.g. for the denoiser's guides.
-inline void plane_to_frame(const std::vector<float>& rgb, int width, int height, FrameBuffer& out) {
-  if (out.width != width || out.height != height) out.resize(width, height);
-  const size_t pixels = static_cast<size_t>(width) * static_cast<size_t>(height);
-  for (size_t p = 0; p < pixels; ++p) {
-    out.rgba[4 * p + 0] = rgb[3 * p + 0];
-    out.rgba[4 * p + 1] = rgb[3 * p + 1];
-    out.rgba[4 * p + 2] = rgb[3 * p + 2];
-    out.rgba[4 * p + 3] = 1.0f;
-  }
-}
 
 }  // namespace cohort::core

@@ -9,6 +9,7 @@
 
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "cohort/core/frame_buffer.h"
 
@@ -24,10 +25,11 @@ OidnQuality parse_oidn_quality(const std::string& name);
 OidnDevice parse_oidn_device(const std::string& name);
 const char* oidn_device_name(OidnDevice device);
 
-// Optional guide images for the denoiser, same size as the colour: albedo in [0, 1], world normals.
+// Optional guide planes for the denoiser, 3 floats a pixel for each of the colour's pixels (GBuffer's
+// layout): albedo in [0, 1], world normals in [-1, 1].
 struct DenoiseGuides {
-  const FrameBuffer* albedo = nullptr;
-  const FrameBuffer* normal = nullptr;
+  const std::vector<float>* albedo = nullptr;
+  const std::vector<float>* normal = nullptr;
 };
 
 class OidnDenoiser {
@@ -44,6 +46,7 @@ class OidnDenoiser {
   OidnDenoiser& operator=(const OidnDenoiser&) = delete;
 
   // Denoises the RGB of `color` (linear HDR) into `out` (resized; alpha copied). `out` may be `color`.
+  // The images go to the filter as half floats: colour clamped to [0, 65504], a NaN read as 0.
   // Throws std::runtime_error with OIDN's message when the filter fails.
   void denoise(const FrameBuffer& color, FrameBuffer& out, const DenoiseGuides& guides = {});
 
