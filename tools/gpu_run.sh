@@ -19,6 +19,9 @@
 #                              COHORT_GPU_ENQUEUE_AHEAD="1 0" renders each of those with COHORT_OPENCL_ENQUEUE_AHEAD=1
 #                              then 0, back to back (the OpenCL tracer's next band enqueued while the current one
 #                              renders, with two in flight; docs/balancing.md, "OpenCL enqueues its next band ahead")
+#                              COHORT_GPU_TRANSFER_QUEUE="1 0" renders each of those with COHORT_OPENCL_TRANSFER_QUEUE=1
+#                              then 0, back to back (the band's uploads and reads off the compute queue, so bands run
+#                              back to back on the device; docs/balancing.md, "OpenCL's bands back to back on the device")
 #   tools/gpu_run.sh compare BASE.tar.xz [MORE.tar.xz ...]  there: A/B of payloads on one machine (the staged
 #                              one against earlier stages' payload.tar.xz, renamed and carried in .gpu/): the CUDA
 #                              tracer tests of the staged one, then end-to-end ms per frame, cuda:0, both maps,
@@ -465,6 +468,7 @@ print(pick[0]["tracer"] if pick else "")' || true)}"
         # Unset: the option is not passed (payloads from before it still run).
         for in_flight in ${COHORT_GPU_IN_FLIGHT:-default}; do
         for ahead in ${COHORT_GPU_ENQUEUE_AHEAD:-default}; do
+        for transfer in ${COHORT_GPU_TRANSFER_QUEUE:-default}; do
           run=/tmp/mg_${map}_${convergence}_$(echo "$mix" | tr ',:' '__')
           in_flight_args=()
           if [ "$in_flight" != default ]; then
@@ -476,6 +480,10 @@ print(pick[0]["tracer"] if pick else "")' || true)}"
             run=${run}_ea${ahead}
             ahead_env=(COHORT_OPENCL_ENQUEUE_AHEAD=$ahead); ahead_label=", COHORT_OPENCL_ENQUEUE_AHEAD=$ahead"
           fi
+          if [ "$transfer" != default ]; then
+            run=${run}_tq${transfer}
+            ahead_env+=(COHORT_OPENCL_TRANSFER_QUEUE=$transfer); ahead_label="$ahead_label, COHORT_OPENCL_TRANSFER_QUEUE=$transfer"
+          fi
           env "${ahead_env[@]}" timeout 120 "$stage/bin/cohort" render "${args[@]}" --tracers "$mix" --spp 1 --light-samples 1 --bounces 1 \
             ${COHORT_GPU_RENDER_ARGS:-} "${in_flight_args[@]}" --convergence $convergence --frames ${COHORT_GPU_FRAMES:-100} \
             --camera-path spin-slow --write last --out $run >$run.log 2>&1 ||
@@ -484,6 +492,7 @@ print(pick[0]["tracer"] if pick else "")' || true)}"
           python3 tools/frame_times.py $run/stats.json --skip ${COHORT_GPU_SKIP:-20} --json $out/$(basename $run).json > $run/summary.txt
           head -n 1 $run/summary.txt
           grep -E "sits out|keeps its rows" $run.log | sed 's/^.*\] //' | head -n 3 || true
+        done
         done
         done
         done

@@ -56,6 +56,12 @@ class OpenCLTracer : public TracerBase {
     // (core::Tracer::enqueues_ahead; docs/balancing.md, "OpenCL enqueues its next band ahead").
     // COHORT_OPENCL_ENQUEUE_AHEAD=0: each band enqueued when its job starts.
     bool enqueue_ahead = true;
+    // With enqueue ahead, the band's edges off the compute queue: its row count clear and its parameter and
+    // camera writes on an upload queue, its reads (rows, row counts) on a read queue behind its last kernel's
+    // event, the buffers they touch in two slots used in turn; so the next band's kernels follow this band's
+    // on the device with no transfer between them (docs/balancing.md, "OpenCL's bands back to back on the
+    // device"). COHORT_OPENCL_TRANSFER_QUEUE=0: everything of a band on the one compute queue, as before.
+    bool transfer_queue = true;
   };
   static constexpr int kMaxFirstHitPieces = 8;
   // The pieces' first rows, relative to the band, and `rows` last: up to `pieces` ranges of whole work
@@ -86,6 +92,11 @@ class OpenCLTracer : public TracerBase {
   size_t bands_enqueued_ahead() const;
   size_t bands_finished_ahead() const;
   size_t bands_dropped_ahead() const;
+  // Bands enqueued ahead with their edges off the compute queue (Options::transfer_queue): their kernels
+  // queued straight behind the band before's, whose reads went on the read queue.
+  size_t bands_back_to_back() const;
+  // Whether the band's edges go on the upload and read queues (Options::transfer_queue with enqueue_ahead).
+  bool transfer_queues() const;
 
   // "platform / device" for every OpenCL device on this machine, in the order Options::device counts.
   static std::vector<std::string> list_devices();
