@@ -66,10 +66,27 @@ void count_ahead(const std::vector<core::Tracer*>&, Rendered&) {}
 
 using MakeTracer = std::function<std::unique_ptr<core::Tracer>(const std::string&)>;
 
+#ifdef COHORT_HAVE_OPENCL
+// The OpenCL tracer's options here: its bands back to back on the device with the transfer queues, which a
+// CPU device (PoCL) leaves off by default (OpenCLTracer::Options::transfer_queue).
+tracers::OpenCLTracer::Options opencl_options() {
+  tracers::OpenCLTracer::Options o;
+  if (const char* device = std::getenv("COHORT_TEST_OPENCL_DEVICE")) o.device = std::atoi(device);
+  o.transfer_queue = tracers::OpenCLTracer::Options::TransferQueue::always;
+  return o;
+}
+std::unique_ptr<core::Tracer> make_sequence_tracer(const std::string& name) {
+  if (name != "opencl") return make_test_tracer(name);
+  return std::make_unique<tracers::OpenCLTracer>(opencl_options());
+}
+#else
+std::unique_ptr<core::Tracer> make_sequence_tracer(const std::string& name) { return make_test_tracer(name); }
+#endif
+
 struct Extras {
   bool move_walker = false;  // the walker posed and moved every frame (skins, instances, the TLAS in every commit)
   kuint aux = 0;             // KFrameParams::aux_outputs
-  MakeTracer make = make_test_tracer;
+  MakeTracer make = make_sequence_tracer;
   std::chrono::milliseconds frame_timeout{120000};
   core::BandFormat band_format = core::BandFormat::rgba32f;
 };
@@ -184,7 +201,7 @@ void expect_enqueued_ahead(const Rendered& one, const Rendered& two, size_t open
   EXPECT_GE(two.finished_ahead, opencl_tracers * 2) << label << ": bands were not enqueued ahead";
   EXPECT_EQ(two.finished_ahead, two.enqueued_ahead) << label << ": a band enqueued ahead was not taken by its job";
   // Each of them back to back on the device: its uploads on the upload queue, the band before's reads on the
-  // read queue (COHORT_OPENCL_TRANSFER_QUEUE=0 fails this).
+  // read queue.
   EXPECT_TRUE(two.transfer_queues) << label << ": the transfer queues are off";
   EXPECT_EQ(two.back_to_back, two.enqueued_ahead) << label << ": a band enqueued ahead was not back to back";
 }
@@ -215,8 +232,7 @@ TEST(FramesInFlightAgreement, OpenCLAloneDrawsTheSameFramesWithTwoInFlightWithAM
   Extras off_extras;
   off_extras.move_walker = true;
   off_extras.make = [](const std::string&) -> std::unique_ptr<core::Tracer> {
-    tracers::OpenCLTracer::Options o;
-    if (const char* device = std::getenv("COHORT_TEST_OPENCL_DEVICE")) o.device = std::atoi(device);
+    tracers::OpenCLTracer::Options o = opencl_options();
     o.enqueue_ahead = false;
     return std::make_unique<tracers::OpenCLTracer>(o);
   };
@@ -316,9 +332,7 @@ void expect_fault_recovered(std::chrono::milliseconds stall_time) {
   auto counts = std::make_shared<AheadCounts>();
   const MakeTracer make = [&](const std::string& name) -> std::unique_ptr<core::Tracer> {
     if (name != "opencl") return make_test_tracer(name);
-    tracers::OpenCLTracer::Options o;
-    if (const char* device = std::getenv("COHORT_TEST_OPENCL_DEVICE")) o.device = std::atoi(device);
-    auto t = std::make_unique<FaultyOpenCL>(o, kFaultFrame, stall_time, counts);
+    auto t = std::make_unique<FaultyOpenCL>(opencl_options(), kFaultFrame, stall_time, counts);
     made = true;
     return t;
   };
@@ -398,10 +412,10 @@ TEST(FramesInFlightAgreement, OpenCLBandsBackToBackOnTheDeviceAreTheBandsRendere
       e.band_format = c.format;
       e.make = [&c, transfer_queue](const std::string& name) -> std::unique_ptr<core::Tracer> {
         if (name != "opencl") return make_test_tracer(name);
-        tracers::OpenCLTracer::Options o;
-        if (const char* device = std::getenv("COHORT_TEST_OPENCL_DEVICE")) o.device = std::atoi(device);
+        tracers::OpenCLTracer::Options o = opencl_options();
         o.wavefront = c.wavefront;
-        o.transfer_queue = transfer_queue;
+        o.transfer_queue = transfer_queue ? tracers::OpenCLTracer::Options::TransferQueue::always
+                                          : tracers::OpenCLTracer::Options::TransferQueue::never;
         return std::make_unique<tracers::OpenCLTracer>(o);
       };
       return e;
@@ -419,5 +433,18 @@ TEST(FramesInFlightAgreement, OpenCLBandsBackToBackOnTheDeviceAreTheBandsRendere
     for (int f = 0; f < kFrames; ++f)
       EXPECT_GT(on.stats[f].tracers[1].row_begin, 0) << c.label << " frame " << f << ": OpenCL's band should start below Embree's";
   }
+}
+
+// Where the transfer queues are on: by default on GPU devices only; never without enqueue ahead.
+TEST(FramesInFlightAgreement, OpenCLTransferQueuesAreOnByDefaultOnGpusOnlyAndNeedEnqueueAhead) {
+  if (!tracer_runs_here("opencl")) GTEST_SKIP() << "needs the OpenCL tracer";
+  tracers::OpenCLTracer::Options o = opencl_options();
+  o.transfer_queue = tracers::OpenCLTracer::Options::TransferQueue::on_gpus;
+  const tracers::OpenCLTracer by_default(o);
+  EXPECT_EQ(by_default.transfer_queues(), by_default.renders_on_gpu());
+  o.transfer_queue = tracers::OpenCLTracer::Options::TransferQueue::always;
+  EXPECT_TRUE(tracers::OpenCLTracer(o).transfer_queues());
+  o.enqueue_ahead = false;
+  EXPECT_FALSE(tracers::OpenCLTracer(o).transfer_queues());
 }
 #endif

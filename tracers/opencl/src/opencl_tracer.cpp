@@ -254,7 +254,7 @@ struct OpenCLTracer::EnqueuedBand {
   bool straight = false, write_aux = false, aux_from_paths = false;
   bool whole_band = false;  // its rows end where the frame's do (row_work is reported then)
   OpenCLWavefront* wave = nullptr;
-  Event band_started, band_done, band_read, last;  // last: the row counts' read, the band's last command
+  Event band_started, band_done, band_read, last;  // last: the band's last command (the row counts' read, or with the transfer queues the band's)
   // The band's last kernel (the packing, or the band's own last kernel): its reads wait on it on the read
   // queue (Options::transfer_queue), and the next band's device gap is timed from its end.
   Event kernels_done;
@@ -341,7 +341,7 @@ struct OpenCLTracer::Impl {
   cl_mem packed = nullptr, packed_aux = nullptr;
   size_t packed_bytes = 0, packed_aux_bytes = 0;
 
-  // Options::transfer_queue (with enqueue ahead): a band's uploads on `upload_queue`, its reads on
+  // Options::transfer_queue on this device (with enqueue ahead): a band's uploads on `upload_queue`, its reads on
   // `read_queue` behind its last kernel, so `queue` holds only kernels and goes from one band's to the next's.
   // The buffers a band's edges write or read (params, camera, output, row_rays, packed above) are the current
   // slot; `spare` is the other, the band before's, whose reads may still run while the next band renders
@@ -566,14 +566,6 @@ OpenCLTracer::OpenCLTracer(const Options& options) : impl_(std::make_unique<Impl
   check(err, "clCreateCommandQueue");
   impl_->aux_queue = clCreateCommandQueue(impl_->context, dev.device, 0, &err);
   check(err, "clCreateCommandQueue(aux)");
-  impl_->transfer = options.transfer_queue && options.enqueue_ahead;
-  if (impl_->transfer) {
-    impl_->upload_queue = clCreateCommandQueue(impl_->context, dev.device, 0, &err);
-    check(err, "clCreateCommandQueue(upload)");
-    // Profiled: the band's read times its way back (finish_band).
-    impl_->read_queue = clCreateCommandQueue(impl_->context, dev.device, CL_QUEUE_PROFILING_ENABLE, &err);
-    check(err, "clCreateCommandQueue(read)");
-  }
 
 #if defined(__GNUC__)
 #pragma GCC diagnostic pop
@@ -589,6 +581,22 @@ OpenCLTracer::OpenCLTracer(const Options& options) : impl_(std::make_unique<Impl
     return o;
   };
   impl_->device = dev.device;
+  impl_->transfer = options.enqueue_ahead && (options.transfer_queue == Options::TransferQueue::always ||
+                                              (options.transfer_queue == Options::TransferQueue::on_gpus && impl_->gpu));
+  if (impl_->transfer) {
+#if defined(__GNUC__)
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wdeprecated-declarations"
+#endif
+    impl_->upload_queue = clCreateCommandQueue(impl_->context, dev.device, 0, &err);
+    check(err, "clCreateCommandQueue(upload)");
+    // Profiled: the band's read times its way back (finish_band).
+    impl_->read_queue = clCreateCommandQueue(impl_->context, dev.device, CL_QUEUE_PROFILING_ENABLE, &err);
+    check(err, "clCreateCommandQueue(read)");
+#if defined(__GNUC__)
+#pragma GCC diagnostic pop
+#endif
+  }
   impl_->wavefront_on = options.wavefront == Options::Wavefront::always ||
                         (options.wavefront == Options::Wavefront::on_gpus && impl_->gpu);
   impl_->shadow_walk = options.shadow_walk;
@@ -939,19 +947,31 @@ std::unique_ptr<OpenCLTracer::EnqueuedBand> OpenCLTracer::enqueue_band(const cor
     b->aux_kernel_done.take(m.aux_kernel_done);
     b->aux_read.take(m.aux_read);
   }
-  // The reads: on the read queue behind the band's last kernel, so that the compute queue goes on to the next
-  // band's kernels at once (its buffers are the other slot's); else behind it in the compute queue.
   void* band_destination = straight ? target.row(int(params.row_begin)) : b->band.data();
-  cl_command_queue read = m.transfer ? m.read_queue : m.queue;
-  const cl_event kernels_done = b->kernels_done.get();
-  const cl_uint waits = m.transfer ? 1 : 0;
-  check(clEnqueueReadBuffer(read, band_mem, CL_FALSE, 0, band_bytes, band_destination, waits,
-                            waits ? &kernels_done : nullptr, b->band_read.out()),
-        "reading the band");
-  check(clEnqueueReadBuffer(read, m.row_rays, CL_FALSE, 0, rows * sizeof(cl_uint), b->row_rays.data(), 0, nullptr,
-                            b->last.out()),
-        "reading the row ray counts");
-  check(clFlush(read), "clFlush");
+  if (m.transfer) {
+    // The reads on the read queue behind the band's last kernel, so that the compute queue goes on to the next
+    // band's kernels at once (its buffers are the other slot's). The row counts (a few KB) first and the band
+    // last: its read's end is the band's (`last`), so a read held back shows in its transfer time. (On PoCL
+    // the second of two reads started only after the next band's kernels, 50 ms late, where they were the
+    // other way round.)
+    const cl_event kernels_done = b->kernels_done.get();
+    check(clEnqueueReadBuffer(m.read_queue, m.row_rays, CL_FALSE, 0, rows * sizeof(cl_uint), b->row_rays.data(), 1,
+                              &kernels_done, nullptr),
+          "reading the row ray counts");
+    check(clEnqueueReadBuffer(m.read_queue, band_mem, CL_FALSE, 0, band_bytes, band_destination, 0, nullptr,
+                              b->band_read.out()),
+          "reading the band");
+    check(clRetainEvent(b->band_read.get()), "clRetainEvent");
+    *b->last.out() = b->band_read.get();
+    check(clFlush(m.read_queue), "clFlush(read)");
+  } else {
+    check(clEnqueueReadBuffer(m.queue, band_mem, CL_FALSE, 0, band_bytes, band_destination, 0, nullptr, b->band_read.out()),
+          "reading the band");
+    check(clEnqueueReadBuffer(m.queue, m.row_rays, CL_FALSE, 0, rows * sizeof(cl_uint), b->row_rays.data(), 0, nullptr,
+                              b->last.out()),
+          "reading the row ray counts");
+    check(clFlush(m.queue), "clFlush");
+  }
   b->enqueue_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - started).count();
   return b;
 }

@@ -60,8 +60,12 @@ class OpenCLTracer : public TracerBase {
     // camera writes on an upload queue, its reads (rows, row counts) on a read queue behind its last kernel's
     // event, the buffers they touch in two slots used in turn; so the next band's kernels follow this band's
     // on the device with no transfer between them (docs/balancing.md, "OpenCL's bands back to back on the
-    // device"). COHORT_OPENCL_TRANSFER_QUEUE=0: everything of a band on the one compute queue, as before.
-    bool transfer_queue = true;
+    // device"). On GPU devices (their copy engines run beside the kernels), or always, or never. A CPU device
+    // keeps one queue by default: on PoCL (2-core VM) a band's read sometimes ran only after the next band's
+    // kernels, a whole band late (p95 frame 100 ms against 55, OpenCL alone at 320x180). COHORT_OPENCL_TRANSFER_QUEUE
+    // (the registry): 1 always, 0 never.
+    enum class TransferQueue { on_gpus, always, never };
+    TransferQueue transfer_queue = TransferQueue::on_gpus;
   };
   static constexpr int kMaxFirstHitPieces = 8;
   // The pieces' first rows, relative to the band, and `rows` last: up to `pieces` ranges of whole work
@@ -95,7 +99,8 @@ class OpenCLTracer : public TracerBase {
   // Bands enqueued ahead with their edges off the compute queue (Options::transfer_queue): their kernels
   // queued straight behind the band before's, whose reads went on the read queue.
   size_t bands_back_to_back() const;
-  // Whether the band's edges go on the upload and read queues (Options::transfer_queue with enqueue_ahead).
+  // Whether the band's edges go on the upload and read queues (Options::transfer_queue on this device, with
+  // enqueue_ahead).
   bool transfer_queues() const;
 
   // "platform / device" for every OpenCL device on this machine, in the order Options::device counts.
