@@ -62,8 +62,8 @@ class OpenCLTracer : public TracerBase {
     // on the device with no transfer between them (docs/balancing.md, "OpenCL's bands back to back on the
     // device"). On GPU devices (their copy engines run beside the kernels), or always, or never. A CPU device
     // keeps one queue by default: on PoCL (2-core VM) a band's read sometimes ran only after the next band's
-    // kernels, a whole band late (p95 frame 100 ms against 55, OpenCL alone at 320x180). COHORT_OPENCL_TRANSFER_QUEUE
-    // (the registry): 1 always, 0 never.
+    // kernels, a whole band late (p95 frame 100-115 ms against 54-61, OpenCL alone at 320x180).
+    // COHORT_OPENCL_TRANSFER_QUEUE (the registry): 1 always, 0 never.
     enum class TransferQueue { on_gpus, always, never };
     TransferQueue transfer_queue = TransferQueue::on_gpus;
   };
