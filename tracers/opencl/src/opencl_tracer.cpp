@@ -807,7 +807,7 @@ core::BandResult OpenCLTracer::render_band(const core::BandJob& job, core::BandB
     }
   }
   if (!band) {
-    band = enqueue_band(job, target);
+    band = enqueue_band(job, target, false);
     if (band->rows == 0) return {};
     if (band->aux_from_paths)
       return render_first_hits_in_pieces(job, target, band->params, band->camera, band->straight, band->wave);
@@ -837,7 +837,7 @@ core::BandResult OpenCLTracer::render_band(const core::BandJob& job, core::BandB
 }
 
 std::unique_ptr<OpenCLTracer::EnqueuedBand> OpenCLTracer::enqueue_band(const core::BandJob& job,
-                                                                      core::BandBuffer& target) {
+                                                                      core::BandBuffer& target, bool ahead) {
   Impl& m = *impl_;
   const auto started = std::chrono::steady_clock::now();
   auto b = std::make_unique<EnqueuedBand>();
@@ -875,19 +875,21 @@ std::unique_ptr<OpenCLTracer::EnqueuedBand> OpenCLTracer::enqueue_band(const cor
   // queue is done before it goes (the guard goes after it).
   DrainOnThrow drain{m.queues()};
   const cl_uint zero = 0;
-  // With the transfer queues these run on the upload queue as soon as they are enqueued (into this band's
-  // slot, which nothing in any queue uses), while the band before renders; the compute queue waits for them
-  // with a barrier that is long done when it comes to it. Without, they run in the compute queue's order.
-  cl_command_queue upload = m.transfer ? m.upload_queue : m.queue;
+  // Enqueued ahead with the transfer queues, these run on the upload queue as soon as they are enqueued (into
+  // this band's slot, which nothing in any queue uses), while the band before renders; the compute queue waits
+  // for them with a barrier that is long done when it comes to it. Otherwise they run in the compute queue's
+  // order (a band enqueued when its job starts finds every queue empty: nothing to overlap).
+  const bool upload_aside = m.transfer && ahead;
+  cl_command_queue upload = upload_aside ? m.upload_queue : m.queue;
   Event uploaded;
   check(clEnqueueFillBuffer(upload, m.row_rays, &zero, sizeof zero, 0, rows * sizeof(cl_uint), 0, nullptr, nullptr),
         "clearing the row ray counts");
   check(clEnqueueWriteBuffer(upload, m.params, CL_FALSE, 0, sizeof params, &params, 0, nullptr, nullptr),
         "writing frame parameters");
   check(clEnqueueWriteBuffer(upload, m.camera, CL_FALSE, 0, sizeof camera, &camera, 0, nullptr,
-                             m.transfer ? uploaded.out() : nullptr),
+                             upload_aside ? uploaded.out() : nullptr),
         "writing the camera");
-  if (m.transfer) {
+  if (upload_aside) {
     check(clFlush(m.upload_queue), "clFlush(upload)");
     const cl_event written = uploaded.get();  // the last of the three, in the upload queue's order
     check(clEnqueueBarrierWithWaitList(m.queue, 1, &written, nullptr), "waiting for the band's uploads");
@@ -1011,7 +1013,7 @@ void OpenCLTracer::enqueue_next_ahead(const EnqueuedBand& current) {
     return;
   }
   try {
-    std::unique_ptr<EnqueuedBand> b = enqueue_band(next->job, *next->target);
+    std::unique_ptr<EnqueuedBand> b = enqueue_band(next->job, *next->target, true);
     if (b->rows == 0) return;
     b->ahead = true;
     m.ahead = std::move(b);

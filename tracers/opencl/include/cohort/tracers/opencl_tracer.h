@@ -139,7 +139,8 @@ class OpenCLTracer : public TracerBase {
   // A band whose commands are all enqueued (render_band's, or the next one's ahead), and its end: the wait
   // for its last command, its rows stored where they came down elsewhere, its clock.
   struct EnqueuedBand;
-  std::unique_ptr<EnqueuedBand> enqueue_band(const core::BandJob& job, core::BandBuffer& target);
+  // ahead: enqueued while the band before is still in the queues (its uploads then go on the upload queue).
+  std::unique_ptr<EnqueuedBand> enqueue_band(const core::BandJob& job, core::BandBuffer& target, bool ahead);
   core::BandResult finish_band(EnqueuedBand& band);
   // Inside render_band, the current band enqueued: the next band enqueued too when the worker has it
   // queued before the current band is done (Tracer::queued_next) and it can go ahead.
