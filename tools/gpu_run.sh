@@ -19,6 +19,12 @@
 #                              COHORT_GPU_ENQUEUE_AHEAD="1 0" renders each of those with COHORT_OPENCL_ENQUEUE_AHEAD=1
 #                              then 0, back to back (the OpenCL tracer's next band enqueued while the current one
 #                              renders, with two in flight; docs/balancing.md, "OpenCL enqueues its next band ahead")
+#                              COHORT_GPU_TEST_FILTER names the tracer tests run first (default 'CudaMultiGpu*:FramePost*')
+#                              COHORT_GPU_TRANSFER_QUEUE="1 0" renders each of those with COHORT_OPENCL_TRANSFER_QUEUE=1
+#                              then 0, back to back (the band's uploads and reads off the compute queue, so bands run
+#                              back to back on the device; docs/balancing.md, "OpenCL's bands back to back on the device")
+#                              COHORT_GPU_BAND_GAPS=1 renders with --log-level debug and prints the OpenCL bands' device gap
+#                              after the band before, kernels and transfer (tools/opencl_band_gaps.py)
 #   tools/gpu_run.sh compare BASE.tar.xz [MORE.tar.xz ...]  there: A/B of payloads on one machine (the staged
 #                              one against earlier stages' payload.tar.xz, renamed and carried in .gpu/): the CUDA
 #                              tracer tests of the staged one, then end-to-end ms per frame, cuda:0, both maps,
@@ -473,7 +479,9 @@ print(pick[0]["tracer"] if pick else "")' || true)}"
     opencl_mixes=""; [ -n "$opencl" ] && opencl_mixes="cuda:0,$opencl embree,cuda:0,$opencl"
     [ -f /tmp/largemap.cpk ] || { python3 tools/gen_testmap.py --large --out /tmp/largemap >/dev/null &&
       "$stage/bin/cohort" pack /tmp/largemap/maps/largemap.map --out /tmp/largemap.cpk | tail -n 1; }
-    COHORT_PACK="$stage/testmap.cpk" "$stage/bin/cohort_tracers_tests" --gtest_filter='CudaMultiGpu*:FramePost*' 2>&1 |
+    # COHORT_GPU_TEST_FILTER: other tests first (e.g. 'CudaMultiGpu*:FramePost*:FramesInFlightAgreement.*:OpenCL*';
+    # opencl there is NVIDIA's OpenCL on the first GPU).
+    COHORT_PACK="$stage/testmap.cpk" "$stage/bin/cohort_tracers_tests" --gtest_filter="${COHORT_GPU_TEST_FILTER:-CudaMultiGpu*:FramePost*}" 2>&1 |
       grep -E "^\[  (PASSED|FAILED|SKIPPED) |^\[       OK" || true
     for map in ${COHORT_GPU_MAPS:-test large}; do
       if [ $map = large ]; then args=(/tmp/largemap.cpk --width 1920 --height 1080 --camera 1690 300 80 5 -12)
@@ -485,6 +493,7 @@ print(pick[0]["tracer"] if pick else "")' || true)}"
         # Unset: the option is not passed (payloads from before it still run).
         for in_flight in ${COHORT_GPU_IN_FLIGHT:-default}; do
         for ahead in ${COHORT_GPU_ENQUEUE_AHEAD:-default}; do
+        for transfer in ${COHORT_GPU_TRANSFER_QUEUE:-default}; do
           run=/tmp/mg_${map}_${convergence}_$(echo "$mix" | tr ',:' '__')
           in_flight_args=()
           if [ "$in_flight" != default ]; then
@@ -496,14 +505,21 @@ print(pick[0]["tracer"] if pick else "")' || true)}"
             run=${run}_ea${ahead}
             ahead_env=(COHORT_OPENCL_ENQUEUE_AHEAD=$ahead); ahead_label=", COHORT_OPENCL_ENQUEUE_AHEAD=$ahead"
           fi
-          env "${ahead_env[@]}" timeout 120 "$stage/bin/cohort" render "${args[@]}" --tracers "$mix" --spp 1 --light-samples 1 --bounces 1 \
+          if [ "$transfer" != default ]; then
+            run=${run}_tq${transfer}
+            ahead_env+=(COHORT_OPENCL_TRANSFER_QUEUE=$transfer); ahead_label="$ahead_label, COHORT_OPENCL_TRANSFER_QUEUE=$transfer"
+          fi
+          log_args=(); [ "${COHORT_GPU_BAND_GAPS:-0}" = 1 ] && log_args=(--log-level debug)
+          env "${ahead_env[@]}" timeout 120 "$stage/bin/cohort" "${log_args[@]}" render "${args[@]}" --tracers "$mix" --spp 1 --light-samples 1 --bounces 1 \
             ${COHORT_GPU_RENDER_ARGS:-} "${in_flight_args[@]}" --convergence $convergence --frames ${COHORT_GPU_FRAMES:-100} \
             --camera-path spin-slow --write last --out $run >$run.log 2>&1 ||
             { echo "== $map $convergence $mix: failed"; tail -n 3 $run.log; continue; }
           echo "== $map map, $convergence, $mix${in_flight_args[*]:+, ${in_flight_args[*]}, round $round}$ahead_label"
           python3 tools/frame_times.py $run/stats.json --skip ${COHORT_GPU_SKIP:-20} --json $out/$(basename $run).json > $run/summary.txt
           head -n 1 $run/summary.txt
+          [ "${COHORT_GPU_BAND_GAPS:-0}" = 1 ] && { python3 tools/opencl_band_gaps.py $run.log --skip ${COHORT_GPU_SKIP:-20} || true; }
           grep -E "sits out|keeps its rows" $run.log | sed 's/^.*\] //' | head -n 3 || true
+        done
         done
         done
         done

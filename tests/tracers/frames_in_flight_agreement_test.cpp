@@ -41,6 +41,11 @@ struct Rendered {
   std::vector<core::FrameStats> stats;
   // Summed over the OpenCL tracers: bands enqueued ahead, and those their job then found enqueued.
   size_t enqueued_ahead = 0, finished_ahead = 0, dropped_ahead = 0;
+  // Those of the bands enqueued ahead whose kernels were queued straight behind the band before's, its reads
+  // on the read queue (OpenCLTracer::bands_back_to_back); and whether every OpenCL tracer had the transfer
+  // queues on.
+  size_t back_to_back = 0;
+  bool transfer_queues = true;
 };
 
 #ifdef COHORT_HAVE_OPENCL
@@ -51,6 +56,8 @@ void count_ahead(const std::vector<core::Tracer*>& tracers, Rendered& out) {
       out.enqueued_ahead += opencl->bands_enqueued_ahead();
       out.finished_ahead += opencl->bands_finished_ahead();
       out.dropped_ahead += opencl->bands_dropped_ahead();
+      out.back_to_back += opencl->bands_back_to_back();
+      out.transfer_queues = out.transfer_queues && opencl->transfer_queues();
     }
 }
 #else
@@ -59,11 +66,29 @@ void count_ahead(const std::vector<core::Tracer*>&, Rendered&) {}
 
 using MakeTracer = std::function<std::unique_ptr<core::Tracer>(const std::string&)>;
 
+#ifdef COHORT_HAVE_OPENCL
+// The OpenCL tracer's options here: its bands back to back on the device with the transfer queues, which a
+// CPU device (PoCL) leaves off by default (OpenCLTracer::Options::transfer_queue).
+tracers::OpenCLTracer::Options opencl_options() {
+  tracers::OpenCLTracer::Options o;
+  if (const char* device = std::getenv("COHORT_TEST_OPENCL_DEVICE")) o.device = std::atoi(device);
+  o.transfer_queue = tracers::OpenCLTracer::Options::TransferQueue::always;
+  return o;
+}
+std::unique_ptr<core::Tracer> make_sequence_tracer(const std::string& name) {
+  if (name != "opencl") return make_test_tracer(name);
+  return std::make_unique<tracers::OpenCLTracer>(opencl_options());
+}
+#else
+std::unique_ptr<core::Tracer> make_sequence_tracer(const std::string& name) { return make_test_tracer(name); }
+#endif
+
 struct Extras {
   bool move_walker = false;  // the walker posed and moved every frame (skins, instances, the TLAS in every commit)
   kuint aux = 0;             // KFrameParams::aux_outputs
-  MakeTracer make = make_test_tracer;
+  MakeTracer make = make_sequence_tracer;
   std::chrono::milliseconds frame_timeout{120000};
+  core::BandFormat band_format = core::BandFormat::rgba32f;
 };
 
 // kFrames of the test map's hall, each frame a little later (its materials change: commits every frame)
@@ -90,6 +115,7 @@ Rendered render_sequence(const std::vector<std::string>& tracer_names, const std
   options.balancer = balancer;
   options.frames_in_flight = in_flight;
   options.frame_timeout = frame_timeout;
+  options.band_format = extras.band_format;
   core::Renderer renderer(std::move(tracers), options);
   renderer.submit_commit(commit::CommitBuffer::full(sync.snapshot(), 0));
   core::FramePipeline pipeline(renderer);
@@ -174,6 +200,10 @@ void expect_enqueued_ahead(const Rendered& one, const Rendered& two, size_t open
   EXPECT_EQ(one.enqueued_ahead, 0u) << label << ": one frame in flight has no next job to enqueue";
   EXPECT_GE(two.finished_ahead, opencl_tracers * 2) << label << ": bands were not enqueued ahead";
   EXPECT_EQ(two.finished_ahead, two.enqueued_ahead) << label << ": a band enqueued ahead was not taken by its job";
+  // Each of them back to back on the device: its uploads on the upload queue, the band before's reads on the
+  // read queue.
+  EXPECT_TRUE(two.transfer_queues) << label << ": the transfer queues are off";
+  EXPECT_EQ(two.back_to_back, two.enqueued_ahead) << label << ": a band enqueued ahead was not back to back";
 }
 
 TEST(FramesInFlightAgreement, EmbreeAndOpenCLDrawTheSameFramesWithTwoInFlight) {
@@ -202,8 +232,7 @@ TEST(FramesInFlightAgreement, OpenCLAloneDrawsTheSameFramesWithTwoInFlightWithAM
   Extras off_extras;
   off_extras.move_walker = true;
   off_extras.make = [](const std::string&) -> std::unique_ptr<core::Tracer> {
-    tracers::OpenCLTracer::Options o;
-    if (const char* device = std::getenv("COHORT_TEST_OPENCL_DEVICE")) o.device = std::atoi(device);
+    tracers::OpenCLTracer::Options o = opencl_options();
     o.enqueue_ahead = false;
     return std::make_unique<tracers::OpenCLTracer>(o);
   };
@@ -254,7 +283,7 @@ TEST(FramesInFlightAgreement, OpenCLWithCentreRayAuxPlanesDrawsTheSameFramesAndP
 #ifdef COHORT_HAVE_OPENCL
 // What an OpenCL tracer enqueued ahead, finished and dropped, as it is destroyed (after its last job).
 struct AheadCounts {
-  size_t enqueued = 0, finished = 0, dropped = 0;
+  size_t enqueued = 0, finished = 0, dropped = 0, back_to_back = 0;
   bool faulted_with_next_enqueued = false;  // the next band was enqueued ahead inside the faulty one
   bool destroyed = false;
 };
@@ -267,7 +296,8 @@ class FaultyOpenCL final : public tracers::OpenCLTracer {
                std::shared_ptr<AheadCounts> counts)
       : tracers::OpenCLTracer(options), fault_frame_(fault_frame), stall_(stall), counts_(std::move(counts)) {}
   ~FaultyOpenCL() override {
-    *counts_ = {bands_enqueued_ahead(), bands_finished_ahead(), bands_dropped_ahead(), faulted_with_next_enqueued_, true};
+    *counts_ = {bands_enqueued_ahead(), bands_finished_ahead(), bands_dropped_ahead(), bands_back_to_back(),
+                faulted_with_next_enqueued_, true};
   }
   using core::Tracer::render_band;
   core::BandResult render_band(const core::BandJob& job, core::BandBuffer& target) override {
@@ -302,9 +332,7 @@ void expect_fault_recovered(std::chrono::milliseconds stall_time) {
   auto counts = std::make_shared<AheadCounts>();
   const MakeTracer make = [&](const std::string& name) -> std::unique_ptr<core::Tracer> {
     if (name != "opencl") return make_test_tracer(name);
-    tracers::OpenCLTracer::Options o;
-    if (const char* device = std::getenv("COHORT_TEST_OPENCL_DEVICE")) o.device = std::atoi(device);
-    auto t = std::make_unique<FaultyOpenCL>(o, kFaultFrame, stall_time, counts);
+    auto t = std::make_unique<FaultyOpenCL>(opencl_options(), kFaultFrame, stall_time, counts);
     made = true;
     return t;
   };
@@ -319,6 +347,7 @@ void expect_fault_recovered(std::chrono::milliseconds stall_time) {
   EXPECT_TRUE(counts->faulted_with_next_enqueued) << "the next band should have been enqueued ahead of the fault";
   EXPECT_GT(counts->finished, 0u);
   EXPECT_EQ(counts->enqueued, counts->finished + counts->dropped) << "a band enqueued ahead was neither taken nor drained";
+  EXPECT_EQ(counts->back_to_back, counts->enqueued) << "the bands enqueued ahead should have gone back to back";
   EXPECT_EQ(counts->dropped, outlasts ? 1u : 0u) << "the job dropped at shutdown had its band enqueued ahead";
   ASSERT_EQ(faulted.images.size(), size_t(kFrames));
   ASSERT_EQ(faulted.stats.size(), size_t(kFrames));
@@ -359,5 +388,63 @@ TEST(FramesInFlightAgreement, AStalledOpenCLBandWithItsSuccessorEnqueuedAheadIsR
 }
 TEST(FramesInFlightAgreement, ShutdownDuringAStalledOpenCLBandDrainsTheBandEnqueuedAheadForTheDroppedJob) {
   expect_fault_recovered(std::chrono::milliseconds(3000));
+}
+#endif
+
+#ifdef COHORT_HAVE_OPENCL
+// The bands back to back on the device (uploads on the upload queue, reads on the read queue behind the
+// band's last kernel, the edges' buffers in two slots) against everything on the compute queue: the same
+// bits, frame after frame, with commits every frame (the walker posed and moved: skins, instances, the TLAS),
+// an OpenCL band that starts below Embree's, the float band and the packed one (RGB9E5, its packing kernel the
+// band's last), the megakernel and the wavefront.
+TEST(FramesInFlightAgreement, OpenCLBandsBackToBackOnTheDeviceAreTheBandsRenderedWithEverythingOnOneQueue) {
+  if (!tracer_runs_here("embree") || !tracer_runs_here("opencl")) GTEST_SKIP() << "needs the Embree and OpenCL tracers";
+  struct Case {
+    tracers::OpenCLTracer::Options::Wavefront wavefront;
+    core::BandFormat format;
+    const char* label;
+  };
+  for (const Case& c : {Case{tracers::OpenCLTracer::Options::Wavefront::never, core::BandFormat::rgba32f, "megakernel, floats"},
+                        Case{tracers::OpenCLTracer::Options::Wavefront::always, core::BandFormat::rgb9e5, "wavefront, RGB9E5"}}) {
+    auto extras_with = [&](bool transfer_queue) {
+      Extras e;
+      e.move_walker = true;
+      e.band_format = c.format;
+      e.make = [&c, transfer_queue](const std::string& name) -> std::unique_ptr<core::Tracer> {
+        if (name != "opencl") return make_test_tracer(name);
+        tracers::OpenCLTracer::Options o = opencl_options();
+        o.wavefront = c.wavefront;
+        o.transfer_queue = transfer_queue ? tracers::OpenCLTracer::Options::TransferQueue::always
+                                          : tracers::OpenCLTracer::Options::TransferQueue::never;
+        return std::make_unique<tracers::OpenCLTracer>(o);
+      };
+      return e;
+    };
+    const Rendered on = render_sequence({"embree", "opencl"}, "none", 2, extras_with(true));
+    const Rendered off = render_sequence({"embree", "opencl"}, "none", 2, extras_with(false));
+    expect_same_frames(on, off, true, std::string("back to back against one queue, ") + c.label);
+    EXPECT_TRUE(on.transfer_queues) << c.label;
+    EXPECT_FALSE(off.transfer_queues) << c.label;
+    EXPECT_GE(on.back_to_back, 2u) << c.label << ": bands should have gone back to back";
+    EXPECT_EQ(on.back_to_back, on.enqueued_ahead) << c.label;
+    EXPECT_EQ(off.back_to_back, 0u) << c.label;
+    EXPECT_GE(off.finished_ahead, 2u) << c.label << ": without the transfer queues bands still go ahead";
+    ASSERT_EQ(on.stats.size(), size_t(kFrames));
+    for (int f = 0; f < kFrames; ++f)
+      EXPECT_GT(on.stats[f].tracers[1].row_begin, 0) << c.label << " frame " << f << ": OpenCL's band should start below Embree's";
+  }
+}
+
+// Where the transfer queues are on: by default on GPU devices only; never without enqueue ahead.
+TEST(FramesInFlightAgreement, OpenCLTransferQueuesAreOnByDefaultOnGpusOnlyAndNeedEnqueueAhead) {
+  if (!tracer_runs_here("opencl")) GTEST_SKIP() << "needs the OpenCL tracer";
+  tracers::OpenCLTracer::Options o = opencl_options();
+  o.transfer_queue = tracers::OpenCLTracer::Options::TransferQueue::on_gpus;
+  const tracers::OpenCLTracer by_default(o);
+  EXPECT_EQ(by_default.transfer_queues(), by_default.renders_on_gpu());
+  o.transfer_queue = tracers::OpenCLTracer::Options::TransferQueue::always;
+  EXPECT_TRUE(tracers::OpenCLTracer(o).transfer_queues());
+  o.enqueue_ahead = false;
+  EXPECT_FALSE(tracers::OpenCLTracer(o).transfer_queues());
 }
 #endif

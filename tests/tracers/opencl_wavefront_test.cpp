@@ -40,6 +40,7 @@ struct Variant {
   int pieces;  // the first-hit pieces (Options::first_hit_pieces)
   const char* name;
   bool lanes = true;  // Options::wave_lanes
+  tracers::OpenCLTracer::Options::TransferQueue transfer = tracers::OpenCLTracer::Options::TransferQueue::on_gpus;
 };
 const Variant kMegakernel{false, true, 1, "megakernel"};
 const Variant kWavefront{true, true, 4, "wavefront"};
@@ -53,6 +54,7 @@ std::unique_ptr<tracers::OpenCLTracer> opencl(const Variant& v) {
   options.shadow_walk = v.shadow_walk;
   options.first_hit_pieces = v.pieces;
   options.wave_lanes = v.lanes;
+  options.transfer_queue = v.transfer;
   return std::make_unique<tracers::OpenCLTracer>(options);
 }
 
@@ -281,13 +283,21 @@ TEST(OpenCLWavefrontScratch, GrowsWithTheBandAndSitsOutFramesWithoutABounce) {
 
 // A band tells its own clock, as a CUDA band does (the frame timeline's kernels and transfer spans): the
 // device time of its kernels, and its way back (packing to half floats where the target takes them, the
-// read), from the queue's profiling; both within the band's wall time.
+// read), from the queue's profiling; both within the band's wall time. With the transfer queues too, where
+// the reads wait on the band's last kernel from a queue of their own.
 TEST(OpenCLBandClock, ReportsItsKernelsAndItsWayBack) {
   if (!tracer_runs_here("opencl")) GTEST_SKIP() << "no OpenCL device here";
   const int w = 32, h = 24;
   const View view = room_view(w, h);
-  for (const Variant& v : {kMegakernel, kWavefront}) {
+  Variant megakernel_transfer = kMegakernel, wavefront_transfer = kWavefront;
+  megakernel_transfer.transfer = wavefront_transfer.transfer = tracers::OpenCLTracer::Options::TransferQueue::always;
+  megakernel_transfer.name = "megakernel, transfer queues";
+  wavefront_transfer.name = "wavefront, transfer queues";
+  for (const Variant& v : {kMegakernel, kWavefront, megakernel_transfer, wavefront_transfer}) {
     auto tracer = opencl(v);
+    if (v.transfer == tracers::OpenCLTracer::Options::TransferQueue::always) {
+      EXPECT_TRUE(tracer->transfer_queues());
+    }
     tracer->apply(commit::CommitBuffer::full(view.scene, 1));
     for (const core::BandFormat format : {core::BandFormat::rgb16f, core::BandFormat::rgb9e5, core::BandFormat::rgba32f}) {
       SCOPED_TRACE(std::string(v.name) + ", " + core::to_string(format));
@@ -319,6 +329,18 @@ TEST(OpenCLWavefrontSwitches, TheEnvironmentSetsThemAndABadValueIsNamed) {
   const auto on_its_own = made();
   EXPECT_EQ(on_its_own.first, make_test_tracer("opencl")->renders_on_gpu()) << "the wavefront on GPUs only";
   EXPECT_TRUE(on_its_own.second);
+  // The transfer queues (bands back to back on the device): on GPUs only unless told.
+  auto transfer_queues = [] {
+    auto tracer = make_test_tracer("opencl");
+    auto* cl = dynamic_cast<tracers::OpenCLTracer*>(tracer.get());
+    return cl && cl->transfer_queues();
+  };
+  EXPECT_EQ(transfer_queues(), make_test_tracer("opencl")->renders_on_gpu());
+  ::setenv("COHORT_OPENCL_TRANSFER_QUEUE", "1", 1);
+  EXPECT_TRUE(transfer_queues());
+  ::setenv("COHORT_OPENCL_TRANSFER_QUEUE", "0", 1);
+  EXPECT_FALSE(transfer_queues());
+  ::unsetenv("COHORT_OPENCL_TRANSFER_QUEUE");
   ::setenv("COHORT_OPENCL_WAVEFRONT", "1", 1);
   EXPECT_EQ(made(), std::make_pair(true, true));
   ::setenv("COHORT_OPENCL_WAVEFRONT", "0", 1);
@@ -331,7 +353,8 @@ TEST(OpenCLWavefrontSwitches, TheEnvironmentSetsThemAndABadValueIsNamed) {
                                                             {"COHORT_OPENCL_WALK_REGISTERS", "64k"},
                                                             {"COHORT_OPENCL_WALK_REGISTERS", "-1"},
                                                             {"COHORT_OPENCL_SHADE_REGISTERS", "256"},
-                                                            {"COHORT_OPENCL_WAVE_LANES", "2"}};
+                                                            {"COHORT_OPENCL_WAVE_LANES", "2"},
+                                                            {"COHORT_OPENCL_TRANSFER_QUEUE", "yes"}};
   for (const auto& [variable, bad] : bad_values) {
     const std::string message = registry_error_with(variable, bad, "opencl:0");
     EXPECT_NE(message.find(std::string(variable) + "='" + bad + "'"), std::string::npos) << bad << ": " << message;

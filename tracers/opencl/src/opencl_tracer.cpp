@@ -254,12 +254,18 @@ struct OpenCLTracer::EnqueuedBand {
   bool straight = false, write_aux = false, aux_from_paths = false;
   bool whole_band = false;  // its rows end where the frame's do (row_work is reported then)
   OpenCLWavefront* wave = nullptr;
-  Event band_started, band_done, band_read, last;  // last: the row counts' read, the band's last command
+  Event band_started, band_done, band_read, last;  // last: the band's last command (the row counts' read, or with the transfer queues the band's)
+  // The band's last kernel (the packing, or the band's own last kernel): its reads wait on it on the read
+  // queue (Options::transfer_queue), and the next band's device gap is timed from its end.
+  Event kernels_done;
   // With aux planes from centre rays: the aux kernel (the band's clock starts there) and the texels' read
   // into page-locked staging, taken over from Impl's once enqueued, so that the next band's may follow.
   Event aux_kernel_done, aux_read;
   double enqueue_ms = 0.0;  // the host's time enqueueing it (enqueue_band), for the debug log
   bool ahead = false;       // enqueued ahead, inside the band before
+  // On the device, from the band before's last kernel to this band's first, when the band before was this
+  // tracer's previous band (for the debug log); negative when unknown.
+  double gap_ms = -1.0;
 };
 
 struct OpenCLTracer::Impl {
@@ -334,6 +340,31 @@ struct OpenCLTracer::Impl {
   cl_kernel to_rgb16f = nullptr, to_rgb9e5 = nullptr, to_texels = nullptr;
   cl_mem packed = nullptr, packed_aux = nullptr;
   size_t packed_bytes = 0, packed_aux_bytes = 0;
+
+  // Options::transfer_queue on this device (with enqueue ahead): a band's uploads on `upload_queue`, its reads on
+  // `read_queue` behind its last kernel, so `queue` holds only kernels and goes from one band's to the next's.
+  // The buffers a band's edges write or read (params, camera, output, row_rays, packed above) are the current
+  // slot; `spare` is the other, the band before's, whose reads may still run while the next band renders
+  // into this one. Every band with rows takes the other slot (take_other_slot); the band before that one is
+  // done by then (its job waited for its last read, or a throw drained every queue).
+  bool transfer = false;
+  cl_command_queue upload_queue = nullptr, read_queue = nullptr;
+  struct Slot {
+    cl_mem params = nullptr, camera = nullptr, output = nullptr, row_rays = nullptr, packed = nullptr;
+    size_t output_bytes = 0, row_rays_rows = 0, packed_bytes = 0;
+  } spare;
+  void take_other_slot() {
+    std::swap(params, spare.params);
+    std::swap(camera, spare.camera);
+    std::swap(output, spare.output);
+    std::swap(row_rays, spare.row_rays);
+    std::swap(packed, spare.packed);
+    std::swap(output_bytes, spare.output_bytes);
+    std::swap(row_rays_rows, spare.row_rays_rows);
+    std::swap(packed_bytes, spare.packed_bytes);
+  }
+  // The end of the previous band's last kernel on the device clock (0: unknown), for the next band's gap.
+  cl_ulong previous_kernels_end = 0;
   // K_AUX_PATH_FIRST_HIT: the band kernel that records its paths' first hits, and the records.
   cl_kernel first_hits_kernel = nullptr;
   cl_mem first_hits = nullptr;
@@ -349,9 +380,11 @@ struct OpenCLTracer::Impl {
   bool enqueue_ahead = true;
   bool applying_ahead = false;
   std::unique_ptr<EnqueuedBand> ahead;
-  std::atomic<size_t> enqueued_ahead{0}, finished_ahead{0}, dropped_ahead{0};
+  std::atomic<size_t> enqueued_ahead{0}, finished_ahead{0}, dropped_ahead{0}, back_to_back{0};
+  // Every queue a band's commands go on.
+  std::array<cl_command_queue, 5> queues() const { return {queue, aux_queue, lane_queue, upload_queue, read_queue}; }
   void finish_queues() {
-    for (cl_command_queue q : {queue, aux_queue, lane_queue})
+    for (cl_command_queue q : queues())
       if (q) clFinish(q);
   }
 
@@ -431,12 +464,14 @@ struct OpenCLTracer::Impl {
   }
   // The float band's pixels [first, first + pixels) packed into `to` in `format` (RGB16F or RGB9E5, whose
   // dither takes the pixel's place in the frame: the band starts at frame pixel `band_first_pixel`).
-  void pack_colour(core::BandFormat format, cl_mem to, size_t first, size_t pixels, size_t band_first_pixel, cl_uint frame) {
-    if (format == core::BandFormat::rgb16f) return pack(to_rgb16f, output, to, first, pixels, "converting the band to half floats");
+  void pack_colour(core::BandFormat format, cl_mem to, size_t first, size_t pixels, size_t band_first_pixel, cl_uint frame,
+                   cl_event* done = nullptr) {
+    if (format == core::BandFormat::rgb16f)
+      return pack(to_rgb16f, output, to, first, pixels, "converting the band to half floats", done);
     const cl_uint band_first = static_cast<cl_uint>(band_first_pixel);
     check(clSetKernelArg(to_rgb9e5, 3, sizeof band_first, &band_first), "setting the RGB9E5 band's first pixel");
     check(clSetKernelArg(to_rgb9e5, 4, sizeof frame, &frame), "setting the RGB9E5 band's frame");
-    pack(to_rgb9e5, output, to, first, pixels, "converting the band to RGB9E5");
+    pack(to_rgb9e5, output, to, first, pixels, "converting the band to RGB9E5", done);
   }
   // Once `read` is done, the aux planes of `rows` band rows from page-locked staging into the target from
   // `first_row` on: packed texels copied on the aux copy threads (`straight`), else full records
@@ -466,7 +501,8 @@ struct OpenCLTracer::Impl {
     ahead.reset();
     wavefront.reset();
     aux_staging.reset();
-    for (cl_mem m : {params, camera, previous_camera, output, row_rays, aux, packed, packed_aux, first_hits})
+    for (cl_mem m : {params, camera, previous_camera, output, row_rays, aux, packed, packed_aux, first_hits, spare.params,
+                     spare.camera, spare.output, spare.row_rays, spare.packed})
       if (m) clReleaseMemObject(m);
     for (cl_kernel k : {kernel, first_hits_kernel, aux_kernel, skin_positions, skin_faces_kernel, skin_normals, refit_leaves, refit_blas,
                         to_rgb16f, to_rgb9e5, to_texels})
@@ -474,6 +510,8 @@ struct OpenCLTracer::Impl {
     if (program) clReleaseProgram(program);
     if (aux_queue) clReleaseCommandQueue(aux_queue);
     if (lane_queue) clReleaseCommandQueue(lane_queue);
+    if (upload_queue) clReleaseCommandQueue(upload_queue);
+    if (read_queue) clReleaseCommandQueue(read_queue);
     if (queue) clReleaseCommandQueue(queue);
     if (context) clReleaseContext(context);
   }
@@ -543,6 +581,22 @@ OpenCLTracer::OpenCLTracer(const Options& options) : impl_(std::make_unique<Impl
     return o;
   };
   impl_->device = dev.device;
+  impl_->transfer = options.enqueue_ahead && (options.transfer_queue == Options::TransferQueue::always ||
+                                              (options.transfer_queue == Options::TransferQueue::on_gpus && impl_->gpu));
+  if (impl_->transfer) {
+#if defined(__GNUC__)
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wdeprecated-declarations"
+#endif
+    impl_->upload_queue = clCreateCommandQueue(impl_->context, dev.device, 0, &err);
+    check(err, "clCreateCommandQueue(upload)");
+    // Profiled: the band's read times its way back (finish_band).
+    impl_->read_queue = clCreateCommandQueue(impl_->context, dev.device, CL_QUEUE_PROFILING_ENABLE, &err);
+    check(err, "clCreateCommandQueue(read)");
+#if defined(__GNUC__)
+#pragma GCC diagnostic pop
+#endif
+  }
   impl_->wavefront_on = options.wavefront == Options::Wavefront::always ||
                         (options.wavefront == Options::Wavefront::on_gpus && impl_->gpu);
   impl_->shadow_walk = options.shadow_walk;
@@ -588,6 +642,12 @@ OpenCLTracer::OpenCLTracer(const Options& options) : impl_(std::make_unique<Impl
   check(err, "clCreateBuffer(params)");
   impl_->camera = clCreateBuffer(impl_->context, CL_MEM_READ_ONLY, sizeof(KCamera), nullptr, &err);
   check(err, "clCreateBuffer(camera)");
+  if (impl_->transfer) {
+    impl_->spare.params = clCreateBuffer(impl_->context, CL_MEM_READ_ONLY, sizeof(KFrameParams), nullptr, &err);
+    check(err, "clCreateBuffer(params)");
+    impl_->spare.camera = clCreateBuffer(impl_->context, CL_MEM_READ_ONLY, sizeof(KCamera), nullptr, &err);
+    check(err, "clCreateBuffer(camera)");
+  }
 }
 
 OpenCLTracer::~OpenCLTracer() = default;
@@ -656,9 +716,9 @@ constexpr size_t kGroupRows = 8;
 // after the host memory the queues read into, it runs before that memory goes.
 // Every queue of a band drained however it leaves (a throw included): nothing may still write its buffers.
 struct FinishQueues {
-  cl_command_queue a, b, c;
+  std::array<cl_command_queue, 5> queues;
   ~FinishQueues() {
-    for (cl_command_queue q : {a, b, c})
+    for (cl_command_queue q : queues)
       if (q) clFinish(q);
   }
 };
@@ -680,11 +740,11 @@ namespace {
 
 // On a throw, every queue drained before the host memory its commands use goes: declared after that memory.
 struct DrainOnThrow {
-  cl_command_queue a, b, c;
+  std::array<cl_command_queue, 5> queues;
   int exceptions = std::uncaught_exceptions();
   ~DrainOnThrow() {
     if (std::uncaught_exceptions() <= exceptions) return;
-    for (cl_command_queue q : {a, b, c})
+    for (cl_command_queue q : queues)
       if (q) clFinish(q);
   }
 };
@@ -735,7 +795,7 @@ core::BandResult OpenCLTracer::render_band(const core::BandJob& job, core::BandB
   std::unique_ptr<EnqueuedBand> band;
   // A throw from here on (the aux copy, the wait, the next band's enqueueing) drains every queue before the
   // band's memory goes; the band enqueued ahead, if any, stays for its job.
-  DrainOnThrow drain{m.queue, m.aux_queue, m.lane_queue};
+  DrainOnThrow drain{m.queues()};
   if (m.ahead) {
     if (m.ahead->target == &target && same_job(m.ahead->job, job)) {
       band = std::move(m.ahead);
@@ -747,7 +807,7 @@ core::BandResult OpenCLTracer::render_band(const core::BandJob& job, core::BandB
     }
   }
   if (!band) {
-    band = enqueue_band(job, target);
+    band = enqueue_band(job, target, false);
     if (band->rows == 0) return {};
     if (band->aux_from_paths)
       return render_first_hits_in_pieces(job, target, band->params, band->camera, band->straight, band->wave);
@@ -766,16 +826,18 @@ core::BandResult OpenCLTracer::render_band(const core::BandJob& job, core::BandB
   if (spdlog::should_log(spdlog::level::debug)) {
     const auto ms = [](Clock::time_point a, Clock::time_point b) { return std::chrono::duration<double, std::milli>(b - a).count(); };
     spdlog::debug("opencl ({}): band [{}, {}) of frame {}: {} in {:.3f} ms; {:.3f} ms before it was all in the queue, "
-                  "{:.3f} ms on the next band ahead ({}), {:.3f} ms waiting",
+                  "{:.3f} ms on the next band ahead ({}), {:.3f} ms waiting; device gap after the band before {:.3f} ms, "
+                  "kernels {:.3f} ms, transfer {:.3f} ms",
                   m.label, band->params.row_begin, band->params.row_end, band->params.frame_index,
                   band->ahead ? "enqueued ahead" : "enqueued", band->enqueue_ms, ms(entry, queued), ms(queued, waiting),
-                  m.ahead ? "enqueued" : "none", ms(waiting, Clock::now()));
+                  m.ahead ? "enqueued" : "none", ms(waiting, Clock::now()), band->gap_ms, result.device_ms,
+                  result.transfer_ms);
   }
   return result;
 }
 
 std::unique_ptr<OpenCLTracer::EnqueuedBand> OpenCLTracer::enqueue_band(const core::BandJob& job,
-                                                                      core::BandBuffer& target) {
+                                                                      core::BandBuffer& target, bool ahead) {
   Impl& m = *impl_;
   const auto started = std::chrono::steady_clock::now();
   auto b = std::make_unique<EnqueuedBand>();
@@ -791,6 +853,8 @@ std::unique_ptr<OpenCLTracer::EnqueuedBand> OpenCLTracer::enqueue_band(const cor
   b->whole_band = params.row_end == frame_params(job).row_end;
   const size_t rows = params.row_end - params.row_begin;
   const size_t bytes = rows * camera.width * 4 * sizeof(float);
+  // The other slot's buffers: the band before (maybe still in the queues) keeps its own.
+  if (m.transfer) m.take_other_slot();
   // Grown buffers are released under the band before still in the queue: OpenCL keeps a memory object until
   // the commands that use it are done.
   cl_int err = CL_SUCCESS;
@@ -809,14 +873,27 @@ std::unique_ptr<OpenCLTracer::EnqueuedBand> OpenCLTracer::enqueue_band(const cor
   b->row_rays.resize(rows);
   // The reads and writes below run from and into the band's own memory without blocking: on a throw every
   // queue is done before it goes (the guard goes after it).
-  DrainOnThrow drain{m.queue, m.aux_queue, m.lane_queue};
+  DrainOnThrow drain{m.queues()};
   const cl_uint zero = 0;
-  check(clEnqueueFillBuffer(m.queue, m.row_rays, &zero, sizeof zero, 0, rows * sizeof(cl_uint), 0, nullptr, nullptr),
+  // Enqueued ahead with the transfer queues, these run on the upload queue as soon as they are enqueued (into
+  // this band's slot, which nothing in any queue uses), while the band before renders; the compute queue waits
+  // for them with a barrier that is long done when it comes to it. Otherwise they run in the compute queue's
+  // order (a band enqueued when its job starts finds every queue empty: nothing to overlap).
+  const bool upload_aside = m.transfer && ahead;
+  cl_command_queue upload = upload_aside ? m.upload_queue : m.queue;
+  Event uploaded;
+  check(clEnqueueFillBuffer(upload, m.row_rays, &zero, sizeof zero, 0, rows * sizeof(cl_uint), 0, nullptr, nullptr),
         "clearing the row ray counts");
-  check(clEnqueueWriteBuffer(m.queue, m.params, CL_FALSE, 0, sizeof params, &params, 0, nullptr, nullptr),
+  check(clEnqueueWriteBuffer(upload, m.params, CL_FALSE, 0, sizeof params, &params, 0, nullptr, nullptr),
         "writing frame parameters");
-  check(clEnqueueWriteBuffer(m.queue, m.camera, CL_FALSE, 0, sizeof camera, &camera, 0, nullptr, nullptr),
+  check(clEnqueueWriteBuffer(upload, m.camera, CL_FALSE, 0, sizeof camera, &camera, 0, nullptr,
+                             upload_aside ? uploaded.out() : nullptr),
         "writing the camera");
+  if (upload_aside) {
+    check(clFlush(m.upload_queue), "clFlush(upload)");
+    const cl_event written = uploaded.get();  // the last of the three, in the upload queue's order
+    check(clEnqueueBarrierWithWaitList(m.queue, 1, &written, nullptr), "waiting for the band's uploads");
+  }
   // Only frames that ask pay for the aux planes. From centre rays: a short kernel before the band's, whose
   // texels go down on the second queue while the band's kernel runs (the CUDA tracer's order); from the
   // paths' first hits: the band's kernel records them and the aux kernel finishes them after it, piece by
@@ -857,7 +934,12 @@ std::unique_ptr<OpenCLTracer::EnqueuedBand> OpenCLTracer::enqueue_band(const cor
   } else if (target.format() != core::BandFormat::rgba32f) {
     band_bytes = pixels * core::bytes_per_pixel(target.format());
     band_mem = m.grow(m.packed, m.packed_bytes, band_bytes, "clCreateBuffer(packed band)");
-    m.pack_colour(target.format(), band_mem, 0, pixels, size_t(params.row_begin) * camera.width, params.frame_index);
+    m.pack_colour(target.format(), band_mem, 0, pixels, size_t(params.row_begin) * camera.width, params.frame_index,
+                  b->kernels_done.out());
+  }
+  if (!b->kernels_done.get()) {
+    check(clRetainEvent(b->band_done.get()), "clRetainEvent");
+    *b->kernels_done.out() = b->band_done.get();
   }
   // Both kernels are on the device before any read is enqueued: a driver that copies into pageable
   // memory at enqueue time then still overlaps the aux read with the band's kernel.
@@ -868,12 +950,30 @@ std::unique_ptr<OpenCLTracer::EnqueuedBand> OpenCLTracer::enqueue_band(const cor
     b->aux_read.take(m.aux_read);
   }
   void* band_destination = straight ? target.row(int(params.row_begin)) : b->band.data();
-  check(clEnqueueReadBuffer(m.queue, band_mem, CL_FALSE, 0, band_bytes, band_destination, 0, nullptr, b->band_read.out()),
-        "reading the band");
-  check(clEnqueueReadBuffer(m.queue, m.row_rays, CL_FALSE, 0, rows * sizeof(cl_uint), b->row_rays.data(), 0, nullptr,
-                            b->last.out()),
-        "reading the row ray counts");
-  check(clFlush(m.queue), "clFlush");
+  if (m.transfer) {
+    // The reads on the read queue behind the band's last kernel, so that the compute queue goes on to the next
+    // band's kernels at once (its buffers are the other slot's). The row counts (a few KB) first and the band
+    // last: its read's end is the band's (`last`), so a read held back shows in its transfer time. (On PoCL
+    // the second of two reads started only after the next band's kernels, 50 ms late, where they were the
+    // other way round.)
+    const cl_event kernels_done = b->kernels_done.get();
+    check(clEnqueueReadBuffer(m.read_queue, m.row_rays, CL_FALSE, 0, rows * sizeof(cl_uint), b->row_rays.data(), 1,
+                              &kernels_done, nullptr),
+          "reading the row ray counts");
+    check(clEnqueueReadBuffer(m.read_queue, band_mem, CL_FALSE, 0, band_bytes, band_destination, 0, nullptr,
+                              b->band_read.out()),
+          "reading the band");
+    check(clRetainEvent(b->band_read.get()), "clRetainEvent");
+    *b->last.out() = b->band_read.get();
+    check(clFlush(m.read_queue), "clFlush(read)");
+  } else {
+    check(clEnqueueReadBuffer(m.queue, band_mem, CL_FALSE, 0, band_bytes, band_destination, 0, nullptr, b->band_read.out()),
+          "reading the band");
+    check(clEnqueueReadBuffer(m.queue, m.row_rays, CL_FALSE, 0, rows * sizeof(cl_uint), b->row_rays.data(), 0, nullptr,
+                              b->last.out()),
+          "reading the row ray counts");
+    check(clFlush(m.queue), "clFlush");
+  }
   b->enqueue_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - started).count();
   return b;
 }
@@ -913,11 +1013,12 @@ void OpenCLTracer::enqueue_next_ahead(const EnqueuedBand& current) {
     return;
   }
   try {
-    std::unique_ptr<EnqueuedBand> b = enqueue_band(next->job, *next->target);
+    std::unique_ptr<EnqueuedBand> b = enqueue_band(next->job, *next->target, true);
     if (b->rows == 0) return;
     b->ahead = true;
     m.ahead = std::move(b);
     ++m.enqueued_ahead;
+    if (m.transfer) ++m.back_to_back;
   } catch (const std::exception& e) {
     // enqueue_band drained the queues: nothing of it is left to write anywhere. Its job enqueues it again.
     spdlog::warn("opencl ({}): enqueueing the next band ahead failed ({}); it is enqueued when its job starts", m.label,
@@ -926,6 +1027,7 @@ void OpenCLTracer::enqueue_next_ahead(const EnqueuedBand& current) {
 }
 
 core::BandResult OpenCLTracer::finish_band(EnqueuedBand& b) {
+  Impl& m = *impl_;
   const cl_event last = b.last.get();
   check(clWaitForEvents(1, &last), "waiting for the band");
   const KFrameParams& params = b.params;
@@ -936,6 +1038,11 @@ core::BandResult OpenCLTracer::finish_band(EnqueuedBand& b) {
   // band's last kernel.
   const cl_ulong start = (b.write_aux ? b.aux_kernel_done : b.band_started).time(CL_PROFILING_COMMAND_START);
   const cl_ulong end = b.band_done.time(CL_PROFILING_COMMAND_END);
+  // The device's gap between the band before's last kernel and this band's first (commits applied between
+  // them included), for the debug log.
+  if (start != 0 && m.previous_kernels_end != 0 && start > m.previous_kernels_end)
+    b.gap_ms = double(start - m.previous_kernels_end) * 1e-6;
+  m.previous_kernels_end = b.kernels_done.time(CL_PROFILING_COMMAND_END);
   core::BandResult result;
   result.device_ms = end > start && start != 0 ? double(end - start) * 1e-6 : 0.0;
   // The band's way back (the packing to RGB16F or RGB9E5, then the read), as the CUDA tracer reports it.
@@ -958,6 +1065,8 @@ void OpenCLTracer::drop_enqueued_ahead() {
 size_t OpenCLTracer::bands_enqueued_ahead() const { return impl_->enqueued_ahead.load(); }
 size_t OpenCLTracer::bands_finished_ahead() const { return impl_->finished_ahead.load(); }
 size_t OpenCLTracer::bands_dropped_ahead() const { return impl_->dropped_ahead.load(); }
+size_t OpenCLTracer::bands_back_to_back() const { return impl_->back_to_back.load(); }
+bool OpenCLTracer::transfer_queues() const { return impl_->transfer; }
 
 core::BandResult OpenCLTracer::render_first_hits_in_pieces(const core::BandJob& job, core::BandBuffer& target,
                                                            const KFrameParams& params, const KCamera& camera,
@@ -973,7 +1082,7 @@ core::BandResult OpenCLTracer::render_first_hits_in_pieces(const core::BandJob& 
   std::vector<cl_uint> row_rays(rows);
   Event band_started;
   std::array<Event, kMaxFirstHitPieces> piece_ready, aux_read, colour_read;
-  FinishQueues finish_queues{m.queue, m.aux_queue, m.lane_queue};
+  FinishQueues finish_queues{m.queues()};
   const bool packed = straight && target.format() != core::BandFormat::rgba32f;
   const size_t colour_bytes = packed ? core::bytes_per_pixel(target.format()) : 4 * sizeof(float);
   cl_mem colour = packed ? m.grow(m.packed, m.packed_bytes, pixels * colour_bytes, "clCreateBuffer(packed band)") : m.output;
@@ -1030,6 +1139,7 @@ core::BandResult OpenCLTracer::render_first_hits_in_pieces(const core::BandJob& 
   // Device time from the first piece's band kernel to the last piece's aux kernel.
   const cl_ulong start = band_started.time(CL_PROFILING_COMMAND_START);
   const cl_ulong end = m.aux_kernel_done.time(CL_PROFILING_COMMAND_END);
+  m.previous_kernels_end = 0;  // the next band's gap unknown: this band's reads ran between
   core::BandResult result;
   result.device_ms = end > start && start != 0 ? double(end - start) * 1e-6 : 0.0;
   if (params.row_end == frame_params(job).row_end) result.row_work.assign(row_rays.begin(), row_rays.end());

@@ -186,6 +186,9 @@ std::unique_ptr<core::Tracer> make_tracer(const TracerSpec& spec) {
     options.shadow_walk = env_switch("COHORT_OPENCL_SHADOW_WALK", options.shadow_walk);
     options.wave_lanes = env_switch("COHORT_OPENCL_WAVE_LANES", options.wave_lanes);
     options.enqueue_ahead = env_switch("COHORT_OPENCL_ENQUEUE_AHEAD", options.enqueue_ahead);
+    if (const char* transfer = std::getenv("COHORT_OPENCL_TRANSFER_QUEUE"); transfer && *transfer)
+      options.transfer_queue = env_switch("COHORT_OPENCL_TRANSFER_QUEUE", true) ? OpenCLTracer::Options::TransferQueue::always
+                                                                              : OpenCLTracer::Options::TransferQueue::never;
     options.walk_registers = env_registers("COHORT_OPENCL_WALK_REGISTERS", options.walk_registers);
     options.shade_registers = env_registers("COHORT_OPENCL_SHADE_REGISTERS", options.shade_registers);
     return std::make_unique<OpenCLTracer>(options);

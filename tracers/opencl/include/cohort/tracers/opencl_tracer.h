@@ -56,6 +56,16 @@ class OpenCLTracer : public TracerBase {
     // (core::Tracer::enqueues_ahead; docs/balancing.md, "OpenCL enqueues its next band ahead").
     // COHORT_OPENCL_ENQUEUE_AHEAD=0: each band enqueued when its job starts.
     bool enqueue_ahead = true;
+    // With enqueue ahead, the band's edges off the compute queue: its row count clear and its parameter and
+    // camera writes on an upload queue, its reads (rows, row counts) on a read queue behind its last kernel's
+    // event, the buffers they touch in two slots used in turn; so the next band's kernels follow this band's
+    // on the device with no transfer between them (docs/balancing.md, "OpenCL's bands back to back on the
+    // device"). On GPU devices (their copy engines run beside the kernels), or always, or never. A CPU device
+    // keeps one queue by default: on PoCL (2-core VM) a band's read sometimes ran only after the next band's
+    // kernels, a whole band late (p95 frame 100-115 ms against 54-61, OpenCL alone at 320x180).
+    // COHORT_OPENCL_TRANSFER_QUEUE (the registry): 1 always, 0 never.
+    enum class TransferQueue { on_gpus, always, never };
+    TransferQueue transfer_queue = TransferQueue::on_gpus;
   };
   static constexpr int kMaxFirstHitPieces = 8;
   // The pieces' first rows, relative to the band, and `rows` last: up to `pieces` ranges of whole work
@@ -86,6 +96,12 @@ class OpenCLTracer : public TracerBase {
   size_t bands_enqueued_ahead() const;
   size_t bands_finished_ahead() const;
   size_t bands_dropped_ahead() const;
+  // Bands enqueued ahead with their edges off the compute queue (Options::transfer_queue): their kernels
+  // queued straight behind the band before's, whose reads went on the read queue.
+  size_t bands_back_to_back() const;
+  // Whether the band's edges go on the upload and read queues (Options::transfer_queue on this device, with
+  // enqueue_ahead).
+  bool transfer_queues() const;
 
   // "platform / device" for every OpenCL device on this machine, in the order Options::device counts.
   static std::vector<std::string> list_devices();
@@ -123,7 +139,8 @@ class OpenCLTracer : public TracerBase {
   // A band whose commands are all enqueued (render_band's, or the next one's ahead), and its end: the wait
   // for its last command, its rows stored where they came down elsewhere, its clock.
   struct EnqueuedBand;
-  std::unique_ptr<EnqueuedBand> enqueue_band(const core::BandJob& job, core::BandBuffer& target);
+  // ahead: enqueued while the band before is still in the queues (its uploads then go on the upload queue).
+  std::unique_ptr<EnqueuedBand> enqueue_band(const core::BandJob& job, core::BandBuffer& target, bool ahead);
   core::BandResult finish_band(EnqueuedBand& band);
   // Inside render_band, the current band enqueued: the next band enqueued too when the worker has it
   // queued before the current band is done (Tracer::queued_next) and it can go ahead.
