@@ -144,6 +144,7 @@ int run_play(PlayArgs a) {
   settings.mode = debug_mode_from_name(a.mode).value_or(K_MODE_PATH);
   settings.tone_curve = a.tone;
   settings.reproject = resolve_convergence(a.convergence, session->any_gpu_tracer(), session->frame_post_place()) == "reproject";
+  settings.accumulate = a.convergence != "none";
   const bool reconstructs_on_gpu = settings.reproject && session->frame_post_place() != "host";
   settings.upsample = core::parse_upsample_method(
       a.upsample != "auto" ? a.upsample : reconstructs_on_gpu ? "joint-bilateral" : "bilinear");
@@ -300,7 +301,8 @@ int run_play(PlayArgs a) {
       hud.accumulation = settings.reproject
                              ? std::string(session->denoising() ? "REPROJECT+ATROUS ON " : "REPROJECT ON ") +
                                    session->frame_post_place()
-                             : "BRIGADE";
+                             : settings.accumulate ? "BRIGADE" : "NONE";
+      if (!session->oidn_label().empty()) hud.accumulation += " + " + session->oidn_label();
       hud.commit_bytes = last.commit_bytes;
       hud.scenario_running = session->scenario_running();
       hud.scenario_paused = session->scenario_paused();
@@ -419,10 +421,10 @@ void add_play_command(CLI::App& app, int& exit_code) {
       ->check(CLI::IsMember(core::light_sampling_names()));
   cmd->add_option("--convergence", a->convergence,
                   "how frames accumulate: reproject (per-pixel history through motion vectors), brigade "
-                  "(whole-frame blend) or auto (reproject, on the first CUDA tracer's GPU if any; Brigade's blend when only OpenCL GPUs would wait "
+                  "(whole-frame blend), none (each frame as rendered, e.g. for --denoise oidn-cuda) or auto (reproject, on the first CUDA tracer's GPU if any; Brigade's blend when only OpenCL GPUs would wait "
                   "for the host's reprojection); see `cohort render --help`")
       ->capture_default_str()
-      ->check(CLI::IsMember({"auto", "brigade", "reproject"}));
+      ->check(CLI::IsMember({"auto", "brigade", "reproject", "none"}));
   cmd->add_option("--aux-rays", a->session.aux_rays,
                   "where the G-buffer for reprojection comes from: auto (first-hit where CUDA GPUs render and no "
                   "OpenCL or mpi tracer does, else centre), centre (a ray of its own through each pixel's "
@@ -433,9 +435,15 @@ void add_play_command(CLI::App& app, int& exit_code) {
   cmd->add_option("--denoise", a->session.denoise,
                   "the real-time a-trous filter after the reprojection: atrous, none, or auto (atrous where the "
                   "reprojection runs on a CUDA GPU, about 1-3 ms a frame; none on the host's threads, where it "
-                  "would set the frame rate); see docs/denoising.md")
+                  "would set the frame rate); or Open Image Denoise after the accumulation: oidn (CPU) or oidn-cuda "
+                  "(an NVIDIA GPU; at 1280x720 on an H100 about 4-5 ms a frame, the lowest FLIP per frame measured, with "
+                  "--convergence none: docs/denoising.md)")
       ->capture_default_str()
-      ->check(CLI::IsMember({"auto", "atrous", "none"}));
+      ->check(CLI::IsMember({"auto", "atrous", "none", "oidn", "oidn-cuda"}));
+  cmd->add_option("--denoise-quality", a->session.denoise_quality,
+                  "Open Image Denoise's filter quality with --denoise oidn or oidn-cuda: high, balanced or fast")
+      ->capture_default_str()
+      ->check(CLI::IsMember({"high", "balanced", "fast"}));
   cmd->add_option("--history-fix", a->session.history_fix,
                   "with the a-trous filter: a pixel whose history is shorter than this many frames gets a wider "
                   "edge-aware blur first (NRD's HistoryFix; 0: off); see `cohort render --help`")

@@ -12,6 +12,7 @@
 #include "cohort/core/atrous_filter.h"
 #include "cohort/core/band_buffer.h"
 #include "cohort/core/convergence.h"
+#include "cohort/core/oidn_denoiser.h"
 #include "cohort/core/frame_post.h"
 #include "cohort/core/frame_defaults.h"
 #include "cohort/core/frame_pipeline.h"
@@ -78,6 +79,9 @@ struct PlaySession::State {
     bool animating = false;
   };
   Prepared prepare(const viewer::FlyCamera& camera, double seconds, const FrameSettings& settings, bool paused);
+  // Denoises `image` where OIDN is on, tone-maps it into `out`.
+  void show(const core::FrameBuffer& image, const core::GBuffer& gbuffer, const FrameSettings& settings,
+            SessionFrame& out);
   // The next frame, prepared and announced as soon as the frame before it was handed out (the input of
   // the call that handed that one out), pushed by the next call; none while the announcement at hand-out
   // is off: COHORT_EARLY_ANNOUNCE=0, or no tracer takes jobs ahead (only remote tracers do), where it would
@@ -101,6 +105,9 @@ struct PlaySession::State {
   bool any_gpu_tracer = false;
   std::string post_place;
   bool denoising = false;
+  std::unique_ptr<core::OidnDenoiser> oidn;  // --denoise oidn / oidn-cuda
+  std::string oidn_label;
+  core::FrameBuffer denoised;
 };
 
 PlaySession::PlaySession(const SessionOptions& options) {
@@ -144,8 +151,16 @@ PlaySession::PlaySession(const SessionOptions& options) {
   core::FramePostOptions post_options;
   s.aux_mode =
       core::aux_rays_mode(options.aux_rays == "auto" ? tracers::auto_aux_rays(started) : options.aux_rays);
-  if (options.denoise != "auto" && options.denoise != "atrous" && options.denoise != "none")
-    throw std::invalid_argument("--denoise '" + options.denoise + "': choose auto, atrous or none");
+  const bool oidn = options.denoise == "oidn" || options.denoise == "oidn-cuda";
+  if (options.denoise != "auto" && options.denoise != "atrous" && options.denoise != "none" && !oidn)
+    throw std::invalid_argument("--denoise '" + options.denoise + "': choose auto, atrous, none, oidn or oidn-cuda");
+  if (oidn) {
+    s.oidn = core::OidnDenoiser::open(core::parse_oidn_device(options.denoise == "oidn-cuda" ? "cuda" : "cpu"),
+                                      core::parse_oidn_quality(options.denoise_quality));
+    s.oidn_label = std::string("oidn on ") + core::oidn_device_name(s.oidn->device());
+    spdlog::info("denoising with Open Image Denoise ({} device, {} quality, {})", core::oidn_device_name(s.oidn->device()),
+                 options.denoise_quality, s.oidn->library_path());
+  }
   post_options.atrous = options.denoise == "atrous" || (options.denoise == "auto" && s.post_place != "host");
   post_options.atrous_options.passes = core::atrous_passes_for_height(options.window_height);
   post_options.atrous_options.history_fix_frames = options.history_fix;
@@ -231,7 +246,7 @@ PlaySession::State::Prepared PlaySession::State::prepare(const viewer::FlyCamera
     p.path_pixels = pattern.pixels;
     p.path_phase = pattern.phase;
   }
-  if (settings.reproject || sparse) {
+  if (settings.reproject || sparse || s.oidn) {  // OIDN takes the albedo and normal planes as its guides
     p.aux_outputs = s.aux_mode;
     job.previous_camera = s.previous_camera;
   }
@@ -290,13 +305,7 @@ SessionFrame PlaySession::frame(const viewer::FlyCamera& camera, double seconds,
     s.reprojection->process(hdr, gbuffer, post_reconstructs ? pattern : core::kEveryPixel);
     out.stats.convergence_f = 1.0 / std::max(s.reprojection->mean_history_length(), 1.0);
     blending.finish();
-    core::ToneMapOptions tm;
-    tm.curve = core::parse_tone_curve(settings.tone_curve);
-    core::ScopedStage tone_mapping(out.stats.stages, core::kCoreTrack, "tone map");
-    out.display = core::tone_map(s.reprojection->image(), tm);
-    tone_mapping.finish();
-    out.width = s.reprojection->image().width;
-    out.height = s.reprojection->image().height;
+    s.show(s.reprojection->image(), gbuffer, settings, out);
     return out;
   }
   // Without per-pixel object ids every pixel counts as possibly moving while the door, fan and
@@ -306,18 +315,38 @@ SessionFrame PlaySession::frame(const viewer::FlyCamera& camera, double seconds,
     s.moving_mask.assign(static_cast<size_t>(hdr.width) * hdr.height, 1.0f);
     mask = &s.moving_mask;
   }
+  if (!settings.accumulate) {
+    out.stats.convergence_f = 1.0;
+    s.show(hdr, gbuffer, settings, out);
+    return out;
+  }
   core::ScopedStage blending(out.stats.stages, core::kCoreTrack, "convergence");
   out.stats.convergence_f = s.convergence.accumulate(done->job.camera, hdr, mask);
   blending.finish();
+  s.show(s.convergence.image(), gbuffer, settings, out);
+  return out;
+}
 
+void PlaySession::State::show(const core::FrameBuffer& image, const core::GBuffer& gbuffer,
+                              const FrameSettings& settings, SessionFrame& out) {
+  const core::FrameBuffer* shown = &image;
+  if (oidn) {
+    core::ScopedStage denoising_stage(out.stats.stages, core::kCoreTrack, "denoise");
+    core::DenoiseGuides guides;
+    if (!gbuffer.empty() && gbuffer.width == image.width && gbuffer.height == image.height) {
+      guides.albedo = &gbuffer.albedo;
+      guides.normal = &gbuffer.normal;
+    }
+    oidn->denoise(image, denoised, guides);
+    shown = &denoised;
+  }
   core::ToneMapOptions tm;
   tm.curve = core::parse_tone_curve(settings.tone_curve);
   core::ScopedStage tone_mapping(out.stats.stages, core::kCoreTrack, "tone map");
-  out.display = core::tone_map(s.convergence.image(), tm);
+  out.display = core::tone_map(*shown, tm);
   tone_mapping.finish();
-  out.width = s.convergence.image().width;
-  out.height = s.convergence.image().height;
-  return out;
+  out.width = shown->width;
+  out.height = shown->height;
 }
 
 void PlaySession::set_balancer(const std::string& name) { state_->renderer->set_balancer(name); }
@@ -329,6 +358,7 @@ bool PlaySession::any_gpu_tracer() const { return state_->any_gpu_tracer; }
 const std::string& PlaySession::frame_post_place() const { return state_->post_place; }
 
 bool PlaySession::denoising() const { return state_->denoising; }
+const std::string& PlaySession::oidn_label() const { return state_->oidn_label; }
 
 std::vector<std::string> PlaySession::tracer_names() const {
   std::vector<std::string> names;

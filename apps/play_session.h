@@ -27,8 +27,11 @@ struct SessionOptions {
   bool scenario = true;
   // The a-trous filter after the reprojection: "atrous", "none", or "auto" (atrous where the
   // post-processing runs on a CUDA GPU, where it costs 1-3 ms; none on the host, where it would set the
-  // frame rate). Passes as `cohort render` picks them for the window's height.
+  // frame rate). Passes as `cohort render` picks them for the window's height. "oidn" / "oidn-cuda": Open
+  // Image Denoise on the CPU / an NVIDIA GPU after the accumulation instead (core/oidn_denoiser.h), at
+  // denoise_quality.
   std::string denoise = "auto";
+  std::string denoise_quality = "balanced";
   // Frames of history below which the a-trous filter's history fix blurs a pixel wider (0: off).
   float history_fix = core::AtrousOptions{}.history_fix_frames;
   // Where the G-buffer comes from: "centre" (a ray of its own through each pixel's centre) or "first-hit"
@@ -54,6 +57,7 @@ struct FrameSettings {
   kuint light_sampling = core::default_frame_params().light_sampling;
   std::string tone_curve = "aces";
   bool reproject = false;           // per-pixel reprojection (core/reprojection.h) instead of Brigade's blend
+  bool accumulate = true;           // false: each frame as rendered (--convergence none), neither of the two
   // Dynamic resolution (core/upsample.h): below 1 with joint_bilateral or nearest, width x height is the
   // window's and paths are traced for about render_scale^2 of its pixels, the rest reconstructed from the
   // G-buffer; with bilinear the caller passes the smaller size and the window stretches it.
@@ -95,6 +99,8 @@ class PlaySession {
   // Where the reprojection runs: "host" or "cuda:N" (the first CUDA tracer's GPU).
   const std::string& frame_post_place() const;
   bool denoising() const;  // whether the reprojected frame also goes through the a-trous filter
+  // "oidn on cpu", "oidn on cuda" where Open Image Denoise filters every shown frame, else empty.
+  const std::string& oidn_label() const;
   // Tracers that did not start, a scenario that cannot run: things the HUD and log should say.
   const std::vector<std::string>& warnings() const { return warnings_; }
   const std::string& map_name() const;
