@@ -216,6 +216,14 @@ def psnr(reference, test):
     return float("inf") if mse == 0.0 else 10.0 * np.log10(1.0 / mse)
 
 
+def temporal_rmse(reference_before, reference, test_before, test):
+    """How far the frame-to-frame change of a method's frames is from the reference's (RMSE over pixels and
+    channels, display values in [0, 1]): flicker, and lag, that each frame's own FLIP does not see. A method
+    that renders each frame afresh shows its noise twice here; one that holds history too long shows its lag."""
+    change = (test.astype(np.float64) - test_before) - (reference.astype(np.float64) - reference_before)
+    return float(np.sqrt(np.mean(change ** 2)))
+
+
 def stage_ms(stats_file):
     """Median ms per frame of the stages a method adds, and of the time per frame."""
     with open(stats_file) as f:
@@ -314,9 +322,13 @@ def main():
         out_dir = os.path.join(args.out, m.replace("+", "_"))
         print(f"{m} ...", flush=True)
         render(args, out_dir, args.spp, METHODS[m] + args.extra_args.split())
-        flips, psnrs, lights, object_flips, swept_flips = [], [], [], [], []
+        flips, psnrs, lights, object_flips, swept_flips, temporal = [], [], [], [], [], []
+        before = None
         for f in range(args.frames):
             test = load_ldr(frame_path(out_dir, f))
+            if before is not None:
+                temporal.append(temporal_rmse(references[f - 1], references[f], before, test))
+            before = test
             flip_map, mean_flip, _ = flip_evaluator.evaluate(references[f], test, "LDR", applyMagma=False)
             flips.append(float(mean_flip))
             psnrs.append(psnr(references[f], test))
@@ -325,7 +337,8 @@ def main():
                 flip_map = np.asarray(flip_map).reshape(test.shape[0], test.shape[1])
                 object_flips.append(masked_mean(flip_map, masks["recent"][f]))
                 swept_flips.append(masked_mean(flip_map, masks["swept"][f]))
-        r = {"flip": flips, "psnr": psnrs, "light_percent": lights, "ms": stage_ms(os.path.join(out_dir, "stats.json"))}
+        r = {"flip": flips, "psnr": psnrs, "light_percent": lights, "temporal_rmse": temporal,
+             "ms": stage_ms(os.path.join(out_dir, "stats.json"))}
         if masks:
             r["object_flip"] = object_flips
             r["object_swept_flip"] = swept_flips
@@ -343,8 +356,10 @@ def main():
               f"pixels and last {args.mask_history} frames' trail, 'swept' = its whole path")
     print("'light %': the frames' mean linearised light against the reference's, averaged over the frames after "
           "the first 8 (a bias: light lost or added)")
+    print("'temporal': RMSE of each frame's change from the frame before against the reference's change, display "
+          "values, mean over the frames (flicker and lag; lower is better)")
     object_header = f"{'obj FLIP':>9}{'obj still':>10}{'swept still':>12}" if masks else ""
-    print(f"{'method':<26}{'mean FLIP':>10}{'last FLIP':>10}{'mean PSNR':>10}{'light %':>9}{object_header}{'frame ms':>10}"
+    print(f"{'method':<26}{'mean FLIP':>10}{'last FLIP':>10}{'mean PSNR':>10}{'light %':>9}{'temporal':>9}{object_header}{'frame ms':>10}"
           f"{'blend ms':>10}{'denoise ms':>11}{'both ms':>9}")
 
     def cell(v, width):
@@ -358,7 +373,7 @@ def main():
                             cell(r["object_swept_flip_still"], 12))
         settled = r["light_percent"][8:] or r["light_percent"]
         print(f"{m:<26}{statistics.mean(r['flip']):>10.4f}{r['flip'][-1]:>10.4f}{statistics.mean(r['psnr']):>10.2f}"
-              f"{statistics.mean(settled):>+9.1f}{object_cells}{ms['frame']:>10.1f}{ms.get('convergence', 0.0):>10.2f}{ms.get('denoise', 0.0):>11.1f}"
+              f"{statistics.mean(settled):>+9.1f}{cell(statistics.mean(r['temporal_rmse']) if r['temporal_rmse'] else None, 9)}{object_cells}{ms['frame']:>10.1f}{ms.get('convergence', 0.0):>10.2f}{ms.get('denoise', 0.0):>11.1f}"
               f"{ms.get('convergence+denoise', 0.0):>9.1f}")
     os.makedirs(args.out, exist_ok=True)
     json_path = os.path.join(args.out, "bench_quality.json")
