@@ -3,12 +3,15 @@
 #include <dlfcn.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cstdint>
 #include <cstdlib>
 #include <filesystem>
 #include <mutex>
 #include <stdexcept>
 #include <vector>
+
+#include <spdlog/spdlog.h>
 
 #include "cohort/core/half_float.h"
 #include "cohort/core/host_threads.h"
@@ -270,6 +273,8 @@ void OidnDenoiser::denoise(const FrameBuffer& color, FrameBuffer& out, const Den
   const bool use_normal = use_albedo && guides.normal != nullptr;
   Impl& m = *impl_;
   m.configure(color.width, color.height, use_albedo, use_normal);
+  using Clock = std::chrono::steady_clock;
+  const Clock::time_point started = Clock::now();
   HostThreads& threads = HostThreads::shared();
   threads.for_ranges(n, kPixelsPerRange, [&](size_t begin, size_t end) {
     for (size_t i = begin; i < end; ++i)
@@ -279,12 +284,16 @@ void OidnDenoiser::denoise(const FrameBuffer& color, FrameBuffer& out, const Den
     if (use_normal)
       for (size_t i = 3 * begin; i < 3 * end; ++i) m.normal.data[i] = float_to_half((*guides.normal)[i]);
   });
+  const Clock::time_point packed = Clock::now();
   for (const Impl::Image* image : {&m.color, &m.albedo, &m.normal}) m.to_device(*image);
   m.check("copying the images to the device");
+  const Clock::time_point uploaded = Clock::now();
   m.api->execute_filter(m.filter);
   m.check("denoising");
+  const Clock::time_point filtered = Clock::now();
   if (m.output.device) m.api->read_buffer(m.output.device, 0, m.image_bytes, m.output.data);
   m.check("reading the result");
+  const Clock::time_point read = Clock::now();
 
   if (&out != &color) {
     out.width = color.width;
@@ -297,6 +306,14 @@ void OidnDenoiser::denoise(const FrameBuffer& color, FrameBuffer& out, const Den
       out.rgba[i * 4 + 3] = color.rgba[i * 4 + 3];
     }
   });
+  if (spdlog::should_log(spdlog::level::debug)) {
+    const auto ms = [](Clock::time_point a, Clock::time_point b) {
+      return std::chrono::duration<double, std::milli>(b - a).count();
+    };
+    spdlog::debug("oidn ({}x{}): pack {:.3f} ms, to the device {:.3f}, filter {:.3f}, back {:.3f}, unpack {:.3f}",
+                  color.width, color.height, ms(started, packed), ms(packed, uploaded), ms(uploaded, filtered),
+                  ms(filtered, read), ms(read, Clock::now()));
+  }
 }
 
 }  // namespace cohort::core
