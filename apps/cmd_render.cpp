@@ -326,6 +326,7 @@ int run_render(const RenderArgs& a) {
       if (!gbuffer.empty()) {  // the aux planes guide the filter where the frame has them
         guides.albedo = &gbuffer.albedo;
         guides.normal = &gbuffer.normal;
+        guides.clean = aux_mode == K_AUX_CENTRE_RAY;
       }
       denoiser->denoise(*shown_image, denoised, guides);
       shown_image = &denoised;
@@ -420,7 +421,8 @@ int run_render(const RenderArgs& a) {
       p.path_pixels = pattern.pixels;
       p.path_phase = pattern.phase;
     }
-    if (reproject || atrous || sparse || a.write_ids) {
+    // Open Image Denoise takes the albedo and normal planes as its guides.
+    if (reproject || atrous || denoiser || sparse || a.write_ids) {
       p.aux_outputs = aux_mode;
       job.previous_camera = previous_camera;
       previous_camera = job.camera;

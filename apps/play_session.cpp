@@ -336,6 +336,7 @@ void PlaySession::State::show(const core::FrameBuffer& image, const core::GBuffe
     if (!gbuffer.empty() && gbuffer.width == image.width && gbuffer.height == image.height) {
       guides.albedo = &gbuffer.albedo;
       guides.normal = &gbuffer.normal;
+      guides.clean = aux_mode == K_AUX_CENTRE_RAY;
     }
     oidn->denoise(image, denoised, guides);
     shown = &denoised;

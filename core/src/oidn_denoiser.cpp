@@ -160,7 +160,7 @@ struct OidnDenoiser::Impl {
   bool on_device = false;
   size_t image_bytes = 0;
   int width = 0, height = 0;
-  bool with_albedo = false, with_normal = false;
+  bool with_albedo = false, with_normal = false, clean_aux = false;
 
   void check(const char* what) const {
     const char* message = nullptr;
@@ -194,8 +194,10 @@ struct OidnDenoiser::Impl {
 
   // (Re)creates buffers and the filter when the size or the set of guide images changes: filter setup is
   // expensive, so it is done once per configuration, not per frame.
-  void configure(int w, int h, bool use_albedo, bool use_normal) {
-    if (filter && w == width && h == height && use_albedo == with_albedo && use_normal == with_normal) return;
+  void configure(int w, int h, bool use_albedo, bool use_normal, bool clean) {
+    if (filter && w == width && h == height && use_albedo == with_albedo && use_normal == with_normal &&
+        clean == clean_aux)
+      return;
     if (filter) api->release_filter(filter);
     filter = nullptr;
     release_buffers();
@@ -211,6 +213,7 @@ struct OidnDenoiser::Impl {
     if (use_normal) api->set_filter_image(filter, "normal", normal.filtered(), kOidnFormatHalf3, w, h, 0, 0, 0);
     api->set_filter_image(filter, "output", output.filtered(), kOidnFormatHalf3, w, h, 0, 0, 0);
     api->set_filter_bool(filter, "hdr", true);
+    if (use_albedo) api->set_filter_bool(filter, "cleanAux", clean);
     api->set_filter_int(filter, "quality", quality);
     api->commit_filter(filter);
     check("creating the RT filter");
@@ -218,6 +221,7 @@ struct OidnDenoiser::Impl {
     height = h;
     with_albedo = use_albedo;
     with_normal = use_normal;
+    clean_aux = clean;
   }
 
   ~Impl() {
@@ -272,7 +276,9 @@ void OidnDenoiser::denoise(const FrameBuffer& color, FrameBuffer& out, const Den
   const bool use_albedo = guides.albedo != nullptr;
   const bool use_normal = use_albedo && guides.normal != nullptr;
   Impl& m = *impl_;
-  m.configure(color.width, color.height, use_albedo, use_normal);
+  const char* clean_env = std::getenv("COHORT_OIDN_CLEAN_AUX");
+  const bool clean = clean_env && *clean_env ? std::string(clean_env) == "1" : guides.clean;
+  m.configure(color.width, color.height, use_albedo, use_normal, use_albedo && clean);
   using Clock = std::chrono::steady_clock;
   const Clock::time_point started = Clock::now();
   HostThreads& threads = HostThreads::shared();
@@ -310,9 +316,12 @@ void OidnDenoiser::denoise(const FrameBuffer& color, FrameBuffer& out, const Den
     const auto ms = [](Clock::time_point a, Clock::time_point b) {
       return std::chrono::duration<double, std::milli>(b - a).count();
     };
-    spdlog::debug("oidn ({}x{}): pack {:.3f} ms, to the device {:.3f}, filter {:.3f}, back {:.3f}, unpack {:.3f}",
-                  color.width, color.height, ms(started, packed), ms(packed, uploaded), ms(uploaded, filtered),
-                  ms(filtered, read), ms(read, Clock::now()));
+    spdlog::debug("oidn ({}x{}, {}): pack {:.3f} ms, to the device {:.3f}, filter {:.3f}, back {:.3f}, unpack {:.3f}",
+                  color.width, color.height,
+                  !use_albedo ? "no guides" : use_normal ? (m.clean_aux ? "clean albedo and normal guides" : "albedo and normal guides")
+                                                         : "albedo guide",
+                  ms(started, packed), ms(packed, uploaded), ms(uploaded, filtered), ms(filtered, read),
+                  ms(read, Clock::now()));
   }
 }
 

@@ -30,6 +30,8 @@ const char* oidn_device_name(OidnDevice device);
 struct DenoiseGuides {
   const std::vector<float>* albedo = nullptr;
   const std::vector<float>* normal = nullptr;
+  // The guides hold no noise (one ray through each pixel's centre, the same every frame): OIDN's cleanAux.
+  bool clean = false;
 };
 
 class OidnDenoiser {
