@@ -156,9 +156,11 @@ struct Renderer::Worker {
       const std::string track = tracer_track(id, name);
       if (last_end && current.posted > *last_end) {
         // Starved: its band before ended with no job queued (docs/balancing.md, "The next frame handed out
-        // as soon as a slot frees").
+        // as soon as a slot frees"). On the timeline only with two in flight, where the job should have been
+        // queued (the span starts before its frame's hand-out); with one, every band waits for the frame's
+        // turnaround by design.
         outcome.job_wait_ms = std::chrono::duration<double, std::milli>(current.posted - *last_end).count();
-        outcome.spans.push_back({track, "wait for job", timeline_ms(*last_end), outcome.job_wait_ms});
+        if (two_in_flight) outcome.spans.push_back({track, "wait for job", timeline_ms(*last_end), outcome.job_wait_ms});
       }
       if (current.enqueued_ahead) handed_ahead = false;
       bool rendered = false;  // whether render_band took the job (one enqueued ahead is then its business)

@@ -5,6 +5,9 @@
 //
 //   for each frame:  prepare it (submit its commits)  ->  pipeline.push(job)  ->  post-process what came back
 //   at the end:      pipeline.drain()                  ->  post-process what came back
+// or, preparing the next frame inside push (prepare_next; with two frames in flight the next frame is then
+// handed out before the caller's post of the frame returned):
+//   next = prepare(0); while (next) { job = next; pipeline.push(job, spans, [&] { return next = prepare(f + 1); }) ... }
 #pragma once
 
 #include <functional>
