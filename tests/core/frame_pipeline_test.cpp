@@ -11,6 +11,8 @@
 #include <mutex>
 #include <thread>
 
+#include <nlohmann/json.hpp>
+
 #include "cohort/core/simulated_tracer.h"
 
 using namespace cohort::core;
@@ -689,6 +691,9 @@ void expect_next_job_queued_during_the_post(bool ahead) {
       }
     }
     EXPECT_EQ(spans_of(frames[f], "wait for job", true).empty(), ahead) << "frame " << f;
+    const nlohmann::json json = frames[f];  // stats.json has the count per tracer
+    for (size_t i = 0; i < frames[f].tracers.size(); ++i)
+      EXPECT_EQ(json["tracers"][i]["job_wait_ms"].get<double>(), frames[f].tracers[i].job_wait_ms);
   }
 }
 
