@@ -394,7 +394,9 @@ void add_play_command(CLI::App& app, int& exit_code) {
   cmd->add_option("--frames-in-flight", a->session.frames_in_flight,
                   "2: hand the next frame's bands out as soon as this one's are, so that each tracer starts it the "
                   "moment its band before is done; where the tracers set the pace this adds a frame of input latency "
-                  "(the frame waits in each tracer's queue behind the one before; docs/balancing.md)")
+                  "(the frame waits in each tracer's queue behind the one before), and one more because the next frame is "
+                  "prepared from the input of this one and handed out before the frame before is shown, so that no "
+                  "tracer waits for the viewer's post and present (docs/balancing.md)")
       ->capture_default_str()
       ->check(CLI::Range(1, 2));
   add_node_port_options(cmd, a->node_port);

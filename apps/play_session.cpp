@@ -144,7 +144,11 @@ PlaySession::PlaySession(const SessionOptions& options) {
   renderer_options.benched_commit_every = 8;  // as `cohort render`'s default
   renderer_options.frames_in_flight = options.frames_in_flight;
   s.renderer = std::make_unique<core::Renderer>(std::move(tracers), renderer_options);
-  s.announce_at_hand_out = core::FramePipeline::announces_at_hand_out() && s.renderer->takes_jobs_ahead();
+  // Also with two frames in flight: the pipeline then hands the next frame out as soon as the frame before
+  // is merged, so that no tracer waits for that frame's post, HUD and present (docs/balancing.md, "The next
+  // frame handed out as soon as a slot frees"); the next frame's camera is this call's input.
+  s.announce_at_hand_out = core::FramePipeline::announces_at_hand_out() &&
+                           (s.renderer->takes_jobs_ahead() || options.frames_in_flight == 2);
   s.renderer->submit_commit(commit::CommitBuffer::full(initial_scene, 0));
   s.pipeline = std::make_unique<core::FramePipeline>(*s.renderer);
   s.post_place = tracers::auto_frame_post_place(started);

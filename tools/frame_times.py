@@ -39,6 +39,21 @@ def summarise(stats, skip):
         for name, ms in totals.items():
             per_stage.setdefault(name, []).append(ms)
     out["stages_median_ms"] = {name: statistics.median(v) for name, v in sorted(per_stage.items())}
+    # Per tracer: its bands whose job was handed out only after its band before had ended (it waited for
+    # work: `job_wait_ms` > 0; stats.json from before the count has none).
+    waits = {}
+    for f in frames:
+        for t in f.get("tracers", []):
+            if t.get("outcome") != "rendered" or "job_wait_ms" not in t:
+                continue
+            w = waits.setdefault(f"tracer {t['id']} ({t['name']})", {"bands": 0, "waits": []})
+            w["bands"] += 1
+            if t["job_wait_ms"] > 0.0:
+                w["waits"].append(t["job_wait_ms"])
+    out["job_waits"] = {name: {"bands": w["bands"], "waited": len(w["waits"]),
+                               "median_wait_ms": statistics.median(w["waits"]) if w["waits"] else 0.0,
+                               "mean_wait_ms_per_band": sum(w["waits"]) / w["bands"]}
+                        for name, w in sorted(waits.items())}
     return out
 
 
@@ -62,6 +77,9 @@ def main():
               f"idle {summary['idle_percent']['mean']:.1f}% mean")
         for name, ms in summary["stages_median_ms"].items():
             print(f"  {name:60s} {ms:8.3f} ms")
+        for name, w in summary["job_waits"].items():
+            print(f"  {name}: waited for its job in {w['waited']} of {w['bands']} bands "
+                  f"(median wait {w['median_wait_ms']:.3f} ms, {w['mean_wait_ms_per_band']:.3f} ms a band)")
         sys.stdout.flush()
     except BrokenPipeError:
         # The reader took what it wanted (`| head -n 1`): no traceback, and none at exit either.

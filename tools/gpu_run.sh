@@ -25,6 +25,10 @@
 #                              back to back on the device; docs/balancing.md, "OpenCL's bands back to back on the device")
 #                              COHORT_GPU_BAND_GAPS=1 renders with --log-level debug and prints the OpenCL bands' device gap
 #                              after the band before, kernels and transfer (tools/opencl_band_gaps.py)
+#                              COHORT_GPU_HAND_OUT_AHEAD="1 0" renders each of those with COHORT_HAND_OUT_AHEAD=1 then 0,
+#                              back to back (with two in flight, frame N+1 handed out as soon as N-1 is merged, before
+#                              N-1's post; docs/balancing.md, "The next frame handed out as soon as a slot frees");
+#                              each run also prints per tracer the bands that waited for their job
 #   tools/gpu_run.sh compare BASE.tar.xz [MORE.tar.xz ...]  there: A/B of payloads on one machine (the staged
 #                              one against earlier stages' payload.tar.xz, renamed and carried in .gpu/): the CUDA
 #                              tracer tests of the staged one, then end-to-end ms per frame, cuda:0, both maps,
@@ -494,6 +498,7 @@ print(pick[0]["tracer"] if pick else "")' || true)}"
         for in_flight in ${COHORT_GPU_IN_FLIGHT:-default}; do
         for ahead in ${COHORT_GPU_ENQUEUE_AHEAD:-default}; do
         for transfer in ${COHORT_GPU_TRANSFER_QUEUE:-default}; do
+        for handout in ${COHORT_GPU_HAND_OUT_AHEAD:-default}; do
           run=/tmp/mg_${map}_${convergence}_$(echo "$mix" | tr ',:' '__')
           in_flight_args=()
           if [ "$in_flight" != default ]; then
@@ -509,6 +514,10 @@ print(pick[0]["tracer"] if pick else "")' || true)}"
             run=${run}_tq${transfer}
             ahead_env+=(COHORT_OPENCL_TRANSFER_QUEUE=$transfer); ahead_label="$ahead_label, COHORT_OPENCL_TRANSFER_QUEUE=$transfer"
           fi
+          if [ "$handout" != default ]; then
+            run=${run}_ho${handout}
+            ahead_env+=(COHORT_HAND_OUT_AHEAD=$handout); ahead_label="$ahead_label, COHORT_HAND_OUT_AHEAD=$handout"
+          fi
           log_args=(); [ "${COHORT_GPU_BAND_GAPS:-0}" = 1 ] && log_args=(--log-level debug)
           env "${ahead_env[@]}" timeout 120 "$stage/bin/cohort" "${log_args[@]}" render "${args[@]}" --tracers "$mix" --spp 1 --light-samples 1 --bounces 1 \
             ${COHORT_GPU_RENDER_ARGS:-} "${in_flight_args[@]}" --convergence $convergence --frames ${COHORT_GPU_FRAMES:-100} \
@@ -517,8 +526,10 @@ print(pick[0]["tracer"] if pick else "")' || true)}"
           echo "== $map map, $convergence, $mix${in_flight_args[*]:+, ${in_flight_args[*]}, round $round}$ahead_label"
           python3 tools/frame_times.py $run/stats.json --skip ${COHORT_GPU_SKIP:-20} --json $out/$(basename $run).json > $run/summary.txt
           head -n 1 $run/summary.txt
+          grep "waited for its job" $run/summary.txt || true  # per tracer: bands whose job came after the band before ended
           [ "${COHORT_GPU_BAND_GAPS:-0}" = 1 ] && { python3 tools/opencl_band_gaps.py $run.log --skip ${COHORT_GPU_SKIP:-20} || true; }
           grep -E "sits out|keeps its rows" $run.log | sed 's/^.*\] //' | head -n 3 || true
+        done
         done
         done
         done

@@ -19,7 +19,8 @@ const char* to_string(TracerOutcome outcome) {
 void to_json(nlohmann::json& j, const TracerFrameStats& s) {
   j = nlohmann::json{{"id", s.id},           {"name", s.name},     {"outcome", to_string(s.outcome)},
                      {"row_begin", s.row_begin}, {"row_end", s.row_end}, {"rows", s.row_end - s.row_begin},
-                     {"ms", s.ms},           {"idle_ms", s.idle_ms}, {"recovery_rows", s.recovery_rows},
+                     {"ms", s.ms},           {"idle_ms", s.idle_ms}, {"job_wait_ms", s.job_wait_ms},
+                     {"recovery_rows", s.recovery_rows},
                      {"recovery_ms", s.recovery_ms}};
   if (s.probe_rows > 0) j["probe_rows"] = s.probe_rows;
   if (!s.error.empty()) j["error"] = s.error;

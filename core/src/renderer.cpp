@@ -56,6 +56,8 @@ struct Renderer::Worker {
     // Handed to the tracer ahead (Tracer::queued_next) while the job before rendered: its commit is applied
     // and its commands may be in the device's queue already.
     bool enqueued_ahead = false;
+    // When the core put it in the inbox: after the worker's job before had ended, the worker waited for it.
+    Clock::time_point posted{};
   };
 
   // Inbox, guarded by inbox_mutex: at most two frames' jobs, and a recovery job behind them.
@@ -152,6 +154,14 @@ struct Renderer::Worker {
       const auto start = Clock::now();
       if (last_end) outcome.waited_ms = std::chrono::duration<double, std::milli>(start - *last_end).count();
       const std::string track = tracer_track(id, name);
+      if (last_end && current.posted > *last_end) {
+        // Starved: its band before ended with no job queued (docs/balancing.md, "The next frame handed out
+        // as soon as a slot frees"). On the timeline only with two in flight, where the job should have been
+        // queued (the span starts before its frame's hand-out); with one, every band waits for the frame's
+        // turnaround by design.
+        outcome.job_wait_ms = std::chrono::duration<double, std::milli>(current.posted - *last_end).count();
+        if (two_in_flight) outcome.spans.push_back({track, "wait for job", timeline_ms(*last_end), outcome.job_wait_ms});
+      }
       if (current.enqueued_ahead) handed_ahead = false;
       bool rendered = false;  // whether render_band took the job (one enqueued ahead is then its business)
       try {
@@ -551,6 +561,7 @@ std::vector<uint64_t> Renderer::assign(std::vector<Assignment>& assignments, con
       queued.commit.emplace();
       w.channel->take(*queued.commit);
     }
+    queued.posted = Clock::now();
     w.inbox.push_back(std::move(queued));
     w.job_posted.store(true, std::memory_order_release);
     w.inbox_cv.notify_one();
@@ -829,6 +840,7 @@ FrameStats Renderer::wait_frame() {
   for (int id : first.finished) {
     TracerFrameStats& t = stats.tracers[static_cast<size_t>(id)];
     t.ms = measured_ms(first.of(id));
+    t.job_wait_ms = first.of(id).job_wait_ms;
     t.outcome = TracerOutcome::rendered;
     stats.frame_ms = std::max(stats.frame_ms, t.ms);
     last_measurements_.push_back({id, balance::Band{t.row_begin, t.row_end}, t.ms});

@@ -5,9 +5,13 @@
 #include <algorithm>
 #include <condition_variable>
 #include <cstring>
+#include <cstdlib>
+#include <functional>
 #include <map>
 #include <mutex>
 #include <thread>
+
+#include <nlohmann/json.hpp>
 
 #include "cohort/core/simulated_tracer.h"
 
@@ -574,4 +578,263 @@ TEST(FramePipeline, PrepareNextAnnouncesTheNextFrameBeforeTheFrameBeforeIsPostPr
   EXPECT_TRUE(saw_serial->wait_for(1, std::chrono::milliseconds(5000)));
   gates_serial->open(2);
   ASSERT_TRUE(serial.drain().has_value());
+}
+
+namespace {
+
+// Which frames' bands have ended, per frame a count of the tracers done with it.
+struct BandsEnded {
+  std::mutex mutex;
+  std::condition_variable cv;
+  std::map<uint64_t, int> ended;
+  void add(uint64_t frame) {
+    std::lock_guard lock(mutex);
+    ++ended[frame];
+    cv.notify_all();
+  }
+  bool wait_for(uint64_t frame, int tracers, std::chrono::milliseconds patience) {
+    std::unique_lock lock(mutex);
+    return cv.wait_for(lock, patience, [&] { return ended[frame] >= tracers; });
+  }
+};
+
+// A GatedTracer that says when its band has ended.
+class EndSignallingTracer final : public Tracer {
+ public:
+  EndSignallingTracer(std::string name, std::shared_ptr<FrameGates> gates, std::shared_ptr<BandsEnded> ended)
+      : name_(std::move(name)), gates_(std::move(gates)), ended_(std::move(ended)) {}
+  std::string name() const override { return name_; }
+  void apply(const cohort::commit::CommitBuffer&) override {}
+  using Tracer::render_band;
+  BandResult render_band(const BandJob& job, BandBuffer& target) override {
+    gates_->wait(job.params.frame_index);
+    fill_band_with_frame_index(job, target);
+    ended_->add(job.params.frame_index);
+    return {};
+  }
+
+ private:
+  std::string name_;
+  std::shared_ptr<FrameGates> gates_;
+  std::shared_ptr<BandsEnded> ended_;
+};
+
+// Pushes `frames` frames the way `cohort render` does (push with prepare_next); `post(f)` stands for the
+// caller's post-processing of delivered frame f. Returns the delivered frames' stats, checked whole and in order.
+std::vector<FrameStats> push_with_prepare_next(FramePipeline& pipeline, uint64_t frames,
+                                               const std::function<void(uint64_t)>& before_push,
+                                               const std::function<void(uint64_t)>& post) {
+  std::vector<FrameStats> delivered;
+  auto take = [&](std::optional<FramePipeline::Delivered> done) {
+    if (!done) return;
+    EXPECT_EQ(done->stats.frame, delivered.size()) << "frames in order";
+    EXPECT_EQ(done->job.params.frame_index, done->stats.frame);
+    for (int y = 0; y < kRows; ++y) EXPECT_EQ(pipeline.image().row(y)[0], static_cast<float>(done->stats.frame)) << "row " << y;
+    post(done->stats.frame);
+    delivered.push_back(std::move(done->stats));
+  };
+  std::optional<BandJob> next = job_for(0);
+  for (uint64_t f = 0; next; ++f) {
+    const BandJob job = *next;
+    next.reset();
+    before_push(f);
+    std::optional<FramePipeline::Delivered> done = pipeline.push(job, {}, [&, f]() -> std::optional<BandJob> {
+      if (f + 1 < frames) next = job_for(f + 1);
+      return next;
+    });
+    if (done) {
+      EXPECT_EQ(done->stats.frame + 1, f) << "push returns the frame pushed before";
+    }
+    take(std::move(done));
+  }
+  take(pipeline.drain());
+  EXPECT_FALSE(pipeline.in_flight());
+  EXPECT_EQ(delivered.size(), frames);
+  return delivered;
+}
+
+// With two frames in flight push(N) hands N+1 out as soon as N-1 is merged, before the caller's post of N-1;
+// so a band of N that ends during that post finds its next job queued. Here each band of N can end only
+// during the post of N-1 (which opens its gate and waits for it to end): with the hand-out after the post
+// (COHORT_HAND_OUT_AHEAD=0, the order before) every such band waited for its next job.
+void expect_next_job_queued_during_the_post(bool ahead) {
+  if (ahead) unsetenv("COHORT_HAND_OUT_AHEAD");
+  else setenv("COHORT_HAND_OUT_AHEAD", "0", 1);
+  auto gates = std::make_shared<FrameGates>();
+  auto ended = std::make_shared<BandsEnded>();
+  std::vector<std::unique_ptr<Tracer>> tracers;
+  tracers.push_back(std::make_unique<EndSignallingTracer>("gated1", gates, ended));
+  tracers.push_back(std::make_unique<EndSignallingTracer>("gated2", gates, ended));
+  RendererOptions options;
+  options.frames_in_flight = 2;
+  Renderer renderer(std::move(tracers), options);
+  FramePipeline pipeline(renderer);
+  constexpr uint64_t kFrames = 8;
+  const std::vector<FrameStats> frames = push_with_prepare_next(
+      pipeline, kFrames, [&](uint64_t f) { if (f == 1) gates->open(0); },
+      [&](uint64_t f) {
+        // The post of frame f: frame f+1's bands end meanwhile, and the post goes on a while after.
+        if (f + 1 == kFrames) return;
+        gates->open(f + 1);
+        EXPECT_TRUE(ended->wait_for(f + 1, 2, std::chrono::milliseconds(5000)));
+        std::this_thread::sleep_for(std::chrono::milliseconds(10));
+      });
+  unsetenv("COHORT_HAND_OUT_AHEAD");
+  EXPECT_FALSE(gates->gave_up);
+  ASSERT_EQ(frames.size(), kFrames);
+  for (uint64_t f = 2; f < kFrames; ++f) {
+    for (const TracerFrameStats& t : frames[f].tracers) {
+      if (ahead) {
+        EXPECT_EQ(t.job_wait_ms, 0.0) << "frame " << f << ", " << t.name << ": its job came after its band before had ended";
+      } else {
+        EXPECT_GE(t.job_wait_ms, 5.0) << "frame " << f << ", " << t.name << ": handed out after the post, it should have waited";
+      }
+    }
+    EXPECT_EQ(spans_of(frames[f], "wait for job", true).empty(), ahead) << "frame " << f;
+    const nlohmann::json json = frames[f];  // stats.json has the count per tracer
+    for (size_t i = 0; i < frames[f].tracers.size(); ++i)
+      EXPECT_EQ(json["tracers"][i]["job_wait_ms"].get<double>(), frames[f].tracers[i].job_wait_ms);
+  }
+}
+
+}  // namespace
+
+TEST(FramePipeline, WithTwoFramesInFlightTheNextFrameIsQueuedBeforeTheCallersPostOfTheFrameBefore) {
+  expect_next_job_queued_during_the_post(true);
+}
+
+TEST(FramePipeline, WithTwoFramesInFlightAndTheHandOutAfterThePostTheBandsWaitForTheirJobs) {
+  expect_next_job_queued_during_the_post(false);
+}
+
+namespace {
+
+// Notes in order each commit applied (its frame number) and each band rendered (its frame index).
+class OrderLoggingTracer final : public Tracer {
+ public:
+  explicit OrderLoggingTracer(std::shared_ptr<std::vector<std::string>> log) : log_(std::move(log)) {}
+  std::string name() const override { return "order"; }
+  void apply(const cohort::commit::CommitBuffer& commit) override { log_->push_back("apply " + std::to_string(commit.frame())); }
+  using Tracer::render_band;
+  BandResult render_band(const BandJob& job, BandBuffer& target) override {
+    std::this_thread::sleep_for(std::chrono::milliseconds(2));
+    fill_band_with_frame_index(job, target);
+    log_->push_back("render " + std::to_string(job.params.frame_index));
+    return {};
+  }
+
+ private:
+  std::shared_ptr<std::vector<std::string>> log_;  // written by its worker only, read once the Renderer is gone
+};
+
+}  // namespace
+
+// The next frame handed out ahead keeps every guarantee: each frame's commit (submitted in prepare_next)
+// applied once, in order, just before that frame's band; every frame whole and in order while a tracer
+// throws on two frames and its rows are re-rendered.
+TEST(FramePipeline, WithTwoFramesInFlightTheFramesHandedOutAheadKeepTheirCommitsInOrderThroughFaults) {
+  auto log = std::make_shared<std::vector<std::string>>();
+  constexpr uint64_t kFrames = 12;
+  std::vector<FrameStats> frames;
+  {
+    std::vector<std::unique_ptr<Tracer>> tracers;
+    tracers.push_back(std::make_unique<OrderLoggingTracer>(log));
+    SimulatedTracerOptions o;
+    o.name = "thrower";
+    o.seed = 2;
+    o.clock = SimulatedClock::sleep;
+    o.throw_on_frames = {4, 5};
+    tracers.push_back(std::make_unique<SimulatedTracer>(std::make_shared<SpinSceneCostModel>(3), o));
+    RendererOptions options;
+    options.frames_in_flight = 2;
+    Renderer renderer(std::move(tracers), options);
+    auto scene = std::make_shared<cohort::commit::TracerScene>();
+    renderer.submit_commit(cohort::commit::CommitBuffer::full(scene, 0));
+    FramePipeline pipeline(renderer);
+    std::optional<BandJob> next = job_for(0);
+    std::map<uint64_t, FrameStats> by_frame;
+    for (uint64_t f = 0; next; ++f) {
+      const BandJob job = *next;
+      next.reset();
+      std::optional<FramePipeline::Delivered> done = pipeline.push(job, {}, [&, f]() -> std::optional<BandJob> {
+        if (f + 1 >= kFrames) return std::nullopt;
+        cohort::commit::CommitBuffer commit;  // frame f+1's commit carries frame number f + 1
+        commit.set_frame(f + 1);
+        commit.set_camera(job_for(f + 1).camera);
+        renderer.submit_commit(commit, [&] { return scene; });
+        next = job_for(f + 1);
+        return next;
+      });
+      if (done) {
+        for (int y = 0; y < kRows; ++y) ASSERT_EQ(pipeline.image().row(y)[0], static_cast<float>(done->stats.frame));
+        frames.push_back(std::move(done->stats));
+      }
+    }
+    if (std::optional<FramePipeline::Delivered> done = pipeline.drain()) frames.push_back(std::move(done->stats));
+  }
+  ASSERT_EQ(frames.size(), kFrames);
+  for (uint64_t f = 0; f < kFrames; ++f) EXPECT_EQ(frames[f].frame, f);
+  for (uint64_t f : {4, 5}) EXPECT_EQ(frames[f].tracers[1].outcome, TracerOutcome::threw) << "frame " << f;
+  EXPECT_EQ(frames[kFrames - 1].tracers[1].outcome, TracerOutcome::rendered) << "it rejoins";
+  // The logging tracer: every commit once, in order (frame f's carries number f, the full scene frame 0's),
+  // each after the band of the frame before and before its own frame's band (the first "render f"; a
+  // recovery band of frames 4 and 5 comes later, queued behind its band of the next frame).
+  std::vector<std::string> applied_in_order, expected_commits;
+  for (const std::string& e : *log)
+    if (e.rfind("apply ", 0) == 0) applied_in_order.push_back(e);
+  for (uint64_t f = 0; f < kFrames; ++f) expected_commits.push_back("apply " + std::to_string(f));
+  EXPECT_EQ(applied_in_order, expected_commits);
+  for (uint64_t f = 0; f < kFrames; ++f) {
+    const auto applied = std::find(log->begin(), log->end(), "apply " + std::to_string(f));
+    const auto rendered = std::find(log->begin(), log->end(), "render " + std::to_string(f));
+    ASSERT_NE(applied, log->end());
+    ASSERT_NE(rendered, log->end());
+    EXPECT_LT(applied, rendered) << "frame " << f;
+    if (f > 0) {
+      EXPECT_LT(std::find(log->begin(), log->end(), "render " + std::to_string(f - 1)), applied)
+          << "frame " << f << "'s commit after frame " << f - 1 << "'s band";
+    }
+  }
+}
+
+// A job handed out ahead must be the one pushed next; the pipeline gone with two frames in flight finishes
+// both; drain() returns a frame handed out ahead that was never pushed.
+TEST(FramePipeline, WithTwoFramesInFlightAFrameHandedOutAheadIsPushedDrainedOrFinished) {
+  for (int round = 0; round < 3; ++round) {
+    std::vector<std::unique_ptr<Tracer>> tracers;
+    tracers.push_back(sleeping_tracer(1));
+    RendererOptions options;
+    options.frames_in_flight = 2;
+    Renderer renderer(std::move(tracers), options);
+    {
+      FramePipeline pipeline(renderer);
+      auto prepare = [](uint64_t f) { return [f]() -> std::optional<BandJob> { return job_for(f); }; };
+      EXPECT_FALSE(pipeline.push(job_for(0), {}, prepare(1)).has_value());
+      std::optional<FramePipeline::Delivered> zero = pipeline.push(job_for(1), {}, prepare(2));
+      ASSERT_TRUE(zero.has_value());
+      EXPECT_EQ(zero->stats.frame, 0u);
+      EXPECT_EQ(renderer.frames_begun(), 2) << "frame 2 handed out ahead";
+      if (round == 0) {
+        EXPECT_THROW(pipeline.push(job_for(5)), std::logic_error) << "frame 2 was handed out, not 5";
+        std::optional<FramePipeline::Delivered> one = pipeline.push(job_for(2));
+        ASSERT_TRUE(one.has_value());
+        EXPECT_EQ(one->stats.frame, 1u);
+        std::optional<FramePipeline::Delivered> two = pipeline.drain();
+        ASSERT_TRUE(two.has_value());
+        EXPECT_EQ(two->stats.frame, 2u);
+        EXPECT_EQ(pipeline.image().row(0)[0], 2.0f);
+      } else if (round == 1) {
+        std::optional<FramePipeline::Delivered> one = pipeline.drain();
+        ASSERT_TRUE(one.has_value());
+        EXPECT_EQ(one->stats.frame, 1u);
+        EXPECT_TRUE(pipeline.in_flight());
+        std::optional<FramePipeline::Delivered> two = pipeline.drain();
+        ASSERT_TRUE(two.has_value());
+        EXPECT_EQ(two->stats.frame, 2u);
+        EXPECT_EQ(pipeline.image().row(kRows - 1)[0], 2.0f);
+        EXPECT_FALSE(pipeline.drain().has_value());
+      }
+    }
+    EXPECT_EQ(renderer.frames_begun(), 0) << "round " << round << ": the pipeline finishes what it handed out";
+  }
 }

@@ -110,11 +110,23 @@ void soak(int frames_in_flight) {
     job.params.frame_index = static_cast<kuint>(f);
     return job;
   };
-  for (int f = 0; f < frames; ++f) {
+  // Frame f's world sync and job; the next frame is prepared as soon as one is handed out (push with
+  // prepare_next), and with two in flight handed out once the frame before is merged, as `cohort render` does.
+  auto prepare = [&](int f) {
     scenario.frame(f);
     world.EndFrame();
     renderer.submit_commit(sync.sync(world.TakeChanges(), uint64_t(f) + 1), [&] { return sync.snapshot(); });
-    if (auto done = pipeline.push(frame_job(uint64_t(f)))) check(*done);
+    return frame_job(uint64_t(f));
+  };
+  std::optional<BandJob> next = prepare(0);
+  for (int f = 0; next; ++f) {
+    const BandJob job = *next;
+    next.reset();
+    if (auto done = pipeline.push(job, {}, [&, f]() -> std::optional<BandJob> {
+          if (f + 1 < frames) next = prepare(f + 1);
+          return next;
+        }))
+      check(*done);
     if (f == warm_up) warm_mib = resident_mib();
     if (f > warm_up) peak_mib = std::max(peak_mib, resident_mib());
   }

@@ -126,7 +126,8 @@ Rendered render_sequence(const std::vector<std::string>& tracer_names, const std
     if (extras.aux) out.planes.push_back(pipeline.gbuffer());
     out.stats.push_back(std::move(done->stats));
   };
-  for (int f = 0; f < kFrames; ++f) {
+  // Frame f's preparation, as `cohort render` does it: its world sync (commits submitted) and its job.
+  auto prepare = [&](int f) {
     if (f > 0) {
       sync.set_time(0.3 * f);
       if (move_walker && walker >= 0 && map.entities[size_t(walker)].anim) {
@@ -149,7 +150,18 @@ Rendered render_sequence(const std::vector<std::string>& tracer_names, const std
     job.params.frame_index = static_cast<kuint>(f);
     job.params.aux_outputs = extras.aux;
     if (f > 0) job.previous_camera = core::make_camera({300, 192, 80}, {180.0f + 4.0f * float(f - 1), 0.0f}, 90.0f, kWidth, kHeight);
-    take(pipeline.push(job));
+    return job;
+  };
+  // The next frame prepared as soon as one is handed out (push with prepare_next), and with two in flight
+  // handed out once the frame before is merged, as `cohort render` does.
+  std::optional<core::BandJob> next = prepare(0);
+  for (int f = 0; next; ++f) {
+    const core::BandJob job = *next;
+    next.reset();
+    take(pipeline.push(job, {}, [&, f]() -> std::optional<core::BandJob> {
+      if (f + 1 < kFrames) next = prepare(f + 1);
+      return next;
+    }));
   }
   take(pipeline.drain());
   count_ahead(made, out);

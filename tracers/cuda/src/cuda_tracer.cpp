@@ -128,13 +128,15 @@ struct CudaTracer::Impl {
   // (about 3 ms of a 1080p frame otherwise). The Renderer alternates two targets by frame parity (the
   // pipeline), so the last two stay registered, with their auxiliary planes when they have them.
   HostRegistrations registered{4};
-  // Bands left on this GPU for the frame's post-processing (BandJob::keep_on_device): two, so that the
-  // post reads frame N's while frame N+1 renders into the other (the Renderer's slots likewise).
+  // Bands left on this GPU for the frame's post-processing (BandJob::keep_on_device): three, so that the
+  // post reads frame N's while N+1 and N+2 render into the others (with two frames in flight the pipeline
+  // hands N+2 out as soon as N is merged, before N's post: core/frame_pipeline.h).
   struct KeptBand {
     DeviceArray<unsigned char> colour;
     DeviceArray<KAuxTexel> aux;
   };
-  KeptBand kept[2];
+  static constexpr int kKeptBands = 3;
+  KeptBand kept[kKeptBands];
   int next_kept = 0;
 
   // Converts `pixels` of the float band, from frame pixel `first_pixel` on, to the packed `format` on the
@@ -358,7 +360,7 @@ core::BandResult CudaTracer::render_band(const core::BandJob& job, core::BandBuf
   // Kept on the GPU, the band skips both copies: nothing goes down, and the post-processing takes it
   // device to device (or over NVLink from a peer).
   Impl::KeptBand* kept = job.keep_on_device >= 0 ? &m.kept[m.next_kept] : nullptr;
-  if (kept) m.next_kept ^= 1;
+  if (kept) m.next_kept = (m.next_kept + 1) % Impl::kKeptBands;
   else m.register_target(target);
   COHORT_CUDA(cudaEventRecord(m.start, m.stream));
   const bool write_aux = params.aux_outputs != 0u && target.has_aux();

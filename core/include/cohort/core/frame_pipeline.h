@@ -5,6 +5,9 @@
 //
 //   for each frame:  prepare it (submit its commits)  ->  pipeline.push(job)  ->  post-process what came back
 //   at the end:      pipeline.drain()                  ->  post-process what came back
+// or, preparing the next frame inside push (prepare_next; with two frames in flight the next frame is then
+// handed out before the caller's post of the frame returned):
+//   next = prepare(0); while (next) { job = next; pipeline.push(job, spans, [&] { return next = prepare(f + 1); }) ... }
 #pragma once
 
 #include <functional>
@@ -44,14 +47,25 @@ class FramePipeline {
   // post-processed the frame returned here. Tracers that take jobs ahead (remote tracers: their nodes)
   // then start on it while this frame renders, without waiting for the core's merge, blend and output of
   // the frame before (docs/cluster.md, "The next frame announced at hand-out"). The returned job is the
-  // one to push next.
+  // one to push next (with its frame index; another throws std::logic_error).
+  // With the Renderer's frames_in_flight 2 the returned job is also handed out here, as soon as the frame
+  // before this one is merged, before that frame is returned for the caller's post: its slot is free then,
+  // and a tracer whose band of this frame ends during the caller's post finds its next job queued. The next
+  // push of that job then only attaches its `preparation` (docs/balancing.md, "The next frame handed out
+  // as soon as a slot frees"). A CUDA tracer's bands kept on its GPU for the post (BandJob::keep_on_device)
+  // are then three deep: the caller's post reads the returned frame's while this one and the next render.
+  // COHORT_HAND_OUT_AHEAD=0 hands it out at its push instead (the order before, for comparison).
   using PrepareNext = std::function<std::optional<BandJob>()>;
   std::optional<Delivered> push(const BandJob& job, std::vector<StageSpan> preparation, const PrepareNext& prepare_next);
   // Whether the apps announce the next frame at hand-out (push with prepare_next): yes, unless the
   // environment says COHORT_EARLY_ANNOUNCE=0 (the order before, for comparison). `cohort render` and
   // `cohort play` both ask here.
   static bool announces_at_hand_out();
-  // Waits for the frame in flight and returns it merged into image(); nothing when none is.
+  // Whether push with prepare_next hands the next frame out ahead (two in flight): yes, unless the
+  // environment says COHORT_HAND_OUT_AHEAD=0.
+  static bool hands_out_ahead();
+  // Waits for the frame in flight and returns it merged into image(); nothing when none is. A frame handed
+  // out ahead that was never pushed stays in flight: the next drain() returns it.
   std::optional<Delivered> drain();
 
   // The last delivered frame, as merged; valid until the next push() or drain().
@@ -78,6 +92,8 @@ class FramePipeline {
   Renderer& renderer_;
   FrameBuffer image_;
   std::optional<InFlight> in_flight_;
+  // Two in flight: the job prepare_next returned, handed out already (its preparation spans come with its push).
+  std::optional<InFlight> ahead_;
 };
 
 }  // namespace cohort::core

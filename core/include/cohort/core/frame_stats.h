@@ -31,6 +31,10 @@ struct TracerFrameStats {
   int row_begin = 0, row_end = 0;
   double ms = 0.0;             // measured cost: commit apply + band render (virtual time: what the tracer reported)
   double idle_ms = 0.0;        // frame_ms - ms for tracers that rendered
+  // How long it waited for this frame's job: from the end of its job before to this one's hand-out, when
+  // the job came after that one had ended (a "starved" band; with two frames in flight the job should
+  // have been queued already); 0 when it was queued in time. Its `wait for job` span shows it on the timeline.
+  double job_wait_ms = 0.0;
   int probe_rows = 0;          // no_rows: rows it renders unwaited to be measured (the balancer's probe)
   int recovery_rows = 0;       // rows it re-rendered for dropped tracers
   double recovery_ms = 0.0;

@@ -164,6 +164,9 @@ class Renderer {
     double balance_ms = 0.0;  // BandResult::balance_ms
     double apply_ms = 0.0;
     double waited_ms = -1.0;  // from the end of the worker's job before to this one's start (< 0: no job before)
+    // From the end of the worker's job before to this job's hand-out, when it was handed out after that
+    // job had ended (the worker was starved of work); 0 when it was queued in time or is the first.
+    double job_wait_ms = 0.0;
     std::vector<float> row_work;
     DeviceBand device_band;        // the band, when it stayed on a GPU
     std::vector<StageSpan> spans;  // the job's apply and render stages

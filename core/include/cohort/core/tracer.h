@@ -24,7 +24,9 @@ struct BandJob {
   // The CUDA device the core will take this band from (the GPU post-processing's, set by the Renderer
   // for a packed merge): a tracer that can hand its rows over there leaves them on its GPU and reports
   // them in BandResult::device instead of writing the target (the rows never cross the bus twice);
-  // -1: write the target, as always. Remote tracers clear it before the job travels.
+  // -1: write the target, as always. Remote tracers clear it before the job travels. A kept band must
+  // stay until the tracer has kept two more: with two frames in flight the post reads frame N's while
+  // N+1 and N+2 render (core/frame_pipeline.h).
   int keep_on_device = -1;
 };
 
