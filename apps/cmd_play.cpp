@@ -428,7 +428,7 @@ void add_play_command(CLI::App& app, int& exit_code) {
       ->capture_default_str()
       ->check(CLI::IsMember({"auto", "brigade", "reproject", "none"}));
   cmd->add_option("--aux-rays", a->session.aux_rays,
-                  "where the G-buffer for reprojection comes from: auto (first-hit where CUDA GPUs render and no "
+                  "where the G-buffer for reprojection comes from: auto (centre with --denoise oidn or oidn-cuda; else first-hit where CUDA GPUs render and no "
                   "OpenCL or mpi tracer does, else centre), centre (a ray of its own through each pixel's "
                   "centre) or first-hit (the first sample's own first surface: no extra ray, about 0.8 ms less a "
                   "1080p frame on an H100; the planes jitter at silhouettes); see `cohort render --help`")

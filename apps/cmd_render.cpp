@@ -204,7 +204,9 @@ int run_render(const RenderArgs& a) {
   core::FrameBuffer denoised;
   const bool atrous = a.denoise == "atrous";
   // KFrameParams.aux_outputs of frames with planes
-  const kuint aux_mode = core::aux_rays_mode(a.aux_rays == "auto" ? tracers::auto_aux_rays(specs) : a.aux_rays);
+  const kuint aux_mode = oidn_wants_centre_rays(a.aux_rays, a.denoise)
+                             ? K_AUX_CENTRE_RAY
+                             : core::aux_rays_mode(a.aux_rays == "auto" ? tracers::auto_aux_rays(specs) : a.aux_rays);
   // Reprojection and the a-trous filter run together, on the host or on a GPU (core/frame_post.h).
   std::unique_ptr<core::FramePost> post;
   if (reproject || atrous) {
@@ -544,7 +546,8 @@ void add_render_command(CLI::App& app, int& exit_code) {
                                                    "-fast, e.g. orbit-fast")
       ->check(camera_path_error);
   cmd->add_option("--aux-rays", a->aux_rays,
-                  "where the G-buffer for reprojection and denoising comes from: auto (first-hit where CUDA GPUs "
+                  "where the G-buffer for reprojection and denoising comes from: auto (centre with --denoise oidn "
+                  "or oidn-cuda, whose guides are then clean; else first-hit where CUDA GPUs "
                   "render and no OpenCL or mpi tracer does, else centre), centre (a ray of its own through "
                   "each pixel's centre: steady planes) or first-hit (the first sample's own first surface: no "
                   "extra ray, about 0.8 ms less a 1080p frame on an H100, but the planes jitter as the samples "
