@@ -276,9 +276,7 @@ void OidnDenoiser::denoise(const FrameBuffer& color, FrameBuffer& out, const Den
   const bool use_albedo = guides.albedo != nullptr;
   const bool use_normal = use_albedo && guides.normal != nullptr;
   Impl& m = *impl_;
-  const char* clean_env = std::getenv("COHORT_OIDN_CLEAN_AUX");
-  const bool clean = clean_env && *clean_env ? std::string(clean_env) == "1" : guides.clean;
-  m.configure(color.width, color.height, use_albedo, use_normal, use_albedo && clean);
+  m.configure(color.width, color.height, use_albedo, use_normal, use_albedo && guides.clean);
   using Clock = std::chrono::steady_clock;
   const Clock::time_point started = Clock::now();
   HostThreads& threads = HostThreads::shared();
