@@ -87,22 +87,41 @@ void fill_band_with_frame_index(const BandJob& job, BandBuffer& target) {
     target.store(static_cast<int>(y), 0, row.data(), static_cast<size_t>(target.width()));
 }
 
-// Fills its band with the frame index once the frame's gate is open.
+// Which frames' bands have ended, per frame a count of the tracers done with it.
+struct BandsEnded {
+  std::mutex mutex;
+  std::condition_variable cv;
+  std::map<uint64_t, int> ended;
+  void add(uint64_t frame) {
+    std::lock_guard lock(mutex);
+    ++ended[frame];
+    cv.notify_all();
+  }
+  bool wait_for(uint64_t frame, int tracers, std::chrono::milliseconds patience) {
+    std::unique_lock lock(mutex);
+    return cv.wait_for(lock, patience, [&] { return ended[frame] >= tracers; });
+  }
+};
+
+// Fills its band with the frame index once the frame's gate is open; says so in `ended` where given.
 class GatedTracer final : public Tracer {
  public:
-  GatedTracer(std::string name, std::shared_ptr<FrameGates> gates) : name_(std::move(name)), gates_(std::move(gates)) {}
+  GatedTracer(std::string name, std::shared_ptr<FrameGates> gates, std::shared_ptr<BandsEnded> ended = nullptr)
+      : name_(std::move(name)), gates_(std::move(gates)), ended_(std::move(ended)) {}
   std::string name() const override { return name_; }
   void apply(const cohort::commit::CommitBuffer&) override {}
   using Tracer::render_band;
   BandResult render_band(const BandJob& job, BandBuffer& target) override {
     gates_->wait(job.params.frame_index);
     fill_band_with_frame_index(job, target);
+    if (ended_) ended_->add(job.params.frame_index);
     return {};
   }
 
  private:
   std::string name_;
   std::shared_ptr<FrameGates> gates_;
+  std::shared_ptr<BandsEnded> ended_;
 };
 
 std::vector<StageSpan> spans_of(const FrameStats& stats, const std::string& stage, bool tracers) {
@@ -582,43 +601,6 @@ TEST(FramePipeline, PrepareNextAnnouncesTheNextFrameBeforeTheFrameBeforeIsPostPr
 
 namespace {
 
-// Which frames' bands have ended, per frame a count of the tracers done with it.
-struct BandsEnded {
-  std::mutex mutex;
-  std::condition_variable cv;
-  std::map<uint64_t, int> ended;
-  void add(uint64_t frame) {
-    std::lock_guard lock(mutex);
-    ++ended[frame];
-    cv.notify_all();
-  }
-  bool wait_for(uint64_t frame, int tracers, std::chrono::milliseconds patience) {
-    std::unique_lock lock(mutex);
-    return cv.wait_for(lock, patience, [&] { return ended[frame] >= tracers; });
-  }
-};
-
-// A GatedTracer that says when its band has ended.
-class EndSignallingTracer final : public Tracer {
- public:
-  EndSignallingTracer(std::string name, std::shared_ptr<FrameGates> gates, std::shared_ptr<BandsEnded> ended)
-      : name_(std::move(name)), gates_(std::move(gates)), ended_(std::move(ended)) {}
-  std::string name() const override { return name_; }
-  void apply(const cohort::commit::CommitBuffer&) override {}
-  using Tracer::render_band;
-  BandResult render_band(const BandJob& job, BandBuffer& target) override {
-    gates_->wait(job.params.frame_index);
-    fill_band_with_frame_index(job, target);
-    ended_->add(job.params.frame_index);
-    return {};
-  }
-
- private:
-  std::string name_;
-  std::shared_ptr<FrameGates> gates_;
-  std::shared_ptr<BandsEnded> ended_;
-};
-
 // Pushes `frames` frames the way `cohort render` does (push with prepare_next); `post(f)` stands for the
 // caller's post-processing of delivered frame f. Returns the delivered frames' stats, checked whole and in order.
 std::vector<FrameStats> push_with_prepare_next(FramePipeline& pipeline, uint64_t frames,
@@ -663,8 +645,8 @@ void expect_next_job_queued_during_the_post(bool ahead) {
   auto gates = std::make_shared<FrameGates>();
   auto ended = std::make_shared<BandsEnded>();
   std::vector<std::unique_ptr<Tracer>> tracers;
-  tracers.push_back(std::make_unique<EndSignallingTracer>("gated1", gates, ended));
-  tracers.push_back(std::make_unique<EndSignallingTracer>("gated2", gates, ended));
+  tracers.push_back(std::make_unique<GatedTracer>("gated1", gates, ended));
+  tracers.push_back(std::make_unique<GatedTracer>("gated2", gates, ended));
   RendererOptions options;
   options.frames_in_flight = 2;
   Renderer renderer(std::move(tracers), options);
