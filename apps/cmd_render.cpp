@@ -559,8 +559,9 @@ void add_render_command(CLI::App& app, int& exit_code) {
   cmd->add_option("--denoise", a->denoise,
                   "denoise the shown frame: none, atrous (the real-time edge-aware a-trous filter of the portable "
                   "kernel, every frame), oidn (Intel Open Image Denoise on the CPU) or oidn-cuda (on an NVIDIA GPU: "
-                  "4-6 ms a 1280x720 frame on an H100, the lowest FLIP measured there with --no-convergence); OIDN "
-                  "takes the albedo and normal planes as guides; tools/fetch_oidn.sh installs the library")
+                  "4-6 ms a 1280x720 frame on an H100 for the colour alone, the lowest FLIP measured there with "
+                  "--no-convergence); OIDN takes the albedo and normal planes as guides (their packing and copies "
+                  "add to that); tools/fetch_oidn.sh installs the library")
       ->capture_default_str()
       ->check(CLI::IsMember({"none", "atrous", "oidn", "oidn-cuda"}));
   cmd->add_option("--atrous-passes", a->atrous_passes,
