@@ -84,16 +84,9 @@ std::optional<FramePipeline::Delivered> FramePipeline::push_two_in_flight(const 
   }
   // The announcement is for workers with no job queued when they end this one (remote tracers start on it
   // ahead). Should the preparation fail, one frame stays in flight, as push() promises.
-  std::optional<BandJob> next;
-  if (prepare_next) {
-    try {
-      next = prepare_next();
-    } catch (...) {
-      if (previous) renderer_.finish_frame();
-      throw;
-    }
-    if (next) renderer_.announce_frame(*next);
-  }
+  const std::optional<BandJob> next = prepare_and_announce(prepare_next, [&] {
+    if (previous) renderer_.finish_frame();
+  });
   if (!previous) return std::nullopt;
   FrameStats stats = renderer_.wait_frame();
   renderer_.merge_frame(stats);
@@ -113,8 +106,9 @@ std::optional<FramePipeline::Delivered> FramePipeline::push_two_in_flight(const 
   return delivered(std::move(*previous), std::move(stats));
 }
 
-void FramePipeline::prepare_and_announce(const PrepareNext& prepare_next, const std::function<void()>& restore) {
-  if (!prepare_next) return;
+std::optional<BandJob> FramePipeline::prepare_and_announce(const PrepareNext& prepare_next,
+                                                           const std::function<void()>& restore) {
+  if (!prepare_next) return std::nullopt;
   std::optional<BandJob> next;
   try {
     next = prepare_next();
@@ -123,6 +117,7 @@ void FramePipeline::prepare_and_announce(const PrepareNext& prepare_next, const 
     throw;
   }
   if (next) renderer_.announce_frame(*next);
+  return next;
 }
 
 bool FramePipeline::hands_out_ahead() {

@@ -85,9 +85,9 @@ class FramePipeline {
   // turnaround. Where the frame before cannot be rendered, `job` is already handed out and stays in flight.
   std::optional<Delivered> push_two_in_flight(const BandJob& job, std::vector<StageSpan> preparation,
                                               const PrepareNext& prepare_next);
-  // Runs prepare_next (when given) and announces the job it returns. If it throws, `restore` runs first,
-  // leaving the Renderer as push() promises, and the exception goes on.
-  void prepare_and_announce(const PrepareNext& prepare_next, const std::function<void()>& restore);
+  // Runs prepare_next (when given), announces the job it returns and returns it. If it throws, `restore`
+  // runs first, leaving the Renderer as push() promises, and the exception goes on.
+  std::optional<BandJob> prepare_and_announce(const PrepareNext& prepare_next, const std::function<void()>& restore);
 
   Renderer& renderer_;
   FrameBuffer image_;
