@@ -182,6 +182,11 @@ class Event {
     return &event_;
   }
   cl_event get() const { return event_; }
+  // Holds `other`'s event too, retained: one command's event under two names.
+  void share(const Event& other) {
+    check(clRetainEvent(other.event_), "clRetainEvent");
+    *out() = other.event_;
+  }
   // Takes `other`'s event over (a band's own copy of an event the tracer keeps for the band being enqueued).
   void take(Event& other) {
     if (event_) clReleaseEvent(event_);
@@ -239,6 +244,14 @@ class PinnedStaging {
   void* host_ = nullptr;
   size_t bytes_ = 0;
 };
+
+// Every queue a band's commands go on (Impl::queues); absent ones are null.
+using BandQueues = std::array<cl_command_queue, 5>;
+
+void finish_all(const BandQueues& queues) {
+  for (cl_command_queue q : queues)
+    if (q) clFinish(q);
+}
 
 }  // namespace
 
@@ -382,11 +395,8 @@ struct OpenCLTracer::Impl {
   std::unique_ptr<EnqueuedBand> ahead;
   std::atomic<size_t> enqueued_ahead{0}, finished_ahead{0}, dropped_ahead{0}, back_to_back{0};
   // Every queue a band's commands go on.
-  std::array<cl_command_queue, 5> queues() const { return {queue, aux_queue, lane_queue, upload_queue, read_queue}; }
-  void finish_queues() {
-    for (cl_command_queue q : queues())
-      if (q) clFinish(q);
-  }
+  BandQueues queues() const { return {queue, aux_queue, lane_queue, upload_queue, read_queue}; }
+  void finish_queues() { finish_all(queues()); }
 
   // A device buffer of at least `bytes`, reallocated (contents lost) when it is smaller.
   cl_mem& grow(cl_mem& mem, size_t& capacity, size_t bytes, const char* what) {
@@ -446,10 +456,7 @@ struct OpenCLTracer::Impl {
     Event* event = done ? done : started;
     check(clEnqueueNDRangeKernel(queue, kernel, 2, offset, global, local, 0, nullptr, event ? event->out() : nullptr),
           "launching the kernel");
-    if (started && done) {
-      check(clRetainEvent(done->get()), "clRetainEvent");
-      *started->out() = done->get();
-    }
+    if (started && done) started->share(*done);
   }
   // Runs a 1-D packing kernel (source, destination, end pixel) over the pixels [first, first + pixels):
   // the kernel stops at the end pixel, so a piece's last work group leaves the next piece's pixels alone.
@@ -712,15 +719,11 @@ namespace {
 // The band kernels' work groups are 8x8 pixels (render_band.cl sums a group's rays per row in local memory).
 constexpr size_t kGroupRows = 8;
 
-// Waits for both queues however the function that declares it leaves (a failed check throws): declared
-// after the host memory the queues read into, it runs before that memory goes.
-// Every queue of a band drained however it leaves (a throw included): nothing may still write its buffers.
+// Every queue of a band drained however the function that declares it leaves (a failed check throws):
+// declared after the host memory the queues read into, it runs before that memory goes.
 struct FinishQueues {
-  std::array<cl_command_queue, 5> queues;
-  ~FinishQueues() {
-    for (cl_command_queue q : queues)
-      if (q) clFinish(q);
-  }
+  BandQueues queues;
+  ~FinishQueues() { finish_all(queues); }
 };
 
 }  // namespace
@@ -740,12 +743,10 @@ namespace {
 
 // On a throw, every queue drained before the host memory its commands use goes: declared after that memory.
 struct DrainOnThrow {
-  std::array<cl_command_queue, 5> queues;
+  BandQueues queues;
   int exceptions = std::uncaught_exceptions();
   ~DrainOnThrow() {
-    if (std::uncaught_exceptions() <= exceptions) return;
-    for (cl_command_queue q : queues)
-      if (q) clFinish(q);
+    if (std::uncaught_exceptions() > exceptions) finish_all(queues);
   }
 };
 
@@ -938,8 +939,7 @@ std::unique_ptr<OpenCLTracer::EnqueuedBand> OpenCLTracer::enqueue_band(const cor
                   b->kernels_done.out());
   }
   if (!b->kernels_done.get()) {
-    check(clRetainEvent(b->band_done.get()), "clRetainEvent");
-    *b->kernels_done.out() = b->band_done.get();
+    b->kernels_done.share(b->band_done);
   }
   // Both kernels are on the device before any read is enqueued: a driver that copies into pageable
   // memory at enqueue time then still overlaps the aux read with the band's kernel.
@@ -963,8 +963,7 @@ std::unique_ptr<OpenCLTracer::EnqueuedBand> OpenCLTracer::enqueue_band(const cor
     check(clEnqueueReadBuffer(m.read_queue, band_mem, CL_FALSE, 0, band_bytes, band_destination, 0, nullptr,
                               b->band_read.out()),
           "reading the band");
-    check(clRetainEvent(b->band_read.get()), "clRetainEvent");
-    *b->last.out() = b->band_read.get();
+    b->last.share(b->band_read);
     check(clFlush(m.read_queue), "clFlush(read)");
   } else {
     check(clEnqueueReadBuffer(m.queue, band_mem, CL_FALSE, 0, band_bytes, band_destination, 0, nullptr, b->band_read.out()),
@@ -1207,8 +1206,7 @@ void OpenCLTracer::enqueue_aux_rows(const KCamera& camera, size_t first_row, siz
   } else {
     // A narrower band keeps the full records (the target converts them row by row): the read waits on
     // the aux kernel itself.
-    check(clRetainEvent(m.aux_kernel_done.get()), "clRetainEvent");
-    *m.aux_packed.out() = m.aux_kernel_done.get();
+    m.aux_packed.share(m.aux_kernel_done);
   }
 }
 
