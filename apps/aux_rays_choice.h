@@ -6,15 +6,19 @@
 #include <vector>
 
 #include "cohort/core/frame_defaults.h"
+#include "cohort/tracers/tracer_registry.h"
 
 namespace cohort::app {
 
-// `--aux-rays auto` with Open Image Denoise (`--denoise oidn|oidn-cuda`): centre rays, whatever the tracers.
-// Their planes are noise-free, so OIDN takes them as clean guides (cleanAux); on the test map's scenario at
-// 320x180 (Embree, 64-spp references) that gave mean FLIP 0.086 against 0.091 from first hits and 0.095
-// with no guides (docs/denoising.md). The extra ray is small beside OIDN's own milliseconds.
-inline bool oidn_wants_centre_rays(const std::string& aux_rays, const std::string& denoise) {
-  return aux_rays == "auto" && (denoise == "oidn" || denoise == "oidn-cuda");
+// KFrameParams.aux_outputs for `--aux-rays` (`cohort render` and `cohort play`). `auto` with Open Image Denoise
+// (`--denoise oidn|oidn-cuda`): centre rays, whatever the tracers. Their planes are noise-free, so OIDN takes
+// them as clean guides (cleanAux); on the test map's scenario at 320x180 (Embree, 64-spp references) that
+// gave mean FLIP 0.086 against 0.091 from first hits and 0.095 with no guides (docs/denoising.md). The extra
+// ray is small beside OIDN's own milliseconds. Otherwise `auto` is tracers::auto_aux_rays's pick.
+inline kuint resolve_aux_rays(const std::string& aux_rays, const std::string& denoise,
+                              const std::vector<tracers::TracerSpec>& tracers) {
+  if (aux_rays == "auto" && (denoise == "oidn" || denoise == "oidn-cuda")) return K_AUX_CENTRE_RAY;
+  return core::aux_rays_mode(aux_rays == "auto" ? tracers::auto_aux_rays(tracers) : aux_rays);
 }
 
 inline std::vector<std::string> aux_rays_choices() {

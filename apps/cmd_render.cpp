@@ -204,9 +204,7 @@ int run_render(const RenderArgs& a) {
   core::FrameBuffer denoised;
   const bool atrous = a.denoise == "atrous";
   // KFrameParams.aux_outputs of frames with planes
-  const kuint aux_mode = oidn_wants_centre_rays(a.aux_rays, a.denoise)
-                             ? K_AUX_CENTRE_RAY
-                             : core::aux_rays_mode(a.aux_rays == "auto" ? tracers::auto_aux_rays(specs) : a.aux_rays);
+  const kuint aux_mode = resolve_aux_rays(a.aux_rays, a.denoise, specs);
   // Reprojection and the a-trous filter run together, on the host or on a GPU (core/frame_post.h).
   std::unique_ptr<core::FramePost> post;
   if (reproject || atrous) {

@@ -154,9 +154,7 @@ PlaySession::PlaySession(const SessionOptions& options) {
   s.pipeline = std::make_unique<core::FramePipeline>(*s.renderer);
   s.post_place = tracers::auto_frame_post_place(started);
   core::FramePostOptions post_options;
-  s.aux_mode = oidn_wants_centre_rays(options.aux_rays, options.denoise)
-                   ? K_AUX_CENTRE_RAY
-                   : core::aux_rays_mode(options.aux_rays == "auto" ? tracers::auto_aux_rays(started) : options.aux_rays);
+  s.aux_mode = resolve_aux_rays(options.aux_rays, options.denoise, started);
   const bool oidn = options.denoise == "oidn" || options.denoise == "oidn-cuda";
   if (options.denoise != "auto" && options.denoise != "atrous" && options.denoise != "none" && !oidn)
     throw std::invalid_argument("--denoise '" + options.denoise + "': choose auto, atrous, none, oidn or oidn-cuda");
