@@ -438,7 +438,7 @@ void add_play_command(CLI::App& app, int& exit_code) {
                   "the real-time a-trous filter after the reprojection: atrous, none, or auto (atrous where the "
                   "reprojection runs on a CUDA GPU, about 1-3 ms a frame; none on the host's threads, where it "
                   "would set the frame rate); or Open Image Denoise after the accumulation: oidn (CPU) or oidn-cuda "
-                  "(an NVIDIA GPU; at 1280x720 on an H100 about 4-5 ms a frame for the colour alone, more with the guides; the lowest FLIP per frame measured, with "
+                  "(an NVIDIA GPU; at 1280x720 on an H100 about 5-7 ms a frame with its guides; the lowest FLIP per frame measured, with "
                   "--convergence none: docs/denoising.md)")
       ->capture_default_str()
       ->check(CLI::IsMember({"auto", "atrous", "none", "oidn", "oidn-cuda"}));

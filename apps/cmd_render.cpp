@@ -557,9 +557,9 @@ void add_render_command(CLI::App& app, int& exit_code) {
   cmd->add_option("--denoise", a->denoise,
                   "denoise the shown frame: none, atrous (the real-time edge-aware a-trous filter of the portable "
                   "kernel, every frame), oidn (Intel Open Image Denoise on the CPU) or oidn-cuda (on an NVIDIA GPU: "
-                  "4-6 ms a 1280x720 frame on an H100 for the colour alone, the lowest FLIP measured there with "
-                  "--no-convergence); OIDN takes the albedo and normal planes as guides (their packing and copies "
-                  "add to that); tools/fetch_oidn.sh installs the library")
+                  "5-7 ms a 1280x720 frame on an H100 with its guides, the lowest FLIP measured there with "
+                  "--no-convergence); OIDN takes the albedo and normal planes as guides (clean ones from centre "
+                  "rays, --aux-rays auto); tools/fetch_oidn.sh installs the library")
       ->capture_default_str()
       ->check(CLI::IsMember({"none", "atrous", "oidn", "oidn-cuda"}));
   cmd->add_option("--atrous-passes", a->atrous_passes,
@@ -642,7 +642,7 @@ void add_render_command(CLI::App& app, int& exit_code) {
                "like any other (by default they stay on the GPUs: device to device, or over NVLink from a peer)");
   cmd->add_option("--denoise-quality", a->denoise_quality,
                   "Open Image Denoise's filter quality: high, balanced or fast (on the CPU several times quicker; "
-                  "on an H100 at 720p 4.1 ms fast against 4.7 high, where copies and packing take half the time)")
+                  "on an H100 at 720p, colour alone, 4.1 ms fast against 4.7 high, where copies and packing take half the time)")
       ->capture_default_str()
       ->check(CLI::IsMember({"high", "balanced", "fast"}));
   cmd->add_option("--convergence", a->convergence,
