@@ -46,6 +46,8 @@ struct Rendered {
   // queues on.
   size_t back_to_back = 0;
   bool transfer_queues = true;
+  // Bands whose colour came through page-locked staging (OpenCLTracer::bands_read_through_staging).
+  size_t staged_reads = 0;
 };
 
 #ifdef COHORT_HAVE_OPENCL
@@ -57,6 +59,7 @@ void count_ahead(const std::vector<core::Tracer*>& tracers, Rendered& out) {
       out.finished_ahead += opencl->bands_finished_ahead();
       out.dropped_ahead += opencl->bands_dropped_ahead();
       out.back_to_back += opencl->bands_back_to_back();
+      out.staged_reads += opencl->bands_read_through_staging();
       out.transfer_queues = out.transfer_queues && opencl->transfer_queues();
     }
 }
@@ -405,19 +408,25 @@ TEST(FramesInFlightAgreement, ShutdownDuringAStalledOpenCLBandDrainsTheBandEnque
 
 #ifdef COHORT_HAVE_OPENCL
 // The bands back to back on the device (uploads on the upload queue, reads on the read queue behind the
-// band's last kernel, the edges' buffers in two slots) against everything on the compute queue: the same
-// bits, frame after frame, with commits every frame (the walker posed and moved: skins, instances, the TLAS),
-// an OpenCL band that starts below Embree's, the float band and the packed one (RGB9E5, its packing kernel the
-// band's last), the megakernel and the wavefront.
+// band's last kernel, the edges' buffers in two slots; the colour read into page-locked staging or straight
+// into the target) against everything on the compute queue: the same bits, frame after frame, with commits
+// every frame (the walker posed and moved: skins, instances, the TLAS), an OpenCL band that starts below
+// Embree's, the float band and the packed one (RGB9E5, its packing kernel the band's last), the megakernel
+// and the wavefront.
 TEST(FramesInFlightAgreement, OpenCLBandsBackToBackOnTheDeviceAreTheBandsRenderedWithEverythingOnOneQueue) {
   if (!tracer_runs_here("embree") || !tracer_runs_here("opencl")) GTEST_SKIP() << "needs the Embree and OpenCL tracers";
   struct Case {
     tracers::OpenCLTracer::Options::Wavefront wavefront;
     core::BandFormat format;
+    bool pinned_reads;
     const char* label;
   };
-  for (const Case& c : {Case{tracers::OpenCLTracer::Options::Wavefront::never, core::BandFormat::rgba32f, "megakernel, floats"},
-                        Case{tracers::OpenCLTracer::Options::Wavefront::always, core::BandFormat::rgb9e5, "wavefront, RGB9E5"}}) {
+  for (const Case& c : {Case{tracers::OpenCLTracer::Options::Wavefront::never, core::BandFormat::rgba32f, true,
+                             "megakernel, floats, through staging"},
+                        Case{tracers::OpenCLTracer::Options::Wavefront::always, core::BandFormat::rgb9e5, true,
+                             "wavefront, RGB9E5, through staging"},
+                        Case{tracers::OpenCLTracer::Options::Wavefront::always, core::BandFormat::rgb9e5, false,
+                             "wavefront, RGB9E5, straight into the target"}}) {
     auto extras_with = [&](bool transfer_queue) {
       Extras e;
       e.move_walker = true;
@@ -426,6 +435,7 @@ TEST(FramesInFlightAgreement, OpenCLBandsBackToBackOnTheDeviceAreTheBandsRendere
         if (name != "opencl") return make_test_tracer(name);
         tracers::OpenCLTracer::Options o = opencl_options();
         o.wavefront = c.wavefront;
+        o.pinned_band_reads = c.pinned_reads;
         o.transfer_queue = transfer_queue ? tracers::OpenCLTracer::Options::TransferQueue::always
                                           : tracers::OpenCLTracer::Options::TransferQueue::never;
         return std::make_unique<tracers::OpenCLTracer>(o);
@@ -441,6 +451,10 @@ TEST(FramesInFlightAgreement, OpenCLBandsBackToBackOnTheDeviceAreTheBandsRendere
     EXPECT_EQ(on.back_to_back, on.enqueued_ahead) << c.label;
     EXPECT_EQ(off.back_to_back, 0u) << c.label;
     EXPECT_GE(off.finished_ahead, 2u) << c.label << ": without the transfer queues bands still go ahead";
+    // Every band of the run (one a frame) through staging, or none: without the transfer queues there is no
+    // second slot to keep the next band's read out of the staging being copied.
+    EXPECT_EQ(on.staged_reads, c.pinned_reads ? size_t(kFrames) : 0u) << c.label;
+    EXPECT_EQ(off.staged_reads, 0u) << c.label;
     ASSERT_EQ(on.stats.size(), size_t(kFrames));
     for (int f = 0; f < kFrames; ++f)
       EXPECT_GT(on.stats[f].tracers[1].row_begin, 0) << c.label << " frame " << f << ": OpenCL's band should start below Embree's";

@@ -263,6 +263,9 @@ struct OpenCLTracer::EnqueuedBand {
   KCamera camera{};
   std::vector<float> band;  // a band narrower than the target, read before it is stored row by row
   std::vector<cl_uint> row_rays;
+  // Options::pinned_band_reads: where the band's colour was read to, copied into its target rows once read.
+  const void* staged = nullptr;
+  size_t staged_bytes = 0;
   size_t rows = 0;
   bool straight = false, write_aux = false, aux_from_paths = false;
   bool whole_band = false;  // its rows end where the frame's do (row_work is reported then)
@@ -366,7 +369,14 @@ struct OpenCLTracer::Impl {
     cl_mem params = nullptr, camera = nullptr, output = nullptr, row_rays = nullptr, packed = nullptr;
     size_t output_bytes = 0, row_rays_rows = 0, packed_bytes = 0;
   } spare;
+  // Options::pinned_band_reads (with `transfer`): the band's colour read into band_staging[band_slot], the
+  // slot's own, so a band's read never lands where the band before's copy out of it may still run.
+  bool pinned_reads = false;
+  PinnedStaging band_staging[2];
+  int band_slot = 0;
+  std::atomic<size_t> staged_reads{0};
   void take_other_slot() {
+    band_slot ^= 1;
     std::swap(params, spare.params);
     std::swap(camera, spare.camera);
     std::swap(output, spare.output);
@@ -508,6 +518,7 @@ struct OpenCLTracer::Impl {
     ahead.reset();
     wavefront.reset();
     aux_staging.reset();
+    for (PinnedStaging& staging : band_staging) staging.reset();
     for (cl_mem m : {params, camera, previous_camera, output, row_rays, aux, packed, packed_aux, first_hits, spare.params,
                      spare.camera, spare.output, spare.row_rays, spare.packed})
       if (m) clReleaseMemObject(m);
@@ -590,6 +601,7 @@ OpenCLTracer::OpenCLTracer(const Options& options) : impl_(std::make_unique<Impl
   impl_->device = dev.device;
   impl_->transfer = options.enqueue_ahead && (options.transfer_queue == Options::TransferQueue::always ||
                                               (options.transfer_queue == Options::TransferQueue::on_gpus && impl_->gpu));
+  impl_->pinned_reads = impl_->transfer && options.pinned_band_reads;
   if (impl_->transfer) {
 #if defined(__GNUC__)
 #pragma GCC diagnostic push
@@ -956,6 +968,14 @@ std::unique_ptr<OpenCLTracer::EnqueuedBand> OpenCLTracer::enqueue_band(const cor
     // last: its read's end is the band's (`last`), so a read held back shows in its transfer time. (On PoCL
     // the second of two reads started only after the next band's kernels, 50 ms late, where they were the
     // other way round.)
+    if (m.pinned_reads && straight) {
+      // Staging as large as the whole target, so that it is mapped once (the map waits for the upload queue).
+      const size_t most = std::max(band_bytes, size_t(target.height()) * target.row_bytes());
+      band_destination = m.band_staging[m.band_slot].reserve(m.context, m.upload_queue, most,
+                                                            "allocating page-locked band memory");
+      b->staged = band_destination;
+      b->staged_bytes = band_bytes;
+    }
     const cl_event kernels_done = b->kernels_done.get();
     check(clEnqueueReadBuffer(m.read_queue, m.row_rays, CL_FALSE, 0, rows * sizeof(cl_uint), b->row_rays.data(), 1,
                               &kernels_done, nullptr),
@@ -1031,6 +1051,10 @@ core::BandResult OpenCLTracer::finish_band(EnqueuedBand& b) {
   check(clWaitForEvents(1, &last), "waiting for the band");
   const KFrameParams& params = b.params;
   const size_t width = b.camera.width;
+  if (b.staged) {
+    std::memcpy(b.target->row(static_cast<int>(params.row_begin)), b.staged, b.staged_bytes);
+    ++m.staged_reads;
+  }
   for (size_t r = 0; r < b.rows && !b.straight; ++r)
     b.target->store(static_cast<int>(params.row_begin + r), 0, b.band.data() + r * width * 4, width, params.frame_index);
   // Device time from the first kernel (the aux one when it ran first, as the CUDA tracer times it) to the
@@ -1066,6 +1090,7 @@ size_t OpenCLTracer::bands_finished_ahead() const { return impl_->finished_ahead
 size_t OpenCLTracer::bands_dropped_ahead() const { return impl_->dropped_ahead.load(); }
 size_t OpenCLTracer::bands_back_to_back() const { return impl_->back_to_back.load(); }
 bool OpenCLTracer::transfer_queues() const { return impl_->transfer; }
+size_t OpenCLTracer::bands_read_through_staging() const { return impl_->staged_reads.load(); }
 
 core::BandResult OpenCLTracer::render_first_hits_in_pieces(const core::BandJob& job, core::BandBuffer& target,
                                                            const KFrameParams& params, const KCamera& camera,

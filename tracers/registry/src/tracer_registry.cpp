@@ -189,6 +189,7 @@ std::unique_ptr<core::Tracer> make_tracer(const TracerSpec& spec) {
     if (const char* transfer = std::getenv("COHORT_OPENCL_TRANSFER_QUEUE"); transfer && *transfer)
       options.transfer_queue = env_switch("COHORT_OPENCL_TRANSFER_QUEUE", true) ? OpenCLTracer::Options::TransferQueue::always
                                                                               : OpenCLTracer::Options::TransferQueue::never;
+    options.pinned_band_reads = env_switch("COHORT_OPENCL_PINNED_READS", options.pinned_band_reads);
     options.walk_registers = env_registers("COHORT_OPENCL_WALK_REGISTERS", options.walk_registers);
     options.shade_registers = env_registers("COHORT_OPENCL_SHADE_REGISTERS", options.shade_registers);
     return std::make_unique<OpenCLTracer>(options);
