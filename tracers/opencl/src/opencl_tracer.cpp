@@ -266,6 +266,7 @@ struct OpenCLTracer::EnqueuedBand {
   // Options::pinned_band_reads: where the band's colour was read to, copied into its target rows once read.
   const void* staged = nullptr;
   size_t staged_bytes = 0;
+  const void* staged_row_rays = nullptr;
   size_t rows = 0;
   bool straight = false, write_aux = false, aux_from_paths = false;
   bool whole_band = false;  // its rows end where the frame's do (row_work is reported then)
@@ -968,16 +969,21 @@ std::unique_ptr<OpenCLTracer::EnqueuedBand> OpenCLTracer::enqueue_band(const cor
     // last: its read's end is the band's (`last`), so a read held back shows in its transfer time. (On PoCL
     // the second of two reads started only after the next band's kernels, 50 ms late, where they were the
     // other way round.)
+    void* row_rays_destination = b->row_rays.data();
     if (m.pinned_reads && straight) {
-      // Staging as large as the whole target, so that it is mapped once (the map waits for the upload queue).
+      // The band, then its row counts, in the slot's staging; as large as the whole target's, so that it is
+      // mapped once (the map waits for the upload queue).
       const size_t most = std::max(band_bytes, size_t(target.height()) * target.row_bytes());
-      band_destination = m.band_staging[m.band_slot].reserve(m.context, m.upload_queue, most,
-                                                            "allocating page-locked band memory");
-      b->staged = band_destination;
+      char* staging = static_cast<char*>(m.band_staging[m.band_slot].reserve(
+          m.context, m.upload_queue, most + size_t(target.height()) * sizeof(cl_uint), "allocating page-locked band memory"));
+      band_destination = staging;
+      row_rays_destination = staging + most;
+      b->staged = staging;
       b->staged_bytes = band_bytes;
+      b->staged_row_rays = row_rays_destination;
     }
     const cl_event kernels_done = b->kernels_done.get();
-    check(clEnqueueReadBuffer(m.read_queue, m.row_rays, CL_FALSE, 0, rows * sizeof(cl_uint), b->row_rays.data(), 1,
+    check(clEnqueueReadBuffer(m.read_queue, m.row_rays, CL_FALSE, 0, rows * sizeof(cl_uint), row_rays_destination, 1,
                               &kernels_done, nullptr),
           "reading the row ray counts");
     check(clEnqueueReadBuffer(m.read_queue, band_mem, CL_FALSE, 0, band_bytes, band_destination, 0, nullptr,
@@ -1053,6 +1059,7 @@ core::BandResult OpenCLTracer::finish_band(EnqueuedBand& b) {
   const size_t width = b.camera.width;
   if (b.staged) {
     std::memcpy(b.target->row(static_cast<int>(params.row_begin)), b.staged, b.staged_bytes);
+    std::memcpy(b.row_rays.data(), b.staged_row_rays, b.rows * sizeof(cl_uint));
     ++m.staged_reads;
   }
   for (size_t r = 0; r < b.rows && !b.straight; ++r)

@@ -66,8 +66,8 @@ class OpenCLTracer : public TracerBase {
     // COHORT_OPENCL_TRANSFER_QUEUE (the registry): 1 always, 0 never.
     enum class TransferQueue { on_gpus, always, never };
     TransferQueue transfer_queue = TransferQueue::on_gpus;
-    // With the transfer queues, a band's colour is read by DMA into page-locked staging (one per slot) and
-    // copied into the target's rows on the host once read, instead of read straight into the target's
+    // With the transfer queues, a band's colour and row counts are read by DMA into page-locked staging (one
+    // per slot) and copied into the target's rows on the host once read, instead of read straight into the target's
     // pageable rows, which NVIDIA's OpenCL copies through staging of its own at a few GB/s (0.6 ms from the
     // last kernel to the read's end for a 360-row 720p band in the design card's mix on nvidia-h100-x2).
     // COHORT_OPENCL_PINNED_READS=0: straight into the target.
