@@ -20,7 +20,7 @@ namespace {
 
 // Closest hits of the tile's n camera rays (all from org), 8 to a packet, with a coherent context.
 void trace_camera_packets(embree_kernel::TraceCtx& ctx, KVec3 org, int n, Arena& a) {
-  embree_kernel::FilterContext fc = embree_kernel::filter_context(&ctx.scene, K_RAY_PRIMARY, 0, true);
+  embree_kernel::FilterContext fc = embree_kernel::filter_context(&ctx.scene, false, true);
   for (int first = 0; first < n; first += kPacketSize) {
     RTCRayHit8& rh = a.packets[first / kPacketSize];
     alignas(32) int valid[kPacketSize];  // Embree loads the mask as one vector: unaligned, it faults on AVX-512 CPUs

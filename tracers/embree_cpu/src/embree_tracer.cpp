@@ -35,13 +35,15 @@ void filter_hit(const RTCFilterFunctionNArguments* args) {
     if (args->valid[i] == 0) continue;
     kuint instance = args->context->instID[0];
     const KInstance& inst = scene->instances[instance];
-    if ((inst.mask & fc->ray_mask) == 0u) {
+    const kuint ray_mask = RTCRayN_mask(args->ray, args->N, i);
+    if ((inst.mask & ray_mask) == 0u) {
       args->valid[i] = 0;
       continue;
     }
     kuint triangle = scene->blases[inst.blas].tri_offset + RTCHitN_primID(args->hit, args->N, i);
     float u = RTCHitN_u(args->hit, args->N, i), v = RTCHitN_v(args->hit, args->N, i);
-    if (k_hit_transmittance(scene, instance, triangle, u, v, fc->shadow_ray) > 0.0f) args->valid[i] = 0;
+    const int ray_kind = fc->occlusion ? k_shadow_ray_kind(ray_mask) : 0;
+    if (k_hit_transmittance(scene, instance, triangle, u, v, ray_kind) > 0.0f) args->valid[i] = 0;
   }
 }
 
