@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <atomic>
 #include <chrono>
+#include <cstdlib>
+#include <cstring>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -71,11 +73,24 @@ void render_tile_x86_64_v3(const Frame& frame, const Tile& tile, Arena& arena, e
                            uint64_t row_rays[kTileHeight]) {
   render_tile(frame, tile, arena, log, row_rays);
 }
+void render_wave_tile_x86_64_v3(const Frame& frame, const Tile& tile, Arena& arena, embree_kernel::RayLog* log,
+                                uint64_t row_rays[kTileHeight]) {
+  render_wave_tile(frame, tile, arena, log, row_rays);
+}
 #endif
 
 }  // namespace embree_tiles
 
 namespace {
+
+// COHORT_EMBREE_WAVEFRONT: 1 (the default) renders tiles as wavefronts, 0 path by path; anything else is
+// named in the error.
+bool wavefront_from_environment() {
+  const char* v = std::getenv("COHORT_EMBREE_WAVEFRONT");
+  if (!v || std::strcmp(v, "1") == 0) return true;
+  if (std::strcmp(v, "0") == 0) return false;
+  throw std::invalid_argument(std::string("EmbreeTracer: COHORT_EMBREE_WAVEFRONT='") + v + "' (expected 0 or 1)");
+}
 
 void check_device(RTCDevice device, const char* what) {
   RTCError code = rtcGetDeviceError(device);
@@ -96,13 +111,16 @@ struct EmbreeTracer::Impl {
   std::unique_ptr<tbb::global_control> thread_limit;
   uint64_t rays_traced = 0;
   bool x86_64_v3 = embree_tiles::has_x86_64_v3();
+  bool wavefront = wavefront_from_environment();
 
   void render_tile(const embree_tiles::Frame& frame, const embree_tiles::Tile& tile, embree_tiles::Arena& arena,
                    embree_kernel::RayLog* log, uint64_t* row_rays) const {
-    if (x86_64_v3)
-      embree_tiles::render_tile_x86_64_v3(frame, tile, arena, log, row_rays);
+    namespace et = embree_tiles;
+    // The BVH heat map traces Cohort's own BVH per pixel (embree_bvh_view.cpp): no rays for a wavefront.
+    if (wavefront && frame.params.mode != K_MODE_BVH)
+      (x86_64_v3 ? et::render_wave_tile_x86_64_v3 : et::render_wave_tile)(frame, tile, arena, log, row_rays);
     else
-      embree_tiles::render_tile(frame, tile, arena, log, row_rays);
+      (x86_64_v3 ? et::render_tile_x86_64_v3 : et::render_tile)(frame, tile, arena, log, row_rays);
   }
   // Each thread's tile buffers, kept from band to band: rendering allocates nothing per tile or ray.
   tbb::enumerable_thread_specific<embree_tiles::Arena> arenas;
@@ -235,6 +253,7 @@ embree_tiles::Frame make_frame(const KFrameParams& params, const core::BandJob& 
   frame.write_aux = target && params.aux_outputs != 0u && target->has_aux();
   frame.base = embree_kernel::TraceCtx{scene, top, 0, nullptr, 0, v3s(0.0f), nullptr};
   frame.target = target;
+  frame.shadow_slots = k_shadow_queue_slots(&params, scene.light_count, scene.emissive_count);
   return frame;
 }
 
@@ -289,6 +308,10 @@ core::BandResult EmbreeTracer::render_band(const core::BandJob& job, core::BandB
   }
   return result;
 }
+
+void EmbreeTracer::set_wavefront(bool on) { impl_->wavefront = on; }
+
+bool EmbreeTracer::wavefront() const { return impl_->wavefront; }
 
 bool EmbreeTracer::prefer_x86_64_v3(bool prefer) {
   impl_->x86_64_v3 = prefer && embree_tiles::has_x86_64_v3();
