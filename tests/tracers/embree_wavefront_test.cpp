@@ -88,11 +88,13 @@ struct Rendered {
 
 // The frame rendered band by band (cuts: the bands' first rows, then the height), with its aux planes when
 // params.aux_outputs asks for them.
-// x86_64_v3: the shading's x86-64-v3 build where this CPU has one, else the baseline build.
-Rendered render_bands(bool wavefront, bool x86_64_v3, const View& view, const KFrameParams& params,
+// x86_64_v3: the shading's x86-64-v3 build where this CPU has one, else the baseline build; packet_width: the
+// wavefront's rays per packet (0: path by path).
+Rendered render_bands(int packet_width, bool x86_64_v3, const View& view, const KFrameParams& params,
                       const std::vector<int>& cuts) {
   tracers::EmbreeTracer tracer;
-  tracer.set_wavefront(wavefront);
+  tracer.set_wavefront(packet_width > 0);
+  if (packet_width > 0) tracer.set_wave_packet_width(packet_width);
   tracer.prefer_x86_64_v3(x86_64_v3);
   tracer.apply(commit::CommitBuffer::full(view.scene, 1));
   Rendered out;
@@ -118,12 +120,11 @@ size_t differing_floats(core::BandBuffer& a, core::BandBuffer& b) {
   return n;
 }
 
-// The wavefront's frame against the path-by-path tiles' in one build of the shading: every float, aux texel
-// and row count the same.
-void expect_the_path_tiles_frame_in_build(bool x86_64_v3, const View& view, const KFrameParams& params,
-                                          const std::vector<int>& cuts) {
-  Rendered paths = render_bands(false, x86_64_v3, view, params, cuts);
-  Rendered wave = render_bands(true, x86_64_v3, view, params, cuts);
+// The wavefront's frame (packets of packet_width rays) against the path-by-path tiles' in one build of the
+// shading: every float, aux texel and row count the same.
+void expect_the_path_tiles_frame_in_build(bool x86_64_v3, int packet_width, Rendered& paths, const View& view,
+                                          const KFrameParams& params, const std::vector<int>& cuts) {
+  Rendered wave = render_bands(packet_width, x86_64_v3, view, params, cuts);
   double sum = 0.0;
   const float* f = static_cast<const float*>(wave.frame.data());
   for (size_t i = 0; i < wave.frame.bytes() / sizeof(float); ++i) {
@@ -142,12 +143,17 @@ void expect_the_path_tiles_frame_in_build(bool x86_64_v3, const View& view, cons
 }
 
 // The wavefront's frame against the path-by-path tiles': every float, aux texel and row count the same, in
-// both builds of the shading (x86-64-v3 contracts multiply-adds into FMAs: the same ones in both renderers).
+// both builds of the shading (x86-64-v3 contracts multiply-adds into FMAs: the same ones in both renderers)
+// and with packets of 8 and 16 rays.
 void expect_the_path_tiles_frame(const View& view, const KFrameParams& params, const std::vector<int>& cuts,
                                  const std::string& what) {
   for (const bool x86_64_v3 : {true, false}) {
-    SCOPED_TRACE(what + (x86_64_v3 ? ", x86-64-v3 build where the CPU has it" : ", baseline build"));
-    expect_the_path_tiles_frame_in_build(x86_64_v3, view, params, cuts);
+    Rendered paths = render_bands(0, x86_64_v3, view, params, cuts);
+    for (const int packet_width : {8, 16}) {
+      SCOPED_TRACE(what + (x86_64_v3 ? ", x86-64-v3 build where the CPU has it" : ", baseline build") +
+                   ", packets of " + std::to_string(packet_width));
+      expect_the_path_tiles_frame_in_build(x86_64_v3, packet_width, paths, view, params, cuts);
+    }
   }
 }
 
@@ -260,8 +266,16 @@ TEST(EmbreeWavefrontRayLog, RecordsTheSameRaysByClass) {
   EXPECT_EQ(sorted(wave.bounce), sorted(paths.bounce)) << "bounce rays";
 }
 
-// COHORT_EMBREE_WAVEFRONT: the wavefront unless it says 0; a value other than 0 or 1 is named.
+// COHORT_EMBREE_WAVEFRONT: the wavefront unless it says 0; a value other than 0 or 1 is named. Packets of 8
+// or 16 rays, nothing else.
 TEST(EmbreeWavefrontSwitch, TheEnvironmentSetsItAndABadValueIsNamed) {
+  {
+    tracers::EmbreeTracer tracer;
+    EXPECT_TRUE(tracer.wave_packet_width() == 8 || tracer.wave_packet_width() == 16);
+    EXPECT_THROW(tracer.set_wave_packet_width(4), std::invalid_argument);
+    tracer.set_wave_packet_width(8);
+    EXPECT_EQ(tracer.wave_packet_width(), 8);
+  }
   ::unsetenv("COHORT_EMBREE_WAVEFRONT");
   EXPECT_TRUE(tracers::EmbreeTracer().wavefront());
   ::setenv("COHORT_EMBREE_WAVEFRONT", "0", 1);

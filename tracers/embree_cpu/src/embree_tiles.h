@@ -40,6 +40,8 @@ struct Frame {
   // The wavefront's shadow-ray slots a vertex gets (k_shadow_queue_slots; 0: past K_SHADOW_QUEUE_MAX, each
   // vertex's shadow rays traced one by one as it shades).
   kuint shadow_slots;
+  // The wavefront's rays per packet: 16 where Embree traces 16-ray packets natively (AVX-512), else 8.
+  int packet_width;
 };
 
 struct Tile {

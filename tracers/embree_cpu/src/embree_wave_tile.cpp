@@ -30,10 +30,27 @@ namespace {
 static_assert(K_SHADOW_QUEUE_MAX <= 8u, "a shadow ray to trace is kept as pixel * 8 + slot");
 static_assert(kTilePixels * 8 <= 65536, "a shadow ray to trace is kept in 16 bits");
 
-constexpr int kWavePacket = 8;  // rays per rtcIntersect8 / rtcOccluded8 packet
+// rtcIntersect8/16, rtcOccluded8/16 by packet width.
+template <int W>
+struct Packets;
+template <>
+struct Packets<8> {
+  using Ray = RTCRay8;
+  using RayHit = RTCRayHit8;
+  static void intersect(const int* valid, RTCScene s, RTCIntersectContext* c, RayHit* r) { rtcIntersect8(valid, s, c, r); }
+  static void occluded(const int* valid, RTCScene s, RTCIntersectContext* c, Ray* r) { rtcOccluded8(valid, s, c, r); }
+};
+template <>
+struct Packets<16> {
+  using Ray = RTCRay16;
+  using RayHit = RTCRayHit16;
+  static void intersect(const int* valid, RTCScene s, RTCIntersectContext* c, RayHit* r) { rtcIntersect16(valid, s, c, r); }
+  static void occluded(const int* valid, RTCScene s, RTCIntersectContext* c, Ray* r) { rtcOccluded16(valid, s, c, r); }
+};
 
 // One lane of a packet: the ray from org along dir up to tmax, seeing the instances of mask.
-void fill_lane(RTCRay8& r, int k, KVec3 org, KVec3 dir, float tmax, kuint mask) {
+template <class Ray>
+void fill_lane(Ray& r, int k, KVec3 org, KVec3 dir, float tmax, kuint mask) {
   r.org_x[k] = org.x; r.org_y[k] = org.y; r.org_z[k] = org.z;
   r.dir_x[k] = dir.x; r.dir_y[k] = dir.y; r.dir_z[k] = dir.z;
   r.tnear[k] = 0.0f;
@@ -44,18 +61,39 @@ void fill_lane(RTCRay8& r, int k, KVec3 org, KVec3 dir, float tmax, kuint mask) 
   r.flags[k] = 0u;
 }
 
-// The tile's n paths a.wave.pixels[0..n) walk their closest-hit rays (ray(j, &org, &dir) for the j-th; tmax infinite,
-// camera and bounce rays' mask) in packets; each hit into a.wave.hits[pixel] (instance K_NONE: a miss).
-// coherent: camera rays (one origin, neighbouring directions). Each ray counts in its pixel's row.
-template <class RayOf>
-void walk_closest(embree_kernel::TraceCtx& ctx, Arena& a, int n, bool coherent, embree_kernel::RayClass ray_class,
-                  int tile_width, uint64_t* row_rays, RayOf ray) {
+// A closest hit into the path's KHit (instance K_NONE: a miss), counted in its pixel's row and logged.
+void take_hit(embree_kernel::TraceCtx& ctx, Arena& a, int p, int tile_width, uint64_t* row_rays,
+              embree_kernel::RayClass ray_class, KVec3 org, KVec3 dir, unsigned geom, unsigned inst, unsigned prim,
+              float t, float u, float v) {
+  namespace ek = embree_kernel;
+  KHit& hit = a.wave.hits[p];
+  hit.cost = 0u;
+  hit.pad0 = hit.pad1 = 0u;
+  row_rays[p / tile_width] += 1u;
+  if (ctx.log) ek::log_ray(ctx.log, ray_class, org, dir, K_INF, K_RAY_PRIMARY);
+  if (geom == RTC_INVALID_GEOMETRY_ID) {
+    hit.instance = K_NONE;
+    return;
+  }
+  hit.t = t;
+  hit.u = u;
+  hit.v = v;
+  hit.instance = inst;
+  hit.triangle = ek::scene_triangle(ctx.scene, inst, prim);
+}
+
+// The tile's n paths a.wave.pixels[0..n) walk their closest-hit rays (ray(j, &org, &dir) for the j-th; tmax
+// infinite, camera and bounce rays' mask) in packets of W; each hit into a.wave.hits[pixel] (take_hit).
+// coherent: camera rays (one origin, neighbouring directions).
+template <int W, class RayOf>
+void walk_closest_packets(embree_kernel::TraceCtx& ctx, Arena& a, int n, bool coherent,
+                          embree_kernel::RayClass ray_class, int tile_width, uint64_t* row_rays, RayOf ray) {
   namespace ek = embree_kernel;
   ek::FilterContext fc = ek::filter_context(&ctx.scene, false, coherent);
-  for (int first = 0; first < n; first += kWavePacket) {
-    alignas(32) RTCRayHit8 rh;
-    alignas(32) int valid[kWavePacket];  // Embree loads the mask as one vector: unaligned, it faults on AVX-512 CPUs
-    for (int k = 0; k < kWavePacket; ++k) {
+  for (int first = 0; first < n; first += W) {
+    alignas(64) typename Packets<W>::RayHit rh;
+    alignas(64) int valid[W];  // Embree loads the mask as one vector: unaligned, it faults on AVX-512 CPUs
+    for (int k = 0; k < W; ++k) {
       const int j = first + k < n ? first + k : n - 1;  // unused lanes repeat the last ray, masked off
       valid[k] = first + k < n ? -1 : 0;
       KVec3 org, dir;
@@ -64,28 +102,54 @@ void walk_closest(embree_kernel::TraceCtx& ctx, Arena& a, int n, bool coherent, 
       rh.hit.geomID[k] = RTC_INVALID_GEOMETRY_ID;
       rh.hit.instID[0][k] = RTC_INVALID_GEOMETRY_ID;
     }
-    rtcIntersect8(valid, ctx.top, &fc.base, &rh);
-    for (int k = 0; k < kWavePacket && first + k < n; ++k) {
-      const int p = a.wave.pixels[first + k];
-      KHit& hit = a.wave.hits[p];
-      hit.cost = 0u;
-      hit.pad0 = hit.pad1 = 0u;
-      row_rays[p / tile_width] += 1u;
-      if (ctx.log)
-        ek::log_ray(ctx.log, ray_class, v3(rh.ray.org_x[k], rh.ray.org_y[k], rh.ray.org_z[k]),
-                    v3(rh.ray.dir_x[k], rh.ray.dir_y[k], rh.ray.dir_z[k]), K_INF, K_RAY_PRIMARY);
-      if (rh.hit.geomID[k] == RTC_INVALID_GEOMETRY_ID) {
-        hit.instance = K_NONE;
-        continue;
-      }
-      hit.t = rh.ray.tfar[k];
-      hit.u = rh.hit.u[k];
-      hit.v = rh.hit.v[k];
-      hit.instance = rh.hit.instID[0][k];
-      hit.triangle = ek::scene_triangle(ctx.scene, hit.instance, rh.hit.primID[k]);
-    }
+    Packets<W>::intersect(valid, ctx.top, &fc.base, &rh);
+    for (int k = 0; k < W && first + k < n; ++k)
+      take_hit(ctx, a, a.wave.pixels[first + k], tile_width, row_rays, ray_class,
+               v3(rh.ray.org_x[k], rh.ray.org_y[k], rh.ray.org_z[k]), v3(rh.ray.dir_x[k], rh.ray.dir_y[k], rh.ray.dir_z[k]),
+               rh.hit.geomID[k], rh.hit.instID[0][k], rh.hit.primID[k], rh.ray.tfar[k], rh.hit.u[k], rh.hit.v[k]);
   }
   ctx.rays += static_cast<uint64_t>(n);
+}
+
+template <class RayOf>
+void walk_closest(embree_kernel::TraceCtx& ctx, Arena& a, int n, bool coherent, embree_kernel::RayClass ray_class,
+                  int tile_width, uint64_t* row_rays, int packets, RayOf ray) {
+  if (packets == 16)
+    walk_closest_packets<16>(ctx, a, n, coherent, ray_class, tile_width, row_rays, ray);
+  else
+    walk_closest_packets<8>(ctx, a, n, coherent, ray_class, tile_width, row_rays, ray);
+}
+
+// A shadow ray's outcome: unblocked, its slot's bit in its pixel's visible bits; counted and logged.
+void take_shadow(embree_kernel::TraceCtx& ctx, Arena& a, int e, bool occluded, int tile_width, uint64_t* row_rays) {
+  namespace ek = embree_kernel;
+  const int p = e >> 3;
+  if (!occluded) a.wave.visible[p] |= 1u << (e & 7);
+  row_rays[p / tile_width] += 1u;
+  if (ctx.log) {
+    const KShadowRay& s = a.wave.shadow_rays[(e & 7) * kTilePixels + p];
+    ek::log_ray(ctx.log, ek::kShadowRay, s.org, s.dir, s.tmax, s.mask & ~K_SHADOW_RAY_EMISSIVE);
+  }
+}
+
+template <int W>
+void trace_shadow_packets(embree_kernel::TraceCtx& ctx, Arena& a, int rays, int tile_width, uint64_t* row_rays) {
+  namespace ek = embree_kernel;
+  Arena::Wave& wv = a.wave;
+  ek::FilterContext fc = ek::filter_context(&ctx.scene, true);
+  for (int first = 0; first < rays; first += W) {
+    alignas(64) typename Packets<W>::Ray r;
+    alignas(64) int valid[W];
+    for (int k = 0; k < W; ++k) {
+      const int e = wv.shadows[first + k < rays ? first + k : rays - 1];
+      valid[k] = first + k < rays ? -1 : 0;
+      const KShadowRay& s = wv.shadow_rays[(e & 7) * kTilePixels + (e >> 3)];
+      fill_lane(r, k, s.org, s.dir, s.tmax, s.mask & ~K_SHADOW_RAY_EMISSIVE);
+    }
+    Packets<W>::occluded(valid, ctx.top, &fc.base, &r);
+    for (int k = 0; k < W && first + k < rays; ++k)
+      take_shadow(ctx, a, wv.shadows[first + k], r.tfar[k] < 0.0f, tile_width, row_rays);  // Embree sets tfar to -inf on occlusion
+  }
 }
 
 // The shadow rays the shaded vertices of the traced pixels left in their slots, all traced together in
@@ -93,8 +157,7 @@ void walk_closest(embree_kernel::TraceCtx& ctx, Arena& a, int n, bool coherent, 
 // (k_wave_shadow_finish_pixel): k_wave_shadow_walk_pixel for the whole tile, its walks batched. A ray whose
 // tmax says it needs no walk (k_shadow_ray_visible) is visible untraced, as there.
 void walk_shadows(embree_kernel::TraceCtx& ctx, const KFrameParams* params, Arena& a, const int* traced, int n,
-                  kuint sample, int tile_width, uint64_t* row_rays) {
-  namespace ek = embree_kernel;
+                  kuint sample, int tile_width, uint64_t* row_rays, int packets) {
   Arena::Wave& wv = a.wave;
   int rays = 0;
   for (int j = 0; j < n; ++j) {
@@ -108,27 +171,10 @@ void walk_shadows(embree_kernel::TraceCtx& ctx, const KFrameParams* params, Aren
         wv.shadows[rays++] = static_cast<uint16_t>(p * 8 + static_cast<int>(k));
     }
   }
-  ek::FilterContext fc = ek::filter_context(&ctx.scene, true);
-  for (int first = 0; first < rays; first += kWavePacket) {
-    alignas(32) RTCRay8 r;
-    alignas(32) int valid[kWavePacket];
-    for (int k = 0; k < kWavePacket; ++k) {
-      const int e = wv.shadows[first + k < rays ? first + k : rays - 1];
-      valid[k] = first + k < rays ? -1 : 0;
-      const KShadowRay& s = wv.shadow_rays[(e & 7) * kTilePixels + (e >> 3)];
-      fill_lane(r, k, s.org, s.dir, s.tmax, s.mask & ~K_SHADOW_RAY_EMISSIVE);
-    }
-    rtcOccluded8(valid, ctx.top, &fc.base, &r);
-    for (int k = 0; k < kWavePacket && first + k < rays; ++k) {
-      const int e = wv.shadows[first + k], p = e >> 3;
-      if (!(r.tfar[k] < 0.0f)) wv.visible[p] |= 1u << (e & 7);  // Embree sets tfar to -inf on occlusion
-      row_rays[p / tile_width] += 1u;
-      if (ctx.log) {
-        const KShadowRay& s = wv.shadow_rays[(e & 7) * kTilePixels + p];
-        ek::log_ray(ctx.log, ek::kShadowRay, s.org, s.dir, s.tmax, s.mask & ~K_SHADOW_RAY_EMISSIVE);
-      }
-    }
-  }
+  if (packets == 16)
+    trace_shadow_packets<16>(ctx, a, rays, tile_width, row_rays);
+  else
+    trace_shadow_packets<8>(ctx, a, rays, tile_width, row_rays);
   ctx.rays += static_cast<uint64_t>(rays);
   for (int j = 0; j < n; ++j) {
     const int p = traced[j];
@@ -187,7 +233,7 @@ void COHORT_RENDER_WAVE_TILE(const Frame& frame, const Tile& tile, Arena& a, emb
                           wv.active, wv.vertices, camera_rays);
         row_rays[p / w] += ctx.rays - before;
       }
-      if (shadow_walk) walk_shadows(ctx, params, a, a.traced, traced, s, w, row_rays);
+      if (shadow_walk) walk_shadows(ctx, params, a, a.traced, traced, s, w, row_rays, frame.packet_width);
     };
 
     for (int j = 0; j < traced; ++j) {
@@ -198,7 +244,7 @@ void COHORT_RENDER_WAVE_TILE(const Frame& frame, const Tile& tile, Arena& a, emb
       wv.pixels[j] = p;
       if (s == 0u && record_first_hits) k_record_first_hit(&a.first_hits[p], K_NONE, 0u, 0u);
     }
-    walk_closest(ctx, a, traced, true, embree_kernel::kCameraRay, w, row_rays, [&](int j, KVec3* o, KVec3* d) {
+    walk_closest(ctx, a, traced, true, embree_kernel::kCameraRay, w, row_rays, frame.packet_width, [&](int j, KVec3* o, KVec3* d) {
       *o = org;
       *d = a.dirs[j];
     });
@@ -208,7 +254,7 @@ void COHORT_RENDER_WAVE_TILE(const Frame& frame, const Tile& tile, Arena& a, emb
       for (int j = 0; j < traced; ++j)
         if (wv.active[a.traced[j]] & K_WAVE_LIVE) wv.pixels[live++] = a.traced[j];
       if (live == 0) break;
-      walk_closest(ctx, a, live, false, embree_kernel::kBounceRay, w, row_rays, [&](int j, KVec3* o, KVec3* d) {
+      walk_closest(ctx, a, live, false, embree_kernel::kBounceRay, w, row_rays, frame.packet_width, [&](int j, KVec3* o, KVec3* d) {
         *o = wv.states[wv.pixels[j]].org;
         *d = wv.states[wv.pixels[j]].dir;
       });

@@ -55,6 +55,10 @@ class EmbreeTracer : public TracerBase {
   // default, unless COHORT_EMBREE_WAVEFRONT=0), or path by path, those rays one by one. Same image.
   void set_wavefront(bool on);
   bool wavefront() const;
+  // The wavefront's rays per packet, 8 or 16: by default 16 where Embree traces 16-ray packets natively
+  // (AVX-512), else 8. Same image either way.
+  void set_wave_packet_width(int rays);
+  int wave_packet_width() const;
   // Camera, bounce and shadow rays traced by render_band since construction.
   uint64_t rays_traced() const;
 
