@@ -338,7 +338,8 @@ EmbreeRaySet EmbreeTracer::record_rays(const core::BandJob& job) {
   if (!impl_->top) throw std::runtime_error("EmbreeTracer: record_rays before any commit was applied");
   const KFrameParams params = frame_params(job);
   const KSceneView scene = host_scene_view(params);
-  const embree_tiles::Frame frame = make_frame(params, job, scene, impl_->top, KAuxHistory{}, nullptr, impl_->packet_width);
+  const embree_tiles::Frame frame =
+      make_frame(params, job, scene, impl_->top, KAuxHistory{}, nullptr, impl_->packet_width);
   auto arena = std::make_unique<embree_tiles::Arena>();
   embree_kernel::RayLog log;
   log.camera_dir = v3s(0.0f);

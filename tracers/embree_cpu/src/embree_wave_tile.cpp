@@ -37,15 +37,23 @@ template <>
 struct Packets<8> {
   using Ray = RTCRay8;
   using RayHit = RTCRayHit8;
-  static void intersect(const int* valid, RTCScene s, RTCIntersectContext* c, RayHit* r) { rtcIntersect8(valid, s, c, r); }
-  static void occluded(const int* valid, RTCScene s, RTCIntersectContext* c, Ray* r) { rtcOccluded8(valid, s, c, r); }
+  static void intersect(const int* valid, RTCScene s, RTCIntersectContext* c, RayHit* r) {
+    rtcIntersect8(valid, s, c, r);
+  }
+  static void occluded(const int* valid, RTCScene s, RTCIntersectContext* c, Ray* r) {
+    rtcOccluded8(valid, s, c, r);
+  }
 };
 template <>
 struct Packets<16> {
   using Ray = RTCRay16;
   using RayHit = RTCRayHit16;
-  static void intersect(const int* valid, RTCScene s, RTCIntersectContext* c, RayHit* r) { rtcIntersect16(valid, s, c, r); }
-  static void occluded(const int* valid, RTCScene s, RTCIntersectContext* c, Ray* r) { rtcOccluded16(valid, s, c, r); }
+  static void intersect(const int* valid, RTCScene s, RTCIntersectContext* c, RayHit* r) {
+    rtcIntersect16(valid, s, c, r);
+  }
+  static void occluded(const int* valid, RTCScene s, RTCIntersectContext* c, Ray* r) {
+    rtcOccluded16(valid, s, c, r);
+  }
 };
 
 // One lane of a packet: the ray from org along dir up to tmax, seeing the instances of mask.
@@ -61,25 +69,27 @@ void fill_lane(Ray& r, int k, KVec3 org, KVec3 dir, float tmax, kuint mask) {
   r.flags[k] = 0u;
 }
 
-// A closest hit into the path's KHit (instance K_NONE: a miss), counted in its pixel's row and logged.
-void take_hit(embree_kernel::TraceCtx& ctx, Arena& a, int p, int tile_width, uint64_t* row_rays,
-              embree_kernel::RayClass ray_class, KVec3 org, KVec3 dir, unsigned geom, unsigned inst, unsigned prim,
-              float t, float u, float v) {
+// Lane k's closest hit into path p's KHit (instance K_NONE: a miss), counted in its pixel's row and logged.
+template <class RayHit>
+void take_hit(embree_kernel::TraceCtx& ctx, Arena& a, const RayHit& rh, int k, int p, int tile_width,
+              uint64_t* row_rays, embree_kernel::RayClass ray_class) {
   namespace ek = embree_kernel;
   KHit& hit = a.wave.hits[p];
   hit.cost = 0u;
   hit.pad0 = hit.pad1 = 0u;
   row_rays[p / tile_width] += 1u;
-  if (ctx.log) ek::log_ray(ctx.log, ray_class, org, dir, K_INF, K_RAY_PRIMARY);
-  if (geom == RTC_INVALID_GEOMETRY_ID) {
+  if (ctx.log)
+    ek::log_ray(ctx.log, ray_class, v3(rh.ray.org_x[k], rh.ray.org_y[k], rh.ray.org_z[k]),
+                v3(rh.ray.dir_x[k], rh.ray.dir_y[k], rh.ray.dir_z[k]), K_INF, K_RAY_PRIMARY);
+  if (rh.hit.geomID[k] == RTC_INVALID_GEOMETRY_ID) {
     hit.instance = K_NONE;
     return;
   }
-  hit.t = t;
-  hit.u = u;
-  hit.v = v;
-  hit.instance = inst;
-  hit.triangle = ek::scene_triangle(ctx.scene, inst, prim);
+  hit.t = rh.ray.tfar[k];
+  hit.u = rh.hit.u[k];
+  hit.v = rh.hit.v[k];
+  hit.instance = rh.hit.instID[0][k];
+  hit.triangle = ek::scene_triangle(ctx.scene, hit.instance, rh.hit.primID[k]);
 }
 
 // The tile's n paths a.wave.pixels[0..n) walk their closest-hit rays (ray(j, &org, &dir) for the j-th; tmax
@@ -104,9 +114,7 @@ void walk_closest_packets(embree_kernel::TraceCtx& ctx, Arena& a, int n, bool co
     }
     Packets<W>::intersect(valid, ctx.top, &fc.base, &rh);
     for (int k = 0; k < W && first + k < n; ++k)
-      take_hit(ctx, a, a.wave.pixels[first + k], tile_width, row_rays, ray_class,
-               v3(rh.ray.org_x[k], rh.ray.org_y[k], rh.ray.org_z[k]), v3(rh.ray.dir_x[k], rh.ray.dir_y[k], rh.ray.dir_z[k]),
-               rh.hit.geomID[k], rh.hit.instID[0][k], rh.hit.primID[k], rh.ray.tfar[k], rh.hit.u[k], rh.hit.v[k]);
+      take_hit(ctx, a, rh, k, a.wave.pixels[first + k], tile_width, row_rays, ray_class);
   }
   ctx.rays += static_cast<uint64_t>(n);
 }
@@ -132,6 +140,8 @@ void take_shadow(embree_kernel::TraceCtx& ctx, Arena& a, int e, bool occluded, i
   }
 }
 
+// The tile's shadow rays to trace (a.wave.shadows[0..rays)) in packets of W. Incoherent: the coherent flag
+// made rtcOccluded16 never finish (docs/embree-tracer.md).
 template <int W>
 void trace_shadow_packets(embree_kernel::TraceCtx& ctx, Arena& a, int rays, int tile_width, uint64_t* row_rays) {
   namespace ek = embree_kernel;
@@ -147,8 +157,8 @@ void trace_shadow_packets(embree_kernel::TraceCtx& ctx, Arena& a, int rays, int 
       fill_lane(r, k, s.org, s.dir, s.tmax, s.mask & ~K_SHADOW_RAY_EMISSIVE);
     }
     Packets<W>::occluded(valid, ctx.top, &fc.base, &r);
-    for (int k = 0; k < W && first + k < rays; ++k)
-      take_shadow(ctx, a, wv.shadows[first + k], r.tfar[k] < 0.0f, tile_width, row_rays);  // Embree sets tfar to -inf on occlusion
+    for (int k = 0; k < W && first + k < rays; ++k)  // Embree sets tfar to -inf on occlusion
+      take_shadow(ctx, a, wv.shadows[first + k], r.tfar[k] < 0.0f, tile_width, row_rays);
   }
 }
 
@@ -244,20 +254,22 @@ void COHORT_RENDER_WAVE_TILE(const Frame& frame, const Tile& tile, Arena& a, emb
       wv.pixels[j] = p;
       if (s == 0u && record_first_hits) k_record_first_hit(&a.first_hits[p], K_NONE, 0u, 0u);
     }
-    walk_closest(ctx, a, traced, true, embree_kernel::kCameraRay, w, row_rays, frame.packet_width, [&](int j, KVec3* o, KVec3* d) {
-      *o = org;
-      *d = a.dirs[j];
-    });
+    walk_closest(ctx, a, traced, true, embree_kernel::kCameraRay, w, row_rays, frame.packet_width,
+                 [&](int j, KVec3* o, KVec3* d) {
+                   *o = org;
+                   *d = a.dirs[j];
+                 });
     shade(1);
     for (;;) {
       int live = 0;
       for (int j = 0; j < traced; ++j)
         if (wv.active[a.traced[j]] & K_WAVE_LIVE) wv.pixels[live++] = a.traced[j];
       if (live == 0) break;
-      walk_closest(ctx, a, live, false, embree_kernel::kBounceRay, w, row_rays, frame.packet_width, [&](int j, KVec3* o, KVec3* d) {
-        *o = wv.states[wv.pixels[j]].org;
-        *d = wv.states[wv.pixels[j]].dir;
-      });
+      walk_closest(ctx, a, live, false, embree_kernel::kBounceRay, w, row_rays, frame.packet_width,
+                   [&](int j, KVec3* o, KVec3* d) {
+                     *o = wv.states[wv.pixels[j]].org;
+                     *d = wv.states[wv.pixels[j]].dir;
+                   });
       shade(0);
     }
   }
