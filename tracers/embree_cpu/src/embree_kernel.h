@@ -39,25 +39,25 @@ struct TraceCtx {
   RayLog* log;  // null unless recording
 };
 
-// Embree hands this back to the filter functions (the RTCIntersectContext must come first).
+// Embree hands this back to the filter functions (the RTCIntersectContext must come first). The filter
+// reads each ray's mask from its lane, so that rays of one packet or stream may differ in it (a tile's
+// shadow rays: from noSelfShadow surfaces or not).
 struct FilterContext {
   RTCIntersectContext base;
   const KSceneView* scene;
-  kuint ray_mask;
-  int shadow_ray;   // material.h's ray kind: 0 camera or bounce, 1 shadow, 2 shadow from a noSelfShadow surface
+  int occlusion;  // shadow rays: material.h's ray kind from each ray's mask (k_shadow_ray_kind); else 0
 };
 
 void filter_hit(const RTCFilterFunctionNArguments* args);
 
 // coherent: rays of one batch start close together and point alike (camera packets), so Embree may
 // trace them together.
-static inline FilterContext filter_context(const KSceneView* scene, kuint ray_mask, int shadow_ray, bool coherent = false) {
+static inline FilterContext filter_context(const KSceneView* scene, bool occlusion, bool coherent = false) {
   FilterContext fc;
   rtcInitIntersectContext(&fc.base);
   if (coherent) fc.base.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
   fc.scene = scene;
-  fc.ray_mask = ray_mask;
-  fc.shadow_ray = shadow_ray;
+  fc.occlusion = occlusion;
   return fc;
 }
 
@@ -102,7 +102,7 @@ static inline int k_trace_closest(KTraceCtx* ctx, KVec3 org, KVec3 dir, float tm
                         dir.z == ctx->log->camera_dir.z;
     ek::log_ray(ctx->log, camera ? ek::kCameraRay : ek::kBounceRay, org, dir, tmax, ray_mask);
   }
-  ek::FilterContext fc = ek::filter_context(&ctx->scene, ray_mask, 0);
+  ek::FilterContext fc = ek::filter_context(&ctx->scene, false);
   RTCRayHit rh;
   rh.ray = ek::make_ray(org, dir, tmax, ray_mask);
   rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
@@ -121,7 +121,7 @@ static inline int k_trace_occluded(KTraceCtx* ctx, KVec3 org, KVec3 dir, float t
   namespace ek = cohort::tracers::embree_kernel;
   ++ctx->rays;
   if (ctx->log) ek::log_ray(ctx->log, ek::kShadowRay, org, dir, tmax, ray_mask);
-  ek::FilterContext fc = ek::filter_context(&ctx->scene, ray_mask, k_shadow_ray_kind(ray_mask));
+  ek::FilterContext fc = ek::filter_context(&ctx->scene, true);
   RTCRay ray = ek::make_ray(org, dir, tmax, ray_mask);
   rtcOccluded1(ctx->top, &fc.base, &ray);
   return ray.tfar < 0.0f;  // Embree sets tfar to -inf on occlusion

@@ -97,11 +97,9 @@ uint64_t trace_stream(RTCScene top, embree_kernel::FilterContext& fc, const Embr
 uint64_t trace(RTCScene top, const KSceneView& scene, const std::vector<EmbreeRay>& rays, bool occlusion,
                EmbreeRayApi api, bool coherent) {
   if (rays.empty()) return 0;
-  // Rays of one class share a mask (K_RAY_PRIMARY or K_RAY_SHADOW); the filter context carries it.
-  const kuint mask = rays.front().mask;
   std::atomic<uint64_t> total{0};
   tbb::parallel_for(tbb::blocked_range<size_t>(0, rays.size(), 4 * kStream), [&](const tbb::blocked_range<size_t>& r) {
-    embree_kernel::FilterContext fc = embree_kernel::filter_context(&scene, mask, occlusion ? k_shadow_ray_kind(mask) : 0, coherent);
+    embree_kernel::FilterContext fc = embree_kernel::filter_context(&scene, occlusion, coherent);
     const EmbreeRay* first = rays.data() + r.begin();
     const size_t n = r.size();
     uint64_t count = 0;

@@ -1,7 +1,12 @@
-// The Embree tracer's unit of work: a tile of the band. Per sample the tile traces all its camera rays
-// ahead in coherent 8-ray packets, then runs the shared integrator (k_trace_path) per pixel from those
-// hits; shadow and bounce rays are traced one by one as the integrator asks for them. Everything a tile
-// needs lives in a per-thread Arena, so rendering allocates nothing per tile or ray.
+// The Embree tracer's unit of work: a tile of the band, rendered one of two ways. Per sample the tile
+// traces all its camera rays ahead in coherent 8-ray packets, then
+// - render_tile: runs the shared integrator (k_trace_path) per pixel from those hits; shadow and bounce
+//   rays are traced one by one as the integrator asks for them;
+// - render_wave_tile (the default): runs the tile as a wavefront of the GPU tracers' stages
+//   (kernel/wave_shade.h, wave_walk.h): every path's segment shaded, then all the tile's shadow rays
+//   traced together in packets, then the live paths' bounce rays in packets, until no path is live.
+// Both draw the same image. Everything a tile needs lives in a per-thread Arena, so rendering allocates
+// nothing per tile or ray.
 #pragma once
 
 #include <embree3/rtcore.h>
@@ -11,6 +16,8 @@
 #include "cohort/core/band_buffer.h"
 #include "cohort/kernel/rng.h"
 #include "cohort/kernel/aux_history.h"
+#include "cohort/kernel/path_state.h"
+#include "cohort/kernel/shadow_ray.h"
 #include "embree_kernel.h"
 
 namespace cohort::tracers::embree_tiles {
@@ -30,6 +37,11 @@ struct Frame {
   bool write_aux;
   embree_kernel::TraceCtx base;
   core::BandBuffer* target;  // null: render without storing (recording rays)
+  // The wavefront's shadow-ray slots a vertex gets (k_shadow_queue_slots; 0: past K_SHADOW_QUEUE_MAX, each
+  // vertex's shadow rays traced one by one as it shades).
+  kuint shadow_slots;
+  // The wavefront's rays per packet: 16 where Embree traces 16-ray packets natively (AVX-512), else 8.
+  int packet_width;
 };
 
 struct Tile {
@@ -47,6 +59,20 @@ struct Arena {
   float rgba[kTileWidth * 4];
   KAux aux[kTileWidth];
   KPathFirstHit first_hits[kTilePixels];  // K_AUX_PATH_FIRST_HIT: the first sample's first surfaces
+
+  // The wavefront's paths between their stages, as the GPU tracers keep them in device memory
+  // (kernel/path_state.h), indexed by the pixel's place in the tile.
+  struct Wave {
+    KPathState states[kTilePixels];
+    KHit hits[kTilePixels];        // each shaded path's walked ray's hit (instance K_NONE: a miss)
+    kuint active[kTilePixels];     // K_WAVE_LIVE, K_WAVE_SHADOWS_OUT
+    KVertexLight vertices[kTilePixels];
+    KShadowRay shadow_rays[K_SHADOW_QUEUE_MAX * kTilePixels];  // slot k of pixel p at [k * kTilePixels + p]
+    kuint visible[kTilePixels];    // per pixel, bit k: slot k's shadow ray is unblocked
+    float band[kTilePixels * 4];   // the pixels' sums of samples (k_wave_finish_sample), RGBA
+    int pixels[kTilePixels];       // the paths a stage traces rays for
+    uint16_t shadows[K_SHADOW_QUEUE_MAX * kTilePixels];  // the shadow rays to trace: pixel * 8 + slot
+  } wave;
 };
 
 // Renders the tile into frame.target and adds the rays traced per row to row_rays[y - tile.y0].
@@ -56,6 +82,11 @@ void render_tile(const Frame& frame, const Tile& tile, Arena& arena, embree_kern
 // The same, compiled for x86-64-v3 (AVX2, FMA): faster shading where the CPU has it (has_x86_64_v3).
 void render_tile_x86_64_v3(const Frame& frame, const Tile& tile, Arena& arena, embree_kernel::RayLog* log,
                            uint64_t row_rays[kTileHeight]);
+// The same image as render_tile, rendered as a wavefront (embree_wave_tile.cpp); any mode but K_MODE_BVH.
+void render_wave_tile(const Frame& frame, const Tile& tile, Arena& arena, embree_kernel::RayLog* log,
+                      uint64_t row_rays[kTileHeight]);
+void render_wave_tile_x86_64_v3(const Frame& frame, const Tile& tile, Arena& arena, embree_kernel::RayLog* log,
+                                uint64_t row_rays[kTileHeight]);
 // Whether this build has render_tile_x86_64_v3 and this CPU can run it.
 bool has_x86_64_v3();
 

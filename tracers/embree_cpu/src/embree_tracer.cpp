@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <atomic>
 #include <chrono>
+#include <cstdlib>
+#include <cstring>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -35,13 +37,15 @@ void filter_hit(const RTCFilterFunctionNArguments* args) {
     if (args->valid[i] == 0) continue;
     kuint instance = args->context->instID[0];
     const KInstance& inst = scene->instances[instance];
-    if ((inst.mask & fc->ray_mask) == 0u) {
+    const kuint ray_mask = RTCRayN_mask(args->ray, args->N, i);
+    if ((inst.mask & ray_mask) == 0u) {
       args->valid[i] = 0;
       continue;
     }
     kuint triangle = scene->blases[inst.blas].tri_offset + RTCHitN_primID(args->hit, args->N, i);
     float u = RTCHitN_u(args->hit, args->N, i), v = RTCHitN_v(args->hit, args->N, i);
-    if (k_hit_transmittance(scene, instance, triangle, u, v, fc->shadow_ray) > 0.0f) args->valid[i] = 0;
+    const int ray_kind = fc->occlusion ? k_shadow_ray_kind(ray_mask) : 0;
+    if (k_hit_transmittance(scene, instance, triangle, u, v, ray_kind) > 0.0f) args->valid[i] = 0;
   }
 }
 
@@ -69,11 +73,24 @@ void render_tile_x86_64_v3(const Frame& frame, const Tile& tile, Arena& arena, e
                            uint64_t row_rays[kTileHeight]) {
   render_tile(frame, tile, arena, log, row_rays);
 }
+void render_wave_tile_x86_64_v3(const Frame& frame, const Tile& tile, Arena& arena, embree_kernel::RayLog* log,
+                                uint64_t row_rays[kTileHeight]) {
+  render_wave_tile(frame, tile, arena, log, row_rays);
+}
 #endif
 
 }  // namespace embree_tiles
 
 namespace {
+
+// COHORT_EMBREE_WAVEFRONT: 1 (the default) renders tiles as wavefronts, 0 path by path; anything else is
+// named in the error.
+bool wavefront_from_environment() {
+  const char* v = std::getenv("COHORT_EMBREE_WAVEFRONT");
+  if (!v || std::strcmp(v, "1") == 0) return true;
+  if (std::strcmp(v, "0") == 0) return false;
+  throw std::invalid_argument(std::string("EmbreeTracer: COHORT_EMBREE_WAVEFRONT='") + v + "' (expected 0 or 1)");
+}
 
 void check_device(RTCDevice device, const char* what) {
   RTCError code = rtcGetDeviceError(device);
@@ -94,13 +111,19 @@ struct EmbreeTracer::Impl {
   std::unique_ptr<tbb::global_control> thread_limit;
   uint64_t rays_traced = 0;
   bool x86_64_v3 = embree_tiles::has_x86_64_v3();
+  bool wavefront = wavefront_from_environment();
+  // The wavefront's packets: 16 rays where Embree traces them natively (AVX-512; 2-3% faster than 8 on the
+  // test map there, docs/embree-tracer.md), else 8.
+  int packet_width = 8;
 
   void render_tile(const embree_tiles::Frame& frame, const embree_tiles::Tile& tile, embree_tiles::Arena& arena,
                    embree_kernel::RayLog* log, uint64_t* row_rays) const {
-    if (x86_64_v3)
-      embree_tiles::render_tile_x86_64_v3(frame, tile, arena, log, row_rays);
+    namespace et = embree_tiles;
+    // The BVH heat map traces Cohort's own BVH per pixel (embree_bvh_view.cpp): no rays for a wavefront.
+    if (wavefront && frame.params.mode != K_MODE_BVH)
+      (x86_64_v3 ? et::render_wave_tile_x86_64_v3 : et::render_wave_tile)(frame, tile, arena, log, row_rays);
     else
-      embree_tiles::render_tile(frame, tile, arena, log, row_rays);
+      (x86_64_v3 ? et::render_tile_x86_64_v3 : et::render_tile)(frame, tile, arena, log, row_rays);
   }
   // Each thread's tile buffers, kept from band to band: rendering allocates nothing per tile or ray.
   tbb::enumerable_thread_specific<embree_tiles::Arena> arenas;
@@ -192,6 +215,7 @@ EmbreeTracer::EmbreeTracer(int threads) : impl_(std::make_unique<Impl>()) {
   impl_->device = rtcNewDevice(nullptr);
   if (!impl_->device) throw std::runtime_error("EmbreeTracer: rtcNewDevice failed");
   impl_->ray_masks = rtcGetDeviceProperty(impl_->device, RTC_DEVICE_PROPERTY_RAY_MASK_SUPPORTED) != 0;
+  if (rtcGetDeviceProperty(impl_->device, RTC_DEVICE_PROPERTY_NATIVE_RAY16_SUPPORTED) != 0) impl_->packet_width = 16;
   if (threads > 0)
     impl_->thread_limit =
         std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism, size_t(threads));
@@ -224,7 +248,8 @@ void EmbreeTracer::upload(const commit::ChangeSet& changes) {
 namespace {
 
 embree_tiles::Frame make_frame(const KFrameParams& params, const core::BandJob& job, const KSceneView& scene,
-                               RTCScene top, const KAuxHistory& history, core::BandBuffer* target) {
+                               RTCScene top, const KAuxHistory& history, core::BandBuffer* target,
+                               int packet_width) {
   embree_tiles::Frame frame;
   frame.params = params;
   frame.camera = job.camera;
@@ -233,6 +258,8 @@ embree_tiles::Frame make_frame(const KFrameParams& params, const core::BandJob& 
   frame.write_aux = target && params.aux_outputs != 0u && target->has_aux();
   frame.base = embree_kernel::TraceCtx{scene, top, 0, nullptr, 0, v3s(0.0f), nullptr};
   frame.target = target;
+  frame.shadow_slots = k_shadow_queue_slots(&params, scene.light_count, scene.emissive_count);
+  frame.packet_width = packet_width;
   return frame;
 }
 
@@ -254,7 +281,7 @@ core::BandResult EmbreeTracer::render_band(const core::BandJob& job, core::BandB
   history.skin_weights = s.skin_weights.data();
   history.joints = previous_joints().empty() ? nullptr : previous_joints().data();
   history.skin_count = static_cast<kuint>(s.skins.size());
-  const embree_tiles::Frame frame = make_frame(params, job, scene, impl_->top, history, &target);
+  const embree_tiles::Frame frame = make_frame(params, job, scene, impl_->top, history, &target, impl_->packet_width);
   // Rays traced per row: the balancer's per-row work proxy (BandResult::row_work), as the GPU tracers count it.
   std::vector<std::atomic<uint64_t>> row_rays(static_cast<size_t>(std::max(row_end - row_begin, 0)));
   std::atomic<uint64_t> rays{0};
@@ -288,6 +315,18 @@ core::BandResult EmbreeTracer::render_band(const core::BandJob& job, core::BandB
   return result;
 }
 
+void EmbreeTracer::set_wavefront(bool on) { impl_->wavefront = on; }
+
+bool EmbreeTracer::wavefront() const { return impl_->wavefront; }
+
+void EmbreeTracer::set_wave_packet_width(int rays) {
+  if (rays != 8 && rays != 16)
+    throw std::invalid_argument("EmbreeTracer: wave packets of " + std::to_string(rays) + " rays (expected 8 or 16)");
+  impl_->packet_width = rays;
+}
+
+int EmbreeTracer::wave_packet_width() const { return impl_->packet_width; }
+
 bool EmbreeTracer::prefer_x86_64_v3(bool prefer) {
   impl_->x86_64_v3 = prefer && embree_tiles::has_x86_64_v3();
   return impl_->x86_64_v3;
@@ -299,7 +338,8 @@ EmbreeRaySet EmbreeTracer::record_rays(const core::BandJob& job) {
   if (!impl_->top) throw std::runtime_error("EmbreeTracer: record_rays before any commit was applied");
   const KFrameParams params = frame_params(job);
   const KSceneView scene = host_scene_view(params);
-  const embree_tiles::Frame frame = make_frame(params, job, scene, impl_->top, KAuxHistory{}, nullptr);
+  const embree_tiles::Frame frame =
+      make_frame(params, job, scene, impl_->top, KAuxHistory{}, nullptr, impl_->packet_width);
   auto arena = std::make_unique<embree_tiles::Arena>();
   embree_kernel::RayLog log;
   log.camera_dir = v3s(0.0f);

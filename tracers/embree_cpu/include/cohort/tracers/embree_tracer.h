@@ -1,7 +1,7 @@
 // The CPU tracer: Embree 3 two-level scene (one geometry per BLAS, one instance per KInstance) and the
 // shared integrator (kernel/include/cohort/kernel/integrator.h), over tiles of its band spread across
 // the cores by TBB. Each tile traces its camera rays ahead in coherent packets; the paths then go on
-// from those hits with single-ray shadow and bounce traces.
+// from those hits as a wavefront, their shadow and bounce rays in packets too (or path by path).
 #pragma once
 
 #include <cstdint>
@@ -51,6 +51,14 @@ class EmbreeTracer : public TracerBase {
   // Which build of the shading code runs: the one for x86-64-v3 (AVX2, FMA) where the CPU has it, the
   // default, or the baseline x86-64 one. Returns whether the x86-64-v3 build is now in use.
   bool prefer_x86_64_v3(bool prefer);
+  // How tiles are rendered (embree_tiles.h): as wavefronts, shadow and bounce rays in packets (on, the
+  // default, unless COHORT_EMBREE_WAVEFRONT=0), or path by path, those rays one by one. Same image.
+  void set_wavefront(bool on);
+  bool wavefront() const;
+  // The wavefront's rays per packet, 8 or 16: by default 16 where Embree traces 16-ray packets natively
+  // (AVX-512), else 8. Same image either way.
+  void set_wave_packet_width(int rays);
+  int wave_packet_width() const;
   // Camera, bounce and shadow rays traced by render_band since construction.
   uint64_t rays_traced() const;
 
