@@ -189,8 +189,8 @@ void walk_shadows(embree_kernel::TraceCtx& ctx, const KFrameParams* params, Aren
   for (int j = 0; j < n; ++j) {
     const int p = traced[j];
     if (wv.active[p] & K_WAVE_SHADOWS_OUT)
-      k_wave_shadow_finish_pixel(params, static_cast<size_t>(p), sample, wv.active[p], wv.visible[p], wv.band,
-                                 wv.states, wv.active, wv.vertices, wv.shadow_rays, kTilePixels);
+      k_wave_shadow_finish_pixel(params, static_cast<size_t>(p), sample, wv.active[p], wv.vertices[p].ray_count,
+                                 wv.visible[p], wv.band, wv.states, wv.active, wv.vertices, wv.shadow_rays, kTilePixels);
   }
 }
 

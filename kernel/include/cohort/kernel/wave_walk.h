@@ -41,18 +41,18 @@ KFN int k_wave_bounce_walk_pixel(KTraceCtx* ctx, int in_band, size_t p, KGLOBAL 
   return inside;
 }
 
-/* The vertex of pixel p once its shadow rays are walked (visible: bit k set where nothing blocks slot k's
- * ray; flags: the pixel's `active` flags before): the visible ones' values added in their order and the
+/* The vertex of pixel p once its shadow rays are walked (count: its vertex's ray_count, read before the
+ * walks; visible: bit k set where nothing blocks slot k's ray; flags: the pixel's `active` flags before): the visible ones' values added in their order and the
  * vertex's light to its path's radiance (k_vertex_light_sum, the integrator's order of additions), a path
  * that ended there finished into the band. The second half of k_wave_shadow_walk_pixel; the Embree tracer
  * calls it after walking a tile's shadow rays together in packets (tracers/embree_cpu). */
-KFN void k_wave_shadow_finish_pixel(const KFrameParams* params, size_t p, kuint sample, kuint flags, kuint visible,
-                                    KGLOBAL float* band, KGLOBAL KPathState* states, KGLOBAL kuint* active,
-                                    KGLOBAL const KVertexLight* vertex_lights, KGLOBAL const KShadowRay* shadow_rays,
+KFN void k_wave_shadow_finish_pixel(const KFrameParams* params, size_t p, kuint sample, kuint flags, kuint count,
+                                    kuint visible, KGLOBAL float* band, KGLOBAL KPathState* states,
+                                    KGLOBAL kuint* active, KGLOBAL const KVertexLight* vertex_lights, KGLOBAL const KShadowRay* shadow_rays,
                                     kuint shadow_stride) {
   KGLOBAL const KShadowRay* rays = shadow_rays + p;
   KVertexLight v = vertex_lights[p];
-  for (kuint k = 0u; k < v.ray_count; ++k)
+  for (kuint k = 0u; k < count; ++k)
     if (visible & (1u << k)) {
       KShadowRay ray = rays[(size_t)k * shadow_stride];
       k_shadow_ray_add(&v, &ray);
@@ -85,8 +85,8 @@ KFN int k_wave_shadow_walk_pixel(KTraceCtx* ctx, const KFrameParams* params, int
       KShadowRay ray = rays[(size_t)k * shadow_stride];
       if (k_shadow_ray_visible(ctx, &ray)) visible |= 1u << k;
     }
-    k_wave_shadow_finish_pixel(params, p, sample, flags, visible, band, states, active, vertex_lights, shadow_rays,
-                               shadow_stride);
+    k_wave_shadow_finish_pixel(params, p, sample, flags, count, visible, band, states, active, vertex_lights,
+                               shadow_rays, shadow_stride);
   }
   return inside;
 }
