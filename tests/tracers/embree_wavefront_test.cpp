@@ -22,6 +22,7 @@
 
 #include "cohort/core/view.h"
 #include "cohort/scene/map_loader.h"
+#include "band_frame_match.h"
 #include "shadow_walk_cases.h"
 #include "test_scenes.h"
 
@@ -112,34 +113,13 @@ Rendered render_bands(int packet_width, bool x86_64_v3, const View& view, const 
   return out;
 }
 
-size_t differing_floats(core::BandBuffer& a, core::BandBuffer& b) {
-  const float* fa = static_cast<const float*>(a.data());
-  const float* fb = static_cast<const float*>(b.data());
-  size_t n = 0;
-  for (size_t i = 0; i < a.bytes() / sizeof(float); ++i) n += std::memcmp(fa + i, fb + i, sizeof(float)) != 0;
-  return n;
-}
-
 // The wavefront's frame (packets of packet_width rays) against the path-by-path tiles' in one build of the
 // shading: every float, aux texel and row count the same.
 void expect_the_path_tiles_frame_in_build(bool x86_64_v3, int packet_width, Rendered& paths, const View& view,
                                           const KFrameParams& params, const std::vector<int>& cuts) {
   Rendered wave = render_bands(packet_width, x86_64_v3, view, params, cuts);
-  double sum = 0.0;
-  const float* f = static_cast<const float*>(wave.frame.data());
-  for (size_t i = 0; i < wave.frame.bytes() / sizeof(float); ++i) {
-    ASSERT_TRUE(std::isfinite(f[i])) << "float " << i;
-    sum += f[i];
-  }
-  EXPECT_GT(sum, 0.0) << "the frame shows something";
-  EXPECT_EQ(differing_floats(paths.frame, wave.frame), 0u) << "floats that differ from the path tiles'";
-  if (params.aux_outputs != 0u) {
-    ASSERT_EQ(paths.frame.aux_bytes(), wave.frame.aux_bytes());
-    EXPECT_EQ(std::memcmp(paths.frame.aux_data(), wave.frame.aux_data(), paths.frame.aux_bytes()), 0)
-        << "the aux planes differ";
-  }
-  ASSERT_EQ(wave.row_work.size(), size_t(view.camera.height)) << "every band reports its row ray counts";
-  EXPECT_EQ(wave.row_work, paths.row_work) << "rays counted per row";
+  expect_same_band_frame(paths.frame, paths.row_work, wave.frame, wave.row_work, params.aux_outputs != 0u,
+                         int(view.camera.height), "the path tiles'");
 }
 
 // The wavefront's frame against the path-by-path tiles': every float, aux texel and row count the same, in

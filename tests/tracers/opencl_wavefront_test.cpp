@@ -20,6 +20,7 @@
 #include "cohort/core/view.h"
 #include "cohort/tracers/device_listing.h"
 #include "cohort/scene/map_loader.h"
+#include "band_frame_match.h"
 #include "shadow_walk_cases.h"
 #include "test_scenes.h"
 #include "test_tracers.h"
@@ -117,35 +118,14 @@ Rendered render_bands(const Variant& v, const View& view, const KFrameParams& pa
   return out;
 }
 
-size_t differing_floats(core::BandBuffer& a, core::BandBuffer& b) {
-  const float* fa = static_cast<const float*>(a.data());
-  const float* fb = static_cast<const float*>(b.data());
-  size_t n = 0;
-  for (size_t i = 0; i < a.bytes() / sizeof(float); ++i) n += std::memcmp(fa + i, fb + i, sizeof(float)) != 0;
-  return n;
-}
-
 // The wavefront's frame against the megakernel's: every float, aux texel and row count the same.
 void expect_the_megakernels_frame(const Variant& v, const View& view, const KFrameParams& params,
                                   const std::vector<int>& cuts, const std::string& what) {
   SCOPED_TRACE(what + ", " + v.name);
   Rendered mega = render_bands(kMegakernel, view, params, cuts);
   Rendered wave = render_bands(v, view, params, cuts);
-  double sum = 0.0;
-  const float* f = static_cast<const float*>(wave.frame.data());
-  for (size_t i = 0; i < wave.frame.bytes() / sizeof(float); ++i) {
-    ASSERT_TRUE(std::isfinite(f[i])) << "float " << i;
-    sum += f[i];
-  }
-  EXPECT_GT(sum, 0.0) << "the frame shows something";
-  EXPECT_EQ(differing_floats(mega.frame, wave.frame), 0u) << "floats that differ from the megakernel's";
-  if (params.aux_outputs != 0u) {
-    ASSERT_EQ(mega.frame.aux_bytes(), wave.frame.aux_bytes());
-    EXPECT_EQ(std::memcmp(mega.frame.aux_data(), wave.frame.aux_data(), mega.frame.aux_bytes()), 0)
-        << "the aux planes differ";
-  }
-  ASSERT_EQ(wave.row_work.size(), size_t(view.camera.height)) << "every band reports its row ray counts";
-  EXPECT_EQ(wave.row_work, mega.row_work) << "rays counted per row";
+  expect_same_band_frame(mega.frame, mega.row_work, wave.frame, wave.row_work, params.aux_outputs != 0u,
+                         int(view.camera.height), "the megakernel's");
   EXPECT_GT(wave.device_ms, 0.0);
 }
 
