@@ -22,7 +22,7 @@
 
 #include "cohort/core/view.h"
 #include "cohort/scene/map_loader.h"
-#include "band_frame_match.h"
+#include "band_frames.h"
 #include "shadow_walk_cases.h"
 #include "test_scenes.h"
 
@@ -37,16 +37,6 @@ using namespace cohort::test;
 
 namespace {
 
-struct View {
-  std::shared_ptr<commit::TracerScene> scene;
-  KCamera camera;
-};
-
-View room_view(int w, int h) {
-  static const auto room = std::make_shared<commit::TracerScene>(core::compile_scene(test_room()).tracer_scene);
-  return {room, test_room_camera(w, h)};
-}
-
 // Where the generated test map is looked at from (tools/gen_testmap.py's README names the areas).
 enum class MapSpot {
   player_start,  // the hall: pillars, table, crates, a blood decal
@@ -55,16 +45,7 @@ enum class MapSpot {
 };
 
 View map_view(MapSpot spot, int w, int h) {
-  struct Map {
-    std::shared_ptr<commit::TracerScene> scene;
-    glm::vec3 eye;
-    float yaw;
-  };
-  static const Map map = [] {
-    const scene::Scene m = load_test_map();
-    return Map{std::make_shared<commit::TracerScene>(core::compile_scene(m).tracer_scene), core::player_eye(m),
-               m.player_yaw};
-  }();
+  const TestMapScene& map = test_map_scene();
   switch (spot) {
     case MapSpot::atrium:
       return {map.scene, core::make_camera({740, 192, 90}, {0.0f, -12.0f}, core::kDefaultFovX, w, h)};
@@ -73,51 +54,25 @@ View map_view(MapSpot spot, int w, int h) {
     case MapSpot::player_start:
       break;
   }
-  return {map.scene, core::make_camera(map.eye, {map.yaw, 0.0f}, core::kDefaultFovX, w, h)};
+  return test::map_view(w, h);
 }
 
-View many_lights_view(int point_lights, int projected_lights, int w, int h) {
-  scene::Scene floor = many_lights_floor_under_a_panel(point_lights, projected_lights);
-  return {std::make_shared<commit::TracerScene>(core::compile_scene(floor).tracer_scene),
-          camera_looking_down({0, 0, 1400}, 0.7f, w, h)};
-}
-
-struct Rendered {
-  core::BandBuffer frame;
-  std::vector<float> row_work;  // the bands' rays per row, band after band
-};
-
-// The frame rendered band by band (cuts: the bands' first rows, then the height), with its aux planes when
-// params.aux_outputs asks for them.
-// x86_64_v3: the shading's x86-64-v3 build where this CPU has one, else the baseline build; packet_width: the
+// The frame rendered band by band (render_in_bands). x86_64_v3: the shading's x86-64-v3 build where this CPU has one, else the baseline build; packet_width: the
 // wavefront's rays per packet (0: path by path).
-Rendered render_bands(int packet_width, bool x86_64_v3, const View& view, const KFrameParams& params,
-                      const std::vector<int>& cuts) {
+BandFrame render_bands(int packet_width, bool x86_64_v3, const View& view, const KFrameParams& params,
+                       const std::vector<int>& cuts) {
   tracers::EmbreeTracer tracer;
   tracer.set_wavefront(packet_width > 0);
   if (packet_width > 0) tracer.set_wave_packet_width(packet_width);
   tracer.prefer_x86_64_v3(x86_64_v3);
-  tracer.apply(commit::CommitBuffer::full(view.scene, 1));
-  Rendered out;
-  out.frame.resize(int(view.camera.width), int(view.camera.height), core::BandFormat::rgba32f);
-  out.frame.enable_aux(params.aux_outputs != 0u);
-  for (size_t i = 0; i + 1 < cuts.size(); ++i) {
-    core::BandJob job;
-    job.params = params;
-    job.params.row_begin = kuint(cuts[i]);
-    job.params.row_end = kuint(cuts[i + 1]);
-    job.camera = view.camera;
-    const core::BandResult result = tracer.render_band(job, out.frame);
-    out.row_work.insert(out.row_work.end(), result.row_work.begin(), result.row_work.end());
-  }
-  return out;
+  return render_in_bands(tracer, view, params, cuts);
 }
 
 // The wavefront's frame (packets of packet_width rays) against the path-by-path tiles' in one build of the
 // shading: every float, aux texel and row count the same.
-void expect_the_path_tiles_frame_in_build(bool x86_64_v3, int packet_width, Rendered& paths, const View& view,
+void expect_the_path_tiles_frame_in_build(bool x86_64_v3, int packet_width, BandFrame& paths, const View& view,
                                           const KFrameParams& params, const std::vector<int>& cuts) {
-  Rendered wave = render_bands(packet_width, x86_64_v3, view, params, cuts);
+  BandFrame wave = render_bands(packet_width, x86_64_v3, view, params, cuts);
   expect_same_band_frame(paths.frame, paths.row_work, wave.frame, wave.row_work, params.aux_outputs != 0u,
                          int(view.camera.height), "the path tiles'");
 }
@@ -128,7 +83,7 @@ void expect_the_path_tiles_frame_in_build(bool x86_64_v3, int packet_width, Rend
 void expect_the_path_tiles_frame(const View& view, const KFrameParams& params, const std::vector<int>& cuts,
                                  const std::string& what) {
   for (const bool x86_64_v3 : {true, false}) {
-    Rendered paths = render_bands(0, x86_64_v3, view, params, cuts);
+    BandFrame paths = render_bands(0, x86_64_v3, view, params, cuts);
     for (const int packet_width : {8, 16}) {
       SCOPED_TRACE(what + (x86_64_v3 ? ", x86-64-v3 build where the CPU has it" : ", baseline build") +
                    ", packets of " + std::to_string(packet_width));
@@ -156,17 +111,8 @@ TEST_P(EmbreeWavefront, DrawsThePathTilesImage) {
   const SceneCase c = GetParam();
   const int w = 40, h = 32;  // a partial tile column (40 = 32 + 8) and rows that do not fill the last tile
   const View view = c.map ? map_view(c.spot, w, h) : room_view(w, h);
-  KFrameParams params = frame_params(c.mode, c.spp, c.bounces, h);
-  params.rr_start = c.rr_start;
-  params.frame_index = 5;
-  params.firefly_clamp = 5.0f;
-  params.soft_shadow_scale = 0.2f;
-  params.shadow_rr = 0.03f;
-  params.aux_outputs = c.aux;
-  params.path_pixels = c.path_pixels;
-  params.path_phase = 3;
-  params.light_sampling = c.light_sampling;
-  params.light_samples = c.light_sampling == K_LIGHTS_EVERY ? 0u : 1u;
+  const KFrameParams params =
+      wave_case_params(c.mode, c.spp, c.bounces, h, c.rr_start, c.aux, c.path_pixels, c.light_sampling);
   const std::vector<int> cuts = c.cuts.empty() ? std::vector<int>{0, 13, h} : c.cuts;
   expect_the_path_tiles_frame(view, params, cuts, c.name);
 }

@@ -20,7 +20,7 @@
 #include "cohort/core/view.h"
 #include "cohort/tracers/device_listing.h"
 #include "cohort/scene/map_loader.h"
-#include "band_frame_match.h"
+#include "band_frames.h"
 #include "shadow_walk_cases.h"
 #include "test_scenes.h"
 #include "test_tracers.h"
@@ -59,71 +59,18 @@ std::unique_ptr<tracers::OpenCLTracer> opencl(const Variant& v) {
   return std::make_unique<tracers::OpenCLTracer>(options);
 }
 
-struct View {
-  std::shared_ptr<commit::TracerScene> scene;
-  KCamera camera;
-};
-
-View room_view(int w, int h) {
-  static const auto room = std::make_shared<commit::TracerScene>(core::compile_scene(test_room()).tracer_scene);
-  return {room, test_room_camera(w, h)};
-}
-
-// The generated test map (what its scene pack holds), from the player start at eye height.
-View map_view(int w, int h) {
-  struct Map {
-    std::shared_ptr<commit::TracerScene> scene;
-    glm::vec3 eye;
-    float yaw;
-  };
-  static const Map map = [] {
-    const scene::Scene m = load_test_map();
-    return Map{std::make_shared<commit::TracerScene>(core::compile_scene(m).tracer_scene), core::player_eye(m),
-               m.player_yaw};
-  }();
-  return {map.scene, core::make_camera(map.eye, {map.yaw, 0.0f}, core::kDefaultFovX, w, h)};
-}
-
-// A floor of point and projected lights under an emissive panel (two emissive triangles), seen from above.
-View many_lights_view(int point_lights, int projected_lights, int w, int h) {
-  scene::Scene floor = many_lights_floor_under_a_panel(point_lights, projected_lights);
-  return {std::make_shared<commit::TracerScene>(core::compile_scene(floor).tracer_scene),
-          camera_looking_down({0, 0, 1400}, 0.7f, w, h)};
-}
-
-struct Rendered {
-  core::BandBuffer frame;
-  std::vector<float> row_work;  // the bands' rays per row, band after band
-  double device_ms = 0.0;
-};
-
-// The frame rendered band by band (cuts: the bands' first rows, then the height), with its aux planes
-// when params.aux_outputs asks for them.
-Rendered render_bands(const Variant& v, const View& view, const KFrameParams& params, const std::vector<int>& cuts) {
+// The frame rendered band by band by a tracer of variant v (render_in_bands).
+BandFrame render_bands(const Variant& v, const View& view, const KFrameParams& params, const std::vector<int>& cuts) {
   auto tracer = opencl(v);
-  tracer->apply(commit::CommitBuffer::full(view.scene, 1));
-  Rendered out;
-  out.frame.resize(int(view.camera.width), int(view.camera.height), core::BandFormat::rgba32f);
-  out.frame.enable_aux(params.aux_outputs != 0u);
-  for (size_t i = 0; i + 1 < cuts.size(); ++i) {
-    core::BandJob job;
-    job.params = params;
-    job.params.row_begin = kuint(cuts[i]);
-    job.params.row_end = kuint(cuts[i + 1]);
-    job.camera = view.camera;
-    const core::BandResult result = tracer->render_band(job, out.frame);
-    out.row_work.insert(out.row_work.end(), result.row_work.begin(), result.row_work.end());
-    out.device_ms += result.device_ms;
-  }
-  return out;
+  return render_in_bands(*tracer, view, params, cuts);
 }
 
 // The wavefront's frame against the megakernel's: every float, aux texel and row count the same.
 void expect_the_megakernels_frame(const Variant& v, const View& view, const KFrameParams& params,
                                   const std::vector<int>& cuts, const std::string& what) {
   SCOPED_TRACE(what + ", " + v.name);
-  Rendered mega = render_bands(kMegakernel, view, params, cuts);
-  Rendered wave = render_bands(v, view, params, cuts);
+  BandFrame mega = render_bands(kMegakernel, view, params, cuts);
+  BandFrame wave = render_bands(v, view, params, cuts);
   expect_same_band_frame(mega.frame, mega.row_work, wave.frame, wave.row_work, params.aux_outputs != 0u,
                          int(view.camera.height), "the megakernel's");
   EXPECT_GT(wave.device_ms, 0.0);
@@ -147,17 +94,8 @@ TEST_P(OpenCLWavefront, DrawsTheMegakernelsImage) {
   const SceneCase c = GetParam();
   const int w = 40, h = 32;
   const View view = c.map ? map_view(w, h) : room_view(w, h);
-  KFrameParams params = frame_params(K_MODE_PATH, c.spp, c.bounces, h);
-  params.rr_start = c.rr_start;
-  params.frame_index = 5;
-  params.firefly_clamp = 5.0f;
-  params.soft_shadow_scale = 0.2f;
-  params.shadow_rr = 0.03f;
-  params.aux_outputs = c.aux;
-  params.path_pixels = c.path_pixels;
-  params.path_phase = 3;
-  params.light_sampling = c.light_sampling;
-  params.light_samples = c.light_sampling == K_LIGHTS_EVERY ? 0u : 1u;
+  const KFrameParams params =
+      wave_case_params(K_MODE_PATH, c.spp, c.bounces, h, c.rr_start, c.aux, c.path_pixels, c.light_sampling);
   const std::vector<int> cuts = c.cuts.empty() ? std::vector<int>{0, 13, h} : c.cuts;
   expect_the_megakernels_frame(kWavefront, view, params, cuts, c.name);
 }
@@ -182,8 +120,8 @@ TEST(OpenCLWaveLanes, DrawTheImageOfOneLane) {
     const Variant one_lane{true, true, 1, "one lane", false};
     const Variant two_lanes{true, true, 1, "two lanes", true};
     const std::vector<int> cuts = {0, 5, 85, h};  // 80 rows (lanes of 40), 65 (32 and 33)
-    Rendered one = render_bands(one_lane, view, params, cuts);
-    Rendered two = render_bands(two_lanes, view, params, cuts);
+    BandFrame one = render_bands(one_lane, view, params, cuts);
+    BandFrame two = render_bands(two_lanes, view, params, cuts);
     SCOPED_TRACE(aux ? "first-hit records" : "no aux planes");
     EXPECT_EQ(differing_floats(one.frame, two.frame), 0u);
     if (aux) {
