@@ -373,6 +373,7 @@ struct OpenCLTracer::Impl {
   // Options::pinned_band_reads (with `transfer`): the band's colour read into band_staging[band_slot], the
   // slot's own, so a band's read never lands where the band before's copy out of it may still run.
   bool pinned_reads = false;
+  bool late_job_cost = false;  // Options::late_job_cost (with `transfer`)
   PinnedStaging band_staging[2];
   int band_slot = 0;
   std::atomic<size_t> staged_reads{0};
@@ -603,6 +604,7 @@ OpenCLTracer::OpenCLTracer(const Options& options) : impl_(std::make_unique<Impl
   impl_->transfer = options.enqueue_ahead && (options.transfer_queue == Options::TransferQueue::always ||
                                               (options.transfer_queue == Options::TransferQueue::on_gpus && impl_->gpu));
   impl_->pinned_reads = impl_->transfer && options.pinned_band_reads;
+  impl_->late_job_cost = impl_->transfer && options.late_job_cost;
   if (impl_->transfer) {
 #if defined(__GNUC__)
 #pragma GCC diagnostic push
@@ -837,6 +839,9 @@ core::BandResult OpenCLTracer::render_band(const core::BandJob& job, core::BandB
   enqueue_next_ahead(*band);
   const auto waiting = Clock::now();
   core::BandResult result = finish_band(*band);
+  if (m.late_job_cost && !band->ahead && m.enqueued_ahead.load() > 0)
+    result.balance_ms = std::max(
+        1e-3, std::chrono::duration<double, std::milli>(Clock::now() - entry).count() - band->enqueue_ms);
   if (spdlog::should_log(spdlog::level::debug)) {
     const auto ms = [](Clock::time_point a, Clock::time_point b) { return std::chrono::duration<double, std::milli>(b - a).count(); };
     spdlog::debug("opencl ({}): band [{}, {}) of frame {}: {} in {:.3f} ms; {:.3f} ms before it was all in the queue, "

@@ -190,6 +190,7 @@ std::unique_ptr<core::Tracer> make_tracer(const TracerSpec& spec) {
       options.transfer_queue = env_switch("COHORT_OPENCL_TRANSFER_QUEUE", true) ? OpenCLTracer::Options::TransferQueue::always
                                                                               : OpenCLTracer::Options::TransferQueue::never;
     options.pinned_band_reads = env_switch("COHORT_OPENCL_PINNED_READS", options.pinned_band_reads);
+    options.late_job_cost = env_switch("COHORT_OPENCL_LATE_JOB_COST", options.late_job_cost);
     options.walk_registers = env_registers("COHORT_OPENCL_WALK_REGISTERS", options.walk_registers);
     options.shade_registers = env_registers("COHORT_OPENCL_SHADE_REGISTERS", options.shade_registers);
     return std::make_unique<OpenCLTracer>(options);

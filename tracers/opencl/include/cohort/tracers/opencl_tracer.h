@@ -72,6 +72,13 @@ class OpenCLTracer : public TracerBase {
     // last kernel to the read's end for a 360-row 720p band in the design card's mix on nvidia-h100-x2).
     // COHORT_OPENCL_PINNED_READS=0: straight into the target.
     bool pinned_band_reads = true;
+    // With the transfer queues, once bands go ahead (two frames in flight): a band that could not go ahead (its
+    // job came after the band before had ended) costs the balancer its wall time less its enqueueing, which a
+    // job that came in time would have hidden. Without it a tracer that ends its bands before the frame's
+    // slowest one gets its jobs too late to enqueue them ahead, pays the enqueueing every band, looks slow to
+    // the balancer, keeps few rows and so keeps ending early (nvidia-h100-x2, cuda:0 + opencl:2: some runs
+    // settled at 448 / 272 rows and 1.57 ms a frame, others at 336 / 384 and 1.31). COHORT_OPENCL_LATE_JOB_COST.
+    bool late_job_cost = true;
   };
   static constexpr int kMaxFirstHitPieces = 8;
   // The pieces' first rows, relative to the band, and `rows` last: up to `pieces` ranges of whole work
