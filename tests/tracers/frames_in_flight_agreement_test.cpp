@@ -8,7 +8,6 @@
 
 #include <algorithm>
 #include <chrono>
-#include <cstdlib>
 #include <cstring>
 #include <functional>
 #include <string>
@@ -74,7 +73,7 @@ using MakeTracer = std::function<std::unique_ptr<core::Tracer>(const std::string
 // CPU device (PoCL) leaves off by default (OpenCLTracer::Options::transfer_queue).
 tracers::OpenCLTracer::Options opencl_options() {
   tracers::OpenCLTracer::Options o;
-  if (const char* device = std::getenv("COHORT_TEST_OPENCL_DEVICE")) o.device = std::atoi(device);
+  o.device = test_opencl_device();
   o.transfer_queue = tracers::OpenCLTracer::Options::TransferQueue::always;
   return o;
 }

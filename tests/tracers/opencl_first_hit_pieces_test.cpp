@@ -6,7 +6,6 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
-#include <cstdlib>
 #include <cstring>
 #include <memory>
 #include <string>
@@ -78,7 +77,7 @@ TEST(OpenCLFirstHitPieces, ABadValueInTheEnvironmentIsNamed) {
 
 std::unique_ptr<tracers::OpenCLTracer> opencl_in_pieces(int pieces, bool aux_into_target = false) {
   tracers::OpenCLTracer::Options options;
-  if (const char* device = std::getenv("COHORT_TEST_OPENCL_DEVICE")) options.device = std::atoi(device);
+  options.device = test_opencl_device();
   options.first_hit_pieces = pieces;
   options.aux_into_target = aux_into_target;
   return std::make_unique<tracers::OpenCLTracer>(options);

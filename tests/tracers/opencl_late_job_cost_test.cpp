@@ -6,7 +6,6 @@
 #include <gtest/gtest.h>
 
 #include <chrono>
-#include <cstdlib>
 #include <optional>
 #include <vector>
 
@@ -33,7 +32,7 @@ struct Band {
 // to the tracer while the first renders (so it goes ahead), the third's only when it starts.
 std::vector<Band> render_three(bool late_job_cost, bool two_in_flight, size_t* enqueued_ahead) {
   tracers::OpenCLTracer::Options o;
-  if (const char* device = std::getenv("COHORT_TEST_OPENCL_DEVICE")) o.device = std::atoi(device);
+  o.device = test_opencl_device();
   o.transfer_queue = tracers::OpenCLTracer::Options::TransferQueue::always;
   o.late_job_cost = late_job_cost;
   tracers::OpenCLTracer tracer(o);

@@ -49,7 +49,7 @@ const Variant kShadowsInTheShadingKernels{true, false, 2, "wavefront, shadow ray
 
 std::unique_ptr<tracers::OpenCLTracer> opencl(const Variant& v) {
   tracers::OpenCLTracer::Options options;
-  if (const char* device = std::getenv("COHORT_TEST_OPENCL_DEVICE")) options.device = std::atoi(device);
+  options.device = test_opencl_device();
   options.wavefront = v.wavefront ? tracers::OpenCLTracer::Options::Wavefront::always
                                   : tracers::OpenCLTracer::Options::Wavefront::never;
   options.shadow_walk = v.shadow_walk;

@@ -21,11 +21,17 @@ inline std::vector<std::string> built_tracers() { return tracers::built_tracer_k
 // device skips; a kernel that fails to compile is a failure, not a skip).
 inline bool tracer_runs_here(const std::string& kind) { return tracers::device_count(kind) > 0; }
 
+// The OpenCL device a plain "opencl" names in the tests: COHORT_TEST_OPENCL_DEVICE, else 0 (the
+// registry's and OpenCLTracer::Options' default).
+inline int test_opencl_device() {
+  const char* device = std::getenv("COHORT_TEST_OPENCL_DEVICE");
+  return device ? std::atoi(device) : 0;
+}
+
 // name: a kind or "kind:N", as the registry takes it.
 inline std::unique_ptr<core::Tracer> make_test_tracer(const std::string& name) {
   tracers::TracerSpec spec = tracers::parse_tracer_list(name).front();
-  if (name == "opencl")
-    if (const char* device = std::getenv("COHORT_TEST_OPENCL_DEVICE")) spec.device = std::atoi(device);
+  if (name == "opencl") spec.device = test_opencl_device();
   return tracers::make_tracer(spec);
 }
 
