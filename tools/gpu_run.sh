@@ -499,6 +499,9 @@ print(pick[0]["tracer"] if pick else "")' || true)}"
         for ahead in ${COHORT_GPU_ENQUEUE_AHEAD:-default}; do
         for transfer in ${COHORT_GPU_TRANSFER_QUEUE:-default}; do
         for handout in ${COHORT_GPU_HAND_OUT_AHEAD:-default}; do
+        # COHORT_GPU_ENVS: sets of environment variables to alternate, each VAR=VALUE[,VAR=VALUE...] (e.g.
+        # "default COHORT_CUDA_FUSED_WALKS=0,COHORT_OPENCL_FUSED_WALKS=0" for an A/B in one round).
+        for envset in ${COHORT_GPU_ENVS:-default}; do
           run=/tmp/mg_${map}_${convergence}_$(echo "$mix" | tr ',:' '__')
           in_flight_args=()
           if [ "$in_flight" != default ]; then
@@ -518,6 +521,11 @@ print(pick[0]["tracer"] if pick else "")' || true)}"
             run=${run}_ho${handout}
             ahead_env+=(COHORT_HAND_OUT_AHEAD=$handout); ahead_label="$ahead_label, COHORT_HAND_OUT_AHEAD=$handout"
           fi
+          if [ "$envset" != default ]; then
+            run=${run}_$(echo "$envset" | tr ',=' '__' | tr -cd 'A-Za-z0-9_' | tail -c 40)_r${round}
+            IFS=, read -r -a envs <<< "$envset"
+            ahead_env+=("${envs[@]}"); ahead_label="$ahead_label, $envset"
+          fi
           log_args=(); [ "${COHORT_GPU_BAND_GAPS:-0}" = 1 ] && log_args=(--log-level debug)
           env "${ahead_env[@]}" timeout 120 "$stage/bin/cohort" "${log_args[@]}" render "${args[@]}" --tracers "$mix" --spp 1 --light-samples 1 --bounces 1 \
             ${COHORT_GPU_RENDER_ARGS:-} "${in_flight_args[@]}" --convergence $convergence --frames ${COHORT_GPU_FRAMES:-100} \
@@ -529,6 +537,7 @@ print(pick[0]["tracer"] if pick else "")' || true)}"
           grep "waited for its job" $run/summary.txt || true  # per tracer: bands whose job came after the band before ended
           [ "${COHORT_GPU_BAND_GAPS:-0}" = 1 ] && { python3 tools/opencl_band_gaps.py $run.log --skip ${COHORT_GPU_SKIP:-20} || true; }
           grep -E "sits out|keeps its rows" $run.log | sed 's/^.*\] //' | head -n 3 || true
+        done
         done
         done
         done

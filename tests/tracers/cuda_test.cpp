@@ -2,10 +2,12 @@
 // the GPU machine through tools/gpu_run.sh.
 #include <gtest/gtest.h>
 
+#include <chrono>
 #include <cmath>
 #include <cstdlib>
 #include <cstring>
 #include <iostream>
+#include <optional>
 #include <stdexcept>
 #include <vector>
 
@@ -312,6 +314,74 @@ TEST(CudaWaveLanes, DrawTheImageOfOneLane) {
     EXPECT_EQ(counts[lanes - 1].closest, counts[0].closest) << lanes << " lanes";
     EXPECT_EQ(counts[lanes - 1].occlusion, counts[0].occlusion) << lanes << " lanes";
   }
+}
+
+// Enqueue ahead (CudaTracer::set_enqueue_ahead) with the Renderer's queued_next hook played by the test: the
+// second of three bands' jobs is queued while the first renders, none after. The second goes ahead and its
+// job takes it; its image, rows and ray counts are those of the same band enqueued when its job came (the
+// option off). The balancer's cost: the first band (the second went ahead inside it) and the third (its job
+// came late) cost their wall time less their enqueueing, the one that went ahead its wall time
+// (BandResult::balance_ms 0); with the option off every band its wall time.
+TEST(CudaEnqueueAhead, TakesTheBandItsJobFindsEnqueuedAndCostsALateOneLessItsEnqueueing) {
+  REQUIRE_GPU();
+  const int w = 96, h = 64;
+  const TestView view = pack_or_room(std::getenv("COHORT_PACK"), w, h);
+  struct Run {
+    core::BandBuffer target;
+    std::vector<core::BandResult> results;
+    std::vector<double> wall_ms;
+    size_t enqueued = 0, finished = 0;
+  };
+  auto run = [&](bool ahead) {
+    tracers::CudaTracer cuda(0);
+    cuda.set_enqueue_ahead(ahead);
+    cuda.set_ray_counting(true);
+    cuda.apply(commit::CommitBuffer::full(std::make_shared<commit::TracerScene>(view.scene), 1));
+    Run r;
+    r.target.resize(w, h, core::BandFormat::rgba32f);
+    std::vector<core::BandJob> jobs(3);
+    for (kuint f = 0; f < 3; ++f) {
+      jobs[f].params = frame_params(K_MODE_PATH, 1, 1, h);
+      jobs[f].params.frame_index = f;
+      jobs[f].params.row_begin = f == 1 ? 8u : 0u;  // the second band a part of the frame
+      jobs[f].params.row_end = f == 1 ? 40u : uint32_t(h);
+      jobs[f].camera = view.camera;
+    }
+    int handed = 0;
+    cuda.set_queued_next(
+        [&](const core::Tracer::BandDone&) -> std::optional<core::Tracer::QueuedNext> {
+          if (handed++ > 0) return std::nullopt;
+          return core::Tracer::QueuedNext{jobs[1], &r.target};
+        },
+        [] {});
+    std::vector<float> second;
+    for (const core::BandJob& job : jobs) {
+      const auto start = std::chrono::steady_clock::now();
+      r.results.push_back(cuda.render_band(job, r.target));
+      r.wall_ms.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count());
+      if (r.results.size() == 2) {  // the second band's rows, before the third overwrites them
+        const float* rows = static_cast<const float*>(r.target.row(8));
+        second.assign(rows, rows + size_t(32) * w * 4);
+      }
+    }
+    std::memcpy(r.target.row(8), second.data(), second.size() * sizeof(float));
+    r.enqueued = cuda.bands_enqueued_ahead();
+    r.finished = cuda.bands_finished_ahead();
+    return r;
+  };
+  const Run on = run(true), off = run(false);
+  ASSERT_EQ(on.enqueued, 1u) << "the second band should have gone ahead";
+  EXPECT_EQ(on.finished, 1u) << "its job should have found it enqueued";
+  EXPECT_EQ(off.enqueued, 0u);
+  EXPECT_EQ(std::memcmp(on.target.row(8), off.target.row(8), size_t(32) * on.target.row_bytes()), 0)
+      << "the band that went ahead draws what it draws enqueued at its job";
+  EXPECT_EQ(on.results[1].row_work, off.results[1].row_work);
+  EXPECT_GT(on.results[1].device_ms, 0.0);
+  EXPECT_GT(on.results[0].balance_ms, 0.0);
+  EXPECT_EQ(on.results[1].balance_ms, 0.0) << "a band that went ahead costs its wall time";
+  EXPECT_GT(on.results[2].balance_ms, 0.0) << "a band whose job came late costs less than its wall time";
+  EXPECT_LT(on.results[2].balance_ms, on.wall_ms[2]);
+  for (const core::BandResult& r : off.results) EXPECT_EQ(r.balance_ms, 0.0) << "option off";
 }
 
 // Next-event estimation's shadow rays walked by a kernel of their own (CudaTracer::set_shadow_walk): the

@@ -26,6 +26,9 @@
 #ifdef COHORT_HAVE_OPENCL
 #include "cohort/tracers/opencl_tracer.h"
 #endif
+#ifdef COHORT_HAVE_CUDA
+#include "cohort/tracers/cuda_tracer.h"
+#endif
 
 using namespace cohort;
 using namespace cohort::test;
@@ -47,6 +50,8 @@ struct Rendered {
   bool transfer_queues = true;
   // Bands whose colour came through page-locked staging (OpenCLTracer::bands_read_through_staging).
   size_t staged_reads = 0;
+  // The same counts summed over the CUDA tracers (CudaTracer::bands_enqueued_ahead, ...).
+  size_t cuda_enqueued_ahead = 0, cuda_finished_ahead = 0, cuda_dropped_ahead = 0;
 };
 
 #ifdef COHORT_HAVE_OPENCL
@@ -65,6 +70,18 @@ void count_ahead(const std::vector<core::Tracer*>& tracers, Rendered& out) {
 #else
 void count_ahead(const std::vector<core::Tracer*>&, Rendered&) {}
 #endif
+
+// Counts what the CUDA tracers enqueued ahead.
+void count_cuda_ahead([[maybe_unused]] const std::vector<core::Tracer*>& tracers, [[maybe_unused]] Rendered& out) {
+#ifdef COHORT_HAVE_CUDA
+  for (core::Tracer* t : tracers)
+    if (const auto* cuda = dynamic_cast<const tracers::CudaTracer*>(t)) {
+      out.cuda_enqueued_ahead += cuda->bands_enqueued_ahead();
+      out.cuda_finished_ahead += cuda->bands_finished_ahead();
+      out.cuda_dropped_ahead += cuda->bands_dropped_ahead();
+    }
+#endif
+}
 
 using MakeTracer = std::function<std::unique_ptr<core::Tracer>(const std::string&)>;
 
@@ -167,6 +184,7 @@ Rendered render_sequence(const std::vector<std::string>& tracer_names, const std
   }
   take(pipeline.drain());
   count_ahead(made, out);
+  count_cuda_ahead(made, out);
   return out;
 }
 
@@ -292,6 +310,59 @@ TEST(FramesInFlightAgreement, OpenCLWithCentreRayAuxPlanesDrawsTheSameFramesAndP
     moving += std::any_of(a.motion.begin(), a.motion.end(), [](float m) { return m != 0.0f; });
   }
   EXPECT_GT(moving, kFrames / 2) << "the camera turns: motion vectors should not all be 0";
+}
+
+// With two in flight each CUDA tracer enqueues its next band while the band before renders (CudaTracer's
+// enqueue ahead), the next commit applied first: materials every frame, the walker posed on the GPU, its
+// instance and the TLAS. Two CUDA tracers on the first GPU, each band's rows the same either way (the even
+// split): the same bits as with one in flight, in float bands, in packed RGB9E5 bands and with the
+// centre-ray aux planes (whose texels of the band before may still be going down when the next band's
+// kernel writes its own); and the bands were enqueued ahead and taken by their jobs. Switched off
+// (COHORT_CUDA_ENQUEUE_AHEAD=0), nothing goes ahead.
+TEST(FramesInFlightAgreement, CudaDrawsTheSameFramesWithItsBandsEnqueuedAhead) {
+  if (!tracer_runs_here("cuda")) GTEST_SKIP() << "needs a CUDA GPU";
+  struct Case {
+    const char* label;
+    kuint aux;
+    core::BandFormat format;
+  };
+  for (const Case& c : {Case{"float bands", 0u, core::BandFormat::rgba32f},
+                        Case{"RGB9E5 bands", 0u, core::BandFormat::rgb9e5},
+                        Case{"centre-ray aux planes", kuint(K_AUX_CENTRE_RAY), core::BandFormat::rgba32f}}) {
+    Extras extras;
+    extras.move_walker = true;
+    extras.aux = c.aux;
+    extras.band_format = c.format;
+    const Rendered one = render_sequence({"cuda", "cuda"}, "none", 1, extras);
+    const Rendered two = render_sequence({"cuda", "cuda"}, "none", 2, extras);
+    expect_same_frames(one, two, true, std::string("cuda,cuda, ") + c.label);
+    EXPECT_EQ(one.cuda_enqueued_ahead, 0u) << c.label << ": one frame in flight has no next job to enqueue";
+    EXPECT_GE(two.cuda_finished_ahead, 4u) << c.label << ": bands were not enqueued ahead";
+    EXPECT_EQ(two.cuda_finished_ahead, two.cuda_enqueued_ahead) << c.label << ": a band enqueued ahead was not taken";
+    EXPECT_EQ(two.cuda_dropped_ahead, 0u) << c.label;
+    if (c.aux) {
+      ASSERT_EQ(two.planes.size(), size_t(kFrames));
+      for (int f = 0; f < kFrames; ++f) {
+        EXPECT_EQ(one.planes[f].depth, two.planes[f].depth) << c.label << ", frame " << f;
+        EXPECT_EQ(one.planes[f].motion, two.planes[f].motion) << c.label << ", frame " << f;
+        EXPECT_EQ(one.planes[f].normal, two.planes[f].normal) << c.label << ", frame " << f;
+        EXPECT_EQ(one.planes[f].id, two.planes[f].id) << c.label << ", frame " << f;
+      }
+    }
+  }
+#ifdef COHORT_HAVE_CUDA
+  Extras off;
+  off.move_walker = true;
+  off.make = [](const std::string& name) -> std::unique_ptr<core::Tracer> {
+    auto tracer = make_test_tracer(name);
+    if (auto* cuda = dynamic_cast<tracers::CudaTracer*>(tracer.get())) cuda->set_enqueue_ahead(false);
+    return tracer;
+  };
+  const Rendered without = render_sequence({"cuda", "cuda"}, "none", 2, off);
+  const Rendered one = render_sequence({"cuda", "cuda"}, "none", 1, Extras{true});
+  expect_same_frames(one, without, true, "cuda,cuda, enqueue ahead off");
+  EXPECT_EQ(without.cuda_enqueued_ahead, 0u);
+#endif
 }
 
 #ifdef COHORT_HAVE_OPENCL

@@ -3,8 +3,13 @@
 #include <cuda_runtime.h>
 
 #include <algorithm>
+#include <atomic>
+#include <chrono>
 #include <cstdlib>
 #include <cstring>
+#include <memory>
+#include <mutex>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -42,13 +47,50 @@ PciBusId cuda_device_pci_bus_id(int device) {
   return PciBusId::of(unsigned(prop.pciDomainID), unsigned(prop.pciBusID), unsigned(prop.pciDeviceID));
 }
 
+struct CudaTracer::BandSlot {
+  cudaEvent_t start = nullptr, stop = nullptr, finished = nullptr;
+  cudaEvent_t counted = nullptr;     // after its row counts' and ray totals' copies: the band is all back
+  cudaEvent_t aux_copied = nullptr;  // on aux_copy_stream, once its aux texels went down
+  unsigned* row_rays = nullptr;      // page-locked, row_rays_capacity rows
+  size_t row_rays_capacity = 0;
+  unsigned long long* counts = nullptr;  // page-locked: closest, occlusion
+};
+
+// A band whose commands are all on the tracer's stream, until its finish.
+struct CudaTracer::EnqueuedBand {
+  core::BandJob job;
+  core::BandBuffer* target = nullptr;
+  BandSlot* slot = nullptr;
+  size_t rows = 0;
+  bool wait_aux_copy = false;
+  std::optional<core::DeviceBand> kept;  // where it stays on the GPU (BandJob::keep_on_device)
+  // Whether it has ended (its counters back); a failed band counts as ended.
+  bool ended() const { return cudaEventQuery(slot->counted) != cudaErrorNotReady; }
+};
+
 struct CudaTracer::Impl {
   int device = 0;
   std::string name;
   cudaStream_t stream = nullptr;
   // The aux planes' download runs here, on the copy engine, while the band's kernel runs on `stream`.
   cudaStream_t aux_copy_stream = nullptr;
-  cudaEvent_t start = nullptr, stop = nullptr, finished = nullptr, aux_ready = nullptr;
+  cudaEvent_t aux_ready = nullptr;
+  // A band's clock and its counters' way back, two slots used in turn: with enqueue ahead the next band's
+  // commands are on the stream while the band before finishes from the other slot.
+  BandSlot slots[2];
+  int next_slot = 0;
+  // The aux texels' copy of the band before (its slot's aux_copied), which a band that writes the same
+  // texels waits for on the stream; null when none is pending.
+  cudaEvent_t aux_copy_before = nullptr;
+  // Enqueue ahead (CudaTracer::set_enqueue_ahead): the next band, enqueued while the band before renders,
+  // until render_band takes it; whether a commit is being applied ahead (the band before still running).
+  bool enqueue_ahead = enabled_unless_zero("COHORT_CUDA_ENQUEUE_AHEAD");
+  bool applying_ahead = false;
+  std::optional<EnqueuedBand> ahead;
+  std::atomic<size_t> enqueued_ahead{0}, finished_ahead{0}, dropped_ahead{0};
+  // Wakes a worker waiting for its next job once a band is back (cudaLaunchHostFunc on a stream of its own
+  // that waits for the band, so that the host function holds no band's stream).
+  cudaStream_t signal_stream = nullptr;
   // render_band_in_pieces: per piece, its rows rendered (the copy stream waits for it) and downloaded.
   std::vector<cudaEvent_t> piece_rendered, piece_downloaded;
   DeviceArray<KVertex> vertices;
@@ -120,7 +162,6 @@ struct CudaTracer::Impl {
   unsigned long long* ray_counts = nullptr;   // device: closest, occlusion
   unsigned* row_rays = nullptr;                // device: rays per band row (the balancer's per-row work)
   size_t row_rays_capacity = 0;                // rows
-  std::vector<unsigned> host_row_rays;
   RayCounts last_counts;
   size_t band_capacity = 0;   // pixels
   // The targets the band is copied into, page-locked (cudaHostRegister) so that the copy is a true
@@ -170,25 +211,43 @@ struct CudaTracer::Impl {
     }
   }
 
-  // The band's end: its counters back once the stream has drained (with `wait_aux_copy`, the aux copy
-  // stream too), the ray totals kept, and the kernels' device time and per-row work in the result.
-  core::BandResult finish_band(size_t rows, bool wait_aux_copy) {
-    host_row_rays.resize(rows);
-    COHORT_CUDA(cudaEventRecord(finished, stream));  // the band's way back (after `stop`) is queued before this
-    COHORT_CUDA(cudaMemcpyAsync(host_row_rays.data(), row_rays, rows * sizeof(unsigned), cudaMemcpyDeviceToHost, stream));
-    unsigned long long counts[2] = {0, 0};
-    if (count_rays) COHORT_CUDA(cudaMemcpyAsync(counts, ray_counts, sizeof counts, cudaMemcpyDeviceToHost, stream));
-    COHORT_CUDA(cudaStreamSynchronize(stream));
-    if (wait_aux_copy) COHORT_CUDA(cudaStreamSynchronize(aux_copy_stream));
-    last_counts = RayCounts{counts[0], counts[1]};
+  BandSlot& take_slot() {
+    BandSlot& s = slots[next_slot];
+    next_slot ^= 1;
+    return s;
+  }
+  // The band's end on the stream: its counters copied into the slot's page-locked memory behind its way
+  // back, then the slot's `counted`.
+  void end_band(BandSlot& s, size_t rows) {
+    if (rows > s.row_rays_capacity) {
+      if (s.row_rays) COHORT_CUDA(cudaFreeHost(s.row_rays));
+      s.row_rays = nullptr;
+      COHORT_CUDA(cudaMallocHost(&s.row_rays, rows * sizeof(unsigned)));
+      s.row_rays_capacity = rows;
+    }
+    if (!s.counts) COHORT_CUDA(cudaMallocHost(&s.counts, 2 * sizeof(unsigned long long)));
+    COHORT_CUDA(cudaEventRecord(s.finished, stream));  // the band's way back (after `stop`) is queued before this
+    COHORT_CUDA(cudaMemcpyAsync(s.row_rays, row_rays, rows * sizeof(unsigned), cudaMemcpyDeviceToHost, stream));
+    if (count_rays)
+      COHORT_CUDA(cudaMemcpyAsync(s.counts, ray_counts, 2 * sizeof(unsigned long long), cudaMemcpyDeviceToHost, stream));
+    COHORT_CUDA(cudaEventRecord(s.counted, stream));
+  }
+  // Waits for the band (with wait_aux_copy, its aux texels' copy too): the ray totals kept, and the kernels'
+  // device time, its way back and the per-row work in the result.
+  core::BandResult finish_band(const EnqueuedBand& b) {
+    BandSlot& s = *b.slot;
+    COHORT_CUDA(cudaEventSynchronize(s.counted));
+    if (b.wait_aux_copy) COHORT_CUDA(cudaEventSynchronize(s.aux_copied));
+    last_counts = count_rays ? RayCounts{s.counts[0], s.counts[1]} : RayCounts{};
     float kernel_ms = 0.0f;
-    COHORT_CUDA(cudaEventElapsedTime(&kernel_ms, start, stop));
+    COHORT_CUDA(cudaEventElapsedTime(&kernel_ms, s.start, s.stop));
     float transfer_ms = 0.0f;
-    COHORT_CUDA(cudaEventElapsedTime(&transfer_ms, stop, finished));
+    COHORT_CUDA(cudaEventElapsedTime(&transfer_ms, s.stop, s.finished));
     core::BandResult result;
     result.device_ms = kernel_ms;
     result.transfer_ms = transfer_ms;
-    result.row_work.assign(host_row_rays.begin(), host_row_rays.end());
+    result.row_work.assign(s.row_rays, s.row_rays + b.rows);
+    if (b.kept) result.device = *b.kept;
     return result;
   }
 
@@ -245,9 +304,14 @@ CudaTracer::CudaTracer(int device) : impl_(std::make_unique<Impl>()) {
   COHORT_CUDA(cudaSetDevice(device));
   COHORT_CUDA(cudaStreamCreateWithFlags(&impl_->stream, cudaStreamNonBlocking));
   COHORT_CUDA(cudaStreamCreateWithFlags(&impl_->aux_copy_stream, cudaStreamNonBlocking));
-  COHORT_CUDA(cudaEventCreate(&impl_->start));
-  COHORT_CUDA(cudaEventCreate(&impl_->stop));
-  COHORT_CUDA(cudaEventCreate(&impl_->finished));
+  COHORT_CUDA(cudaStreamCreateWithFlags(&impl_->signal_stream, cudaStreamNonBlocking));
+  for (BandSlot& s : impl_->slots) {
+    COHORT_CUDA(cudaEventCreate(&s.start));
+    COHORT_CUDA(cudaEventCreate(&s.stop));
+    COHORT_CUDA(cudaEventCreate(&s.finished));
+    COHORT_CUDA(cudaEventCreateWithFlags(&s.counted, cudaEventDisableTiming));
+    COHORT_CUDA(cudaEventCreateWithFlags(&s.aux_copied, cudaEventDisableTiming));
+  }
   COHORT_CUDA(cudaEventCreateWithFlags(&impl_->aux_ready, cudaEventDisableTiming));
   COHORT_CUDA(cudaEventCreateWithFlags(&impl_->wave_lanes.forked, cudaEventDisableTiming));
   set_wave_lanes(wave_lanes_from_environment());
@@ -255,14 +319,19 @@ CudaTracer::CudaTracer(int device) : impl_(std::make_unique<Impl>()) {
 
 CudaTracer::~CudaTracer() {
   cudaSetDevice(impl_->device);
+  // A band enqueued ahead whose job never came writes into its target until it ends.
+  if (impl_->ahead) cudaEventSynchronize(impl_->ahead->slot->counted);
   if (impl_->texel_texture) cudaDestroyTextureObject(impl_->texel_texture);
   if (impl_->band) cudaFree(impl_->band);
   if (impl_->band_packed) cudaFree(impl_->band_packed);
   if (impl_->ray_counts) cudaFree(impl_->ray_counts);
   if (impl_->row_rays) cudaFree(impl_->row_rays);
-  if (impl_->start) cudaEventDestroy(impl_->start);
-  if (impl_->stop) cudaEventDestroy(impl_->stop);
-  if (impl_->finished) cudaEventDestroy(impl_->finished);
+  for (const BandSlot& s : impl_->slots) {
+    for (cudaEvent_t e : {s.start, s.stop, s.finished, s.counted, s.aux_copied})
+      if (e) cudaEventDestroy(e);
+    if (s.row_rays) cudaFreeHost(s.row_rays);
+    if (s.counts) cudaFreeHost(s.counts);
+  }
   if (impl_->aux_ready) cudaEventDestroy(impl_->aux_ready);
   for (cudaEvent_t e : impl_->piece_rendered) cudaEventDestroy(e);
   for (cudaEvent_t e : impl_->piece_downloaded) cudaEventDestroy(e);
@@ -273,6 +342,7 @@ CudaTracer::~CudaTracer() {
     if (lanes.joined[lane]) cudaEventDestroy(lanes.joined[lane]);
   }
   if (impl_->stream) cudaStreamDestroy(impl_->stream);
+  if (impl_->signal_stream) cudaStreamDestroy(impl_->signal_stream);
   if (impl_->aux_copy_stream) cudaStreamDestroy(impl_->aux_copy_stream);
 }
 
@@ -284,6 +354,10 @@ void CudaTracer::upload(const commit::ChangeSet& changes) {
   const commit::TracerScene& scene = this->scene();
   const bool all = changes.full_resync;
   cudaStream_t s = m.stream;
+  // Applied ahead (enqueue_next_ahead), the band before may still run. Copies and kernels on the stream come
+  // after it in order (a grown array's cudaFree waits for the device); a new texel texture does not (its
+  // object destroyed, the kernels' constant rewritten), so that and a full resync wait for the band first.
+  if (m.applying_ahead && (all || changes.textures)) COHORT_CUDA(cudaStreamSynchronize(s));
   if (all || changes.geometry) {
     // Appended BLASes upload only their new tail; anything else re-sends the array.
     m.vertices.upload(scene.vertices, all ? 0 : changes.vertices_from, s);
@@ -344,25 +418,103 @@ void CudaTracer::upload(const commit::ChangeSet& changes) {
   COHORT_CUDA(cudaStreamSynchronize(s));
 }
 
+namespace {
+
+bool same_job(const core::BandJob& a, const core::BandJob& b) {
+  return std::memcmp(&a.params, &b.params, sizeof a.params) == 0 && std::memcmp(&a.camera, &b.camera, sizeof a.camera) == 0 &&
+         std::memcmp(&a.previous_camera, &b.previous_camera, sizeof a.previous_camera) == 0 &&
+         a.keep_on_device == b.keep_on_device;
+}
+
+// Set by a host function the driver runs once a band is back (on a thread of its own, maybe after the
+// band's wait has returned): while armed, it wakes the worker waiting for the next job.
+struct BandSignal {
+  std::atomic<bool> done{false};
+  std::mutex mutex;
+  bool armed = true;
+  const core::Tracer* tracer = nullptr;
+  void fire() {
+    done = true;
+    std::lock_guard lock(mutex);
+    if (armed) tracer->wake_queued_next();
+  }
+  void disarm() {
+    std::lock_guard lock(mutex);
+    armed = false;
+  }
+};
+
+void CUDART_CB band_back(void* user) {
+  auto* signal = static_cast<std::shared_ptr<BandSignal>*>(user);
+  (*signal)->fire();
+  delete signal;
+}
+
+}  // namespace
+
 core::BandResult CudaTracer::render_band(const core::BandJob& job, core::BandBuffer& target) {
   Impl& m = *impl_;
   COHORT_CUDA(cudaSetDevice(m.device));
   if (!has_scene()) throw std::runtime_error(m.name + ": render_band before any commit was applied");
+  using Clock = std::chrono::steady_clock;
+  const auto entry = Clock::now();
+  std::optional<EnqueuedBand> band;
+  if (m.ahead) {
+    if (m.ahead->target == &target && same_job(m.ahead->job, job)) {
+      band = std::move(m.ahead);
+      m.ahead.reset();
+      ++m.finished_ahead;
+    } else {
+      drop_enqueued_ahead();
+    }
+  }
+  const bool went_ahead = band.has_value();
+  if (!band) band = enqueue_band(job, target);
+  if (band->rows == 0) return {};
+  const auto enqueued = Clock::now();
+  try {
+    enqueue_next_ahead(*band);
+  } catch (...) {
+    // Nothing of this band may still be landing in the target once it is given up.
+    cudaEventSynchronize(band->slot->counted);
+    if (band->wait_aux_copy) cudaEventSynchronize(band->slot->aux_copied);
+    throw;
+  }
+  core::BandResult result = m.finish_band(*band);
+  // A band that could not go ahead (its job came after the band before had ended) costs the balancer its wall
+  // time less its enqueueing, as a band that went ahead does. Else a GPU whose bands end before the frame's
+  // slowest one gets its jobs too late to go ahead, looks slower by its enqueueing, keeps fewer rows and so
+  // keeps ending early: the OpenCL tracer's late-job cost (nvidia-h100-x4, four GPUs: one such GPU fell to a
+  // sliver of the rows and was benched by the sit-out trial, 0.98 ms a frame against 0.70).
+  if (m.enqueue_ahead && !went_ahead && m.enqueued_ahead.load() > 0) {
+    const auto ms = [](Clock::time_point a, Clock::time_point b) { return std::chrono::duration<double, std::milli>(b - a).count(); };
+    result.balance_ms = std::max(1e-3, ms(entry, Clock::now()) - ms(entry, enqueued));
+  }
+  return result;
+}
+
+CudaTracer::EnqueuedBand CudaTracer::enqueue_band(const core::BandJob& job, core::BandBuffer& target) {
+  Impl& m = *impl_;
+  EnqueuedBand b;
+  b.job = job;
+  b.target = &target;
   const KFrameParams params = frame_params(job);
   const KCamera& camera = job.camera;
-  if (params.row_end <= params.row_begin) return {};
+  if (params.row_end <= params.row_begin) return b;
   if (camera.width != kuint(target.width()) || params.row_end > kuint(target.height()))
     throw std::invalid_argument(m.name + ": band does not fit the frame buffer");
   const size_t pixels = size_t(camera.width) * (params.row_end - params.row_begin);
   const bool packed = target.format() != core::BandFormat::rgba32f;
   const size_t rows = params.row_end - params.row_begin;
+  b.rows = rows;
+  b.slot = &m.take_slot();
   m.prepare_band(pixels, rows, packed);
   // Kept on the GPU, the band skips both copies: nothing goes down, and the post-processing takes it
   // device to device (or over NVLink from a peer).
   Impl::KeptBand* kept = job.keep_on_device >= 0 ? &m.kept[m.next_kept] : nullptr;
   if (kept) m.next_kept = (m.next_kept + 1) % Impl::kKeptBands;
   else m.register_target(target);
-  COHORT_CUDA(cudaEventRecord(m.start, m.stream));
+  COHORT_CUDA(cudaEventRecord(b.slot->start, m.stream));
   const bool write_aux = params.aux_outputs != 0u && target.has_aux();
   const bool aux_from_paths = write_aux && k_aux_from_paths(&params);
   KAuxHistory history{};
@@ -375,6 +527,8 @@ core::BandResult CudaTracer::render_band(const core::BandJob& job, core::BandBuf
     COHORT_CUDA(cudaStreamWaitEvent(m.aux_copy_stream, m.aux_ready, 0));
     COHORT_CUDA(cudaMemcpyAsync(target.aux_row(int(params.row_begin)), texels, pixels * sizeof(KAuxTexel),
                                 cudaMemcpyDeviceToHost, m.aux_copy_stream));
+    COHORT_CUDA(cudaEventRecord(b.slot->aux_copied, m.aux_copy_stream));
+    m.aux_copy_before = b.slot->aux_copied;
   };
   if (write_aux) {
     m.previous_transforms.upload(previous_transforms(), 0, m.stream);
@@ -386,6 +540,8 @@ core::BandResult CudaTracer::render_band(const core::BandJob& job, core::BandBuf
     history.joints = previous_joints().empty() ? nullptr : m.previous_joints.data();
     history.skin_count = static_cast<kuint>(scene().skins.size());
     texels = kept ? kept->aux.scratch(pixels) : m.aux_texels.scratch(pixels);
+    // The band before's texels may still be going down (it was enqueued ahead of this one's job).
+    if (!kept && m.aux_copy_before) COHORT_CUDA(cudaStreamWaitEvent(m.stream, m.aux_copy_before, 0));
     // Centre rays: a short kernel of their own before the band's, whose texels go down while it runs.
     if (!aux_from_paths) {
       launch_aux_band(m.view(params), params, camera, previous, history, texels, m.stream);
@@ -400,7 +556,7 @@ core::BandResult CudaTracer::render_band(const core::BandJob& job, core::BandBuf
     launch_aux_from_first_hits(m.view(params), params, camera, previous, history, first_hits, texels, m.stream);
     if (!kept) download_aux();
   }
-  COHORT_CUDA(cudaEventRecord(m.stop, m.stream));
+  COHORT_CUDA(cudaEventRecord(b.slot->stop, m.stream));
   // The band's rows are contiguous in the target: one copy straight into place, in its format.
   const size_t colour_bytes = pixels * core::bytes_per_pixel(target.format());
   const void* source = m.band;
@@ -414,9 +570,66 @@ core::BandResult CudaTracer::render_band(const core::BandJob& job, core::BandBuf
   }
   if (!kept)
     COHORT_CUDA(cudaMemcpyAsync(target.row(int(params.row_begin)), source, colour_bytes, cudaMemcpyDeviceToHost, m.stream));
-  core::BandResult result = m.finish_band(rows, write_aux && !kept);
-  if (kept) result.device = {m.device, source, write_aux ? kept->aux.data() : nullptr};
-  return result;
+  m.end_band(*b.slot, rows);
+  b.wait_aux_copy = write_aux && !kept;
+  if (kept) b.kept = core::DeviceBand{m.device, source, write_aux ? kept->aux.data() : nullptr};
+  return b;
+}
+
+void CudaTracer::enqueue_next_ahead(const EnqueuedBand& current) {
+  Impl& m = *impl_;
+  if (!m.enqueue_ahead || m.ahead) return;
+  // The worker waits for the next job until the current band is back: a host function the driver runs then
+  // wakes it (it also looks at the band's event every millisecond).
+  auto signal = std::make_shared<BandSignal>();
+  signal->tracer = this;
+  auto* user = new std::shared_ptr<BandSignal>(signal);
+  if (cudaStreamWaitEvent(m.signal_stream, current.slot->counted, 0) != cudaSuccess ||
+      cudaLaunchHostFunc(m.signal_stream, band_back, user) != cudaSuccess) {
+    cudaGetLastError();
+    delete user;
+  }
+  struct Disarm {
+    BandSignal& signal;
+    ~Disarm() { signal.disarm(); }
+  } disarm{*signal};
+  const BandDone band_done = [&] { return signal->done.load() || current.ended(); };
+  // The next job's commit is applied inside queued_next, on this thread, while the current band runs
+  // (upload() knows: what cannot wait in the stream's order waits for the band first).
+  struct Applying {
+    bool& flag;
+    explicit Applying(bool& f) : flag(f) { flag = true; }
+    ~Applying() { flag = false; }
+  };
+  std::optional<QueuedNext> next;
+  {
+    Applying applying(m.applying_ahead);
+    next = queued_next(band_done);
+  }
+  if (!next) return;
+  // A target not yet page-locked: registering it may let go of the oldest registration, which the current
+  // band may still be copying into; so the current band ends first.
+  if (next->job.keep_on_device < 0 && !(m.registered.contains(next->target->data(), next->target->bytes()) &&
+                                        (!next->target->has_aux() ||
+                                         m.registered.contains(next->target->aux_data(), next->target->aux_bytes())))) {
+    COHORT_CUDA(cudaEventSynchronize(current.slot->counted));
+    if (current.wait_aux_copy) COHORT_CUDA(cudaEventSynchronize(current.slot->aux_copied));
+  }
+  EnqueuedBand b = enqueue_band(next->job, *next->target);
+  if (b.rows == 0) return;
+  m.ahead = std::move(b);
+  ++m.enqueued_ahead;
+}
+
+bool CudaTracer::enqueues_ahead() const { return impl_->enqueue_ahead; }
+
+void CudaTracer::drop_enqueued_ahead() {
+  Impl& m = *impl_;
+  if (!m.ahead) return;
+  COHORT_CUDA(cudaEventSynchronize(m.ahead->slot->counted));
+  if (m.ahead->wait_aux_copy) COHORT_CUDA(cudaEventSynchronize(m.ahead->slot->aux_copied));
+  m.ahead.reset();
+  ++m.dropped_ahead;
 }
 
 core::BandResult CudaTracer::render_band_in_pieces(const core::BandJob& job, core::BandBuffer& target,
@@ -425,6 +638,7 @@ core::BandResult CudaTracer::render_band_in_pieces(const core::BandJob& job, cor
   const bool write_aux = job.params.aux_outputs != 0u && target.has_aux();
   if (cuts.size() < 3 || write_aux) return core::Tracer::render_band_in_pieces(job, target, cuts, ready);
   COHORT_CUDA(cudaSetDevice(m.device));
+  drop_enqueued_ahead();  // pieces are not enqueued ahead (a remote node's bands)
   if (!has_scene()) throw std::runtime_error(m.name + ": render_band before any commit was applied");
   const KFrameParams params = frame_params(job);
   const KCamera& camera = job.camera;
@@ -454,7 +668,12 @@ core::BandResult CudaTracer::render_band_in_pieces(const core::BandJob& job, cor
   // piece i + 1.
   const size_t pixel_bytes = core::bytes_per_pixel(target.format());
   const WavefrontScratch* wave = m.wave(pixels, params);  // the pieces take turns with it on `stream`
-  COHORT_CUDA(cudaEventRecord(m.start, m.stream));
+  EnqueuedBand b;
+  b.job = job;
+  b.target = &target;
+  b.rows = rows;
+  b.slot = &m.take_slot();
+  COHORT_CUDA(cudaEventRecord(b.slot->start, m.stream));
   for (size_t i = 0; i < pieces; ++i) {
     KFrameParams piece = params;
     piece.row_begin = kuint(cuts[i]);
@@ -478,7 +697,8 @@ core::BandResult CudaTracer::render_band_in_pieces(const core::BandJob& job, cor
                                   m.aux_copy_stream));
     COHORT_CUDA(cudaEventRecord(m.piece_downloaded[i], m.aux_copy_stream));
   }
-  COHORT_CUDA(cudaEventRecord(m.stop, m.stream));
+  COHORT_CUDA(cudaEventRecord(b.slot->stop, m.stream));
+  m.end_band(*b.slot, rows);
   try {
     for (size_t i = 0; i < pieces; ++i) {
       COHORT_CUDA(cudaEventSynchronize(m.piece_downloaded[i]));
@@ -490,14 +710,19 @@ core::BandResult CudaTracer::render_band_in_pieces(const core::BandJob& job, cor
     cudaStreamSynchronize(m.aux_copy_stream);
     throw;
   }
-  // Only now: these small copies go to pageable memory, and such a copy returns only once it is done,
-  // which would hold every piece back until the last kernel.
-  return m.finish_band(rows, false);
+  return m.finish_band(b);
 }
 
 void CudaTracer::set_ray_counting(bool on) { impl_->count_rays = on; }
 void CudaTracer::set_wavefront(bool on) { impl_->wavefront = on; }
 void CudaTracer::set_shadow_walk(bool on) { impl_->shadow_walk = on; }
+void CudaTracer::set_enqueue_ahead(bool on) {
+  if (!on) drop_enqueued_ahead();
+  impl_->enqueue_ahead = on;
+}
+size_t CudaTracer::bands_enqueued_ahead() const { return impl_->enqueued_ahead.load(); }
+size_t CudaTracer::bands_finished_ahead() const { return impl_->finished_ahead.load(); }
+size_t CudaTracer::bands_dropped_ahead() const { return impl_->dropped_ahead.load(); }
 void CudaTracer::set_wave_lanes(int lanes) {
   if (lanes < 1 || lanes > kMaxWaveLanes)
     throw std::invalid_argument(impl_->name + ": wave lanes " + std::to_string(lanes) + " (expected 1 to " +

@@ -26,6 +26,12 @@ class HostRegistrations {
   // `what` names the range in the one warning logged when the driver refuses to page-lock it (the
   // copies then run at pageable speed: a third of the bus on an H100, measured).
   void ensure(const void* ptr, size_t bytes, const char* what);
+  // Whether exactly this range is registered (ensure() would change nothing).
+  bool contains(const void* ptr, size_t bytes) const {
+    for (const Slot& s : slots_)
+      if (s.ptr == ptr && s.bytes == bytes) return true;
+    return false;
+  }
 
  private:
   struct Slot {

@@ -47,6 +47,16 @@ class CudaTracer final : public TracerBase {
   // lane's kernels fill the GPU while another's drain (default: COHORT_CUDA_WAVE_LANES, else 2). The image
   // is the same for any count.
   void set_wave_lanes(int lanes);
+  // With two frames in flight, the next band's commands (its commit applied first) are enqueued while the
+  // current band renders (core::Tracer::enqueues_ahead), so that its kernels follow on the GPU without the
+  // host's turn-around between bands (docs/balancing.md). On unless COHORT_CUDA_ENQUEUE_AHEAD=0.
+  void set_enqueue_ahead(bool on);
+  bool enqueues_ahead() const override;
+  void drop_enqueued_ahead() override;
+  // Bands enqueued ahead, those their job then found enqueued, and those dropped (their job never came).
+  size_t bands_enqueued_ahead() const;
+  size_t bands_finished_ahead() const;
+  size_t bands_dropped_ahead() const;
   bool shadow_walk() const;
   RayCounts last_ray_counts() const;
   int device() const;
@@ -54,6 +64,13 @@ class CudaTracer final : public TracerBase {
  private:
   void upload(const commit::ChangeSet& changes) override;
   bool skins_on_device() const override { return true; }
+
+  struct BandSlot;
+  struct EnqueuedBand;
+  // The band's commands on the stream (render_band's first half); a band of no rows enqueues nothing.
+  EnqueuedBand enqueue_band(const core::BandJob& job, core::BandBuffer& target);
+  // With enqueue ahead: waits for the next job until `current` is back, and enqueues it.
+  void enqueue_next_ahead(const EnqueuedBand& current);
 
   struct Impl;
   std::unique_ptr<Impl> impl_;
