@@ -484,8 +484,8 @@ core::BandResult CudaTracer::render_band(const core::BandJob& job, core::BandBuf
   // A band that could not go ahead (its job came after the band before had ended) costs the balancer its wall
   // time less its enqueueing, as a band that went ahead does. Else a GPU whose bands end before the frame's
   // slowest one gets its jobs too late to go ahead, looks slower by its enqueueing, keeps fewer rows and so
-  // keeps ending early: the OpenCL tracer's late-job cost (nvidia-h100-x4, four GPUs: one such GPU fell to a
-  // sliver of the rows and was benched by the sit-out trial, 0.98 ms a frame against 0.70).
+  // keeps ending early: the OpenCL tracer's late-job cost (nvidia-h100-x4, four GPUs, without it: in one of two
+  // runs a GPU fell to half an even share or less, the sit-out trial benched it, 0.98 ms a frame against 0.70).
   if (m.enqueue_ahead && !went_ahead && m.enqueued_ahead.load() > 0) {
     const auto ms = [](Clock::time_point a, Clock::time_point b) { return std::chrono::duration<double, std::milli>(b - a).count(); };
     result.balance_ms = std::max(1e-3, ms(entry, Clock::now()) - ms(entry, enqueued));
