@@ -278,6 +278,7 @@ PY
     ;;
   compare)
     # Each payload unpacks into .gpu/cmp/NAME (NAME: its file name without .tar.xz; the staged one is "new").
+    # COHORT_GPU_TRACERS: the tracers of the timed runs (default cuda:0).
     [ $# -ge 2 ] || { echo "usage: gpu_run.sh compare BASE_PAYLOAD.tar.xz [MORE.tar.xz ...]"; exit 2; }
     shift
     names=()
@@ -303,8 +304,9 @@ PY
           if [ $map = large ]; then args=(/tmp/cmp_${name}_large.cpk --width 1920 --height 1080 --camera 1690 300 80 5 -12)
           else args=(/tmp/cmp_${name}_test.cpk --width 1280 --height 720); fi
           run=/tmp/cmp_${name}_${map}_$round
-          "$stage/cmp/$name/bin/cohort" render "${args[@]}" --tracers cuda:0 --spp 1 --bounces 1 --convergence brigade \
-            --frames 60 --camera-path spin-slow ${COHORT_GPU_COMPARE_ARGS:-} --write last --out $run >/dev/null 2>&1
+          "$stage/cmp/$name/bin/cohort" render "${args[@]}" --tracers "${COHORT_GPU_TRACERS:-cuda:0}" --spp 1 --bounces 1 \
+            --convergence brigade --frames 60 --camera-path spin-slow ${COHORT_GPU_COMPARE_ARGS:-} --write last --out $run \
+            >/dev/null 2>&1
           echo "== round $round, $name, $map map: $(python3 tools/frame_times.py $run/stats.json --skip 10 | head -n 1)"
         done
       done
