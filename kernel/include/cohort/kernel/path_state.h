@@ -1,4 +1,4 @@
-/* A path between two of its rays: all the integrator (integrator.h's k_path_hit_queued) carries from one surface
+/* A path between two of its rays: all the integrator (integrator.h's k_path_hit_lit and k_path_vertex_end) carries from one surface
  * to the next. Plain data, so that a wavefront tracer keeps it in memory between the kernel that walks a
  * path's next ray and the one that shades what it met (tracers/cuda, tracers/opencl), where the megakernel keeps it in
  * registers. */
