@@ -9,10 +9,11 @@
 
 typedef struct KLitVertex {
   KSurface sf;          /* as the light samples saw it (regularised after a bounce) */
-  KVec3 dir;            /* the ray that met it */
+  KVec3 wo;             /* toward where the ray came from */
   KVec3 contribution;   /* its emission and environment: the vertex light's base */
   KRng rng;             /* the path's stream after the light samples */
   float path_weight;
+  int emissive_nee;     /* it takes an emissive sample */
 } KLitVertex;
 
 /* k_path_hit_lit's and k_path_segment_lit's answer at such a vertex (beside 0: the path ended, 1: it goes on). */

@@ -1,8 +1,9 @@
 /* A path from its current ray up to its next bounce: what every tracer's loop over k_path_hit_lit and
- * k_path_vertex_end does, written once. The megakernels and the host tracers run a whole path as segments one
- * after the other (integrator.h's k_trace_path); the wavefront tracers (tracers/cuda, tracers/opencl) run one segment per
- * shading kernel, the path waiting in memory (path_state.h) while its next ray is walked by a kernel of its
- * own. integrator.h includes this header once k_path_vertex_end is defined: include integrator.h. */
+ * k_path_vertex_end does, written once. The megakernels and the host tracers run a whole path as segments
+ * one after the other (integrator.h's k_trace_path); the wavefront tracers (tracers/cuda, tracers/opencl)
+ * run one segment per shading kernel, the path waiting in memory (path_state.h) while its next ray is walked
+ * by a kernel of its own. integrator.h includes this header once k_path_hit_queued is defined: include
+ * integrator.h. */
 #ifndef COHORT_KERNEL_PATH_SEGMENT_H
 #define COHORT_KERNEL_PATH_SEGMENT_H
 
@@ -35,12 +36,30 @@ KFN int k_path_segment_lit(KTraceCtx* ctx, const KFrameParams* params, KPathStat
 }
 
 /* Runs the path from its current ray (s->org, s->dir) until it ends (0) or has bounced (1: its next ray in
- * *s): k_path_segment_lit, then the vertex's k_path_vertex_end. Arguments as there. */
+ * *s): k_path_segment_lit's walk with each hit shaded by both halves (k_path_hit_queued), the loop the GPU
+ * kernels were tuned with (the two halves called after the loop spilled twice the bytes, ptxas sm_90).
+ * Arguments as k_path_segment_lit's. */
 KFN int k_path_segment(KTraceCtx* ctx, const KFrameParams* params, KPathState* s, const KHit* traced,
                        KGLOBAL KPathFirstHit* first_hit, KShadowQueue* shadows, KVertexLight* vertex) {
-  KLitVertex lit;
-  int shaded = k_path_segment_lit(ctx, params, s, traced, first_hit, shadows, vertex, &lit);
-  return shaded == K_PATH_VERTEX_LIT ? k_path_vertex_end(ctx, params, s, &lit, 0, shadows, vertex) : shaded;
+  kuint bounce = s->bounce;
+  for (;;) {
+    KHit hit;
+    int met;
+    if (traced) {
+      hit = *traced;
+      met = hit.instance != K_NONE;
+      traced = 0;
+    } else {
+      hit.cost = 0u;
+      met = k_trace_closest(ctx, s->org, s->dir, K_INF, K_RAY_PRIMARY, &hit);
+    }
+    if (!met) {
+      k_path_miss(K_CTX_SCENE(ctx), params, s, &hit);
+      return 0;
+    }
+    if (!k_path_hit_queued(ctx, params, s, hit, first_hit, shadows, vertex)) return 0;
+    if (s->bounce != bounce) return 1;
+  }
 }
 
 #endif
