@@ -355,8 +355,8 @@ KFN void k_path_miss(const KSceneView* scene, const KFrameParams* params, KPathS
 /* The opaque vertex's shading after its Doom 3 lights (the locals of k_path_hit_lit, KLitVertex's fields): its
  * emissive sample (picked here, or ahead: picked, may be null), its light, its bounce. 1 when the path goes on
  * with its bounce ray in s->org and s->dir (s->bounce one more); 0 when it ends. */
-KFN int k_path_vertex_shade(KTraceCtx* ctx, const KFrameParams* params, KPathState* s, const KSurface* sf, KVec3 wo,
-                            KVec3 contribution, float path_weight, KRng rng, int emissive_nee,
+KFN int k_path_vertex_shade(KTraceCtx* ctx, const KFrameParams* params, KPathState* s, const KSurface* sf,
+                            KVec3 wo, KVec3 contribution, float path_weight, KRng rng, int emissive_nee,
                             const KEmissivePick* picked, KShadowQueue* shadows, KVertexLight* vertex) {
   if (emissive_nee) {
     int bounce_follows = params->mode != K_MODE_DIRECT && s->bounce < params->max_bounces;

@@ -36,9 +36,10 @@ KFN int k_path_segment_lit(KTraceCtx* ctx, const KFrameParams* params, KPathStat
 }
 
 /* Runs the path from its current ray (s->org, s->dir) until it ends (0) or has bounced (1: its next ray in
- * *s): k_path_segment_lit's walk with each hit shaded by both halves (k_path_hit_queued), the loop the GPU
- * kernels were tuned with (the two halves called after the loop spilled twice the bytes, ptxas sm_90).
- * Arguments as k_path_segment_lit's. */
+ * *s): k_path_segment_lit's walk with each hit shaded to its end (k_path_hit_queued), what every tracer but
+ * the Embree wavefront runs. Arguments as k_path_segment_lit's. A loop of its own, not k_path_segment_lit
+ * with a null KLitVertex: the GPU kernels compile as before the split only so (ptxas sm_90: the one loop
+ * moved their spills by a few bytes; the two halves called after it, by 40-60 %). */
 KFN int k_path_segment(KTraceCtx* ctx, const KFrameParams* params, KPathState* s, const KHit* traced,
                        KGLOBAL KPathFirstHit* first_hit, KShadowQueue* shadows, KVertexLight* vertex) {
   kuint bounce = s->bounce;
