@@ -29,11 +29,6 @@ __attribute__((noinline, noipa)) static int path_vertex_end(KTraceCtx* ctx, cons
   return k_path_vertex_end(ctx, params, s, lit, picked, shadows, vertex);
 }
 
-// Whether a lit vertex takes an emissive sample (k_path_vertex_end's emissive_nee), so needs a pick.
-static bool takes_emissive_sample(const KSceneView* scene, const KFrameParams* params) {
-  return params->emissive_samples > 0u && scene->emissive_count > 0u;
-}
-
 // The number the vertex's emissive sample picks its triangle with: the first it draws (k_emissive_lighting).
 static float emissive_pick_number(const KLitVertex& lit) {
   KRng rng = lit.rng;

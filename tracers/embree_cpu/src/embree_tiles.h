@@ -75,8 +75,9 @@ struct Arena {
     int pixels[kTilePixels];       // the paths a stage traces rays for
     uint16_t shadows[K_SHADOW_QUEUE_MAX * kTilePixels];  // the shadow rays to trace: pixel * 8 + slot
     // The opaque vertices a shade stage lit, waiting for their emissive picks (all of the stage's at once):
-    // each as k_path_vertex_end takes it, the rays in its shadow queue, and, in the order of lit_paths (their
-    // places in the tile's traced pixels), the picks' points, numbers and results.
+    // each as k_path_vertex_end takes it and the rays in its shadow queue; lit_paths: their places in the
+    // tile's traced pixels, in order; then the picks' points, numbers and results, in the same order for those
+    // of them that take an emissive sample.
     KLitVertex lit[kTilePixels];
     kuint queued[kTilePixels];
     int lit_paths[kTilePixels];
