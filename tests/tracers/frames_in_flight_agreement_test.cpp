@@ -315,10 +315,10 @@ TEST(FramesInFlightAgreement, OpenCLWithCentreRayAuxPlanesDrawsTheSameFramesAndP
 // With two in flight each CUDA tracer enqueues its next band while the band before renders (CudaTracer's
 // enqueue ahead), the next commit applied first: materials every frame, the walker posed on the GPU, its
 // instance and the TLAS. Two CUDA tracers on the first GPU, each band's rows the same either way (the even
-// split): the same bits as with one in flight, in float bands, in packed RGB9E5 bands and with the
-// centre-ray aux planes (whose texels of the band before may still be going down when the next band's
-// kernel writes its own); and the bands were enqueued ahead and taken by their jobs. Switched off
-// (COHORT_CUDA_ENQUEUE_AHEAD=0), nothing goes ahead.
+// split): the same bits as with one in flight, in float bands, in packed RGB9E5 bands and with the aux
+// planes from centre rays and from the paths' first hits (whose texels of the band before may still be
+// going down when the next band's kernel writes its own); and the bands were enqueued ahead and taken by
+// their jobs. Switched off (COHORT_CUDA_ENQUEUE_AHEAD=0), nothing goes ahead.
 TEST(FramesInFlightAgreement, CudaDrawsTheSameFramesWithItsBandsEnqueuedAhead) {
   if (!tracer_runs_here("cuda")) GTEST_SKIP() << "needs a CUDA GPU";
   struct Case {
@@ -328,7 +328,8 @@ TEST(FramesInFlightAgreement, CudaDrawsTheSameFramesWithItsBandsEnqueuedAhead) {
   };
   for (const Case& c : {Case{"float bands", 0u, core::BandFormat::rgba32f},
                         Case{"RGB9E5 bands", 0u, core::BandFormat::rgb9e5},
-                        Case{"centre-ray aux planes", kuint(K_AUX_CENTRE_RAY), core::BandFormat::rgba32f}}) {
+                        Case{"centre-ray aux planes", kuint(K_AUX_CENTRE_RAY), core::BandFormat::rgba32f},
+                        Case{"first-hit aux planes", kuint(K_AUX_PATH_FIRST_HIT), core::BandFormat::rgb9e5}}) {
     Extras extras;
     extras.move_walker = true;
     extras.aux = c.aux;
