@@ -8,7 +8,6 @@
 #include <cstdlib>
 #include <cstring>
 #include <memory>
-#include <mutex>
 #include <optional>
 #include <stdexcept>
 #include <string>
@@ -16,6 +15,7 @@
 
 #include "cohort/kernel/aux_mode.h"
 #include "cohort/kernel/path_state.h"
+#include "cohort/tracers/enqueue_ahead.h"
 #include "device_array.h"
 #include "host_registrations.h"
 #include "render_band_launch.h"
@@ -420,35 +420,8 @@ void CudaTracer::upload(const commit::ChangeSet& changes) {
 
 namespace {
 
-bool same_job(const core::BandJob& a, const core::BandJob& b) {
-  return std::memcmp(&a.params, &b.params, sizeof a.params) == 0 && std::memcmp(&a.camera, &b.camera, sizeof a.camera) == 0 &&
-         std::memcmp(&a.previous_camera, &b.previous_camera, sizeof a.previous_camera) == 0 &&
-         a.keep_on_device == b.keep_on_device;
-}
-
-// Set by a host function the driver runs once a band is back (on a thread of its own, maybe after the
-// band's wait has returned): while armed, it wakes the worker waiting for the next job.
-struct BandSignal {
-  std::atomic<bool> done{false};
-  std::mutex mutex;
-  bool armed = true;
-  const core::Tracer* tracer = nullptr;
-  void fire() {
-    done = true;
-    std::lock_guard lock(mutex);
-    if (armed) tracer->wake_queued_next();
-  }
-  void disarm() {
-    std::lock_guard lock(mutex);
-    armed = false;
-  }
-};
-
-void CUDART_CB band_back(void* user) {
-  auto* signal = static_cast<std::shared_ptr<BandSignal>*>(user);
-  (*signal)->fire();
-  delete signal;
-}
+// The driver runs it once a band is back (cudaLaunchHostFunc).
+void CUDART_CB band_back(void* user) { BandSignal::fire_and_release(user); }
 
 }  // namespace
 
@@ -460,7 +433,7 @@ core::BandResult CudaTracer::render_band(const core::BandJob& job, core::BandBuf
   const auto entry = Clock::now();
   std::optional<EnqueuedBand> band;
   if (m.ahead) {
-    if (m.ahead->target == &target && same_job(m.ahead->job, job)) {
+    if (m.ahead->target == &target && same_band_job(m.ahead->job, job)) {
       band = std::move(m.ahead);
       m.ahead.reset();
       ++m.finished_ahead;
@@ -583,27 +556,19 @@ void CudaTracer::enqueue_next_ahead(const EnqueuedBand& current) {
   // wakes it (it also looks at the band's event every millisecond).
   auto signal = std::make_shared<BandSignal>();
   signal->tracer = this;
-  auto* user = new std::shared_ptr<BandSignal>(signal);
+  void* user = BandSignal::callback_argument(signal);
   if (cudaStreamWaitEvent(m.signal_stream, current.slot->counted, 0) != cudaSuccess ||
       cudaLaunchHostFunc(m.signal_stream, band_back, user) != cudaSuccess) {
     cudaGetLastError();
-    delete user;
+    BandSignal::release(user);
   }
-  struct Disarm {
-    BandSignal& signal;
-    ~Disarm() { signal.disarm(); }
-  } disarm{*signal};
+  const DisarmOnExit disarm{*signal};
   const BandDone band_done = [&] { return signal->done.load() || current.ended(); };
   // The next job's commit is applied inside queued_next, on this thread, while the current band runs
   // (upload() knows: what cannot wait in the stream's order waits for the band first).
-  struct Applying {
-    bool& flag;
-    explicit Applying(bool& f) : flag(f) { flag = true; }
-    ~Applying() { flag = false; }
-  };
   std::optional<QueuedNext> next;
   {
-    Applying applying(m.applying_ahead);
+    const FlagForScope applying(m.applying_ahead);
     next = queued_next(band_done);
   }
   if (!next) return;

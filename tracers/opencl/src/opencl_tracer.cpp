@@ -21,6 +21,7 @@
 #include "cohort/kernel/aux_mode.h"
 #include "cohort/kernel/path_state.h"
 #include "cohort/kernel/shadow_ray.h"
+#include "cohort/tracers/enqueue_ahead.h"
 #include "cohort/tracers/wave_lanes.h"
 #include "opencl_support.h"
 #include "opencl_wavefront.h"
@@ -765,29 +766,8 @@ struct DrainOnThrow {
   }
 };
 
-// Set by the OpenCL runtime's completion callback on a band's last command (on a thread of its own, maybe
-// after the band's wait has returned): while armed, it wakes the worker waiting for the next job.
-struct BandSignal {
-  std::atomic<bool> done{false};
-  std::mutex mutex;
-  bool armed = true;
-  const core::Tracer* tracer = nullptr;
-  void fire() {
-    done = true;
-    std::lock_guard lock(mutex);
-    if (armed) tracer->wake_queued_next();
-  }
-  void disarm() {
-    std::lock_guard lock(mutex);
-    armed = false;
-  }
-};
-
-void CL_CALLBACK band_completed(cl_event, cl_int, void* user) {
-  auto* signal = static_cast<std::shared_ptr<BandSignal>*>(user);
-  (*signal)->fire();
-  delete signal;
-}
+// The OpenCL runtime's completion callback on a band's last command.
+void CL_CALLBACK band_completed(cl_event, cl_int, void* user) { BandSignal::fire_and_release(user); }
 
 bool event_ended(cl_event event) {
   cl_int status = CL_COMPLETE;
@@ -795,11 +775,6 @@ bool event_ended(cl_event event) {
   return status <= CL_COMPLETE;  // complete, or failed (negative)
 }
 
-bool same_job(const core::BandJob& a, const core::BandJob& b) {
-  return std::memcmp(&a.params, &b.params, sizeof a.params) == 0 && std::memcmp(&a.camera, &b.camera, sizeof a.camera) == 0 &&
-         std::memcmp(&a.previous_camera, &b.previous_camera, sizeof a.previous_camera) == 0 &&
-         a.keep_on_device == b.keep_on_device;
-}
 
 }  // namespace
 
@@ -813,7 +788,7 @@ core::BandResult OpenCLTracer::render_band(const core::BandJob& job, core::BandB
   // band's memory goes; the band enqueued ahead, if any, stays for its job.
   DrainOnThrow drain{m.queues()};
   if (m.ahead) {
-    if (m.ahead->target == &target && same_job(m.ahead->job, job)) {
+    if (m.ahead->target == &target && same_band_job(m.ahead->job, job)) {
       band = std::move(m.ahead);
       ++m.finished_ahead;
     } else {
@@ -1016,22 +991,14 @@ void OpenCLTracer::enqueue_next_ahead(const EnqueuedBand& current) {
   const cl_event last = current.last.get();
   auto signal = std::make_shared<BandSignal>();
   signal->tracer = this;
-  auto* user = new std::shared_ptr<BandSignal>(signal);
-  if (clSetEventCallback(last, CL_COMPLETE, band_completed, user) != CL_SUCCESS) delete user;
-  struct Disarm {
-    BandSignal& signal;
-    ~Disarm() { signal.disarm(); }
-  } disarm{*signal};
+  void* user = BandSignal::callback_argument(signal);
+  if (clSetEventCallback(last, CL_COMPLETE, band_completed, user) != CL_SUCCESS) BandSignal::release(user);
+  const DisarmOnExit disarm{*signal};
   const BandDone band_done = [&] { return signal->done.load() || event_ended(last); };
   // The next job's commit is applied inside queued_next, on this thread: its uploads staged, not blocking.
-  struct Applying {
-    bool& flag;
-    explicit Applying(bool& f) : flag(f) { flag = true; }
-    ~Applying() { flag = false; }
-  };
   std::optional<QueuedNext> next;
   {
-    Applying applying(m.applying_ahead);
+    const FlagForScope applying(m.applying_ahead);
     next = queued_next(band_done);
   }
   if (!next) return;
