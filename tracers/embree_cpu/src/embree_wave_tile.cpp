@@ -224,7 +224,7 @@ void COHORT_RENDER_WAVE_TILE(const Frame& frame, const Tile& tile, Arena& a, emb
     // The segments of the paths a stage shades (camera_rays: the paths begin, from their camera rays' hits),
     // then the shadow rays they left. k_path_segment in three steps over all of them: each path up to its opaque
     // vertex's Doom 3 lights (the vertex, its path and shadow queue then wait in the arena), the waiting
-    // vertices' emissive picks and points eight at a time, then each vertex's shading ended.
+    // vertices' emissive picks eight at a time, then each vertex's shading ended.
     auto shade = [&](int camera_rays) {
       KPathFirstHit* records = s == 0u && record_first_hits && camera_rays ? a.first_hits : nullptr;
       int lit = 0, picking = 0;
@@ -249,19 +249,15 @@ void COHORT_RENDER_WAVE_TILE(const Frame& frame, const Tile& tile, Arena& a, emb
           wv.vertices[p] = vertex;
           wv.lit_paths[lit++] = j;
           if (wv.lit[p].emissive_nee) {
-            wv.sample_vertices[picking] = &wv.lit[p];
             wv.pick_points[picking] = wv.lit[p].sf.position;
-            emissive_numbers(wv.lit[p], &wv.pick_numbers[picking], &wv.point_numbers[0][picking],
-                             &wv.point_numbers[1][picking]);
-            ++picking;
+            wv.pick_numbers[picking++] = emissive_pick_number(wv.lit[p]);
           }
           continue;
         }
         k_wave_path_store(params, static_cast<size_t>(p), s, shaded, &path, &shadows, &vertex, wv.band, wv.states,
                           wv.active, wv.vertices, camera_rays);
       }
-      emissive_samples(&ctx.scene, picking, wv.sample_vertices, wv.pick_points, wv.pick_numbers,
-                       wv.point_numbers[0], wv.point_numbers[1], wv.picks, wv.samples);
+      emissive_picks(&ctx.scene, picking, wv.pick_points, wv.pick_numbers, wv.picks);
       for (int i = 0, picked = 0; i < lit; ++i) {
         const int j = wv.lit_paths[i], p = a.traced[j];
         const uint64_t before = ctx.rays;
@@ -273,8 +269,8 @@ void COHORT_RENDER_WAVE_TILE(const Frame& frame, const Tile& tile, Arena& a, emb
                          kTilePixels, 0, shadow_walk, &path, &hit, &shadows);
         shadows.count = wv.queued[p];
         KVertexLight vertex = wv.vertices[p];
-        const KEmissiveSample* sample = wv.lit[p].emissive_nee ? &wv.samples[picked++] : nullptr;
-        const int goes_on = path_vertex_end(&ctx, params, &path, &wv.lit[p], sample, &shadows, &vertex);
+        const KEmissivePick* pick = wv.lit[p].emissive_nee ? &wv.picks[picked++] : nullptr;
+        const int goes_on = path_vertex_end(&ctx, params, &path, &wv.lit[p], pick, &shadows, &vertex);
         k_wave_path_store(params, static_cast<size_t>(p), s, goes_on, &path, &shadows, &vertex, wv.band, wv.states,
                           wv.active, wv.vertices, camera_rays);
         row_rays[p / w] += ctx.rays - before;

@@ -13,7 +13,6 @@
  * Entry point: k_render_pixel(ctx, params, camera, x, y) -> linear RGB averaged over params->spp. */
 #ifndef COHORT_KERNEL_INTEGRATOR_H
 #define COHORT_KERNEL_INTEGRATOR_H
-#include "emissive_sample.h"
 #include "emissive_tree.h"
 #include "emitters.h"
 #include "fog.h"
@@ -225,28 +224,43 @@ KFN float k_emissive_pdf(const KSceneView* scene, KVec3 p, kuint instance, kuint
 }
 
 /* One emissive-triangle sample for next-event estimation: a triangle picked through the emissive tree
- * (near and bright ones first), a uniform point on it (emissive_sample.h), its emission there, one shadow ray
- * (to the queue, which sets the vertex's emissive term when the point is visible). With a bounce to follow
- * from this vertex the value is weighted by the power heuristic against BRDF sampling, which weighs the
- * emission it finds the same way (k_path_hit_lit); without one it stands alone (weight 1). sampled: the
- * pick and point made ahead from this sample's random numbers, or null to make them here. */
+ * (near and bright ones first), a uniform point on it, its emission there, one shadow ray (to the queue,
+ * which sets the vertex's emissive term when the point is visible). With a bounce to follow from this
+ * vertex the value is weighted by the power heuristic against BRDF sampling, which weighs the emission it
+ * finds the same way (k_path_hit_lit); without one it stands alone (weight 1). picked: the pick made
+ * ahead for this sample's first random number, or null to pick here. */
 KFN void k_emissive_lighting(KTraceCtx* ctx, const KSurface* sf, KVec3 wo, int bounce_follows, float shadow_rr,
-                             float path_weight, KRng* rng, const KEmissiveSample* sampled, KShadowQueue* queue,
+                             float path_weight, KRng* rng, const KEmissivePick* picked, KShadowQueue* queue,
                              KVertexLight* vertex) {
   const KSceneView* scene = K_CTX_SCENE(ctx);
   float u_pick = k_rng_next(rng), u1 = k_rng_next(rng), u2 = k_rng_next(rng);
-  KEmissiveSample es;
-  if (sampled) {
-    es = *sampled;
-    if (es.index == K_NONE) return;
+  float pick = 0.0f;
+  kuint index;
+  if (picked) {
+    index = picked->index;
+    pick = picked->prob;
   } else {
-    float pick = 0.0f;
-    kuint index = k_emissive_tree_pick(scene, sf->position, u_pick, &pick);
-    if (!k_emissive_sample_point(scene, sf, wo, index, pick, u1, u2, &es)) return;
+    index = k_emissive_tree_pick(scene, sf->position, u_pick, &pick);
   }
-  KGLOBAL const KEmissiveTriangle* e = &scene->emissive[es.index];
-  float bu = es.bu, bv = es.bv, pdf = es.pdf;
-  KVec3 x = es.x, wi = es.wi, f = es.f;
+  if (index == K_NONE || !(pick > 0.0f)) return;
+  KGLOBAL const KEmissiveTriangle* e = &scene->emissive[index];
+
+  float su = k_sqrt(u1);
+  float bu = su * (1.0f - u2), bv = su * u2;   /* barycentrics of p1 and p2 */
+  KVec3 p0 = v3_load_g(e->p0), p1 = v3_load_g(e->p1), p2 = v3_load_g(e->p2);
+  KVec3 x = v3_add(v3_scale(p0, 1.0f - bu - bv), v3_add(v3_scale(p1, bu), v3_scale(p2, bv)));
+  KVec3 cr = v3_cross(v3_sub(p1, p0), v3_sub(p2, p0));
+  float double_area = v3_length(cr);
+  if (!(double_area > 0.0f)) return;
+  KVec3 to_light = v3_sub(x, sf->position);
+  float dist2 = v3_dot(to_light, to_light);
+  if (!(dist2 > 0.0f)) return;
+  float dist = k_sqrt(dist2);
+  KVec3 wi = v3_scale(to_light, 1.0f / dist);
+  float cos_light = k_fabs(v3_dot(cr, wi)) / double_area;   /* emitters shine from both faces */
+  if (cos_light <= 1e-6f) return;
+  KVec3 f = k_brdf_eval_cos(sf, wo, wi, 1.0f);
+  if (v3_max_component(f) <= 0.0f) return;
 
   KGLOBAL const KMaterial* m = &scene->materials[k_hit_material(scene, e->instance, e->triangle)];
   KVec3 le = v3(m->emissive_color[0], m->emissive_color[1], m->emissive_color[2]);
@@ -258,6 +272,7 @@ KFN void k_emissive_lighting(KTraceCtx* ctx, const KSurface* sf, KVec3 wo, int b
   le = v3_mul(le, v4_rgb(k_hit_vertex_color(scene, e->triangle, bu, bv, m->flags)));
   if (v3_max_component(le) <= 0.0f) return;
 
+  float pdf = pick * 2.0f / double_area * dist2 / cos_light;
   float weight = 1.0f;
   if (bounce_follows)
     weight = k_power_heuristic(pdf, k_brdf_pdf(sf, wo, wi));
@@ -338,14 +353,14 @@ KFN void k_path_miss(const KSceneView* scene, const KFrameParams* params, KPathS
 }
 
 /* The opaque vertex's shading after its Doom 3 lights (the locals of k_path_hit_lit, KLitVertex's fields): its
- * emissive sample (made here, or ahead: sampled, may be null), its light, its bounce. 1 when the path goes on
+ * emissive sample (picked here, or ahead: picked, may be null), its light, its bounce. 1 when the path goes on
  * with its bounce ray in s->org and s->dir (s->bounce one more); 0 when it ends. */
 KFN int k_path_vertex_shade(KTraceCtx* ctx, const KFrameParams* params, KPathState* s, const KSurface* sf,
                             KVec3 wo, KVec3 contribution, float path_weight, KRng rng, int emissive_nee,
-                            const KEmissiveSample* sampled, KShadowQueue* shadows, KVertexLight* vertex) {
+                            const KEmissivePick* picked, KShadowQueue* shadows, KVertexLight* vertex) {
   if (emissive_nee) {
     int bounce_follows = params->mode != K_MODE_DIRECT && s->bounce < params->max_bounces;
-    k_emissive_lighting(ctx, sf, wo, bounce_follows, params->shadow_rr, path_weight, &rng, sampled, shadows,
+    k_emissive_lighting(ctx, sf, wo, bounce_follows, params->shadow_rr, path_weight, &rng, picked, shadows,
                         vertex);
   }
   vertex->throughput = s->throughput;
@@ -379,12 +394,12 @@ KFN int k_path_vertex_shade(KTraceCtx* ctx, const KFrameParams* params, KPathSta
 }
 
 /* The opaque vertex's shading after its Doom 3 lights, from what k_path_hit_lit left in *lit (the emissive
- * sample's pick and point made ahead: sampled, may be null). 1 when the path goes on with its bounce ray in s->org and s->dir
+ * pick made ahead: picked, may be null). 1 when the path goes on with its bounce ray in s->org and s->dir
  * (s->bounce one more); 0 when it ends. */
 KFN int k_path_vertex_end(KTraceCtx* ctx, const KFrameParams* params, KPathState* s, const KLitVertex* lit,
-                          const KEmissiveSample* sampled, KShadowQueue* shadows, KVertexLight* vertex) {
+                          const KEmissivePick* picked, KShadowQueue* shadows, KVertexLight* vertex) {
   return k_path_vertex_shade(ctx, params, s, &lit->sf, lit->wo, lit->contribution, lit->path_weight, lit->rng,
-                             lit->emissive_nee, sampled, shadows, vertex);
+                             lit->emissive_nee, picked, shadows, vertex);
 }
 
 /* The path's ray (s->org, s->dir) met `hit`: shades it. 1 when the path goes on, with its next ray in s->org

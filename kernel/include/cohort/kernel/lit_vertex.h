@@ -1,7 +1,7 @@
 /* An opaque vertex between its two halves of shading (integrator.h's k_path_hit_lit, then k_path_vertex_end):
- * lit by the Doom 3 lights, its emissive sample and bounce still to come. Two halves so that a tracer may make
- * the emissive samples of many vertices together in between (emissive_sample.h's KEmissiveSample: the
- * Embree tracer's wavefront); the others shade a vertex to its end in one call (k_path_hit_queued, path_segment.h's
+ * lit by the Doom 3 lights, its emissive sample and bounce still to come. Two halves so that a tracer may pick
+ * the emissive triangles of many vertices together in between (emissive_tree.h's KEmissivePick: the Embree
+ * tracer's wavefront); the others shade a vertex to its end in one call (k_path_hit_queued, path_segment.h's
  * k_path_segment), which never stores one of these. */
 #ifndef COHORT_KERNEL_LIT_VERTEX_H
 #define COHORT_KERNEL_LIT_VERTEX_H
