@@ -11,7 +11,6 @@
 
 #include "cohort/tracers/embree_texture.h"  // before the kernel headers: K_TEXEL_BILINEAR
 #include "cohort/tracers/embree_light_box.h"  // and K_LIGHT_NODE_HOLDS
-#include "cohort/tracers/embree_light_coords.h"  // and K_LIGHT_COORDS
 #include "cohort/kernel/material.h"
 #include "cohort/tracers/embree_tracer.h"
 

@@ -23,13 +23,8 @@ KFN float k_window_falloff(float d2) {
 KFN int k_inside01(float x) { return x >= 0.0f && x <= 1.0f; }
 
 /* Where p lies in the light's volume: its S and T coordinates (divided by Q for projected lights) and
- * F. Returns 0 when p lies outside the volume, where the light is zero (s, t, f then unspecified). A tracer
- * may give its own with the same answers by defining K_LIGHT_COORDS(light, p, s, t, f) before including the
- * kernel headers (Embree: SSE, embree_light_coords.h). */
+ * F. Returns 0 when p lies outside the volume, where the light is zero. */
 KFN int k_light_coords(KGLOBAL const KLight* light, KVec3 p, float* s, float* t, float* f) {
-#ifdef K_LIGHT_COORDS
-  return K_LIGHT_COORDS(light, p, s, t, f);
-#else
   *s = k_plane_eval(light->plane_s, p);
   *t = k_plane_eval(light->plane_t, p);
   *f = k_plane_eval(light->plane_f, p);
@@ -40,7 +35,6 @@ KFN int k_light_coords(KGLOBAL const KLight* light, KVec3 p, float* s, float* t,
     *t /= q;
   }
   return k_inside01(*s) && k_inside01(*t) && k_inside01(*f);
-#endif
 }
 
 /* Light colour times attenuation at volume coordinates (k_light_coords) inside the volume: the falloff
