@@ -56,6 +56,7 @@ void SitOutTrials::forget_state() {
   counted_window_frame_ = -1;
   sitting_out_.clear();
   next_trial_at_.clear();
+  small_for_.clear();
   probes_.clear();
 }
 
@@ -91,21 +92,25 @@ void SitOutTrials::finish_trial() {
 }
 
 void SitOutTrials::start_trial_if_due(const DivideInput& in, const std::vector<Band>& bands) {
-  if (trial_ || frames_ < options_.trial_warmup) return;
   int takers = 0;
   for (const Band& b : bands) takers += !b.empty();
-  if (takers < 2) return;
+  // A small taker: at most trial_share of the frame and half an even share (four GPUs' quarters are not
+  // tried beside a CPU tracer's sliver), for a whole trial window in a row: a share that dips for a frame or
+  // two while the split settles (a band that ended late, a hiccup) is no reason to try a tracer out.
+  for (size_t i = 0; i < in.tracers.size(); ++i) {
+    const bool small = takers >= 2 && !bands[i].empty() && bands[i].rows() <= options_.trial_share * in.rows &&
+                       bands[i].rows() <= 0.5 * in.rows / takers;
+    int& run = small_for_[in.tracers[i]];
+    run = small ? run + 1 : 0;
+  }
+  if (trial_ || frames_ < options_.trial_warmup || takers < 2) return;
   for (size_t i = 0; i < in.tracers.size(); ++i) {
     const int id = in.tracers[i];
     auto due = next_trial_at_.find(id);
     if (due != next_trial_at_.end() && frames_ < due->second) continue;
     // Out by verdict and due again: back in; the inner balancer's band says whether it is a candidate.
     sitting_out_.erase(id);
-    // A small taker: at most trial_share of the frame and half an even share (four GPUs' quarters are
-    // not tried beside a CPU tracer's sliver).
-    if (bands[i].empty() || bands[i].rows() > options_.trial_share * in.rows ||
-        bands[i].rows() > 0.5 * in.rows / takers)
-      continue;
+    if (small_for_[id] < std::max(options_.trial_window, 1)) continue;
     trial_ = Trial{id, 0, {}, {}};
     return;
   }

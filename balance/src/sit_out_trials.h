@@ -43,6 +43,7 @@ class SitOutTrials final : public Balancer {
   bool previous_without_ = false;      // whether the previous frame ran without the trial's tracer
   std::set<int> sitting_out_;          // by verdict, until their next trial
   std::map<int, int> next_trial_at_;   // tracer id -> frames_ when it may be tried (again)
+  std::map<int, int> small_for_;       // tracer id -> frames in a row it has been a small taker
   std::vector<Band> probes_;
   std::vector<SitOutVerdict> verdicts_;
 };

@@ -164,3 +164,26 @@ TEST(SitOutTrials, EvenSharesAreNotTried) {
     for (const Band& band : bands) EXPECT_GE(band.rows(), 150) << "frame " << frame;
   }
 }
+
+TEST(SitOutTrials, AShareThatDipsForAFewFramesIsNotTried) {
+  // Four equal GPU-like tracers; three bands in a row of the fourth are measured five times slower now and
+  // then (bands that ended late), so Whole Cost shrinks its share for a few frames, under half an even share.
+  // Trials start only for takers small for a whole window in a row: none here.
+  HiddenCostFrame f{720, {0.006, 0.006, 0.006, 0.006}, {0.0, 0.0, 0.0, 0.0}, {0.0, 0.0, 0.0, 0.0}, 0.02};
+  auto b = make_balancer("whole-cost");
+  std::mt19937 rng(5);
+  std::vector<TracerMeasurement> previous;
+  double interval = 0.0;
+  int dipped = 0;
+  for (int frame = 0; frame < 400; ++frame) {
+    const std::vector<Band> bands = b->divide({f.rows, {0, 1, 2, 3}, previous, {}, interval});
+    if (frame > 60 && bands[3].rows() <= 90) ++dipped;
+    previous = f.measure(bands);
+    interval = f.interval(bands, rng);
+    if (frame % 50 < 3)
+      for (TracerMeasurement& m : previous)
+        if (m.tracer == 3) m.ms *= 5.0;
+    EXPECT_TRUE(b->take_verdicts().empty()) << "frame " << frame;
+  }
+  EXPECT_GT(dipped, 0) << "the fourth tracer's share should dip under half an even share, or nothing was tested";
+}

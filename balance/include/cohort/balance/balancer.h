@@ -83,7 +83,8 @@ struct BalancerOptions {
   bool fine_cuts = true;
   // Whole Cost's sit-out trials. Its model sees each tracer's band time, not what a tracer costs the
   // others (a CPU tracer's threads slow the host's merge and the GPU drivers' threads): so a taker with
-  // at most trial_share of the rows, and at most half an even share, is tried out end to end. Windows of
+  // at most trial_share of the rows, and at most half an even share, for trial_window frames in a row (not
+  // a share that dips for a frame or two while the split settles), is tried out end to end. Windows of
   // trial_window frames alternate, its share rendered / its rows handed to the others in proportion,
   // trial_pairs times; the first
   // trial_settle intervals of each window are not counted (the pipeline still carries the other mode).
