@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "cohort/tracers/embree_texture.h"  // before the kernel headers: K_TEXEL_BILINEAR
+#include "cohort/tracers/embree_light_box.h"  // and K_LIGHT_NODE_HOLDS
 #include "cohort/kernel/material.h"
 #include "cohort/tracers/embree_tracer.h"
 

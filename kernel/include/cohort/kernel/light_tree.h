@@ -22,9 +22,15 @@
  * gather stack never holds more than that plus one node. */
 #define K_LIGHT_TREE_STACK 16
 
+/* Whether the node's box holds p. A tracer may give its own test with the same answer by defining
+ * K_LIGHT_NODE_HOLDS(n, p) before including the kernel headers (Embree: SSE, embree_light_box.h). */
 KFN int k_light_node_holds(KGLOBAL const KLightNode* n, KVec3 p) {
+#ifdef K_LIGHT_NODE_HOLDS
+  return K_LIGHT_NODE_HOLDS(n, p);
+#else
   return p.x >= n->bmin[0] && p.x <= n->bmax[0] && p.y >= n->bmin[1] && p.y <= n->bmax[1] && p.z >= n->bmin[2] &&
          p.z <= n->bmax[2];
+#endif
 }
 
 KFN float k_light_node_importance(KGLOBAL const KLightNode* n, KVec3 p) {
