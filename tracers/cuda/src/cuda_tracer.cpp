@@ -66,6 +66,12 @@ struct CudaTracer::EnqueuedBand {
   std::optional<core::DeviceBand> kept;  // where it stays on the GPU (BandJob::keep_on_device)
   // Whether it has ended (its counters back); a failed band counts as ended.
   bool ended() const { return cudaEventQuery(slot->counted) != cudaErrorNotReady; }
+  // Waits until nothing of it is still landing anywhere: its counters back and, with wait_aux_copy, its aux
+  // texels too.
+  cudaError_t wait() const {
+    const cudaError_t error = cudaEventSynchronize(slot->counted);
+    return error == cudaSuccess && wait_aux_copy ? cudaEventSynchronize(slot->aux_copied) : error;
+  }
 };
 
 struct CudaTracer::Impl {
@@ -236,8 +242,7 @@ struct CudaTracer::Impl {
   // device time, its way back and the per-row work in the result.
   core::BandResult finish_band(const EnqueuedBand& b) {
     BandSlot& s = *b.slot;
-    COHORT_CUDA(cudaEventSynchronize(s.counted));
-    if (b.wait_aux_copy) COHORT_CUDA(cudaEventSynchronize(s.aux_copied));
+    COHORT_CUDA(b.wait());
     last_counts = count_rays ? RayCounts{s.counts[0], s.counts[1]} : RayCounts{};
     float kernel_ms = 0.0f;
     COHORT_CUDA(cudaEventElapsedTime(&kernel_ms, s.start, s.stop));
@@ -254,6 +259,11 @@ struct CudaTracer::Impl {
   void register_target(core::BandBuffer& target) {
     registered.ensure(target.data(), target.bytes(), "a band target");
     if (target.has_aux()) registered.ensure(target.aux_data(), target.aux_bytes(), "a band target's aux texels");
+  }
+  // Whether register_target would change nothing.
+  bool target_registered(core::BandBuffer& target) const {
+    return registered.contains(target.data(), target.bytes()) &&
+           (!target.has_aux() || registered.contains(target.aux_data(), target.aux_bytes()));
   }
 
   void rebind_texel_texture() {
@@ -320,7 +330,7 @@ CudaTracer::CudaTracer(int device) : impl_(std::make_unique<Impl>()) {
 CudaTracer::~CudaTracer() {
   cudaSetDevice(impl_->device);
   // A band enqueued ahead whose job never came writes into its target until it ends.
-  if (impl_->ahead) cudaEventSynchronize(impl_->ahead->slot->counted);
+  if (impl_->ahead) impl_->ahead->wait();
   if (impl_->texel_texture) cudaDestroyTextureObject(impl_->texel_texture);
   if (impl_->band) cudaFree(impl_->band);
   if (impl_->band_packed) cudaFree(impl_->band_packed);
@@ -430,7 +440,6 @@ core::BandResult CudaTracer::render_band(const core::BandJob& job, core::BandBuf
   COHORT_CUDA(cudaSetDevice(m.device));
   if (!has_scene()) throw std::runtime_error(m.name + ": render_band before any commit was applied");
   using Clock = std::chrono::steady_clock;
-  const auto entry = Clock::now();
   std::optional<EnqueuedBand> band;
   if (m.ahead) {
     if (m.ahead->target == &target && same_band_job(m.ahead->job, job)) {
@@ -448,9 +457,7 @@ core::BandResult CudaTracer::render_band(const core::BandJob& job, core::BandBuf
   try {
     enqueue_next_ahead(*band);
   } catch (...) {
-    // Nothing of this band may still be landing in the target once it is given up.
-    cudaEventSynchronize(band->slot->counted);
-    if (band->wait_aux_copy) cudaEventSynchronize(band->slot->aux_copied);
+    band->wait();  // nothing of this band may still be landing in the target once it is given up
     throw;
   }
   core::BandResult result = m.finish_band(*band);
@@ -459,10 +466,8 @@ core::BandResult CudaTracer::render_band(const core::BandJob& job, core::BandBuf
   // slowest one gets its jobs too late to go ahead, looks slower by its enqueueing, keeps fewer rows and so
   // keeps ending early: the OpenCL tracer's late-job cost (nvidia-h100-x4, four GPUs, without it: in one of two
   // runs a GPU fell to half an even share or less, the sit-out trial benched it, 0.98 ms a frame against 0.70).
-  if (m.enqueue_ahead && !went_ahead && m.enqueued_ahead.load() > 0) {
-    const auto ms = [](Clock::time_point a, Clock::time_point b) { return std::chrono::duration<double, std::milli>(b - a).count(); };
-    result.balance_ms = std::max(1e-3, ms(entry, Clock::now()) - ms(entry, enqueued));
-  }
+  if (m.enqueue_ahead && !went_ahead && m.enqueued_ahead.load() > 0)
+    result.balance_ms = std::max(1e-3, std::chrono::duration<double, std::milli>(Clock::now() - enqueued).count());
   return result;
 }
 
@@ -574,12 +579,7 @@ void CudaTracer::enqueue_next_ahead(const EnqueuedBand& current) {
   if (!next) return;
   // A target not yet page-locked: registering it may let go of the oldest registration, which the current
   // band may still be copying into; so the current band ends first.
-  if (next->job.keep_on_device < 0 && !(m.registered.contains(next->target->data(), next->target->bytes()) &&
-                                        (!next->target->has_aux() ||
-                                         m.registered.contains(next->target->aux_data(), next->target->aux_bytes())))) {
-    COHORT_CUDA(cudaEventSynchronize(current.slot->counted));
-    if (current.wait_aux_copy) COHORT_CUDA(cudaEventSynchronize(current.slot->aux_copied));
-  }
+  if (next->job.keep_on_device < 0 && !m.target_registered(*next->target)) COHORT_CUDA(current.wait());
   EnqueuedBand b = enqueue_band(next->job, *next->target);
   if (b.rows == 0) return;
   m.ahead = std::move(b);
@@ -591,8 +591,7 @@ bool CudaTracer::enqueues_ahead() const { return impl_->enqueue_ahead; }
 void CudaTracer::drop_enqueued_ahead() {
   Impl& m = *impl_;
   if (!m.ahead) return;
-  COHORT_CUDA(cudaEventSynchronize(m.ahead->slot->counted));
-  if (m.ahead->wait_aux_copy) COHORT_CUDA(cudaEventSynchronize(m.ahead->slot->aux_copied));
+  COHORT_CUDA(m.ahead->wait());
   m.ahead.reset();
   ++m.dropped_ahead;
 }
