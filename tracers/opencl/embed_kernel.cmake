@@ -2,7 +2,8 @@
 # file's folder, then INCLUDE_ROOT), each file once, and writes the result as a C++ string so the
 # tracer has no run-time dependence on the source tree.
 # NAME: the string's name in cohort::tracers::opencl_source (default kRenderBand).
-#   cmake -DENTRY=... -DINCLUDE_ROOT=... -DOUTPUT=... [-DNAME=...] -P embed_kernel.cmake
+# PLAIN=1: write the inlined OpenCL C itself instead, for COHORT_OPENCL_SOURCE_DIR (opencl_support.h).
+#   cmake -DENTRY=... -DINCLUDE_ROOT=... -DOUTPUT=... [-DNAME=...] [-DPLAIN=1] -P embed_kernel.cmake
 cmake_minimum_required(VERSION 3.25)
 set(_seen "")
 function(_inline file out_var)
@@ -36,6 +37,10 @@ if(NOT NAME)
 endif()
 get_filename_component(entry ${ENTRY} REALPATH)
 _inline(${entry} source)
+if(PLAIN)
+  file(WRITE ${OUTPUT} "${source}")
+  return()
+endif()
 file(WRITE ${OUTPUT}.tmp "// Generated from ${ENTRY} by embed_kernel.cmake; do not edit.\n"
      "namespace cohort::tracers::opencl_source {\nextern const char* const ${NAME};\n"
      "const char* const ${NAME} = R\"COHORTCL(\n${source})COHORTCL\";\n}\n")

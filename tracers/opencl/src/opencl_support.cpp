@@ -1,5 +1,8 @@
 #include "opencl_support.h"
 
+#include <cstdlib>
+#include <fstream>
+#include <sstream>
 #include <stdexcept>
 
 #include <spdlog/spdlog.h>
@@ -10,9 +13,25 @@ void check(cl_int err, const char* what) {
   if (err != CL_SUCCESS) throw std::runtime_error(std::string("OpenCLTracer: ") + what + " failed (error " + std::to_string(err) + ")");
 }
 
-cl_program build_program(cl_context context, cl_device_id device, const char* source, const std::string& options,
-                         const std::string& label) {
+std::string program_source(const char* built_in, const char* program_name) {
+  const char* dir = std::getenv("COHORT_OPENCL_SOURCE_DIR");
+  if (!dir || !*dir) return built_in;
+  const std::string path = std::string(dir) + "/" + program_name + ".cl";
+  std::ifstream file(path, std::ios::binary);
+  if (!file)
+    throw std::runtime_error("OpenCLTracer: COHORT_OPENCL_SOURCE_DIR is set, but " + path + " cannot be read");
+  std::ostringstream text;
+  text << file.rdbuf();
+  spdlog::warn("OpenCLTracer: building {} from {} instead of the built-in source (COHORT_OPENCL_SOURCE_DIR)",
+               program_name, path);
+  return text.str();
+}
+
+cl_program build_program(cl_context context, cl_device_id device, const char* built_in_source,
+                         const char* program_name, const std::string& options, const std::string& label) {
   cl_int err = CL_SUCCESS;
+  const std::string text = program_source(built_in_source, program_name);
+  const char* source = text.c_str();
   cl_program program = clCreateProgramWithSource(context, 1, &source, nullptr, &err);
   check(err, "clCreateProgramWithSource");
   err = clBuildProgram(program, 1, &device, options.c_str(), nullptr, nullptr);
