@@ -7,17 +7,38 @@
 
 #include "cohort/kernel/integrator.h"
 #include "cohort/kernel/aux_outputs.h"
+#include "cohort/tracers/embree_emissive_picks.h"
 #include "embree_tiles.h"
 
 namespace cohort::tracers::embree_tiles {
 
-// k_path_segment (kernel/path_segment.h) as a function of its own, the same in both renderers: inlined into
-// each, the compiler contracted a few different multiply-adds into FMAs (x86-64-v3), so their images
-// differed in the last bits. noipa: no copy specialised for one caller's constant arguments either.
-__attribute__((noinline, noipa)) static int path_segment(KTraceCtx* ctx, const KFrameParams* params, KPathState* s,
-                                                         const KHit* traced, KPathFirstHit* first_hit,
-                                                         KShadowQueue* shadows, KVertexLight* vertex) {
-  return k_path_segment(ctx, params, s, traced, first_hit, shadows, vertex);
+// The halves of k_path_segment (kernel/path_segment.h), each a function of its own, the same in both renderers:
+// inlined into each, the compiler contracted a few different multiply-adds into FMAs (x86-64-v3), so their
+// images differed in the last bits. noipa: no copy specialised for one caller's constant arguments either.
+__attribute__((noinline, noipa)) static int path_segment_lit(KTraceCtx* ctx, const KFrameParams* params,
+                                                             KPathState* s, const KHit* traced,
+                                                             KPathFirstHit* first_hit, KShadowQueue* shadows,
+                                                             KVertexLight* vertex, KLitVertex* lit) {
+  return k_path_segment_lit(ctx, params, s, traced, first_hit, shadows, vertex, lit);
+}
+
+__attribute__((noinline, noipa)) static int path_vertex_end(KTraceCtx* ctx, const KFrameParams* params,
+                                                            KPathState* s, const KLitVertex* lit,
+                                                            const KEmissivePick* picked, KShadowQueue* shadows,
+                                                            KVertexLight* vertex) {
+  return k_path_vertex_end(ctx, params, s, lit, picked, shadows, vertex);
+}
+
+// The number the vertex's emissive sample picks its triangle with: the first it draws (k_emissive_lighting).
+static float emissive_pick_number(const KLitVertex& lit) {
+  KRng rng = lit.rng;
+  return k_rng_next(&rng);
+}
+
+// The emissive picks of n lit vertices (embree_emissive_picks.h), the same code in both renderers.
+__attribute__((noinline, noipa)) static void emissive_picks(const KSceneView* scene, int n, const KVec3* points,
+                                                            const float* us, KEmissivePick* out) {
+  embree_emissive::picks(scene, n, points, us, out);
 }
 
 // Closest hits of the tile's n camera rays (all from org), 8 to a packet, with a coherent context.

@@ -17,6 +17,20 @@ namespace cohort::tracers::embree_tiles {
 
 namespace {
 
+// k_path_segment for one path, its emissive pick through emissive_picks like the wavefront's.
+int path_segment(KTraceCtx* ctx, const KFrameParams* params, KPathState* s, const KHit* traced,
+                 KPathFirstHit* first_hit, KShadowQueue* shadows, KVertexLight* vertex) {
+  KLitVertex lit;
+  const int shaded = path_segment_lit(ctx, params, s, traced, first_hit, shadows, vertex, &lit);
+  if (shaded != K_PATH_VERTEX_LIT) return shaded;
+  KEmissivePick pick{K_NONE, 0.0f};
+  if (lit.emissive_nee) {
+    const float u = emissive_pick_number(lit);
+    emissive_picks(&ctx->scene, 1, &lit.sf.position, &u, &pick);
+  }
+  return path_vertex_end(ctx, params, s, &lit, lit.emissive_nee ? &pick : nullptr, shadows, vertex);
+}
+
 void store_rows(const Frame& frame, const Tile& tile, Arena& a, embree_kernel::TraceCtx& ctx, uint64_t* row_rays,
                 float scale) {
   const int w = tile.x1 - tile.x0;

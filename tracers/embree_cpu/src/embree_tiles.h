@@ -16,6 +16,8 @@
 #include "cohort/core/band_buffer.h"
 #include "cohort/kernel/rng.h"
 #include "cohort/kernel/aux_history.h"
+#include "cohort/kernel/emissive_tree.h"
+#include "cohort/kernel/lit_vertex.h"
 #include "cohort/kernel/path_state.h"
 #include "cohort/kernel/shadow_ray.h"
 #include "embree_kernel.h"
@@ -72,6 +74,16 @@ struct Arena {
     float band[kTilePixels * 4];   // the pixels' sums of samples (k_wave_finish_sample), RGBA
     int pixels[kTilePixels];       // the paths a stage traces rays for
     uint16_t shadows[K_SHADOW_QUEUE_MAX * kTilePixels];  // the shadow rays to trace: pixel * 8 + slot
+    // The opaque vertices a shade stage lit, waiting for their emissive picks (all of the stage's at once):
+    // each as k_path_vertex_end takes it and the rays in its shadow queue; lit_paths: their places in the
+    // tile's traced pixels, in order; then the picks' points, numbers and results, in the same order for those
+    // of them that take an emissive sample.
+    KLitVertex lit[kTilePixels];
+    kuint queued[kTilePixels];
+    int lit_paths[kTilePixels];
+    KVec3 pick_points[kTilePixels];
+    float pick_numbers[kTilePixels];
+    KEmissivePick picks[kTilePixels];
   } wave;
 };
 

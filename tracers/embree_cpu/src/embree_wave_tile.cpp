@@ -222,9 +222,12 @@ void COHORT_RENDER_WAVE_TILE(const Frame& frame, const Tile& tile, Arena& a, emb
 
   for (kuint s = 0u; s < spp; ++s) {
     // The segments of the paths a stage shades (camera_rays: the paths begin, from their camera rays' hits),
-    // then the shadow rays they left.
+    // then the shadow rays they left. k_path_segment in three steps over all of them: each path up to its opaque
+    // vertex's Doom 3 lights (the vertex, its path and shadow queue then wait in the arena), the waiting
+    // vertices' emissive picks eight at a time, then each vertex's shading ended.
     auto shade = [&](int camera_rays) {
       KPathFirstHit* records = s == 0u && record_first_hits && camera_rays ? a.first_hits : nullptr;
+      int lit = 0, picking = 0;
       for (int j = 0; j < traced; ++j) {
         const int p = a.traced[j];
         if (!k_wave_shades(1, static_cast<size_t>(p), wv.active, camera_rays)) continue;
@@ -237,8 +240,37 @@ void COHORT_RENDER_WAVE_TILE(const Frame& frame, const Tile& tile, Arena& a, emb
         k_wave_path_load(params, camera, x, y, static_cast<size_t>(p), s, wv.states, wv.hits, wv.shadow_rays,
                          kTilePixels, camera_rays, shadow_walk, &path, &hit, &shadows);
         KVertexLight vertex;
-        const int goes_on =
-            path_segment(&ctx, params, &path, &hit, records ? records + p : nullptr, &shadows, &vertex);
+        const int shaded = path_segment_lit(&ctx, params, &path, &hit, records ? records + p : nullptr, &shadows,
+                                            &vertex, &wv.lit[p]);
+        row_rays[p / w] += ctx.rays - before;
+        if (shaded == K_PATH_VERTEX_LIT) {
+          wv.states[p] = path;
+          wv.queued[p] = shadows.count;
+          wv.vertices[p] = vertex;
+          wv.lit_paths[lit++] = j;
+          if (wv.lit[p].emissive_nee) {
+            wv.pick_points[picking] = wv.lit[p].sf.position;
+            wv.pick_numbers[picking++] = emissive_pick_number(wv.lit[p]);
+          }
+          continue;
+        }
+        k_wave_path_store(params, static_cast<size_t>(p), s, shaded, &path, &shadows, &vertex, wv.band, wv.states,
+                          wv.active, wv.vertices, camera_rays);
+      }
+      emissive_picks(&ctx.scene, picking, wv.pick_points, wv.pick_numbers, wv.picks);
+      for (int i = 0, picked = 0; i < lit; ++i) {
+        const int j = wv.lit_paths[i], p = a.traced[j];
+        const uint64_t before = ctx.rays;
+        if (log) log->camera_dir = a.dirs[j];
+        KPathState path;
+        KHit hit;
+        KShadowQueue shadows;  // as the first step had it
+        k_wave_path_load(params, camera, 0u, 0u, static_cast<size_t>(p), s, wv.states, wv.hits, wv.shadow_rays,
+                         kTilePixels, 0, shadow_walk, &path, &hit, &shadows);
+        shadows.count = wv.queued[p];
+        KVertexLight vertex = wv.vertices[p];
+        const KEmissivePick* pick = wv.lit[p].emissive_nee ? &wv.picks[picked++] : nullptr;
+        const int goes_on = path_vertex_end(&ctx, params, &path, &wv.lit[p], pick, &shadows, &vertex);
         k_wave_path_store(params, static_cast<size_t>(p), s, goes_on, &path, &shadows, &vertex, wv.band, wv.states,
                           wv.active, wv.vertices, camera_rays);
         row_rays[p / w] += ctx.rays - before;

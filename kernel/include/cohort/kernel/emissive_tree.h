@@ -13,6 +13,14 @@
 #include "scene_view.h"
 #include "vec.h"
 
+/* An emissive triangle picked ahead of its vertex's sample: what k_emissive_tree_pick returns at the vertex
+ * for the sample's first random number (index K_NONE: none), from a tracer that picks for many vertices at
+ * once (the Embree tracer's wavefront, tracers/embree_cpu). */
+typedef struct KEmissivePick {
+  kuint index;
+  float prob;
+} KEmissivePick;
+
 /* The emissive tree's root, or K_NONE when there are no emitters (or no tree for them). */
 KFN kuint k_emissive_root(const KSceneView* scene) {
   return k_emissive_tree_nodes(scene) > 0u ? k_light_tree_nodes(scene) : K_NONE;

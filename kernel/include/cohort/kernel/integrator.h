@@ -18,6 +18,7 @@
 #include "fog.h"
 #include "path_state.h"
 #include "light_gather.h"
+#include "lit_vertex.h"
 #include "shadow_queue.h"
 #include "light_tree.h"
 #include "rng.h"
@@ -226,13 +227,21 @@ KFN float k_emissive_pdf(const KSceneView* scene, KVec3 p, kuint instance, kuint
  * (near and bright ones first), a uniform point on it, its emission there, one shadow ray (to the queue,
  * which sets the vertex's emissive term when the point is visible). With a bounce to follow from this
  * vertex the value is weighted by the power heuristic against BRDF sampling, which weighs the emission it
- * finds the same way (k_path_hit_queued); without one it stands alone (weight 1). */
+ * finds the same way (k_path_hit_lit); without one it stands alone (weight 1). picked: the pick made
+ * ahead for this sample's first random number, or null to pick here. */
 KFN void k_emissive_lighting(KTraceCtx* ctx, const KSurface* sf, KVec3 wo, int bounce_follows, float shadow_rr,
-                             float path_weight, KRng* rng, KShadowQueue* queue, KVertexLight* vertex) {
+                             float path_weight, KRng* rng, const KEmissivePick* picked, KShadowQueue* queue,
+                             KVertexLight* vertex) {
   const KSceneView* scene = K_CTX_SCENE(ctx);
   float u_pick = k_rng_next(rng), u1 = k_rng_next(rng), u2 = k_rng_next(rng);
   float pick = 0.0f;
-  kuint index = k_emissive_tree_pick(scene, sf->position, u_pick, &pick);
+  kuint index;
+  if (picked) {
+    index = picked->index;
+    pick = picked->prob;
+  } else {
+    index = k_emissive_tree_pick(scene, sf->position, u_pick, &pick);
+  }
   if (index == K_NONE || !(pick > 0.0f)) return;
   KGLOBAL const KEmissiveTriangle* e = &scene->emissive[index];
 
@@ -343,15 +352,68 @@ KFN void k_path_miss(const KSceneView* scene, const KFrameParams* params, KPathS
   if (lit_mode) k_apply_fog(scene, s->org, s->dir, K_INF, &s->radiance, &s->throughput);
 }
 
-/* The path's ray (s->org, s->dir) met `hit`: shades it. 1 when the path goes on, with its next ray in
- * s->org and s->dir (through a transparent layer, s->bounce unchanged, or a bounce, s->bounce one more);
- * 0 when it ends. first_hit (may be null): where the ray's first opaque surface is recorded for the aux
- * planes (recorded before the first bounce only). shadows (empty on entry): where an opaque vertex's
- * shadow rays go; when some are left in its slots (shadows->count > 0) the vertex's light waits in
- * *vertex, for the caller to add k_vertex_light_sum to s->radiance once they are walked, before the
- * path's next segment; otherwise it is in s->radiance already. */
-KFN int k_path_hit_queued(KTraceCtx* ctx, const KFrameParams* params, KPathState* s, KHit hit,
-                          KGLOBAL KPathFirstHit* first_hit, KShadowQueue* shadows, KVertexLight* vertex) {
+/* The opaque vertex's shading after its Doom 3 lights (the locals of k_path_hit_lit, KLitVertex's fields): its
+ * emissive sample (picked here, or ahead: picked, may be null), its light, its bounce. 1 when the path goes on
+ * with its bounce ray in s->org and s->dir (s->bounce one more); 0 when it ends. */
+KFN int k_path_vertex_shade(KTraceCtx* ctx, const KFrameParams* params, KPathState* s, const KSurface* sf,
+                            KVec3 wo, KVec3 contribution, float path_weight, KRng rng, int emissive_nee,
+                            const KEmissivePick* picked, KShadowQueue* shadows, KVertexLight* vertex) {
+  if (emissive_nee) {
+    int bounce_follows = params->mode != K_MODE_DIRECT && s->bounce < params->max_bounces;
+    k_emissive_lighting(ctx, sf, wo, bounce_follows, params->shadow_rr, path_weight, &rng, picked, shadows,
+                        vertex);
+  }
+  vertex->throughput = s->throughput;
+  vertex->clamp = s->bounce > 0u ? params->firefly_clamp : 0.0f;
+  vertex->base = contribution;
+  vertex->direct_scale = k_lights_one_ray_each(params) ? 0.0f : 1.0f / (float)params->light_samples;
+  vertex->has_emissive = (kuint)emissive_nee;
+  if (shadows->count == 0u) s->radiance = v3_add(s->radiance, k_vertex_light_sum(vertex));
+
+  if (params->mode == K_MODE_DIRECT || s->bounce >= params->max_bounces) { s->rng = rng; return 0; }
+
+  KVec3 wi;
+  float u_lobe = k_rng_next(&rng), u1 = k_rng_next(&rng), u2 = k_rng_next(&rng);
+  KVec3 weight = k_brdf_sample(sf, wo, u_lobe, u1, u2, &wi);
+  if (v3_max_component(weight) <= 0.0f || v3_dot(wi, sf->geo_normal) <= 0.0f) { s->rng = rng; return 0; }
+  s->throughput = v3_mul(s->throughput, weight);
+  s->vertex_position = sf->position;
+  s->vertex_brdf_pdf = k_brdf_pdf(sf, wo, wi);
+  s->spread += K_BOUNCE_SPREAD;
+  ++s->bounce;
+  if ((float)s->bounce >= params->rr_start) {
+    float keep = k_clamp(v3_max_component(s->throughput), 0.05f, 0.95f);
+    if (k_rng_next(&rng) >= keep) { s->rng = rng; return 0; }
+    s->throughput = v3_scale(s->throughput, 1.0f / keep);
+  }
+  s->rng = rng;
+  s->org = v3_madd(sf->position, sf->geo_normal, k_ray_epsilon(sf->position));
+  s->dir = wi;
+  s->layers = 0u;
+  return 1;
+}
+
+/* The opaque vertex's shading after its Doom 3 lights, from what k_path_hit_lit left in *lit (the emissive
+ * pick made ahead: picked, may be null). 1 when the path goes on with its bounce ray in s->org and s->dir
+ * (s->bounce one more); 0 when it ends. */
+KFN int k_path_vertex_end(KTraceCtx* ctx, const KFrameParams* params, KPathState* s, const KLitVertex* lit,
+                          const KEmissivePick* picked, KShadowQueue* shadows, KVertexLight* vertex) {
+  return k_path_vertex_shade(ctx, params, s, &lit->sf, lit->wo, lit->contribution, lit->path_weight, lit->rng,
+                             lit->emissive_nee, picked, shadows, vertex);
+}
+
+/* The path's ray (s->org, s->dir) met `hit`: shades it. 1 when the path goes on, with its next ray in s->org
+ * and s->dir (through a transparent layer, s->bounce unchanged, or a bounce, s->bounce one more); 0 when it
+ * ends. With lit (may be null), an opaque vertex of a lit mode stops after its Doom 3 lights instead:
+ * K_PATH_VERTEX_LIT, its shading to be ended by k_path_vertex_end from *lit (and a transparent layer's 1 is
+ * never a bounce). first_hit (may be null): where the ray's first opaque surface is recorded for the aux
+ * planes (recorded before the first bounce only). shadows (empty on entry): where an opaque vertex's shadow
+ * rays go; when some are left in its slots (shadows->count > 0) the vertex's light waits in *vertex, for the
+ * caller to add k_vertex_light_sum to s->radiance once they are walked, before the path's next segment;
+ * otherwise it is in s->radiance already. */
+KFN int k_path_hit_lit(KTraceCtx* ctx, const KFrameParams* params, KPathState* s, KHit hit,
+                       KGLOBAL KPathFirstHit* first_hit, KShadowQueue* shadows, KVertexLight* vertex,
+                       KLitVertex* lit) {
   const KSceneView* scene = K_CTX_SCENE(ctx);
   int emissive_nee = params->emissive_samples > 0u && scene->emissive_count > 0u;
   KVec3 org = s->org, dir = s->dir;
@@ -427,38 +489,22 @@ KFN int k_path_hit_queued(KTraceCtx* ctx, const KFrameParams* params, KPathState
   float path_weight = v3_max_component(s->throughput);
   KRng rng = s->rng;
   k_direct_lighting(ctx, &vertex_params, &sf, wo, path_weight, &rng, shadows, vertex);
-  if (emissive_nee) {
-    int bounce_follows = params->mode != K_MODE_DIRECT && s->bounce < params->max_bounces;
-    k_emissive_lighting(ctx, &sf, wo, bounce_follows, params->shadow_rr, path_weight, &rng, shadows, vertex);
-  }
-  vertex->throughput = s->throughput;
-  vertex->clamp = s->bounce > 0u ? params->firefly_clamp : 0.0f;
-  vertex->base = contribution;
-  vertex->direct_scale = k_lights_one_ray_each(params) ? 0.0f : 1.0f / (float)params->light_samples;
-  vertex->has_emissive = (kuint)emissive_nee;
-  if (shadows->count == 0u) s->radiance = v3_add(s->radiance, k_vertex_light_sum(vertex));
+  if (!lit) return k_path_vertex_shade(ctx, params, s, &sf, wo, contribution, path_weight, rng, emissive_nee, 0,
+                                      shadows, vertex);
+  lit->sf = sf;
+  lit->wo = wo;
+  lit->contribution = contribution;
+  lit->rng = rng;
+  lit->path_weight = path_weight;
+  lit->emissive_nee = emissive_nee;
+  return K_PATH_VERTEX_LIT;
+}
 
-  if (params->mode == K_MODE_DIRECT || s->bounce >= params->max_bounces) { s->rng = rng; return 0; }
-
-  KVec3 wi;
-  float u_lobe = k_rng_next(&rng), u1 = k_rng_next(&rng), u2 = k_rng_next(&rng);
-  KVec3 weight = k_brdf_sample(&sf, wo, u_lobe, u1, u2, &wi);
-  if (v3_max_component(weight) <= 0.0f || v3_dot(wi, sf.geo_normal) <= 0.0f) { s->rng = rng; return 0; }
-  s->throughput = v3_mul(s->throughput, weight);
-  s->vertex_position = sf.position;
-  s->vertex_brdf_pdf = k_brdf_pdf(&sf, wo, wi);
-  s->spread += K_BOUNCE_SPREAD;
-  ++s->bounce;
-  if ((float)s->bounce >= params->rr_start) {
-    float keep = k_clamp(v3_max_component(s->throughput), 0.05f, 0.95f);
-    if (k_rng_next(&rng) >= keep) { s->rng = rng; return 0; }
-    s->throughput = v3_scale(s->throughput, 1.0f / keep);
-  }
-  s->rng = rng;
-  s->org = v3_madd(sf.position, sf.geo_normal, k_ray_epsilon(sf.position));
-  s->dir = wi;
-  s->layers = 0u;
-  return 1;
+/* k_path_hit_lit with the vertex shaded to its end: the GPU kernels' form, compiled as the one function it was
+ * before the split (the halves called in sequence spilled more, ptxas sm_90). */
+KFN int k_path_hit_queued(KTraceCtx* ctx, const KFrameParams* params, KPathState* s, KHit hit,
+                          KGLOBAL KPathFirstHit* first_hit, KShadowQueue* shadows, KVertexLight* vertex) {
+  return k_path_hit_lit(ctx, params, s, hit, first_hit, shadows, vertex, 0);
 }
 
 #include "path_segment.h"

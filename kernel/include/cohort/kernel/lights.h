@@ -99,26 +99,33 @@ KFN KVec3 k_light_jittered_direction(KGLOBAL const KLight* light, KVec3 p, float
  * pi x the radiance it contributes through the Lambert term: Doom's brightness, physical BRDF. */
 KFN KVec3 k_light_unshadowed(const KSceneView* scene, KGLOBAL const KLight* light, const KSurface* sf, KVec3 wo,
                              float spec_boost) {
-  if (light->flags & K_LIGHT_VOLUME_EFFECT) return v3s(0.0f);   /* fog and blend lights: fog.h */
-  if (light->flags & K_LIGHT_AMBIENT) {
+  /* One exit: with a return per case, GCC (x86-64) merged the results through the stack and read x and y
+   * back as one 8-byte load of two 4-byte stores, a store-forwarding stall on every call. */
+  KVec3 value = v3s(0.0f);
+  if (light->flags & K_LIGHT_VOLUME_EFFECT) {
+    /* fog and blend lights: fog.h */
+  } else if (light->flags & K_LIGHT_AMBIENT) {
     /* The engine's ambient interaction lights from the `_ambient` cube's constant tangent-space vector
      * (about (0, -0.77, 0.78)), no specular: a flat surface gets N.L = 0.78 whichever way it faces. */
     KVec3 radiance = v3_scale(k_light_radiance_at(scene, light, sf->position), K_PI);
-    if (v3_max_component(radiance) <= 0.0f) return v3s(0.0f);
-    return v3_scale(v3_mul(radiance, k_brdf_eval_cos(sf, wo, sf->normal, 0.0f)), K_AMBIENT_N_DOT_L);
+    if (!(v3_max_component(radiance) <= 0.0f))
+      value = v3_scale(v3_mul(radiance, k_brdf_eval_cos(sf, wo, sf->normal, 0.0f)), K_AMBIENT_N_DOT_L);
+  } else {
+    /* Outside the volume (plane tests), then behind the surface (k_brdf_eval_cos's own test): both known
+     * before the falloff and light images are read, which the light tree's gather does for up to 16
+     * lights a hit. */
+    float s, t, f, dist;
+    if (k_light_coords(light, sf->position, &s, &t, &f)) {
+      KVec3 wi = k_light_direction(light, sf->position, &dist);
+      if (!(v3_dot(sf->normal, wi) <= 0.0f || v3_dot(sf->geo_normal, wi) <= 0.0f)) {
+        KVec3 radiance = v3_scale(k_light_radiance_in(scene, light, s, t, f), K_PI);
+        float spec_scale = (light->flags & K_LIGHT_NO_SPECULAR) ? 0.0f : spec_boost;
+        if (!(v3_max_component(radiance) <= 0.0f))
+          value = v3_mul(radiance, k_brdf_eval_cos(sf, wo, wi, spec_scale));
+      }
+    }
   }
-  /* Outside the volume (plane tests), then behind the surface (k_brdf_eval_cos's own test): both known
-   * before the falloff and light images are read, which the light tree's gather does for up to 16
-   * lights a hit. */
-  float s, t, f;
-  if (!k_light_coords(light, sf->position, &s, &t, &f)) return v3s(0.0f);
-  float dist;
-  KVec3 wi = k_light_direction(light, sf->position, &dist);
-  if (v3_dot(sf->normal, wi) <= 0.0f || v3_dot(sf->geo_normal, wi) <= 0.0f) return v3s(0.0f);
-  KVec3 radiance = v3_scale(k_light_radiance_in(scene, light, s, t, f), K_PI);
-  if (v3_max_component(radiance) <= 0.0f) return v3s(0.0f);
-  float spec_scale = (light->flags & K_LIGHT_NO_SPECULAR) ? 0.0f : spec_boost;
-  return v3_mul(radiance, k_brdf_eval_cos(sf, wo, wi, spec_scale));
+  return value;
 }
 
 #endif

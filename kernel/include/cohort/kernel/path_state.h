@@ -1,7 +1,7 @@
-/* A path between two of its rays: all the integrator (integrator.h's k_path_hit_queued) carries from one surface
- * to the next. Plain data, so that a wavefront tracer keeps it in memory between the kernel that walks a
- * path's next ray and the one that shades what it met (tracers/cuda, tracers/opencl), where the megakernel keeps it in
- * registers. */
+/* A path between two of its rays: all the integrator (integrator.h's k_path_hit_lit and k_path_vertex_end)
+ * carries from one surface to the next. Plain data, so that a wavefront tracer keeps it in memory between the
+ * kernel that walks a path's next ray and the one that shades what it met (tracers/cuda, tracers/opencl),
+ * where the megakernel keeps it in registers. */
 #ifndef COHORT_KERNEL_PATH_STATE_H
 #define COHORT_KERNEL_PATH_STATE_H
 #include "layout.h"

@@ -5,7 +5,10 @@
 #define COHORT_KERNEL_PORTABLE_H
 
 #if defined(__OPENCL_VERSION__)
-  #define KFN static inline
+  /* Always inlined, as CUDA's __forceinline__: NVIDIA's OpenCL compiler left a large one-caller function (the
+   * vertex's shading after its lights) as a call, and that build faulted at frame 58 of every 720p test-map
+   * run (error -9999); inlined, it renders them (docs/integrator.md, "Inlining on OpenCL"). */
+  #define KFN static inline __attribute__((always_inline))
   #define KFN_OUTLINED static
   #define KGLOBAL __global
   #define KCONSTANT __constant

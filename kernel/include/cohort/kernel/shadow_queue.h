@@ -1,7 +1,7 @@
 /* Where an opaque vertex's shadow rays wait (integrator.h's k_direct_lighting and k_emissive_lighting emit
- * them, k_path_hit_queued owns the queue). A queue without slots walks each ray as it comes: the
- * megakernels and the host tracers. A wavefront tracer gives it a slot in memory for every ray a vertex may
- * emit (k_shadow_queue_slots; with more, it walks them as they come), leaves the rays there for a kernel
+ * them, k_path_hit_lit and k_path_vertex_end own the queue). A queue without slots walks each ray as it
+ * comes: the megakernels and the host tracers. A wavefront tracer gives it a slot in memory for every ray a
+ * vertex may emit (k_shadow_queue_slots; with more, it walks them as they come), leaves the rays there for a kernel
  * that only walks shadow rays, and finishes the vertex after them (integrator.h's k_vertex_light_sum).
  * Either way the visible values are added in emission order, so the image is the same bit for bit. Needs
  * k_trace_occluded (integrator.h's includer defines it). */
