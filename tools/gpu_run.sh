@@ -91,11 +91,11 @@ case "${1:-}" in
     cmake --preset gpu-travel
     # COHORT_GPU_TARGETS narrows the build while iterating on one part (e.g. "cohort cohort_tracers_tests").
     cmake --build --preset gpu-travel -j2 --target ${COHORT_GPU_TARGETS:-cohort cohort_tracers_tests bench_cuda bench_bvh \
-      bench_scaling bench_host_frame bench_skinning}
+      bench_scaling bench_host_frame bench_skinning bench_tracers}
     rm -rf "$stage" && mkdir -p "$stage/bin" "$stage/lib"
     for exe in build/gpu/bin/cohort build/gpu/bin/cohort_tracers_tests build/gpu/bin/bench_cuda \
                build/gpu/bin/bench_bvh build/gpu/bin/bench_scaling build/gpu/bin/bench_host_frame \
-               build/gpu/bin/bench_skinning; do
+               build/gpu/bin/bench_skinning build/gpu/bin/bench_tracers; do
       [ -x "$exe" ] && [ -f "$exe" ] && strip -o "$stage/bin/$(basename "$exe")" "$exe"
     done
     for lib in libembree3.so.3 libtbb.so.12 libzip.so.4; do

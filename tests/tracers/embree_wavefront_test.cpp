@@ -193,7 +193,7 @@ TEST(EmbreeWavefrontRayLog, RecordsTheSameRaysByClass) {
 }
 
 // COHORT_EMBREE_WAVEFRONT: the wavefront unless it says 0; a value other than 0 or 1 is named. Packets of 8
-// or 16 rays, nothing else.
+// or 16 rays, nothing else, also through COHORT_EMBREE_PACKET_WIDTH.
 TEST(EmbreeWavefrontSwitch, TheEnvironmentSetsItAndABadValueIsNamed) {
   {
     tracers::EmbreeTracer tracer;
@@ -216,6 +216,18 @@ TEST(EmbreeWavefrontSwitch, TheEnvironmentSetsItAndABadValueIsNamed) {
     EXPECT_NE(std::string(e.what()).find("COHORT_EMBREE_WAVEFRONT='yes'"), std::string::npos) << e.what();
   }
   ::unsetenv("COHORT_EMBREE_WAVEFRONT");
+  ::setenv("COHORT_EMBREE_PACKET_WIDTH", "8", 1);
+  EXPECT_EQ(tracers::EmbreeTracer().wave_packet_width(), 8);
+  ::setenv("COHORT_EMBREE_PACKET_WIDTH", "16", 1);
+  EXPECT_EQ(tracers::EmbreeTracer().wave_packet_width(), 16);
+  ::setenv("COHORT_EMBREE_PACKET_WIDTH", "4", 1);
+  try {
+    tracers::EmbreeTracer tracer;
+    ADD_FAILURE() << "COHORT_EMBREE_PACKET_WIDTH=4 accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("COHORT_EMBREE_PACKET_WIDTH='4'"), std::string::npos) << e.what();
+  }
+  ::unsetenv("COHORT_EMBREE_PACKET_WIDTH");
 }
 
 }  // namespace

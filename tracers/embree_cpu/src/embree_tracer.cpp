@@ -92,6 +92,16 @@ bool wavefront_from_environment() {
   throw std::invalid_argument(std::string("EmbreeTracer: COHORT_EMBREE_WAVEFRONT='") + v + "' (expected 0 or 1)");
 }
 
+// COHORT_EMBREE_PACKET_WIDTH: the wavefront's rays per packet, 8 or 16 (unset: Embree's native width); anything
+// else is named in the error.
+int packet_width_from_environment(int native) {
+  const char* v = std::getenv("COHORT_EMBREE_PACKET_WIDTH");
+  if (!v || !*v) return native;
+  if (std::strcmp(v, "8") == 0) return 8;
+  if (std::strcmp(v, "16") == 0) return 16;
+  throw std::invalid_argument(std::string("EmbreeTracer: COHORT_EMBREE_PACKET_WIDTH='") + v + "' (expected 8 or 16)");
+}
+
 void check_device(RTCDevice device, const char* what) {
   RTCError code = rtcGetDeviceError(device);
   if (code != RTC_ERROR_NONE)
@@ -216,6 +226,7 @@ EmbreeTracer::EmbreeTracer(int threads) : impl_(std::make_unique<Impl>()) {
   if (!impl_->device) throw std::runtime_error("EmbreeTracer: rtcNewDevice failed");
   impl_->ray_masks = rtcGetDeviceProperty(impl_->device, RTC_DEVICE_PROPERTY_RAY_MASK_SUPPORTED) != 0;
   if (rtcGetDeviceProperty(impl_->device, RTC_DEVICE_PROPERTY_NATIVE_RAY16_SUPPORTED) != 0) impl_->packet_width = 16;
+  impl_->packet_width = packet_width_from_environment(impl_->packet_width);
   if (threads > 0)
     impl_->thread_limit =
         std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism, size_t(threads));
