@@ -133,26 +133,6 @@ TEST(OpenCLWaveLanes, DrawTheImageOfOneLane) {
   ::unsetenv("COHORT_TEST_OPENCL_DEVICE");
 }
 
-// The wavefront's kernels keep their arguments from band to band: bands of one size on the same buffers set them
-// once, and draw the megakernel's image; a band of another size sets them again, every time the size changes.
-TEST(OpenCLWavefrontArguments, AreSetOnceForBandsOfOneSizeAndAgainWhenTheSizeChanges) {
-  if (!tracer_runs_here("opencl")) GTEST_SKIP() << "no OpenCL device here";
-  const int w = 24, h = 32;
-  const View view = room_view(w, h);
-  const KFrameParams params = frame_params(K_MODE_PATH, 1, 2, h);
-  auto tracer = opencl(kWavefront);
-  const std::vector<int> even = {0, 8, 16, 24, h};
-  BandFrame wave = render_in_bands(*tracer, view, params, even);
-  EXPECT_EQ(tracer->wavefront_argument_sets(), 1u) << "four bands of 8 rows";
-  BandFrame mega = render_bands(kMegakernel, view, params, even);
-  expect_same_band_frame(mega.frame, mega.row_work, wave.frame, wave.row_work, false, h, "the megakernel's");
-
-  const size_t before = tracer->wavefront_argument_sets();
-  // 8 rows (as the band before: kept), then 12, 8 and 4 (each set anew).
-  render_in_bands(*tracer, view, params, {0, 8, 20, 28, h});
-  EXPECT_EQ(tracer->wavefront_argument_sets(), before + 3u);
-}
-
 INSTANTIATE_TEST_SUITE_P(
     Paths, OpenCLWavefront,
     ::testing::Values(SceneCase{false, 1, 1, "room_bounce1"},

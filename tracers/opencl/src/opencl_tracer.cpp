@@ -1070,9 +1070,6 @@ size_t OpenCLTracer::bands_dropped_ahead() const { return impl_->dropped_ahead.l
 size_t OpenCLTracer::bands_back_to_back() const { return impl_->back_to_back.load(); }
 bool OpenCLTracer::transfer_queues() const { return impl_->transfer; }
 size_t OpenCLTracer::bands_read_through_staging() const { return impl_->staged_reads.load(); }
-size_t OpenCLTracer::wavefront_argument_sets() const {
-  return impl_->wavefront ? impl_->wavefront->argument_sets() : 0;
-}
 
 core::BandResult OpenCLTracer::render_first_hits_in_pieces(const core::BandJob& job, core::BandBuffer& target,
                                                            const KFrameParams& params, const KCamera& camera,

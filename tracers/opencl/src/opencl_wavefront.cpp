@@ -44,7 +44,6 @@ OpenCLWavefront::OpenCLWavefront(cl_context context, cl_device_id device, cl_pro
 OpenCLWavefront::~OpenCLWavefront() { release(); }
 
 void OpenCLWavefront::release() {
-  forget_prepared();
   for (cl_mem m : {states_, hits_, active_, vertices_, shadow_rays_})
     if (m) clReleaseMemObject(m);
   for (const auto& builds : shade_)
@@ -70,18 +69,11 @@ void OpenCLWavefront::prepare(const BandArgs& band, size_t pixels, kuint slots, 
   first_hits_ = first_hits != nullptr;
   const cl_uint stride = static_cast<cl_uint>(pixels);
   const cl_uint sample = 0;
-  // A kernel keeps its arguments between launches, and from band to band they seldom change (a buffer grown or
-  // replaced, another band size): set them only when they did. Each set is a driver call (nine kernels of 25
-  // arguments), paid in front of every band that could not be enqueued ahead.
-  // The buffers a set refers to are retained until the next set, so an equal handle is the same buffer: a buffer
-  // released and created again cannot come back under the handle of the one the kernels hold.
-  const PreparedArgs args{band, {states_, hits_, active_, vertices, shadow_rays}, stride, first_hits};
-  if (prepared_ && *prepared_ == args) return;
-  forget_prepared();  // a set that throws half way leaves the kernels to be set again next time
   auto set = [&](cl_kernel k) {
     for (cl_uint a = 0; a < kBandArgs; ++a) check(clSetKernelArg(k, a, sizeof(cl_mem), &band[a]), "clSetKernelArg(wavefront)");
-    for (cl_uint a = 0; a < args.scratch.size(); ++a)
-      check(clSetKernelArg(k, kStatesArg + a, sizeof(cl_mem), &args.scratch[a]), "clSetKernelArg(wavefront scratch)");
+    const cl_mem scratch[] = {states_, hits_, active_, vertices, shadow_rays};
+    for (cl_uint a = 0; a < 5; ++a)
+      check(clSetKernelArg(k, kStatesArg + a, sizeof(cl_mem), &scratch[a]), "clSetKernelArg(wavefront scratch)");
     check(clSetKernelArg(k, kStrideArg, sizeof stride, &stride), "clSetKernelArg(wavefront stride)");
     check(clSetKernelArg(k, kSampleArg, sizeof sample, &sample), "clSetKernelArg(wavefront sample)");
     check(clSetKernelArg(k, kFirstHitsArg, sizeof(cl_mem), &first_hits), "clSetKernelArg(wavefront first hits)");
@@ -89,14 +81,6 @@ void OpenCLWavefront::prepare(const BandArgs& band, size_t pixels, kuint slots, 
   for (cl_kernel k : {camera_walk_, bounce_walk_, shadow_walk_}) set(k);
   for (const auto& builds : shade_)
     for (cl_kernel k : builds) set(k);
-  args.for_each_buffer([](cl_mem m) { clRetainMemObject(m); });
-  prepared_ = args;
-  ++argument_sets_;
-}
-
-void OpenCLWavefront::forget_prepared() {
-  if (prepared_) prepared_->for_each_buffer([](cl_mem m) { clReleaseMemObject(m); });
-  prepared_.reset();
 }
 
 void OpenCLWavefront::enqueue(cl_command_queue queue, const KFrameParams& params, size_t width, size_t first_row,

@@ -10,7 +10,6 @@
 
 #include <array>
 #include <cstddef>
-#include <optional>
 #include <string>
 
 #include "cohort/kernel/layout.h"
@@ -33,11 +32,8 @@ class OpenCLWavefront {
 
   // Sets every kernel's arguments for a band of `pixels`, the scratch grown to it: slots, the shadow-ray
   // slots a pixel (k_shadow_queue_slots; 0: the shading kernels walk the shadow rays as they come);
-  // first_hits: the aux planes' first-hit records, or null. Arguments the same as the last band's are not set
-  // again.
+  // first_hits: the aux planes' first-hit records, or null.
   void prepare(const BandArgs& band, size_t pixels, kuint slots, cl_mem first_hits);
-  // How many times prepare() has set the kernels' arguments (not counting the bands that kept the last ones).
-  size_t argument_sets() const { return argument_sets_; }
   // Enqueues the frame's samples over the band rows [first_row, first_row + rows) of `width` pixels, in
   // whole 8x8 work groups from first_row (the megakernel's launch shape). started / done (may be null):
   // the first and the last kernel's events.
@@ -56,25 +52,6 @@ class OpenCLWavefront {
   size_t states_bytes_ = 0, hits_bytes_ = 0, active_bytes_ = 0, vertices_bytes_ = 0, shadow_rays_bytes_ = 0;
   kuint slots_ = 0;
   bool first_hits_ = false;
-  // What prepare() last set on every kernel (its sample argument aside, which enqueue() sets per sample).
-  struct PreparedArgs {
-    BandArgs band;
-    std::array<cl_mem, 5> scratch;  // states, hits, active, vertices, shadow rays
-    cl_uint stride;
-    cl_mem first_hits;
-    bool operator==(const PreparedArgs&) const = default;
-    template <class F>
-    void for_each_buffer(F f) const {
-      for (cl_mem m : band)
-        if (m) f(m);
-      for (cl_mem m : scratch)
-        if (m) f(m);
-      if (first_hits) f(first_hits);
-    }
-  };
-  void forget_prepared();
-  std::optional<PreparedArgs> prepared_;
-  size_t argument_sets_ = 0;
 };
 
 }  // namespace cohort::tracers

@@ -117,9 +117,6 @@ class OpenCLTracer : public TracerBase {
   bool transfer_queues() const;
   // Bands whose colour came through page-locked staging (Options::pinned_band_reads).
   size_t bands_read_through_staging() const;
-  // Times the wavefront set its kernels' arguments: a band with the buffers and size of the one before keeps
-  // them (each set is some 225 driver calls in front of the band).
-  size_t wavefront_argument_sets() const;
 
   // "platform / device" for every OpenCL device on this machine, in the order Options::device counts.
   static std::vector<std::string> list_devices();
