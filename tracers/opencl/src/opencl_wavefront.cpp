@@ -1,5 +1,8 @@
 #include "opencl_wavefront.h"
 
+#include <stdexcept>
+#include <string>
+
 #include "cohort/kernel/path_pattern.h"
 #include "cohort/kernel/path_state.h"
 #include "cohort/kernel/scene_view.h"
@@ -95,16 +98,26 @@ void OpenCLWavefront::enqueue(cl_command_queue queue, const KFrameParams& params
       if (event) clReleaseEvent(event);
     }
   } last;
-  // Each kernel behind the one before (one in-order queue); the first's event kept, the last's handed out.
-  auto run = [&](cl_kernel k) {
-    cl_event event = nullptr;
-    const cl_int err = clEnqueueNDRangeKernel(queue, k, 2, offset, global, local, 0, nullptr, &event);
-    if (err == CL_SUCCESS && started && !*started && clRetainEvent(event) == CL_SUCCESS) *started = event;
-    if (last.event) clReleaseEvent(last.event);
-    last.event = event;
-    check(err, "launching a wavefront kernel");
-  };
   const int walk = slots_ > 0u ? 1 : 0;
+  const kuint spp = k_paths_per_pixel(params.spp);
+  // Each kernel behind the one before (one in-order queue). Only the first (started) and the last (done) ask for
+  // an event: an event is a driver object made and recorded per launch, host time in front of the band. Per
+  // sample and stage (the camera's, then each bounce's): a walk, a shading kernel and, with slots, the shadow walk.
+  const size_t launches = size_t(spp) * (1u + params.max_bounces) * (walk ? 3u : 2u);
+  size_t launched = 0;
+  auto run = [&](cl_kernel k) {
+    ++launched;
+    const bool first = launched == 1 && started && !*started, final = launched == launches && done;
+    cl_event event = nullptr;
+    const cl_int err =
+        clEnqueueNDRangeKernel(queue, k, 2, offset, global, local, 0, nullptr, first || final ? &event : nullptr);
+    check(err, "launching a wavefront kernel");
+    if (first && clRetainEvent(event) == CL_SUCCESS) *started = event;
+    if (event) {
+      if (last.event) clReleaseEvent(last.event);
+      last.event = event;
+    }
+  };
   auto shade = [&](cl_kernel k, cl_uint sample) {
     check(clSetKernelArg(k, kSampleArg, sizeof sample, &sample), "clSetKernelArg(wavefront sample)");
     run(k);
@@ -112,7 +125,6 @@ void OpenCLWavefront::enqueue(cl_command_queue queue, const KFrameParams& params
     check(clSetKernelArg(shadow_walk_, kSampleArg, sizeof sample, &sample), "clSetKernelArg(wavefront sample)");
     run(shadow_walk_);
   };
-  const kuint spp = k_paths_per_pixel(params.spp);
   for (cl_uint sample = 0; sample < spp; ++sample) {
     check(clSetKernelArg(camera_walk_, kSampleArg, sizeof sample, &sample), "clSetKernelArg(wavefront sample)");
     run(camera_walk_);
@@ -123,6 +135,8 @@ void OpenCLWavefront::enqueue(cl_command_queue queue, const KFrameParams& params
     }
   }
   if (done) {
+    if (launched != launches) throw std::logic_error("OpenCLWavefront: launched " + std::to_string(launched) +
+                                                     " kernels, counted " + std::to_string(launches));
     *done = last.event;
     last.event = nullptr;
   }
