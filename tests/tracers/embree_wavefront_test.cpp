@@ -192,6 +192,18 @@ TEST(EmbreeWavefrontRayLog, RecordsTheSameRaysByClass) {
   EXPECT_EQ(sorted(wave.bounce), sorted(paths.bounce)) << "bounce rays";
 }
 
+// With `variable` set to `value`, building an Embree tracer throws std::invalid_argument naming both; unset after.
+void expect_tracer_refuses(const char* variable, const char* value) {
+  ::setenv(variable, value, 1);
+  try {
+    tracers::EmbreeTracer tracer;
+    ADD_FAILURE() << variable << "=" << value << " accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find(std::string(variable) + "='" + value + "'"), std::string::npos) << e.what();
+  }
+  ::unsetenv(variable);
+}
+
 // COHORT_EMBREE_WAVEFRONT: the wavefront unless it says 0; a value other than 0 or 1 is named. Packets of 8
 // or 16 rays, nothing else, also through COHORT_EMBREE_PACKET_WIDTH.
 TEST(EmbreeWavefrontSwitch, TheEnvironmentSetsItAndABadValueIsNamed) {
@@ -208,26 +220,12 @@ TEST(EmbreeWavefrontSwitch, TheEnvironmentSetsItAndABadValueIsNamed) {
   EXPECT_FALSE(tracers::EmbreeTracer().wavefront());
   ::setenv("COHORT_EMBREE_WAVEFRONT", "1", 1);
   EXPECT_TRUE(tracers::EmbreeTracer().wavefront());
-  ::setenv("COHORT_EMBREE_WAVEFRONT", "yes", 1);
-  try {
-    tracers::EmbreeTracer tracer;
-    ADD_FAILURE() << "COHORT_EMBREE_WAVEFRONT=yes accepted";
-  } catch (const std::invalid_argument& e) {
-    EXPECT_NE(std::string(e.what()).find("COHORT_EMBREE_WAVEFRONT='yes'"), std::string::npos) << e.what();
-  }
-  ::unsetenv("COHORT_EMBREE_WAVEFRONT");
+  expect_tracer_refuses("COHORT_EMBREE_WAVEFRONT", "yes");
   ::setenv("COHORT_EMBREE_PACKET_WIDTH", "8", 1);
   EXPECT_EQ(tracers::EmbreeTracer().wave_packet_width(), 8);
   ::setenv("COHORT_EMBREE_PACKET_WIDTH", "16", 1);
   EXPECT_EQ(tracers::EmbreeTracer().wave_packet_width(), 16);
-  ::setenv("COHORT_EMBREE_PACKET_WIDTH", "4", 1);
-  try {
-    tracers::EmbreeTracer tracer;
-    ADD_FAILURE() << "COHORT_EMBREE_PACKET_WIDTH=4 accepted";
-  } catch (const std::invalid_argument& e) {
-    EXPECT_NE(std::string(e.what()).find("COHORT_EMBREE_PACKET_WIDTH='4'"), std::string::npos) << e.what();
-  }
-  ::unsetenv("COHORT_EMBREE_PACKET_WIDTH");
+  expect_tracer_refuses("COHORT_EMBREE_PACKET_WIDTH", "4");
 }
 
 }  // namespace
