@@ -13,6 +13,9 @@ void check(cl_int err, const char* what) {
   if (err != CL_SUCCESS) throw std::runtime_error(std::string("OpenCLTracer: ") + what + " failed (error " + std::to_string(err) + ")");
 }
 
+namespace {
+
+// The built-in source, or with COHORT_OPENCL_SOURCE_DIR set, that folder's <program_name>.cl.
 std::string program_source(const char* built_in, const char* program_name) {
   const char* dir = std::getenv("COHORT_OPENCL_SOURCE_DIR");
   if (!dir || !*dir) return built_in;
@@ -26,6 +29,8 @@ std::string program_source(const char* built_in, const char* program_name) {
                program_name, path);
   return text.str();
 }
+
+}  // namespace
 
 cl_program build_program(cl_context context, cl_device_id device, const char* built_in_source,
                          const char* program_name, const std::string& options, const std::string& label) {

@@ -636,7 +636,8 @@ OpenCLTracer::OpenCLTracer(const Options& options) : impl_(std::make_unique<Impl
   }
   impl_->walk_options = with_registers(options.walk_registers);
   impl_->main_options = with_registers(options.shade_registers);
-  impl_->program = build_program(impl_->context, dev.device, opencl_source::kRenderBand, "render_band", impl_->main_options, dev.label);
+  impl_->program = build_program(impl_->context, dev.device, opencl_source::kRenderBand, "render_band",
+                                 impl_->main_options, dev.label);
   impl_->kernel = clCreateKernel(impl_->program, "cohort_render_band", &err);
   check(err, "clCreateKernel");
   impl_->skin_positions = clCreateKernel(impl_->program, "cohort_skin_positions", &err);

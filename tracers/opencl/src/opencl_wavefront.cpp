@@ -28,7 +28,8 @@ OpenCLWavefront::OpenCLWavefront(cl_context context, cl_device_id device, cl_pro
                                  const std::string& walk_options, const std::string& label)
     : context_(context) {
   try {
-    walk_program_ = build_program(context, device, opencl_source::kWavefrontWalk, "wavefront_walk", walk_options, label);
+    walk_program_ =
+        build_program(context, device, opencl_source::kWavefrontWalk, "wavefront_walk", walk_options, label);
     camera_walk_ = create_kernel(walk_program_, "cohort_wave_camera_walk");
     bounce_walk_ = create_kernel(walk_program_, "cohort_wave_bounce_walk");
     shadow_walk_ = create_kernel(walk_program_, "cohort_wave_shadow_walk");
