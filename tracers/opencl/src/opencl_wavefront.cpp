@@ -1,7 +1,6 @@
 #include "opencl_wavefront.h"
 
-#include <stdexcept>
-#include <string>
+#include <vector>
 
 #include "cohort/kernel/path_pattern.h"
 #include "cohort/kernel/path_state.h"
@@ -100,44 +99,43 @@ void OpenCLWavefront::enqueue(cl_command_queue queue, const KFrameParams& params
     }
   } last;
   const int walk = slots_ > 0u ? 1 : 0;
+  // The band's kernels in order, on one in-order queue: per sample the camera walk, then per stage (the camera
+  // rays', each bounce's, after its bounce walk) a shading kernel and, with slots, the shadow walk. Each but the
+  // bounce walk has its sample argument set just before its launch.
+  struct Launch {
+    cl_kernel kernel;
+    bool takes_sample;
+    cl_uint sample;
+  };
+  std::vector<Launch> launches;
   const kuint spp = k_paths_per_pixel(params.spp);
-  // Each kernel behind the one before (one in-order queue). Only the first (started) and the last (done) ask for
-  // an event: an event is a driver object made and recorded per launch, host time in front of the band. Per
-  // sample and stage (the camera's, then each bounce's): a walk, a shading kernel and, with slots, the shadow walk.
-  const size_t launches = size_t(spp) * (1u + params.max_bounces) * (walk ? 3u : 2u);
-  size_t launched = 0;
-  auto run = [&](cl_kernel k) {
-    ++launched;
-    const bool first = launched == 1 && started && !*started, final = launched == launches && done;
+  for (cl_uint sample = 0; sample < spp; ++sample) {
+    launches.push_back({camera_walk_, true, sample});
+    for (kuint bounce = 0u; bounce <= params.max_bounces; ++bounce) {
+      if (bounce > 0u) launches.push_back({bounce_walk_, false, 0u});
+      const int build = bounce > 0u ? 2 : sample == 0u && first_hits_ ? 1 : 0;
+      launches.push_back({shade_[walk][build], true, sample});
+      if (walk) launches.push_back({shadow_walk_, true, sample});
+    }
+  }
+  // Only the first (started) and the last (done) ask for an event: an event is a driver object made and recorded
+  // per launch, host time in front of the band.
+  for (size_t i = 0; i < launches.size(); ++i) {
+    const Launch& l = launches[i];
+    if (l.takes_sample)
+      check(clSetKernelArg(l.kernel, kSampleArg, sizeof l.sample, &l.sample), "clSetKernelArg(wavefront sample)");
+    const bool first = i == 0 && started && !*started, final = i + 1 == launches.size() && done;
     cl_event event = nullptr;
-    const cl_int err =
-        clEnqueueNDRangeKernel(queue, k, 2, offset, global, local, 0, nullptr, first || final ? &event : nullptr);
-    check(err, "launching a wavefront kernel");
+    check(clEnqueueNDRangeKernel(queue, l.kernel, 2, offset, global, local, 0, nullptr,
+                                 first || final ? &event : nullptr),
+          "launching a wavefront kernel");
     if (first && clRetainEvent(event) == CL_SUCCESS) *started = event;
     if (event) {
       if (last.event) clReleaseEvent(last.event);
       last.event = event;
     }
-  };
-  auto shade = [&](cl_kernel k, cl_uint sample) {
-    check(clSetKernelArg(k, kSampleArg, sizeof sample, &sample), "clSetKernelArg(wavefront sample)");
-    run(k);
-    if (!walk) return;
-    check(clSetKernelArg(shadow_walk_, kSampleArg, sizeof sample, &sample), "clSetKernelArg(wavefront sample)");
-    run(shadow_walk_);
-  };
-  for (cl_uint sample = 0; sample < spp; ++sample) {
-    check(clSetKernelArg(camera_walk_, kSampleArg, sizeof sample, &sample), "clSetKernelArg(wavefront sample)");
-    run(camera_walk_);
-    shade(shade_[walk][sample == 0u && first_hits_ ? 1 : 0], sample);
-    for (kuint bounce = 1u; bounce <= params.max_bounces; ++bounce) {
-      run(bounce_walk_);
-      shade(shade_[walk][2], sample);
-    }
   }
   if (done) {
-    if (launched != launches) throw std::logic_error("OpenCLWavefront: launched " + std::to_string(launched) +
-                                                     " kernels, counted " + std::to_string(launches));
     *done = last.event;
     last.event = nullptr;
   }
