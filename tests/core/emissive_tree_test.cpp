@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "cohort/core/light_sampling.h"
+#include "cohort/test_support/scene_builders.h"
 #include "cohort/kernel/emissive_tree.h"
 
 using namespace cohort;
@@ -138,18 +139,8 @@ TEST(EmissiveTree, EveryTriangleIsFoundAndOthersAreNot) {
 
 TEST(EmissiveTree, FollowsTheLightTreeInTheNodeArray) {
   Sources s = scattered_emitters(10, 2);
-  KLight light{};
-  light.type = K_LIGHT_POINT;
-  for (int k = 0; k < 3; ++k) {
-    light.radius[k] = 100.0f;
-    light.color[k] = 1.0f;
-  }
   // A point light's box comes from its S, T, F planes: the cube of radius 100 about the origin.
-  const float planes[3][4] = {{0.005f, 0, 0, 0.5f}, {0, 0.005f, 0, 0.5f}, {0, 0, 0.005f, 0.5f}};
-  std::copy(planes[0], planes[0] + 4, light.plane_s);
-  std::copy(planes[1], planes[1] + 4, light.plane_t);
-  std::copy(planes[2], planes[2] + 4, light.plane_f);
-  light.plane_q[3] = 1.0f;
+  const KLight light = test::kernel_point_light_about_origin(100.0f);
   s.lights = {light, light, light};
   s.nodes = core::build_light_nodes(s.lights, s.emissive);
   const size_t light_nodes = core::build_light_tree(s.lights).size();

@@ -102,4 +102,18 @@ scene::Light point_light(glm::vec3 origin, glm::vec3 radius, glm::vec3 colour) {
   return l;
 }
 
+KLight kernel_point_light_about_origin(float half_size) {
+  KLight light{};
+  light.type = K_LIGHT_POINT;
+  const float slope = 0.5f / half_size;  // s = slope x + 0.5: 0 to 1 over [-half_size, half_size]
+  for (int k = 0; k < 3; ++k) {
+    light.radius[k] = half_size;
+    light.color[k] = 1.0f;
+  }
+  light.plane_s[0] = light.plane_t[1] = light.plane_f[2] = slope;
+  light.plane_s[3] = light.plane_t[3] = light.plane_f[3] = 0.5f;
+  light.plane_q[3] = 1.0f;
+  return light;
+}
+
 }  // namespace cohort::test

@@ -10,12 +10,12 @@
 
 #include <gtest/gtest.h>
 
-#include <algorithm>
 #include <cstring>
 #include <random>
 #include <vector>
 
 #include "cohort/core/light_sampling.h"
+#include "cohort/test_support/scene_builders.h"
 
 #ifdef COHORT_HAVE_EMBREE
 using namespace cohort;
@@ -52,17 +52,7 @@ void build(Emitters& s, int n, uint32_t seed, bool with_lights, float zero_power
     s.emissive.power.push_back(unit(rng) < zero_power_share ? 0.0f : power(rng));
   }
   if (with_lights) {
-    KLight light{};
-    light.type = K_LIGHT_POINT;
-    for (int k = 0; k < 3; ++k) {
-      light.radius[k] = 100.0f;
-      light.color[k] = 1.0f;
-    }
-    const float planes[3][4] = {{0.005f, 0, 0, 0.5f}, {0, 0.005f, 0, 0.5f}, {0, 0, 0.005f, 0.5f}};
-    std::copy(planes[0], planes[0] + 4, light.plane_s);
-    std::copy(planes[1], planes[1] + 4, light.plane_t);
-    std::copy(planes[2], planes[2] + 4, light.plane_f);
-    light.plane_q[3] = 1.0f;
+    const KLight light = test::kernel_point_light_about_origin(100.0f);
     s.lights = {light, light, light};
   }
   s.nodes = core::build_light_nodes(s.lights, s.emissive);

@@ -6,6 +6,7 @@
 
 #include <glm/glm.hpp>
 
+#include "cohort/kernel/layout.h"
 #include "cohort/scene/scene.h"
 
 namespace cohort::test {
@@ -31,5 +32,10 @@ int add_occluder(scene::Scene& scene, int material);
 
 // A point light named "light": a box of half-size `radius` around `origin`.
 scene::Light point_light(glm::vec3 origin, glm::vec3 radius, glm::vec3 colour = glm::vec3(1.0f));
+
+// A white point light in the kernel's layout whose S, T and F planes make its box the cube of half-size
+// `half_size` about the origin (radius `half_size` on every axis): for light and emissive tree tests that build
+// their nodes without a scene.
+KLight kernel_point_light_about_origin(float half_size);
 
 }  // namespace cohort::test
