@@ -52,6 +52,8 @@ struct Rendered {
   size_t staged_reads = 0;
   // The same counts summed over the CUDA tracers (CudaTracer::bands_enqueued_ahead, ...).
   size_t cuda_enqueued_ahead = 0, cuda_finished_ahead = 0, cuda_dropped_ahead = 0;
+  // Bands let start at the band before's release point (CudaTracer::bands_overlapping).
+  size_t cuda_overlapping = 0;
 };
 
 #ifdef COHORT_HAVE_OPENCL
@@ -79,6 +81,7 @@ void count_cuda_ahead([[maybe_unused]] const std::vector<core::Tracer*>& tracers
       out.cuda_enqueued_ahead += cuda->bands_enqueued_ahead();
       out.cuda_finished_ahead += cuda->bands_finished_ahead();
       out.cuda_dropped_ahead += cuda->bands_dropped_ahead();
+      out.cuda_overlapping += cuda->bands_overlapping();
     }
 #endif
 }
@@ -318,22 +321,38 @@ TEST(FramesInFlightAgreement, OpenCLWithCentreRayAuxPlanesDrawsTheSameFramesAndP
 // split): the same bits as with one in flight, in float bands, in packed RGB9E5 bands and with the aux
 // planes from centre rays and from the paths' first hits (whose texels of the band before may still be
 // going down when the next band's kernel writes its own); and the bands were enqueued ahead and taken by
-// their jobs. Switched off (COHORT_CUDA_ENQUEUE_AHEAD=0), nothing goes ahead.
+// their jobs. With the materials' commits alone (the walker still), each slot's own arrays take them and the
+// next band starts at the band before's release point (CudaTracer::set_band_overlap), by default and with
+// every kernel of the next band free to run beside the band before: still the same bits. Switched off
+// (COHORT_CUDA_ENQUEUE_AHEAD=0), nothing goes ahead.
 TEST(FramesInFlightAgreement, CudaDrawsTheSameFramesWithItsBandsEnqueuedAhead) {
   if (!tracer_runs_here("cuda")) GTEST_SKIP() << "needs a CUDA GPU";
   struct Case {
     const char* label;
     kuint aux;
     core::BandFormat format;
+    bool move_walker;
+    int overlap;  // CudaTracer::set_band_overlap; -1: the default
   };
-  for (const Case& c : {Case{"float bands", 0u, core::BandFormat::rgba32f},
-                        Case{"RGB9E5 bands", 0u, core::BandFormat::rgb9e5},
-                        Case{"centre-ray aux planes", kuint(K_AUX_CENTRE_RAY), core::BandFormat::rgba32f},
-                        Case{"first-hit aux planes", kuint(K_AUX_PATH_FIRST_HIT), core::BandFormat::rgb9e5}}) {
+  for (const Case& c : {Case{"float bands", 0u, core::BandFormat::rgba32f, true, -1},
+                        Case{"RGB9E5 bands", 0u, core::BandFormat::rgb9e5, true, -1},
+                        Case{"centre-ray aux planes", kuint(K_AUX_CENTRE_RAY), core::BandFormat::rgba32f, true, -1},
+                        Case{"first-hit aux planes", kuint(K_AUX_PATH_FIRST_HIT), core::BandFormat::rgb9e5, true, -1},
+                        Case{"materials' commits only", 0u, core::BandFormat::rgb9e5, false, -1},
+                        Case{"materials' commits only, whole bands overlapping", 0u, core::BandFormat::rgba32f, false,
+                             64}}) {
     Extras extras;
-    extras.move_walker = true;
+    extras.move_walker = c.move_walker;
     extras.aux = c.aux;
     extras.band_format = c.format;
+#ifdef COHORT_HAVE_CUDA
+    if (c.overlap >= 0)
+      extras.make = [overlap = c.overlap](const std::string& name) -> std::unique_ptr<core::Tracer> {
+        auto tracer = make_test_tracer(name);
+        if (auto* cuda = dynamic_cast<tracers::CudaTracer*>(tracer.get())) cuda->set_band_overlap(overlap);
+        return tracer;
+      };
+#endif
     const Rendered one = render_sequence({"cuda", "cuda"}, "none", 1, extras);
     const Rendered two = render_sequence({"cuda", "cuda"}, "none", 2, extras);
     expect_same_frames(one, two, true, std::string("cuda,cuda, ") + c.label);
@@ -341,6 +360,9 @@ TEST(FramesInFlightAgreement, CudaDrawsTheSameFramesWithItsBandsEnqueuedAhead) {
     EXPECT_GE(two.cuda_finished_ahead, 4u) << c.label << ": bands were not enqueued ahead";
     EXPECT_EQ(two.cuda_finished_ahead, two.cuda_enqueued_ahead) << c.label << ": a band enqueued ahead was not taken";
     EXPECT_EQ(two.cuda_dropped_ahead, 0u) << c.label;
+    if (!c.move_walker && !c.aux) {
+      EXPECT_GE(two.cuda_overlapping, 4u) << c.label << ": bands should start at the band before's release point";
+    }
     if (c.aux) {
       ASSERT_EQ(two.planes.size(), size_t(kFrames));
       for (int f = 0; f < kFrames; ++f) {

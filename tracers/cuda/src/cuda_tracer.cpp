@@ -47,16 +47,53 @@ PciBusId cuda_device_pci_bus_id(int device) {
   return PciBusId::of(unsigned(prop.pciDomainID), unsigned(prop.pciBusID), unsigned(prop.pciDeviceID));
 }
 
+// The scene arrays a frame's commit changes without touching geometry (animated materials and lights, moving
+// entities and so the TLAS): each band slot keeps its own copy, brought up to date on its stream as its band
+// is enqueued, so that a commit applied while the band before renders neither waits for it nor changes what
+// it reads (the test map's animated materials commit every frame).
+enum SlotArray { kInstances, kTlasNodes, kMaterials, kLights, kLightNodes, kEmissive, kSlotArrays };
+struct SlotScene {
+  DeviceArray<KInstance> instances;
+  DeviceArray<KBvhNode> tlas_nodes;
+  DeviceArray<KMaterial> materials;
+  DeviceArray<KLight> lights;
+  DeviceArray<KLightNode> light_nodes;
+  DeviceArray<KEmissiveTriangle> emissive;
+  uint64_t versions[kSlotArrays] = {};  // of the host's arrays (CudaTracer::Impl::slot_array_versions) held here
+};
+
+// A band's stream, device storage, clock and way back. Two slots, used in turn: with enqueue ahead the next
+// band's kernels run on the other slot's stream, into its own storage, so that they may start while this
+// band's last kernels drain (band overlap, CudaTracer::set_band_overlap).
 struct CudaTracer::BandSlot {
+  SlotScene scene;
+  cudaStream_t stream = nullptr;
+  WaveLanes lanes;
+  int released_lanes = 0;  // lanes.released recorded by the band's kernels (0: the next band waits for `stop`)
   cudaEvent_t start = nullptr, stop = nullptr, finished = nullptr;
   cudaEvent_t counted = nullptr;     // after its row counts' and ray totals' copies: the band is all back
   cudaEvent_t aux_copied = nullptr;  // on aux_copy_stream, once its aux texels went down
   unsigned* row_rays = nullptr;      // page-locked, row_rays_capacity rows
   size_t row_rays_capacity = 0;
   unsigned long long* counts = nullptr;  // page-locked: closest, occlusion
+  // Device: the band (float4 per pixel), its packed copy for an RGB16F or RGB9E5 target, the rays per band
+  // row (the balancer's per-row work), the ray totals (closest, occlusion).
+  float4* band = nullptr;
+  unsigned char* band_packed = nullptr;
+  size_t band_capacity = 0;  // pixels
+  unsigned* device_row_rays = nullptr;
+  size_t device_row_rays_capacity = 0;  // rows
+  unsigned long long* ray_counts = nullptr;
+  // The wavefront's scratch (render_band.cu).
+  DeviceArray<KPathState> wave_states;
+  DeviceArray<KHit> wave_hits;
+  DeviceArray<kuint> wave_active;
+  DeviceArray<KVertexLight> wave_vertices;
+  DeviceArray<KShadowRay> wave_shadow_rays;
+  WavefrontScratch wave_scratch;
 };
 
-// A band whose commands are all on the tracer's stream, until its finish.
+// A band whose commands are all on its slot's stream, until its finish.
 struct CudaTracer::EnqueuedBand {
   core::BandJob job;
   core::BandBuffer* target = nullptr;
@@ -77,23 +114,26 @@ struct CudaTracer::EnqueuedBand {
 struct CudaTracer::Impl {
   int device = 0;
   std::string name;
+  // Commits (upload) go here, behind the kernels of every band in flight; bands run on their slot's stream.
   cudaStream_t stream = nullptr;
-  // The aux planes' download runs here, on the copy engine, while the band's kernel runs on `stream`.
+  // The aux planes' download runs here, on the copy engine, while the band's kernel runs on its slot's stream.
   cudaStream_t aux_copy_stream = nullptr;
   cudaEvent_t aux_ready = nullptr;
-  // A band's clock and its counters' way back, two slots used in turn: with enqueue ahead the next band's
-  // commands are on the stream while the band before finishes from the other slot.
   BandSlot slots[2];
   int next_slot = 0;
+  BandSlot* band_before = nullptr;  // the slot of the band enqueued last
+  // How many kernels before the end of a band's lanes the next band may start (COHORT_CUDA_BAND_OVERLAP;
+  // 0: once the band's kernels are done).
+  int band_overlap = 0;
   // The aux texels' copy of the band before (its slot's aux_copied), which a band that writes the same
-  // texels waits for on the stream; null when none is pending.
+  // texels waits for on its stream; null when none is pending.
   cudaEvent_t aux_copy_before = nullptr;
   // Enqueue ahead (CudaTracer::set_enqueue_ahead): the next band, enqueued while the band before renders,
   // until render_band takes it; whether a commit is being applied ahead (the band before still running).
   bool enqueue_ahead = enabled_unless_zero("COHORT_CUDA_ENQUEUE_AHEAD");
   bool applying_ahead = false;
   std::optional<EnqueuedBand> ahead;
-  std::atomic<size_t> enqueued_ahead{0}, finished_ahead{0}, dropped_ahead{0};
+  std::atomic<size_t> enqueued_ahead{0}, finished_ahead{0}, dropped_ahead{0}, overlapping{0};
   // Wakes a worker waiting for its next job once a band is back (cudaLaunchHostFunc on a stream of its own
   // that waits for the band, so that the host function holds no band's stream).
   cudaStream_t signal_stream = nullptr;
@@ -105,15 +145,12 @@ struct CudaTracer::Impl {
   // The triangles' corners and edges (KTriangleEdges), made on the device after every geometry upload and
   // skinning pass: the walk's leaf test reads them instead of following vertex indices (render_band.cu).
   DeviceArray<KTriangleEdges> triangle_edges;
-  DeviceArray<KBvhNode> blas_nodes, tlas_nodes;
+  DeviceArray<KBvhNode> blas_nodes;
   DeviceArray<KBlas> blases;
-  DeviceArray<KInstance> instances;
-  DeviceArray<KMaterial> materials;
   DeviceArray<KTexture> textures;
   DeviceArray<uint32_t> texels;
-  DeviceArray<KLight> lights;
-  DeviceArray<KLightNode> light_nodes;
-  DeviceArray<KEmissiveTriangle> emissive;
+  // Bumped as commits change the slots' arrays (SlotScene); a slot whose copy is older uploads it again.
+  uint64_t slot_array_versions[kSlotArrays] = {1, 1, 1, 1, 1, 1};
   DeviceArray<KSkin> skins;
   DeviceArray<KSkinVertex> skin_vertices;
   DeviceArray<KSkinWeight> skin_weights;
@@ -127,49 +164,36 @@ struct CudaTracer::Impl {
   DeviceArray<KJoint> previous_joints;
   DeviceArray<KAuxTexel> aux_texels;
   DeviceArray<KPathFirstHit> first_hits;  // K_AUX_PATH_FIRST_HIT: the band's paths' records
-  float4* band = nullptr;
-  unsigned char* band_packed = nullptr;   // the band as RGB halves or RGB9E5 words, for packed targets
   bool count_rays = false;
   // The bounce rays' wavefront (render_band.cu) instead of the megakernel, unless COHORT_CUDA_WAVEFRONT=0.
   bool wavefront = enabled_unless_zero("COHORT_CUDA_WAVEFRONT");
-  DeviceArray<KPathState> wave_states;
-  DeviceArray<KHit> wave_hits;
-  DeviceArray<kuint> wave_active;
   // Its shadow rays walked by a kernel of their own, unless COHORT_CUDA_SHADOW_WALK=0 (the shading kernels
   // walk them as they come).
   bool shadow_walk = enabled_unless_zero("COHORT_CUDA_SHADOW_WALK");
-  DeviceArray<KVertexLight> wave_vertices;
-  DeviceArray<KShadowRay> wave_shadow_rays;
-  WavefrontScratch wave_scratch;
-  // Its lanes (render_band_launch.h, CudaTracer::set_wave_lanes).
-  WaveLanes wave_lanes;
-  // The wavefront's scratch for a band of `pixels` rendered with `params`, or null for the megakernel (also
-  // for frames the wavefront does not render: no scratch allocated for them).
-  const WavefrontScratch* wave(size_t pixels, const KFrameParams& params) {
+  // The wavefront's scratch in slot `s` for a band of `pixels` rendered with `params`, or null for the
+  // megakernel (also for frames the wavefront does not render: no scratch allocated for them).
+  const WavefrontScratch* wave(BandSlot& s, size_t pixels, const KFrameParams& params) {
     if (!wavefront || !k_wavefront_renders(&params)) return nullptr;
-    wave_scratch = {};
-    wave_scratch.states = wave_states.scratch(pixels);
-    wave_scratch.hits = wave_hits.scratch(pixels);
-    wave_scratch.active = wave_active.scratch(pixels);
-    wave_scratch.lanes = &wave_lanes;
-    const KSceneView scene = view(params);
+    WavefrontScratch& w = s.wave_scratch;
+    w = {};
+    w.states = s.wave_states.scratch(pixels);
+    w.hits = s.wave_hits.scratch(pixels);
+    w.active = s.wave_active.scratch(pixels);
+    w.lanes = &s.lanes;
+    const KSceneView scene = view(s, params);
     const kuint slots = shadow_walk ? k_shadow_queue_slots(&params, scene.light_count, scene.emissive_count) : 0u;
     if (slots > 0u) {
-      wave_scratch.vertices = wave_vertices.scratch(pixels);
-      wave_scratch.shadow_rays = wave_shadow_rays.scratch(pixels * slots);
-      wave_scratch.shadow_slots = slots;
+      w.vertices = s.wave_vertices.scratch(pixels);
+      w.shadow_rays = s.wave_shadow_rays.scratch(pixels * slots);
+      w.shadow_slots = slots;
     }
-    return &wave_scratch;
+    return &w;
   }
   static bool enabled_unless_zero(const char* variable) {
     const char* v = std::getenv(variable);
     return !(v && std::strcmp(v, "0") == 0);
   }
-  unsigned long long* ray_counts = nullptr;   // device: closest, occlusion
-  unsigned* row_rays = nullptr;                // device: rays per band row (the balancer's per-row work)
-  size_t row_rays_capacity = 0;                // rows
   RayCounts last_counts;
-  size_t band_capacity = 0;   // pixels
   // The targets the band is copied into, page-locked (cudaHostRegister) so that the copy is a true
   // asynchronous DMA on the tracer's stream instead of going through the driver's pageable staging
   // (about 3 ms of a 1080p frame otherwise). The Renderer alternates two targets by frame parity (the
@@ -187,40 +211,59 @@ struct CudaTracer::Impl {
   int next_kept = 0;
 
   // Converts `pixels` of the float band, from frame pixel `first_pixel` on, to the packed `format` on the
-  // stream.
-  void pack_band(core::BandFormat format, const float4* from, void* to, size_t pixels, size_t first_pixel, kuint frame) {
-    if (format == core::BandFormat::rgb16f) launch_band_to_rgb16f(from, static_cast<unsigned short*>(to), pixels, stream);
-    else launch_band_to_rgb9e5(from, static_cast<unsigned*>(to), pixels, unsigned(first_pixel), frame, stream);
+  // slot's stream.
+  static void pack_band(const BandSlot& s, core::BandFormat format, const float4* from, void* to, size_t pixels,
+                        size_t first_pixel, kuint frame) {
+    if (format == core::BandFormat::rgb16f)
+      launch_band_to_rgb16f(from, static_cast<unsigned short*>(to), pixels, s.stream);
+    else
+      launch_band_to_rgb9e5(from, static_cast<unsigned*>(to), pixels, unsigned(first_pixel), frame, s.stream);
   }
-  // Device storage for a band of `pixels` in `rows` (the float band, its packed copy for an RGB16F or
-  // RGB9E5 target, the per-row ray counts), grown as bands grow, and the band's ray counters cleared on
-  // the stream.
-  void prepare_band(size_t pixels, size_t rows, bool packed) {
-    if (pixels > band_capacity) {
-      if (band) COHORT_CUDA(cudaFree(band));
-      if (band_packed) COHORT_CUDA(cudaFree(band_packed));
-      band_packed = nullptr;
-      COHORT_CUDA(cudaMalloc(&band, pixels * sizeof(float4)));
-      band_capacity = pixels;
+  // The slot's device storage for a band of `pixels` in `rows`, grown as bands grow, and the band's ray
+  // counters cleared on its stream.
+  void prepare_band(BandSlot& s, size_t pixels, size_t rows, bool packed) {
+    if (pixels > s.band_capacity) {
+      if (s.band) COHORT_CUDA(cudaFree(s.band));
+      if (s.band_packed) COHORT_CUDA(cudaFree(s.band_packed));
+      s.band_packed = nullptr;
+      COHORT_CUDA(cudaMalloc(&s.band, pixels * sizeof(float4)));
+      s.band_capacity = pixels;
     }
     // Room for the larger packed format (6 bytes a pixel), so a change of format needs no reallocation.
-    if (packed && !band_packed) COHORT_CUDA(cudaMalloc(&band_packed, band_capacity * core::bytes_per_pixel(core::BandFormat::rgb16f)));
-    if (rows > row_rays_capacity) {
-      if (row_rays) COHORT_CUDA(cudaFree(row_rays));
-      COHORT_CUDA(cudaMalloc(&row_rays, rows * sizeof(unsigned)));
-      row_rays_capacity = rows;
+    if (packed && !s.band_packed)
+      COHORT_CUDA(cudaMalloc(&s.band_packed, s.band_capacity * core::bytes_per_pixel(core::BandFormat::rgb16f)));
+    if (rows > s.device_row_rays_capacity) {
+      if (s.device_row_rays) COHORT_CUDA(cudaFree(s.device_row_rays));
+      COHORT_CUDA(cudaMalloc(&s.device_row_rays, rows * sizeof(unsigned)));
+      s.device_row_rays_capacity = rows;
     }
-    COHORT_CUDA(cudaMemsetAsync(row_rays, 0, rows * sizeof(unsigned), stream));
+    COHORT_CUDA(cudaMemsetAsync(s.device_row_rays, 0, rows * sizeof(unsigned), s.stream));
     if (count_rays) {
-      if (!ray_counts) COHORT_CUDA(cudaMalloc(&ray_counts, 2 * sizeof(unsigned long long)));
-      COHORT_CUDA(cudaMemsetAsync(ray_counts, 0, 2 * sizeof(unsigned long long), stream));
+      if (!s.ray_counts) COHORT_CUDA(cudaMalloc(&s.ray_counts, 2 * sizeof(unsigned long long)));
+      COHORT_CUDA(cudaMemsetAsync(s.ray_counts, 0, 2 * sizeof(unsigned long long), s.stream));
     }
   }
 
+  // The next band's slot. Its band before in that slot has ended: at most two bands are in flight (the
+  // current one and the one enqueued ahead), and each is finished before its slot comes round again.
   BandSlot& take_slot() {
     BandSlot& s = slots[next_slot];
     next_slot ^= 1;
     return s;
+  }
+  // The slot's stream waits for the band enqueued before it: for its lanes' release points (band overlap) or,
+  // with `whole` or when it recorded none, for its kernels' end. Then the slot becomes the band before.
+  void follow_band_before(BandSlot& s, bool whole) {
+    BandSlot* before = band_before;
+    band_before = &s;
+    if (!before || before == &s) return;
+    if (whole || before->released_lanes == 0) {
+      COHORT_CUDA(cudaStreamWaitEvent(s.stream, before->stop, 0));
+      return;
+    }
+    for (int lane = 0; lane < before->released_lanes; ++lane)
+      COHORT_CUDA(cudaStreamWaitEvent(s.stream, before->lanes.released[lane], 0));
+    ++overlapping;
   }
   // The band's end on the stream: its counters copied into the slot's page-locked memory behind its way
   // back, then the slot's `counted`.
@@ -232,11 +275,13 @@ struct CudaTracer::Impl {
       s.row_rays_capacity = rows;
     }
     if (!s.counts) COHORT_CUDA(cudaMallocHost(&s.counts, 2 * sizeof(unsigned long long)));
-    COHORT_CUDA(cudaEventRecord(s.finished, stream));  // the band's way back (after `stop`) is queued before this
-    COHORT_CUDA(cudaMemcpyAsync(s.row_rays, row_rays, rows * sizeof(unsigned), cudaMemcpyDeviceToHost, stream));
+    COHORT_CUDA(cudaEventRecord(s.finished, s.stream));  // the band's way back (after `stop`) is queued before this
+    COHORT_CUDA(
+        cudaMemcpyAsync(s.row_rays, s.device_row_rays, rows * sizeof(unsigned), cudaMemcpyDeviceToHost, s.stream));
     if (count_rays)
-      COHORT_CUDA(cudaMemcpyAsync(s.counts, ray_counts, 2 * sizeof(unsigned long long), cudaMemcpyDeviceToHost, stream));
-    COHORT_CUDA(cudaEventRecord(s.counted, stream));
+      COHORT_CUDA(
+          cudaMemcpyAsync(s.counts, s.ray_counts, 2 * sizeof(unsigned long long), cudaMemcpyDeviceToHost, s.stream));
+    COHORT_CUDA(cudaEventRecord(s.counted, s.stream));
   }
   // Waits for the band (with wait_aux_copy, its aux texels' copy too): the ray totals kept, and the kernels'
   // device time, its way back and the per-row work in the result.
@@ -279,12 +324,31 @@ struct CudaTracer::Impl {
     set_texel_texture(texel_texture);
   }
 
-  KSceneView view(const KFrameParams& params) const {
+  // The scene as slot `s`'s bands see it: the shared arrays and the slot's own.
+  KSceneView view(const BandSlot& s, const KFrameParams& params) const {
+    const SlotScene& own = s.scene;
     KSceneView v = k_scene_view(vertices.data(), vertex_colors.data(), triangles.data(), blas_nodes.data(), blases.data(),
-                                instances.data(), tlas_nodes.data(), materials.data(), textures.data(), texels.data(),
-                                lights.data(), light_nodes.data(), emissive.data(), &params);
+                                own.instances.data(), own.tlas_nodes.data(), own.materials.data(), textures.data(),
+                                texels.data(), own.lights.data(), own.light_nodes.data(), own.emissive.data(), &params);
     v.triangle_edges = triangle_edges.data();
     return v;
+  }
+  // Slot `s`'s arrays made those of `scene` on its stream, where a commit changed them since. The band before
+  // in this slot has ended (take_slot); the host's arrays may change once this returns (copies from pageable
+  // memory are staged before cudaMemcpyAsync returns).
+  void refresh_slot_scene(BandSlot& s, const commit::TracerScene& scene) {
+    SlotScene& own = s.scene;
+    auto refresh = [&](SlotArray which, auto& array, const auto& host) {
+      if (own.versions[which] == slot_array_versions[which]) return;
+      array.upload(host, 0, s.stream);
+      own.versions[which] = slot_array_versions[which];
+    };
+    refresh(kInstances, own.instances, scene.instances);
+    refresh(kTlasNodes, own.tlas_nodes, scene.tlas_nodes);
+    refresh(kMaterials, own.materials, scene.materials);
+    refresh(kLights, own.lights, scene.lights);
+    refresh(kLightNodes, own.light_nodes, scene.light_nodes);
+    refresh(kEmissive, own.emissive, scene.emissive_triangles);
   }
 };
 
@@ -302,6 +366,18 @@ int wave_lanes_from_environment() {
   return static_cast<int>(lanes);
 }
 
+// COHORT_CUDA_BAND_OVERLAP: CudaTracer::set_band_overlap's kernels (0 to 64; default kDefaultBandOverlap).
+constexpr int kDefaultBandOverlap = 2;
+int band_overlap_from_environment() {
+  const char* v = std::getenv("COHORT_CUDA_BAND_OVERLAP");
+  if (!v || !*v) return kDefaultBandOverlap;
+  char* end = nullptr;
+  const long kernels = std::strtol(v, &end, 10);
+  if (*end != '\0' || kernels < 0 || kernels > 64)
+    throw std::invalid_argument(std::string("COHORT_CUDA_BAND_OVERLAP=") + v + ": expected 0 to 64 kernels");
+  return static_cast<int>(kernels);
+}
+
 }  // namespace
 
 CudaTracer::CudaTracer(int device) : impl_(std::make_unique<Impl>()) {
@@ -316,6 +392,8 @@ CudaTracer::CudaTracer(int device) : impl_(std::make_unique<Impl>()) {
   COHORT_CUDA(cudaStreamCreateWithFlags(&impl_->aux_copy_stream, cudaStreamNonBlocking));
   COHORT_CUDA(cudaStreamCreateWithFlags(&impl_->signal_stream, cudaStreamNonBlocking));
   for (BandSlot& s : impl_->slots) {
+    COHORT_CUDA(cudaStreamCreateWithFlags(&s.stream, cudaStreamNonBlocking));
+    COHORT_CUDA(cudaEventCreateWithFlags(&s.lanes.forked, cudaEventDisableTiming));
     COHORT_CUDA(cudaEventCreate(&s.start));
     COHORT_CUDA(cudaEventCreate(&s.stop));
     COHORT_CUDA(cudaEventCreate(&s.finished));
@@ -323,8 +401,8 @@ CudaTracer::CudaTracer(int device) : impl_(std::make_unique<Impl>()) {
     COHORT_CUDA(cudaEventCreateWithFlags(&s.aux_copied, cudaEventDisableTiming));
   }
   COHORT_CUDA(cudaEventCreateWithFlags(&impl_->aux_ready, cudaEventDisableTiming));
-  COHORT_CUDA(cudaEventCreateWithFlags(&impl_->wave_lanes.forked, cudaEventDisableTiming));
   set_wave_lanes(wave_lanes_from_environment());
+  set_band_overlap(band_overlap_from_environment());
 }
 
 CudaTracer::~CudaTracer() {
@@ -332,25 +410,27 @@ CudaTracer::~CudaTracer() {
   // A band enqueued ahead whose job never came writes into its target until it ends.
   if (impl_->ahead) impl_->ahead->wait();
   if (impl_->texel_texture) cudaDestroyTextureObject(impl_->texel_texture);
-  if (impl_->band) cudaFree(impl_->band);
-  if (impl_->band_packed) cudaFree(impl_->band_packed);
-  if (impl_->ray_counts) cudaFree(impl_->ray_counts);
-  if (impl_->row_rays) cudaFree(impl_->row_rays);
   for (const BandSlot& s : impl_->slots) {
+    if (s.stream) cudaStreamSynchronize(s.stream);
     for (cudaEvent_t e : {s.start, s.stop, s.finished, s.counted, s.aux_copied})
       if (e) cudaEventDestroy(e);
     if (s.row_rays) cudaFreeHost(s.row_rays);
     if (s.counts) cudaFreeHost(s.counts);
+    for (void* p : {static_cast<void*>(s.band), static_cast<void*>(s.band_packed), static_cast<void*>(s.device_row_rays),
+                    static_cast<void*>(s.ray_counts)})
+      if (p) cudaFree(p);
+    const WaveLanes& lanes = s.lanes;
+    if (lanes.forked) cudaEventDestroy(lanes.forked);
+    for (int lane = 0; lane < kMaxWaveLanes; ++lane) {
+      if (lanes.streams[lane]) cudaStreamDestroy(lanes.streams[lane]);
+      if (lanes.joined[lane]) cudaEventDestroy(lanes.joined[lane]);
+      if (lanes.released[lane]) cudaEventDestroy(lanes.released[lane]);
+    }
+    if (s.stream) cudaStreamDestroy(s.stream);
   }
   if (impl_->aux_ready) cudaEventDestroy(impl_->aux_ready);
   for (cudaEvent_t e : impl_->piece_rendered) cudaEventDestroy(e);
   for (cudaEvent_t e : impl_->piece_downloaded) cudaEventDestroy(e);
-  const WaveLanes& lanes = impl_->wave_lanes;
-  if (lanes.forked) cudaEventDestroy(lanes.forked);
-  for (int lane = 1; lane < kMaxWaveLanes; ++lane) {
-    if (lanes.streams[lane]) cudaStreamDestroy(lanes.streams[lane]);
-    if (lanes.joined[lane]) cudaEventDestroy(lanes.joined[lane]);
-  }
   if (impl_->stream) cudaStreamDestroy(impl_->stream);
   if (impl_->signal_stream) cudaStreamDestroy(impl_->signal_stream);
   if (impl_->aux_copy_stream) cudaStreamDestroy(impl_->aux_copy_stream);
@@ -363,10 +443,24 @@ void CudaTracer::upload(const commit::ChangeSet& changes) {
   COHORT_CUDA(cudaSetDevice(m.device));
   const commit::TracerScene& scene = this->scene();
   const bool all = changes.full_resync;
+  // The slots' own arrays: each slot uploads them as its next band is enqueued (Impl::refresh_slot_scene).
+  auto changed = [&](SlotArray which, bool flag) {
+    if (all || flag) ++m.slot_array_versions[which];
+  };
+  changed(kInstances, changes.instances || changes.tlas);
+  changed(kTlasNodes, changes.instances || changes.tlas);
+  changed(kMaterials, changes.materials);
+  changed(kLights, changes.lights);
+  changed(kLightNodes, changes.light_tree);
+  changed(kEmissive, changes.emissive);
+  const bool shared = all || changes.geometry || changes.textures || changes.skin_data || !changes.posed_skins.empty();
+  if (!shared) return;
   cudaStream_t s = m.stream;
-  // Applied ahead (enqueue_next_ahead), the band before may still run. Copies and kernels on the stream come
-  // after it in order (a grown array's cudaFree waits for the device); a new texel texture does not (its
-  // object destroyed, the kernels' constant rewritten), so that and a full resync wait for the band first.
+  // The shared arrays change under every band: copies and kernels on this stream wait for the kernels of both
+  // slots' bands (applied ahead, the band before may still run; a grown array's cudaFree waits for the
+  // device), and a new texel texture (its object destroyed, the kernels' constant rewritten) waits for them on
+  // the host first. The host waits for the uploads at the end, so bands enqueued after this need not.
+  for (const BandSlot& slot : m.slots) COHORT_CUDA(cudaStreamWaitEvent(s, slot.stop, 0));
   if (m.applying_ahead && (all || changes.textures)) COHORT_CUDA(cudaStreamSynchronize(s));
   if (all || changes.geometry) {
     // Appended BLASes upload only their new tail; anything else re-sends the array.
@@ -379,14 +473,6 @@ void CudaTracer::upload(const commit::ChangeSet& changes) {
     launch_triangle_edges(m.triangle_edges.scratch(scene.triangles.size()), m.triangles.data(), m.vertices.data(), 0,
                           scene.triangles.size(), s);
   }
-  if (all || changes.instances || changes.tlas) {
-    m.instances.upload(scene.instances, 0, s);
-    m.tlas_nodes.upload(scene.tlas_nodes, 0, s);
-  }
-  if (all || changes.materials) m.materials.upload(scene.materials, 0, s);
-  if (all || changes.lights) m.lights.upload(scene.lights, 0, s);
-  if (all || changes.light_tree) m.light_nodes.upload(scene.light_nodes, 0, s);
-  if (all || changes.emissive) m.emissive.upload(scene.emissive_triangles, 0, s);
   if (all || changes.textures) {
     m.textures.upload(scene.textures, 0, s);
     // A texture object needs storage: a scene without texels binds one unused white texel instead.
@@ -486,14 +572,20 @@ CudaTracer::EnqueuedBand CudaTracer::enqueue_band(const core::BandJob& job, core
   const size_t rows = params.row_end - params.row_begin;
   b.rows = rows;
   b.slot = &m.take_slot();
-  m.prepare_band(pixels, rows, packed);
+  BandSlot& slot = *b.slot;
+  const cudaStream_t stream = slot.stream;
+  m.prepare_band(slot, pixels, rows, packed);
+  m.refresh_slot_scene(slot, scene());
   // Kept on the GPU, the band skips both copies: nothing goes down, and the post-processing takes it
   // device to device (or over NVLink from a peer).
   Impl::KeptBand* kept = job.keep_on_device >= 0 ? &m.kept[m.next_kept] : nullptr;
   if (kept) m.next_kept = (m.next_kept + 1) % Impl::kKeptBands;
   else m.register_target(target);
-  COHORT_CUDA(cudaEventRecord(b.slot->start, m.stream));
   const bool write_aux = params.aux_outputs != 0u && target.has_aux();
+  // The aux planes' inputs and outputs are one set for both slots: a band that writes them follows the whole
+  // band before.
+  m.follow_band_before(slot, write_aux);
+  COHORT_CUDA(cudaEventRecord(slot.start, stream));
   const bool aux_from_paths = write_aux && k_aux_from_paths(&params);
   KAuxHistory history{};
   KAuxTexel* texels = nullptr;
@@ -501,7 +593,7 @@ CudaTracer::EnqueuedBand CudaTracer::enqueue_band(const core::BandJob& job, core
   // The planes go down on the copy engine while the next kernel runs (after the band, on its stream,
   // they added 2.2 ms to a 1080p frame on an H100).
   auto download_aux = [&] {
-    COHORT_CUDA(cudaEventRecord(m.aux_ready, m.stream));
+    COHORT_CUDA(cudaEventRecord(m.aux_ready, stream));
     COHORT_CUDA(cudaStreamWaitEvent(m.aux_copy_stream, m.aux_ready, 0));
     COHORT_CUDA(cudaMemcpyAsync(target.aux_row(int(params.row_begin)), texels, pixels * sizeof(KAuxTexel),
                                 cudaMemcpyDeviceToHost, m.aux_copy_stream));
@@ -509,8 +601,8 @@ CudaTracer::EnqueuedBand CudaTracer::enqueue_band(const core::BandJob& job, core
     m.aux_copy_before = b.slot->aux_copied;
   };
   if (write_aux) {
-    m.previous_transforms.upload(previous_transforms(), 0, m.stream);
-    m.previous_joints.upload(previous_joints(), 0, m.stream);
+    m.previous_transforms.upload(previous_transforms(), 0, stream);
+    m.previous_joints.upload(previous_joints(), 0, stream);
     history.object_to_world = previous_transforms().empty() ? nullptr : m.previous_transforms.data();
     history.skins = m.skins.data();
     history.skin_vertices = m.skin_vertices.data();
@@ -519,36 +611,39 @@ CudaTracer::EnqueuedBand CudaTracer::enqueue_band(const core::BandJob& job, core
     history.skin_count = static_cast<kuint>(scene().skins.size());
     texels = kept ? kept->aux.scratch(pixels) : m.aux_texels.scratch(pixels);
     // The band before's texels may still be going down (it was enqueued ahead of this one's job).
-    if (!kept && m.aux_copy_before) COHORT_CUDA(cudaStreamWaitEvent(m.stream, m.aux_copy_before, 0));
+    if (!kept && m.aux_copy_before) COHORT_CUDA(cudaStreamWaitEvent(stream, m.aux_copy_before, 0));
     // Centre rays: a short kernel of their own before the band's, whose texels go down while it runs.
     if (!aux_from_paths) {
-      launch_aux_band(m.view(params), params, camera, previous, history, texels, m.stream);
+      launch_aux_band(m.view(slot, params), params, camera, previous, history, texels, stream);
       if (!kept) download_aux();
     }
   }
   KPathFirstHit* first_hits = aux_from_paths ? m.first_hits.scratch(pixels) : nullptr;
-  launch_render_band(m.view(params), params, camera, m.band, m.count_rays ? m.ray_counts : nullptr, m.row_rays,
-                     first_hits, m.wave(pixels, params), m.stream);
+  slot.released_lanes = launch_render_band(m.view(slot, params), params, camera, slot.band,
+                                           m.count_rays ? slot.ray_counts : nullptr, slot.device_row_rays, first_hits,
+                                           m.wave(slot, pixels, params), stream);
   if (aux_from_paths) {
     // From the paths' first hits: after the band's kernel, no ray of their own (counted in the band's time).
-    launch_aux_from_first_hits(m.view(params), params, camera, previous, history, first_hits, texels, m.stream);
+    launch_aux_from_first_hits(m.view(slot, params), params, camera, previous, history, first_hits, texels, stream);
     if (!kept) download_aux();
   }
-  COHORT_CUDA(cudaEventRecord(b.slot->stop, m.stream));
+  COHORT_CUDA(cudaEventRecord(slot.stop, stream));
   // The band's rows are contiguous in the target: one copy straight into place, in its format.
   const size_t colour_bytes = pixels * core::bytes_per_pixel(target.format());
-  const void* source = m.band;
+  const void* source = slot.band;
   if (packed) {
-    void* to = kept ? static_cast<void*>(kept->colour.scratch(colour_bytes)) : m.band_packed;
-    m.pack_band(target.format(), m.band, to, pixels, size_t(params.row_begin) * camera.width, params.frame_index);
+    void* to = kept ? static_cast<void*>(kept->colour.scratch(colour_bytes)) : slot.band_packed;
+    Impl::pack_band(slot, target.format(), slot.band, to, pixels, size_t(params.row_begin) * camera.width,
+                    params.frame_index);
     source = to;
   } else if (kept) {
-    COHORT_CUDA(cudaMemcpyAsync(kept->colour.scratch(colour_bytes), m.band, colour_bytes, cudaMemcpyDeviceToDevice, m.stream));
+    COHORT_CUDA(cudaMemcpyAsync(kept->colour.scratch(colour_bytes), slot.band, colour_bytes, cudaMemcpyDeviceToDevice,
+                                stream));
     source = kept->colour.data();
   }
   if (!kept)
-    COHORT_CUDA(cudaMemcpyAsync(target.row(int(params.row_begin)), source, colour_bytes, cudaMemcpyDeviceToHost, m.stream));
-  m.end_band(*b.slot, rows);
+    COHORT_CUDA(cudaMemcpyAsync(target.row(int(params.row_begin)), source, colour_bytes, cudaMemcpyDeviceToHost, stream));
+  m.end_band(slot, rows);
   b.wait_aux_copy = write_aux && !kept;
   if (kept) b.kept = core::DeviceBand{m.device, source, write_aux ? kept->aux.data() : nullptr};
   return b;
@@ -617,7 +712,15 @@ core::BandResult CudaTracer::render_band_in_pieces(const core::BandJob& job, cor
   const size_t rows = params.row_end - params.row_begin;
   const size_t pixels = width * rows;
   const bool packed = target.format() != core::BandFormat::rgba32f;
-  m.prepare_band(pixels, rows, packed);
+  EnqueuedBand b;
+  b.job = job;
+  b.target = &target;
+  b.rows = rows;
+  b.slot = &m.take_slot();
+  BandSlot& slot = *b.slot;
+  const cudaStream_t stream = slot.stream;
+  m.prepare_band(slot, pixels, rows, packed);
+  m.refresh_slot_scene(slot, scene());
   const size_t pieces = cuts.size() - 1;
   while (m.piece_rendered.size() < pieces) {
     cudaEvent_t rendered = nullptr, downloaded = nullptr;
@@ -631,38 +734,36 @@ core::BandResult CudaTracer::render_band_in_pieces(const core::BandJob& job, cor
   // download never races the next piece's kernel: the copy stream takes piece i while `stream` runs
   // piece i + 1.
   const size_t pixel_bytes = core::bytes_per_pixel(target.format());
-  const WavefrontScratch* wave = m.wave(pixels, params);  // the pieces take turns with it on `stream`
-  EnqueuedBand b;
-  b.job = job;
-  b.target = &target;
-  b.rows = rows;
-  b.slot = &m.take_slot();
-  COHORT_CUDA(cudaEventRecord(b.slot->start, m.stream));
+  const WavefrontScratch* wave = m.wave(slot, pixels, params);  // the pieces take turns with it on `stream`
+  m.follow_band_before(slot, true);
+  COHORT_CUDA(cudaEventRecord(slot.start, stream));
   for (size_t i = 0; i < pieces; ++i) {
     KFrameParams piece = params;
     piece.row_begin = kuint(cuts[i]);
     piece.row_end = kuint(cuts[i + 1]);
     const size_t first_row = size_t(cuts[i]) - params.row_begin;
     const size_t piece_pixels = width * size_t(cuts[i + 1] - cuts[i]);
-    float4* band = m.band + first_row * width;
+    float4* band = slot.band + first_row * width;
     if (piece_pixels > 0)
-      launch_render_band(m.view(piece), piece, camera, band, m.count_rays ? m.ray_counts : nullptr,
-                         m.row_rays + first_row, nullptr, wave, m.stream);
+      launch_render_band(m.view(slot, piece), piece, camera, band, m.count_rays ? slot.ray_counts : nullptr,
+                         slot.device_row_rays + first_row, nullptr, wave, stream);
     const void* source = band;
     if (packed) {
-      void* to = m.band_packed + first_row * width * pixel_bytes;
-      if (piece_pixels > 0) m.pack_band(target.format(), band, to, piece_pixels, size_t(cuts[i]) * width, params.frame_index);
+      void* to = slot.band_packed + first_row * width * pixel_bytes;
+      if (piece_pixels > 0)
+        Impl::pack_band(slot, target.format(), band, to, piece_pixels, size_t(cuts[i]) * width, params.frame_index);
       source = to;
     }
-    COHORT_CUDA(cudaEventRecord(m.piece_rendered[i], m.stream));
+    COHORT_CUDA(cudaEventRecord(m.piece_rendered[i], stream));
     COHORT_CUDA(cudaStreamWaitEvent(m.aux_copy_stream, m.piece_rendered[i], 0));
     if (piece_pixels > 0)
       COHORT_CUDA(cudaMemcpyAsync(target.row(cuts[i]), source, piece_pixels * pixel_bytes, cudaMemcpyDeviceToHost,
                                   m.aux_copy_stream));
     COHORT_CUDA(cudaEventRecord(m.piece_downloaded[i], m.aux_copy_stream));
   }
-  COHORT_CUDA(cudaEventRecord(b.slot->stop, m.stream));
-  m.end_band(*b.slot, rows);
+  slot.released_lanes = 0;  // the next band follows the whole band (its last piece's release is not the band's)
+  COHORT_CUDA(cudaEventRecord(slot.stop, stream));
+  m.end_band(slot, rows);
   try {
     for (size_t i = 0; i < pieces; ++i) {
       COHORT_CUDA(cudaEventSynchronize(m.piece_downloaded[i]));
@@ -670,7 +771,7 @@ core::BandResult CudaTracer::render_band_in_pieces(const core::BandJob& job, cor
     }
   } catch (...) {
     // Nothing of this band may still be landing in the target once it is given up.
-    cudaStreamSynchronize(m.stream);
+    cudaStreamSynchronize(stream);
     cudaStreamSynchronize(m.aux_copy_stream);
     throw;
   }
@@ -691,14 +792,24 @@ void CudaTracer::set_wave_lanes(int lanes) {
   if (lanes < 1 || lanes > kMaxWaveLanes)
     throw std::invalid_argument(impl_->name + ": wave lanes " + std::to_string(lanes) + " (expected 1 to " +
                                 std::to_string(kMaxWaveLanes) + ")");
-  WaveLanes& w = impl_->wave_lanes;
   COHORT_CUDA(cudaSetDevice(impl_->device));
-  for (int lane = 1; lane < lanes; ++lane) {  // made once, kept for later counts
-    if (!w.streams[lane]) COHORT_CUDA(cudaStreamCreateWithFlags(&w.streams[lane], cudaStreamNonBlocking));
-    if (!w.joined[lane]) COHORT_CUDA(cudaEventCreateWithFlags(&w.joined[lane], cudaEventDisableTiming));
+  for (BandSlot& s : impl_->slots) {
+    WaveLanes& w = s.lanes;
+    for (int lane = 0; lane < lanes; ++lane) {  // made once, kept for later counts (lane 0 runs on the slot's stream)
+      if (lane > 0 && !w.streams[lane]) COHORT_CUDA(cudaStreamCreateWithFlags(&w.streams[lane], cudaStreamNonBlocking));
+      if (lane > 0 && !w.joined[lane]) COHORT_CUDA(cudaEventCreateWithFlags(&w.joined[lane], cudaEventDisableTiming));
+      if (!w.released[lane]) COHORT_CUDA(cudaEventCreateWithFlags(&w.released[lane], cudaEventDisableTiming));
+    }
+    w.count = lanes;
   }
-  w.count = lanes;
 }
+void CudaTracer::set_band_overlap(int kernels) {
+  if (kernels < 0) throw std::invalid_argument(impl_->name + ": band overlap of " + std::to_string(kernels) + " kernels");
+  impl_->band_overlap = kernels;
+  for (BandSlot& s : impl_->slots) s.lanes.release_before_end = kernels;
+}
+int CudaTracer::band_overlap() const { return impl_->band_overlap; }
+size_t CudaTracer::bands_overlapping() const { return impl_->overlapping.load(); }
 bool CudaTracer::shadow_walk() const { return impl_->shadow_walk; }
 bool CudaTracer::wavefront() const { return impl_->wavefront; }
 CudaTracer::RayCounts CudaTracer::last_ray_counts() const { return impl_->last_counts; }

@@ -104,27 +104,43 @@ bool dense_lights(const KFrameParams& params) {
 
 // One lane of a band (all of it, or launch_render_band's rows of it) as a wavefront on `stream`: per sample
 // the camera walk, then per bounce a shading kernel, its shadow walk and the next bounce's walk.
+// released (may be null): recorded on `stream` before the last release_before_end kernels.
 void render_wavefront(const KSceneView& scene, const KFrameParams& params, const KCamera& camera, float4* band,
                       unsigned long long* ray_counts, unsigned* row_rays, KPathFirstHit* first_hits,
-                      const WavefrontScratch& scratch, cudaStream_t stream) {
+                      const WavefrontScratch& scratch, cudaStream_t stream, cudaEvent_t released,
+                      int release_before_end) {
   const kuint rows = params.row_end - params.row_begin;
   const dim3 block(16, 8);  // 16 wide: the row ray counts rely on two rows per warp
   const dim3 grid((camera.width + block.x - 1) / block.x, (rows + block.y - 1) / block.y);
   const kuint spp = params.spp > 0u ? params.spp : 1u;  // k_paths_per_pixel (device-only in this translation unit)
   const bool shadow_walk = scratch.shadow_slots > 0u;
   const PathKernels& kernels = dense_lights(params) ? dense::path_kernels : path_kernels;
+  // The kernels in order: per sample the camera walk, then per stage a shading kernel (and its shadow walk).
+  const kuint per_stage = shadow_walk ? 2u : 1u;
+  const kuint total = spp * (1u + per_stage + params.max_bounces * (1u + per_stage));
+  const kuint release_at = total > kuint(release_before_end) ? total - kuint(release_before_end) : 0u;
+  kuint launched = 0u;
+  auto next_launch = [&] {
+    if (released && launched == release_at) COHORT_CUDA(cudaEventRecord(released, stream));
+    ++launched;
+  };
   // A shading kernel and, after it, the shadow rays it left, before the next one shades the paths further.
   auto shade = [&](kuint sample, bool camera_rays, KPathFirstHit* records) {
+    next_launch();
     kernels.wave_shade(camera_rays, records, shadow_walk, grid, block, scene, params, camera, sample, band, scratch,
                        ray_counts, row_rays, stream);
-    if (shadow_walk)
+    if (shadow_walk) {
+      next_launch();
       launch_wave_shadow_walk(grid, block, scene, params, camera, sample, band, scratch, ray_counts, row_rays, stream);
+    }
   };
   for (kuint sample = 0u; sample < spp; ++sample) {
     KPathFirstHit* records = sample == 0u ? first_hits : nullptr;
+    next_launch();
     launch_wave_camera_walk(grid, block, scene, params, camera, sample, scratch, records, ray_counts, row_rays, stream);
     shade(sample, true, records);
     for (kuint bounce = 1u; bounce <= params.max_bounces; ++bounce) {
+      next_launch();
       launch_wave_bounce_walk(grid, block, scene, params, camera, scratch, ray_counts, row_rays, stream);
       shade(sample, false, nullptr);
     }
@@ -133,13 +149,14 @@ void render_wavefront(const KSceneView& scene, const KFrameParams& params, const
 
 }  // namespace
 
-void launch_render_band(const KSceneView& scene, const KFrameParams& params, const KCamera& camera, float4* band,
-                        unsigned long long* ray_counts, unsigned* row_rays, KPathFirstHit* first_hits,
-                        const WavefrontScratch* wave, cudaStream_t stream) {
+int launch_render_band(const KSceneView& scene, const KFrameParams& params, const KCamera& camera, float4* band,
+                       unsigned long long* ray_counts, unsigned* row_rays, KPathFirstHit* first_hits,
+                       const WavefrontScratch* wave, cudaStream_t stream) {
   const kuint rows = params.row_end - params.row_begin;
   const dim3 block(16, 8);
   const dim3 grid((camera.width + block.x - 1) / block.x, (rows + block.y - 1) / block.y);
   const bool sparse = params.path_pixels != 0u && params.path_pixels < K_PATH_PATTERN_PIXELS;
+  int released_lanes = 0;
   if (wave) {
     // Every kernel indexes its lane's pixels from the lane's first row: each lane gets the band's buffers
     // from its first pixel on (shadow slots keep the whole band's stride, so lanes never share one).
@@ -163,8 +180,11 @@ void launch_render_band(const KSceneView& scene, const KFrameParams& params, con
       s.active += offset;
       if (s.vertices) s.vertices += offset;
       if (s.shadow_rays) s.shadow_rays += offset;
+      const bool release = wave->lanes && wave->lanes->release_before_end > 0;
       render_wavefront(scene, lane_params, camera, band + offset, ray_counts, row_rays ? row_rays + first : nullptr,
-                       first_hits ? first_hits + offset : nullptr, s, lane == 0 ? stream : wave->lanes->streams[lane]);
+                       first_hits ? first_hits + offset : nullptr, s, lane == 0 ? stream : wave->lanes->streams[lane],
+                       release ? wave->lanes->released[lane] : nullptr, release ? wave->lanes->release_before_end : 0);
+      if (release) released_lanes = lane + 1;
     }
     for (int lane = 1; lane < lanes; ++lane) {
       COHORT_CUDA(cudaEventRecord(wave->lanes->joined[lane], wave->lanes->streams[lane]));
@@ -176,6 +196,7 @@ void launch_render_band(const KSceneView& scene, const KFrameParams& params, con
                             stream);
   }
   COHORT_CUDA(cudaGetLastError());
+  return released_lanes;
 }
 
 }  // namespace cohort::tracers

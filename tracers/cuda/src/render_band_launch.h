@@ -24,6 +24,11 @@ struct WaveLanes {
   cudaStream_t streams[kMaxWaveLanes] = {};
   cudaEvent_t forked = nullptr;
   cudaEvent_t joined[kMaxWaveLanes] = {};
+  // Where the next band may start (CudaTracer's band overlap): each lane records released[lane] on its stream
+  // before its last `release_before_end` kernels, so that the next band's first kernels fill the SMs while
+  // this band's last ones drain. 0: nothing recorded (the next band waits for the whole band).
+  int release_before_end = 0;
+  cudaEvent_t released[kMaxWaveLanes] = {};
 };
 
 // The bounce rays' wavefront (render_band.cu): where paths wait between its kernels. Device pointers, each
@@ -80,8 +85,9 @@ void set_texel_texture(cudaTextureObject_t texture);
 // first_hits (may be null; only for bands where every pixel traces paths): each pixel's record of its first
 // sample's first surface, for launch_aux_from_first_hits. wave (may be null): scratch for the wavefront;
 // given, the band renders as one, so the caller gives it only where k_wavefront_renders (path_state.h: lit
-// paths that bounce, the sparse pattern too), and the megakernel renders the rest.
-void launch_render_band(const KSceneView& scene, const KFrameParams& params, const KCamera& camera, float4* band,
+// paths that bounce, the sparse pattern too), and the megakernel renders the rest. Returns how many lanes
+// recorded their `released` event (WaveLanes::release_before_end; 0: none, e.g. for the megakernel).
+int launch_render_band(const KSceneView& scene, const KFrameParams& params, const KCamera& camera, float4* band,
                         unsigned long long* ray_counts, unsigned* row_rays, KPathFirstHit* first_hits,
                         const WavefrontScratch* wave, cudaStream_t stream);
 // The band's auxiliary planes (kernel/aux_outputs.h) as the 32-byte KAuxTexel the host's BandBuffer

@@ -1,6 +1,7 @@
 // The CUDA tracer: one per GPU. Device buffers mirror the tracer's commit::TracerScene; commits are
-// applied with async copies on the tracer's own stream; the band is rendered by the shared integrator
-// (kernel/include/cohort/kernel/) compiled as CUDA, and kernel time is measured with CUDA events.
+// applied with async copies (the arrays a frame's commit changes, per band slot, on the band's stream); the
+// band is rendered by the shared integrator (kernel/include/cohort/kernel/) compiled as CUDA, and kernel
+// time is measured with CUDA events.
 #pragma once
 
 #include <memory>
@@ -47,6 +48,15 @@ class CudaTracer final : public TracerBase {
   // lane's kernels fill the GPU while another's drain (default: COHORT_CUDA_WAVE_LANES, else 2). The image
   // is the same for any count.
   void set_wave_lanes(int lanes);
+  // Each band runs on one of two streams in turn, and the next band's kernels may start once the current
+  // band's lanes have come to their last `kernels` kernels (0: once its kernels are done), so that the next
+  // band fills the SMs while this one's last waves drain. Only bands enqueued ahead (two frames in flight) can
+  // overlap; a band whose frame writes aux planes always follows the whole band before. The image is the same
+  // for any value (docs/balancing.md, "Bands that overlap"). Default: COHORT_CUDA_BAND_OVERLAP, else 2.
+  void set_band_overlap(int kernels);
+  int band_overlap() const;
+  // Bands whose kernels were let start at the band before's release point (not after its whole kernels).
+  size_t bands_overlapping() const;
   // With two frames in flight, the next band's commands (its commit applied first) are enqueued while the
   // current band renders (core::Tracer::enqueues_ahead), so that its kernels follow on the GPU without the
   // host's turn-around between bands (docs/balancing.md). On unless COHORT_CUDA_ENQUEUE_AHEAD=0.
