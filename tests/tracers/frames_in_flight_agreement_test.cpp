@@ -50,10 +50,6 @@ struct Rendered {
   bool transfer_queues = true;
   // Bands whose colour came through page-locked staging (OpenCLTracer::bands_read_through_staging).
   size_t staged_reads = 0;
-  // Bands let start at the band before's release point (OpenCLTracer::bands_overlapping), and whether any
-  // OpenCL tracer rendered on a GPU device (the only place bands overlap).
-  size_t overlapping = 0;
-  bool opencl_on_gpu = false;
   // The same counts summed over the CUDA tracers (CudaTracer::bands_enqueued_ahead, ...).
   size_t cuda_enqueued_ahead = 0, cuda_finished_ahead = 0, cuda_dropped_ahead = 0;
   // Bands let start at the band before's release point (CudaTracer::bands_overlapping).
@@ -71,8 +67,6 @@ void count_ahead(const std::vector<core::Tracer*>& tracers, Rendered& out) {
       out.back_to_back += opencl->bands_back_to_back();
       out.staged_reads += opencl->bands_read_through_staging();
       out.transfer_queues = out.transfer_queues && opencl->transfer_queues();
-      out.overlapping += opencl->bands_overlapping();
-      out.opencl_on_gpu = out.opencl_on_gpu || opencl->renders_on_gpu();
     }
 }
 #else
@@ -281,36 +275,6 @@ TEST(FramesInFlightAgreement, OpenCLAloneDrawsTheSameFramesWithTwoInFlightWithAM
   expect_same_frames(one, off, true, "opencl, enqueue ahead off");
   EXPECT_EQ(off.enqueued_ahead, 0u);
 #endif
-}
-
-// With the transfer queues on a GPU device, bands take turns on two compute queues and the next starts at the
-// band before's release point (OpenCLTracer::Options::band_overlap). With the materials' commits alone (each
-// slot's own arrays take them) bands do start there, by default and with every kernel of the next band free
-// to run beside the band before: the bits of one frame in flight either way. A CPU device keeps one compute
-// queue (PoCL and two queues), so there nothing overlaps and only the slots' arrays are tested.
-TEST(FramesInFlightAgreement, OpenCLBandsThatOverlapDrawTheSameFrames) {
-  if (!tracer_runs_here("opencl")) GTEST_SKIP() << "needs the OpenCL tracer";
-  const Rendered one = render_sequence({"opencl"}, "none", 1);
-  for (int overlap : {-1, 64}) {
-    Extras extras;
-#ifdef COHORT_HAVE_OPENCL
-    if (overlap >= 0)
-      extras.make = [overlap](const std::string&) -> std::unique_ptr<core::Tracer> {
-        tracers::OpenCLTracer::Options o = opencl_options();
-        o.band_overlap = overlap;
-        return std::make_unique<tracers::OpenCLTracer>(o);
-      };
-#endif
-    const std::string label = "opencl, materials' commits only, overlap " + std::to_string(overlap);
-    const Rendered two = render_sequence({"opencl"}, "none", 2, extras);
-    expect_same_frames(one, two, true, label);
-    expect_enqueued_ahead(one, two, 1, label);
-    if (two.opencl_on_gpu) {
-      EXPECT_GE(two.overlapping, 4u) << label << ": bands should start at the band before's release point";
-    } else {
-      EXPECT_EQ(two.overlapping, 0u) << label << ": a CPU device has one compute queue";
-    }
-  }
 }
 
 TEST(FramesInFlightAgreement, TwoOpenCLTracersDrawTheSameFramesWithTwoInFlightWithAMovingWalker) {

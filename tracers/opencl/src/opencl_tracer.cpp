@@ -183,7 +183,6 @@ class Event {
     return &event_;
   }
   cl_event get() const { return event_; }
-  void reset() { out(); }
   // Holds `other`'s event too, retained: one command's event under two names.
   void share(const Event& other) {
     check(clRetainEvent(other.event_), "clRetainEvent");
@@ -248,18 +247,7 @@ class PinnedStaging {
 };
 
 // Every queue a band's commands go on (Impl::queues); absent ones are null.
-using BandQueues = std::array<cl_command_queue, 7>;
-
-// The scene arrays a frame's commit changes without touching geometry (animated materials and lights, moving
-// entities and so the TLAS): each band slot keeps its own copy, written on its compute queue as its band is
-// enqueued, so that with two compute queues (Options::band_overlap) a commit applied while the band before
-// renders does not change what it reads (the CUDA tracer's SlotScene).
-enum SlotArray { kInstances, kTlasNodes, kMaterials, kLights, kLightNodes, kEmissive, kSlotArrays };
-
-struct SlotScene {
-  DeviceBuffer instances, tlas_nodes, materials, lights, light_nodes, emissive;
-  uint64_t versions[kSlotArrays] = {};  // of the host's arrays (Impl::slot_array_versions) written here
-};
+using BandQueues = std::array<cl_command_queue, 5>;
 
 void finish_all(const BandQueues& queues) {
   for (cl_command_queue q : queues)
@@ -316,34 +304,8 @@ struct OpenCLTracer::Impl {
   int first_hit_pieces = 1;  // Options::first_hit_pieces
   bool aux_into_target = false;  // Options::aux_into_target
   DeviceBuffer previous_transforms, previous_joints;
-  DeviceBuffer vertices, vertex_colors, triangles, blas_nodes, blases, textures, texels;
-  // Each band slot's own copy of the arrays a frame's commit changes (SlotScene), written as its band is
-  // enqueued where a commit bumped the array's version since.
-  SlotScene slot_scene[2];
-  uint64_t slot_array_versions[kSlotArrays] = {1, 1, 1, 1, 1, 1};
-  void refresh_slot_scene(const commit::TracerScene& s) {
-    SlotScene& own = slot_scene[band_slot];
-    // Staged: written from a copy without blocking (the queue may still hold the band before).
-    auto refresh = [&](SlotArray which, DeviceBuffer& buffer, const auto& data, const char* what) {
-      if (own.versions[which] == slot_array_versions[which]) return;
-      buffer.upload(context, queue, data, what, CL_FALSE, true);
-      own.versions[which] = slot_array_versions[which];
-    };
-    refresh(kInstances, own.instances, s.instances, "uploading instances");
-    refresh(kTlasNodes, own.tlas_nodes, s.tlas_nodes, "uploading TLAS nodes");
-    refresh(kMaterials, own.materials, s.materials, "uploading materials");
-    refresh(kLights, own.lights, s.lights, "uploading lights");
-    refresh(kLightNodes, own.light_nodes, s.light_nodes, "uploading the light tree");
-    refresh(kEmissive, own.emissive, s.emissive_triangles, "uploading emissive triangles");
-  }
-  // The band kernels' arguments (kernel/band_params.cl's order) with the current slot's arrays.
-  std::array<cl_mem, 13> scene_args() {
-    const SlotScene& own = slot_scene[band_slot];
-    return {vertices.mem(),     vertex_colors.mem(),  triangles.mem(), blas_nodes.mem(),
-            blases.mem(),       own.instances.mem(),  own.tlas_nodes.mem(), own.materials.mem(),
-            textures.mem(),     texels.mem(),         own.lights.mem(),      own.light_nodes.mem(),
-            own.emissive.mem()};
-  }
+  DeviceBuffer vertices, vertex_colors, triangles, blas_nodes, blases, instances, tlas_nodes, materials, textures, texels, lights, light_nodes,
+      emissive;
   DeviceBuffer skins, skin_vertices, skin_weights, skin_triangles, skin_adjacency, skin_faces, joints;
   cl_kernel skin_positions = nullptr, skin_faces_kernel = nullptr, skin_normals = nullptr, refit_leaves = nullptr,
             refit_blas = nullptr;
@@ -418,10 +380,6 @@ struct OpenCLTracer::Impl {
   std::atomic<size_t> staged_reads{0};
   void take_other_slot() {
     band_slot ^= 1;
-    if (spare_queue) {
-      std::swap(queue, spare_queue);
-      std::swap(lane_queue, spare_lane_queue);
-    }
     std::swap(params, spare.params);
     std::swap(camera, spare.camera);
     std::swap(output, spare.output);
@@ -449,38 +407,8 @@ struct OpenCLTracer::Impl {
   bool applying_ahead = false;
   std::unique_ptr<EnqueuedBand> ahead;
   std::atomic<size_t> enqueued_ahead{0}, finished_ahead{0}, dropped_ahead{0}, back_to_back{0};
-  // Options::band_overlap on this device: the other slot's compute and lane queues, swapped in with its slot
-  // (take_other_slot); null: one compute queue, bands back to back in its order.
-  cl_command_queue spare_queue = nullptr, spare_lane_queue = nullptr;
-  int band_overlap = 0;
-  // The band enqueued last, which the next band (on the other compute queue) follows: its lanes' release
-  // markers (none: follow before_done), its last kernel; and the shared arrays' uploads since (upload()), on
-  // that band's queue behind it.
-  Event before_released[2];
-  int before_released_count = 0;
-  Event before_done, shared_uploads;
-  std::atomic<size_t> overlapping{0};
-  // With two compute queues: the current queue waits for the band before's release point or, with `whole` or
-  // where it marked none, its last kernel, and for the shared uploads since.
-  void follow_band_before(bool whole) {
-    if (!spare_queue) return;
-    std::array<cl_event, 3> wait{};
-    cl_uint count = 0;
-    const bool at_release = !whole && before_released_count > 0;
-    if (at_release) {
-      for (int lane = 0; lane < before_released_count; ++lane) wait[count++] = before_released[lane].get();
-      ++overlapping;
-    } else if (before_done.get()) {
-      wait[count++] = before_done.get();
-    }
-    if (shared_uploads.get()) wait[count++] = shared_uploads.get();
-    if (count > 0) check(clEnqueueBarrierWithWaitList(queue, count, wait.data(), nullptr), "following the band before");
-    shared_uploads.reset();
-  }
   // Every queue a band's commands go on.
-  BandQueues queues() const {
-    return {queue, aux_queue, lane_queue, upload_queue, read_queue, spare_queue, spare_lane_queue};
-  }
+  BandQueues queues() const { return {queue, aux_queue, lane_queue, upload_queue, read_queue}; }
   void finish_queues() { finish_all(queues()); }
 
   // A device buffer of at least `bytes`, reallocated (contents lost) when it is smaller.
@@ -504,19 +432,16 @@ struct OpenCLTracer::Impl {
                    label, walk_options, main_options);
     }
     const kuint slots = shadow_walk ? k_shadow_queue_slots(&params, params.light_count, params.emissive_count) : 0u;
-    wavefront->prepare(band, pixels, slots, first_hit_records, band_slot);
+    wavefront->prepare(band, pixels, slots, first_hit_records);
     return wavefront.get();
   }
   // The wavefront's second lane (Options::wave_lanes; null: one lane): an in-order queue of its own.
   cl_command_queue lane_queue = nullptr;
   // The band's rows [first_row, first_row + rows): the wavefront's kernels where `wave`, else the
   // megakernel `kernel`, in 8x8 work groups from first_row; started / done: the first and last kernel's events
-  // (with lanes, `done` is the join: both lanes' kernels are before it). With two compute queues the
-  // wavefront's lanes mark their release points into before_released (before_released_count: how many).
+  // (with lanes, `done` is the join: both lanes' kernels are before it).
   void enqueue_band_rows(cl_kernel kernel, OpenCLWavefront* wave, const KFrameParams& params, size_t width,
                          size_t first_row, size_t rows, Event* started, Event* done) {
-    before_released_count = 0;
-    const bool release = wave && spare_queue && band_overlap > 0;
     if (wave && lane_queue && wave_lane_count(2, static_cast<unsigned>(rows)) == 2) {
       // Two lanes (cohort/tracers/wave_lanes.h, the CUDA tracer's rule), the second on lane_queue behind
       // everything queued so far, joined back before what follows the band.
@@ -525,11 +450,8 @@ struct OpenCLTracer::Impl {
       check(clEnqueueMarkerWithWaitList(queue, 0, nullptr, forked.out()), "forking the wavefront's lanes");
       cl_event fork = forked.get();
       check(clEnqueueMarkerWithWaitList(lane_queue, 1, &fork, nullptr), "forking the wavefront's lanes");
-      wave->enqueue(queue, params, width, first_row, split, started ? started->out() : nullptr, nullptr,
-                    release ? before_released[0].out() : nullptr, band_overlap);
-      wave->enqueue(lane_queue, params, width, first_row + split, rows - split, nullptr, second_done.out(),
-                    release ? before_released[1].out() : nullptr, band_overlap);
-      if (release) before_released_count = 2;
+      wave->enqueue(queue, params, width, first_row, split, started ? started->out() : nullptr, nullptr);
+      wave->enqueue(lane_queue, params, width, first_row + split, rows - split, nullptr, second_done.out());
       check(clFlush(lane_queue), "clFlush(lane)");
       cl_event join = second_done.get();
       check(clEnqueueMarkerWithWaitList(queue, 1, &join, done ? done->out() : nullptr), "joining the wavefront's lanes");
@@ -537,8 +459,7 @@ struct OpenCLTracer::Impl {
     }
     if (wave) {
       wave->enqueue(queue, params, width, first_row, rows, started ? started->out() : nullptr,
-                    done ? done->out() : nullptr, release ? before_released[0].out() : nullptr, band_overlap);
-      if (release) before_released_count = 1;
+                    done ? done->out() : nullptr);
       return;
     }
     const size_t local[2] = {8, 8};
@@ -608,13 +529,8 @@ struct OpenCLTracer::Impl {
                         to_rgb16f, to_rgb9e5, to_texels})
       if (k) clReleaseKernel(k);
     if (program) clReleaseProgram(program);
-    before_done.reset();
-    shared_uploads.reset();
-    for (Event& e : before_released) e.reset();
     if (aux_queue) clReleaseCommandQueue(aux_queue);
     if (lane_queue) clReleaseCommandQueue(lane_queue);
-    if (spare_queue) clReleaseCommandQueue(spare_queue);
-    if (spare_lane_queue) clReleaseCommandQueue(spare_lane_queue);
     if (upload_queue) clReleaseCommandQueue(upload_queue);
     if (read_queue) clReleaseCommandQueue(read_queue);
     if (queue) clReleaseCommandQueue(queue);
@@ -718,22 +634,6 @@ OpenCLTracer::OpenCLTracer(const Options& options) : impl_(std::make_unique<Impl
 #endif
     check(err, "clCreateCommandQueue(lane)");
   }
-  if (options.band_overlap > 0 && impl_->gpu && impl_->transfer) {
-#if defined(__GNUC__)
-#pragma GCC diagnostic push
-#pragma GCC diagnostic ignored "-Wdeprecated-declarations"
-#endif
-    impl_->spare_queue = clCreateCommandQueue(impl_->context, dev.device, CL_QUEUE_PROFILING_ENABLE, &err);
-    check(err, "clCreateCommandQueue(second compute queue)");
-    if (impl_->lane_queue) {
-      impl_->spare_lane_queue = clCreateCommandQueue(impl_->context, dev.device, 0, &err);
-      check(err, "clCreateCommandQueue(second lane)");
-    }
-#if defined(__GNUC__)
-#pragma GCC diagnostic pop
-#endif
-    impl_->band_overlap = options.band_overlap;
-  }
   impl_->walk_options = with_registers(options.walk_registers);
   impl_->main_options = with_registers(options.shade_registers);
   impl_->program = build_program(impl_->context, dev.device, opencl_source::kRenderBand, "render_band",
@@ -799,20 +699,18 @@ void OpenCLTracer::upload(const commit::ChangeSet& changes) {
     up(m.blas_nodes, s.blas_nodes, "uploading BLAS nodes");
     up(m.blases, s.blases, "uploading BLASes");
   }
-  // The slots' own arrays: each slot writes them as its next band is enqueued (Impl::refresh_slot_scene).
-  auto changed = [&](SlotArray which, bool flag) {
-    if (all || flag) ++m.slot_array_versions[which];
-  };
-  changed(kInstances, changes.instances || changes.tlas);
-  changed(kTlasNodes, changes.instances || changes.tlas);
-  changed(kMaterials, changes.materials);
-  changed(kLights, changes.lights);
-  changed(kLightNodes, changes.light_tree);
-  changed(kEmissive, changes.emissive);
+  if (all || changes.instances || changes.tlas) {
+    up(m.instances, s.instances, "uploading instances");
+    up(m.tlas_nodes, s.tlas_nodes, "uploading TLAS nodes");
+  }
+  if (all || changes.materials) up(m.materials, s.materials, "uploading materials");
   if (all || changes.textures) {
     up(m.textures, s.textures, "uploading textures");
     up(m.texels, s.texels, "uploading texels");
   }
+  if (all || changes.lights) up(m.lights, s.lights, "uploading lights");
+  if (all || changes.light_tree) up(m.light_nodes, s.light_nodes, "uploading the light tree");
+  if (all || changes.emissive) up(m.emissive, s.emissive_triangles, "uploading emissive triangles");
   if (all || changes.skin_data) {
     up(m.skins, s.skins, "uploading skins");
     up(m.skin_vertices, s.skin_vertices, "uploading skin vertices");
@@ -831,11 +729,6 @@ void OpenCLTracer::upload(const commit::ChangeSet& changes) {
   } else {
     m.run_skinning(s, changes.posed_skins);
   }
-  // The shared arrays were written on the queue of the band in flight, behind it: the next band, on the other
-  // compute queue, waits for them (Impl::follow_band_before).
-  const bool shared = all || changes.geometry || changes.textures || changes.skin_data || !changes.posed_skins.empty();
-  if (shared && m.spare_queue)
-    check(clEnqueueMarkerWithWaitList(q, 0, nullptr, m.shared_uploads.out()), "marking the commit's uploads");
 }
 
 namespace {
@@ -976,11 +869,6 @@ std::unique_ptr<OpenCLTracer::EnqueuedBand> OpenCLTracer::enqueue_band(const cor
   // The reads and writes below run from and into the band's own memory without blocking: on a throw every
   // queue is done before it goes (the guard goes after it).
   DrainOnThrow drain{m.queues()};
-  // Only frames that ask pay for the aux planes (below); their buffers are one set for both slots, so such a
-  // band follows the whole band before.
-  const bool write_aux = params.aux_outputs != 0u && target.has_aux();
-  m.refresh_slot_scene(scene());
-  m.follow_band_before(write_aux);
   const cl_uint zero = 0;
   // Enqueued ahead with the transfer queues, these run on the upload queue as soon as they are enqueued (into
   // this band's slot, which nothing in any queue uses), while the band before renders; the compute queue waits
@@ -1005,19 +893,17 @@ std::unique_ptr<OpenCLTracer::EnqueuedBand> OpenCLTracer::enqueue_band(const cor
   // texels go down on the second queue while the band's kernel runs (the CUDA tracer's order); from the
   // paths' first hits: the band's kernel records them and the aux kernel finishes them after it, piece by
   // piece (render_first_hits_in_pieces).
+  const bool write_aux = params.aux_outputs != 0u && target.has_aux();
   const bool aux_from_paths = write_aux && k_aux_from_paths(&params);
   const bool straight = target.width() == static_cast<int>(camera.width);
   b->rows = rows;
   b->straight = straight;
   b->write_aux = write_aux;
   b->aux_from_paths = aux_from_paths;
-  const std::array<cl_mem, 13> scene_args = m.scene_args();
-  cl_mem args[17];
-  std::copy(scene_args.begin(), scene_args.end(), args);
-  args[13] = m.params;
-  args[14] = m.camera;
-  args[15] = m.output;
-  args[16] = m.row_rays;
+  cl_mem args[] = {m.vertices.mem(),  m.vertex_colors.mem(), m.triangles.mem(), m.blas_nodes.mem(), m.blases.mem(),
+                   m.instances.mem(), m.tlas_nodes.mem(), m.materials.mem(), m.textures.mem(),
+                   m.texels.mem(),    m.lights.mem(),     m.light_nodes.mem(), m.emissive.mem(),
+                   m.params,          m.camera,           m.output,           m.row_rays};
   cl_kernel band_kernel = aux_from_paths ? m.first_hits_kernel : m.kernel;
   cl_uint arg_count = sizeof(args) / sizeof(args[0]);
   for (cl_uint i = 0; i < arg_count; ++i)
@@ -1031,12 +917,7 @@ std::unique_ptr<OpenCLTracer::EnqueuedBand> OpenCLTracer::enqueue_band(const cor
   OpenCLWavefront::BandArgs band_args;
   std::copy(std::begin(args), std::end(args), band_args.begin());
   b->wave = m.wavefront_for(params, band_args, rows * camera.width, records);
-  if (aux_from_paths) {
-    // The rest in pieces, in render_first_hits_in_pieces, which finishes every queue: nothing to follow.
-    m.before_released_count = 0;
-    m.before_done.reset();
-    return b;
-  }
+  if (aux_from_paths) return b;  // the rest in pieces, in render_first_hits_in_pieces
   if (write_aux) enqueue_aux(job, camera, rows, straight);
   m.enqueue_band_rows(band_kernel, b->wave, params, camera.width, 0, rows, &b->band_started, &b->band_done);
   // The band goes straight into its rows of the target, converted on the device to the target's format.
@@ -1054,7 +935,6 @@ std::unique_ptr<OpenCLTracer::EnqueuedBand> OpenCLTracer::enqueue_band(const cor
   if (!b->kernels_done.get()) {
     b->kernels_done.share(b->band_done);
   }
-  if (m.spare_queue) m.before_done.share(b->kernels_done);
   // Both kernels are on the device before any read is enqueued: a driver that copies into pageable
   // memory at enqueue time then still overlaps the aux read with the band's kernel.
   check(clFlush(m.queue), "clFlush");
@@ -1188,7 +1068,6 @@ void OpenCLTracer::drop_enqueued_ahead() {
 size_t OpenCLTracer::bands_enqueued_ahead() const { return impl_->enqueued_ahead.load(); }
 size_t OpenCLTracer::bands_finished_ahead() const { return impl_->finished_ahead.load(); }
 size_t OpenCLTracer::bands_dropped_ahead() const { return impl_->dropped_ahead.load(); }
-size_t OpenCLTracer::bands_overlapping() const { return impl_->overlapping.load(); }
 size_t OpenCLTracer::bands_back_to_back() const { return impl_->back_to_back.load(); }
 bool OpenCLTracer::transfer_queues() const { return impl_->transfer; }
 size_t OpenCLTracer::bands_read_through_staging() const { return impl_->staged_reads.load(); }
@@ -1301,12 +1180,11 @@ void OpenCLTracer::prepare_aux(const core::BandJob& job, const KCamera& camera, 
   cl_mem skin_args[] = {m.skins.mem(), m.skin_vertices.mem(), m.skin_weights.mem(), m.previous_joints.mem()};
   if (!skinned)
     for (cl_mem& a : skin_args) a = m.previous_transforms.mem();  // never read: any valid buffer
-  const std::array<cl_mem, 13> scene_args = m.scene_args();
-  cl_mem args[21];
-  std::copy(scene_args.begin(), scene_args.end(), args);
-  const cl_mem rest[] = {m.params,     m.camera,     m.previous_camera, m.previous_transforms.mem(),
-                         skin_args[0], skin_args[1], skin_args[2],      skin_args[3]};
-  std::copy(std::begin(rest), std::end(rest), args + 13);
+  cl_mem args[] = {m.vertices.mem(),  m.vertex_colors.mem(), m.triangles.mem(),  m.blas_nodes.mem(),  m.blases.mem(),
+                   m.instances.mem(), m.tlas_nodes.mem(), m.materials.mem(),   m.textures.mem(),
+                   m.texels.mem(),    m.lights.mem(),     m.light_nodes.mem(), m.emissive.mem(),
+                   m.params,          m.camera,           m.previous_camera,   m.previous_transforms.mem(),
+                   skin_args[0],      skin_args[1],       skin_args[2],        skin_args[3]};
   cl_uint arg = 0;
   for (; arg < sizeof(args) / sizeof(args[0]); ++arg)
     check(clSetKernelArg(m.aux_kernel, arg, sizeof(cl_mem), &args[arg]), "clSetKernelArg(aux)");

@@ -1,6 +1,5 @@
 #include "opencl_wavefront.h"
 
-#include <algorithm>
 #include <vector>
 
 #include "cohort/kernel/path_pattern.h"
@@ -48,9 +47,8 @@ OpenCLWavefront::OpenCLWavefront(cl_context context, cl_device_id device, cl_pro
 OpenCLWavefront::~OpenCLWavefront() { release(); }
 
 void OpenCLWavefront::release() {
-  for (const Scratch& s : scratch_)
-    for (cl_mem m : {s.states, s.hits, s.active, s.vertices, s.shadow_rays})
-      if (m) clReleaseMemObject(m);
+  for (cl_mem m : {states_, hits_, active_, vertices_, shadow_rays_})
+    if (m) clReleaseMemObject(m);
   for (const auto& builds : shade_)
     for (cl_kernel k : builds)
       if (k) clReleaseKernel(k);
@@ -59,16 +57,15 @@ void OpenCLWavefront::release() {
   if (walk_program_) clReleaseProgram(walk_program_);
 }
 
-void OpenCLWavefront::prepare(const BandArgs& band, size_t pixels, kuint slots, cl_mem first_hits, int scratch_set) {
-  Scratch& s = scratch_[scratch_set];
-  grow_buffer(context_, s.states, s.states_bytes, pixels * sizeof(KPathState), "clCreateBuffer(wavefront states)");
-  grow_buffer(context_, s.hits, s.hits_bytes, pixels * sizeof(KHit), "clCreateBuffer(wavefront hits)");
-  grow_buffer(context_, s.active, s.active_bytes, pixels * sizeof(kuint), "clCreateBuffer(wavefront flags)");
+void OpenCLWavefront::prepare(const BandArgs& band, size_t pixels, kuint slots, cl_mem first_hits) {
+  grow_buffer(context_, states_, states_bytes_, pixels * sizeof(KPathState), "clCreateBuffer(wavefront states)");
+  grow_buffer(context_, hits_, hits_bytes_, pixels * sizeof(KHit), "clCreateBuffer(wavefront hits)");
+  grow_buffer(context_, active_, active_bytes_, pixels * sizeof(kuint), "clCreateBuffer(wavefront flags)");
   cl_mem vertices = nullptr, shadow_rays = nullptr;
   if (slots > 0u) {
-    vertices = grow_buffer(context_, s.vertices, s.vertices_bytes, pixels * sizeof(KVertexLight),
+    vertices = grow_buffer(context_, vertices_, vertices_bytes_, pixels * sizeof(KVertexLight),
                            "clCreateBuffer(wavefront vertices)");
-    shadow_rays = grow_buffer(context_, s.shadow_rays, s.shadow_rays_bytes, pixels * slots * sizeof(KShadowRay),
+    shadow_rays = grow_buffer(context_, shadow_rays_, shadow_rays_bytes_, pixels * slots * sizeof(KShadowRay),
                               "clCreateBuffer(wavefront shadow rays)");
   }
   slots_ = slots;
@@ -77,7 +74,7 @@ void OpenCLWavefront::prepare(const BandArgs& band, size_t pixels, kuint slots, 
   const cl_uint sample = 0;
   auto set = [&](cl_kernel k) {
     for (cl_uint a = 0; a < kBandArgs; ++a) check(clSetKernelArg(k, a, sizeof(cl_mem), &band[a]), "clSetKernelArg(wavefront)");
-    const cl_mem scratch[] = {s.states, s.hits, s.active, vertices, shadow_rays};
+    const cl_mem scratch[] = {states_, hits_, active_, vertices, shadow_rays};
     for (cl_uint a = 0; a < 5; ++a)
       check(clSetKernelArg(k, kStatesArg + a, sizeof(cl_mem), &scratch[a]), "clSetKernelArg(wavefront scratch)");
     check(clSetKernelArg(k, kStrideArg, sizeof stride, &stride), "clSetKernelArg(wavefront stride)");
@@ -90,8 +87,7 @@ void OpenCLWavefront::prepare(const BandArgs& band, size_t pixels, kuint slots, 
 }
 
 void OpenCLWavefront::enqueue(cl_command_queue queue, const KFrameParams& params, size_t width, size_t first_row,
-                              size_t rows, cl_event* started, cl_event* done, cl_event* released,
-                              int release_before_end) {
+                              size_t rows, cl_event* started, cl_event* done) {
   const size_t local[2] = {8, 8};
   const size_t offset[2] = {0, first_row};
   const size_t global[2] = {(width + 7) / 8 * 8, (rows + 7) / 8 * 8};
@@ -124,12 +120,8 @@ void OpenCLWavefront::enqueue(cl_command_queue queue, const KFrameParams& params
   }
   // Only the first (started) and the last (done) ask for an event: an event is a driver object made and recorded
   // per launch, host time in front of the band.
-  const size_t release_at = released && release_before_end > 0
-                                ? launches.size() - std::min(launches.size(), size_t(release_before_end))
-                                : launches.size() + 1;
   for (size_t i = 0; i < launches.size(); ++i) {
     const Launch& l = launches[i];
-    if (i == release_at) check(clEnqueueMarkerWithWaitList(queue, 0, nullptr, released), "marking the band's release");
     if (l.takes_sample)
       check(clSetKernelArg(l.kernel, kSampleArg, sizeof l.sample, &l.sample), "clSetKernelArg(wavefront sample)");
     const bool first = i == 0 && started && !*started, final = i + 1 == launches.size() && done;

@@ -30,19 +30,15 @@ class OpenCLWavefront {
   OpenCLWavefront(const OpenCLWavefront&) = delete;
   OpenCLWavefront& operator=(const OpenCLWavefront&) = delete;
 
-  // Two sets of scratch, one per band slot: bands in turn use their own, so that one may start while the
-  // band before still runs (OpenCLTracer's band overlap).
-  static constexpr int kScratchSets = 2;
-  // Sets every kernel's arguments for a band of `pixels`, scratch set `scratch_set` grown to it: slots, the shadow-ray
+  // Sets every kernel's arguments for a band of `pixels`, the scratch grown to it: slots, the shadow-ray
   // slots a pixel (k_shadow_queue_slots; 0: the shading kernels walk the shadow rays as they come);
   // first_hits: the aux planes' first-hit records, or null.
-  void prepare(const BandArgs& band, size_t pixels, kuint slots, cl_mem first_hits, int scratch_set = 0);
+  void prepare(const BandArgs& band, size_t pixels, kuint slots, cl_mem first_hits);
   // Enqueues the frame's samples over the band rows [first_row, first_row + rows) of `width` pixels, in
   // whole 8x8 work groups from first_row (the megakernel's launch shape). started / done (may be null):
-  // the first and the last kernel's events. released (may be null): a marker's event before the last
-  // release_before_end kernels (where the next band may start).
+  // the first and the last kernel's events.
   void enqueue(cl_command_queue queue, const KFrameParams& params, size_t width, size_t first_row, size_t rows,
-               cl_event* started, cl_event* done, cl_event* released = nullptr, int release_before_end = 0);
+               cl_event* started, cl_event* done);
 
  private:
   void release();
@@ -52,11 +48,8 @@ class OpenCLWavefront {
   cl_kernel camera_walk_ = nullptr, bounce_walk_ = nullptr, shadow_walk_ = nullptr;
   // Shading builds: [shadow walk][camera rays, camera rays recording first hits, bounce rays].
   std::array<std::array<cl_kernel, 3>, 2> shade_{};
-  struct Scratch {
-    cl_mem states = nullptr, hits = nullptr, active = nullptr, vertices = nullptr, shadow_rays = nullptr;
-    size_t states_bytes = 0, hits_bytes = 0, active_bytes = 0, vertices_bytes = 0, shadow_rays_bytes = 0;
-  };
-  Scratch scratch_[kScratchSets];
+  cl_mem states_ = nullptr, hits_ = nullptr, active_ = nullptr, vertices_ = nullptr, shadow_rays_ = nullptr;
+  size_t states_bytes_ = 0, hits_bytes_ = 0, active_bytes_ = 0, vertices_bytes_ = 0, shadow_rays_bytes_ = 0;
   kuint slots_ = 0;
   bool first_hits_ = false;
 };

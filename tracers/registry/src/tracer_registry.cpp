@@ -144,18 +144,6 @@ namespace {
   return std::string(value) == "1";
 }
 
-// A count from 0 to `most`, `otherwise` when unset or empty; `what` names the count in the error.
-[[maybe_unused]] int env_count(const char* variable, int otherwise, int most, const char* what) {
-  const char* value = std::getenv(variable);
-  if (!value || !*value) return otherwise;
-  char* end = nullptr;
-  const long count = std::strtol(value, &end, 10);
-  if (*end != '\0' || count < 0 || count > most)
-    throw std::invalid_argument(std::string(variable) + "='" + value + "': expected " + what + " from 0 to " +
-                                std::to_string(most));
-  return static_cast<int>(count);
-}
-
 // A register cap for an OpenCL program: 0 (none) to 255, `otherwise` when unset or empty.
 [[maybe_unused]] int env_registers(const char* variable, int otherwise) {
   const char* value = std::getenv(variable);
@@ -203,7 +191,6 @@ std::unique_ptr<core::Tracer> make_tracer(const TracerSpec& spec) {
                                                                               : OpenCLTracer::Options::TransferQueue::never;
     options.pinned_band_reads = env_switch("COHORT_OPENCL_PINNED_READS", options.pinned_band_reads);
     options.late_job_cost = env_switch("COHORT_OPENCL_LATE_JOB_COST", options.late_job_cost);
-    options.band_overlap = env_count("COHORT_OPENCL_BAND_OVERLAP", options.band_overlap, 64, "a kernel count");
     options.walk_registers = env_registers("COHORT_OPENCL_WALK_REGISTERS", options.walk_registers);
     options.shade_registers = env_registers("COHORT_OPENCL_SHADE_REGISTERS", options.shade_registers);
     return std::make_unique<OpenCLTracer>(options);

@@ -79,14 +79,6 @@ class OpenCLTracer : public TracerBase {
     // the balancer, keeps few rows and so keeps ending early (nvidia-h100-x2, cuda:0 + opencl:2: some runs
     // settled at 448 / 272 rows and 1.57 ms a frame, others at 336 / 384 and 1.31). COHORT_OPENCL_LATE_JOB_COST.
     bool late_job_cost = true;
-    // With the transfer queues on a GPU device, bands in turn on two compute queues (each with its lane queue
-    // and its own wavefront scratch), and the next band enqueued ahead starts once the band before's lanes
-    // have come to their last `band_overlap` kernels, so that its first kernels fill the device while the band
-    // before drains (CudaTracer::set_band_overlap; docs/balancing.md, "Bands that overlap"). A band that
-    // writes aux planes, or follows a commit of shared arrays, waits for the whole band before. 0: one compute
-    // queue, bands back to back. Never on a CPU device (PoCL and two queues: wave_lanes above).
-    // COHORT_OPENCL_BAND_OVERLAP.
-    int band_overlap = 2;
   };
   static constexpr int kMaxFirstHitPieces = 8;
   // The pieces' first rows, relative to the band, and `rows` last: up to `pieces` ranges of whole work
@@ -120,8 +112,6 @@ class OpenCLTracer : public TracerBase {
   // Bands enqueued ahead with their edges off the compute queue (Options::transfer_queue): their kernels
   // queued straight behind the band before's, whose reads went on the read queue.
   size_t bands_back_to_back() const;
-  // Bands let start at the band before's release point on the other compute queue (Options::band_overlap).
-  size_t bands_overlapping() const;
   // Whether the band's edges go on the upload and read queues (Options::transfer_queue on this device, with
   // enqueue_ahead).
   bool transfer_queues() const;
