@@ -91,6 +91,12 @@ struct CudaTracer::BandSlot {
   DeviceArray<KVertexLight> wave_vertices;
   DeviceArray<KShadowRay> wave_shadow_rays;
   WavefrontScratch wave_scratch;
+  // The aux planes' inputs (the previous frame's transforms and joints), the paths' first-hit records
+  // (K_AUX_PATH_FIRST_HIT) and the texels on their way down (bands not kept on the GPU).
+  DeviceArray<float> previous_transforms;
+  DeviceArray<KJoint> previous_joints;
+  DeviceArray<KPathFirstHit> first_hits;
+  DeviceArray<KAuxTexel> aux_texels;
 };
 
 // A band whose commands are all on its slot's stream, until its finish.
@@ -125,9 +131,6 @@ struct CudaTracer::Impl {
   // How many kernels before the end of a band's lanes the next band may start (COHORT_CUDA_BAND_OVERLAP;
   // 0: once the band's kernels are done).
   int band_overlap = 0;
-  // The aux texels' copy of the band before (its slot's aux_copied), which a band that writes the same
-  // texels waits for on its stream; null when none is pending.
-  cudaEvent_t aux_copy_before = nullptr;
   // Enqueue ahead (CudaTracer::set_enqueue_ahead): the next band, enqueued while the band before renders,
   // until render_band takes it; whether a commit is being applied ahead (the band before still running).
   bool enqueue_ahead = enabled_unless_zero("COHORT_CUDA_ENQUEUE_AHEAD");
@@ -160,10 +163,6 @@ struct CudaTracer::Impl {
   DeviceArray<KJoint> joints;
   DeviceArray<kuint> refit_scratch;
   cudaTextureObject_t texel_texture = 0;
-  DeviceArray<float> previous_transforms;
-  DeviceArray<KJoint> previous_joints;
-  DeviceArray<KAuxTexel> aux_texels;
-  DeviceArray<KPathFirstHit> first_hits;  // K_AUX_PATH_FIRST_HIT: the band's paths' records
   bool count_rays = false;
   // The bounce rays' wavefront (render_band.cu) instead of the megakernel, unless COHORT_CUDA_WAVEFRONT=0.
   bool wavefront = enabled_unless_zero("COHORT_CUDA_WAVEFRONT");
@@ -582,9 +581,12 @@ CudaTracer::EnqueuedBand CudaTracer::enqueue_band(const core::BandJob& job, core
   if (kept) m.next_kept = (m.next_kept + 1) % Impl::kKeptBands;
   else m.register_target(target);
   const bool write_aux = params.aux_outputs != 0u && target.has_aux();
-  // The aux planes' inputs and outputs are one set for both slots: a band that writes them follows the whole
-  // band before.
-  m.follow_band_before(slot, write_aux);
+  // Copies from pageable memory may wait for the stream: before it waits for the band before.
+  if (write_aux) {
+    slot.previous_transforms.upload(previous_transforms(), 0, stream);
+    slot.previous_joints.upload(previous_joints(), 0, stream);
+  }
+  m.follow_band_before(slot, false);
   COHORT_CUDA(cudaEventRecord(slot.start, stream));
   const bool aux_from_paths = write_aux && k_aux_from_paths(&params);
   KAuxHistory history{};
@@ -597,28 +599,24 @@ CudaTracer::EnqueuedBand CudaTracer::enqueue_band(const core::BandJob& job, core
     COHORT_CUDA(cudaStreamWaitEvent(m.aux_copy_stream, m.aux_ready, 0));
     COHORT_CUDA(cudaMemcpyAsync(target.aux_row(int(params.row_begin)), texels, pixels * sizeof(KAuxTexel),
                                 cudaMemcpyDeviceToHost, m.aux_copy_stream));
-    COHORT_CUDA(cudaEventRecord(b.slot->aux_copied, m.aux_copy_stream));
-    m.aux_copy_before = b.slot->aux_copied;
+    COHORT_CUDA(cudaEventRecord(slot.aux_copied, m.aux_copy_stream));
   };
   if (write_aux) {
-    m.previous_transforms.upload(previous_transforms(), 0, stream);
-    m.previous_joints.upload(previous_joints(), 0, stream);
-    history.object_to_world = previous_transforms().empty() ? nullptr : m.previous_transforms.data();
+    history.object_to_world = previous_transforms().empty() ? nullptr : slot.previous_transforms.data();
     history.skins = m.skins.data();
     history.skin_vertices = m.skin_vertices.data();
     history.skin_weights = m.skin_weights.data();
-    history.joints = previous_joints().empty() ? nullptr : m.previous_joints.data();
+    history.joints = previous_joints().empty() ? nullptr : slot.previous_joints.data();
     history.skin_count = static_cast<kuint>(scene().skins.size());
-    texels = kept ? kept->aux.scratch(pixels) : m.aux_texels.scratch(pixels);
-    // The band before's texels may still be going down (it was enqueued ahead of this one's job).
-    if (!kept && m.aux_copy_before) COHORT_CUDA(cudaStreamWaitEvent(stream, m.aux_copy_before, 0));
+    // The slot's texels: the band before in this slot, whose copy went down from them, has ended (take_slot).
+    texels = kept ? kept->aux.scratch(pixels) : slot.aux_texels.scratch(pixels);
     // Centre rays: a short kernel of their own before the band's, whose texels go down while it runs.
     if (!aux_from_paths) {
       launch_aux_band(m.view(slot, params), params, camera, previous, history, texels, stream);
       if (!kept) download_aux();
     }
   }
-  KPathFirstHit* first_hits = aux_from_paths ? m.first_hits.scratch(pixels) : nullptr;
+  KPathFirstHit* first_hits = aux_from_paths ? slot.first_hits.scratch(pixels) : nullptr;
   slot.released_lanes = launch_render_band(m.view(slot, params), params, camera, slot.band,
                                            m.count_rays ? slot.ray_counts : nullptr, slot.device_row_rays, first_hits,
                                            m.wave(slot, pixels, params), stream);

@@ -51,8 +51,8 @@ class CudaTracer final : public TracerBase {
   // Each band runs on one of two streams in turn, and the next band's kernels may start once the current
   // band's lanes have come to their last `kernels` kernels (0: once its kernels are done), so that the next
   // band fills the SMs while this one's last waves drain. Only bands enqueued ahead (two frames in flight) can
-  // overlap; a band whose frame writes aux planes always follows the whole band before. The image is the same
-  // for any value (docs/balancing.md, "Bands that overlap"). Default: COHORT_CUDA_BAND_OVERLAP, else 2.
+  // overlap, and only after commits that change no shared array (geometry, textures, skins). The image is the
+  // same for any value (docs/balancing.md, "Bands that overlap"). Default: COHORT_CUDA_BAND_OVERLAP, else 2.
   void set_band_overlap(int kernels);
   int band_overlap() const;
   // Bands whose kernels were let start at the band before's release point (not after its whole kernels).
