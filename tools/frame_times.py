@@ -1,7 +1,9 @@
 #!/usr/bin/env python3
-"""Summarises a `cohort render` stats.json: median and 95th percentile of the frame interval (time
+"""Summarises a `cohort render` stats.json: median, mean and 95th percentile of the frame interval (time
 between delivered frames: the pipeline overlaps frames, so this is the time per frame), the end-to-end
 latency, the Renderer's wall time, and per stage (the frame timeline), over the frames after a warm-up.
+The headline's mean leaves out the run's last frame, whose interval holds the final image's write
+(`--write last`): where frames alternate between two speeds the median picks one, the mean is the rate.
 
     tools/frame_times.py out/run/stats.json [--skip 20] [--json summary.json]
 """
@@ -30,6 +32,9 @@ def summarise(stats, skip):
         values = [f[key] for f in frames if key in f]
         out[key] = {"median": statistics.median(values), "p95": percentile(values, 95),
                     "mean": statistics.fmean(values)} if values else None
+    but_last = [f["interval_ms"] for f in frames[:-1] if "interval_ms" in f]
+    if out["interval_ms"] and but_last:
+        out["interval_ms"]["mean_but_last"] = statistics.fmean(but_last)
     per_stage = {}
     for f in frames:
         totals = {}
@@ -72,7 +77,8 @@ def main():
     interval = summary["interval_ms"] or e2e  # stats.json from before the pipeline has no interval
     try:
         print(f"{summary['tracers']}: {summary['frames']} frames at {summary['width']}x{summary['height']}: "
-              f"per frame median {interval['median']:.2f} ms (p95 {interval['p95']:.2f}), "
+              f"per frame median {interval['median']:.2f} ms "
+              f"(mean {interval.get('mean_but_last', interval['mean']):.2f}, p95 {interval['p95']:.2f}), "
               f"latency median {e2e['median']:.2f} ms, renderer wall {wall['median']:.2f} ms, "
               f"idle {summary['idle_percent']['mean']:.1f}% mean")
         for name, ms in summary["stages_median_ms"].items():

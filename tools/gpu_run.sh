@@ -29,6 +29,9 @@
 #                              back to back (with two in flight, frame N+1 handed out as soon as N-1 is merged, before
 #                              N-1's post; docs/balancing.md, "The next frame handed out as soon as a slot frees");
 #                              each run also prints per tracer the bands that waited for their job
+#                              COHORT_GPU_KEEP_RUNS=1 brings every run's stats.json and log back as one file,
+#                              $OUT/runs.tar.xz (frame by frame: rows, stages and band gaps of each tracer; $OUT
+#                              returns at most 8 files)
 #   tools/gpu_run.sh compare BASE.tar.xz [MORE.tar.xz ...]  there: A/B of payloads on one machine (the staged
 #                              one against earlier stages' payload.tar.xz, renamed and carried in .gpu/): the CUDA
 #                              tracer tests of the staged one, then end-to-end ms per frame, cuda:0, both maps,
@@ -534,7 +537,9 @@ print(pick[0]["tracer"] if pick else "")' || true)}"
             --camera-path spin-slow --write last --out $run >$run.log 2>&1 ||
             { echo "== $map $convergence $mix: failed"; tail -n 3 $run.log; continue; }
           echo "== $map map, $convergence, $mix${in_flight_args[*]:+, ${in_flight_args[*]}, round $round}$ahead_label"
-          python3 tools/frame_times.py $run/stats.json --skip ${COHORT_GPU_SKIP:-20} --json $out/$(basename $run).json > $run/summary.txt
+          # With COHORT_GPU_KEEP_RUNS the summaries travel inside runs.tar.xz: $OUT returns at most 8 files.
+          summary_dir=$out; [ "${COHORT_GPU_KEEP_RUNS:-0}" = 1 ] && summary_dir=$run
+          python3 tools/frame_times.py $run/stats.json --skip ${COHORT_GPU_SKIP:-20} --json $summary_dir/$(basename $run).json > $run/summary.txt
           head -n 1 $run/summary.txt
           grep "waited for its job" $run/summary.txt || true  # per tracer: bands whose job came after the band before ended
           [ "${COHORT_GPU_BAND_GAPS:-0}" = 1 ] && { python3 tools/opencl_band_gaps.py $run.log --skip ${COHORT_GPU_SKIP:-20} || true; }
@@ -550,6 +555,9 @@ print(pick[0]["tracer"] if pick else "")' || true)}"
       [ "${COHORT_GPU_SKIP_DEVICES:-0}" = 1 ] || timeout 300 "$stage/bin/cohort" bench devices --scene "${args[0]}" --width "${args[2]}" --height "${args[4]}" \
         --frames 60 --json "$out/bench_devices_$map.json" 2>&1 | tail -n 14 || true
     done
+    if [ "${COHORT_GPU_KEEP_RUNS:-0}" = 1 ]; then
+      (cd /tmp && ls -d mg_*/stats.json mg_*/mg_*.json mg_*.log 2>/dev/null | tar -cJf "$out/runs.tar.xz" -T -) && ls -la "$out/runs.tar.xz"
+    fi
     for real in ${COHORT_GPU_BALANCE_MIXES:-cuda:0,cuda:1}; do
     echo "== Table 1, real tracers $real"
     timeout 200 "$stage/bin/cohort" bench balance --real $real --scene "$stage/testmap.cpk" --rows 720 \
