@@ -243,6 +243,15 @@ struct CudaTracer::Impl {
     }
   }
 
+  // Band `b` of `rows` rows in the next slot: the slot's storage grown for it and its scene arrays brought up to
+  // date.
+  BandSlot& open_band(EnqueuedBand& b, const commit::TracerScene& scene, size_t pixels, size_t rows, bool packed) {
+    b.rows = rows;
+    b.slot = &take_slot();
+    prepare_band(*b.slot, pixels, rows, packed);
+    refresh_slot_scene(*b.slot, scene);
+    return *b.slot;
+  }
   // The next band's slot. Its band before in that slot has ended: at most two bands are in flight (the
   // current one and the one enqueued ahead), and each is finished before its slot comes round again.
   BandSlot& take_slot() {
@@ -569,12 +578,8 @@ CudaTracer::EnqueuedBand CudaTracer::enqueue_band(const core::BandJob& job, core
   const size_t pixels = size_t(camera.width) * (params.row_end - params.row_begin);
   const bool packed = target.format() != core::BandFormat::rgba32f;
   const size_t rows = params.row_end - params.row_begin;
-  b.rows = rows;
-  b.slot = &m.take_slot();
-  BandSlot& slot = *b.slot;
+  BandSlot& slot = m.open_band(b, scene(), pixels, rows, packed);
   const cudaStream_t stream = slot.stream;
-  m.prepare_band(slot, pixels, rows, packed);
-  m.refresh_slot_scene(slot, scene());
   // Kept on the GPU, the band skips both copies: nothing goes down, and the post-processing takes it
   // device to device (or over NVLink from a peer).
   Impl::KeptBand* kept = job.keep_on_device >= 0 ? &m.kept[m.next_kept] : nullptr;
@@ -713,12 +718,8 @@ core::BandResult CudaTracer::render_band_in_pieces(const core::BandJob& job, cor
   EnqueuedBand b;
   b.job = job;
   b.target = &target;
-  b.rows = rows;
-  b.slot = &m.take_slot();
-  BandSlot& slot = *b.slot;
+  BandSlot& slot = m.open_band(b, scene(), pixels, rows, packed);
   const cudaStream_t stream = slot.stream;
-  m.prepare_band(slot, pixels, rows, packed);
-  m.refresh_slot_scene(slot, scene());
   const size_t pieces = cuts.size() - 1;
   while (m.piece_rendered.size() < pieces) {
     cudaEvent_t rendered = nullptr, downloaded = nullptr;
