@@ -27,6 +27,14 @@ std::vector<char> blases_with_passing_materials(const commit::TracerScene& scene
   return passing;
 }
 
+bool triangle_may_pass(const commit::TracerScene& scene, size_t t) {
+  return t >= scene.triangles.size() || material_may_pass(scene, scene.triangles[t].material);
+}
+
+std::vector<char> blases_with_passing_overrides(const commit::TracerScene& scene, bool device_ray_masks) {
+  return blases_needing_filters(scene, std::vector<char>(scene.blases.size(), 0), device_ray_masks);
+}
+
 std::vector<char> blases_needing_filters(const commit::TracerScene& scene, const std::vector<char>& own_materials,
                                          bool device_ray_masks) {
   if (!device_ray_masks) return std::vector<char>(scene.blases.size(), 1);

@@ -28,8 +28,16 @@ enum RayClass { kCameraRay, kShadowRay, kBounceRay };
 // x86-64-v3, and no code compiled that way may end up shared with the baseline build (std templates).
 void log_ray(RayLog* log, RayClass ray_class, KVec3 org, KVec3 dir, float tmax, kuint ray_mask);
 
+// A BLAS split in two Embree geometries (EmbreeTracer::set_split_filters): its triangles that no ray can pass
+// in geometry 0, without a filter function, and those a ray may pass in geometry 1, with it. Per geometry, the
+// scene triangle of each primitive; null where a BLAS is one geometry over its triangles in order.
+struct SplitBlas {
+  const kuint* triangles[2];
+};
+
 struct TraceCtx {
   KSceneView scene;
+  const SplitBlas* split;  // per BLAS (may be null: no BLAS is split)
   RTCScene top;
   uint64_t rays;  // rays traced through this context, for the benchmarks and the balancer's row work
   // The camera ray's closest hit, traced ahead in a packet: taken by the next k_trace_closest along
@@ -46,6 +54,7 @@ struct TraceCtx {
 struct FilterContext {
   RTCIntersectContext base;
   const KSceneView* scene;
+  const SplitBlas* split;
   int occlusion;  // shadow rays: material.h's ray kind from each ray's mask (k_shadow_ray_kind); else 0
 };
 
@@ -53,11 +62,13 @@ void filter_hit(const RTCFilterFunctionNArguments* args);
 
 // coherent: rays of one batch start close together and point alike (camera packets), so Embree may
 // trace them together.
-static inline FilterContext filter_context(const KSceneView* scene, bool occlusion, bool coherent = false) {
+static inline FilterContext filter_context(const KSceneView* scene, const SplitBlas* split, bool occlusion,
+                                           bool coherent = false) {
   FilterContext fc;
   rtcInitIntersectContext(&fc.base);
   if (coherent) fc.base.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
   fc.scene = scene;
+  fc.split = split;
   fc.occlusion = occlusion;
   return fc;
 }
@@ -77,9 +88,13 @@ static inline RTCRay make_ray(KVec3 org, KVec3 dir, float tmax, kuint ray_mask) 
   return ray;
 }
 
-// The scene's triangle index of an Embree hit (primID counts within the instance's BLAS).
-static inline kuint scene_triangle(const KSceneView& scene, kuint instance, kuint prim) {
-  return scene.blases[scene.instances[instance].blas].tri_offset + prim;
+// The scene's triangle index of an Embree hit: primID counts within the instance's BLAS, or within one of a
+// split BLAS's two geometries.
+static inline kuint scene_triangle(const KSceneView& scene, const SplitBlas* split, kuint instance, kuint geometry,
+                                   kuint prim) {
+  const kuint blas = scene.instances[instance].blas;
+  if (split && split[blas].triangles[geometry & 1u]) return split[blas].triangles[geometry & 1u][prim];
+  return scene.blases[blas].tri_offset + prim;
 }
 
 }  // namespace cohort::tracers::embree_kernel
@@ -103,7 +118,7 @@ static inline int k_trace_closest(KTraceCtx* ctx, KVec3 org, KVec3 dir, float tm
                         dir.z == ctx->log->camera_dir.z;
     ek::log_ray(ctx->log, camera ? ek::kCameraRay : ek::kBounceRay, org, dir, tmax, ray_mask);
   }
-  ek::FilterContext fc = ek::filter_context(&ctx->scene, false);
+  ek::FilterContext fc = ek::filter_context(&ctx->scene, ctx->split, false);
   RTCRayHit rh;
   rh.ray = ek::make_ray(org, dir, tmax, ray_mask);
   rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
@@ -114,7 +129,7 @@ static inline int k_trace_closest(KTraceCtx* ctx, KVec3 org, KVec3 dir, float tm
   hit->u = rh.hit.u;
   hit->v = rh.hit.v;
   hit->instance = rh.hit.instID[0];
-  hit->triangle = ek::scene_triangle(ctx->scene, hit->instance, rh.hit.primID);
+  hit->triangle = ek::scene_triangle(ctx->scene, ctx->split, hit->instance, rh.hit.geomID, rh.hit.primID);
   return 1;
 }
 
@@ -122,7 +137,7 @@ static inline int k_trace_occluded(KTraceCtx* ctx, KVec3 org, KVec3 dir, float t
   namespace ek = cohort::tracers::embree_kernel;
   ++ctx->rays;
   if (ctx->log) ek::log_ray(ctx->log, ek::kShadowRay, org, dir, tmax, ray_mask);
-  ek::FilterContext fc = ek::filter_context(&ctx->scene, true);
+  ek::FilterContext fc = ek::filter_context(&ctx->scene, ctx->split, true);
   RTCRay ray = ek::make_ray(org, dir, tmax, ray_mask);
   rtcOccluded1(ctx->top, &fc.base, &ray);
   return ray.tfar < 0.0f;  // Embree sets tfar to -inf on occlusion

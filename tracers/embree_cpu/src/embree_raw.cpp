@@ -94,12 +94,12 @@ uint64_t trace_stream(RTCScene top, embree_kernel::FilterContext& fc, const Embr
 
 }  // namespace
 
-uint64_t trace(RTCScene top, const KSceneView& scene, const std::vector<EmbreeRay>& rays, bool occlusion,
-               EmbreeRayApi api, bool coherent) {
+uint64_t trace(RTCScene top, const KSceneView& scene, const embree_kernel::SplitBlas* split,
+               const std::vector<EmbreeRay>& rays, bool occlusion, EmbreeRayApi api, bool coherent) {
   if (rays.empty()) return 0;
   std::atomic<uint64_t> total{0};
   tbb::parallel_for(tbb::blocked_range<size_t>(0, rays.size(), 4 * kStream), [&](const tbb::blocked_range<size_t>& r) {
-    embree_kernel::FilterContext fc = embree_kernel::filter_context(&scene, occlusion, coherent);
+    embree_kernel::FilterContext fc = embree_kernel::filter_context(&scene, split, occlusion, coherent);
     const EmbreeRay* first = rays.data() + r.begin();
     const size_t n = r.size();
     uint64_t count = 0;

@@ -43,7 +43,7 @@ __attribute__((noinline, noipa)) static void emissive_picks(const KSceneView* sc
 
 // Closest hits of the tile's n camera rays (all from org), 8 to a packet, with a coherent context.
 static void trace_camera_packets(embree_kernel::TraceCtx& ctx, KVec3 org, int n, Arena& a) {
-  embree_kernel::FilterContext fc = embree_kernel::filter_context(&ctx.scene, false, true);
+  embree_kernel::FilterContext fc = embree_kernel::filter_context(&ctx.scene, ctx.split, false, true);
   for (int first = 0; first < n; first += kPacketSize) {
     RTCRayHit8& rh = a.packets[first / kPacketSize];
     alignas(32) int valid[kPacketSize];  // Embree loads the mask as one vector: unaligned, it faults on AVX-512 CPUs
@@ -71,7 +71,8 @@ static void trace_camera_packets(embree_kernel::TraceCtx& ctx, KVec3 org, int n,
       hit.u = rh.hit.u[k];
       hit.v = rh.hit.v[k];
       hit.instance = rh.hit.instID[0][k];
-      hit.triangle = embree_kernel::scene_triangle(ctx.scene, hit.instance, rh.hit.primID[k]);
+      hit.triangle =
+          embree_kernel::scene_triangle(ctx.scene, ctx.split, hit.instance, rh.hit.geomID[k], rh.hit.primID[k]);
       hit.cost = 0u;
       hit.pad0 = hit.pad1 = 0u;
     }

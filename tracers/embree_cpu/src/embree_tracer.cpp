@@ -1,6 +1,7 @@
 #include "cohort/tracers/embree_tracer.h"
 
 #include <algorithm>
+#include <array>
 #include <atomic>
 #include <chrono>
 #include <cstdlib>
@@ -42,7 +43,8 @@ void filter_hit(const RTCFilterFunctionNArguments* args) {
       args->valid[i] = 0;
       continue;
     }
-    kuint triangle = scene->blases[inst.blas].tri_offset + RTCHitN_primID(args->hit, args->N, i);
+    const kuint triangle = scene_triangle(*scene, fc->split, instance, RTCHitN_geomID(args->hit, args->N, i),
+                                          RTCHitN_primID(args->hit, args->N, i));
     float u = RTCHitN_u(args->hit, args->N, i), v = RTCHitN_v(args->hit, args->N, i);
     const int ray_kind = fc->occlusion ? k_shadow_ray_kind(ray_mask) : 0;
     if (k_hit_transmittance(scene, instance, triangle, u, v, ray_kind) > 0.0f) args->valid[i] = 0;
@@ -83,14 +85,16 @@ void render_wave_tile_x86_64_v3(const Frame& frame, const Tile& tile, Arena& are
 
 namespace {
 
-// COHORT_EMBREE_WAVEFRONT: 1 (the default) renders tiles as wavefronts, 0 path by path; anything else is
-// named in the error.
-bool wavefront_from_environment() {
-  const char* v = std::getenv("COHORT_EMBREE_WAVEFRONT");
+// An on/off switch from the environment: 1 or unset on, 0 off; anything else is named in the error.
+bool switch_from_environment(const char* variable) {
+  const char* v = std::getenv(variable);
   if (!v || std::strcmp(v, "1") == 0) return true;
   if (std::strcmp(v, "0") == 0) return false;
-  throw std::invalid_argument(std::string("EmbreeTracer: COHORT_EMBREE_WAVEFRONT='") + v + "' (expected 0 or 1)");
+  throw std::invalid_argument(std::string("EmbreeTracer: ") + variable + "='" + v + "' (expected 0 or 1)");
 }
+
+// COHORT_EMBREE_WAVEFRONT: 1 (the default) renders tiles as wavefronts, 0 path by path.
+bool wavefront_from_environment() { return switch_from_environment("COHORT_EMBREE_WAVEFRONT"); }
 
 // COHORT_EMBREE_PACKET_WIDTH: the wavefront's rays per packet, 8 or 16 (unset: Embree's native width); anything
 // else is named in the error.
@@ -117,7 +121,14 @@ struct EmbreeTracer::Impl {
   std::vector<RTCScene> blas_scenes;
   bool ray_masks = false;            // the device applies instance masks itself (rtcSetGeometryMask)
   std::vector<char> passing_materials;  // per BLAS: embree_filters::blases_with_passing_materials
-  std::vector<char> filtered;           // per BLAS: whether its geometry has filter_hit attached
+  std::vector<char> filtered;           // per BLAS: whether its geometry 0 has filter_hit attached
+  // set_split_filters (COHORT_EMBREE_SPLIT_FILTERS): a BLAS whose own materials let rays pass on some of its
+  // triangles only is two geometries, the others without the filter function (embree_kernel::SplitBlas).
+  bool split_filters = switch_from_environment("COHORT_EMBREE_SPLIT_FILTERS");
+  std::vector<std::array<std::vector<kuint>, 2>> split_triangles;  // per BLAS; both empty where not split
+  std::vector<embree_kernel::SplitBlas> split_view;                 // per BLAS, into split_triangles
+  size_t blases_split = 0;
+  const embree_kernel::SplitBlas* split() const { return blases_split > 0 ? split_view.data() : nullptr; }
   std::unique_ptr<tbb::global_control> thread_limit;
   uint64_t rays_traced = 0;
   bool x86_64_v3 = embree_tiles::has_x86_64_v3();
@@ -159,16 +170,33 @@ struct EmbreeTracer::Impl {
     rtcSetGeometryOccludedFilterFunction(g, on ? embree_kernel::filter_hit : nullptr);
   }
 
+  // Whether geometry 0 of BLAS b needs filter_hit: for a split BLAS only where an instance's material
+  // override may let rays pass (its passing triangles are geometry 1, always filtered).
+  char geometry0_filter(size_t b, const std::vector<char>& needs, const std::vector<char>& overrides) const {
+    return b < split_triangles.size() && !split_triangles[b][1].empty() ? overrides[b] : needs[b];
+  }
+  // Whether a split BLAS's unfiltered geometry now holds a triangle whose material may let rays pass (a
+  // material changed): the BLASes must then be built again.
+  bool split_outdated(const commit::TracerScene& scene) const {
+    for (const auto& parts : split_triangles) {
+      if (parts[1].empty()) continue;
+      for (kuint t : parts[0])
+        if (embree_filters::triangle_may_pass(scene, t)) return true;
+    }
+    return false;
+  }
+
   // Attaches or detaches filter_hit where a BLAS's need changed (materials or overrides changed).
   // Returns whether any BLAS changed: the instance scene must then be rebuilt.
-  bool update_filters(const std::vector<char>& needs) {
+  bool update_filters(const std::vector<char>& needs, const std::vector<char>& overrides) {
     bool changed = false;
     for (size_t b = 0; b < blas_scenes.size() && b < needs.size(); ++b) {
-      if (filtered[b] == needs[b]) continue;
-      filtered[b] = needs[b];
+      const char want = geometry0_filter(b, needs, overrides);
+      if (filtered[b] == want) continue;
+      filtered[b] = want;
       RTCGeometry g = rtcGetGeometry(blas_scenes[b], 0);
       if (!g) continue;
-      set_filter(g, needs[b] != 0);
+      set_filter(g, want != 0);
       rtcCommitGeometry(g);
       rtcCommitScene(blas_scenes[b]);
       changed = true;
@@ -176,21 +204,60 @@ struct EmbreeTracer::Impl {
     return changed;
   }
 
-  // One Embree scene per KBlas, sharing the TracerScene's vertex and triangle arrays (no copies).
-  void build_blases(const commit::TracerScene& scene, const std::vector<char>& needs_filter) {
+  // A triangle geometry over the scene's vertices (shared, no copy).
+  RTCGeometry new_triangles(const commit::TracerScene& scene) const {
+    RTCGeometry g = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_TRIANGLE);
+    rtcSetSharedGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, scene.vertices.data(), 0,
+                               sizeof(KVertex), scene.vertices.size());
+    return g;
+  }
+
+  // One Embree scene per KBlas, sharing the TracerScene's vertex and triangle arrays (no copies); or, for a
+  // BLAS whose own materials let rays pass on some triangles only (and no instance overrides them so, and
+  // not skinned), two geometries with index buffers of their own: the triangles no ray passes (geometry 0,
+  // no filter function, so Embree takes their hits without calling back) and the others (geometry 1).
+  void build_blases(const commit::TracerScene& scene, const std::vector<char>& needs_filter,
+                    const std::vector<char>& overrides) {
     release_blases();
     filtered = needs_filter;
+    split_triangles.assign(scene.blases.size(), {});
+    split_view.assign(scene.blases.size(), embree_kernel::SplitBlas{{nullptr, nullptr}});
+    blases_split = 0;
     for (size_t index = 0; index < scene.blases.size(); ++index) {
       const KBlas& b = scene.blases[index];
       RTCScene s = rtcNewScene(device);
-      if (b.tri_count > 0) {
-        RTCGeometry g = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_TRIANGLE);
-        rtcSetSharedGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, scene.vertices.data(), 0,
-                                   sizeof(KVertex), scene.vertices.size());
+      const bool skinned = embree_skinned::is_skinned(scene, uint32_t(index));
+      auto& parts = split_triangles[index];
+      if (split_filters && ray_masks && !skinned && needs_filter[index] && !overrides[index]) {
+        for (kuint t = b.tri_offset; t < b.tri_offset + b.tri_count && t < scene.triangles.size(); ++t)
+          parts[embree_filters::triangle_may_pass(scene, t) ? 1 : 0].push_back(t);
+        if (parts[0].empty() || parts[1].empty()) parts = {};  // nothing to split off
+      }
+      if (!parts[1].empty()) {
+        for (unsigned part = 0; part < 2; ++part) {
+          RTCGeometry g = new_triangles(scene);
+          auto* index_buffer = static_cast<unsigned*>(rtcSetNewGeometryBuffer(
+              g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, 3 * sizeof(unsigned), parts[part].size()));
+          for (size_t i = 0; i < parts[part].size(); ++i) {
+            const KTriangle& tri = scene.triangles[parts[part][i]];
+            index_buffer[3 * i] = tri.v0;
+            index_buffer[3 * i + 1] = tri.v1;
+            index_buffer[3 * i + 2] = tri.v2;
+          }
+          set_filter(g, part == 1);
+          rtcCommitGeometry(g);
+          rtcAttachGeometryByID(s, g, part);
+          rtcReleaseGeometry(g);
+        }
+        filtered[index] = 0;
+        split_view[index] = embree_kernel::SplitBlas{{parts[0].data(), parts[1].data()}};
+        ++blases_split;
+      } else if (b.tri_count > 0) {
+        RTCGeometry g = new_triangles(scene);
         rtcSetSharedGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, scene.triangles.data(),
                                    size_t(b.tri_offset) * sizeof(KTriangle), sizeof(KTriangle), b.tri_count);
         set_filter(g, needs_filter[index] != 0);
-        if (embree_skinned::is_skinned(scene, uint32_t(index))) embree_skinned::prepare(s, g);
+        if (skinned) embree_skinned::prepare(s, g);
         rtcCommitGeometry(g);
         rtcAttachGeometryByID(s, g, 0);
         rtcReleaseGeometry(g);
@@ -198,6 +265,13 @@ struct EmbreeTracer::Impl {
       rtcCommitScene(s);
       blas_scenes.push_back(s);
     }
+  }
+  // Every BLAS and the instance scene built again for the scene as it is now.
+  void rebuild(const commit::TracerScene& scene) {
+    build_blases(scene, embree_filters::blases_needing_filters(scene, passing_materials, ray_masks),
+                 embree_filters::blases_with_passing_overrides(scene, ray_masks));
+    check_device(device, "building the BLAS scenes");
+    build_top(scene);
   }
 
   // Instance geometry IDs equal KInstance indices, so instID[0] indexes the instance array directly.
@@ -238,16 +312,14 @@ void EmbreeTracer::upload(const commit::ChangeSet& changes) {
   const bool rebuild = changes.full_resync || changes.geometry;
   if (rebuild || changes.materials)
     impl_->passing_materials = embree_filters::blases_with_passing_materials(scene());
-  if (rebuild) {
-    impl_->build_blases(scene(),
-                        embree_filters::blases_needing_filters(scene(), impl_->passing_materials, impl_->ray_masks));
-    check_device(impl_->device, "building the BLAS scenes");
-    impl_->build_top(scene());
+  if (rebuild || (changes.materials && impl_->split_outdated(scene()))) {
+    impl_->rebuild(scene());
   } else {
     bool top_changed = changes.instances || changes.tlas || !changes.posed_skins.empty() || !impl_->top;
     if (changes.materials || changes.instances)
       top_changed |= impl_->update_filters(
-          embree_filters::blases_needing_filters(scene(), impl_->passing_materials, impl_->ray_masks));
+          embree_filters::blases_needing_filters(scene(), impl_->passing_materials, impl_->ray_masks),
+          embree_filters::blases_with_passing_overrides(scene(), impl_->ray_masks));
     if (top_changed) {
       embree_skinned::refit(scene(), changes.posed_skins, impl_->blas_scenes);
       impl_->build_top(scene());
@@ -259,15 +331,15 @@ void EmbreeTracer::upload(const commit::ChangeSet& changes) {
 namespace {
 
 embree_tiles::Frame make_frame(const KFrameParams& params, const core::BandJob& job, const KSceneView& scene,
-                               RTCScene top, const KAuxHistory& history, core::BandBuffer* target,
-                               int packet_width) {
+                               const embree_kernel::SplitBlas* split, RTCScene top, const KAuxHistory& history,
+                               core::BandBuffer* target, int packet_width) {
   embree_tiles::Frame frame;
   frame.params = params;
   frame.camera = job.camera;
   frame.previous_camera = job.previous_camera.width > 0 ? job.previous_camera : job.camera;
   frame.history = history;
   frame.write_aux = target && params.aux_outputs != 0u && target->has_aux();
-  frame.base = embree_kernel::TraceCtx{scene, top, 0, nullptr, 0, v3s(0.0f), nullptr};
+  frame.base = embree_kernel::TraceCtx{scene, split, top, 0, nullptr, 0, v3s(0.0f), nullptr};
   frame.target = target;
   frame.shadow_slots = k_shadow_queue_slots(&params, scene.light_count, scene.emissive_count);
   frame.packet_width = packet_width;
@@ -292,7 +364,8 @@ core::BandResult EmbreeTracer::render_band(const core::BandJob& job, core::BandB
   history.skin_weights = s.skin_weights.data();
   history.joints = previous_joints().empty() ? nullptr : previous_joints().data();
   history.skin_count = static_cast<kuint>(s.skins.size());
-  const embree_tiles::Frame frame = make_frame(params, job, scene, impl_->top, history, &target, impl_->packet_width);
+  const embree_tiles::Frame frame =
+      make_frame(params, job, scene, impl_->split(), impl_->top, history, &target, impl_->packet_width);
   // Rays traced per row: the balancer's per-row work proxy (BandResult::row_work), as the GPU tracers count it.
   std::vector<std::atomic<uint64_t>> row_rays(static_cast<size_t>(std::max(row_end - row_begin, 0)));
   std::atomic<uint64_t> rays{0};
@@ -350,7 +423,7 @@ EmbreeRaySet EmbreeTracer::record_rays(const core::BandJob& job) {
   const KFrameParams params = frame_params(job);
   const KSceneView scene = host_scene_view(params);
   const embree_tiles::Frame frame =
-      make_frame(params, job, scene, impl_->top, KAuxHistory{}, nullptr, impl_->packet_width);
+      make_frame(params, job, scene, impl_->split(), impl_->top, KAuxHistory{}, nullptr, impl_->packet_width);
   auto arena = std::make_unique<embree_tiles::Arena>();
   embree_kernel::RayLog log;
   log.camera_dir = v3s(0.0f);
@@ -368,7 +441,15 @@ EmbreeRaySet EmbreeTracer::record_rays(const core::BandJob& job) {
 uint64_t EmbreeTracer::trace_raw(const std::vector<EmbreeRay>& rays, bool occlusion, EmbreeRayApi api, bool coherent) {
   if (!impl_->top) throw std::runtime_error("EmbreeTracer: trace_raw before any commit was applied");
   const KFrameParams params = frame_params(core::BandJob{});
-  return embree_raw::trace(impl_->top, host_scene_view(params), rays, occlusion, api, coherent);
+  return embree_raw::trace(impl_->top, host_scene_view(params), impl_->split(), rays, occlusion, api, coherent);
 }
+
+void EmbreeTracer::set_split_filters(bool on) {
+  if (impl_->split_filters == on) return;
+  impl_->split_filters = on;
+  if (impl_->top) impl_->rebuild(scene());
+}
+bool EmbreeTracer::split_filters() const { return impl_->split_filters; }
+size_t EmbreeTracer::blases_split() const { return impl_->blases_split; }
 
 }  // namespace cohort::tracers

@@ -89,7 +89,7 @@ void take_hit(embree_kernel::TraceCtx& ctx, Arena& a, const RayHit& rh, int k, i
   hit.u = rh.hit.u[k];
   hit.v = rh.hit.v[k];
   hit.instance = rh.hit.instID[0][k];
-  hit.triangle = ek::scene_triangle(ctx.scene, hit.instance, rh.hit.primID[k]);
+  hit.triangle = ek::scene_triangle(ctx.scene, ctx.split, hit.instance, rh.hit.geomID[k], rh.hit.primID[k]);
 }
 
 // The tile's n paths a.wave.pixels[0..n) walk their closest-hit rays (ray(j, &org, &dir) for the j-th; tmax
@@ -99,7 +99,7 @@ template <int W, class RayOf>
 void walk_closest_packets(embree_kernel::TraceCtx& ctx, Arena& a, int n, bool coherent,
                           embree_kernel::RayClass ray_class, int tile_width, uint64_t* row_rays, RayOf ray) {
   namespace ek = embree_kernel;
-  ek::FilterContext fc = ek::filter_context(&ctx.scene, false, coherent);
+  ek::FilterContext fc = ek::filter_context(&ctx.scene, ctx.split, false, coherent);
   for (int first = 0; first < n; first += W) {
     alignas(64) typename Packets<W>::RayHit rh;
     alignas(64) int valid[W];  // Embree loads the mask as one vector: unaligned, it faults on AVX-512 CPUs
@@ -146,7 +146,7 @@ template <int W>
 void trace_shadow_packets(embree_kernel::TraceCtx& ctx, Arena& a, int rays, int tile_width, uint64_t* row_rays) {
   namespace ek = embree_kernel;
   Arena::Wave& wv = a.wave;
-  ek::FilterContext fc = ek::filter_context(&ctx.scene, true);
+  ek::FilterContext fc = ek::filter_context(&ctx.scene, ctx.split, true);
   for (int first = 0; first < rays; first += W) {
     alignas(64) typename Packets<W>::Ray r;
     alignas(64) int valid[W];

@@ -59,6 +59,15 @@ class EmbreeTracer : public TracerBase {
   // (AVX-512), else 8. Same image either way.
   void set_wave_packet_width(int rays);
   int wave_packet_width() const;
+  // A BLAS whose own materials let rays pass (alpha tests, pass-through, noShadows, ...) on some of its
+  // triangles only is two Embree geometries, and only the second has the filter function, so that hits on
+  // the rest end Embree's search without calling back (on unless COHORT_EMBREE_SPLIT_FILTERS=0; where the
+  // device has ray masks, and not for skinned BLASes or BLASes an instance overrides with such a material).
+  // Same image. Switching rebuilds the applied scene's BLASes.
+  void set_split_filters(bool on);
+  bool split_filters() const;
+  // BLASes of the applied scene that are two geometries.
+  size_t blases_split() const;
   // Camera, bounce and shadow rays traced by render_band since construction.
   uint64_t rays_traced() const;
 
