@@ -324,7 +324,9 @@ PY
     variable=$2; shift 2
     [ -d "$stage/bin" ] || tar -C "$stage" -xJf "$stage/payload.tar.xz"
     export LD_LIBRARY_PATH="$PWD/$stage/lib${LD_LIBRARY_PATH:+:$LD_LIBRARY_PATH}"
-    # NVIDIA's OpenCL only, so that opencl:0 is the first GPU (COHORT_GPU_TRACERS=opencl:0, the OpenCL tests).
+    # NVIDIA's OpenCL registered. PoCL still lists itself first on the GPU machines (2026-11-28: opencl:0 was PoCL's
+    # CPU device, opencl:1 the first GPU, with only nvidia.icd in OCL_ICD_VENDORS): name the GPU's OpenCL device as
+    # `cohort devices` lists it there (COHORT_GPU_TRACERS=opencl:1, COHORT_TEST_OPENCL_DEVICE=1).
     mkdir -p /tmp/icd && echo libnvidia-opencl.so.1 > /tmp/icd/nvidia.icd
     export OCL_ICD_VENDORS=/tmp/icd
     nvidia-smi --query-gpu=index,name --format=csv,noheader
