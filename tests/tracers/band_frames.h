@@ -49,6 +49,26 @@ inline View map_view(int w, int h) {
   return {map.scene, core::make_camera(map.eye, {map.yaw, 0.0f}, core::kDefaultFovX, w, h)};
 }
 
+// Where the generated test map is looked at from (tools/gen_testmap.py's README names the areas).
+enum class MapSpot {
+  player_start,  // the hall: pillars, table, crates, a blood decal
+  atrium,        // from the corridor's end: the glass screen, the grate under the skylight, the stairwell's fog
+  gallery,       // the glass case on its pedestal, the sky court's noSelfShadow shrub behind
+};
+
+inline View map_view(MapSpot spot, int w, int h) {
+  const TestMapScene& map = test_map_scene();
+  switch (spot) {
+    case MapSpot::atrium:
+      return {map.scene, core::make_camera({740, 192, 90}, {0.0f, -12.0f}, core::kDefaultFovX, w, h)};
+    case MapSpot::gallery:
+      return {map.scene, core::make_camera({1440, 160, 170}, {20.0f, 12.0f}, core::kDefaultFovX, w, h)};
+    case MapSpot::player_start:
+      break;
+  }
+  return map_view(w, h);
+}
+
 // A floor of point and projected lights under an emissive panel (two emissive triangles), seen from above.
 inline View many_lights_view(int point_lights, int projected_lights, int w, int h) {
   scene::Scene floor = many_lights_floor_under_a_panel(point_lights, projected_lights);
@@ -80,25 +100,31 @@ struct BandFrame {
   double device_ms = 0.0;       // the bands' BandResult::device_ms, summed
 };
 
-// The frame rendered band by band by `tracer` (its scene applied here; cuts: the bands' first rows, then the
-// height), with its aux planes when params.aux_outputs asks for them.
-inline BandFrame render_in_bands(core::Tracer& tracer, const View& view, const KFrameParams& params,
+// The frame through `camera` rendered band by band by `tracer` on the scene it has (cuts: the bands' first
+// rows, then the height), with its aux planes when params.aux_outputs asks for them.
+inline BandFrame render_bands_of(core::Tracer& tracer, const KCamera& camera, const KFrameParams& params,
                                  const std::vector<int>& cuts) {
-  tracer.apply(commit::CommitBuffer::full(view.scene, 1));
   BandFrame out;
-  out.frame.resize(int(view.camera.width), int(view.camera.height), core::BandFormat::rgba32f);
+  out.frame.resize(int(camera.width), int(camera.height), core::BandFormat::rgba32f);
   out.frame.enable_aux(params.aux_outputs != 0u);
   for (size_t i = 0; i + 1 < cuts.size(); ++i) {
     core::BandJob job;
     job.params = params;
     job.params.row_begin = kuint(cuts[i]);
     job.params.row_end = kuint(cuts[i + 1]);
-    job.camera = view.camera;
+    job.camera = camera;
     const core::BandResult result = tracer.render_band(job, out.frame);
     out.row_work.insert(out.row_work.end(), result.row_work.begin(), result.row_work.end());
     out.device_ms += result.device_ms;
   }
   return out;
+}
+
+// The same with the view's scene applied first.
+inline BandFrame render_in_bands(core::Tracer& tracer, const View& view, const KFrameParams& params,
+                                 const std::vector<int>& cuts) {
+  tracer.apply(commit::CommitBuffer::full(view.scene, 1));
+  return render_bands_of(tracer, view.camera, params, cuts);
 }
 
 // The floats of a and b (RGBA32F bands of one size) whose bits differ.

@@ -37,12 +37,10 @@ namespace {
 constexpr int kWidth = 96, kHeight = 64;
 
 // The player start's hall, the atrium (glass screen, grate, the stairwell's fog) and the gallery (glass case,
-// noSelfShadow shrub), as embree_wavefront_test.cpp looks at them.
+// noSelfShadow shrub).
 std::vector<View> map_views() {
-  const TestMapScene& map = test_map_scene();
-  return {map_view(kWidth, kHeight),
-          {map.scene, core::make_camera({740, 192, 90}, {0.0f, -12.0f}, core::kDefaultFovX, kWidth, kHeight)},
-          {map.scene, core::make_camera({1440, 160, 170}, {20.0f, 12.0f}, core::kDefaultFovX, kWidth, kHeight)}};
+  return {map_view(MapSpot::player_start, kWidth, kHeight), map_view(MapSpot::atrium, kWidth, kHeight),
+          map_view(MapSpot::gallery, kWidth, kHeight)};
 }
 
 KFrameParams split_case_params() {
@@ -142,20 +140,8 @@ TEST(EmbreeSplitFilters, AMaterialThatStartsLettingRaysPassRebuildsTheSplit) {
   commit.set_material(uint32_t(chosen), see_through);
   split.apply(commit);
   whole.apply(commit);
-  BandFrame a, b;
-  for (auto [tracer, out] : {std::pair{&split, &a}, std::pair{&whole, &b}}) {
-    out->frame.resize(kWidth, kHeight, core::BandFormat::rgba32f);
-    out->frame.enable_aux(true);
-    for (size_t i = 0; i + 1 < kCuts.size(); ++i) {
-      core::BandJob job;
-      job.params = params;
-      job.params.row_begin = kuint(kCuts[i]);
-      job.params.row_end = kuint(kCuts[i + 1]);
-      job.camera = view.camera;
-      const core::BandResult result = tracer->render_band(job, out->frame);
-      out->row_work.insert(out->row_work.end(), result.row_work.begin(), result.row_work.end());
-    }
-  }
+  BandFrame a = render_bands_of(split, view.camera, params, kCuts);
+  BandFrame b = render_bands_of(whole, view.camera, params, kCuts);
   expect_same_image_but_for_grazing_rays(a, b, "split against one geometry a BLAS, after the commit");
   EXPECT_GT(differing_floats(before.frame, a.frame), 0.05 * kWidth * kHeight)
       << "the see-through material should change the image";

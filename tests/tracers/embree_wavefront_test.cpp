@@ -37,26 +37,6 @@ using namespace cohort::test;
 
 namespace {
 
-// Where the generated test map is looked at from (tools/gen_testmap.py's README names the areas).
-enum class MapSpot {
-  player_start,  // the hall: pillars, table, crates, a blood decal
-  atrium,        // from the corridor's end: the glass screen, the grate under the skylight, the stairwell's fog
-  gallery,       // the glass case on its pedestal, the sky court's noSelfShadow shrub behind
-};
-
-View map_view(MapSpot spot, int w, int h) {
-  const TestMapScene& map = test_map_scene();
-  switch (spot) {
-    case MapSpot::atrium:
-      return {map.scene, core::make_camera({740, 192, 90}, {0.0f, -12.0f}, core::kDefaultFovX, w, h)};
-    case MapSpot::gallery:
-      return {map.scene, core::make_camera({1440, 160, 170}, {20.0f, 12.0f}, core::kDefaultFovX, w, h)};
-    case MapSpot::player_start:
-      break;
-  }
-  return test::map_view(w, h);
-}
-
 // The frame rendered band by band (render_in_bands). x86_64_v3: the shading's x86-64-v3 build where this CPU has one, else the baseline build; packet_width: the
 // wavefront's rays per packet (0: path by path).
 BandFrame render_bands(int packet_width, bool x86_64_v3, const View& view, const KFrameParams& params,
