@@ -209,6 +209,16 @@ KLight to_klight(const scene::Light& light, const scene::Scene& scene, const Gpu
       k.extent = 4.0f;
       break;
   }
+  if (k.type != K_LIGHT_PROJECTED) {
+    // The box's farthest corner from its origin, whatever the axis (box_light_planes' radius floor).
+    const glm::vec3 r = glm::max(light.radius, glm::vec3(1e-3f));
+    float reach = 0.0f;
+    for (int corner = 0; corner < 8; ++corner) {
+      const glm::vec3 c((corner & 1) ? r.x : -r.x, (corner & 2) ? r.y : -r.y, (corner & 4) ? r.z : -r.z);
+      reach = std::max(reach, glm::length(light.axis * c));
+    }
+    k.volume_reach = reach;
+  }
   store_world_plane(k.plane_s, planes[0], light.axis, light.origin);
   store_world_plane(k.plane_t, planes[1], light.axis, light.origin);
   store_world_plane(k.plane_q, planes[2], light.axis, light.origin);

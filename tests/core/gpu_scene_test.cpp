@@ -132,6 +132,12 @@ TEST(GpuScene, PointLightPlanesSpanTheRotatedBox) {
   EXPECT_NEAR(k.center[1], 55.0f, 1e-5f) << "light_center is rotated by the axis";
   EXPECT_EQ(k.light_tex, K_NONE);
   EXPECT_EQ(k.falloff_tex, K_NONE);
+  EXPECT_NEAR(k.volume_reach, std::sqrt(40.0f * 40.0f + 20.0f * 20.0f + 10.0f * 10.0f), 1e-3f)
+      << "the fog reject's bound: the box's farthest corner from its origin";
+  // A skewed axis (not a rotation): the farthest corner is still the bound.
+  l.axis = glm::mat3(glm::vec3(1, 0, 0), glm::vec3(1, 1, 0), glm::vec3(0, 0, 2));
+  k = core::to_klight(l, s);
+  EXPECT_NEAR(k.volume_reach, glm::length(glm::vec3(40 + 20, 20, 20)), 1e-3f);
 }
 
 TEST(GpuScene, ProjectedLightPlanesMapTheFrustum) {

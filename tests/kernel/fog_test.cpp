@@ -74,3 +74,43 @@ TEST(KernelFog, RayLengthInsideAProjectedVolume) {
   // Behind the apex: nothing.
   EXPECT_EQ(k_light_volume_length(&l, v3(-200, 0, -10), v3(1, 0, 0), K_INF), 0.0f);
 }
+
+// The box light's cheap reject (k_segment_misses_box_light) never drops a segment that has a length inside
+// the volume: random boxes and segments (some starting inside, some ending short of it, some endless), every
+// rejected one has length 0 by the six clips; it rejects the far ones (most here); projected lights, and box
+// lights without a reach (packs from before it), never.
+TEST(KernelFog, TheBoxRejectNeverDropsASegmentInsideTheVolume) {
+  uint32_t state = 12345u;
+  auto uniform = [&](float lo, float hi) {
+    state = state * 1664525u + 1013904223u;
+    return lo + (hi - lo) * float(state >> 8) / float(1u << 24);
+  };
+  int rejected = 0, crossing = 0;
+  for (int i = 0; i < 20000; ++i) {
+    const KVec3 c = v3(uniform(-500, 500), uniform(-500, 500), uniform(-100, 300));
+    const KVec3 r = v3(uniform(0.0005f, 200), uniform(0.0005f, 200), uniform(0.0005f, 200));
+    KLight l = box_light(c, v3(std::max(r.x, 1e-3f), std::max(r.y, 1e-3f), std::max(r.z, 1e-3f)));
+    l.type = K_LIGHT_POINT;
+    l.origin[0] = c.x, l.origin[1] = c.y, l.origin[2] = c.z;
+    l.radius[0] = r.x, l.radius[1] = r.y, l.radius[2] = r.z;
+    l.volume_reach = std::sqrt(std::max(r.x, 1e-3f) * std::max(r.x, 1e-3f) + std::max(r.y, 1e-3f) * std::max(r.y, 1e-3f) +
+                               std::max(r.z, 1e-3f) * std::max(r.z, 1e-3f));
+    const KVec3 o = v3(uniform(-800, 800), uniform(-800, 800), uniform(-300, 500));
+    const KVec3 d = v3_normalize(v3(uniform(-1, 1), uniform(-1, 1), uniform(-1, 1)));
+    const float tmax = i % 4 == 0 ? K_INF : uniform(0, 1500);
+    const float length = k_light_volume_length(&l, o, d, tmax);
+    const bool misses = k_segment_misses_box_light(&l, o, d, tmax) != 0;
+    crossing += length > 0.0f;
+    rejected += misses;
+    if (misses) {
+      ASSERT_EQ(length, 0.0f) << "segment " << i << " was dropped but crosses the volume";
+    }
+    l.type = K_LIGHT_PROJECTED;
+    ASSERT_EQ(k_segment_misses_box_light(&l, o, d, tmax), 0) << "projected lights are never rejected";
+    l.type = K_LIGHT_POINT;
+    l.volume_reach = 0.0f;
+    ASSERT_EQ(k_segment_misses_box_light(&l, o, d, tmax), 0) << "a light without a reach is never rejected";
+  }
+  EXPECT_GT(crossing, 100) << "some segments should cross their box";
+  EXPECT_GT(rejected, 10000) << "most far segments should be rejected";
+}

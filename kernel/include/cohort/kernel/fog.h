@@ -55,12 +55,27 @@ KFN float k_light_volume_length(KGLOBAL const KLight* light, KVec3 org, KVec3 di
   return t1 >= K_INF ? K_INF : t1 - t0;
 }
 
+/* Whether the segment (0, tmax) of a ray surely misses a box light's volume: it passes farther from the
+ * light's origin than the volume's farthest corner (volume_reach, with a margin for the planes' rounding). A
+ * cheap reject before k_light_volume_length's six clips: most of a map's rays never come near its fog
+ * volumes. Projected lights (frusta) and lights without a reach: never. */
+KFN int k_segment_misses_box_light(KGLOBAL const KLight* light, KVec3 org, KVec3 dir, float tmax) {
+  if (light->type == K_LIGHT_PROJECTED || !(light->volume_reach > 0.0f)) return 0;
+  float reach2 = light->volume_reach * light->volume_reach * 1.001f + 1e-2f;
+  KVec3 oc = v3_sub(org, v3_load_g(light->origin));
+  float dd = v3_dot(dir, dir);
+  float t = dd > 0.0f ? -v3_dot(oc, dir) / dd : 0.0f;
+  t = k_fmin(k_fmax(t, 0.0f), tmax);
+  KVec3 nearest = v3_madd(oc, dir, t);
+  return v3_dot(nearest, nearest) > reach2;
+}
+
 /* Fog along the segment (0, tmax) of a ray: adds the fog colour seen through it to *radiance and
  * leaves in *throughput what reaches the segment's end. */
 KFN void k_apply_fog(const KSceneView* scene, KVec3 org, KVec3 dir, float tmax, KVec3* radiance, KVec3* throughput) {
   for (kuint i = scene->volume_light_begin; i < scene->volume_light_end; ++i) {
     KGLOBAL const KLight* light = &scene->lights[i];
-    if (!(light->flags & K_LIGHT_FOG)) continue;
+    if (!(light->flags & K_LIGHT_FOG) || k_segment_misses_box_light(light, org, dir, tmax)) continue;
     float a = k_fog_opacity(k_light_volume_length(light, org, dir, tmax), light->fog_distance);
     if (a <= 0.0f) continue;
     *radiance = v3_add(*radiance, v3_mul(*throughput, v3_scale(v3_load_g(light->color), a)));

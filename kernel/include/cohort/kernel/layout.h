@@ -156,7 +156,8 @@ typedef struct KLight {
   float plane_s[4]; float plane_t[4]; float plane_q[4]; float plane_f[4];  /* world space lightProject */
   float extent;                         /* soft-shadow jitter radius in world units */
   float fog_distance;                   /* fog lights: distance D of the engine's fog table */
-  float pad[2];
+  float volume_reach;                   /* box lights: farthest corner of the volume from origin; 0: unknown */
+  float pad;
 } KLight;
 
 /* ---- Light trees: which light sources to sample at a point, at a cost that does not grow with their
