@@ -57,8 +57,11 @@ void projected_light_planes(const scene::Light& light, glm::vec4 planes[4]) {
   planes[0] = s; planes[1] = t; planes[2] = q; planes[3] = f;
 }
 
+// A point or parallel light's box: its half extents along the light's axes, each at least 1e-3.
+glm::vec3 box_light_radius(const scene::Light& light) { return glm::max(light.radius, glm::vec3(1e-3f)); }
+
 void box_light_planes(const scene::Light& light, glm::vec4 planes[4]) {
-  glm::vec3 r = glm::max(light.radius, glm::vec3(1e-3f));
+  const glm::vec3 r = box_light_radius(light);
   planes[0] = glm::vec4(0.5f / r.x, 0.0f, 0.0f, 0.5f);
   planes[1] = glm::vec4(0.0f, 0.5f / r.y, 0.0f, 0.5f);
   planes[2] = glm::vec4(0.0f, 0.0f, 0.0f, 1.0f);
@@ -210,8 +213,8 @@ KLight to_klight(const scene::Light& light, const scene::Scene& scene, const Gpu
       break;
   }
   if (k.type != K_LIGHT_PROJECTED) {
-    // The box's farthest corner from its origin, whatever the axis (box_light_planes' radius floor).
-    const glm::vec3 r = glm::max(light.radius, glm::vec3(1e-3f));
+    // The box's farthest corner from its origin, whatever the axis.
+    const glm::vec3 r = box_light_radius(light);
     float reach = 0.0f;
     for (int corner = 0; corner < 8; ++corner) {
       const glm::vec3 c((corner & 1) ? r.x : -r.x, (corner & 2) ? r.y : -r.y, (corner & 4) ? r.z : -r.z);
